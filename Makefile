@@ -1,0 +1,115 @@
+# hairbench — the front door. `make help` lists the targets.
+#
+#   make          build build/hairsim-cpu and, where nvcc is present, the CUDA binaries
+#   make test     build, then run the pytest suite (GPU tests skip with a reason without a GPU)
+#   make bench    build, validate the GPU variants against the CPU, sweep, plot, report
+#   make report   rebuild report/ from the results already in results/
+
+SHELL := /bin/bash
+CC      ?= gcc
+NVCC    ?= nvcc
+PYTHON  ?= python3
+CUDA_ARCH ?= sm_90
+BUILD   := build
+OBJ     := $(BUILD)/obj
+
+# ---- HDF5: pkg-config first, then h5cc, then Debian's serial layout ----
+HDF5_CFLAGS ?= $(shell pkg-config --cflags hdf5 2>/dev/null)
+HDF5_LIBS   ?= $(shell pkg-config --libs hdf5 2>/dev/null)
+ifeq ($(strip $(HDF5_LIBS)),)
+  H5CC_SHOW := $(shell h5cc -show 2>/dev/null)
+  HDF5_CFLAGS := $(filter -I%,$(H5CC_SHOW))
+  HDF5_LIBS := $(filter -L%,$(H5CC_SHOW)) -lhdf5
+endif
+
+GIT_REV := $(shell git rev-parse --short=12 HEAD 2>/dev/null || cat REVISION 2>/dev/null || echo unknown)$(shell git diff --quiet HEAD -- c_ref cuda Makefile 2>/dev/null || echo -dirty)
+
+# The C reference: C11, no fast-math and no FMA contraction, so it is the oracle.
+CSTD    := -std=c11 -D_DEFAULT_SOURCE
+COPT    ?= -O2 -g
+CWARN   := -Wall -Wextra -Wno-unused-parameter
+CFLAGS_REF := $(CSTD) $(COPT) -ffp-contract=off -fno-fast-math $(CWARN)
+CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp
+
+SHARED_SRC := c_ref/params.c c_ref/cli.c c_ref/state_io.c c_ref/record.c c_ref/driver.c
+SHARED_OBJ := $(SHARED_SRC:c_ref/%.c=$(OBJ)/%.o)
+CPU_SRC    := c_ref/model.c c_ref/backend_cpu.c
+CPU_OBJ    := $(CPU_SRC:c_ref/%.c=$(OBJ)/%.o)
+C_HEADERS  := $(wildcard c_ref/*.h)
+
+# ---- CUDA: three builds of one source; the flags are recorded in every output ----
+HAVE_NVCC := $(shell command -v $(NVCC) >/dev/null 2>&1 && echo yes)
+CUDA_SRC  := $(wildcard cuda/*.cu)
+CUDA_HDR  := $(wildcard cuda/*.cuh cuda/*.h)
+NVCC_BASE := -arch=$(CUDA_ARCH) -O3 -std=c++17 -Ic_ref -lineinfo -Xcompiler -Wall
+NVCC_MODE_normal   :=
+NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false
+NVCC_MODE_fastmath := --use_fast_math
+CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
+
+.PHONY: all cpu cuda test test-cpu test-gpu bench report help clean check-python check-hdf5 sanitize
+
+all: cpu cuda
+
+cpu: $(BUILD)/hairsim-cpu
+
+help:
+	@echo "make          build build/hairsim-cpu (and the CUDA binaries where nvcc is present)"
+	@echo "make test     build and run the pytest suite (GPU tests skip with a reason without a GPU)"
+	@echo "make bench    validate GPU variants against the CPU, sweep, plot and report (python3 -m harness bench)"
+	@echo "make report   rebuild report/ from results/ (python3 -m harness report)"
+	@echo "make sanitize build the C reference with ASan+UBSan and run the C tests under it"
+	@echo "make clean    remove build/"
+
+check-hdf5:
+	@echo '#include <hdf5.h>' | $(CC) $(HDF5_CFLAGS) -E -x c - >/dev/null 2>&1 || { \
+	  echo "error: the HDF5 C library is missing (hdf5.h not found): install it, e.g. 'sudo apt-get install libhdf5-dev hdf5-tools'"; exit 1; }
+
+check-python:
+	@for m in h5py numpy pandas matplotlib pytest hypothesis; do \
+	  $(PYTHON) -c "import $$m" 2>/dev/null || { \
+	    echo "error: the Python package '$$m' is missing for $(PYTHON): run '$(PYTHON) -m pip install -r requirements.txt'"; exit 1; }; \
+	done
+
+$(OBJ)/%.o: c_ref/%.c $(C_HEADERS) | check-hdf5
+	@mkdir -p $(OBJ)
+	$(CC) $(CFLAGS_REF) -fopenmp $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' -DHB_FLAGS='"$(CPU_FLAGS_STR)"' -c $< -o $@
+
+$(BUILD)/hairsim-cpu: $(SHARED_OBJ) $(CPU_OBJ)
+	$(CC) -fopenmp $^ -o $@ $(HDF5_LIBS) -lm
+
+ifeq ($(HAVE_NVCC),yes)
+cuda: $(CUDA_BINS)
+$(BUILD)/hairsim-cuda$(if $(filter normal,normal),): MODE := normal
+$(BUILD)/hairsim-cuda-strict: MODE := strict
+$(BUILD)/hairsim-cuda-fastmath: MODE := fastmath
+$(BUILD)/hairsim-cuda: MODE := normal
+$(CUDA_BINS): $(CUDA_SRC) $(CUDA_HDR) $(C_HEADERS) $(SHARED_OBJ)
+	@if [ -z "$(CUDA_SRC)" ]; then echo "note: no CUDA sources in cuda/ yet"; exit 0; fi
+	@mkdir -p $(BUILD)
+	$(NVCC) $(NVCC_BASE) $(NVCC_MODE_$(MODE)) $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' \
+	  -DHB_FLAGS='"$(NVCC) $(NVCC_BASE) $(NVCC_MODE_$(MODE))"' -DHB_MATH_MODE='"$(MODE)"' \
+	  $(CUDA_SRC) $(SHARED_OBJ) -o $@ $(HDF5_LIBS)
+else
+cuda:
+	@if [ -n "$(REQUIRE_NVCC)" ]; then echo "error: nvcc not found: the CUDA sources must compile here (install the CUDA toolkit or put nvcc on PATH)"; exit 1; fi
+	@echo "note: nvcc not found: CUDA binaries not built (install the CUDA toolkit to build them)"
+endif
+
+test: check-python all
+	$(PYTHON) -m pytest tests -q -ra
+
+bench: check-python all
+	$(PYTHON) -m harness bench
+
+report: check-python
+	$(PYTHON) -m harness report
+
+# ASan + UBSan over the C reference: a separate build in build/asan, the C tests run on it.
+sanitize: check-python check-hdf5
+	$(MAKE) BUILD=build/asan COPT="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" \
+	  CC="$(CC) -fsanitize=address,undefined" build/asan/hairsim-cpu
+	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(PYTHON) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume"
+
+clean:
+	rm -rf $(BUILD)

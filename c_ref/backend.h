@@ -1,0 +1,74 @@
+/* backend.h — what a backend (cpu, cuda) gives the shared driver (driver.c).
+ *
+ * The driver owns the command line, the stage loop, repeats and their statistics, the
+ * HDF5 file and the JSON record; a backend owns the state memory and the model's
+ * arithmetic. States cross this interface in the canonical layout [N·P][3] of the run's
+ * precision.
+ */
+#ifndef HB_BACKEND_H
+#define HB_BACKEND_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "params.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct hb_backend hb_backend;
+
+/* The result of running one stage (or a fused group) once. */
+typedef struct {
+    double ms;            /* the stage's own time: kernels only (cuda events) or the loop (cpu) */
+    int64_t moved_points; /* collide: points changed; −1 otherwise */
+    int consumed;         /* stages this call ran: 1, or 2 for a fused wind+collide */
+} hb_stage_result;
+
+struct hb_backend {
+    const char *name;            /* "cpu" | "cuda" */
+    const char *default_variant;
+    const char *const *variants; /* NULL-terminated */
+    const char *flags;           /* build flags, recorded in every output */
+    void *impl;                  /* backend's private state */
+    int threads, block_size;     /* what the run uses, set by setup (0 where not used) */
+
+    /* Check memory and allocate for the run (saving a copy for repeats when `need_save`;
+     * the driver's own host buffers take `driver_host_bytes`). Returns HB_EXIT_OK or an
+     * exit status with one line in err. */
+    int (*setup)(hb_backend *b, const hb_options *o, int need_save, uint64_t driver_host_bytes,
+                 char *err, size_t errlen);
+    /* Load a canonical host state as the current state; *ms gets the transfer time (cuda). */
+    int (*load)(hb_backend *b, const void *canonical, double *ms, char *err, size_t errlen);
+    /* Run stages[i] (and, for a fusing variant, possibly stages[i+1]) on the current state. */
+    int (*run_stage)(hb_backend *b, const hb_stage *stages, int i, int n, hb_stage_result *r,
+                     char *err, size_t errlen);
+    /* Keep a copy of the current state / make the copy current again (for repeats). */
+    int (*save)(hb_backend *b, char *err, size_t errlen);
+    int (*restore)(hb_backend *b, char *err, size_t errlen);
+    /* Copy the current state into a canonical host buffer; *ms gets the transfer time. */
+    int (*fetch)(hb_backend *b, void *canonical, double *ms, char *err, size_t errlen);
+    /* After a fused call with consumed == 2: the state between the two stages (the wind
+     * frame), canonical. Only asked for when a file is written. */
+    int (*fetch_intermediate)(hb_backend *b, void *canonical, char *err, size_t errlen);
+    /* Tell the backend whether fused calls must keep the intermediate state. */
+    void (*keep_intermediate)(hb_backend *b, int keep);
+    /* Measure copy bandwidth (bytes read + bytes written per second, GB/s). */
+    int (*measure_bandwidth)(hb_backend *b, const hb_options *o, double *gbps, double *bytes,
+                             char *err, size_t errlen);
+    /* Descriptions for the metadata. */
+    void (*describe)(hb_backend *b, char *device, size_t dlen, char *driver, size_t vlen);
+    void (*teardown)(hb_backend *b);
+};
+
+/* Bytes of host memory available for a new allocation (MemAvailable); 0 if unknown. */
+uint64_t hb_host_memory_available(void);
+
+/* Runs the whole command line with this backend; returns the process exit status. */
+int hb_main(int argc, char **argv, hb_backend *b);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

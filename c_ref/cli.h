@@ -1,0 +1,22 @@
+/* cli.h — command-line parsing shared by hairsim-cpu and hairsim-cuda (docs/interfaces.md). */
+#ifndef HB_CLI_H
+#define HB_CLI_H
+
+#include <stdio.h>
+
+#include "params.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Fills o from argv. Returns 0 to run, 1 when --help/--version was printed (exit 0), or
+ * −1 with one line in err. `backend` is "cpu" or "cuda" (some flags belong to one). */
+int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, char *err, size_t errlen);
+void hb_print_usage(FILE *f, const char *prog, const char *backend);
+void hb_default_options(hb_options *o);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

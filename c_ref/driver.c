@@ -1,0 +1,360 @@
+/* driver.c — the run shared by every backend: parse, refuse bad input before any work,
+ * run the listed stages (DESIGN §8: only those), time them (DESIGN §7), write the HDF5
+ * state (§4) and the JSON record. */
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "backend.h"
+#include "cli.h"
+#include "philox.h"
+#include "record.h"
+#include "state_io.h"
+
+static const char *g_prog = "hairsim";
+
+static int die(int status, const char *msg)
+{
+    fprintf(stderr, "%s: error: %s\n", g_prog, msg);
+    return status;
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+uint64_t hb_host_memory_available(void)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (!f) return 0;
+    char line[256];
+    unsigned long long kb = 0;
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) break;
+    fclose(f);
+    return (uint64_t)kb * 1024u;
+}
+
+/* ---- --self-test rng: Random123's published known-answer vectors (kat_vectors) ------- */
+static int self_test_rng(void)
+{
+    static const struct {
+        int rounds;
+        uint32_t ctr[4], key[2], want[4];
+    } kat[] = {
+        {10, {0, 0, 0, 0}, {0, 0}, {0x6627e8d5, 0xe169c58d, 0xbc57ac4c, 0x9b00dbd8}},
+        {10, {0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff}, {0xffffffff, 0xffffffff},
+         {0x408f276d, 0x41c83b0e, 0xa20bc7c6, 0x6d5451fd}},
+        {10, {0x243f6a88, 0x85a308d3, 0x13198a2e, 0x03707344}, {0xa4093822, 0x299f31d0},
+         {0xd16cfe09, 0x94fdcceb, 0x5001e420, 0x24126ea1}},
+        {7, {0x243f6a88, 0x85a308d3, 0x13198a2e, 0x03707344}, {0xa4093822, 0x299f31d0},
+         {0x4dfccaba, 0x190a87f0, 0xc47362ba, 0xb6b5242a}},
+    };
+    int failed = 0;
+    for (size_t i = 0; i < sizeof kat / sizeof kat[0]; i++) {
+        uint32_t out[4];
+        hb_philox4x32(kat[i].rounds, kat[i].ctr, kat[i].key, out);
+        int ok = memcmp(out, kat[i].want, sizeof out) == 0;
+        failed += !ok;
+        printf("philox4x32 %d %08x %08x %08x %08x %08x %08x -> %08x %08x %08x %08x %s\n", kat[i].rounds,
+               kat[i].ctr[0], kat[i].ctr[1], kat[i].ctr[2], kat[i].ctr[3], kat[i].key[0], kat[i].key[1], out[0],
+               out[1], out[2], out[3], ok ? "ok" : "MISMATCH");
+    }
+    return failed ? 1 : 0;
+}
+
+/* With --input the geometry comes from the file; a flag given that disagrees is refused. */
+static int adopt_input_scene(hb_options *o, const hb_scene *f, char *err, size_t errlen)
+{
+    hb_scene *s = &o->scene;
+#define SAME(bit, field, flag, fmt, cast)                                                     \
+    if ((o->given & (bit)) && s->field != f->field) {                                        \
+        snprintf(err, errlen, flag " " fmt " does not match the input file's " fmt, cast s->field, cast f->field); \
+        return -1;                                                                           \
+    }
+    SAME(HB_GIVEN_STRANDS, n_strands, "--strands", "%lld", (long long))
+    SAME(HB_GIVEN_POINTS, points, "--points", "%lld", (long long))
+    SAME(HB_GIVEN_SEED, seed, "--seed", "%llu", (unsigned long long))
+    SAME(HB_GIVEN_RADIUS, head_radius, "--head-radius", "%.17g", (double))
+    SAME(HB_GIVEN_OFFSET, hair_offset, "--hair-offset", "%.17g", (double))
+    SAME(HB_GIVEN_LENGTH, hair_length, "--hair-length", "%.17g", (double))
+    SAME(HB_GIVEN_MARGIN, face_margin, "--face-margin", "%.17g", (double))
+#undef SAME
+    if ((o->given & HB_GIVEN_PRECISION) && s->precision != f->precision) {
+        snprintf(err, errlen, "--precision %s does not match the input file's %s", hb_precision_name(s->precision),
+                 hb_precision_name(f->precision));
+        return -1;
+    }
+    double w = s->wind_strength, a = s->wind_angle;
+    *s = *f;
+    s->wind_strength = w;
+    s->wind_angle = a;
+    return 0;
+}
+
+static int same_file(const char *a, const char *b)
+{
+    char ra[PATH_MAX], rb[PATH_MAX];
+    if (!realpath(a, ra) || !realpath(b, rb)) return 0;
+    return strcmp(ra, rb) == 0;
+}
+
+static void frame_meta(hb_frame_meta *m, hb_stage st, const hb_scene *s, const char *backend,
+                       const char *variant)
+{
+    memset(m, 0, sizeof *m);
+    snprintf(m->stage, sizeof m->stage, "%s", hb_stage_name(st));
+    snprintf(m->backend, sizeof m->backend, "%s/%s", backend, variant);
+    m->moved_points = -1;
+    m->wind_strength = st == HB_STAGE_WIND ? s->wind_strength : NAN;
+    m->wind_angle = st == HB_STAGE_WIND ? s->wind_angle : NAN;
+}
+
+typedef struct {
+    hb_backend *b;
+    hb_options *o;
+    hb_record *rec;
+    hb_writer *w;
+    void *host;       /* canonical host frame (output, end-to-end) */
+    void *input;      /* the input's last frame */
+    hb_input in;
+    int have_input;
+    double *times;    /* all stages' timed runs */
+} hb_run;
+
+static void run_free(hb_run *r)
+{
+    if (r->w) hb_writer_abort(r->w);
+    if (r->have_input) hb_input_close(&r->in);
+    if (r->b->teardown) r->b->teardown(r->b);
+    free(r->host);
+    free(r->input);
+    free(r->times);
+}
+
+#define CHECK(call, status)                                                                  \
+    do {                                                                                     \
+        if ((call) != 0) {                                                                   \
+            run_free(&run);                                                                  \
+            return die(status, err);                                                         \
+        }                                                                                    \
+    } while (0)
+
+int hb_main(int argc, char **argv, hb_backend *b)
+{
+    char err[HB_ERRLEN] = "";
+    hb_options o;
+    const char *slash = strrchr(argv[0], '/');
+    g_prog = slash ? slash + 1 : argv[0];
+
+    int rc = hb_parse_args(argc, argv, b->name, &o, err, sizeof err);
+    if (rc < 0) return die(HB_EXIT_USAGE, err);
+    if (rc > 0) return HB_EXIT_OK;
+    if (o.self_test) return self_test_rng();
+
+    if (!o.variant) o.variant = b->default_variant;
+    int known = 0;
+    for (const char *const *v = b->variants; *v; v++) known |= strcmp(*v, o.variant) == 0;
+    if (!known) {
+        char list[256] = "";
+        for (const char *const *v = b->variants; *v; v++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? ", " : "", *v);
+        snprintf(err, sizeof err, "--variant %s is not a %s variant (known: %s)", o.variant, b->name, list);
+        return die(HB_EXIT_USAGE, err);
+    }
+
+    hb_record rec;
+    memset(&rec, 0, sizeof rec);
+    rec.opt = &o;
+    rec.backend = b->name;
+    rec.variant = o.variant;
+    rec.flags = b->flags;
+    rec.compiler = hb_compiler();
+    rec.git_revision = hb_git_revision();
+    rec.end_to_end_ms = rec.h2d_ms = rec.d2h_ms = rec.hdf5_write_ms = NAN;
+
+    hb_run run;
+    memset(&run, 0, sizeof run);
+    run.b = b;
+    run.o = &o;
+    run.rec = &rec;
+
+    if (o.measure_bandwidth) {
+        double gbps = 0, bytes = 0;
+        CHECK(b->measure_bandwidth(b, &o, &gbps, &bytes, err, sizeof err), HB_EXIT_RUNTIME);
+        b->describe(b, rec.device, sizeof rec.device, rec.driver, sizeof rec.driver);
+        if (o.json) printf("{\"backend\": \"%s\", \"copy_gbps\": %.6g, \"bytes\": %.17g, \"device\": \"%s\"}\n",
+                           b->name, gbps, bytes, rec.device);
+        else printf("%s copy bandwidth: %.1f GB/s (read + write, %.0f bytes per copy) on %s\n", b->name, gbps, bytes,
+                    rec.device);
+        run_free(&run);
+        return HB_EXIT_OK;
+    }
+
+    /* ---- refuse bad input before any work (DESIGN §8) ---- */
+    if (o.input) {
+        CHECK(hb_input_open(o.input, &run.in, err, sizeof err), HB_EXIT_USAGE);
+        run.have_input = 1;
+        CHECK(adopt_input_scene(&o, &run.in.scene, err, sizeof err), HB_EXIT_USAGE);
+        for (int i = 0; i < o.n_stages; i++)
+            if (o.stages[i] == HB_STAGE_INIT) {
+                snprintf(err, sizeof err, "--stages: init cannot run on an --input state (it would replace it)");
+                CHECK(1, HB_EXIT_USAGE);
+            }
+    } else if (o.stages[0] != HB_STAGE_INIT) {
+        snprintf(err, sizeof err, "--stages: '%s' needs a state: list init first or give --input",
+                 hb_stage_name(o.stages[0]));
+        CHECK(1, HB_EXIT_USAGE);
+    }
+    CHECK(hb_scene_validate(&o.scene, err, sizeof err), HB_EXIT_USAGE);
+    if (o.output && o.input && same_file(o.output, o.input)) {
+        snprintf(err, sizeof err, "--output %s is the --input file; write to another name", o.output);
+        CHECK(1, HB_EXIT_USAGE);
+    }
+
+    const uint64_t bytes = hb_state_bytes(&o.scene);
+    const int need_host = o.output != NULL || o.end_to_end;
+    uint64_t driver_bytes = (need_host ? bytes : 0) + (o.input ? bytes : 0);
+    const int need_save = o.repeat > 1 || o.warmup > 0;
+    CHECK(b->setup(b, &o, need_save, driver_bytes, err, sizeof err), HB_EXIT_MEMORY);
+    b->describe(b, rec.device, sizeof rec.device, rec.driver, sizeof rec.driver);
+    rec.threads = b->threads;
+    rec.block_size = b->block_size;
+    if (need_host && !(run.host = malloc(bytes))) {
+        snprintf(err, sizeof err, "cannot allocate the %llu-byte host frame", (unsigned long long)bytes);
+        CHECK(1, HB_EXIT_MEMORY);
+    }
+    if (o.input && !(run.input = malloc(bytes))) {
+        snprintf(err, sizeof err, "cannot allocate the %llu-byte input frame", (unsigned long long)bytes);
+        CHECK(1, HB_EXIT_MEMORY);
+    }
+    run.times = calloc((size_t)o.n_stages * (size_t)o.repeat, sizeof *run.times);
+    if (!run.times) {
+        snprintf(err, sizeof err, "out of host memory");
+        CHECK(1, HB_EXIT_MEMORY);
+    }
+    if (o.output) {
+        run.w = hb_writer_open(o.output, o.force, &o.scene, err, sizeof err);
+        if (!run.w) CHECK(1, HB_EXIT_USAGE);
+    }
+
+    /* ---- the input state: its frames go into the output first ---- */
+    int frame = 0;
+    if (o.input) {
+        int last = run.in.n_frames - 1;
+        CHECK(hb_input_read_frame(&run.in, last, run.input, err, sizeof err), HB_EXIT_USAGE);
+        if (run.w) {
+            for (int f = 0; f < run.in.n_frames; f++) {
+                const void *src = run.input;
+                if (f != last) {
+                    CHECK(hb_input_read_frame(&run.in, f, run.host, err, sizeof err), HB_EXIT_USAGE);
+                    src = run.host;
+                }
+                CHECK(hb_writer_append(run.w, src, &run.in.frames[f], err, sizeof err), HB_EXIT_RUNTIME);
+            }
+        }
+        frame = run.in.n_frames;
+        double ms;
+        CHECK(b->load(b, run.input, &ms, err, sizeof err), HB_EXIT_RUNTIME);
+    }
+    if (b->keep_intermediate) b->keep_intermediate(b, run.w != NULL);
+
+    /* ---- the stages, each timed from the same input (DESIGN §7) ---- */
+    double *times = run.times;
+    for (int i = 0; i < o.n_stages;) {
+        hb_stage st = o.stages[i];
+        hb_stage_record *sr = &rec.stages[rec.n_stages++];
+        sr->frame = frame;
+        sr->stage = st;
+        frame_meta(&sr->meta, st, &o.scene, b->name, o.variant);
+        if (st == HB_STAGE_WIND && o.scene.wind_strength == 0.0) {
+            /* a stage whose effect is nil is not launched (DESIGN §8) */
+            sr->meta.skipped = 1;
+            if (run.w) {
+                double ms;
+                CHECK(b->fetch(b, run.host, &ms, err, sizeof err), HB_EXIT_RUNTIME);
+                CHECK(hb_writer_append(run.w, run.host, &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
+            }
+            frame++;
+            i++;
+            continue;
+        }
+        if (need_save) CHECK(b->save(b, err, sizeof err), HB_EXIT_RUNTIME);
+        hb_stage_result r = {0, -1, 1};
+        for (int j = 0; j < o.warmup + o.repeat; j++) {
+            if (j > 0) CHECK(b->restore(b, err, sizeof err), HB_EXIT_RUNTIME);
+            CHECK(b->run_stage(b, o.stages, i, o.n_stages, &r, err, sizeof err), HB_EXIT_RUNTIME);
+            if (j >= o.warmup) times[j - o.warmup] = r.ms;
+        }
+        sr->times_ms = times;
+        sr->n_times = o.repeat;
+        times += o.repeat;
+        hb_time_stats(sr->times_ms, sr->n_times, &sr->meta.median_ms, &sr->meta.min_ms, &sr->meta.max_ms);
+        if (r.consumed == 2) {
+            /* a fused wind+collide: one time for the pair, two frames */
+            hb_stage_record *sc = &rec.stages[rec.n_stages++];
+            snprintf(sr->meta.fused, sizeof sr->meta.fused, "wind+collide");
+            sc->frame = frame + 1;
+            sc->stage = o.stages[i + 1];
+            frame_meta(&sc->meta, sc->stage, &o.scene, b->name, o.variant);
+            snprintf(sc->meta.fused, sizeof sc->meta.fused, "into-previous");
+            sc->meta.moved_points = r.moved_points;
+            if (run.w) {
+                CHECK(b->fetch_intermediate(b, run.host, err, sizeof err), HB_EXIT_RUNTIME);
+                CHECK(hb_writer_append(run.w, run.host, &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
+            }
+            sr = sc;
+        } else {
+            sr->meta.moved_points = r.moved_points;
+        }
+        if (run.w) {
+            double ms;
+            CHECK(b->fetch(b, run.host, &ms, err, sizeof err), HB_EXIT_RUNTIME);
+            CHECK(hb_writer_append(run.w, run.host, &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
+        }
+        frame += r.consumed;
+        i += r.consumed;
+    }
+
+    /* ---- one whole pass, transfers included, timed apart from the stages ---- */
+    if (o.end_to_end) {
+        if (b->keep_intermediate) b->keep_intermediate(b, 0);
+        double t0 = now_ms(), h2d = 0, d2h = 0;
+        if (o.input) CHECK(b->load(b, run.input, &h2d, err, sizeof err), HB_EXIT_RUNTIME);
+        for (int i = 0; i < o.n_stages;) {
+            if (o.stages[i] == HB_STAGE_WIND && o.scene.wind_strength == 0.0) {
+                i++;
+                continue;
+            }
+            hb_stage_result r = {0, -1, 1};
+            CHECK(b->run_stage(b, o.stages, i, o.n_stages, &r, err, sizeof err), HB_EXIT_RUNTIME);
+            i += r.consumed;
+        }
+        CHECK(b->fetch(b, run.host, &d2h, err, sizeof err), HB_EXIT_RUNTIME);
+        rec.end_to_end_ms = now_ms() - t0;
+        if (strcmp(b->name, "cpu") != 0) {
+            rec.h2d_ms = o.input ? h2d : NAN;
+            rec.d2h_ms = d2h;
+        }
+    }
+
+    if (run.w) {
+        hb_run_meta rm = {b->name, o.variant, rec.git_revision, rec.compiler, b->flags, rec.device, rec.driver,
+                          rec.threads, rec.block_size, o.repeat, o.warmup, rec.end_to_end_ms, 0};
+        double t0 = now_ms(), before = 1e3 * hb_writer_seconds(run.w);
+        hb_writer *w = run.w;
+        run.w = NULL;
+        CHECK(hb_writer_close(w, &rm, err, sizeof err), HB_EXIT_RUNTIME);
+        rec.hdf5_write_ms = before + (now_ms() - t0);
+    }
+    if (o.json) hb_record_json(stdout, &rec);
+    if (!o.quiet) hb_record_summary(stderr, &rec);
+    run_free(&run);
+    return HB_EXIT_OK;
+}

@@ -1,0 +1,64 @@
+/* params.c — scene validation (DESIGN §8: bad scenes are refused before any work, with a
+ * message naming the flag). */
+#include "params.h"
+
+#include <math.h>
+#include <stdio.h>
+
+const char *hb_stage_name(hb_stage s)
+{
+    switch (s) {
+    case HB_STAGE_INIT: return "init";
+    case HB_STAGE_WIND: return "wind";
+    case HB_STAGE_COLLIDE: return "collide";
+    }
+    return "?";
+}
+
+const char *hb_precision_name(hb_precision p) { return p == HB_FP64 ? "fp64" : "fp32"; }
+
+uint64_t hb_state_bytes(const hb_scene *s)
+{
+    if (s->n_strands <= 0 || s->points <= 0) return 0;
+    uint64_t n = (uint64_t)s->n_strands, p = (uint64_t)s->points;
+    uint64_t per_strand = p * 3u * hb_real_size(s->precision);
+    if (per_strand / p != 3u * hb_real_size(s->precision)) return 0;
+    if (n > UINT64_MAX / per_strand) return 0;
+    return n * per_strand;
+}
+
+double hb_wind_angle_reduced(const hb_scene *s)
+{
+    double a = remainder(s->wind_angle, 2.0 * M_PI); /* [−π, π] */
+    if (a <= -M_PI) a += 2.0 * M_PI;
+    return a;
+}
+
+#define FAIL(...) do { snprintf(err, errlen, __VA_ARGS__); return -1; } while (0)
+
+static int finite_positive(double v) { return isfinite(v) && v > 0.0; }
+
+int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
+{
+    if (s->n_strands < 1) FAIL("--strands must be at least 1 (got %lld)", (long long)s->n_strands);
+    if (s->points < 2) FAIL("--points must be at least 2 (got %lld)", (long long)s->points);
+    if (!finite_positive(s->head_radius)) FAIL("--head-radius must be a finite number > 0 (got %g)", s->head_radius);
+    if (!finite_positive(s->hair_offset)) FAIL("--hair-offset must be a finite number > 0 (got %g)", s->hair_offset);
+    if (!finite_positive(s->hair_length)) FAIL("--hair-length must be a finite number > 0 (got %g)", s->hair_length);
+    if (!isfinite(s->face_margin) || s->face_margin < 0.0)
+        FAIL("--face-margin must be a finite number >= 0 (got %g)", s->face_margin);
+    if (!isfinite(s->wind_strength) || s->wind_strength < 0.0 || s->wind_strength > 1.0)
+        FAIL("--wind-strength must be in [0, 1] (got %g)", s->wind_strength);
+    if (!isfinite(s->wind_angle)) FAIL("--wind-angle must be a finite number of radians (got %g)", s->wind_angle);
+    double ell = hb_segment_length(s);
+    if (!(ell >= s->hair_offset))
+        FAIL("--hair-length/(--points - 1) = %g is shorter than --hair-offset %g: a segment could not reach the "
+             "shell (DESIGN §3 collide needs l >= h)", ell, s->hair_offset);
+    if (s->precision == HB_FP32) {
+        /* The scene must be representable: every length must round to a normal float. */
+        if (s->head_radius > 1e30 || s->hair_length > 1e30 || s->hair_offset < 1e-30 || ell < 1e-30)
+            FAIL("scene lengths are outside the fp32 range (use --precision fp64)");
+    }
+    if (hb_state_bytes(s) == 0) FAIL("--strands x --points is too large to address");
+    return 0;
+}

@@ -1,0 +1,168 @@
+/* record.c — the run record as JSON (docs/interfaces.md) and as a short summary. */
+#include "record.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef HB_GIT_REV
+#define HB_GIT_REV "unknown"
+#endif
+
+const char *hb_git_revision(void) { return HB_GIT_REV; }
+
+const char *hb_compiler(void)
+{
+#if defined(__clang__)
+    return "clang " __clang_version__;
+#elif defined(__GNUC__)
+    return "gcc " __VERSION__;
+#else
+    return "unknown";
+#endif
+}
+
+void hb_cpu_model(char *out, size_t n)
+{
+    snprintf(out, n, "unknown CPU");
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    if (!f) return;
+    char line[512];
+    while (fgets(line, sizeof line, f)) {
+        if (strncmp(line, "model name", 10) == 0) {
+            char *c = strchr(line, ':');
+            if (c) {
+                c++;
+                while (*c == ' ') c++;
+                c[strcspn(c, "\n")] = '\0';
+                snprintf(out, n, "%s", c);
+            }
+            break;
+        }
+    }
+    fclose(f);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+void hb_time_stats(const double *t, int n, double *median, double *min, double *max)
+{
+    if (n <= 0) {
+        *median = *min = *max = 0.0;
+        return;
+    }
+    double *s = malloc((size_t)n * sizeof *s);
+    if (!s) {
+        *median = *min = *max = NAN;
+        return;
+    }
+    memcpy(s, t, (size_t)n * sizeof *s);
+    qsort(s, (size_t)n, sizeof *s, cmp_double);
+    *min = s[0];
+    *max = s[n - 1];
+    *median = n % 2 ? s[n / 2] : 0.5 * (s[n / 2 - 1] + s[n / 2]);
+    free(s);
+}
+
+static void json_str(FILE *f, const char *s)
+{
+    if (!s) {
+        fputs("null", f);
+        return;
+    }
+    fputc('"', f);
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\') fprintf(f, "\\%c", *p);
+        else if (*p < 0x20) fprintf(f, "\\u%04x", *p);
+        else fputc(*p, f);
+    }
+    fputc('"', f);
+}
+
+static void json_num(FILE *f, double v)
+{
+    if (isfinite(v)) fprintf(f, "%.17g", v);
+    else fputs("null", f);
+}
+
+void hb_record_json(FILE *f, const hb_record *r)
+{
+    const hb_scene *s = &r->opt->scene;
+    fputs("{\"backend\": ", f); json_str(f, r->backend);
+    fputs(", \"variant\": ", f); json_str(f, r->variant);
+    fputs(", \"precision\": ", f); json_str(f, hb_precision_name(s->precision));
+    fprintf(f, ", \"strands\": %lld, \"points\": %lld, \"seed\": %llu", (long long)s->n_strands,
+            (long long)s->points, (unsigned long long)s->seed);
+    fputs(", \"head_radius\": ", f); json_num(f, s->head_radius);
+    fputs(", \"hair_offset\": ", f); json_num(f, s->hair_offset);
+    fputs(", \"hair_length\": ", f); json_num(f, s->hair_length);
+    fputs(", \"face_margin\": ", f); json_num(f, s->face_margin);
+    fputs(", \"wind_strength\": ", f); json_num(f, s->wind_strength);
+    fputs(", \"wind_angle\": ", f); json_num(f, s->wind_angle);
+    if (r->threads > 0) fprintf(f, ", \"threads\": %d", r->threads);
+    else fputs(", \"threads\": null", f);
+    if (r->block_size > 0) fprintf(f, ", \"block_size\": %d", r->block_size);
+    else fputs(", \"block_size\": null", f);
+    fprintf(f, ", \"repeat\": %d, \"warmup\": %d", r->opt->repeat, r->opt->warmup);
+    fputs(", \"input\": ", f); json_str(f, r->opt->input);
+    fputs(", \"output\": ", f); json_str(f, r->opt->output);
+    fputs(", \"stages\": [", f);
+    for (int i = 0; i < r->n_stages; i++) {
+        const hb_stage_record *st = &r->stages[i];
+        fprintf(f, "%s{\"frame\": %d, \"stage\": ", i ? ", " : "", st->frame);
+        json_str(f, st->meta.stage);
+        fprintf(f, ", \"skipped\": %s, \"fused\": ", st->meta.skipped ? "true" : "false");
+        json_str(f, st->meta.fused[0] ? st->meta.fused : NULL);
+        fputs(", \"median_ms\": ", f); json_num(f, st->meta.median_ms);
+        fputs(", \"min_ms\": ", f); json_num(f, st->meta.min_ms);
+        fputs(", \"max_ms\": ", f); json_num(f, st->meta.max_ms);
+        fputs(", \"times_ms\": [", f);
+        for (int k = 0; k < st->n_times; k++) {
+            if (k) fputs(", ", f);
+            json_num(f, st->times_ms[k]);
+        }
+        fputs("], \"moved_points\": ", f);
+        if (st->meta.moved_points >= 0) fprintf(f, "%lld", (long long)st->meta.moved_points);
+        else fputs("null", f);
+        fputc('}', f);
+    }
+    fputs("]", f);
+    fputs(", \"end_to_end_ms\": ", f); json_num(f, r->end_to_end_ms);
+    fputs(", \"h2d_ms\": ", f); json_num(f, r->h2d_ms);
+    fputs(", \"d2h_ms\": ", f); json_num(f, r->d2h_ms);
+    fputs(", \"hdf5_write_ms\": ", f); json_num(f, r->hdf5_write_ms);
+    fprintf(f, ", \"state_bytes\": %llu", (unsigned long long)hb_state_bytes(s));
+    fputs(", \"git_revision\": ", f); json_str(f, r->git_revision);
+    fputs(", \"compiler\": ", f); json_str(f, r->compiler);
+    fputs(", \"flags\": ", f); json_str(f, r->flags);
+    fputs(", \"device\": ", f); json_str(f, r->device);
+    fputs(", \"driver\": ", f); json_str(f, r->driver[0] ? r->driver : NULL);
+    fputs(", \"version\": ", f); json_str(f, HB_VERSION);
+    fputs("}\n", f);
+}
+
+void hb_record_summary(FILE *f, const hb_record *r)
+{
+    const hb_scene *s = &r->opt->scene;
+    fprintf(f, "hairsim %s/%s %s: %lld strands x %lld points on %s", r->backend, r->variant,
+            hb_precision_name(s->precision), (long long)s->n_strands, (long long)s->points, r->device);
+    if (r->threads > 0) fprintf(f, ", %d threads", r->threads);
+    if (r->block_size > 0) fprintf(f, ", block %d", r->block_size);
+    fputc('\n', f);
+    for (int i = 0; i < r->n_stages; i++) {
+        const hb_stage_record *st = &r->stages[i];
+        fprintf(f, "  frame %-3d %-8s", st->frame, st->meta.stage);
+        if (st->meta.skipped) fprintf(f, " skipped (nil effect: wind strength 0)");
+        else if (strcmp(st->meta.fused, "into-previous") == 0) fprintf(f, " fused into the previous kernel");
+        else fprintf(f, " median %.3f ms (min %.3f, max %.3f, %d runs)", st->meta.median_ms, st->meta.min_ms,
+                     st->meta.max_ms, st->n_times);
+        if (st->meta.moved_points >= 0) fprintf(f, ", %lld points moved", (long long)st->meta.moved_points);
+        fputc('\n', f);
+    }
+    if (isfinite(r->end_to_end_ms)) fprintf(f, "  end-to-end %.3f ms\n", r->end_to_end_ms);
+    if (isfinite(r->hdf5_write_ms)) fprintf(f, "  HDF5 write %.3f ms -> %s\n", r->hdf5_write_ms, r->opt->output);
+}

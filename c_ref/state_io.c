@@ -1,0 +1,563 @@
+/* state_io.c — HDF5 states, H5MD 1.1 shaped (DESIGN §4; layout in docs/interfaces.md). */
+#include "state_io.h"
+
+#include <errno.h>
+#include <stddef.h>
+#include <hdf5.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#define FAIL(...) do { snprintf(err, errlen, __VA_ARGS__); goto fail; } while (0)
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void quiet_hdf5(void) { H5Eset_auto2(H5E_DEFAULT, NULL, NULL); }
+
+static hid_t str_type(void)
+{
+    hid_t t = H5Tcopy(H5T_C_S1);
+    H5Tset_size(t, H5T_VARIABLE);
+    H5Tset_cset(t, H5T_CSET_UTF8);
+    return t;
+}
+
+/* ---- small attribute / dataset writers: each returns < 0 on failure ------------------- */
+static int attr_str(hid_t loc, const char *name, const char *v)
+{
+    hid_t t = str_type(), sp = H5Screate(H5S_SCALAR);
+    hid_t a = H5Acreate2(loc, name, t, sp, H5P_DEFAULT, H5P_DEFAULT);
+    const char *val = v ? v : "";
+    herr_t rc = a < 0 ? -1 : H5Awrite(a, t, &val);
+    if (a >= 0) H5Aclose(a);
+    H5Sclose(sp);
+    H5Tclose(t);
+    return rc < 0 ? -1 : 0;
+}
+
+static int attr_num(hid_t loc, const char *name, hid_t file_type, hid_t mem_type, const void *v)
+{
+    hid_t sp = H5Screate(H5S_SCALAR);
+    hid_t a = H5Acreate2(loc, name, file_type, sp, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = a < 0 ? -1 : H5Awrite(a, mem_type, v);
+    if (a >= 0) H5Aclose(a);
+    H5Sclose(sp);
+    return rc < 0 ? -1 : 0;
+}
+
+static int attr_f64(hid_t loc, const char *name, double v)
+{
+    return attr_num(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &v);
+}
+
+static int attr_i64(hid_t loc, const char *name, int64_t v)
+{
+    return attr_num(loc, name, H5T_STD_I64LE, H5T_NATIVE_INT64, &v);
+}
+
+static int ds_1d(hid_t loc, const char *name, hid_t file_type, hid_t mem_type, hsize_t n, const void *v)
+{
+    hid_t sp = H5Screate_simple(1, &n, NULL);
+    hid_t d = H5Dcreate2(loc, name, file_type, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = d < 0 ? -1 : (n ? H5Dwrite(d, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) : 0);
+    if (d >= 0) H5Dclose(d);
+    H5Sclose(sp);
+    return rc < 0 ? -1 : 0;
+}
+
+static int ds_str(hid_t loc, const char *name, hsize_t n, const char **v)
+{
+    hid_t t = str_type();
+    int rc = ds_1d(loc, name, t, t, n, v);
+    H5Tclose(t);
+    return rc;
+}
+
+static hid_t make_group(hid_t loc, const char *name) { return H5Gcreate2(loc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT); }
+
+/* ---- writer ------------------------------------------------------------------------- */
+struct hb_writer {
+    char *path, *tmp;
+    hid_t file, value;
+    hb_scene scene;
+    uint64_t rows; /* N·P */
+    int n_frames, cap;
+    hb_frame_meta *frames;
+    double seconds;
+};
+
+double hb_writer_seconds(const hb_writer *w) { return w->seconds; }
+
+static void writer_free(hb_writer *w)
+{
+    if (!w) return;
+    free(w->path);
+    free(w->tmp);
+    free(w->frames);
+    free(w);
+}
+
+void hb_writer_abort(hb_writer *w)
+{
+    if (!w) return;
+    if (w->value >= 0) H5Dclose(w->value);
+    if (w->file >= 0) H5Fclose(w->file);
+    if (w->tmp) unlink(w->tmp);
+    writer_free(w);
+}
+
+hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, char *err, size_t errlen)
+{
+    quiet_hdf5();
+    double t0 = now_s();
+    hb_writer *w = calloc(1, sizeof *w);
+    if (!w) { snprintf(err, errlen, "out of host memory"); return NULL; }
+    w->file = w->value = -1;
+    w->scene = *scene;
+    w->rows = (uint64_t)scene->n_strands * (uint64_t)scene->points;
+    if (!force && access(path, F_OK) == 0)
+        FAIL("--output %s exists; choose another name or pass --force to replace it", path);
+    w->path = strdup(path);
+    size_t n = strlen(path) + 32;
+    w->tmp = malloc(n);
+    if (!w->path || !w->tmp) FAIL("out of host memory");
+    snprintf(w->tmp, n, "%s.tmp.%ld", path, (long)getpid());
+    w->file = H5Fcreate(w->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    if (w->file < 0) FAIL("--output %s: cannot create %s (%s)", path, w->tmp, strerror(errno));
+
+    /* /h5md: version, author, creator (H5MD 1.1 §"H5MD metadata") */
+    hid_t h5md = make_group(w->file, "h5md");
+    int32_t version[2] = {1, 1};
+    hsize_t two = 2;
+    hid_t sp2 = H5Screate_simple(1, &two, NULL);
+    hid_t av = H5Acreate2(h5md, "version", H5T_STD_I32LE, sp2, H5P_DEFAULT, H5P_DEFAULT);
+    int bad = av < 0 || H5Awrite(av, H5T_NATIVE_INT32, version) < 0;
+    if (av >= 0) H5Aclose(av);
+    H5Sclose(sp2);
+    hid_t author = make_group(h5md, "author");
+    bad |= attr_str(author, "name", "hairbench") < 0;
+    hid_t creator = make_group(h5md, "creator");
+    bad |= attr_str(creator, "name", "hairbench") < 0;
+    bad |= attr_str(creator, "version", HB_VERSION) < 0;
+    H5Gclose(creator);
+    H5Gclose(author);
+    H5Gclose(h5md);
+
+    /* /particles/hair/{box,position} */
+    hid_t particles = make_group(w->file, "particles");
+    hid_t hair = make_group(particles, "hair");
+    hid_t box = make_group(hair, "box");
+    int32_t dim = 3;
+    bad |= attr_num(box, "dimension", H5T_STD_I32LE, H5T_NATIVE_INT32, &dim) < 0;
+    {
+        hsize_t three = 3;
+        const char *boundary[3] = {"none", "none", "none"};
+        hid_t t = str_type(), sp = H5Screate_simple(1, &three, NULL);
+        hid_t a = H5Acreate2(box, "boundary", t, sp, H5P_DEFAULT, H5P_DEFAULT);
+        bad |= a < 0 || H5Awrite(a, t, boundary) < 0;
+        if (a >= 0) H5Aclose(a);
+        H5Sclose(sp);
+        H5Tclose(t);
+    }
+    H5Gclose(box);
+    hid_t position = make_group(hair, "position");
+    hsize_t dims[3] = {0, w->rows, 3}, maxdims[3] = {H5S_UNLIMITED, w->rows, 3};
+    hsize_t chunk[3] = {1, w->rows < (1u << 20) ? w->rows : (1u << 20), 3};
+    hid_t space = H5Screate_simple(3, dims, maxdims);
+    hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(dcpl, 3, chunk);
+    hid_t ftype = scene->precision == HB_FP64 ? H5T_IEEE_F64LE : H5T_IEEE_F32LE;
+    w->value = H5Dcreate2(position, "value", ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    H5Pclose(dcpl);
+    H5Sclose(space);
+    H5Gclose(position);
+    H5Gclose(hair);
+    H5Gclose(particles);
+    if (bad || w->value < 0) FAIL("--output %s: HDF5 could not create the layout", path);
+    w->seconds += now_s() - t0;
+    return w;
+fail:
+    hb_writer_abort(w);
+    return NULL;
+}
+
+int hb_writer_append(hb_writer *w, const void *frame, const hb_frame_meta *fm, char *err, size_t errlen)
+{
+    double t0 = now_s();
+    if (w->n_frames == w->cap) {
+        int cap = w->cap ? 2 * w->cap : 8;
+        hb_frame_meta *f = realloc(w->frames, (size_t)cap * sizeof *f);
+        if (!f) { snprintf(err, errlen, "out of host memory"); return -1; }
+        w->frames = f;
+        w->cap = cap;
+    }
+    hsize_t dims[3] = {(hsize_t)w->n_frames + 1, w->rows, 3};
+    if (H5Dset_extent(w->value, dims) < 0) {
+        snprintf(err, errlen, "--output %s: HDF5 could not extend the frame dataset", w->path);
+        return -1;
+    }
+    hid_t fs = H5Dget_space(w->value);
+    hsize_t start[3] = {(hsize_t)w->n_frames, 0, 0}, count[3] = {1, w->rows, 3};
+    H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
+    hid_t ms = H5Screate_simple(3, count, NULL);
+    hid_t mt = w->scene.precision == HB_FP64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT;
+    herr_t rc = H5Dwrite(w->value, mt, ms, fs, H5P_DEFAULT, frame);
+    H5Sclose(ms);
+    H5Sclose(fs);
+    if (rc < 0) {
+        snprintf(err, errlen, "--output %s: HDF5 write of frame %d failed (disk full?)", w->path, w->n_frames);
+        return -1;
+    }
+    w->frames[w->n_frames++] = *fm;
+    w->seconds += now_s() - t0;
+    return 0;
+}
+
+int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errlen)
+{
+    double t0 = now_s();
+    const hb_scene *s = &w->scene;
+    int F = w->n_frames, bad = 0;
+    int64_t *i64 = calloc((size_t)F + 1, sizeof *i64);
+    double *f64 = calloc((size_t)F + 1, sizeof *f64);
+    int8_t *i8 = calloc((size_t)F + 1, sizeof *i8);
+    const char **str = calloc((size_t)F + 1, sizeof *str);
+    if (!i64 || !f64 || !i8 || !str) { snprintf(err, errlen, "out of host memory"); bad = 1; goto out; }
+
+    {
+        hid_t pos = H5Gopen2(w->file, "particles/hair/position", H5P_DEFAULT);
+        for (int f = 0; f < F; f++) { i64[f] = f; f64[f] = f; }
+        bad |= ds_1d(pos, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, (hsize_t)F, i64) < 0;
+        bad |= ds_1d(pos, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
+        H5Gclose(pos);
+    }
+
+    hid_t p = make_group(w->file, "parameters");
+    bad |= p < 0;
+    bad |= attr_f64(p, "head_radius", s->head_radius) < 0;
+    bad |= attr_f64(p, "hair_offset", s->hair_offset) < 0;
+    bad |= attr_f64(p, "hair_length", s->hair_length) < 0;
+    bad |= attr_f64(p, "face_margin", s->face_margin) < 0;
+    bad |= attr_f64(p, "wind_strength", s->wind_strength) < 0;
+    bad |= attr_f64(p, "wind_angle", s->wind_angle) < 0;
+    bad |= attr_f64(p, "segment_length", hb_segment_length(s)) < 0;
+    bad |= attr_num(p, "seed", H5T_STD_U64LE, H5T_NATIVE_UINT64, &s->seed) < 0;
+    bad |= attr_i64(p, "n_strands", s->n_strands) < 0;
+    bad |= attr_i64(p, "points_per_strand", s->points) < 0;
+    bad |= attr_str(p, "precision", hb_precision_name(s->precision)) < 0;
+    bad |= attr_str(p, "backend", rm->backend) < 0;
+    bad |= attr_str(p, "variant", rm->variant) < 0;
+    bad |= attr_i64(p, "threads", rm->threads) < 0;
+    bad |= attr_i64(p, "block_size", rm->block_size) < 0;
+    bad |= attr_i64(p, "repeat", rm->repeat) < 0;
+    bad |= attr_i64(p, "warmup", rm->warmup) < 0;
+    bad |= attr_str(p, "git_revision", rm->git_revision) < 0;
+    bad |= attr_str(p, "compiler", rm->compiler) < 0;
+    bad |= attr_str(p, "flags", rm->flags) < 0;
+    bad |= attr_str(p, "device", rm->device) < 0;
+    bad |= attr_str(p, "driver", rm->driver) < 0;
+    bad |= attr_str(p, "version", HB_VERSION) < 0;
+    bad |= attr_f64(p, "end_to_end_ms", rm->end_to_end_ms) < 0;
+
+    for (int f = 0; f < F; f++) str[f] = w->frames[f].stage;
+    bad |= ds_str(p, "stage", (hsize_t)F, str) < 0;
+    for (int f = 0; f < F; f++) str[f] = w->frames[f].fused;
+    bad |= ds_str(p, "fused", (hsize_t)F, str) < 0;
+    for (int f = 0; f < F; f++) str[f] = w->frames[f].backend;
+    bad |= ds_str(p, "frame_backend", (hsize_t)F, str) < 0;
+    for (int f = 0; f < F; f++) i8[f] = (int8_t)w->frames[f].skipped;
+    bad |= ds_1d(p, "skipped", H5T_STD_I8LE, H5T_NATIVE_INT8, (hsize_t)F, i8) < 0;
+    for (int f = 0; f < F; f++) i64[f] = w->frames[f].moved_points;
+    bad |= ds_1d(p, "moved_points", H5T_STD_I64LE, H5T_NATIVE_INT64, (hsize_t)F, i64) < 0;
+#define FRAME_F64(field)                                                                     \
+    for (int f = 0; f < F; f++) f64[f] = w->frames[f].field;                                 \
+    bad |= ds_1d(p, #field, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
+    FRAME_F64(wind_strength)
+    FRAME_F64(wind_angle)
+#undef FRAME_F64
+    for (int f = 0; f < F; f++) f64[f] = w->frames[f].median_ms;
+    bad |= ds_1d(p, "stage_median_ms", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
+    for (int f = 0; f < F; f++) f64[f] = w->frames[f].min_ms;
+    bad |= ds_1d(p, "stage_min_ms", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
+    for (int f = 0; f < F; f++) f64[f] = w->frames[f].max_ms;
+    bad |= ds_1d(p, "stage_max_ms", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
+    /* the write time so far, frames included; the closing itself is not counted */
+    bad |= attr_f64(p, "hdf5_write_ms", 1e3 * (w->seconds + now_s() - t0)) < 0;
+    if (p >= 0) H5Gclose(p);
+    if (bad) snprintf(err, errlen, "--output %s: HDF5 could not write /parameters", w->path);
+out:
+    free(i64);
+    free(f64);
+    free(i8);
+    free(str);
+    if (bad) {
+        hb_writer_abort(w);
+        return -1;
+    }
+    H5Dclose(w->value);
+    w->value = -1;
+    herr_t rc = H5Fclose(w->file);
+    w->file = -1;
+    if (rc < 0) {
+        snprintf(err, errlen, "--output %s: HDF5 could not close the file (disk full?)", w->path);
+        hb_writer_abort(w);
+        return -1;
+    }
+    if (rename(w->tmp, w->path) != 0) {
+        snprintf(err, errlen, "--output %s: cannot rename %s into place (%s)", w->path, w->tmp, strerror(errno));
+        hb_writer_abort(w);
+        return -1;
+    }
+    w->seconds += now_s() - t0;
+    writer_free(w);
+    return 0;
+}
+
+/* ---- reader ------------------------------------------------------------------------- */
+static int has_path(hid_t file, const char *path)
+{
+    /* H5Lexists checks one link at a time: walk the path. */
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", path);
+    char partial[256] = "";
+    char *save = NULL;
+    for (char *tok = strtok_r(buf, "/", &save); tok; tok = strtok_r(NULL, "/", &save)) {
+        strncat(partial, "/", sizeof partial - strlen(partial) - 1);
+        strncat(partial, tok, sizeof partial - strlen(partial) - 1);
+        if (H5Lexists(file, partial, H5P_DEFAULT) <= 0) return 0;
+    }
+    return 1;
+}
+
+static int read_attr(hid_t loc, const char *name, hid_t mem_type, void *v)
+{
+    if (H5Aexists(loc, name) <= 0) return -1;
+    hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+    if (a < 0) return -1;
+    hid_t sp = H5Aget_space(a);
+    int ok = H5Sget_simple_extent_npoints(sp) == 1 && H5Aread(a, mem_type, v) >= 0;
+    H5Sclose(sp);
+    H5Aclose(a);
+    return ok ? 0 : -1;
+}
+
+static int read_attr_str(hid_t loc, const char *name, char *out, size_t n)
+{
+    if (H5Aexists(loc, name) <= 0) return -1;
+    hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+    hid_t t = H5Aget_type(a);
+    int rc = -1;
+    if (H5Tget_class(t) == H5T_STRING) {
+        if (H5Tis_variable_str(t) > 0) {
+            char *s = NULL;
+            hid_t mt = str_type();
+            if (H5Aread(a, mt, &s) >= 0 && s) {
+                snprintf(out, n, "%s", s);
+                H5free_memory(s);
+                rc = 0;
+            }
+            H5Tclose(mt);
+        } else {
+            size_t sz = H5Tget_size(t);
+            char *buf = calloc(sz + 1, 1);
+            if (buf && H5Aread(a, t, buf) >= 0) {
+                snprintf(out, n, "%s", buf);
+                rc = 0;
+            }
+            free(buf);
+        }
+    }
+    H5Tclose(t);
+    H5Aclose(a);
+    return rc;
+}
+
+/* Reads a 1-D dataset of length F under /parameters into mem_type; missing → −1. */
+static int read_frames_ds(hid_t p, const char *name, hid_t mem_type, hsize_t F, void *v)
+{
+    if (H5Lexists(p, name, H5P_DEFAULT) <= 0) return -1;
+    hid_t d = H5Dopen2(p, name, H5P_DEFAULT);
+    if (d < 0) return -1;
+    hid_t sp = H5Dget_space(d);
+    hsize_t n = 0;
+    int ok = H5Sget_simple_extent_ndims(sp) == 1 && H5Sget_simple_extent_dims(sp, &n, NULL) == 1 && n == F;
+    ok = ok && H5Dread(d, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0;
+    H5Sclose(sp);
+    H5Dclose(d);
+    return ok ? 0 : -1;
+}
+
+static int read_frames_str(hid_t p, const char *name, hsize_t F, hb_frame_meta *fm, size_t offset, size_t width)
+{
+    char **s = calloc(F ? F : 1, sizeof *s);
+    if (!s) return -1;
+    hid_t t = str_type();
+    int rc = read_frames_ds(p, name, t, F, s);
+    if (rc == 0) {
+        for (hsize_t f = 0; f < F; f++) snprintf((char *)&fm[f] + offset, width, "%s", s[f] ? s[f] : "");
+        for (hsize_t f = 0; f < F; f++) H5free_memory(s[f]);
+    }
+    H5Tclose(t);
+    free(s);
+    return rc;
+}
+
+void hb_input_close(hb_input *in)
+{
+    if (in->hid > 0) H5Fclose((hid_t)in->hid);
+    in->hid = 0;
+    free(in->frames);
+    in->frames = NULL;
+}
+
+#undef FAIL
+#define FAIL(...) do { snprintf(err, errlen, __VA_ARGS__); hb_input_close(in); return -1; } while (0)
+
+int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
+{
+    quiet_hdf5();
+    memset(in, 0, sizeof *in);
+    if (access(path, F_OK) != 0) FAIL("--input %s: no such file", path);
+    if (access(path, R_OK) != 0) FAIL("--input %s: not readable (%s)", path, strerror(errno));
+    if (H5Fis_hdf5(path) <= 0) FAIL("--input %s is not an HDF5 file", path);
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0) FAIL("--input %s: HDF5 cannot open it (truncated or damaged?)", path);
+    in->hid = f;
+    if (!has_path(f, "h5md") || !has_path(f, "particles/hair/position/value") || !has_path(f, "parameters"))
+        FAIL("--input %s is not a hairbench state: it lacks /h5md, /particles/hair/position/value or /parameters", path);
+
+    hid_t p = H5Gopen2(f, "parameters", H5P_DEFAULT);
+    hb_scene *s = &in->scene;
+    char prec[16] = "";
+    int bad = 0;
+    const char *missing = NULL;
+#define NEED(call, name) if (!missing && (call) < 0) missing = name
+    NEED(read_attr(p, "n_strands", H5T_NATIVE_INT64, &s->n_strands), "n_strands");
+    NEED(read_attr(p, "points_per_strand", H5T_NATIVE_INT64, &s->points), "points_per_strand");
+    NEED(read_attr(p, "seed", H5T_NATIVE_UINT64, &s->seed), "seed");
+    NEED(read_attr(p, "head_radius", H5T_NATIVE_DOUBLE, &s->head_radius), "head_radius");
+    NEED(read_attr(p, "hair_offset", H5T_NATIVE_DOUBLE, &s->hair_offset), "hair_offset");
+    NEED(read_attr(p, "hair_length", H5T_NATIVE_DOUBLE, &s->hair_length), "hair_length");
+    NEED(read_attr(p, "face_margin", H5T_NATIVE_DOUBLE, &s->face_margin), "face_margin");
+    NEED(read_attr(p, "wind_strength", H5T_NATIVE_DOUBLE, &s->wind_strength), "wind_strength");
+    NEED(read_attr(p, "wind_angle", H5T_NATIVE_DOUBLE, &s->wind_angle), "wind_angle");
+    NEED(read_attr_str(p, "precision", prec, sizeof prec), "precision");
+#undef NEED
+    if (missing) {
+        H5Gclose(p);
+        FAIL("--input %s: /parameters lacks the attribute '%s'", path, missing);
+    }
+    if (strcmp(prec, "fp32") == 0) s->precision = HB_FP32;
+    else if (strcmp(prec, "fp64") == 0) s->precision = HB_FP64;
+    else { H5Gclose(p); FAIL("--input %s: unknown precision '%s'", path, prec); }
+    char why[HB_ERRLEN];
+    if (hb_scene_validate(s, why, sizeof why) != 0) {
+        H5Gclose(p);
+        FAIL("--input %s holds an invalid scene: %s", path, why);
+    }
+
+    hid_t d = H5Dopen2(f, "particles/hair/position/value", H5P_DEFAULT);
+    hid_t sp = H5Dget_space(d);
+    hid_t t = H5Dget_type(d);
+    hsize_t dims[3] = {0, 0, 0};
+    int rank = H5Sget_simple_extent_ndims(sp);
+    if (rank == 3) H5Sget_simple_extent_dims(sp, dims, NULL);
+    size_t tsize = H5Tget_size(t);
+    int is_float = H5Tget_class(t) == H5T_FLOAT;
+    H5Tclose(t);
+    H5Sclose(sp);
+    H5Dclose(d);
+    uint64_t rows = (uint64_t)s->n_strands * (uint64_t)s->points;
+    if (rank != 3 || dims[2] != 3)
+        bad = snprintf(err, errlen, "--input %s: position/value must be [frames][N*P][3] (rank %d)", path, rank);
+    else if (dims[1] != rows)
+        bad = snprintf(err, errlen, "--input %s: position/value has %llu rows, but n_strands x points_per_strand = %llu",
+                       path, (unsigned long long)dims[1], (unsigned long long)rows);
+    else if (!is_float || tsize != hb_real_size(s->precision))
+        bad = snprintf(err, errlen, "--input %s: position/value is not %s floating point as /parameters says", path, prec);
+    else if (dims[0] < 1)
+        bad = snprintf(err, errlen, "--input %s has no frames", path);
+    if (bad) {
+        H5Gclose(p);
+        hb_input_close(in);
+        return -1;
+    }
+    in->n_frames = (int)dims[0];
+    hsize_t F = dims[0];
+    in->frames = calloc(F, sizeof *in->frames);
+    if (!in->frames) { H5Gclose(p); FAIL("out of host memory"); }
+    for (hsize_t i = 0; i < F; i++) {
+        in->frames[i].moved_points = -1;
+        in->frames[i].wind_strength = in->frames[i].wind_angle = NAN;
+        in->frames[i].median_ms = in->frames[i].min_ms = in->frames[i].max_ms = NAN;
+    }
+    if (read_frames_str(p, "stage", F, in->frames, offsetof(hb_frame_meta, stage), sizeof in->frames[0].stage) < 0) {
+        H5Gclose(p);
+        FAIL("--input %s: /parameters/stage is missing or does not have one entry per frame (%llu)", path,
+             (unsigned long long)F);
+    }
+    /* The rest of the per-frame record is copied when present. */
+    read_frames_str(p, "fused", F, in->frames, offsetof(hb_frame_meta, fused), sizeof in->frames[0].fused);
+    read_frames_str(p, "frame_backend", F, in->frames, offsetof(hb_frame_meta, backend), sizeof in->frames[0].backend);
+    {
+        int8_t *sk = calloc(F, 1);
+        int64_t *mv = calloc(F, sizeof *mv);
+        double *v = calloc(F, sizeof *v);
+        if (sk && read_frames_ds(p, "skipped", H5T_NATIVE_INT8, F, sk) == 0)
+            for (hsize_t i = 0; i < F; i++) in->frames[i].skipped = sk[i];
+        if (mv && read_frames_ds(p, "moved_points", H5T_NATIVE_INT64, F, mv) == 0)
+            for (hsize_t i = 0; i < F; i++) in->frames[i].moved_points = mv[i];
+#define COPY_F64(name, field)                                                                \
+    if (v && read_frames_ds(p, name, H5T_NATIVE_DOUBLE, F, v) == 0)                          \
+        for (hsize_t i = 0; i < F; i++) in->frames[i].field = v[i];
+        COPY_F64("wind_strength", wind_strength)
+        COPY_F64("wind_angle", wind_angle)
+        COPY_F64("stage_median_ms", median_ms)
+        COPY_F64("stage_min_ms", min_ms)
+        COPY_F64("stage_max_ms", max_ms)
+#undef COPY_F64
+        free(sk);
+        free(mv);
+        free(v);
+    }
+    H5Gclose(p);
+    return 0;
+}
+
+int hb_input_read_frame(hb_input *in, int fidx, void *buf, char *err, size_t errlen)
+{
+    const hb_scene *s = &in->scene;
+    hsize_t rows = (hsize_t)s->n_strands * (hsize_t)s->points;
+    hid_t d = H5Dopen2((hid_t)in->hid, "particles/hair/position/value", H5P_DEFAULT);
+    hid_t fs = H5Dget_space(d);
+    hsize_t start[3] = {(hsize_t)fidx, 0, 0}, count[3] = {1, rows, 3};
+    H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
+    hid_t ms = H5Screate_simple(3, count, NULL);
+    hid_t mt = s->precision == HB_FP64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT;
+    herr_t rc = H5Dread(d, mt, ms, fs, H5P_DEFAULT, buf);
+    H5Sclose(ms);
+    H5Sclose(fs);
+    H5Dclose(d);
+    if (rc < 0) {
+        snprintf(err, errlen, "--input: HDF5 could not read frame %d (truncated file?)", fidx);
+        return -1;
+    }
+    uint64_t n = (uint64_t)rows * 3u;
+    for (uint64_t i = 0; i < n; i++) {
+        double v = s->precision == HB_FP64 ? ((const double *)buf)[i] : (double)((const float *)buf)[i];
+        if (!isfinite(v)) {
+            snprintf(err, errlen, "--input: frame %d holds a NaN or Inf at point %llu", fidx,
+                     (unsigned long long)(i / 3));
+            return -1;
+        }
+    }
+    return 0;
+}

@@ -1,0 +1,63 @@
+/* state_io.h — the HDF5 state of DESIGN §4 (layout in docs/interfaces.md): a writer that
+ * appends frames to a temporary file and renames it when complete, and a reader that
+ * validates an --input file before any work. */
+#ifndef HB_STATE_IO_H
+#define HB_STATE_IO_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "params.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* What each frame records beside its positions. */
+typedef struct {
+    char stage[16];
+    char fused[16];
+    char backend[48];      /* "cpu/ref", "cuda/fused", … */
+    int skipped;
+    int64_t moved_points;  /* −1 where not a collide frame */
+    double wind_strength;  /* NaN where not a wind frame */
+    double wind_angle;
+    double median_ms, min_ms, max_ms;
+} hb_frame_meta;
+
+/* Run-wide metadata written as attributes of /parameters. */
+typedef struct {
+    const char *backend, *variant, *git_revision, *compiler, *flags, *device, *driver;
+    int threads, block_size, repeat, warmup;
+    double end_to_end_ms, hdf5_write_ms;
+} hb_run_meta;
+
+typedef struct hb_writer hb_writer;
+
+/* Opens FILE.tmp.<pid>; refuses an existing `path` unless `force`. */
+hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, char *err, size_t errlen);
+int hb_writer_append(hb_writer *w, const void *frame, const hb_frame_meta *fm, char *err, size_t errlen);
+/* Writes /parameters, closes, renames to the final name. Frees w in every case. */
+int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errlen);
+/* Closes and deletes the temporary file. Frees w. */
+void hb_writer_abort(hb_writer *w);
+double hb_writer_seconds(const hb_writer *w); /* time spent writing so far */
+
+/* An --input file, validated. */
+typedef struct {
+    hb_scene scene;
+    int n_frames;
+    hb_frame_meta *frames; /* n_frames entries */
+    int64_t hid;           /* the open file */
+} hb_input;
+
+/* Opens and checks the layout and the scene; one line in err on failure. */
+int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen);
+/* Reads frame f into buf (canonical, the file's precision); checks for NaN/Inf. */
+int hb_input_read_frame(hb_input *in, int f, void *buf, char *err, size_t errlen);
+void hb_input_close(hb_input *in);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

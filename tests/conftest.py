@@ -1,0 +1,64 @@
+"""Shared pytest fixtures: where the binaries are, and the `gpu` marker.
+
+GPU tests are marked `@pytest.mark.gpu`; they are skipped, with the reason, where no
+usable NVIDIA GPU (or no built CUDA binary) is present.
+"""
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+BUILD = ROOT / "build"
+CPU_BIN = BUILD / "hairsim-cpu"
+CUDA_BIN = BUILD / "hairsim-cuda"
+CUDA_STRICT_BIN = BUILD / "hairsim-cuda-strict"
+CUDA_FASTMATH_BIN = BUILD / "hairsim-cuda-fastmath"
+
+
+def _gpu_reason():
+    """Return None when a GPU is usable here, else the reason it is not."""
+    if os.environ.get("HAIRBENCH_NO_GPU"):
+        return "HAIRBENCH_NO_GPU is set"
+    smi = shutil.which("nvidia-smi")
+    if smi is None:
+        return "no nvidia-smi on PATH: this machine has no NVIDIA GPU"
+    try:
+        out = subprocess.run([smi, "-L"], capture_output=True, text=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired) as e:
+        return f"nvidia-smi failed: {e}"
+    if out.returncode != 0 or "GPU" not in out.stdout:
+        return "nvidia-smi lists no GPU"
+    if not CUDA_BIN.exists():
+        return f"{CUDA_BIN} is not built (run make)"
+    return None
+
+
+GPU_REASON = _gpu_reason()
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "gpu: needs an NVIDIA GPU; skipped with a reason where there is none")
+
+
+def pytest_collection_modifyitems(config, items):
+    if GPU_REASON is None:
+        return
+    skip = pytest.mark.skip(reason=f"GPU test skipped: {GPU_REASON}")
+    for item in items:
+        if "gpu" in item.keywords:
+            item.add_marker(skip)
+
+
+@pytest.fixture(scope="session")
+def cpu_bin():
+    if not CPU_BIN.exists():
+        pytest.fail(f"{CPU_BIN} is not built: run `make` first")
+    return CPU_BIN
+
+
+@pytest.fixture(scope="session")
+def cuda_bin():
+    return CUDA_BIN
