@@ -166,7 +166,7 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         } else {
             if (strlen(a) >= sizeof name) FAIL("unknown flag '%s' (see --help)", a);
             strcpy(name, a);
-            if (i + 1 >= argc) FAIL("%s needs a value", name);
+            if (i + 1 >= argc || strncmp(argv[i + 1], "--", 2) == 0) FAIL("%s needs a value", name);
             v = argv[++i];
         }
         int64_t iv;

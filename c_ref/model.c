@@ -11,7 +11,7 @@
 #define SQRT sqrtf
 #define SIN sinf
 #define COS cosf
-#define ACOS acosf
+#define ASIN asinf
 #define ATAN2 atan2f
 #define EPS 0x1p-23f
 #include "model_impl.h"
@@ -21,7 +21,7 @@
 #undef SQRT
 #undef SIN
 #undef COS
-#undef ACOS
+#undef ASIN
 #undef ATAN2
 #undef EPS
 
@@ -31,7 +31,7 @@
 #define SQRT sqrt
 #define SIN sin
 #define COS cos
-#define ACOS acos
+#define ASIN asin
 #define ATAN2 atan2
 #define EPS 0x1p-52
 #include "model_impl.h"

@@ -1,9 +1,9 @@
 /* model_impl.h — the paper model (DESIGN §3), written once for a floating type REAL.
  *
  * Included twice by model.c (REAL = float, then double) with the math functions named by
- * SQRT, SIN, COS, ACOS, ATAN2 and the machine epsilon EPS. The CUDA port (cuda/model.cuh)
+ * SQRT, SIN, COS, ASIN, ATAN2 and the machine epsilon EPS. The CUDA port (cuda/model.cuh)
  * follows this file operation by operation, so that a strict GPU build differs from it
- * only where the platforms' sin/cos/acos/atan2 differ.
+ * only where the platforms' sin/cos/asin/atan2 differ.
  *
  * Coordinates: s[3k+0] = x (depth, never changes), s[3k+1] = y (up), s[3k+2] = z (toward
  * the face). Angles θ are measured from +z toward +y.
@@ -57,16 +57,22 @@ static void SFX(drape)(const MODEL *m, REAL *s)
     for (int64_t k = 1; k < P; k++) {
         REAL *q = s + 3 * k;
         if (!hanging) {
-            /* Step onto the shell circle: cos α = (ρ² + rc² − ℓ²) / (2ρ rc). */
+            /* Step onto the shell circle: the angle α of the triangle (origin,
+             * predecessor, new point) has cos α = (ρ² + rc² − ℓ²) / (2ρ rc). Evaluated in
+             * the equivalent half-angle form sin²(α/2) = (ℓ − g)(ℓ + g) / (4ρ rc), g = rc − ρ,
+             * which keeps its accuracy for short segments where cos α is near 1
+             * (docs/decisions.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
+             * is s² < 0. */
             int fits = 0;
-            REAL c = 0;
+            REAL s2 = 0;
             if (rho > (REAL)0) {
-                c = (rho * rho + rc * rc - ell * ell) / ((REAL)2 * rho * rc);
-                fits = c >= (REAL)-1; /* cos α < −1: the step does not fit the circle */
+                const REAL g = rc - rho;
+                s2 = ((ell - g) * (ell + g)) / ((REAL)4 * rho * rc);
+                fits = s2 <= (REAL)1; /* cos α < −1: the step does not fit the circle */
             }
             if (fits) {
-                if (c > (REAL)1) c = (REAL)1; /* the shell is out of reach only by rounding */
-                const REAL next = theta + ACOS(c);
+                if (s2 < (REAL)0) s2 = (REAL)0; /* the shell is out of reach only by rounding */
+                const REAL next = theta + (REAL)2 * ASIN(SQRT(s2));
                 if (next <= PI_R) {
                     theta = next;
                     pz = rc * COS(next);
@@ -174,12 +180,16 @@ int64_t SFX(hb_collide_strand)(const MODEL *m, REAL *s)
             /* Intersect the shell (radius rc, centre 0) with the circle of radius ℓ around
              * the predecessor at distance d from the centre: the chord's foot lies at
              * a = (d² + rc² − ℓ²) / 2d along the unit u towards the predecessor, the
-             * candidates at a·u ± hh·u⊥ with hh = √(rc² − a²). */
+             * candidates at a·u ± hh·u⊥ with hh = √(rc² − a²). Evaluated through
+             * t = d − a = ((d − rc)(d + rc) + ℓ²) / 2d and hh² = (rc − a)(rc + a), which
+             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions.md,
+             * "collide_short_segment"). */
             const REAL d2 = py * py + pz * pz;
             const REAL d = SQRT(d2);
             if (d > (REAL)0) {
-                const REAL a = (d2 + rc * rc - ell * ell) / ((REAL)2 * d);
-                const REAL h2 = rc * rc - a * a;
+                const REAL t = ((d - rc) * (d + rc) + ell * ell) / ((REAL)2 * d);
+                const REAL a = d - t;
+                const REAL h2 = ((rc - d) + t) * (rc + a);
                 const REAL hh = SQRT(h2 > (REAL)0 ? h2 : (REAL)0);
                 const REAL uy = py / d, uz = pz / d;
                 const REAL fy = a * uy, fz = a * uz;

@@ -12,7 +12,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "build"
-CPU_BIN = BUILD / "hairsim-cpu"
+# `make sanitize` points the CPU tests at the ASan/UBSan build through HAIRBENCH_CPU_BIN.
+CPU_BIN = Path(os.environ.get("HAIRBENCH_CPU_BIN", BUILD / "hairsim-cpu")).resolve()
 CUDA_BIN = BUILD / "hairsim-cuda"
 CUDA_STRICT_BIN = BUILD / "hairsim-cuda-strict"
 CUDA_FASTMATH_BIN = BUILD / "hairsim-cuda-fastmath"
