@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 const char *hb_stage_name(hb_stage s)
 {
@@ -51,13 +52,26 @@ int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
         FAIL("--wind-strength must be in [0, 1] (got %g)", s->wind_strength);
     if (!isfinite(s->wind_angle)) FAIL("--wind-angle must be a finite number of radians (got %g)", s->wind_angle);
     double ell = hb_segment_length(s);
-    if (!(ell >= s->hair_offset))
+    /* ℓ = L/(P−1) computed in double may round just below h when the user asked for ℓ = h
+     * exactly; a relative allowance of 1e-12 keeps that edge usable. */
+    if (!(ell >= s->hair_offset * (1.0 - 1e-12)))
         FAIL("--hair-length/(--points - 1) = %g is shorter than --hair-offset %g: a segment could not reach the "
              "shell (DESIGN §3 collide needs l >= h)", ell, s->hair_offset);
-    if (s->precision == HB_FP32) {
-        /* The scene must be representable: every length must round to a normal float. */
-        if (s->head_radius > 1e30 || s->hair_length > 1e30 || s->hair_offset < 1e-30 || ell < 1e-30)
-            FAIL("scene lengths are outside the fp32 range (use --precision fp64)");
+    /* Every length must square without leaving the precision's normal range, or the
+     * model's r², ℓ² and ρ·rc underflow to denormals or zero (docs/decisions.md,
+     * "fp32_near_denormal_range"). */
+    const double lo = s->precision == HB_FP32 ? 1e-18 : 1e-150;
+    const double hi = s->precision == HB_FP32 ? 1e18 : 1e150;
+    const struct { const char *flag; double v; } len[] = {
+        {"--head-radius", s->head_radius}, {"--hair-offset", s->hair_offset}, {"--hair-length", s->hair_length},
+        {"--hair-length/(--points - 1)", ell}, {"--face-margin", s->face_margin},
+    };
+    for (size_t i = 0; i < sizeof len / sizeof len[0]; i++) {
+        if (len[i].v == 0.0 && strcmp(len[i].flag, "--face-margin") == 0) continue;
+        if (len[i].v < lo || len[i].v > hi)
+            FAIL("%s = %g is outside the lengths %s can square without underflow or overflow [%g, %g]%s", len[i].flag,
+                 len[i].v, hb_precision_name(s->precision), lo, hi,
+                 s->precision == HB_FP32 ? " (use --precision fp64)" : "");
     }
     if (hb_state_bytes(s) == 0) FAIL("--strands x --points is too large to address");
     return 0;
