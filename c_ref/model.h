@@ -33,11 +33,14 @@ typedef struct {
  * docs/decisions.md). */
 #define HB_SHELL_ULPS 16
 
+/* init = place the root from the RNG, then drape; drape alone re-drapes from s[0..2]. */
 void hb_init_strand_f32(const hb_model_f32 *m, uint64_t strand, float *s);
+void hb_drape_strand_f32(const hb_model_f32 *m, float *s);
 void hb_wind_strand_f32(const hb_model_f32 *m, float *s);
 int64_t hb_collide_strand_f32(const hb_model_f32 *m, float *s);
 
 void hb_init_strand_f64(const hb_model_f64 *m, uint64_t strand, double *s);
+void hb_drape_strand_f64(const hb_model_f64 *m, double *s);
 void hb_wind_strand_f64(const hb_model_f64 *m, double *s);
 int64_t hb_collide_strand_f64(const hb_model_f64 *m, double *s);
 

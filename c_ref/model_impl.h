@@ -40,7 +40,7 @@ static void SFX(place_root)(const MODEL *m, uint64_t strand, REAL *s)
 }
 
 /* ---- DESIGN §3 "Stage init — drape (SetEndPoint, interpolated points, slerp)" -------- */
-static void SFX(drape)(const MODEL *m, REAL *s)
+void SFX(hb_drape_strand)(const MODEL *m, REAL *s)
 {
     const int64_t P = m->points;
     const REAL ell = m->seg_len;
@@ -104,7 +104,7 @@ static void SFX(drape)(const MODEL *m, REAL *s)
 void SFX(hb_init_strand)(const MODEL *m, uint64_t strand, REAL *s)
 {
     SFX(place_root)(m, strand, s);
-    SFX(drape)(m, s);
+    SFX(hb_drape_strand)(m, s);
 }
 
 /* ---- DESIGN §3 "Stage wind" ----------------------------------------------------------- */
