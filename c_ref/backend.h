@@ -57,6 +57,9 @@ struct hb_backend {
     /* Measure copy bandwidth (bytes read + bytes written per second, GB/s). */
     int (*measure_bandwidth)(hb_backend *b, const hb_options *o, double *gbps, double *bytes,
                              char *err, size_t errlen);
+    /* Optional (NULL: not measured): a STREAM-style triad a = b + q·c, bytes = 2 reads + 1 write. */
+    int (*measure_triad)(hb_backend *b, const hb_options *o, double *gbps, double *bytes,
+                         char *err, size_t errlen);
     /* Descriptions for the metadata. */
     void (*describe)(hb_backend *b, char *device, size_t dlen, char *driver, size_t vlen);
     void (*teardown)(hb_backend *b);

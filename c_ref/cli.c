@@ -63,7 +63,7 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
             "  --measure-bandwidth  only measure the %s copy bandwidth (GB/s, read + write)\n"
             "  --self-test rng      print the Philox4x32-10 known-answer checks and exit\n"
             "  --help, --version\n",
-            prog, backend, cuda ? "paper | soa | fused (default fused)" : "ref (default ref)",
+            prog, backend, cuda ? "paper | soa | fused (default fused)" : "ref | simd (default ref)",
             cuda ? "  --block-size B       threads per block, 32..1024 (default 256)\n"
                  : "  --threads T          OpenMP threads over strands (default: all cores)\n",
             cuda ? "device-to-device" : "all-core memory");

@@ -186,13 +186,20 @@ int hb_main(int argc, char **argv, hb_backend *b)
     run.rec = &rec;
 
     if (o.measure_bandwidth) {
-        double gbps = 0, bytes = 0;
+        double gbps = 0, bytes = 0, triad = NAN, triad_bytes = NAN;
         CHECK(b->measure_bandwidth(b, &o, &gbps, &bytes, err, sizeof err), HB_EXIT_RUNTIME);
+        if (b->measure_triad) CHECK(b->measure_triad(b, &o, &triad, &triad_bytes, err, sizeof err), HB_EXIT_RUNTIME);
         b->describe(b, rec.device, sizeof rec.device, rec.driver, sizeof rec.driver);
-        if (o.json) printf("{\"backend\": \"%s\", \"copy_gbps\": %.6g, \"bytes\": %.17g, \"device\": \"%s\"}\n",
-                           b->name, gbps, bytes, rec.device);
-        else printf("%s copy bandwidth: %.1f GB/s (read + write, %.0f bytes per copy) on %s\n", b->name, gbps, bytes,
-                    rec.device);
+        if (o.json) {
+            printf("{\"backend\": \"%s\", \"copy_gbps\": %.6g, \"bytes\": %.17g", b->name, gbps, bytes);
+            if (isfinite(triad)) printf(", \"triad_gbps\": %.6g, \"triad_bytes\": %.17g", triad, triad_bytes);
+            if (b->threads > 0) printf(", \"threads\": %d", b->threads);
+            printf(", \"device\": \"%s\"}\n", rec.device);
+        } else {
+            printf("%s copy bandwidth: %.1f GB/s (read + write, %.0f bytes per copy)", b->name, gbps, bytes);
+            if (isfinite(triad)) printf("; triad %.1f GB/s (%.0f bytes)", triad, triad_bytes);
+            printf(" on %s\n", rec.device);
+        }
         run_free(&run);
         return HB_EXIT_OK;
     }
@@ -222,7 +229,11 @@ int hb_main(int argc, char **argv, hb_backend *b)
     const int need_host = o.output != NULL || o.end_to_end;
     uint64_t driver_bytes = (need_host ? bytes : 0) + (o.input ? bytes : 0);
     const int need_save = o.repeat > 1 || o.warmup > 0;
-    CHECK(b->setup(b, &o, need_save, driver_bytes, err, sizeof err), HB_EXIT_MEMORY);
+    int status = b->setup(b, &o, need_save, driver_bytes, err, sizeof err);
+    if (status != HB_EXIT_OK) {
+        run_free(&run);
+        return die(status, err);
+    }
     b->describe(b, rec.device, sizeof rec.device, rec.driver, sizeof rec.driver);
     rec.threads = b->threads;
     rec.block_size = b->block_size;

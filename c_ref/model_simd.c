@@ -1,0 +1,99 @@
+/* model_simd.c — instantiates model_simd_impl.h for float and for double (the `simd`
+ * variant of hairsim-cpu; docs/cpu_simd.md).
+ *
+ * Built with its own flags (Makefile, SIMD_CFLAGS): -O3 -march=x86-64-v3 -fopenmp-simd
+ * -fno-math-errno -fno-trapping-math, on top of the reference's -ffp-contract=off and
+ * without -ffast-math. How the loops get glibc's vector math (libmvec) without it:
+ *
+ *  - glibc's <math.h> declares the vector variants of sin, cos, asin, atan2 … (the
+ *    `simd("notinbranch")` attribute, bits/math-vector.h) only when __FAST_MATH__ is
+ *    defined, and GCC defines that only with all of -ffast-math's value-changing flags
+ *    (-funsafe-math-optimizations, -ffinite-math-only, -fno-signed-zeros, …). We declare
+ *    the same attribute on the eight functions we call, below: the declarations glibc
+ *    makes, without those flags. The vector functions are libmvec's, accurate to 4 ulp
+ *    (glibc manual, "Errors in Math Functions").
+ *  - -fno-math-errno: sqrt becomes the vector sqrt instruction, and the math builtins
+ *    have no side effect (with errno, GCC calls sqrtf for negative arguments, a branch
+ *    that blocks vectorisation). No value changes.
+ *  - -fno-trapping-math: GCC may then if-convert the branches of a loop, evaluating FP
+ *    operations whose result a select discards (we never enable FP traps). No value
+ *    changes. Without it only the branch-free loops are vectorised.
+ *  - -ffp-contract=off stays (the reference's flags): no FMA contraction, so the
+ *    arithmetic between the calls is the reference's, operation for operation.
+ *  - A sin and a cos of the same angle in one loop are merged by GCC into a sincos call,
+ *    which has no vector variant it can use, and the loop is then not vectorised at all
+ *    (with or without -ffast-math): model_simd_impl.h puts them in two loops.
+ *
+ * Check that the calls are vectorised: objdump -dr build/obj/model_simd.o | grep _ZGV
+ * (tests/test_cpu_simd.py fails on any scalar call to these functions).
+ */
+#include "model_simd.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "philox.h"
+
+#if !defined(__x86_64__) || !defined(__GLIBC__)
+#error "model_simd.c needs x86_64 and glibc's libmvec"
+#elif !__GLIBC_PREREQ(2, 35)
+#error "model_simd.c needs glibc >= 2.35 (libmvec's asin/atan2 vector variants)"
+#endif
+
+#define HB_SIMD_DECL __attribute__((__simd__("notinbranch")))
+HB_SIMD_DECL float sinf(float);
+HB_SIMD_DECL float cosf(float);
+HB_SIMD_DECL float asinf(float);
+HB_SIMD_DECL float atan2f(float, float);
+HB_SIMD_DECL double sin(double);
+HB_SIMD_DECL double cos(double);
+HB_SIMD_DECL double asin(double);
+HB_SIMD_DECL double atan2(double, double);
+
+#define HB_ALIGNED __attribute__((aligned(64)))
+#define HB_ASSUME_ALIGNED(p) ((__typeof__(p))__builtin_assume_aligned((p), 64))
+
+#if defined(__AVX512F__)
+const char hb_simd_isa[] = "x86-64-v4 (AVX-512)";
+#elif defined(__AVX2__) && defined(__FMA__)
+const char hb_simd_isa[] = "x86-64-v3 (AVX2 + FMA)";
+#else
+const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
+#endif
+
+#define REAL float
+#define ITYPE int32_t
+#define BLOCK HB_SIMD_BLOCK_F32
+#define SFX(name) name##_f32
+#define MODEL hb_model_f32
+#define SQRT sqrtf
+#define SIN sinf
+#define COS cosf
+#define ASIN asinf
+#define ATAN2 atan2f
+#define EPS 0x1p-23f
+#include "model_simd_impl.h"
+#undef REAL
+#undef ITYPE
+#undef BLOCK
+#undef SFX
+#undef MODEL
+#undef SQRT
+#undef SIN
+#undef COS
+#undef ASIN
+#undef ATAN2
+#undef EPS
+
+#define REAL double
+#define ITYPE int64_t
+#define BLOCK HB_SIMD_BLOCK_F64
+#define SFX(name) name##_f64
+#define MODEL hb_model_f64
+#define SQRT sqrt
+#define SIN sin
+#define COS cos
+#define ASIN asin
+#define ATAN2 atan2
+#define EPS 0x1p-52
+#include "model_simd_impl.h"

@@ -1,0 +1,63 @@
+/* model_simd.h — the paper model of DESIGN §3 on the point-major layout, vectorised across
+ * strands: the `simd` variant of hairsim-cpu (docs/cpu_simd.md).
+ *
+ * Layout: three arrays X, Y, Z of [P][S] reals, S = the row stride (N rounded up to a whole
+ * number of blocks); point k of strand i is element k·S + i. A block is HB_SIMD_BLOCK(prec)
+ * consecutive strands; each function below computes one whole block, one strand per SIMD
+ * lane from the first point to the last, with the running state of every lane in small
+ * arrays on the stack (L1). The block's pointers point at its first strand in row 0 and
+ * must be 64-byte aligned; every lane of the block is computed (lanes past the last real
+ * strand are padding: computed, never read back, never counted).
+ *
+ * The formulas are those of model_impl.h, operation for operation (including the two
+ * better-conditioned evaluations of docs/decisions.md), with its branches turned into
+ * selects; the only difference is that sin/cos/asin/atan2 are glibc's libmvec vector
+ * functions. model_simd.c is compiled for x86-64-v3 (AVX2 + FMA): call these only after
+ * hb_simd_cpu_ok() in a file compiled for the baseline ISA (backend_cpu.c does).
+ */
+#ifndef HB_MODEL_SIMD_H
+#define HB_MODEL_SIMD_H
+
+#include <stdint.h>
+
+#include "model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Strands per block: 2 KiB of one row in either precision, so that a lane state of a few
+ * reals per strand stays in L1. Fixed: it does not depend on the thread count, and since
+ * every strand is one lane start to finish, the bits do not depend on it either. */
+#ifndef HB_SIMD_BLOCK_F32 /* (overridable with -D for experiments; a multiple of 64) */
+#define HB_SIMD_BLOCK_F32 512
+#endif
+#ifndef HB_SIMD_BLOCK_F64
+#define HB_SIMD_BLOCK_F64 256
+#endif
+/* collide runs its pull (or its projection) on a chunk of this many lanes only at a point
+ * where one lane of the chunk has moved (or penetrates); a multiple of every vector width,
+ * so no lane is ever left to a scalar remainder loop */
+#define HB_SIMD_CHUNK 16
+
+/* init: roots (strands first … first + block − 1) and drape; writes X, Y, Z. */
+void hb_simd_init_block_f32(const hb_model_f32 *m, uint64_t first, float *X, float *Y, float *Z, int64_t stride);
+void hb_simd_init_block_f64(const hb_model_f64 *m, uint64_t first, double *X, double *Y, double *Z,
+                            int64_t stride);
+
+/* wind (w ≠ 0): reads and writes Y, Z; X is not touched. */
+void hb_simd_wind_block_f32(const hb_model_f32 *m, float *Y, float *Z, int64_t stride);
+void hb_simd_wind_block_f64(const hb_model_f64 *m, double *Y, double *Z, int64_t stride);
+
+/* collide: reads Y, Z and writes only the points it changes; returns the number of points
+ * changed in the first `real` lanes of the block. */
+int64_t hb_simd_collide_block_f32(const hb_model_f32 *m, int real, float *Y, float *Z, int64_t stride);
+int64_t hb_simd_collide_block_f64(const hb_model_f64 *m, int real, double *Y, double *Z, int64_t stride);
+
+/* The ISA model_simd.c is compiled for, as the compiler saw it (for messages). */
+extern const char hb_simd_isa[];
+
+#ifdef __cplusplus
+}
+#endif
+#endif

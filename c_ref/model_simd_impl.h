@@ -1,0 +1,307 @@
+/* model_simd_impl.h — the stages of model_impl.h on a block of strands in the point-major
+ * layout, one strand per SIMD lane (model_simd.h says the layout and the contract).
+ *
+ * Included twice by model_simd.c with REAL (float, double), ITYPE (an integer as wide as
+ * REAL, for per-lane flags and counts), BLOCK (lanes per block), SFX, MODEL, SQRT, SIN,
+ * COS, ASIN, ATAN2 and EPS. Every `#pragma omp simd` loop below runs over the BLOCK lanes
+ * of one point k (collide: over a chunk of HB_SIMD_CHUNK of them): its body is the body of
+ * the matching loop of model_impl.h for one strand, with each `if` turned into values
+ * computed on every lane and a select. Nothing in a lane depends on another lane, and
+ * BLOCK and HB_SIMD_CHUNK are multiples of every vector width, so no lane is ever computed
+ * by a scalar remainder loop: every strand goes through the same vector code whatever its
+ * position, its block and the thread that runs it.
+ *
+ * Where model_impl.h evaluates X in a branch, the lanes here evaluate X everywhere and
+ * discard it where the branch was not taken; such values may be Inf or NaN (e.g. s² with
+ * ρ = 0) and are never selected.
+ */
+
+#define PI_R ((REAL)3.14159265358979323846)
+#define HALF_PI_R ((REAL)1.57079632679489661923)
+#define TWO_PI_R ((REAL)6.28318530717958647692)
+
+#define ROW(A, k) ((A) + (size_t)(k) * (size_t)stride)
+
+/* ---- init: roots (model_impl.h place_root) and drape (model_impl.h drape) ------------- */
+void SFX(hb_simd_init_block)(const MODEL *m, uint64_t first, REAL *X, REAL *Y, REAL *Z, int64_t stride)
+{
+    const int64_t P = m->points;
+    const REAL R = m->head_radius, h = m->hair_offset, ell = m->seg_len;
+    /* the lane state: the strand's x, its predecessor (py, pz), shell radius, angle θ,
+     * slice radius ρ of the predecessor, and whether it hangs */
+    REAL x0[BLOCK] HB_ALIGNED, py[BLOCK] HB_ALIGNED, pz[BLOCK] HB_ALIGNED, rc[BLOCK] HB_ALIGNED;
+    REAL theta[BLOCK] HB_ALIGNED, rho[BLOCK] HB_ALIGNED;
+    ITYPE hang[BLOCK] HB_ALIGNED;
+    /* within one point: whether the lane stepped onto the shell, and its y if it did not */
+    ITYPE stepped[BLOCK] HB_ALIGNED;
+    REAL ynot[BLOCK] HB_ALIGNED;
+
+    /* Roots: integer Philox draws and IEEE arithmetic only, so they are the bits of
+     * place_root whether this loop is vectorised or not. */
+    for (int j = 0; j < BLOCK; j++) {
+        uint32_t r[4];
+        hb_draw_block(m->seed, first + (uint64_t)j, 0u, r);
+        const REAL u1 = (REAL)hb_u01(r[0]);
+        const REAL u2 = (REAL)hb_u01(r[1]);
+        const REAL u3 = (REAL)hb_u01(r[2]);
+        REAL z = ((REAL)2 * u1 - (REAL)1) * R - m->face_margin;
+        if (z < -R) z = -R;
+        if (z > R) z = R;
+        REAL dd = R * R - z * z;
+        const REAL d = SQRT(dd > (REAL)0 ? dd : (REAL)0);
+        const REAL y = z > (REAL)0 ? d * ((REAL)0.3 + (REAL)0.7 * u2) : ((REAL)2 * u2 - (REAL)1) * d;
+        REAL xx = R * R - z * z - y * y;
+        REAL x = SQRT(xx > (REAL)0 ? xx : (REAL)0);
+        if (u3 >= (REAL)0.5) x = -x;
+        x0[j] = x;
+        py[j] = y;
+        pz[j] = z;
+    }
+
+    {
+        REAL *restrict X0 = HB_ASSUME_ALIGNED(X), *restrict Y0 = HB_ASSUME_ALIGNED(Y),
+                       *restrict Z0 = HB_ASSUME_ALIGNED(Z);
+#pragma omp simd
+        for (int j = 0; j < BLOCK; j++) {
+            const REAL y = py[j], z = pz[j];
+            const REAL r0 = SQRT(y * y + z * z);
+            rc[j] = r0 + h;
+            REAL th = ATAN2(y, z);                      /* (−π, π] … */
+            th = th <= -HALF_PI_R ? th + TWO_PI_R : th; /* … taken in (−π/2, 3π/2] */
+            theta[j] = th;
+            hang[j] = th > PI_R; /* a root on the lower back hangs from the root */
+            rho[j] = r0;
+            X0[j] = x0[j];
+            Y0[j] = y;
+            Z0[j] = z;
+        }
+    }
+
+    for (int64_t k = 1; k < P; k++) {
+        REAL *restrict Xk = HB_ASSUME_ALIGNED(ROW(X, k)), *restrict Yk = HB_ASSUME_ALIGNED(ROW(Y, k)),
+                       *restrict Zk = HB_ASSUME_ALIGNED(ROW(Z, k));
+        /* Two loops per point: the cos and the sin of the same angle in one loop would be
+         * merged by GCC into one sincos call, which it cannot vectorise (model_simd.c). The
+         * first loop does everything but the sin, the second the sin and y. */
+#pragma omp simd
+        for (int j = 0; j < BLOCK; j++) {
+            const REAL th = theta[j], rh = rho[j], y = py[j], z = pz[j], c = rc[j];
+            const ITYPE hg = hang[j];
+            /* the step onto the shell, in the half-angle form of model_impl.h:
+             * s² = sin²(α/2) = (ℓ − g)(ℓ + g) / (4ρ rc), g = rc − ρ; it fits when ρ > 0 and
+             * s² ≤ 1, and s² < 0 (out of reach only by rounding) is clamped to 0 */
+            const REAL g = c - rh;
+            const REAL s2 = ((ell - g) * (ell + g)) / ((REAL)4 * rh * c);
+            const ITYPE fits = (rh > (REAL)0) & (s2 <= (REAL)1);
+            const ITYPE neg = s2 < (REAL)0;
+            const REAL s2c = fits & (neg == 0) ? s2 : (REAL)0;
+            const REAL next = th + (REAL)2 * ASIN(SQRT(s2c));
+            const ITYPE step = (hg == 0) & fits & (next <= PI_R);
+            const REAL sz = c * COS(next);
+            /* not stepping: the first hanging point goes onto the tangent line z = −rc at
+             * distance ℓ below the predecessor; a hanging one goes straight down */
+            const REAL dz = z + c;
+            const REAL dy2 = ell * ell - dz * dz;
+            const REAL tangent = y - SQRT(dy2 > (REAL)0 ? dy2 : (REAL)0), down = y - ell, mc = -c;
+            const REAL hz = hg ? z : mc;
+            const REAL nz = step ? sz : hz;
+            theta[j] = step ? next : th;
+            rho[j] = step ? c : rh;
+            hang[j] = step ? 0 : 1;
+            stepped[j] = step;
+            ynot[j] = hg ? down : tangent;
+            pz[j] = nz;
+            Xk[j] = x0[j];
+            Zk[j] = nz;
+        }
+#pragma omp simd
+        for (int j = 0; j < BLOCK; j++) {
+            const REAL sy = rc[j] * SIN(theta[j]); /* θ is `next` where the lane stepped */
+            const REAL ny = stepped[j] ? sy : ynot[j];
+            py[j] = ny;
+            Yk[j] = ny;
+        }
+    }
+}
+
+/* ---- wind (model_impl.h hb_wind_strand) ----------------------------------------------- */
+void SFX(hb_simd_wind_block)(const MODEL *m, REAL *Y, REAL *Z, int64_t stride)
+{
+    const int64_t P = m->points;
+    const REAL ell = m->seg_len;
+    const REAL w = m->wind_strength;
+    const REAL psi = m->wind_angle; /* already reduced to (−π, π] */
+    const REAL last = (REAL)(P - 1);
+    /* the predecessor before (oy, oz) and after (ny, nz) the wind; the root never moves */
+    REAL oy[BLOCK] HB_ALIGNED, oz[BLOCK] HB_ALIGNED, ny[BLOCK] HB_ALIGNED, nz[BLOCK] HB_ALIGNED;
+    REAL angle[BLOCK] HB_ALIGNED; /* within one point: the turned direction */
+    {
+        const REAL *restrict Y0 = HB_ASSUME_ALIGNED(Y), *restrict Z0 = HB_ASSUME_ALIGNED(Z);
+#pragma omp simd
+        for (int j = 0; j < BLOCK; j++) {
+            oy[j] = ny[j] = Y0[j];
+            oz[j] = nz[j] = Z0[j];
+        }
+    }
+    for (int64_t k = 1; k < P; k++) {
+        REAL *restrict Yk = HB_ASSUME_ALIGNED(ROW(Y, k)), *restrict Zk = HB_ASSUME_ALIGNED(ROW(Z, k));
+        const REAL t = (w * (REAL)k) / last;
+        /* Two loops per point, the cos in the first and the sin in the second (see init). */
+#pragma omp simd
+        for (int j = 0; j < BLOCK; j++) {
+            const REAL cy = Yk[j], cz = Zk[j];
+            const REAL dy = cy - oy[j], dz = cz - oz[j];
+            const REAL phi = ATAN2(dy, dz);
+            REAL delta = psi - phi; /* in [−2π, 2π]: wrap to (−π, π] */
+            const REAL dm = delta - TWO_PI_R, dp = delta + TWO_PI_R;
+            const ITYPE above = delta > PI_R, below = delta <= -PI_R;
+            delta = above ? dm : (below ? dp : delta);
+            /* exactly opposite: the arc through +y (the sign of dz, model_impl.h) */
+            const ITYPE opposite = delta == PI_R, up = dz >= (REAL)0;
+            delta = opposite ? (up ? PI_R : -PI_R) : delta;
+            const REAL turned = phi + t * delta;
+            const REAL z = nz[j] + ell * COS(turned);
+            angle[j] = turned;
+            nz[j] = z;
+            Zk[j] = z;
+            oy[j] = cy;
+            oz[j] = cz;
+        }
+#pragma omp simd
+        for (int j = 0; j < BLOCK; j++) {
+            const REAL y = ny[j] + ell * SIN(angle[j]);
+            ny[j] = y;
+            Yk[j] = y;
+        }
+    }
+}
+
+/* ---- collide (model_impl.h hb_collide_strand) ----------------------------------------- */
+int64_t SFX(hb_simd_collide_block)(const MODEL *m, int real, REAL *Y, REAL *Z, int64_t stride)
+{
+    const int64_t P = m->points;
+    const REAL ell = m->seg_len, h = m->hair_offset;
+    /* the predecessor (after this pass), the shell, whether the strand has moved, and the
+     * count of points changed */
+    REAL py[BLOCK] HB_ALIGNED, pz[BLOCK] HB_ALIGNED, rc[BLOCK] HB_ALIGNED, inner2[BLOCK] HB_ALIGNED;
+    ITYPE moved[BLOCK] HB_ALIGNED, changed[BLOCK] HB_ALIGNED;
+    /* within one point: the point after the pull and the projection, and whether it is
+     * inside the shell (then: whether it was projected) */
+    REAL ny[BLOCK] HB_ALIGNED, nz[BLOCK] HB_ALIGNED;
+    ITYPE inside[BLOCK] HB_ALIGNED;
+    {
+        const REAL *restrict Y0 = HB_ASSUME_ALIGNED(Y), *restrict Z0 = HB_ASSUME_ALIGNED(Z);
+#pragma omp simd
+        for (int j = 0; j < BLOCK; j++) {
+            const REAL y = Y0[j], z = Z0[j];
+            const REAL r0 = SQRT(y * y + z * z);
+            const REAL c = r0 + h;
+            const REAL inner = c - c * ((REAL)HB_SHELL_ULPS * EPS); /* rounding allowance */
+            rc[j] = c;
+            inner2[j] = inner * inner;
+            py[j] = y;
+            pz[j] = z;
+            moved[j] = 0;
+            changed[j] = 0;
+        }
+    }
+    for (int64_t k = 1; k < P; k++) {
+        REAL *restrict Yk = HB_ASSUME_ALIGNED(ROW(Y, k)), *restrict Zk = HB_ASSUME_ALIGNED(ROW(Z, k));
+        /* model_impl.h's two branches, the pull of a moved strand and the projection of a
+         * point inside the shell, cost divisions and square roots that selects would
+         * compute on every lane; most lanes take neither. So each chunk of HB_SIMD_CHUNK
+         * lanes runs a branch's loop only when one of its lanes takes it; every lane of
+         * the chunk then computes it and the select keeps it where model_impl.h would. */
+        for (int j0 = 0; j0 < BLOCK; j0 += HB_SIMD_CHUNK) {
+            const int j1 = j0 + HB_SIMD_CHUNK;
+            ITYPE any_moved = 0, any_inside = 0;
+#pragma omp simd reduction(| : any_moved)
+            for (int j = j0; j < j1; j++) any_moved |= moved[j];
+            if (any_moved) {
+                /* follow the leader once the strand has moved:
+                 * p_k ← p_{k−1} + ℓ·unit(p_k − p_{k−1}), or ℓ straight down when there is
+                 * no direction left */
+#pragma omp simd reduction(| : any_inside)
+                for (int j = j0; j < j1; j++) {
+                    const REAL y = py[j], z = pz[j], qy = Yk[j], qz = Zk[j];
+                    const REAL dy = qy - y, dz = qz - z;
+                    const REAL len = SQRT(dy * dy + dz * dz);
+                    const ITYPE dir = len > (REAL)0;
+                    const REAL fy = y + ell * (dy / len), fz = z + ell * (dz / len), down = y - ell;
+                    const REAL cy = moved[j] ? (dir ? fy : down) : qy;
+                    const REAL cz = moved[j] ? (dir ? fz : z) : qz;
+                    const ITYPE in = cy * cy + cz * cz < inner2[j];
+                    ny[j] = cy;
+                    nz[j] = cz;
+                    inside[j] = in;
+                    any_inside |= in;
+                }
+            } else {
+#pragma omp simd reduction(| : any_inside)
+                for (int j = j0; j < j1; j++) {
+                    const REAL cy = Yk[j], cz = Zk[j];
+                    const ITYPE in = cy * cy + cz * cz < inner2[j];
+                    ny[j] = cy;
+                    nz[j] = cz;
+                    inside[j] = in;
+                    any_inside |= in;
+                }
+            }
+            if (any_inside) {
+                /* inside the shell: the intersection of the shell with the circle of radius
+                 * ℓ around the predecessor closest to the point (ties: the upper one),
+                 * through t = d − a and hh² = (rc − d + t)(rc + a) as in model_impl.h */
+#pragma omp simd
+                for (int j = j0; j < j1; j++) {
+                    const REAL y = py[j], z = pz[j], c = rc[j], cy = ny[j], cz = nz[j];
+                    const REAL d2 = y * y + z * z;
+                    const REAL d = SQRT(d2);
+                    const ITYPE proj = inside[j] & (d > (REAL)0);
+                    const REAL t = ((d - c) * (d + c) + ell * ell) / ((REAL)2 * d);
+                    const REAL a = d - t;
+                    const REAL h2 = ((c - d) + t) * (c + a);
+                    const REAL hh = SQRT(h2 > (REAL)0 ? h2 : (REAL)0);
+                    const REAL uy = y / d, uz = z / d;
+                    const REAL fy = a * uy, fz = a * uz;
+                    const REAL y1 = fy + hh * uz, z1 = fz - hh * uy;
+                    const REAL y2 = fy - hh * uz, z2 = fz + hh * uy;
+                    const REAL e1 = (y1 - cy) * (y1 - cy) + (z1 - cz) * (z1 - cz);
+                    const REAL e2 = (y2 - cy) * (y2 - cy) + (z2 - cz) * (z2 - cz);
+                    const ITYPE upper = (e1 < e2) | ((e1 == e2) & (y1 >= y2));
+                    ny[j] = proj ? (upper ? y1 : y2) : cy;
+                    nz[j] = proj ? (upper ? z1 : z2) : cz;
+                    inside[j] = proj;
+                }
+            }
+            if (!any_moved && !any_inside) {
+#pragma omp simd
+                for (int j = j0; j < j1; j++) {
+                    py[j] = ny[j];
+                    pz[j] = nz[j];
+                }
+                continue;
+            }
+#pragma omp simd
+            for (int j = j0; j < j1; j++) {
+                const REAL cy = ny[j], cz = nz[j];
+                const ITYPE now = moved[j] | inside[j]; /* inside[] is now "projected" */
+                if (now) { /* a masked store: untouched points are not written */
+                    Yk[j] = cy;
+                    Zk[j] = cz;
+                }
+                moved[j] = now;
+                changed[j] += now;
+                py[j] = cy;
+                pz[j] = cz;
+            }
+        }
+    }
+    int64_t total = 0;
+    for (int j = 0; j < real && j < BLOCK; j++) total += (int64_t)changed[j];
+    return total;
+}
+
+#undef ROW
+#undef PI_R
+#undef HALF_PI_R
+#undef TWO_PI_R
