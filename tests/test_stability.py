@@ -166,3 +166,46 @@ def test_collide_at_the_slice_poles(cpu_bin, tmp_path, precision):
     assert np.abs(seg - ell).max() < 1e-5
     rc = np.hypot(fr[:, 0, 1], fr[:, 0, 2]) + 0.1
     assert (np.hypot(fr[:, 1:, 1], fr[:, 1:, 2]) >= rc[:, None] * (1 - 1e-6)).all()
+
+
+@pytest.fixture(scope="module")
+def drape_poles(tmp_path_factory):
+    """tests/c/drape_poles.c built against the C reference's model."""
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    cc = shutil.which("cc") or shutil.which("gcc")
+    if cc is None:
+        pytest.skip("no C compiler to build tests/c/drape_poles.c")
+    root = Path(__file__).resolve().parent.parent
+    exe = tmp_path_factory.mktemp("poles") / "drape_poles"
+    subprocess.run([cc, "-std=c11", "-D_DEFAULT_SOURCE", "-O2", "-ffp-contract=off", f"-I{root / 'c_ref'}",
+                    str(root / "tests/c/drape_poles.c"), str(root / "c_ref/model.c"), "-lm", "-o", str(exe)],
+                   check=True)
+    return exe
+
+
+@pytest.mark.parametrize("L", [5.5, 1.1, 25.0, 250.0])  # ℓ = 0.5, exactly h, 2.27, > head diameter
+def test_drape_at_the_slice_poles(drape_poles, L):
+    """Roots the RNG cannot produce (slice centre, θ0 = π, θ0 = −π/2, just past π, a tiny
+    slice near the side): drape, collide and wind+collide stay finite, keep ℓ, keep x and
+    the root, and leave no point inside the shell."""
+    import subprocess
+
+    out = subprocess.run([str(drape_poles), repr(L)], capture_output=True, text=True, check=True).stdout
+    rows = {}
+    for line in out.splitlines():
+        prec, i, stage, k, x, y, z = line.split()
+        rows.setdefault((prec, int(i), stage), []).append([float.fromhex(v) for v in (x, y, z)])
+    ell = L / 11
+    for (prec, i, stage), pts in rows.items():
+        s = np.asarray(pts)
+        eps = 2.0 ** -23 if prec == "fp32" else 2.0 ** -52
+        assert np.isfinite(s).all(), (prec, i, stage)
+        assert (s[:, 0] == s[0, 0]).all(), (prec, i, stage, "x changed")
+        seg = np.linalg.norm(np.diff(s, axis=0), axis=1)
+        assert np.abs(seg - ell).max() <= 16 * eps * (10 + L), (prec, i, stage, seg)
+        if stage != "drape":
+            rc = math.hypot(s[0, 1], s[0, 2]) + 0.1
+            assert (np.hypot(s[1:, 1], s[1:, 2]) >= rc * (1 - 32 * eps)).all(), (prec, i, stage)
