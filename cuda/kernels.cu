@@ -1,0 +1,208 @@
+/* kernels.cu — the stage kernels of the CUDA backend: init, wind, collide and the fused
+ * wind+collide, one thread per strand, templated on the precision T and the layout
+ * (cuda/model.cuh holds the per-strand math; this file only maps threads to strands).
+ *
+ * Launch shape: `block` threads per block (--block-size, 32…1024, a multiple of 32), a
+ * grid of ceil(N / block) blocks; each kernel loops with the grid's stride so that a
+ * grid capped at 2^31 − 1 blocks still covers every strand (at the sizes that fit in GPU
+ * memory the cap is never reached and each thread takes exactly one strand).
+ *
+ * __launch_bounds__(1024): every stage kernel must launch with any block size up to 1024,
+ * so it must fit in 64 registers a thread (65536 / 1024). The fp32 kernels need fewer; the
+ * fp64 fused and point-major collide kernels spill a few words at 64. A second build with
+ * __launch_bounds__(512) (up to 128 registers, no spills) for blocks of at most 512 threads
+ * was measured and dropped: on an H100 its lower occupancy made the fp64 fused pair slower
+ * (4M x 32: 2.73 ms at block 256, 3.57 ms at block 512, against 2.61 ms for the 64-register
+ * build at block 1024); docs/cuda.md.
+ *
+ * Point-major kernels take X, Y, Z as separate __restrict__ pointers; wind, collide and the
+ * fused kernel without the intermediate never touch X.
+ *
+ * Prefetch depth (model.cuh, walk_points): the paper variant's strand-major kernels load
+ * each point when its turn comes (D = 0, as the C code and the paper do: that variant is
+ * the untuned baseline); the point-major kernels keep HB_PREFETCH_F32 (fp32) or HB_PREFETCH_F64 (fp64)
+ * points' loads in flight per thread.
+ */
+#include "kernels.cuh"
+
+namespace hb {
+
+namespace {
+
+constexpr int kMaxThreads = 1024;
+
+/* The stage kernels' register bound. HB_MAXNREG (an experiment knob, unset in the Makefile's
+ * builds) caps the registers instead, to measure occupancy against spills. */
+#if defined(HB_MAXNREG)
+#define HB_STAGE_BOUNDS __maxnreg__(HB_MAXNREG)
+#else
+#define HB_STAGE_BOUNDS __launch_bounds__(kMaxThreads)
+#endif
+
+/* Prefetch depth of the point-major kernels, per precision: D points of y and z in flight
+ * per thread. Measured on an H100 (4M strands x 32 points, block 256, fused wind+collide):
+ * fp32 D = 1: 1.35 ms, 2: 1.50, 4: 1.52, 8: 1.53; fp64 D = 1: 2.74, 2: 2.73. The kernels are
+ * compute-bound (docs/cuda.md), so the loads of one point ahead already hide the memory
+ * latency among the other warps, and every extra level only costs registers. */
+#ifndef HB_PREFETCH_F32
+#define HB_PREFETCH_F32 1
+#endif
+#ifndef HB_PREFETCH_F64
+#define HB_PREFETCH_F64 1
+#endif
+template <typename T> struct Prefetch;
+template <> struct Prefetch<float> { static constexpr int value = HB_PREFETCH_F32; };
+template <> struct Prefetch<double> { static constexpr int value = HB_PREFETCH_F64; };
+
+template <class Layout> struct Depth;
+template <typename T> struct Depth<StrandMajor<T>> { static constexpr int value = 0; }; /* paper: untuned */
+template <typename T> struct Depth<PointMajor<T>> { static constexpr int value = Prefetch<T>::value; };
+
+__device__ __forceinline__ int64_t first_strand() { return (int64_t)blockIdx.x * blockDim.x + threadIdx.x; }
+__device__ __forceinline__ int64_t grid_stride() { return (int64_t)gridDim.x * blockDim.x; }
+
+/* Adds every thread's v into *out exactly: a shuffle reduction in each warp, the warps'
+ * sums through shared memory, then one 64-bit atomicAdd for the block. Every thread of
+ * the block must call it (blockDim.x is a multiple of 32). */
+__device__ __forceinline__ void block_add(unsigned long long v, unsigned long long *out)
+{
+    __shared__ unsigned long long warp_sum[kMaxThreads / 32];
+    const unsigned lane = threadIdx.x & 31u, warp = threadIdx.x >> 5;
+    for (int off = 16; off > 0; off >>= 1) v += __shfl_down_sync(0xffffffffu, v, off);
+    if (lane == 0) warp_sum[warp] = v;
+    __syncthreads();
+    if (warp == 0) {
+        const unsigned nwarps = blockDim.x >> 5;
+        v = lane < nwarps ? warp_sum[lane] : 0ull;
+        for (int off = 16; off > 0; off >>= 1) v += __shfl_down_sync(0xffffffffu, v, off);
+        if (lane == 0 && v != 0ull) atomicAdd(out, v);
+    }
+}
+
+unsigned grid_for(int64_t N, int block)
+{
+    int64_t g = (N + block - 1) / block;
+    if (g > 0x7fffffff) g = 0x7fffffff;
+    if (g < 1) g = 1;
+    return (unsigned)g;
+}
+
+} /* namespace */
+
+/* ---- the kernels ------------------------------------------------------------------------ */
+/* a, b, c: StrandMajor: the canonical array (b, c unused); PointMajor: X, Y, Z. */
+
+template <typename T, class Layout>
+__global__ void HB_STAGE_BOUNDS
+    k_init(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c, const int64_t N)
+{
+    const Layout lay = Layout::make(a, b, c, N, m.points);
+    for (int64_t i = first_strand(); i < N; i += grid_stride()) init_strand(m, lay, i);
+}
+
+template <typename T, class Layout>
+__global__ void HB_STAGE_BOUNDS
+    k_wind(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c, const int64_t N)
+{
+    const Layout lay = Layout::make(a, b, c, N, m.points);
+    for (int64_t i = first_strand(); i < N; i += grid_stride()) wind_strand<Depth<Layout>::value>(m, lay, i);
+}
+
+template <typename T, class Layout>
+__global__ void HB_STAGE_BOUNDS
+    k_collide(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c, const int64_t N,
+              unsigned long long *__restrict__ count)
+{
+    const Layout lay = Layout::make(a, b, c, N, m.points);
+    unsigned long long changed = 0;
+    for (int64_t i = first_strand(); i < N; i += grid_stride())
+        changed += (unsigned long long)collide_strand<Depth<Layout>::value>(m, lay, i);
+    block_add(changed, count);
+}
+
+template <typename T, bool Keep>
+__global__ void HB_STAGE_BOUNDS
+    k_wind_collide(const Model<T> m, T *__restrict__ X, T *__restrict__ Y, T *__restrict__ Z, const int64_t N,
+                   T *__restrict__ inter, unsigned long long *__restrict__ count)
+{
+    const PointMajor<T> lay = {X, Y, Z, N};
+    const StrandMajor<T> keep = {inter, m.points};
+    unsigned long long changed = 0;
+    for (int64_t i = first_strand(); i < N; i += grid_stride())
+        changed += (unsigned long long)wind_collide_strand<Keep, Prefetch<T>::value>(m, lay, i, keep);
+    block_add(changed, count);
+}
+
+/* ---- the launchers ---------------------------------------------------------------------- */
+template <typename T>
+cudaError_t launch_init(const Model<T> &m, const StrandMajor<T> &lay, int64_t N, int block, cudaStream_t stream)
+{
+    k_init<T, StrandMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.s, nullptr, nullptr, N);
+    return cudaGetLastError();
+}
+
+template <typename T>
+cudaError_t launch_init(const Model<T> &m, const PointMajor<T> &lay, int64_t N, int block, cudaStream_t stream)
+{
+    k_init<T, PointMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N);
+    return cudaGetLastError();
+}
+
+template <typename T>
+cudaError_t launch_wind(const Model<T> &m, const StrandMajor<T> &lay, int64_t N, int block, cudaStream_t stream)
+{
+    k_wind<T, StrandMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.s, nullptr, nullptr, N);
+    return cudaGetLastError();
+}
+
+template <typename T>
+cudaError_t launch_wind(const Model<T> &m, const PointMajor<T> &lay, int64_t N, int block, cudaStream_t stream)
+{
+    k_wind<T, PointMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N);
+    return cudaGetLastError();
+}
+
+template <typename T>
+cudaError_t launch_collide(const Model<T> &m, const StrandMajor<T> &lay, int64_t N, unsigned long long *count,
+                           int block, cudaStream_t stream)
+{
+    k_collide<T, StrandMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.s, nullptr, nullptr, N, count);
+    return cudaGetLastError();
+}
+
+template <typename T>
+cudaError_t launch_collide(const Model<T> &m, const PointMajor<T> &lay, int64_t N, unsigned long long *count,
+                           int block, cudaStream_t stream)
+{
+    k_collide<T, PointMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, count);
+    return cudaGetLastError();
+}
+
+template <typename T>
+cudaError_t launch_wind_collide(const Model<T> &m, const PointMajor<T> &lay, int64_t N, T *inter,
+                                unsigned long long *count, int block, cudaStream_t stream)
+{
+    if (inter) {
+        k_wind_collide<T, true><<<grid_for(N, block), block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, inter, count);
+    } else {
+        k_wind_collide<T, false><<<grid_for(N, block), block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, nullptr, count);
+    }
+    return cudaGetLastError();
+}
+
+#define HB_INSTANTIATE(T)                                                                                  \
+    template cudaError_t launch_init<T>(const Model<T> &, const StrandMajor<T> &, int64_t, int, cudaStream_t); \
+    template cudaError_t launch_init<T>(const Model<T> &, const PointMajor<T> &, int64_t, int, cudaStream_t);  \
+    template cudaError_t launch_wind<T>(const Model<T> &, const StrandMajor<T> &, int64_t, int, cudaStream_t); \
+    template cudaError_t launch_wind<T>(const Model<T> &, const PointMajor<T> &, int64_t, int, cudaStream_t);  \
+    template cudaError_t launch_collide<T>(const Model<T> &, const StrandMajor<T> &, int64_t,                 \
+                                           unsigned long long *, int, cudaStream_t);                          \
+    template cudaError_t launch_collide<T>(const Model<T> &, const PointMajor<T> &, int64_t,                  \
+                                           unsigned long long *, int, cudaStream_t);                          \
+    template cudaError_t launch_wind_collide<T>(const Model<T> &, const PointMajor<T> &, int64_t, T *,        \
+                                                unsigned long long *, int, cudaStream_t);
+
+HB_INSTANTIATE(float)
+HB_INSTANTIATE(double)
+
+} /* namespace hb */

@@ -1,0 +1,489 @@
+/* model.cuh — the paper model (DESIGN §3) for the CUDA port: c_ref/model_impl.h written as
+ * `__host__ __device__` templates over the floating type T and the memory layout.
+ *
+ * This file follows c_ref/model_impl.h operation by operation: the same expressions in the
+ * same order, the same constants, the same branches. A build without FMA contraction and
+ * with IEEE division and square root (hairsim-cuda-strict) therefore differs from the C
+ * reference only where CUDA's sinf/cosf/asinf/atan2f (sin/cos/asin/atan2) differ from
+ * glibc's. Compiled for the host (cuda/hostcheck/model_hostcheck.cu) the same templates call
+ * glibc and must reproduce c_ref/model.c bit for bit.
+ *
+ * The only departures from the C file are in *when memory is read*, never in arithmetic:
+ *   - with a prefetch depth D ≥ 1 (walk_points; the soa and fused variants) the walks load
+ *     point k+D before they compute point k (the addresses differ from the ones written,
+ *     so the values are the same); D = 0 (the paper variant) loads as the C code does;
+ *   - init keeps the root in registers instead of reading it back for the drape;
+ *   - point-major wind and collide never read or write x (it never changes);
+ *   - the fused walk (wind_collide_strand) runs wind and collide in one pass over the
+ *     points, keeping both running predecessors, see there.
+ *
+ * Layouts (element (i, k, c) = coordinate c of point k of strand i; c: 0 = x, 1 = y, 2 = z):
+ *   StrandMajor<T>: the canonical array [N][P][3], element at (i·P + k)·3 + c;
+ *   PointMajor<T>:  three arrays X, Y, Z of [P][N], element (i, k) at k·N + i, so the
+ *                   consecutive strands of a warp load consecutive words.
+ * All indices are 64-bit (N·P·3 passes 2^31).
+ */
+#ifndef HB_MODEL_CUH
+#define HB_MODEL_CUH
+
+#include <math.h>
+#include <stdint.h>
+
+#include "model.h"  /* HB_SHELL_ULPS, hb_model_f32/f64 */
+#include "philox.h" /* hb_draw_block, hb_u01, HB_HD = __host__ __device__ __forceinline__ */
+
+/* #pragma unroll for the device pass only (the host compiler does not know it) */
+#if defined(__CUDA_ARCH__)
+#define HB_UNROLL _Pragma("unroll")
+#define HB_NO_UNROLL _Pragma("unroll 1")
+#else
+#define HB_UNROLL
+#define HB_NO_UNROLL
+#endif
+
+namespace hb {
+
+/* The scene's numbers rounded once to the working precision (the fields of hb_model_f32/
+ * hb_model_f64, as backend_cpu.c's round_scene makes them). Passed to kernels by value. */
+template <typename T>
+struct Model {
+    uint64_t seed;
+    int64_t points;
+    T head_radius, hair_offset, face_margin, seg_len, wind_strength, wind_angle;
+};
+
+template <typename M, typename T>
+inline Model<T> model_from(const M &m)
+{
+    Model<T> r;
+    r.seed = m.seed;
+    r.points = m.points;
+    r.head_radius = m.head_radius;
+    r.hair_offset = m.hair_offset;
+    r.face_margin = m.face_margin;
+    r.seg_len = m.seg_len;
+    r.wind_strength = m.wind_strength;
+    r.wind_angle = m.wind_angle;
+    return r;
+}
+
+/* ---- the math functions: the float overloads for float, the double ones for double ---- */
+HB_HD float m_sqrt(float x) { return sqrtf(x); }
+HB_HD double m_sqrt(double x) { return sqrt(x); }
+HB_HD float m_asin(float x) { return asinf(x); }
+HB_HD double m_asin(double x) { return asin(x); }
+HB_HD float m_atan2(float y, float x) { return atan2f(y, x); }
+HB_HD double m_atan2(double y, double x) { return atan2(y, x); }
+/* sin and cos of one argument. On the device one call, sincosf/sincos, shares the range
+ * reduction; on an H200 it gave exactly sinf(x) and cosf(x) for every float |x| <= 16, and
+ * sin/cos for 2e8 sampled doubles, in all three builds (docs/cuda.md). On the host sinf
+ * and cosf, as model.c calls them. */
+HB_HD void m_sincos(float x, float *s, float *c)
+{
+#if defined(__CUDA_ARCH__)
+    sincosf(x, s, c);
+#else
+    *s = sinf(x);
+    *c = cosf(x);
+#endif
+}
+HB_HD void m_sincos(double x, double *s, double *c)
+{
+#if defined(__CUDA_ARCH__)
+    sincos(x, s, c);
+#else
+    *s = sin(x);
+    *c = cos(x);
+#endif
+}
+/* the machine epsilon EPS of model.c: 2^-23 / 2^-52 */
+HB_HD float m_eps(float) { return 0x1p-23f; }
+HB_HD double m_eps(double) { return 0x1p-52; }
+
+/* PI_R, HALF_PI_R, TWO_PI_R of model_impl.h: the double literals rounded to T */
+template <typename T> HB_HD T pi_r() { return (T)3.14159265358979323846; }
+template <typename T> HB_HD T half_pi_r() { return (T)1.57079632679489661923; }
+template <typename T> HB_HD T two_pi_r() { return (T)6.28318530717958647692; }
+
+/* ---- layouts ------------------------------------------------------------------------- */
+/* A layout hands out a view of one strand: x(k), y(k), z(k) are references to point k. */
+template <typename T>
+struct StrandMajor {
+    T *s;      /* [N][P][3] */
+    int64_t P; /* points per strand */
+    struct View {
+        T *p; /* strand i's first element: s + i·P·3 */
+        HB_HD T &x(int64_t k) const { return p[3 * k]; }
+        HB_HD T &y(int64_t k) const { return p[3 * k + 1]; }
+        HB_HD T &z(int64_t k) const { return p[3 * k + 2]; }
+        /* the walks' cursors: &y(k), &z(k), and the distance from point k to point k+1 */
+        HB_HD T *yp(int64_t k) const { return p + 3 * k + 1; }
+        HB_HD T *zp(int64_t k) const { return p + 3 * k + 2; }
+        HB_HD int64_t stride() const { return 3; }
+    };
+    HB_HD View strand(int64_t i) const { return View{s + i * P * 3}; }
+    /* from a kernel's pointer arguments (a = the array; b, c unused) */
+    HB_HD static StrandMajor make(T *a, T *, T *, int64_t, int64_t P) { return StrandMajor{a, P}; }
+};
+
+template <typename T>
+struct PointMajor {
+    T *X, *Y, *Z; /* each [P][N] */
+    int64_t N;    /* strands */
+    struct View {
+        T *px, *py, *pz; /* X + i, Y + i, Z + i */
+        int64_t n;       /* the stride between points: N */
+        HB_HD T &x(int64_t k) const { return px[k * n]; }
+        HB_HD T &y(int64_t k) const { return py[k * n]; }
+        HB_HD T &z(int64_t k) const { return pz[k * n]; }
+        HB_HD T *yp(int64_t k) const { return py + k * n; }
+        HB_HD T *zp(int64_t k) const { return pz + k * n; }
+        HB_HD int64_t stride() const { return n; }
+    };
+    HB_HD View strand(int64_t i) const { return View{X + i, Y + i, Z + i, N}; }
+    /* from a kernel's pointer arguments (a, b, c = X, Y, Z) */
+    HB_HD static PointMajor make(T *a, T *b, T *c, int64_t N, int64_t) { return PointMajor{a, b, c, N}; }
+};
+
+/* ---- DESIGN §3 "Stage init — drape" (model_impl.h: hb_drape_strand) ------------------------------ */
+/* The root (x0, py, pz) is already stored; writes points 1 … P−1. */
+template <typename T, class V>
+HB_HD void drape(const Model<T> &m, const V &s, const T x0, T py, T pz)
+{
+    const int64_t P = m.points;
+    const T ell = m.seg_len;
+    const T r0 = m_sqrt(py * py + pz * pz); /* head circle of the slice */
+    const T rc = r0 + m.hair_offset;        /* shell circle */
+    T theta = m_atan2(py, pz);              /* (−π, π] … */
+    if (theta <= -half_pi_r<T>()) theta += two_pi_r<T>(); /* … taken in (−π/2, 3π/2] */
+    /* A root on the lower back (θ0 > π) hangs straight down from the root. */
+    int hanging = theta > pi_r<T>();
+    T rho = r0; /* slice radius of the predecessor: r0 for the first step, rc after */
+
+    for (int64_t k = 1; k < P; k++) {
+        if (!hanging) {
+            /* Step onto the shell circle: the angle α of the triangle (origin,
+             * predecessor, new point) has cos α = (ρ² + rc² − ℓ²) / (2ρ rc). Evaluated in
+             * the equivalent half-angle form sin²(α/2) = (ℓ − g)(ℓ + g) / (4ρ rc), g = rc − ρ,
+             * which keeps its accuracy for short segments where cos α is near 1
+             * (docs/decisions.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
+             * is s² < 0. */
+            int fits = 0;
+            T s2 = 0;
+            if (rho > (T)0) {
+                const T g = rc - rho;
+                s2 = ((ell - g) * (ell + g)) / ((T)4 * rho * rc);
+                fits = s2 <= (T)1; /* cos α < −1: the step does not fit the circle */
+            }
+            if (fits) {
+                if (s2 < (T)0) s2 = (T)0; /* the shell is out of reach only by rounding */
+                const T next = theta + (T)2 * m_asin(m_sqrt(s2));
+                if (next <= pi_r<T>()) {
+                    theta = next;
+                    T sin_n, cos_n;
+                    m_sincos(next, &sin_n, &cos_n);
+                    pz = rc * cos_n;
+                    py = rc * sin_n;
+                    rho = rc;
+                    s.x(k) = x0;
+                    s.y(k) = py;
+                    s.z(k) = pz;
+                    continue;
+                }
+            }
+            /* The strand starts to hang: the first hanging point goes onto the vertical
+             * tangent line z = −rc, at distance ℓ below its predecessor. */
+            const T dz = pz + rc;
+            const T dy2 = ell * ell - dz * dz;
+            py = py - m_sqrt(dy2 > (T)0 ? dy2 : (T)0);
+            pz = -rc;
+            hanging = 1;
+        } else {
+            /* Every later point hangs straight down: p_k = p_{k−1} − ℓŷ. */
+            py = py - ell;
+        }
+        s.x(k) = x0;
+        s.y(k) = py;
+        s.z(k) = pz;
+    }
+}
+
+/* ---- DESIGN §3 "Stage init": roots (model_impl.h: place_root) then the drape ----------- */
+template <typename T, class Layout>
+HB_HD void init_strand(const Model<T> &m, const Layout &lay, int64_t i)
+{
+    const typename Layout::View s = lay.strand(i);
+    uint32_t r[4];
+    hb_draw_block(m.seed, (uint64_t)i, 0u, r); /* draws 0, 1, 2 of this strand */
+    const T u1 = (T)hb_u01(r[0]);
+    const T u2 = (T)hb_u01(r[1]);
+    const T u3 = (T)hb_u01(r[2]);
+    const T R = m.head_radius;
+
+    /* z = clamp((2u1 − 1)R − m, −R, R): the clamp keeps the square roots real. */
+    T z = ((T)2 * u1 - (T)1) * R - m.face_margin;
+    if (z < -R) z = -R;
+    if (z > R) z = R;
+    T dd = R * R - z * z;
+    const T d = m_sqrt(dd > (T)0 ? dd : (T)0);
+    /* Face side (z > 0): y in [0.3d, d), so no root sits on the lower face. */
+    const T y = z > (T)0 ? d * ((T)0.3 + (T)0.7 * u2) : ((T)2 * u2 - (T)1) * d;
+    T xx = R * R - z * z - y * y;
+    T x = m_sqrt(xx > (T)0 ? xx : (T)0);
+    if (u3 >= (T)0.5) x = -x;
+    s.x(0) = x;
+    s.y(0) = y;
+    s.z(0) = z;
+    drape(m, s, x, y, z);
+}
+
+/* Re-drapes strand i from its stored root (model.h: hb_drape_strand). */
+template <typename T, class Layout>
+HB_HD void drape_strand(const Model<T> &m, const Layout &lay, int64_t i)
+{
+    const typename Layout::View s = lay.strand(i);
+    drape(m, s, s.x(0), s.y(0), s.z(0));
+}
+
+/* ---- DESIGN §3 "Stage wind": one step of the walk (model_impl.h: hb_wind_strand) ------- */
+/* Keeps the predecessor before the wind (oy, oz) and after it (ny, nz). */
+template <typename T>
+struct WindWalk {
+    T ell, w, psi, last;
+    T oy, oz; /* the predecessor before the wind */
+    T ny, nz; /* the predecessor after the wind (the root never moves) */
+
+    HB_HD WindWalk(const Model<T> &m, T y0, T z0)
+    {
+        ell = m.seg_len;
+        w = m.wind_strength;
+        psi = m.wind_angle; /* already reduced to (−π, π] */
+        last = (T)(m.points - 1);
+        oy = y0;
+        oz = z0;
+        ny = oy;
+        nz = oz;
+    }
+
+    /* Point k was (cy, cz) before the wind; afterwards it is (ny, nz). */
+    HB_HD void step(int64_t k, const T cy, const T cz)
+    {
+        const T dy = cy - oy, dz = cz - oz;
+        const T phi = m_atan2(dy, dz);
+        T delta = psi - phi; /* in [−2π, 2π]: wrap to (−π, π] */
+        if (delta > pi_r<T>()) delta -= two_pi_r<T>();
+        else if (delta <= -pi_r<T>()) delta += two_pi_r<T>();
+        /* Exactly opposite: take the arc through +y. Turning by +π passes through the
+         * direction φ + π/2, whose y component has the sign of cos φ, i.e. of dz. */
+        if (delta == pi_r<T>()) delta = dz >= (T)0 ? pi_r<T>() : -pi_r<T>();
+        const T t = (w * (T)k) / last;
+        const T turned = phi + t * delta;
+        T sin_t, cos_t;
+        m_sincos(turned, &sin_t, &cos_t);
+        nz = nz + ell * cos_t;
+        ny = ny + ell * sin_t;
+        oy = cy;
+        oz = cz;
+    }
+};
+
+/* ---- DESIGN §3 "Stage collide": one step of the walk (model_impl.h: hb_collide_strand) -- */
+template <typename T>
+struct CollideWalk {
+    T ell, rc, inner2;
+    T py, pz; /* the predecessor, after collision */
+    int moved;
+    int64_t changed;
+
+    HB_HD CollideWalk(const Model<T> &m, T y0, T z0)
+    {
+        ell = m.seg_len;
+        const T r0 = m_sqrt(y0 * y0 + z0 * z0);
+        rc = r0 + m.hair_offset;
+        const T inner = rc - rc * ((T)HB_SHELL_ULPS * m_eps(T())); /* rounding allowance */
+        inner2 = inner * inner;
+        moved = 0;
+        changed = 0;
+        py = y0;
+        pz = z0;
+    }
+
+    /* Point k is (cy, cz) on entry and its collided position on return; returns whether
+     * the point changed (the C code writes it back exactly then). */
+    HB_HD int step(T &cy, T &cz)
+    {
+        if (moved) {
+            /* Follow the leader: p_k ← p_{k−1} + ℓ·unit(p_k − p_{k−1}). */
+            const T dy = cy - py, dz = cz - pz;
+            const T len = m_sqrt(dy * dy + dz * dz);
+            if (len > (T)0) {
+                cy = py + ell * (dy / len);
+                cz = pz + ell * (dz / len);
+            } else { /* no direction left: hang down */
+                cy = py - ell;
+                cz = pz;
+            }
+        }
+        if (cy * cy + cz * cz < inner2) {
+            /* Intersect the shell (radius rc, centre 0) with the circle of radius ℓ around
+             * the predecessor at distance d from the centre: the chord's foot lies at
+             * a = (d² + rc² − ℓ²) / 2d along the unit u towards the predecessor, the
+             * candidates at a·u ± hh·u⊥ with hh = √(rc² − a²). Evaluated through
+             * t = d − a = ((d − rc)(d + rc) + ℓ²) / 2d and hh² = (rc − a)(rc + a), which
+             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions.md,
+             * "collide_short_segment"). */
+            const T d2 = py * py + pz * pz;
+            const T d = m_sqrt(d2);
+            if (d > (T)0) {
+                const T t = ((d - rc) * (d + rc) + ell * ell) / ((T)2 * d);
+                const T a = d - t;
+                const T h2 = ((rc - d) + t) * (rc + a);
+                const T hh = m_sqrt(h2 > (T)0 ? h2 : (T)0);
+                const T uy = py / d, uz = pz / d;
+                const T fy = a * uy, fz = a * uz;
+                const T y1 = fy + hh * uz, z1 = fz - hh * uy;
+                const T y2 = fy - hh * uz, z2 = fz + hh * uy;
+                const T e1 = (y1 - cy) * (y1 - cy) + (z1 - cz) * (z1 - cz);
+                const T e2 = (y2 - cy) * (y2 - cy) + (z2 - cz) * (z2 - cz);
+                if (e1 < e2 || (e1 == e2 && y1 >= y2)) {
+                    cy = y1;
+                    cz = z1;
+                } else {
+                    cy = y2;
+                    cz = z2;
+                }
+                moved = 1;
+            }
+        }
+        const int write = moved;
+        if (moved) changed++;
+        py = cy;
+        pz = cz;
+        return write;
+    }
+};
+
+/* ---- the walk over a strand's points ------------------------------------------------------ */
+/* Calls f(k, cy, cz, y, z) for k = 1 … P−1 in order: (cy, cz) = point k's y and z as loaded,
+ * y and z = references to where they are stored (f writes the point back through them).
+ * D = 0: each point is loaded when its turn comes, as the C code does (the paper variant).
+ * D ≥ 1: the load of point k + D is issued before point k is computed, so every thread keeps
+ * D points' loads in flight while it computes (the per-strand walk is sequential, so this is
+ * where the memory-level parallelism of one thread comes from). The loads wait in a queue
+ * of D registers that shifts by one each step (the loop is not unrolled: one copy of the
+ * step's code, and the queue is indexed with constants only, so it stays in registers).
+ * The addresses advance by the layout's stride instead of being recomputed from k.
+ * Loading early is safe: point k + D is not written before its turn. */
+template <int D, typename T, class V, class F>
+HB_HD void walk_points(const V &s, const int64_t P, F &&f)
+{
+    if constexpr (D == 0) {
+        for (int64_t k = 1; k < P; k++) {
+            const T cy = s.y(k), cz = s.z(k);
+            f(k, cy, cz, s.y(k), s.z(k));
+        }
+    } else {
+        const int64_t step = s.stride(), ahead = D * step;
+        T *py = s.yp(1), *pz = s.zp(1); /* point k's y and z */
+        T qy[D] = {}, qz[D] = {};       /* q[j] = point k + j, loaded */
+        HB_UNROLL
+        for (int j = 0; j < D; j++)
+            if (1 + j < P) {
+                qy[j] = py[j * step];
+                qz[j] = pz[j * step];
+            }
+        HB_NO_UNROLL
+        for (int64_t k = 1; k < P; k++) {
+            const T cy = qy[0], cz = qz[0];
+            HB_UNROLL
+            for (int j = 0; j + 1 < D; j++) {
+                qy[j] = qy[j + 1];
+                qz[j] = qz[j + 1];
+            }
+            if (k + D < P) {
+                qy[D - 1] = py[ahead];
+                qz[D - 1] = pz[ahead];
+            }
+            f(k, cy, cz, *py, *pz);
+            py += step;
+            pz += step;
+        }
+    }
+}
+
+/* ---- the per-strand stages ------------------------------------------------------------ */
+/* Wind on strand i, in place. The caller does not call it when w = 0 (the identity).
+ * D: the prefetch depth of walk_points. */
+template <int D, typename T, class Layout>
+HB_HD void wind_strand(const Model<T> &m, const Layout &lay, int64_t i)
+{
+    const int64_t P = m.points;
+    if (P < 2) return;
+    const typename Layout::View s = lay.strand(i);
+    WindWalk<T> wind(m, s.y(0), s.z(0));
+    walk_points<D, T>(s, P, [&](int64_t k, T cy, T cz, T &y, T &z) {
+        wind.step(k, cy, cz);
+        y = wind.ny;
+        z = wind.nz;
+    });
+}
+
+/* Collide on strand i, in place; returns the number of points changed. */
+template <int D, typename T, class Layout>
+HB_HD int64_t collide_strand(const Model<T> &m, const Layout &lay, int64_t i)
+{
+    const int64_t P = m.points;
+    if (P < 2) return 0;
+    const typename Layout::View s = lay.strand(i);
+    CollideWalk<T> col(m, s.y(0), s.z(0));
+    walk_points<D, T>(s, P, [&](int64_t, T cy, T cz, T &y, T &z) {
+        if (col.step(cy, cz)) {
+            y = cy;
+            z = cz;
+        }
+    });
+    return col.changed;
+}
+
+/* Wind immediately followed by collide on strand i, in one walk over the points: wind
+ * rebuilds point k from the wind-rotated predecessor, and collide at once checks (and
+ * pulls) it against the collided predecessor. Both running predecessors are kept (the
+ * wind walk needs the one before the wind and the one after the wind, the collide walk
+ * the collided one), so the result is bit for bit wind_strand then collide_strand. Each
+ * point is read once and written once; with Keep the post-wind state (the frame between
+ * the two stages) is also stored, canonically, into `inter` (x included, so then x is read
+ * too); without Keep x is neither read nor written. Returns the points collide changed. */
+template <bool Keep, int D, typename T, class Layout>
+HB_HD int64_t wind_collide_strand(const Model<T> &m, const Layout &lay, int64_t i, const StrandMajor<T> &inter)
+{
+    const int64_t P = m.points;
+    if (P < 2) return 0;
+    const typename Layout::View s = lay.strand(i);
+    const T y0 = s.y(0), z0 = s.z(0);
+    typename StrandMajor<T>::View q = {nullptr};
+    if (Keep) {
+        q = inter.strand(i);
+        q.x(0) = s.x(0); /* the root: wind does not move it */
+        q.y(0) = y0;
+        q.z(0) = z0;
+    }
+    WindWalk<T> wind(m, y0, z0);
+    CollideWalk<T> col(m, y0, z0);
+    walk_points<D, T>(s, P, [&](int64_t k, T cy, T cz, T &y, T &z) {
+        wind.step(k, cy, cz);
+        T wy = wind.ny, wz = wind.nz;
+        if (Keep) {
+            q.x(k) = s.x(k);
+            q.y(k) = wy;
+            q.z(k) = wz;
+        }
+        col.step(wy, wz); /* unchanged when collide leaves the point alone */
+        y = wy;
+        z = wz;
+    });
+    return col.changed;
+}
+
+} /* namespace hb */
+
+#endif

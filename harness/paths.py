@@ -1,0 +1,44 @@
+"""Where things live: the repository root, the built binaries, configs/, results/, report/.
+
+HAIRBENCH_BUILD_DIR overrides the build directory (the tests use it to point the harness
+at stand-in binaries)."""
+import os
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+CONFIGS = ROOT / "configs"
+RESULTS = ROOT / "results"
+REPORT = ROOT / "report"
+
+# cuda builds: the same source compiled three ways (docs/interfaces.md)
+CUDA_BUILDS = {
+    "default": "hairsim-cuda",
+    "strict": "hairsim-cuda-strict",
+    "fastmath": "hairsim-cuda-fastmath",
+}
+
+
+def build_dir():
+    return Path(os.environ.get("HAIRBENCH_BUILD_DIR") or ROOT / "build")
+
+
+def binary_path(backend, build="default"):
+    """The binary that runs `backend` ('cpu' or 'cuda') in `build` (cuda only)."""
+    if backend == "cpu":
+        return build_dir() / "hairsim-cpu"
+    if backend == "cuda":
+        if build not in CUDA_BUILDS:
+            from . import HarnessError
+            raise HarnessError(f"unknown cuda build '{build}' (known: {', '.join(CUDA_BUILDS)})")
+        return build_dir() / CUDA_BUILDS[build]
+    from . import HarnessError
+    raise HarnessError(f"unknown backend '{backend}' (known: cpu, cuda)")
+
+
+def display(path):
+    """A path as the user would type it: relative to the repo root when inside it."""
+    p = Path(path)
+    try:
+        return str(p.resolve().relative_to(ROOT))
+    except ValueError:
+        return str(p)

@@ -1,0 +1,188 @@
+"""Read HDF5 states in the layout of docs/interfaces.md and check that layout.
+
+A state file holds F frames of N strands × P points × (x, y, z). On disk a frame is
+[N·P][3] (point k of strand i is row i·P + k); `State.frame(f)` returns it as [N][P][3].
+Any departure from the layout is a `StateError` (a HarnessError, exit status 2) naming the
+file and what is wrong, so `harness diff` can say "could not compare" in one line.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import HarnessError
+
+POSITION = "particles/hair/position/value"
+PARAMETERS = "parameters"
+REQUIRED_ATTRS = ("n_strands", "points_per_strand", "precision", "hair_length",
+                  "head_radius", "hair_offset")
+DTYPE_OF_PRECISION = {"fp32": np.dtype(np.float32), "fp64": np.dtype(np.float64)}
+
+
+class StateError(HarnessError):
+    """The file is missing, unreadable, or not in the documented layout."""
+
+
+def as_text(value):
+    """An HDF5 attribute or string element as str (h5py gives bytes, str or numpy scalars)."""
+    if isinstance(value, bytes):
+        return value.decode("utf-8", "replace")
+    if isinstance(value, np.ndarray) and value.shape == ():
+        return as_text(value[()])
+    if isinstance(value, np.generic):
+        return as_text(value.item())
+    return str(value)
+
+
+def as_python(value):
+    """An HDF5 attribute as a plain Python value (for JSON and comparisons)."""
+    if isinstance(value, (bytes, np.bytes_)):
+        return value.decode("utf-8", "replace")
+    if isinstance(value, np.ndarray):
+        return [as_python(v) for v in value.tolist()] if value.shape else as_python(value[()])
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+@dataclass
+class State:
+    """An open state file. Use as a context manager, or call close()."""
+    path: str
+    n_strands: int
+    points: int
+    n_frames: int
+    precision: str                  # "fp32" | "fp64"
+    params: dict                    # every /parameters attribute, as Python values
+    stages: list                    # stage name of each frame
+    skipped: list                   # bool per frame
+    fused: list                     # "" | "wind+collide" | "into-previous" per frame
+    _file: object = field(repr=False, default=None)
+    _dset: object = field(repr=False, default=None)
+
+    @property
+    def dtype(self):
+        return self._dset.dtype
+
+    @property
+    def flags(self):
+        return as_text(self.params.get("flags", ""))
+
+    @property
+    def fast_math(self):
+        """Built with fast math (nvcc --use_fast_math, or -ffast-math)."""
+        f = self.flags
+        return "use_fast_math" in f or "ffast-math" in f
+
+    @property
+    def hair_length(self):
+        return float(self.params["hair_length"])
+
+    @property
+    def segment_length(self):
+        """ℓ = L/(P−1), in double (each backend rounds it once to its precision)."""
+        return self.hair_length / (self.points - 1)
+
+    @property
+    def label(self):
+        backend = as_text(self.params.get("backend", "?"))
+        variant = as_text(self.params.get("variant", "?"))
+        return f"{backend}/{variant} {self.precision}{' fast-math' if self.fast_math else ''}"
+
+    def frame(self, f):
+        """Frame f (negative counts from the end) as an [N][P][3] array of the file's dtype."""
+        if not -self.n_frames <= f < self.n_frames:
+            raise StateError(f"{self.path}: has no frame {f} (it has {self.n_frames})")
+        try:
+            flat = self._dset[f % self.n_frames]
+        except Exception as e:  # h5py raises many kinds for corrupt chunks
+            raise StateError(f"{self.path}: cannot read frame {f}: {e}") from None
+        return flat.reshape(self.n_strands, self.points, 3)
+
+    def close(self):
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _string_list(group, name, n_frames, default, path):
+    if name not in group:
+        return [default] * n_frames
+    ds = group[name]
+    if ds.shape != (n_frames,):
+        raise StateError(f"{path}: /parameters/{name} has shape {ds.shape}, "
+                         f"expected ({n_frames},) (one per frame)")
+    return [as_text(v) for v in ds[()]]
+
+
+def open_state(path):
+    """Open and check a state file; raise StateError with one clear line if it is not one."""
+    import h5py  # imported here so `--help` works without h5py
+
+    path = str(path)
+    try:
+        f = h5py.File(path, "r")
+    except FileNotFoundError:
+        raise StateError(f"{path}: no such file") from None
+    except OSError as e:
+        reason = "not an HDF5 file" if "signature" in str(e) else str(e).split("(")[0].strip()
+        raise StateError(f"{path}: cannot read: {reason}") from None
+    try:
+        return _checked_state(f, path)
+    except Exception:
+        f.close()
+        raise
+
+
+def _checked_state(f, path):
+    if POSITION not in f:
+        raise StateError(f"{path}: no /{POSITION} dataset (not a hairbench state)")
+    dset = f[POSITION]
+    if not hasattr(dset, "shape"):
+        raise StateError(f"{path}: /{POSITION} is not a dataset")
+    if dset.ndim != 3 or dset.shape[2] != 3:
+        raise StateError(f"{path}: /{POSITION} has shape {dset.shape}, expected [F][N·P][3]")
+    if dset.dtype not in (np.float32, np.float64):
+        raise StateError(f"{path}: /{POSITION} has dtype {dset.dtype}, expected float32 or float64")
+    if PARAMETERS not in f:
+        raise StateError(f"{path}: no /{PARAMETERS} group")
+    group = f[PARAMETERS]
+    params = {k: as_python(v) for k, v in group.attrs.items()}
+    missing = [a for a in REQUIRED_ATTRS if a not in params]
+    if missing:
+        raise StateError(f"{path}: /{PARAMETERS} lacks attribute(s) {', '.join(missing)}")
+    try:
+        n = int(params["n_strands"])
+        p = int(params["points_per_strand"])
+        float(params["hair_length"])
+        float(params["head_radius"])
+        float(params["hair_offset"])
+    except (TypeError, ValueError):
+        raise StateError(f"{path}: /{PARAMETERS} has a non-numeric size or length attribute") from None
+    if n < 1 or p < 2:
+        raise StateError(f"{path}: n_strands = {n}, points_per_strand = {p}: need N ≥ 1, P ≥ 2")
+    if dset.shape[1] != n * p:
+        raise StateError(f"{path}: frames have {dset.shape[1]} points but n_strands × "
+                         f"points_per_strand = {n} × {p} = {n * p}")
+    precision = as_text(params["precision"])
+    if precision not in DTYPE_OF_PRECISION:
+        raise StateError(f"{path}: precision attribute is '{precision}', expected fp32 or fp64")
+    if DTYPE_OF_PRECISION[precision] != dset.dtype:
+        raise StateError(f"{path}: precision attribute says {precision} but positions are {dset.dtype}")
+    n_frames = dset.shape[0]
+    if n_frames < 1:
+        raise StateError(f"{path}: has no frames")
+    stages = _string_list(group, "stage", n_frames, None, path)
+    if None in stages:
+        raise StateError(f"{path}: no /{PARAMETERS}/stage (the stage of each frame)")
+    skipped = [bool(int(v)) for v in group["skipped"][()]] if "skipped" in group else [False] * n_frames
+    if len(skipped) != n_frames:
+        raise StateError(f"{path}: /{PARAMETERS}/skipped has {len(skipped)} entries for {n_frames} frames")
+    fused = _string_list(group, "fused", n_frames, "", path)
+    return State(path=path, n_strands=n, points=p, n_frames=n_frames, precision=precision,
+                 params=params, stages=stages, skipped=skipped, fused=fused, _file=f, _dset=dset)

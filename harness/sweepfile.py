@@ -1,0 +1,196 @@
+"""Sweep files (configs/<sweep>.toml) → the list of cases to run.
+
+    name = "default"          # results/<name>/ (optional; defaults to the file's stem)
+    description = "…"
+    scene = "paper"           # a scene name in configs/ or a path
+    repeat = 9                # timed repetitions per stage (≥ 9: median and IQR)
+    warmup = 1                # untimed runs per stage before them
+    timeout_s = 600           # per case
+    [axes]                    # shared by every backend
+    strands = [1000, 10000]
+    points = [32]
+    precision = ["fp32", "fp64"]
+    [cpu]                     # leave the table out to run no cpu case
+    variant = ["ref", "simd"]
+    threads = [1, "all"]      # "all" = every core (the binary's default)
+    [cuda]
+    build = ["default"]       # default | strict | fastmath (binaries hairsim-cuda[-…])
+    variant = ["paper", "soa", "fused"]
+    block_size = [32, 64, 128, 256, 512, 1024]
+
+A backend table may also set strands, points or precision, replacing the shared axis for
+that backend (e.g. fewer strands for the single-thread CPU). Write [[cpu]] / [[cuda]]
+(arrays of tables) for several groups of one backend, e.g. every block size for the
+default build but one for the fast-math build. The cases are the product of the axes of
+each group; a case that two groups both produce runs once.
+"""
+import itertools
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import HarnessError
+from .paths import CONFIGS, CUDA_BUILDS
+from .scenes import PRECISIONS, load_scene
+
+MIN_REPEAT = 9
+SHARED_AXES = ("strands", "points", "precision")
+BACKEND_AXES = {"cpu": ("variant", "threads"), "cuda": ("build", "variant", "block_size")}
+DEFAULTS = {"cpu": {"variant": ["ref"], "threads": ["all"]},
+            "cuda": {"build": ["default"], "variant": ["fused"], "block_size": [256]}}
+TOP_KEYS = ("name", "description", "scene", "repeat", "warmup", "timeout_s", "axes", "cpu", "cuda")
+VARIANTS = {"cpu": ("ref", "simd"), "cuda": ("paper", "soa", "fused")}
+
+
+class SweepError(HarnessError):
+    pass
+
+
+@dataclass(frozen=True)
+class Case:
+    scene: str
+    backend: str
+    build: str          # cuda build, "" for cpu
+    variant: str
+    precision: str
+    block_size: int     # 0 for cpu
+    threads: str        # "1", "2", … or "all"; "" for cuda
+    strands: int
+    points: int
+    repeat: int
+    warmup: int
+
+    @property
+    def case_id(self):
+        where = (f"t{self.threads}" if self.backend == "cpu" else f"{self.build}:b{self.block_size}")
+        return (f"{self.scene}:{self.backend}:{self.variant}:{where}:{self.precision}:"
+                f"N{self.strands}:P{self.points}:r{self.repeat}w{self.warmup}")
+
+
+@dataclass
+class Sweep:
+    name: str
+    path: Path
+    scene: object
+    repeat: int
+    warmup: int
+    timeout_s: int
+    axes: list          # (backend, {axis: values}) per group; the cases are each group's product
+    description: str = ""
+
+    def cases(self):
+        out, seen = [], set()
+        for backend, axes in self.axes:
+            names = list(axes)
+            for values in itertools.product(*(axes[n] for n in names)):
+                v = dict(zip(names, values))
+                out.append(Case(scene=self.scene.name, backend=backend,
+                                build=v.get("build", ""), variant=v["variant"],
+                                precision=v["precision"], block_size=int(v.get("block_size", 0)),
+                                threads=str(v.get("threads", "")), strands=int(v["strands"]),
+                                points=int(v["points"]), repeat=self.repeat, warmup=self.warmup))
+                if out[-1].case_id in seen:
+                    out.pop()  # the same case from two groups runs once
+                else:
+                    seen.add(out[-1].case_id)
+        # cheap cases first, so a short run already covers every configuration
+        out.sort(key=lambda c: (c.strands * c.points, c.backend, c.case_id))
+        return out
+
+
+def _list(where, key, value):
+    if not isinstance(value, list):
+        value = [value]
+    if not value:
+        raise SweepError(f"{where}: {key} is an empty list")
+    return value
+
+
+def _check_axis(where, label, values, backend):
+    """Check the values of one axis; `label` names it in messages (e.g. cuda.block_size)."""
+    key = label.rsplit(".", 1)[-1]
+    for v in values:
+        if key in ("strands", "points", "block_size"):
+            low = {"strands": 1, "points": 2, "block_size": 1}[key]
+            if isinstance(v, bool) or not isinstance(v, int) or v < low:
+                raise SweepError(f"{where}: {label} values must be whole numbers ≥ {low}, got {v!r}")
+            if key == "block_size" and not (32 <= v <= 1024 and v % 32 == 0):
+                raise SweepError(f"{where}: {label} {v} is not a multiple of 32 in 32…1024")
+        elif key == "precision" and v not in PRECISIONS:
+            raise SweepError(f"{where}: {label} '{v}' is not fp32 or fp64")
+        elif key == "threads" and not (v == "all" or (isinstance(v, int) and not isinstance(v, bool) and v >= 1)):
+            raise SweepError(f"{where}: {label} values must be whole numbers ≥ 1 or \"all\", got {v!r}")
+        elif key == "build" and v not in CUDA_BUILDS:
+            raise SweepError(f"{where}: {label} '{v}' is not one of {', '.join(CUDA_BUILDS)}")
+        elif key == "variant" and v not in VARIANTS[backend]:
+            raise SweepError(f"{where}: {label} '{v}' is not one of {', '.join(VARIANTS[backend])}")
+    return values
+
+
+def find_sweep_file(ref):
+    p = Path(ref)
+    if p.is_file():
+        return p
+    candidate = CONFIGS / f"{ref}.toml"
+    if p.suffix == "" and candidate.is_file():
+        return candidate
+    raise SweepError(f"no sweep file '{ref}'")
+
+
+def load_sweep(ref):
+    path = find_sweep_file(ref)
+    where = f"sweep {path}"
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+    except tomllib.TOMLDecodeError as e:
+        raise SweepError(f"{where}: not valid TOML: {e}") from None
+    for key in data:
+        if key not in TOP_KEYS:
+            raise SweepError(f"{where}: unknown key '{key}' (known: {', '.join(TOP_KEYS)})")
+    if "scene" not in data:
+        raise SweepError(f"{where}: missing key 'scene'")
+    scene = load_scene(data["scene"])
+    repeat = data.get("repeat", MIN_REPEAT)
+    if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < MIN_REPEAT:
+        raise SweepError(f"{where}: repeat must be a whole number ≥ {MIN_REPEAT} (median and IQR), got {repeat!r}")
+    warmup = data.get("warmup", 1)
+    if isinstance(warmup, bool) or not isinstance(warmup, int) or warmup < 0:
+        raise SweepError(f"{where}: warmup must be a whole number ≥ 0, got {warmup!r}")
+    timeout = data.get("timeout_s", 600)
+    if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not timeout > 0:
+        raise SweepError(f"{where}: timeout_s must be a number > 0")
+    shared = data.get("axes", {})
+    for key in shared:
+        if key not in SHARED_AXES:
+            raise SweepError(f"{where}: unknown key 'axes.{key}' (known: {', '.join(SHARED_AXES)})")
+    shared_axes = {"strands": [scene.strands], "points": [scene.points], "precision": [scene.precision]}
+    for key, value in shared.items():
+        shared_axes[key] = _check_axis(where, f"axes.{key}", _list(where, f"axes.{key}", value), None)
+    groups = []
+    for backend in ("cpu", "cuda"):
+        if backend not in data:
+            continue
+        tables = data[backend] if isinstance(data[backend], list) else [data[backend]]
+        for n, table in enumerate(tables):
+            label = backend if len(tables) == 1 else f"{backend}[{n}]"
+            if not isinstance(table, dict):
+                raise SweepError(f"{where}: '{backend}' must be a table [{backend}] or tables [[{backend}]]")
+            known = BACKEND_AXES[backend] + SHARED_AXES
+            for key in table:
+                if key not in known:
+                    raise SweepError(f"{where}: unknown key '{label}.{key}' (known: {', '.join(known)})")
+            b = dict(DEFAULTS[backend])
+            b.update(shared_axes)
+            for key, value in table.items():
+                b[key] = _check_axis(where, f"{label}.{key}", _list(where, f"{label}.{key}", value), backend)
+            groups.append((backend, b))
+    axes = groups
+    if not axes:
+        raise SweepError(f"{where}: no [cpu] or [cuda] table: nothing to run")
+    for backend, b in axes:
+        for p in b["points"]:
+            scene.with_overrides(points=p)  # ℓ ≥ h for every point count
+    return Sweep(name=data.get("name", path.stem), path=path, scene=scene, repeat=repeat,
+                 warmup=warmup, timeout_s=int(timeout), axes=axes,
+                 description=data.get("description", ""))

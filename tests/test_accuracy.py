@@ -1,0 +1,43 @@
+"""`python -m harness accuracy` (issue #5): the speed/accuracy table, the Pareto plot and the
+recommendation, on the modes this machine can run."""
+import csv
+
+import numpy as np
+
+from harness import accuracy
+
+
+def test_along_curve_error_is_zero_on_a_straight_strand_and_sees_a_bend():
+    fine = np.zeros((1, 9, 3))
+    fine[0, :, 2] = np.arange(9) * 0.5          # a straight strand of length 4
+    coarse = fine[:, ::4, :].copy()              # P = 3 on the same curve
+    assert np.allclose(accuracy.along_curve_error(coarse, fine), 0)
+    bent = coarse.copy()
+    bent[0, 1, 1] = 0.3                          # the middle point off the curve by 0.3
+    assert np.isclose(accuracy.along_curve_error(bent, fine).max(), 0.3)
+
+
+def test_accuracy_study_writes_table_plot_and_recommendation(cpu_bin, tmp_path):
+    rows = accuracy.run_study("paper", strands=1500, points=16, repeat=3, resolution=(4, 16, 46),
+                              res_strands=500, out_dir=tmp_path / "acc", report_dir=tmp_path / "rep",
+                              log=lambda *_: None)
+    with open(tmp_path / "acc" / "accuracy.csv") as fh:
+        table = list(csv.DictReader(fh))
+    assert set(accuracy.COLUMNS) <= set(table[0])
+    modes = {r["mode"] for r in table if r["study"] == "mode"}
+    assert {"cpu fp64 ref", "cpu fp32 ref"} <= modes
+    fp32 = [r for r in rows if r["mode"] == "cpu fp32 ref"]
+    assert len(fp32) == 4  # one row per frame of the paper scene
+    assert all(0 < r["max_err_L"] < 1e-4 for r in fp32)       # fp32 rounding, not a bug
+    assert all(r["time_ms"] > 0 for r in rows)
+    ref = [r for r in rows if r["mode"] == "cpu fp64 ref"]
+    assert all(r["max_err_L"] == 0 for r in ref)
+    res = sorted((r for r in rows if r["study"] == "resolution"), key=lambda r: r["points"])
+    assert [r["points"] for r in res] == [4, 16, 46]
+    assert res[0]["max_err_L"] > res[1]["max_err_L"] > 0 and res[2]["max_err_L"] == 0
+    png = tmp_path / "rep" / "accuracy_pareto.png"
+    assert png.stat().st_size > 5000
+    md = (tmp_path / "rep" / "accuracy.md").read_text()
+    assert "| cpu fp32 ref |" in md and "Which mode for which use" in md
+    assert "GPU modes absent" in md or "gpu fp32 strict" in md
+    assert not (tmp_path / "acc" / "states").exists()  # scratch states removed

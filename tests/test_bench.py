@@ -1,0 +1,89 @@
+"""`harness bench` (what `make bench` runs), end to end on the tiny configs/quick.toml.
+
+The CPU test needs build/hairsim-cpu (skipped with the reason without it; `make test`
+builds it first); the GPU test is marked `gpu`. The failure paths use the stand-in
+backend harness.fakebackend."""
+import csv
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from harness.fakebackend import install
+
+from conftest import CPU_BIN, ROOT
+
+needs_cpu = pytest.mark.skipif(not CPU_BIN.exists(), reason=f"{CPU_BIN} is not built (run make)")
+
+
+def bench(tmp_path, *extra, env=None):
+    cmd = [sys.executable, "-m", "harness", "bench", "--sweep", "configs/quick.toml",
+           "--out", str(tmp_path / "results"), "--report-dir", str(tmp_path / "report"), *extra]
+    return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600,
+                          env=dict(os.environ, **(env or {})))
+
+
+@needs_cpu
+def test_bench_end_to_end_on_cpu(tmp_path):
+    p = bench(tmp_path, env={"HAIRBENCH_NO_GPU": "1"})
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert "Traceback" not in p.stderr
+    gpu_lines = [ln for ln in p.stdout.splitlines() if "GPU" in ln]
+    assert gpu_lines == ["harness: GPU rows skipped: HAIRBENCH_NO_GPU is set"]
+    results = tmp_path / "results"
+    validation = json.loads((results / "validation.json").read_text())
+    assert validation["checks"] and all(c["equivalent"] for c in validation["checks"])
+    whats = " ".join(c["what"] for c in validation["checks"])
+    assert "1 thread vs all cores" in whats and "fp32 vs cpu fp64" in whats and "resumed" in whats
+    with open(results / "runs.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    cases = {r["case_id"] for r in rows}
+    assert len(cases) == 2 * 2 * 2 and len(rows) == 4 * len(cases)   # strands × precision × threads
+    assert all(r["backend"] == "cpu" and float(r["median_ms"]) > 0 for r in rows)
+    assert all(int(r["n_times"]) >= 9 and r["copy_gbps"] for r in rows)
+    env = json.loads((results / "env.json").read_text())
+    assert env["sessions"][0]["skipped"][0]["reason"] == "HAIRBENCH_NO_GPU is set"
+    md = (tmp_path / "report" / "report.md").read_text()
+    assert "GPU rows are absent**: HAIRBENCH_NO_GPU is set" in md
+    n = len(validation["checks"])
+    assert f"{n} of {n} comparisons equivalent" in md
+    for png in ("speedup_fp32.png", "fig1_initialized.png", "fig2_after_wind.png"):
+        assert (tmp_path / "report" / png).stat().st_size > 5000
+    # run again: the sweep resumes (nothing to do), the report is rebuilt
+    p = bench(tmp_path, env={"HAIRBENCH_NO_GPU": "1"})
+    assert p.returncode == 0 and "8 case(s) already complete" in p.stdout
+    with open(results / "runs.csv", newline="") as f:
+        assert len(list(csv.DictReader(f))) == len(rows)
+
+
+def test_bench_without_binaries_says_run_make(tmp_path):
+    p = bench(tmp_path, env={"HAIRBENCH_BUILD_DIR": str(tmp_path / "empty")})
+    assert p.returncode == 2
+    assert p.stderr.strip().endswith("hairsim-cpu not found: run make")
+    assert p.stderr.count("\n") == 1 and not (tmp_path / "results").exists()
+
+
+def test_bench_fails_before_timing_when_not_equivalent(tmp_path):
+    build = install(tmp_path / "build", ["hairsim-cpu"])
+    p = bench(tmp_path, env={"HAIRBENCH_BUILD_DIR": str(build), "HAIRBENCH_NO_GPU": "1",
+                             "FAKE_SHIFT_FP32": "0.01"})
+    assert p.returncode == 1, p.stdout + p.stderr
+    assert "harness: error: validation failed" in p.stderr and "nothing was timed" in p.stderr
+    assert "NOT EQUIVALENT: cpu fp32 vs cpu fp64" in p.stdout
+    results = tmp_path / "results"
+    assert not (results / "runs.csv").exists()
+    checks = json.loads((results / "validation.json").read_text())["checks"]
+    assert not next(c for c in checks if c["what"] == "cpu fp32 vs cpu fp64")["equivalent"]
+
+
+@pytest.mark.gpu
+def test_bench_validates_every_gpu_variant(tmp_path):
+    p = bench(tmp_path, "--gpu", "yes")
+    assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
+    checks = json.loads((tmp_path / "results" / "validation.json").read_text())["checks"]
+    gpu = [c for c in checks if c["what"].startswith("cuda")]
+    assert len(gpu) >= 3 * 6 * 2 and all(c["equivalent"] for c in gpu)
+    with open(tmp_path / "results" / "runs.csv", newline="") as f:
+        assert any(r["backend"] == "cuda" for r in csv.DictReader(f))
