@@ -50,7 +50,7 @@ NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
 
-.PHONY: all cpu cuda test test-cpu test-gpu bench report help clean check-python check-hdf5 sanitize
+.PHONY: all cpu cuda test bench report help clean check-python check-hdf5 sanitize sanitize-gpu
 
 all: cpu cuda
 
@@ -61,7 +61,8 @@ help:
 	@echo "make test     build and run the pytest suite (GPU tests skip with a reason without a GPU)"
 	@echo "make bench    validate GPU variants against the CPU, sweep, plot and report (python3 -m harness bench)"
 	@echo "make report   rebuild report/ from results/ (python3 -m harness report)"
-	@echo "make sanitize build the C reference with ASan+UBSan and run the C tests under it"
+	@echo "make sanitize build the C reference with ASan+UBSan and run the CPU tests under it"
+	@echo "make sanitize-gpu  compute-sanitizer memcheck + racecheck over every CUDA variant (GPU node)"
 	@echo "make clean    remove build/"
 
 check-hdf5:
@@ -85,7 +86,6 @@ $(BUILD)/hairsim-cpu: $(SHARED_OBJ) $(CPU_OBJ)
 
 ifeq ($(HAVE_NVCC),yes)
 cuda: $(CUDA_BINS)
-$(BUILD)/hairsim-cuda$(if $(filter normal,normal),): MODE := normal
 $(BUILD)/hairsim-cuda-strict: MODE := strict
 $(BUILD)/hairsim-cuda-fastmath: MODE := fastmath
 $(BUILD)/hairsim-cuda: MODE := normal
@@ -115,6 +115,22 @@ sanitize: check-python check-hdf5
 	$(MAKE) BUILD=build/asan COPT="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" \
 	  CC="$(CC) -fsanitize=address,undefined" build/asan/hairsim-cpu
 	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(PYTHON) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume"
+
+# compute-sanitizer (memcheck, racecheck) over every CUDA variant on a small run that also
+# exercises the output, resume and end-to-end paths. Needs a GPU.
+SAN_RUN := --strands 1000 --points 16 --hair-length 10 --repeat 2 --end-to-end --quiet
+sanitize-gpu: cuda
+	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
+	@set -e; for v in paper soa fused; do for p in fp32 fp64; do \
+	  echo "memcheck $$v $$p"; \
+	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_RUN) \
+	    --variant $$v --precision $$p --output $(BUILD)/san-$$v-$$p.h5 --force; \
+	  compute-sanitizer --tool memcheck --error-exitcode 9 $(BUILD)/hairsim-cuda --input $(BUILD)/san-$$v-$$p.h5 \
+	    --stages wind,collide --variant $$v --end-to-end --quiet --output $(BUILD)/san-$$v-$$p-r.h5 --force; \
+	  done; \
+	  echo "racecheck $$v"; \
+	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_RUN) --variant $$v; \
+	done; rm -f $(BUILD)/san-*.h5; echo "compute-sanitizer: memcheck and racecheck found no errors in any variant"
 
 clean:
 	rm -rf $(BUILD)

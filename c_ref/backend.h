@@ -31,6 +31,7 @@ struct hb_backend {
     const char *default_variant;
     const char *const *variants; /* NULL-terminated */
     const char *flags;           /* build flags, recorded in every output */
+    const char *compiler;        /* NULL: the host C compiler that built the driver */
     void *impl;                  /* backend's private state */
     int threads, block_size;     /* what the run uses, set by setup (0 where not used) */
 

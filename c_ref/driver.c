@@ -175,7 +175,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
     rec.backend = b->name;
     rec.variant = o.variant;
     rec.flags = b->flags;
-    rec.compiler = hb_compiler();
+    rec.compiler = b->compiler ? b->compiler : hb_compiler();
     rec.git_revision = hb_git_revision();
     rec.end_to_end_ms = rec.h2d_ms = rec.d2h_ms = rec.hdf5_write_ms = NAN;
 

@@ -486,6 +486,8 @@ const char *const cuda_variants[] = {"paper", "soa", "fused", NULL};
 
 /* The build, recorded in every output: the math mode (normal | strict | fastmath), the
  * nvcc version and the flags the Makefile passed. */
+static const char hb_cuda_compiler[] = "nvcc " HB_STR(__CUDACC_VER_MAJOR__) "." HB_STR(__CUDACC_VER_MINOR__) "." HB_STR(
+    __CUDACC_VER_BUILD__) " (host gcc " HB_STR(__GNUC__) "." HB_STR(__GNUC_MINOR__) ")";
 static const char hb_cuda_flags[] = "math-mode=" HB_MATH_MODE "; nvcc " HB_STR(__CUDACC_VER_MAJOR__) "." HB_STR(
     __CUDACC_VER_MINOR__) "." HB_STR(__CUDACC_VER_BUILD__) "; " HB_FLAGS;
 
@@ -497,6 +499,7 @@ int main(int argc, char **argv)
     b.default_variant = "fused";
     b.variants = cuda_variants;
     b.flags = hb_cuda_flags;
+    b.compiler = hb_cuda_compiler;
     b.setup = cuda_setup;
     b.load = cuda_load;
     b.run_stage = cuda_run_stage;

@@ -1,6 +1,6 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
-Commands: run, diff, sweep, plot, report, bench, accuracy, calibrate (`--help` on each). User
+Commands: run, diff, sweep, plot, report, bench, accuracy, headline, calibrate (`--help` on each). User
 errors print one line `harness: error: …` and exit non-zero, never a traceback."""
 import argparse
 import json
@@ -68,6 +68,14 @@ def cmd_accuracy(args):
     accuracy.run_study(args.scene, strands=args.strands, points=args.points, repeat=args.repeat,
                        resolution=tuple(args.resolution), res_strands=args.resolution_strands,
                        out_dir=args.out, report_dir=args.report_dir)
+    return 0
+
+
+def cmd_headline(args):
+    from . import headline
+
+    headline.run(strands=args.strands, points=args.points, repeat=args.repeat, cpu_repeat=args.cpu_repeat,
+                 block_size=args.block_size, out_dir=args.out)
     return 0
 
 
@@ -164,6 +172,19 @@ def parser():
     a.add_argument("--out", default=None, help="results directory (default results/accuracy)")
     a.add_argument("--report-dir", default=None, help="where to write (default report/)")
     a.set_defaults(func=cmd_accuracy)
+
+    h = sub.add_parser("headline", help="the issues' headline numbers: bandwidth fractions and speedups",
+                       description="At one size, measure the copy bandwidths, every CUDA variant's init and "
+                                   "wind+collide time and bandwidth fraction, and three CPU baselines "
+                                   "(ref 1 thread, ref all cores, simd all cores); write "
+                                   "results/headline/headline.json.")
+    h.add_argument("--strands", type=int, default=4 * 1024 * 1024)
+    h.add_argument("--points", type=int, default=32)
+    h.add_argument("--repeat", type=int, default=9, help="GPU repetitions per stage (default 9)")
+    h.add_argument("--cpu-repeat", type=int, default=3, help="CPU repetitions per stage (default 3)")
+    h.add_argument("--block-size", type=int, default=256)
+    h.add_argument("--out", default=None, help="results directory (default results/headline)")
+    h.set_defaults(func=cmd_headline)
 
     c = sub.add_parser("calibrate", help="measure fp32-vs-fp64 errors behind tolerances.py",
                        description="Run the cpu binary at fp32 and fp64 on the paper scene and print "

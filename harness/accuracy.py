@@ -114,6 +114,7 @@ def _time(binary, flags, repeat):
 
 def run_study(scene_name="paper", *, strands=100_000, points=32, repeat=9, resolution=(4, 8, 16, 32, 64, 128, 256),
               res_strands=20_000, out_dir=None, report_dir=None, log=print):
+    scene = scenes.load_scene(scene_name).with_overrides(strands=strands, points=points)
     out_dir = Path(out_dir or RESULTS / "accuracy")
     report_dir = Path(report_dir or REPORT)
     scratch = out_dir / "states"
@@ -121,7 +122,6 @@ def run_study(scene_name="paper", *, strands=100_000, points=32, repeat=9, resol
     report_dir.mkdir(parents=True, exist_ok=True)
     gpu_ok, why = env.gpu_status()
     cpu_variants = _cpu_variants()
-    scene = scenes.load_scene(scene_name).with_overrides(strands=strands, points=points)
     L = scene.hair_length
     rows = []
 

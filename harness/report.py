@@ -246,10 +246,14 @@ def build(results_dir="results/default", report_dir=None):
         lines.append("")
     lines += timing_table(cases) if not cases.empty else []
     lines += ["## Roofline", "",
-              "Bytes a stage must move (harness/roofline.py): init writes N·P·3·s; wind and collide "
-              "each read and write y and z: N·P·2·s·2; a fused wind+collide counts that once; "
+              "Bytes a stage must move (harness/roofline.py): init writes N·P·3·s; wind reads and "
+              "writes y and z: N·P·2·s·2; collide reads y and z and writes the points it moves: "
+              "N·P·2·s + M·2·s (M = moved points); a fused wind+collide counts N·P·2·s·2 once; "
               "s = 4 (fp32) or 8 (fp64). The fraction is those bytes over the stage's median time, "
               "over the copy bandwidth the binary measured on the same device in the same sweep.", ""]
+    accuracy_md = out_dir / "accuracy.md"
+    if accuracy_md.exists():  # written by `python -m harness accuracy` (issue #5)
+        lines += accuracy_md.read_text().splitlines() + [""]
     lines += environment_section(env)
     path = out_dir / "report.md"
     tmp = path.with_name(f"report.md.tmp.{os.getpid()}")

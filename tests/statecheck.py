@@ -29,6 +29,7 @@ class State:
     """An HDF5 state: frames [F][N][P][3], the /parameters attributes and per-frame data."""
 
     def __init__(self, path):
+        self.path = str(path)
         with h5py.File(path, "r") as f:
             self.params = dict(f["parameters"].attrs)
             self.n = int(self.params["n_strands"])
