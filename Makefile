@@ -22,7 +22,14 @@ ifeq ($(strip $(HDF5_LIBS)),)
   HDF5_LIBS := $(filter -L%,$(H5CC_SHOW)) -lhdf5
 endif
 
-GIT_REV := $(shell git rev-parse --short=12 HEAD 2>/dev/null || cat REVISION 2>/dev/null || echo unknown)$(shell git diff --quiet HEAD -- c_ref cuda Makefile 2>/dev/null || echo -dirty)
+# The revision compiled into every output: git where there is a checkout (with -dirty for
+# uncommitted changes to the sources), else a REVISION file written beside a copied tree.
+IN_GIT := $(shell git rev-parse --is-inside-work-tree 2>/dev/null)
+ifeq ($(IN_GIT),true)
+  GIT_REV := $(shell git rev-parse --short=12 HEAD 2>/dev/null || echo unknown)$(shell git diff --quiet HEAD -- c_ref cuda Makefile 2>/dev/null || echo -dirty)
+else
+  GIT_REV := $(shell cat REVISION 2>/dev/null || echo unknown)
+endif
 
 # The C reference: C11, no fast-math and no FMA contraction, so it is the oracle.
 CSTD    := -std=c11 -D_DEFAULT_SOURCE

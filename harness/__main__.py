@@ -65,6 +65,9 @@ def cmd_bench(args):
 def cmd_accuracy(args):
     from . import accuracy
 
+    if args.from_csv:
+        accuracy.report_from_csv(args.from_csv, report_dir=args.report_dir)
+        return 0
     accuracy.run_study(args.scene, strands=args.strands, points=args.points, repeat=args.repeat,
                        resolution=tuple(args.resolution), res_strands=args.resolution_strands,
                        out_dir=args.out, report_dir=args.report_dir)
@@ -171,6 +174,8 @@ def parser():
     a.add_argument("--resolution-strands", type=int, default=20_000)
     a.add_argument("--out", default=None, help="results directory (default results/accuracy)")
     a.add_argument("--report-dir", default=None, help="where to write (default report/)")
+    a.add_argument("--from-csv", default=None, help="only rewrite the table and plot from an existing "
+                                                      "accuracy.csv (e.g. results/accuracy/accuracy.csv)")
     a.set_defaults(func=cmd_accuracy)
 
     h = sub.add_parser("headline", help="the issues' headline numbers: bandwidth fractions and speedups",

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import HarnessError, env, runner, scenes
+from . import HarnessError, env, invariants, runner, scenes
 from .paths import REPORT, RESULTS, binary_path, display
 from .states import open_state
 
@@ -88,7 +88,7 @@ def frame_errors(test, ref, f, L):
     seg = np.linalg.norm(np.diff(a, axis=1), axis=-1)
     drift = float(np.abs(seg - ell).max() / ell) if seg.size else 0.0
     pen = 0.0
-    if test.stages[f] == "collide" or test.fused[f] == "wind+collide":
+    if invariants.is_collide_frame(test, f):
         rc = np.hypot(a[:, 0, 1], a[:, 0, 2]) + float(test.params["hair_offset"])
         r = np.hypot(a[:, 1:, 1], a[:, 1:, 2])
         pen = float(max(0.0, ((rc[:, None] - r) / rc[:, None]).max())) if r.size else 0.0
@@ -185,7 +185,7 @@ def run_study(scene_name="paper", *, strands=100_000, points=32, repeat=9, resol
         for row in rows:
             w.writerow({k: row.get(k) for k in COLUMNS})
     os.replace(tmp, csv_path)
-    (out_dir / "env.json").write_text(json.dumps(env.collect(), indent=1) + "\n")
+    (out_dir / "env.json").write_text(json.dumps(dict(env.collect(), resolution_strands=res_strands), indent=1) + "\n")
     png = pareto_plot(rows, report_dir / "accuracy_pareto.png", strands, points)
     md = write_markdown(rows, report_dir / "accuracy.md", strands, points, res_strands, gpu_ok, why)
     for p in scratch.glob("*.h5"):
@@ -193,6 +193,51 @@ def run_study(scene_name="paper", *, strands=100_000, points=32, repeat=9, resol
     scratch.rmdir()
     log(f"wrote {display(csv_path)}, {display(png)}, {display(md)}")
     return rows
+
+
+def load_rows(csv_path):
+    """The rows of an accuracy.csv, numbers as numbers."""
+    ints = ("strands", "points", "frame")
+    floats = ("max_err_L", "rms_err_L", "seg_drift", "penetration", "time_ms")
+    try:
+        with open(csv_path, newline="") as fh:
+            rows = list(csv.DictReader(fh))
+    except OSError as e:
+        raise HarnessError(f"{display(csv_path)}: cannot read ({e.strerror})") from None
+    for r in rows:
+        for k in ints:
+            r[k] = int(r[k])
+        for k in floats:
+            r[k] = float(r[k]) if r[k] not in ("", None) else float("nan")
+    return rows
+
+
+def report_from_csv(csv_path, report_dir=None, log=print):
+    """Rewrite report/accuracy.md and the Pareto plot from a committed accuracy.csv."""
+    rows = load_rows(csv_path)
+    if not rows:
+        raise HarnessError(f"{display(csv_path)} has no rows")
+    report_dir = Path(report_dir or REPORT)
+    report_dir.mkdir(parents=True, exist_ok=True)
+    mode_rows = [r for r in rows if r["study"] == "mode"]
+    res_rows = [r for r in rows if r["study"] == "resolution"]
+    strands, points = mode_rows[0]["strands"], mode_rows[0]["points"]
+    res_note = _res_strands_note(csv_path)
+    gpu_ran = any(r["backend"] == "cuda" for r in mode_rows)
+    png = pareto_plot(rows, report_dir / "accuracy_pareto.png", strands, points)
+    md = write_markdown(rows, report_dir / "accuracy.md", strands, points, res_note, gpu_ran,
+                        "no GPU rows in this results file")
+    log(f"wrote {display(png)}, {display(md)} from {display(csv_path)} ({len(mode_rows)} mode rows, "
+        f"{len(res_rows)} resolution rows)")
+    return md
+
+
+def _res_strands_note(csv_path):
+    """Strands of the resolution study, from env.json beside the CSV (recorded by run_study)."""
+    try:
+        return int(json.loads((Path(csv_path).parent / "env.json").read_text()).get("resolution_strands"))
+    except (OSError, ValueError, TypeError, AttributeError):
+        return None
 
 
 def _end_to_end(rows):
@@ -286,7 +331,8 @@ def write_markdown(rows, path, strands, points, res_strands, gpu_ok, why):
                    f"{fmt(r['rms_err_L'])} | {fmt(worst)} | {fmt(drift)} | {fmt(pen)} |")
     res = [r for r in rows if r["study"] == "resolution"]
     if res:
-        out += ["", f"Model resolution ({res_strands:,} strands, fp64, compared with the finest strand along the "
+        how_many = f"{res_strands:,} strands, " if res_strands else ""
+        out += ["", f"Model resolution ({how_many}fp64, compared with the finest strand along the "
                 "curve; timed with " f"{res[0]['backend']}/{res[0]['variant']} fp32 at {strands:,} strands):", "",
                 "| points per strand | time (ms) | max err / L | rms err / L |", "|---|---|---|---|"]
         for r in sorted(res, key=lambda r: r["points"]):

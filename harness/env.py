@@ -71,7 +71,11 @@ def nvcc_version():
 def git_revision():
     rev = _cmd(["git", "rev-parse", "--short", "HEAD"])
     if rev is None:
-        return "unknown (no commit)"
+        # a copied tree without .git (a GPU node): the REVISION file written beside it, if any
+        try:
+            return (ROOT / "REVISION").read_text().strip() + " (REVISION file)"
+        except OSError:
+            return "unknown (no commit)"
     dirty = _cmd(["git", "status", "--porcelain", "--untracked-files=no"])
     return rev + ("-dirty" if dirty else "")
 

@@ -225,6 +225,28 @@ def timing_table(cases):
     return lines
 
 
+def headline_section(path):
+    """The issues' headline numbers (python -m harness headline), when they were measured."""
+    if not path.exists():
+        return []
+    from .headline import table
+
+    h = json.loads(path.read_text())
+    host = h.get("env", {})
+    gpus = ", ".join(g.get("name", "?") for g in host.get("gpus") or []) or "no GPU"
+    lines = ["## Headline: bandwidth fractions and speedups", "",
+             f"From `{display(path)}` (`python -m harness headline`, git {host.get('git_revision')}, "
+             f"{gpus}, {host.get('cpu_model')} with {host.get('cpu_cores')} cores, {host.get('date')}). "
+             f"Copy bandwidth: GPU {h.get('gpu_copy_gbps') or 0:.0f} GB/s (device to device), CPU "
+             f"{h.get('cpu_copy_gbps') or 0:.1f} GB/s (STREAM-style copy, all cores; triad "
+             f"{h.get('cpu_triad_gbps') or 0:.1f} GB/s). %BW = bytes the stage must move (roofline below) "
+             "over its median time, over that copy bandwidth.", "", "```"]
+    lines += table(h).splitlines() + ["```", ""]
+    if h.get("gpu_skipped"):
+        lines += [f"GPU rows skipped: {h['gpu_skipped']}", ""]
+    return lines
+
+
 def build(results_dir="results/default", report_dir=None):
     out_dir = Path(report_dir) if report_dir else REPORT
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -236,6 +258,9 @@ def build(results_dir="results/default", report_dir=None):
              f"`{display(results_dir)}` ({len(rows)} rows, {len(cases)} cases) by `python -m harness report`.",
              "Times are medians of ≥ 9 repetitions per stage after warm-up (min, max and IQR in "
              "`runs.csv`); per-stage kernel time only, not transfers or HDF5 writes.", ""]
+    if env.get("provenance"):
+        lines += ["## Provenance", "", env["provenance"], ""]
+    lines += headline_section(Path(results_dir).parent / "headline" / "headline.json")
     lines += gpu_section(cases, env)
     lines += scenes_section(env, cases)
     lines += validation_section(results_dir)
@@ -250,7 +275,9 @@ def build(results_dir="results/default", report_dir=None):
               "writes y and z: N·P·2·s·2; collide reads y and z and writes the points it moves: "
               "N·P·2·s + M·2·s (M = moved points); a fused wind+collide counts N·P·2·s·2 once; "
               "s = 4 (fp32) or 8 (fp64). The fraction is those bytes over the stage's median time, "
-              "over the copy bandwidth the binary measured on the same device in the same sweep.", ""]
+              "over the copy bandwidth the binary measured on the same device in the same sweep. "
+              "A fraction above 1 means the state fit in the caches (the GPU's L2, the CPU's L2/L3): "
+              "the limit is the memory's copy bandwidth, and a state that small beats it.", ""]
     accuracy_md = out_dir / "accuracy.md"
     if accuracy_md.exists():  # written by `python -m harness accuracy` (issue #5)
         lines += accuracy_md.read_text().splitlines() + [""]

@@ -41,3 +41,23 @@ def test_accuracy_study_writes_table_plot_and_recommendation(cpu_bin, tmp_path):
     assert "| cpu fp32 ref |" in md and "Which mode for which use" in md
     assert "GPU modes absent" in md or "gpu fp32 strict" in md
     assert not (tmp_path / "acc" / "states").exists()  # scratch states removed
+
+
+def test_a_fused_wind_frame_is_not_checked_for_penetration(tmp_path):
+    """Regression: the GPU's fused wind frame (stage 'wind', fused 'wind+collide') holds the
+    state after the wind half, inside the shell by design; accuracy once counted it as a
+    collide frame and reported 6% penetration."""
+    from harness.states import open_state
+    from harness.synthetic import write_state
+
+    inside = np.zeros((1, 1, 3, 3))
+    inside[0, 0, :, 2] = [10.0, 9.0, 8.0]      # root on the head, then two points inside
+    frames = np.concatenate([inside, inside])   # frame 0 init, frame 1 the fused wind frame
+    a = write_state(tmp_path / "a.h5", frames, ["init", "wind"], fused=["", "wind+collide"],
+                    params={"hair_length": 2.0})
+    with open_state(a) as s:
+        e = accuracy.frame_errors(s, s, 1, 2.0)
+    assert e["penetration"] == 0
+    b = write_state(tmp_path / "b.h5", frames, ["init", "collide"], params={"hair_length": 2.0})
+    with open_state(b) as s:
+        assert accuracy.frame_errors(s, s, 1, 2.0)["penetration"] > 0.1
