@@ -67,7 +67,7 @@ help:
 	@echo "make          build build/hairsim-cpu (and the CUDA binaries where nvcc is present)"
 	@echo "make test     build and run the pytest suite (GPU tests skip with a reason without a GPU)"
 	@echo "make bench    validate GPU variants against the CPU, sweep, plot and report (python3 -m harness bench)"
-	@echo "make report   rebuild report/ from results/ (python3 -m harness report)"
+	@echo "make report   rebuild report/ from results/default (REPORT_FROM=results/reference-h200/sweep for the committed H200 run)"
 	@echo "make sanitize build the C reference with ASan+UBSan and run the CPU tests under it"
 	@echo "make sanitize-gpu  compute-sanitizer memcheck + racecheck over every CUDA variant (GPU node)"
 	@echo "make clean    remove build/"
@@ -112,10 +112,12 @@ test: check-python all
 	$(PYTHON) -m pytest tests -q -ra
 
 bench: check-python all
-	$(PYTHON) -m harness bench
+	$(PYTHON) -m harness bench $(if $(OUT),--out $(OUT))
 
+# REPORT_FROM: the results to render (default results/default; the committed reference run
+# from an H200 is results/reference-h200/sweep)
 report: check-python
-	$(PYTHON) -m harness report
+	$(PYTHON) -m harness report $(REPORT_FROM)
 
 # ASan + UBSan over the C reference: a separate build in build/asan, the C tests run on it.
 sanitize: check-python check-hdf5

@@ -111,6 +111,24 @@ def write_json(path, data):
     os.replace(tmp, path)
 
 
+def machine_of(host):
+    """What makes two sessions' times comparable: the CPU, its cores and the GPUs."""
+    gpus = tuple(g.get("name") for g in host.get("gpus") or [])
+    return host.get("cpu_model"), host.get("cpu_cores"), gpus
+
+
+def check_same_machine(before, now, out_dir):
+    """A resumed sweep must run where its rows were measured: rows of two machines in one
+    runs.csv would make curves that no machine produced."""
+    if machine_of(before) != machine_of(now):
+        def describe(h):
+            cpu, cores, gpus = machine_of(h)
+            return f"{cpu}, {cores} cores, {', '.join(gpus) if gpus else 'no GPU'}"
+        raise HarnessError(f"{display(out_dir)} holds rows measured on another machine ({describe(before)}); "
+                           f"this one is {describe(now)}: give another --out (make bench OUT=results/NAME) "
+                           f"or move it away")
+
+
 def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
     """Run (or resume) a sweep; return (results dir, number of failed cases)."""
     sweep = load_sweep(sweep_ref)
@@ -125,6 +143,8 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
                                               if k != "source"},
                                     "sessions": []}
     done, dropped = runlog.resume(csv_path)
+    if done and record.get("sessions"):
+        check_same_machine(record["sessions"][-1].get("host") or {}, env.collect(), out_dir)
     cases = sweep.cases()
     reasons = backend_reasons(cases, gpu)
     skipped = []

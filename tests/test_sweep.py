@@ -182,3 +182,15 @@ def test_groups_and_overrides(tmp_path):
                  '[[cpu]]\nthreads = [1, "all"]\nstrands = [2, 3]\n')
     cases = load_sweep(p).cases()
     assert sorted((c.strands, c.threads) for c in cases) == [(1, "1"), (2, "1"), (2, "all"), (3, "1"), (3, "all")]
+
+
+def test_a_sweep_does_not_resume_rows_of_another_machine(tmp_path):
+    """Rows measured on two machines must never mix in one runs.csv."""
+    from harness import HarnessError
+    from harness.sweep import check_same_machine
+
+    h200 = {"cpu_model": "Intel(R) Xeon(R) Processor", "cpu_cores": 16, "gpus": [{"name": "NVIDIA H200"}]}
+    laptop = {"cpu_model": "AMD EPYC", "cpu_cores": 2, "gpus": []}
+    check_same_machine(h200, dict(h200), tmp_path)  # same machine: fine
+    with pytest.raises(HarnessError, match="another machine .*NVIDIA H200.*this one is AMD EPYC, 2 cores, no GPU"):
+        check_same_machine(h200, laptop, tmp_path)
