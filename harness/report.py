@@ -278,9 +278,18 @@ def build(results_dir="results/default", report_dir=None):
               "over the copy bandwidth the binary measured on the same device in the same sweep. "
               "A fraction above 1 means the state fit in the caches (the GPU's L2, the CPU's L2/L3): "
               "the limit is the memory's copy bandwidth, and a state that small beats it.", ""]
-    accuracy_md = out_dir / "accuracy.md"
-    if accuracy_md.exists():  # written by `python -m harness accuracy` (issue #5)
-        lines += accuracy_md.read_text().splitlines() + [""]
+    # the accuracy study of the same machine (`python -m harness accuracy`, issue #5): its CSV
+    # beside this results directory, rendered again here so the report never mixes machines
+    accuracy_csv = Path(results_dir).parent / "accuracy" / "accuracy.csv"
+    if accuracy_csv.exists():
+        from .accuracy import report_from_csv
+
+        md = report_from_csv(accuracy_csv, out_dir, log=lambda *_: None)
+        lines += md.read_text().splitlines() + [""]
+    else:
+        lines += ["## Speed against accuracy", "",
+                  f"Not measured with these results (no `{display(accuracy_csv)}`): run "
+                  "`python3 -m harness accuracy` on this machine.", ""]
     lines += environment_section(env)
     path = out_dir / "report.md"
     tmp = path.with_name(f"report.md.tmp.{os.getpid()}")
