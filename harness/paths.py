@@ -42,3 +42,14 @@ def display(path):
         return str(p.resolve().relative_to(ROOT))
     except ValueError:
         return str(p)
+
+
+def config_file(ref):
+    """A config path as given, or a bare name looked up as configs/<name>.toml; None if neither."""
+    p = Path(ref)
+    if p.is_file():
+        return p
+    candidate = CONFIGS / f"{ref}.toml"
+    if p.suffix == "" and candidate.is_file():
+        return candidate
+    return None

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from . import HarnessError
-from .paths import CONFIGS
+from .paths import CONFIGS, config_file
 
 STAGES = ("init", "collide", "wind")
 PRECISIONS = ("fp32", "fp64")
@@ -205,12 +205,9 @@ def scene_from_dict(data, name, where):
 
 def find_scene_file(ref):
     """A scene path, or a name looked up as configs/<name>.toml."""
-    p = Path(ref)
-    if p.is_file():
-        return p
-    candidate = CONFIGS / f"{ref}.toml"
-    if p.suffix == "" and candidate.is_file():
-        return candidate
+    found = config_file(ref)
+    if found:
+        return found
     known = sorted(q.stem for q in CONFIGS.glob("*.toml") if is_scene_file(q))
     raise SceneError(f"no scene '{ref}' (not a file; scenes in configs/: {', '.join(known) or 'none'})")
 

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import HarnessError
-from .paths import CONFIGS, CUDA_BUILDS
+from .paths import CONFIGS, CUDA_BUILDS, config_file
 from .scenes import PRECISIONS, load_scene
 
 MIN_REPEAT = 9
@@ -128,12 +128,9 @@ def _check_axis(where, label, values, backend):
 
 
 def find_sweep_file(ref):
-    p = Path(ref)
-    if p.is_file():
-        return p
-    candidate = CONFIGS / f"{ref}.toml"
-    if p.suffix == "" and candidate.is_file():
-        return candidate
+    found = config_file(ref)
+    if found:
+        return found
     raise SweepError(f"no sweep file '{ref}'")
 
 
