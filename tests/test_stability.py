@@ -61,6 +61,32 @@ def test_cpu_invariants_hold_across_the_scene_space(cpu_bin, tmp_path_factory, s
     assert_invariants(State(out))
 
 
+GPU_SETTINGS = settings(max_examples=60, deadline=None, derandomize=True,
+                        suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+
+
+@pytest.mark.gpu
+@GPU_SETTINGS
+@given(s=scenes(), variant=st.sampled_from(["paper", "soa", "fused"]), block=st.sampled_from([32, 64, 256, 1024]))
+def test_gpu_agrees_with_cpu_across_the_scene_space(cpu_bin, tmp_path_factory, s, variant, block):
+    """The same scene space on the strict CUDA build: the DESIGN §3 invariants on the GPU
+    output, and equivalence with the CPU under the harness's tolerance (DESIGN §6)."""
+    from conftest import CUDA_STRICT_BIN
+    from harness import diff
+
+    d = tmp_path_factory.mktemp("stabgpu")
+    cpu, gpu = d / "cpu.h5", d / "gpu.h5"
+    p = run(cpu_bin, *scene_args(s), "--output", cpu, "--quiet", check=False)
+    if p.returncode != 0:  # refused scenes are refused by both
+        q = run(CUDA_STRICT_BIN, *scene_args(s), "--output", gpu, "--quiet", check=False)
+        assert q.returncode == p.returncode == 2, (p.stderr, q.stderr)
+        return
+    run(CUDA_STRICT_BIN, *scene_args(s), "--variant", variant, "--block-size", block, "--output", gpu, "--quiet")
+    assert_invariants(State(gpu))
+    result = diff.compare(str(cpu), str(gpu))
+    assert result.equivalent, diff.format_result(result)
+
+
 # ---- regression tests, one per instability found ------------------------------------------
 
 @pytest.mark.parametrize("R", [3.44e-20, 8.49e-28, 1e-40])
