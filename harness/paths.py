@@ -53,3 +53,16 @@ def config_file(ref):
     if p.suffix == "" and candidate.is_file():
         return candidate
     return None
+
+
+def read_toml(path, where, error):
+    """A TOML file as a dict; an unreadable or invalid file raises `error` with one line."""
+    import tomllib
+
+    try:
+        with open(path, "rb") as f:
+            return tomllib.load(f)
+    except tomllib.TOMLDecodeError as e:
+        raise error(f"{where}: not valid TOML: {e}") from None
+    except OSError as e:
+        raise error(f"{where}: cannot read: {e.strerror}") from None

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from . import HarnessError
-from .paths import CONFIGS, config_file
+from .paths import CONFIGS, config_file, read_toml
 
 STAGES = ("init", "collide", "wind")
 PRECISIONS = ("fp32", "fp64")
@@ -223,11 +223,5 @@ def is_scene_file(path):
 def load_scene(ref):
     path = find_scene_file(ref)
     where = f"scene {path}"
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except tomllib.TOMLDecodeError as e:
-        raise SceneError(f"{where}: not valid TOML: {e}") from None
-    except OSError as e:
-        raise SceneError(f"{where}: cannot read: {e.strerror}") from None
+    data = read_toml(path, where, SceneError)
     return scene_from_dict(data, path.stem, where)

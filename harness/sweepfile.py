@@ -25,12 +25,11 @@ default build but one for the fast-math build. The cases are the product of the 
 each group; a case that two groups both produce runs once.
 """
 import itertools
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 from . import HarnessError
-from .paths import CONFIGS, CUDA_BUILDS, config_file
+from .paths import CONFIGS, CUDA_BUILDS, config_file, read_toml
 from .scenes import PRECISIONS, load_scene
 
 MIN_REPEAT = 9
@@ -137,11 +136,7 @@ def find_sweep_file(ref):
 def load_sweep(ref):
     path = find_sweep_file(ref)
     where = f"sweep {path}"
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except tomllib.TOMLDecodeError as e:
-        raise SweepError(f"{where}: not valid TOML: {e}") from None
+    data = read_toml(path, where, SweepError)
     for key in data:
         if key not in TOP_KEYS:
             raise SweepError(f"{where}: unknown key '{key}' (known: {', '.join(TOP_KEYS)})")
