@@ -22,14 +22,22 @@ ifeq ($(strip $(HDF5_LIBS)),)
   HDF5_LIBS := $(filter -L%,$(H5CC_SHOW)) -lhdf5
 endif
 
-# The revision compiled into every output: git where there is a checkout (with -dirty for
-# uncommitted changes to the sources), else a REVISION file written beside a copied tree.
+# The revision compiled into every output: a REVISION file when one is present (written
+# beside a tree copied to a GPU node, whose own .git, if any, can be stale: one was seen at
+# an older commit), else git (with -dirty for uncommitted changes to the sources).
+REVISION_FILE := $(strip $(shell cat REVISION 2>/dev/null))
 IN_GIT := $(shell git rev-parse --is-inside-work-tree 2>/dev/null)
-ifeq ($(IN_GIT),true)
+ifneq ($(REVISION_FILE),)
+  GIT_REV := $(REVISION_FILE) (REVISION file)
+else ifeq ($(IN_GIT),true)
   GIT_REV := $(shell git rev-parse --short=12 HEAD 2>/dev/null || echo unknown)$(shell git diff --quiet HEAD -- c_ref cuda Makefile 2>/dev/null || echo -dirty)
 else
-  GIT_REV := $(shell cat REVISION 2>/dev/null || echo unknown)
+  GIT_REV := unknown
 endif
+# record.c compiles GIT_REV in; this stamp changes only when GIT_REV does, so a commit or a
+# new REVISION rebuilds record.o and relinks the binaries instead of keeping an old revision.
+REV_STAMP := $(BUILD)/revision.stamp
+$(shell mkdir -p $(BUILD) && { [ "$$(cat $(REV_STAMP) 2>/dev/null)" = '$(GIT_REV)' ] || printf '%s\n' '$(GIT_REV)' > $(REV_STAMP); })
 
 # The C reference: C11, no fast-math and no FMA contraction, so it is the oracle.
 CSTD    := -std=c11 -D_DEFAULT_SOURCE
@@ -87,6 +95,7 @@ $(OBJ)/%.o: c_ref/%.c $(C_HEADERS) | check-hdf5
 	$(CC) $(CFLAGS_REF) -fopenmp $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' -DHB_FLAGS='"$(CPU_FLAGS_STR)"' -c $< -o $@
 
 $(OBJ)/model_simd.o: CFLAGS_REF += $(SIMD_CFLAGS)
+$(OBJ)/record.o: $(REV_STAMP)
 
 $(BUILD)/hairsim-cpu: $(SHARED_OBJ) $(CPU_OBJ)
 	$(CC) -fopenmp $^ -o $@ $(HDF5_LIBS) -lm

@@ -69,13 +69,17 @@ def nvcc_version():
 
 
 def git_revision():
+    # A REVISION file wins (the Makefile's rule): it is written beside a tree copied to a
+    # GPU node, whose own .git, if any, can be stale.
+    try:
+        written = (ROOT / "REVISION").read_text().strip()
+    except OSError:
+        written = ""
+    if written:
+        return written + " (REVISION file)"
     rev = _cmd(["git", "rev-parse", "--short", "HEAD"])
     if rev is None:
-        # a copied tree without .git (a GPU node): the REVISION file written beside it, if any
-        try:
-            return (ROOT / "REVISION").read_text().strip() + " (REVISION file)"
-        except OSError:
-            return "unknown (no commit)"
+        return "unknown (no commit)"
     dirty = _cmd(["git", "status", "--porcelain", "--untracked-files=no"])
     return rev + ("-dirty" if dirty else "")
 
