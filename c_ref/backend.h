@@ -19,6 +19,15 @@ extern "C" {
 
 typedef struct hb_backend hb_backend;
 
+/* One kernel variant of a backend: its name, the stages it runs (bit 1 << hb_stage) and
+ * a one-line summary. Declared once, in the backend; `--list-variants` prints the table
+ * as JSON and the harness reads it from there. */
+typedef struct {
+    const char *name;
+    unsigned stages;
+    const char *summary;
+} hb_variant;
+
 /* The result of running one stage (or a fused group) once. */
 typedef struct {
     double ms;            /* the stage's own time: kernels only (cuda events) or the loop (cpu) */
@@ -29,7 +38,8 @@ typedef struct {
 struct hb_backend {
     const char *name;            /* "cpu" | "cuda" */
     const char *default_variant;
-    const char *const *variants; /* NULL-terminated */
+    const hb_variant *variants;  /* terminated by a NULL name */
+    const char *build;           /* "default" | "strict" | "fastmath" (the math mode) */
     const char *flags;           /* build flags, recorded in every output */
     const char *compiler;        /* NULL: the host C compiler that built the driver */
     void *impl;                  /* backend's private state */

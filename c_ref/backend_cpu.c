@@ -476,7 +476,12 @@ static void cpu_teardown(hb_backend *b)
     b->impl = NULL;
 }
 
-static const char *const cpu_variants[] = {"ref", "simd", NULL};
+#define CPU_PAPER_STAGES ((1u << HB_STAGE_INIT) | (1u << HB_STAGE_COLLIDE) | (1u << HB_STAGE_WIND))
+static const hb_variant cpu_variants[] = {
+    {"ref", CPU_PAPER_STAGES, "the oracle: model_impl.h one strand at a time, OpenMP over strands"},
+    {"simd", CPU_PAPER_STAGES, "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks"},
+    {NULL, 0, NULL},
+};
 
 #ifndef HB_FLAGS
 #define HB_FLAGS "unknown"
@@ -488,6 +493,7 @@ int main(int argc, char **argv)
     b.name = "cpu";
     b.default_variant = "ref";
     b.variants = cpu_variants;
+    b.build = "default";
     b.flags = HB_FLAGS;
     b.setup = cpu_setup;
     b.load = cpu_load;

@@ -62,8 +62,9 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
             "  --quiet              no summary on stderr\n"
             "  --measure-bandwidth  only measure the %s copy bandwidth (GB/s, read + write)\n"
             "  --self-test rng      print the Philox4x32-10 known-answer checks and exit\n"
+            "  --list-variants      print this binary's variants, the stages each runs and its build as JSON\n"
             "  --help, --version\n",
-            prog, backend, cuda ? "paper | soa | fused (default fused)" : "ref | simd (default ref)",
+            prog, backend, "kernel variant (--list-variants names them)",
             cuda ? "  --block-size B       threads per block, 32..1024 (default 256)\n"
                  : "  --threads T          OpenMP threads over strands (default: all cores)\n",
             cuda ? "device-to-device" : "all-core memory");
@@ -152,6 +153,7 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         if (strcmp(a, "--quiet") == 0) { o->quiet = 1; continue; }
         if (strcmp(a, "--end-to-end") == 0) { o->end_to_end = 1; continue; }
         if (strcmp(a, "--measure-bandwidth") == 0) { o->measure_bandwidth = 1; continue; }
+        if (strcmp(a, "--list-variants") == 0) { o->list_variants = 1; continue; }
         if (strncmp(a, "--", 2) != 0) FAIL("unexpected argument '%s' (see --help)", a);
         /* every other flag takes a value: --flag V or --flag=V */
         const char *eq = strchr(a, '=');

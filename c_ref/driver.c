@@ -69,6 +69,27 @@ static int self_test_rng(void)
     return failed ? 1 : 0;
 }
 
+/* --list-variants: the backend's variants, declared once in the backend, as one JSON
+ * object (docs/interfaces.md); the harness reads it instead of spelling the names. */
+static int list_variants(const hb_backend *b)
+{
+    static const hb_stage all[] = {HB_STAGE_INIT, HB_STAGE_COLLIDE, HB_STAGE_WIND};
+    printf("{\"backend\": \"%s\", \"build\": \"%s\", \"default_variant\": \"%s\", "
+           "\"precisions\": [\"fp32\", \"fp64\"], \"variants\": [", b->name, b->build, b->default_variant);
+    for (const hb_variant *v = b->variants; v->name; v++) {
+        printf("%s{\"name\": \"%s\", \"stages\": [", v == b->variants ? "" : ", ", v->name);
+        int first = 1;
+        for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+            if (v->stages & (1u << all[i])) {
+                printf("%s\"%s\"", first ? "" : ", ", hb_stage_name(all[i]));
+                first = 0;
+            }
+        printf("], \"summary\": \"%s\"}", v->summary);
+    }
+    printf("]}\n");
+    return HB_EXIT_OK;
+}
+
 /* With --input the geometry comes from the file; a flag given that disagrees is refused. */
 static int adopt_input_scene(hb_options *o, const hb_scene *f, char *err, size_t errlen)
 {
@@ -158,16 +179,25 @@ int hb_main(int argc, char **argv, hb_backend *b)
     if (rc > 0) return HB_EXIT_OK;
     if (o.self_test) return self_test_rng();
 
+    if (o.list_variants) return list_variants(b);
+
     if (!o.variant) o.variant = b->default_variant;
-    int known = 0;
-    for (const char *const *v = b->variants; *v; v++) known |= strcmp(*v, o.variant) == 0;
-    if (!known) {
+    const hb_variant *var = NULL;
+    for (const hb_variant *v = b->variants; v->name; v++)
+        if (strcmp(v->name, o.variant) == 0) var = v;
+    if (!var) {
         char list[256] = "";
-        for (const char *const *v = b->variants; *v; v++)
-            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? ", " : "", *v);
+        for (const hb_variant *v = b->variants; v->name; v++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? ", " : "", v->name);
         snprintf(err, sizeof err, "--variant %s is not a %s variant (known: %s)", o.variant, b->name, list);
         return die(HB_EXIT_USAGE, err);
     }
+    for (int i = 0; i < o.n_stages; i++)
+        if (!(var->stages & (1u << o.stages[i]))) {
+            snprintf(err, sizeof err, "--stages: the %s variant %s does not run '%s' (see --list-variants)", b->name,
+                     var->name, hb_stage_name(o.stages[i]));
+            return die(HB_EXIT_USAGE, err);
+        }
 
     hb_record rec;
     memset(&rec, 0, sizeof rec);

@@ -52,6 +52,7 @@ typedef struct {
     int end_to_end;          /* measure one extra untimed-by-stage pass */
     int measure_bandwidth;   /* only measure the copy bandwidth */
     const char *self_test;   /* "rng": print the known-answer checks */
+    int list_variants;       /* print the backend's variants as JSON and exit */
     /* which scene flags the user gave explicitly (for --input consistency checks) */
     unsigned given;
 } hb_options;

@@ -471,7 +471,13 @@ void cuda_teardown(hb_backend *b)
     b->impl = NULL;
 }
 
-const char *const cuda_variants[] = {"paper", "soa", "fused", NULL};
+#define CUDA_PAPER_STAGES ((1u << HB_STAGE_INIT) | (1u << HB_STAGE_COLLIDE) | (1u << HB_STAGE_WIND))
+const hb_variant cuda_variants[] = {
+    {"paper", CUDA_PAPER_STAGES, "the paper's scheme: strand-major, one thread per strand, one kernel per stage"},
+    {"soa", CUDA_PAPER_STAGES, "point-major structure of arrays, one thread per strand, one kernel per stage"},
+    {"fused", CUDA_PAPER_STAGES, "point-major, wind and the collide after it in one kernel"},
+    {NULL, 0, NULL},
+};
 
 } /* namespace */
 
@@ -498,6 +504,7 @@ int main(int argc, char **argv)
     b.name = "cuda";
     b.default_variant = "fused";
     b.variants = cuda_variants;
+    b.build = strcmp(HB_MATH_MODE, "normal") == 0 ? "default" : HB_MATH_MODE;
     b.flags = hb_cuda_flags;
     b.compiler = hb_cuda_compiler;
     b.setup = cuda_setup;
