@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "dynamics.h"
 #include "params.h"
 
 #ifdef __cplusplus
@@ -71,6 +72,15 @@ struct hb_backend {
     /* Optional (NULL: not measured): a STREAM-style triad a = b + q·c, bytes = 2 reads + 1 write. */
     int (*measure_triad)(hb_backend *b, const hb_options *o, double *gbps, double *bytes,
                          char *err, size_t errlen);
+    /* The dynamic model (the simulate stage; NULL where no variant runs it). The positions
+     * come through load; this gives their velocities (NULL: all zero) and the rest shape,
+     * canonical, and computes what the run derives from the rest shape once. */
+    int (*dyn_load)(hb_backend *b, const void *velocity, const void *rest, char *err, size_t errlen);
+    /* Advance the current state by one frame; r->ms is the frame's own time. */
+    int (*dyn_frame)(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen);
+    /* The observables of the current state (docs/model.md §3.8). */
+    int (*dyn_observe)(hb_backend *b, hb_observables *obs, char *err, size_t errlen);
+    int (*dyn_fetch_velocity)(hb_backend *b, void *canonical, char *err, size_t errlen);
     /* Descriptions for the metadata. */
     void (*describe)(hb_backend *b, char *device, size_t dlen, char *driver, size_t vlen);
     void (*teardown)(hb_backend *b);

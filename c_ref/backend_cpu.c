@@ -18,6 +18,8 @@
 
 #include "backend.h"
 #include "cli.h"
+#include "dynamics.h"
+#include "host.h"
 #include "model.h"
 #include "model_simd.h"
 #include "record.h"
@@ -34,24 +36,14 @@ typedef struct {
     int64_t block, nblocks, stride;
     void *pm[3], *pm_saved[3];
     size_t pm_bytes; /* bytes of one of X, Y, Z (allocation size) */
+    /* simulate (ref): velocities [N·P][3], rest shape [N·P][3], bend rest lengths [N][P−2],
+     * a copy of the velocities for repeats; the run's constants */
+    int dynamic;
+    void *vel, *vel_saved, *rest, *bend_rest;
+    hb_dyn_model_f32 d32;
+    hb_dyn_model_f64 d64;
 } cpu_impl;
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
-}
-
-/* The scene's numbers rounded once to the working precision (docs/decisions.md). */
-static void round_scene(cpu_impl *c, const hb_scene *s)
-{
-    c->m64 = (hb_model_f64){s->seed, s->points, s->head_radius, s->hair_offset, s->face_margin,
-                            hb_segment_length(s), s->wind_strength, hb_wind_angle_reduced(s)};
-    c->m32 = (hb_model_f32){s->seed, s->points, (float)c->m64.head_radius, (float)c->m64.hair_offset,
-                            (float)c->m64.face_margin, (float)c->m64.seg_len, (float)c->m64.wind_strength,
-                            (float)c->m64.wind_angle};
-}
 
 /* First touch: each thread zeroes the strands it will compute (static schedule). */
 static void first_touch(void *p, const hb_scene *s)
@@ -73,28 +65,45 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     b->impl = c;
     c->scene = o->scene;
     c->bytes = hb_state_bytes(&o->scene);
-    round_scene(c, &o->scene);
+    hb_model_round(&o->scene, &c->m32, &c->m64);
     if (o->threads > 0) omp_set_num_threads(o->threads);
     b->threads = omp_get_max_threads();
     if (o->variant && strcmp(o->variant, "simd") == 0)
         return simd_setup(c, o, need_save, driver_bytes, err, errlen);
 
-    uint64_t need = c->bytes * (need_save ? 2u : 1u) + driver_bytes;
+    for (int i = 0; i < o->n_stages; i++) c->dynamic |= o->stages[i] == HB_STAGE_SIMULATE;
+    /* simulate adds velocities, the rest shape, bend rest lengths and a saved velocity copy */
+    const uint64_t bend_bytes = (uint64_t)o->scene.n_strands * (uint64_t)(o->scene.points - 2 > 0 ? o->scene.points - 2 : 1) *
+                                hb_real_size(o->scene.precision);
+    const uint64_t dyn = c->dynamic ? c->bytes * (need_save ? 3u : 2u) + bend_bytes : 0;
+    uint64_t need = c->bytes * (need_save ? 2u : 1u) + dyn + driver_bytes;
     uint64_t avail = hb_host_memory_available();
     if (avail && need > avail) {
-        snprintf(err, errlen, "the state needs %.2f GB of host memory (%lld strands x %lld points, %s) but only %.2f GB "
-                 "is available", 1e-9 * (double)need, (long long)o->scene.n_strands, (long long)o->scene.points,
-                 hb_precision_name(o->scene.precision), 1e-9 * (double)avail);
+        hb_memory_message(err, errlen, &o->scene, "host", need, avail, c->dynamic ? ", simulate" : "", NULL);
         return HB_EXIT_MEMORY;
     }
     c->state = malloc(c->bytes);
     if (need_save) c->saved = malloc(c->bytes);
-    if (!c->state || (need_save && !c->saved)) {
+    int bad = !c->state || (need_save && !c->saved);
+    if (c->dynamic) {
+        c->vel = malloc(c->bytes);
+        c->rest = malloc(c->bytes);
+        c->bend_rest = malloc(bend_bytes);
+        if (need_save) c->vel_saved = malloc(c->bytes);
+        bad |= !c->vel || !c->rest || !c->bend_rest || (need_save && !c->vel_saved);
+        hb_dyn_round(&o->scene, &c->d32, &c->d64);
+    }
+    if (bad) {
         snprintf(err, errlen, "cannot allocate %.2f GB of host memory for the state", 1e-9 * (double)need);
         return HB_EXIT_MEMORY;
     }
     first_touch(c->state, &o->scene);
     if (c->saved) first_touch(c->saved, &o->scene);
+    if (c->dynamic) {
+        first_touch(c->vel, &o->scene);
+        first_touch(c->rest, &o->scene);
+        if (c->vel_saved) first_touch(c->vel_saved, &o->scene);
+    }
     return HB_EXIT_OK;
 }
 
@@ -178,9 +187,7 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
     uint64_t need = 3u * one * (need_save ? 2u : 1u) + driver_bytes;
     uint64_t avail = hb_host_memory_available();
     if ((avail && need > avail) || one > SIZE_MAX / 4) {
-        snprintf(err, errlen, "the state needs %.2f GB of host memory (%lld strands x %lld points, %s, simd) but "
-                 "only %.2f GB is available", 1e-9 * (double)need, (long long)s->n_strands, (long long)s->points,
-                 hb_precision_name(s->precision), 1e-9 * (double)avail);
+        hb_memory_message(err, errlen, s, "host", need, avail, ", simd", NULL);
         return HB_EXIT_MEMORY;
     }
     c->pm_bytes = (size_t)one;
@@ -287,14 +294,14 @@ static int cpu_load(hb_backend *b, const void *canonical, double *ms, char *err,
 {
     (void)err; (void)errlen;
     cpu_impl *c = b->impl;
-    double t0 = now_ms();
+    double t0 = hb_now_ms();
     if (c->simd) {
         simd_convert(c, (void *)canonical, 1);
-        *ms = now_ms() - t0;
+        *ms = hb_now_ms() - t0;
         return 0;
     }
     memcpy(c->state, canonical, c->bytes);
-    *ms = now_ms() - t0;
+    *ms = hb_now_ms() - t0;
     return 0;
 }
 
@@ -302,14 +309,14 @@ static int cpu_fetch(hb_backend *b, void *canonical, double *ms, char *err, size
 {
     (void)err; (void)errlen;
     cpu_impl *c = b->impl;
-    double t0 = now_ms();
+    double t0 = hb_now_ms();
     if (c->simd) {
         simd_convert(c, canonical, 0);
-        *ms = now_ms() - t0;
+        *ms = hb_now_ms() - t0;
         return 0;
     }
     memcpy(canonical, c->state, c->bytes);
-    *ms = now_ms() - t0;
+    *ms = hb_now_ms() - t0;
     return 0;
 }
 
@@ -319,6 +326,7 @@ static int cpu_save(hb_backend *b, char *err, size_t errlen)
     cpu_impl *c = b->impl;
     if (c->simd) pm_copy(c, c->pm_saved, c->pm);
     else memcpy(c->saved, c->state, c->bytes);
+    if (c->vel_saved) memcpy(c->vel_saved, c->vel, c->bytes);
     return 0;
 }
 
@@ -328,6 +336,7 @@ static int cpu_restore(hb_backend *b, char *err, size_t errlen)
     cpu_impl *c = b->impl;
     if (c->simd) pm_copy(c, c->pm, c->pm_saved);
     else memcpy(c->state, c->saved, c->bytes);
+    if (c->vel_saved) memcpy(c->vel, c->vel_saved, c->bytes);
     return 0;
 }
 
@@ -341,7 +350,7 @@ static int cpu_run_stage(hb_backend *b, const hb_stage *stages, int i, int n, hb
     const size_t stride = (size_t)c->scene.points * 3u;
     const hb_stage st = stages[i];
     int64_t moved = 0;
-    double t0 = now_ms();
+    double t0 = hb_now_ms();
     if (c->simd) {
         moved = simd_run_stage(c, st);
     } else if (c->scene.precision == HB_FP32) {
@@ -371,9 +380,113 @@ static int cpu_run_stage(hb_backend *b, const hb_stage *stages, int i, int n, hb
             for (int64_t k = 0; k < N; k++) moved += hb_collide_strand_f64(m, s + (size_t)k * stride);
         }
     }
-    r->ms = now_ms() - t0;
+    r->ms = hb_now_ms() - t0;
     r->moved_points = st == HB_STAGE_COLLIDE ? moved : -1;
     r->consumed = 1;
+    return 0;
+}
+
+/* ---- the dynamic model (ref): one strand per thread from start to finish ------------- */
+
+static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, char *err, size_t errlen)
+{
+    (void)err; (void)errlen;
+    cpu_impl *c = b->impl;
+    const int64_t N = c->scene.n_strands, P = c->scene.points;
+    const size_t stride = (size_t)P * 3u, bstride = (size_t)(P - 2 > 0 ? P - 2 : 0);
+    if (velocity) memcpy(c->vel, velocity, c->bytes);
+    else memset(c->vel, 0, c->bytes);
+    memcpy(c->rest, rest, c->bytes);
+    if (c->scene.precision == HB_FP32) {
+#pragma omp parallel for schedule(static)
+        for (int64_t i = 0; i < N; i++)
+            hb_dyn_bend_rest_f32(&c->d32, (const float *)c->rest + (size_t)i * stride, (float *)c->bend_rest + (size_t)i * bstride);
+    } else {
+#pragma omp parallel for schedule(static)
+        for (int64_t i = 0; i < N; i++)
+            hb_dyn_bend_rest_f64(&c->d64, (const double *)c->rest + (size_t)i * stride, (double *)c->bend_rest + (size_t)i * bstride);
+    }
+    return 0;
+}
+
+/* Strands over threads; each thread's scratch (9·P reals) is its own. */
+#define DYN_FRAME(T, SFX, M)                                                                    \
+    _Pragma("omp parallel")                                                                     \
+    {                                                                                           \
+        T *scratch = malloc((size_t)P * 9u * sizeof(T));                                        \
+        if (!scratch) {                                                                         \
+            _Pragma("omp atomic write") failed = 1;                                             \
+        } else {                                                                                \
+            _Pragma("omp for schedule(static)")                                                 \
+            for (int64_t i = 0; i < N; i++)                                                     \
+                hb_dyn_frame_strand_##SFX(M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride, \
+                                          (const T *)c->rest + (size_t)i * stride,              \
+                                          (const T *)c->bend_rest + (size_t)i * bstride, scratch); \
+            free(scratch);                                                                      \
+        }                                                                                       \
+    }
+
+static int cpu_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen)
+{
+    cpu_impl *c = b->impl;
+    const int64_t N = c->scene.n_strands, P = c->scene.points;
+    const size_t stride = (size_t)P * 3u, bstride = (size_t)(P - 2 > 0 ? P - 2 : 0);
+    int failed = 0;
+    const double t0 = hb_now_ms();
+    if (c->scene.precision == HB_FP32) DYN_FRAME(float, f32, &c->d32)
+    else DYN_FRAME(double, f64, &c->d64)
+    r->ms = hb_now_ms() - t0;
+    r->moved_points = -1;
+    r->consumed = 1;
+    if (failed) {
+        snprintf(err, errlen, "out of host memory for the per-thread scratch (%lld points)", (long long)P);
+        return -1;
+    }
+    return 0;
+}
+#undef DYN_FRAME
+
+/* Partials over fixed chunks of strands, combined in chunk order: the same sums for every
+ * thread count. */
+#define OBS_CHUNK 1024
+
+static int cpu_dyn_observe(hb_backend *b, hb_observables *obs, char *err, size_t errlen)
+{
+    cpu_impl *c = b->impl;
+    const int64_t N = c->scene.n_strands, P = c->scene.points;
+    const size_t stride = (size_t)P * 3u;
+    const int64_t nchunks = (N + OBS_CHUNK - 1) / OBS_CHUNK;
+    hb_obs_partial *part = calloc((size_t)nchunks, sizeof *part);
+    if (!part) {
+        snprintf(err, errlen, "out of host memory for the observables");
+        return -1;
+    }
+#pragma omp parallel for schedule(static)
+    for (int64_t ch = 0; ch < nchunks; ch++) {
+        const int64_t i1 = (ch + 1) * OBS_CHUNK < N ? (ch + 1) * OBS_CHUNK : N;
+        hb_obs_partial acc = {0, 0, 0, 0};
+        for (int64_t i = ch * OBS_CHUNK; i < i1; i++) {
+            hb_obs_partial o;
+            if (c->scene.precision == HB_FP32)
+                hb_dyn_observe_strand_f32(&c->scene, (const float *)c->state + (size_t)i * stride,
+                                          (const float *)c->vel + (size_t)i * stride, &o);
+            else
+                hb_dyn_observe_strand_f64(&c->scene, (const double *)c->state + (size_t)i * stride,
+                                          (const double *)c->vel + (size_t)i * stride, &o);
+            hb_dyn_reduce_into(&acc, &o);
+        }
+        part[ch] = acc;
+    }
+    hb_dyn_reduce(part, nchunks, P, N, obs);
+    free(part);
+    return 0;
+}
+
+static int cpu_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, size_t errlen)
+{
+    (void)err; (void)errlen;
+    cpu_impl *c = b->impl;
+    memcpy(canonical, c->vel, c->bytes);
     return 0;
 }
 
@@ -405,10 +518,10 @@ static int cpu_stream(const hb_options *o, double *copy_gbps, double *copy_bytes
     }
     double best = 1e30;
     for (int rep = 0; rep < 7; rep++) {
-        double t0 = now_ms();
+        double t0 = hb_now_ms();
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) c[i] = a[i];
-        double t = now_ms() - t0;
+        double t = hb_now_ms() - t0;
         if (rep > 0 && t < best) best = t; /* the first run warms up */
     }
     *copy_bytes = 2.0 * (double)n * sizeof(double);
@@ -418,10 +531,10 @@ static int cpu_stream(const hb_options *o, double *copy_gbps, double *copy_bytes
         const double q = 3.0;
         best = 1e30;
         for (int rep = 0; rep < 7; rep++) {
-            double t0 = now_ms();
+            double t0 = hb_now_ms();
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < n; i++) a[i] = bb[i] + q * c[i];
-            double t = now_ms() - t0;
+            double t = hb_now_ms() - t0;
             if (rep > 0 && t < best) best = t;
         }
         *triad_bytes = 3.0 * (double)n * sizeof(double);
@@ -468,6 +581,10 @@ static void cpu_teardown(hb_backend *b)
     if (!c) return;
     free(c->state);
     free(c->saved);
+    free(c->vel);
+    free(c->vel_saved);
+    free(c->rest);
+    free(c->bend_rest);
     for (int d = 0; d < 3; d++) {
         free(c->pm[d]);
         free(c->pm_saved[d]);
@@ -478,7 +595,7 @@ static void cpu_teardown(hb_backend *b)
 
 #define CPU_PAPER_STAGES ((1u << HB_STAGE_INIT) | (1u << HB_STAGE_COLLIDE) | (1u << HB_STAGE_WIND))
 static const hb_variant cpu_variants[] = {
-    {"ref", CPU_PAPER_STAGES, "the oracle: model_impl.h one strand at a time, OpenMP over strands"},
+    {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE), "the oracle: model_impl.h one strand at a time, OpenMP over strands"},
     {"simd", CPU_PAPER_STAGES, "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks"},
     {NULL, 0, NULL},
 };
@@ -505,5 +622,9 @@ int main(int argc, char **argv)
     b.describe = cpu_describe;
     b.teardown = cpu_teardown;
     b.measure_triad = cpu_measure_triad;
+    b.dyn_load = cpu_dyn_load;
+    b.dyn_frame = cpu_dyn_frame;
+    b.dyn_observe = cpu_dyn_observe;
+    b.dyn_fetch_velocity = cpu_dyn_fetch_velocity;
     return hb_main(argc, argv, &b);
 }

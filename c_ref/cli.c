@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -29,6 +30,70 @@ void hb_default_options(hb_options *o)
     o->block_size = 256;
     o->repeat = 1;
     o->warmup = -1;
+    o->input_frame = -1;
+    o->frames = 1;
+    o->output_every = 1;
+    hb_dynamics_defaults(&o->scene.dyn);
+}
+
+/* ---- the dynamic model's flags (docs/model.md §3), one table -------------------------- */
+typedef enum { DF_REAL, DF_COUNT, DF_SOLVER, DF_MOTION, DF_SWITCH } dyn_kind;
+typedef struct {
+    const char *flag;
+    dyn_kind kind;
+    size_t offset;      /* into hb_dynamics */
+    size_t declares;    /* an int in hb_dynamics set to 1 when the flag is given (0: none) */
+    const char *help;
+} dyn_flag;
+
+#define DYN(field) offsetof(hb_dynamics, field)
+static const dyn_flag dyn_flags[] = {
+    {"--frame-dt", DF_REAL, DYN(frame_dt), 0, "frame length Δt, s (default 1/60)"},
+    {"--substeps", DF_COUNT, DYN(substeps), 0, "substeps S per frame (default 1)"},
+    {"--iterations", DF_COUNT, DYN(iterations), 0, "solver iterations I per substep (default 1)"},
+    {"--solver", DF_SOLVER, DYN(solver), 0, "xpbd | ftl (default xpbd)"},
+    {"--gravity", DF_REAL, DYN(gravity), 0, "gravity g0, cm/s² (default 981)"},
+    {"--drag", DF_REAL, DYN(drag), DYN(drag_declared), "air drag c_d toward the wind velocity, 1/s (default: none)"},
+    {"--damping", DF_REAL, DYN(damping), DYN(drag_declared), "velocity damping β, 1/s (default: none)"},
+    {"--stretch-compliance", DF_REAL, DYN(stretch_compliance), 0, "stretch compliance α_s (default 0: rigid)"},
+    {"--bend-compliance", DF_REAL, DYN(bend_compliance), DYN(bend), "bend compliance α_b; declares bend"},
+    {"--shape-compliance", DF_REAL, DYN(shape_compliance), DYN(shape), "shape compliance α_g; declares shape"},
+    {"--shape-range", DF_REAL, DYN(shape_range), 0, "fraction ρ_g in (0, 1] of the strand held in shape (default 1)"},
+    {"--ftl-damping", DF_REAL, DYN(ftl_damping), 0, "follow-the-leader damping s in [0, 1] (default 0.9)"},
+    {"--collision-margin", DF_REAL, DYN(collision_margin), 0, "collider radius R + margin, cm (default 0)"},
+    {"--no-collider", DF_SWITCH, DYN(collider), 0, "no head collision"},
+    {"--wind-speed", DF_REAL, DYN(wind_speed), 0, "wind speed U, cm/s, along --wind-angle (default 0: none)"},
+    {"--gust-amplitude", DF_REAL, DYN(gust_amplitude), 0, "relative gust amplitude A_g (default 0: none)"},
+    {"--gust-frequency", DF_REAL, DYN(gust_frequency), 0, "gust frequency f_g, Hz (default 1)"},
+    {"--gust-wavelength", DF_REAL, DYN(gust_wavelength), 0, "gust wavelength λ_g, cm (default 100)"},
+    {"--head-motion", DF_MOTION, DYN(motion), 0, "still | nod | shake | tilt (default still)"},
+    {"--motion-amplitude", DF_REAL, DYN(motion_amplitude), 0, "head motion amplitude A, radians (default 0.25)"},
+    {"--motion-frequency", DF_REAL, DYN(motion_frequency), 0, "head motion frequency f, Hz (default 1)"},
+};
+#undef DYN
+#define N_DYN_FLAGS (sizeof dyn_flags / sizeof dyn_flags[0])
+
+const char *hb_dyn_flag_name(int i) { return i >= 0 && i < (int)N_DYN_FLAGS ? dyn_flags[i].flag : NULL; }
+
+int hb_dyn_flag_differs(int i, const hb_dynamics *a, const hb_dynamics *b)
+{
+    const dyn_flag *df = &dyn_flags[i];
+    const char *pa = (const char *)a + df->offset, *pb = (const char *)b + df->offset;
+    switch (df->kind) {
+    case DF_REAL: return *(const double *)pa != *(const double *)pb;
+    case DF_COUNT: return *(const int64_t *)pa != *(const int64_t *)pb;
+    case DF_SOLVER: return *(const hb_solver *)pa != *(const hb_solver *)pb;
+    case DF_MOTION: return *(const hb_motion *)pa != *(const hb_motion *)pb;
+    case DF_SWITCH: return *(const int *)pa != *(const int *)pb;
+    }
+    return 0;
+}
+
+int hb_dyn_flag_index(const char *flag)
+{
+    for (size_t i = 0; i < N_DYN_FLAGS; i++)
+        if (strcmp(dyn_flags[i].flag, flag) == 0) return (int)i;
+    return -1;
 }
 
 void hb_print_usage(FILE *f, const char *prog, const char *backend)
@@ -63,11 +128,21 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
             "  --measure-bandwidth  only measure the %s copy bandwidth (GB/s, read + write)\n"
             "  --self-test rng      print the Philox4x32-10 known-answer checks and exit\n"
             "  --list-variants      print this binary's variants, the stages each runs and its build as JSON\n"
+            "  --input-frame K      with --input: resume after frame K of the file (default: its last)\n"
             "  --help, --version\n",
             prog, backend, "kernel variant (--list-variants names them)",
             cuda ? "  --block-size B       threads per block, 32..1024 (default 256)\n"
                  : "  --threads T          OpenMP threads over strands (default: all cores)\n",
             cuda ? "device-to-device" : "all-core memory");
+    fprintf(f, "\nthe simulate stage (docs/model.md §3; a feature left undeclared is not evaluated):\n"
+               "  --frames F           frames to simulate (default 1)\n"
+               "  --output-every K     write every K-th simulated frame; the last always (default 1)\n"
+               "  --velocities W       last | all: write the velocities of the last or of every written frame\n");
+    for (size_t i = 0; i < N_DYN_FLAGS; i++) {
+        char name[64];
+        snprintf(name, sizeof name, "%s%s", dyn_flags[i].flag, dyn_flags[i].kind == DF_SWITCH ? "" : " V");
+        fprintf(f, "  %-20s %s\n", name, dyn_flags[i].help);
+    }
 }
 
 #define FAIL(...) do { snprintf(err, errlen, __VA_ARGS__); return -1; } while (0)
@@ -114,6 +189,38 @@ static int parse_f64(const char *flag, const char *v, double *out, char *err, si
     return 0;
 }
 
+static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err, size_t errlen)
+{
+    char *base = (char *)&o->scene.dyn;
+    int64_t iv;
+    switch (df->kind) {
+    case DF_REAL:
+        if (parse_f64(df->flag, v, (double *)(base + df->offset), err, errlen)) return -1;
+        break;
+    case DF_COUNT:
+        if (parse_i64(df->flag, v, 1, &iv, err, errlen)) return -1;
+        *(int64_t *)(base + df->offset) = iv;
+        break;
+    case DF_SOLVER:
+        if (strcmp(v, "xpbd") == 0) o->scene.dyn.solver = HB_SOLVER_XPBD;
+        else if (strcmp(v, "ftl") == 0) o->scene.dyn.solver = HB_SOLVER_FTL;
+        else FAIL("--solver must be xpbd or ftl (got '%s')", v);
+        break;
+    case DF_MOTION:
+        if (strcmp(v, "still") == 0) o->scene.dyn.motion = HB_MOTION_STILL;
+        else if (strcmp(v, "nod") == 0) o->scene.dyn.motion = HB_MOTION_NOD;
+        else if (strcmp(v, "shake") == 0) o->scene.dyn.motion = HB_MOTION_SHAKE;
+        else if (strcmp(v, "tilt") == 0) o->scene.dyn.motion = HB_MOTION_TILT;
+        else FAIL("--head-motion must be still, nod, shake or tilt (got '%s')", v);
+        break;
+    case DF_SWITCH:
+        *(int *)(base + df->offset) = 0;
+        break;
+    }
+    if (df->declares) *(int *)(base + df->declares) = 1;
+    return 0;
+}
+
 static int parse_stages(const char *v, hb_options *o, char *err, size_t errlen)
 {
     char buf[1024];
@@ -126,7 +233,8 @@ static int parse_stages(const char *v, hb_options *o, char *err, size_t errlen)
         if (strcmp(tok, "init") == 0) s = HB_STAGE_INIT;
         else if (strcmp(tok, "wind") == 0) s = HB_STAGE_WIND;
         else if (strcmp(tok, "collide") == 0) s = HB_STAGE_COLLIDE;
-        else FAIL("--stages: unknown stage '%s' (known: init, collide, wind)", tok);
+        else if (strcmp(tok, "simulate") == 0) s = HB_STAGE_SIMULATE;
+        else FAIL("--stages: unknown stage '%s' (known: init, collide, wind, simulate)", tok);
         if (o->n_stages == HB_MAX_STAGES) FAIL("--stages: at most %d stages", HB_MAX_STAGES);
         o->stages[o->n_stages++] = s;
     }
@@ -154,6 +262,14 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         if (strcmp(a, "--end-to-end") == 0) { o->end_to_end = 1; continue; }
         if (strcmp(a, "--measure-bandwidth") == 0) { o->measure_bandwidth = 1; continue; }
         if (strcmp(a, "--list-variants") == 0) { o->list_variants = 1; continue; }
+        {
+            int di = hb_dyn_flag_index(a);
+            if (di >= 0 && dyn_flags[di].kind == DF_SWITCH) {
+                if (parse_dyn(&dyn_flags[di], "", o, err, errlen)) return -1;
+                o->dyn_given |= 1ull << di;
+                continue;
+            }
+        }
         if (strncmp(a, "--", 2) != 0) FAIL("unexpected argument '%s' (see --help)", a);
         /* every other flag takes a value: --flag V or --flag=V */
         const char *eq = strchr(a, '=');
@@ -173,7 +289,27 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         }
         int64_t iv;
         hb_scene *s = &o->scene;
-        if (strcmp(name, "--strands") == 0) {
+        const int di = hb_dyn_flag_index(name);
+        if (di >= 0) {
+            if (dyn_flags[di].kind == DF_SWITCH) FAIL("%s takes no value", name);
+            if (parse_dyn(&dyn_flags[di], v, o, err, errlen)) return -1;
+            o->dyn_given |= 1ull << di;
+        } else if (strcmp(name, "--frames") == 0) {
+            if (parse_i64(name, v, 1, &o->frames, err, errlen)) return -1;
+            o->dyn_given |= HB_DYN_GIVEN_RUN;
+        } else if (strcmp(name, "--output-every") == 0) {
+            if (parse_i64(name, v, 1, &o->output_every, err, errlen)) return -1;
+            o->dyn_given |= HB_DYN_GIVEN_RUN;
+        } else if (strcmp(name, "--velocities") == 0) {
+            if (strcmp(v, "all") == 0) o->all_velocities = 1;
+            else if (strcmp(v, "last") == 0) o->all_velocities = 0;
+            else FAIL("--velocities must be last or all (got '%s')", v);
+            o->dyn_given |= HB_DYN_GIVEN_RUN;
+        } else if (strcmp(name, "--input-frame") == 0) {
+            if (parse_i64(name, v, 0, &iv, err, errlen)) return -1;
+            if (iv > INT32_MAX) FAIL("--input-frame is out of range (got %lld)", (long long)iv);
+            o->input_frame = (int)iv;
+        } else if (strcmp(name, "--strands") == 0) {
             if (parse_i64(name, v, 1, &s->n_strands, err, errlen)) return -1;
             o->given |= HB_GIVEN_STRANDS;
         } else if (strcmp(name, "--points") == 0) {
@@ -198,6 +334,7 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
             if (parse_f64(name, v, &s->wind_strength, err, errlen)) return -1;
         } else if (strcmp(name, "--wind-angle") == 0) {
             if (parse_f64(name, v, &s->wind_angle, err, errlen)) return -1;
+            o->given |= HB_GIVEN_ANGLE;
         } else if (strcmp(name, "--stages") == 0) {
             if (parse_stages(v, o, err, errlen)) return -1;
         } else if (strcmp(name, "--precision") == 0) {
@@ -239,5 +376,20 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         }
     }
     if (o->warmup < 0) o->warmup = o->repeat > 1 ? 1 : 0;
+    /* simulate runs once, last: the paper stages assume a strand in its slice plane */
+    int sim = 0;
+    for (int i = 0; i < o->n_stages; i++)
+        if (o->stages[i] == HB_STAGE_SIMULATE) {
+            if (sim || i != o->n_stages - 1) FAIL("--stages: simulate may appear once, as the last stage");
+            sim = 1;
+        }
+    if (!sim && o->dyn_given) {
+        for (size_t i = 0; i < N_DYN_FLAGS; i++)
+            if (o->dyn_given & (1ull << i))
+                FAIL("%s belongs to the simulate stage, which --stages does not list", dyn_flags[i].flag);
+        FAIL("--frames, --output-every and --velocities belong to the simulate stage, which --stages does not list");
+    }
+    if (o->scene.dyn.shape == 0 && (o->dyn_given & (1ull << hb_dyn_flag_index("--shape-range"))))
+        FAIL("--shape-range needs --shape-compliance (shape is off unless its compliance is given)");
     return 0;
 }

@@ -16,6 +16,14 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
 void hb_print_usage(FILE *f, const char *prog, const char *backend);
 void hb_default_options(hb_options *o);
 
+/* The dynamic flags' table: bit i of hb_options.dyn_given is entry i; the run-shape flags
+ * (--frames, --output-every, --velocities) set HB_DYN_GIVEN_RUN. */
+#define HB_DYN_GIVEN_RUN (1ull << 63)
+const char *hb_dyn_flag_name(int i);
+int hb_dyn_flag_index(const char *flag);
+/* Whether the field of flag i differs between a and b. */
+int hb_dyn_flag_differs(int i, const hb_dynamics *a, const hb_dynamics *b);
+
 #ifdef __cplusplus
 }
 #endif

@@ -10,6 +10,7 @@
 
 #include "backend.h"
 #include "cli.h"
+#include "host.h"
 #include "philox.h"
 #include "record.h"
 #include "state_io.h"
@@ -22,12 +23,6 @@ static int die(int status, const char *msg)
     return status;
 }
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
-}
 
 uint64_t hb_host_memory_available(void)
 {
@@ -91,7 +86,7 @@ static int list_variants(const hb_backend *b)
 }
 
 /* With --input the geometry comes from the file; a flag given that disagrees is refused. */
-static int adopt_input_scene(hb_options *o, const hb_scene *f, char *err, size_t errlen)
+static int adopt_input_scene(hb_options *o, const hb_scene *f, int dynamic, char *err, size_t errlen)
 {
     hb_scene *s = &o->scene;
 #define SAME(bit, field, flag, fmt, cast)                                                     \
@@ -113,9 +108,26 @@ static int adopt_input_scene(hb_options *o, const hb_scene *f, char *err, size_t
         return -1;
     }
     double w = s->wind_strength, a = s->wind_angle;
+    hb_dynamics dyn = s->dyn;
     *s = *f;
     s->wind_strength = w;
     s->wind_angle = a;
+    if (!dynamic) {
+        s->dyn = dyn; /* a paper file: the simulation's physics come from the flags */
+        return 0;
+    }
+    /* a dynamic file: its physics continue; a flag given that disagrees is refused */
+    for (int i = 0; hb_dyn_flag_name(i); i++)
+        if ((o->dyn_given & (1ull << i)) && hb_dyn_flag_differs(i, &dyn, &f->dyn)) {
+            snprintf(err, errlen, "%s does not match the input file's simulation (a resumed run keeps its physics)",
+                     hb_dyn_flag_name(i));
+            return -1;
+        }
+    if (o->given & HB_GIVEN_ANGLE && a != f->wind_angle) {
+        snprintf(err, errlen, "--wind-angle does not match the input file's simulation (a resumed run keeps its physics)");
+        return -1;
+    }
+    s->wind_angle = f->wind_angle;
     return 0;
 }
 
@@ -147,6 +159,11 @@ typedef struct {
     hb_input in;
     int have_input;
     double *times;    /* all stages' timed runs */
+    struct {          /* the simulation, for the file's /parameters */
+        int dynamic;
+        int64_t paper_frames, last_frame;
+        char features[96];
+    } sim;
 } hb_run;
 
 static void run_free(hb_run *r)
@@ -157,6 +174,137 @@ static void run_free(hb_run *r)
     free(r->host);
     free(r->input);
     free(r->times);
+}
+
+
+/* ---- the simulate stage (docs/model.md §3) ---------------------------------------------
+ * Starts from the current state: a new simulation takes it as the rest shape with zero
+ * velocities; a resumed one (--input of a dynamic file at a simulated frame) continues with
+ * that file's rest shape, velocities and time. Each frame is timed on its own (--repeat
+ * times from the same state); the observables and the file's frames are taken between the
+ * timed frames, outside them. Memory does not grow with the frame count: one host frame. */
+static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times, char *err, size_t errlen)
+{
+    hb_backend *b = r->b;
+    const hb_options *o = r->o;
+    const hb_scene *s = &o->scene;
+    const hb_dynamics *d = &s->dyn;
+    const uint64_t bytes = hb_state_bytes(s);
+    const int need_save = o->repeat > 1 || o->warmup > 0;
+    int64_t gf0 = 0, paper_frames = frame;
+    void *rest = malloc(bytes), *vel = NULL;
+    hb_dyn_frame plan;
+    memset(&plan, 0, sizeof plan);
+    int status = HB_EXIT_OK;
+#define FAIL_IF(cond, st)                                                                    \
+    do {                                                                                     \
+        if (cond) {                                                                          \
+            status = (st);                                                                   \
+            goto out;                                                                        \
+        }                                                                                    \
+    } while (0)
+    if (!rest || hb_dyn_frame_alloc(&plan, d->substeps) != 0) {
+        snprintf(err, errlen, "out of host memory for the simulation's rest shape and substep tables");
+        FAIL_IF(1, HB_EXIT_MEMORY);
+    }
+    if (r->have_input && r->in.dynamic && o->input_frame >= r->in.paper_frames) {
+        /* resume: the frame's velocities, the rest shape and the global frame index */
+        const int64_t step = r->in.frames[o->input_frame].step;
+        int vi = -1;
+        for (int i = 0; i < r->in.n_vel; i++)
+            if (r->in.vel_step[i] == step) vi = i;
+        if (vi < 0) {
+            snprintf(err, errlen, "--input %s: frame %d has no stored velocities, so the simulation cannot resume "
+                     "from it (write the file with --velocities all, or resume from its last frame)", o->input,
+                     o->input_frame);
+            FAIL_IF(1, HB_EXIT_USAGE);
+        }
+        paper_frames = r->in.paper_frames;
+        gf0 = step - paper_frames + 1;
+        vel = malloc(bytes);
+        if (!vel) {
+            snprintf(err, errlen, "out of host memory for the input's velocities");
+            FAIL_IF(1, HB_EXIT_MEMORY);
+        }
+        FAIL_IF(hb_input_read_rest(&r->in, rest, err, errlen), HB_EXIT_USAGE);
+        FAIL_IF(hb_input_read_velocity(&r->in, vi, vel, err, errlen), HB_EXIT_USAGE);
+        if (r->w) {
+            char *hv = r->host;
+            for (int i = 0; i < r->in.n_vel; i++)
+                if (r->in.vel_step[i] <= step && (o->all_velocities || 0)) {
+                    FAIL_IF(hb_input_read_velocity(&r->in, i, hv, err, errlen), HB_EXIT_USAGE);
+                    FAIL_IF(hb_writer_velocity(r->w, hv, r->in.vel_step[i], r->in.vel_time[i], err, errlen),
+                            HB_EXIT_RUNTIME);
+                }
+            for (int i = 0; i < r->in.n_obs; i++)
+                if (r->in.obs_step[i] <= step)
+                    FAIL_IF(hb_writer_observables(r->w, &r->in.obs[i], r->in.obs_step[i], r->in.obs_time[i], err, errlen),
+                            HB_EXIT_RUNTIME);
+        }
+    } else {
+        double ms;
+        FAIL_IF(b->fetch(b, rest, &ms, err, errlen), HB_EXIT_RUNTIME);
+    }
+    if (gf0 + o->frames > (INT64_C(1) << 53) / d->substeps) {
+        snprintf(err, errlen, "--frames %lld x --substeps %lld from frame %lld passes 2^53 substeps: times would "
+                 "no longer be exact", (long long)o->frames, (long long)d->substeps, (long long)gf0);
+        FAIL_IF(1, HB_EXIT_USAGE);
+    }
+    FAIL_IF(b->dyn_load(b, vel, rest, err, errlen), HB_EXIT_RUNTIME);
+    if (r->w) FAIL_IF(hb_writer_rest(r->w, rest, err, errlen), HB_EXIT_RUNTIME);
+
+    r->sim.dynamic = 1;
+    r->sim.paper_frames = paper_frames;
+    hb_dyn_feature_names(hb_dyn_features(s), r->sim.features, sizeof r->sim.features);
+    snprintf(sr->features, sizeof sr->features, "%s", r->sim.features);
+    sr->frames = o->frames;
+    sr->times_ms = times;
+    sr->n_times = (int)(o->frames * o->repeat);
+    double observe_ms = 0.0;
+    for (int64_t j = 1; j <= o->frames; j++) {
+        const int64_t gf = gf0 + j;
+        hb_dyn_frame_plan(s, (gf - 1) * d->substeps, &plan);
+        if (need_save) FAIL_IF(b->save(b, err, errlen), HB_EXIT_RUNTIME);
+        double *ft = times + (j - 1) * o->repeat;
+        for (int k = 0; k < o->warmup + o->repeat; k++) {
+            if (k > 0) FAIL_IF(b->restore(b, err, errlen), HB_EXIT_RUNTIME);
+            hb_stage_result res = {0, -1, 1};
+            FAIL_IF(b->dyn_frame(b, &plan, &res, err, errlen), HB_EXIT_RUNTIME);
+            if (k >= o->warmup) ft[k - o->warmup] = res.ms;
+        }
+        hb_observables obs;
+        const double t0 = hb_now_ms();
+        FAIL_IF(b->dyn_observe(b, &obs, err, errlen), HB_EXIT_RUNTIME);
+        observe_ms += hb_now_ms() - t0;
+        const int64_t step = paper_frames - 1 + gf;
+        const double time = (double)gf * d->frame_dt;
+        sr->last = obs;
+        sr->blown_frames += hb_obs_blown_up(&obs);
+        r->sim.last_frame = gf;
+        if (!r->w) continue;
+        FAIL_IF(hb_writer_observables(r->w, &obs, step, time, err, errlen), HB_EXIT_RUNTIME);
+        if (j % o->output_every != 0 && j != o->frames) continue;
+        hb_frame_meta m;
+        frame_meta(&m, HB_STAGE_SIMULATE, s, b->name, o->variant);
+        hb_time_stats(ft, o->repeat, &m.median_ms, &m.min_ms, &m.max_ms);
+        m.step = step;
+        m.time = time;
+        double ms;
+        FAIL_IF(b->fetch(b, r->host, &ms, err, errlen), HB_EXIT_RUNTIME);
+        FAIL_IF(hb_writer_append(r->w, r->host, &m, err, errlen), HB_EXIT_RUNTIME);
+        if (o->all_velocities || j == o->frames) {
+            FAIL_IF(b->dyn_fetch_velocity(b, r->host, err, errlen), HB_EXIT_RUNTIME);
+            FAIL_IF(hb_writer_velocity(r->w, r->host, step, time, err, errlen), HB_EXIT_RUNTIME);
+        }
+    }
+    sr->observe_ms = observe_ms;
+    hb_time_stats(sr->times_ms, sr->n_times, &sr->meta.median_ms, &sr->meta.min_ms, &sr->meta.max_ms);
+out:
+#undef FAIL_IF
+    hb_dyn_frame_free(&plan);
+    free(rest);
+    free(vel);
+    return status;
 }
 
 #define CHECK(call, status)                                                                  \
@@ -238,7 +386,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
     if (o.input) {
         CHECK(hb_input_open(o.input, &run.in, err, sizeof err), HB_EXIT_USAGE);
         run.have_input = 1;
-        CHECK(adopt_input_scene(&o, &run.in.scene, err, sizeof err), HB_EXIT_USAGE);
+        CHECK(adopt_input_scene(&o, &run.in.scene, run.in.dynamic, err, sizeof err), HB_EXIT_USAGE);
         for (int i = 0; i < o.n_stages; i++)
             if (o.stages[i] == HB_STAGE_INIT) {
                 snprintf(err, sizeof err, "--stages: init cannot run on an --input state (it would replace it)");
@@ -250,14 +398,39 @@ int hb_main(int argc, char **argv, hb_backend *b)
         CHECK(1, HB_EXIT_USAGE);
     }
     CHECK(hb_scene_validate(&o.scene, err, sizeof err), HB_EXIT_USAGE);
+    const int simulate = o.stages[o.n_stages - 1] == HB_STAGE_SIMULATE;
+    if (simulate) {
+        CHECK(hb_dynamics_validate(&o.scene.dyn, err, sizeof err), HB_EXIT_USAGE);
+        if (o.end_to_end) {
+            snprintf(err, sizeof err, "--end-to-end is not measured for simulate: its frames are timed one by one");
+            CHECK(1, HB_EXIT_USAGE);
+        }
+    }
+    if (o.input) {
+        if (o.input_frame >= run.in.n_frames) {
+            snprintf(err, sizeof err, "--input-frame %d: %s has frames 0 to %d", o.input_frame, o.input,
+                     run.in.n_frames - 1);
+            CHECK(1, HB_EXIT_USAGE);
+        }
+        if (o.input_frame < 0) o.input_frame = run.in.n_frames - 1;
+        if (run.in.dynamic && o.input_frame >= run.in.paper_frames && !simulate) {
+            snprintf(err, sizeof err, "--stages: frame %d of %s is simulated; only simulate can follow it",
+                     o.input_frame, o.input);
+            CHECK(1, HB_EXIT_USAGE);
+        }
+    } else if (o.input_frame >= 0) {
+        snprintf(err, sizeof err, "--input-frame needs --input");
+        CHECK(1, HB_EXIT_USAGE);
+    }
     if (o.output && o.input && same_file(o.output, o.input)) {
         snprintf(err, sizeof err, "--output %s is the --input file; write to another name", o.output);
         CHECK(1, HB_EXIT_USAGE);
     }
 
     const uint64_t bytes = hb_state_bytes(&o.scene);
-    const int need_host = o.output != NULL || o.end_to_end;
-    uint64_t driver_bytes = (need_host ? bytes : 0) + (o.input ? bytes : 0);
+    const int need_host = o.output != NULL || o.end_to_end || simulate;
+    /* simulate: the rest shape and the velocities pass through the host once */
+    uint64_t driver_bytes = (need_host ? bytes : 0) + (o.input ? bytes : 0) + (simulate ? 2 * bytes : 0);
     const int need_save = o.repeat > 1 || o.warmup > 0;
     int status = b->setup(b, &o, need_save, driver_bytes, err, sizeof err);
     if (status != HB_EXIT_OK) {
@@ -275,7 +448,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
         snprintf(err, sizeof err, "cannot allocate the %llu-byte input frame", (unsigned long long)bytes);
         CHECK(1, HB_EXIT_MEMORY);
     }
-    run.times = calloc((size_t)o.n_stages * (size_t)o.repeat, sizeof *run.times);
+    run.times = calloc(((size_t)o.n_stages + (simulate ? (size_t)o.frames : 0)) * (size_t)o.repeat, sizeof *run.times);
     if (!run.times) {
         snprintf(err, sizeof err, "out of host memory");
         CHECK(1, HB_EXIT_MEMORY);
@@ -288,10 +461,10 @@ int hb_main(int argc, char **argv, hb_backend *b)
     /* ---- the input state: its frames go into the output first ---- */
     int frame = 0;
     if (o.input) {
-        int last = run.in.n_frames - 1;
+        const int last = o.input_frame;
         CHECK(hb_input_read_frame(&run.in, last, run.input, err, sizeof err), HB_EXIT_USAGE);
         if (run.w) {
-            for (int f = 0; f < run.in.n_frames; f++) {
+            for (int f = 0; f <= last; f++) {
                 const void *src = run.input;
                 if (f != last) {
                     CHECK(hb_input_read_frame(&run.in, f, run.host, err, sizeof err), HB_EXIT_USAGE);
@@ -300,7 +473,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
                 CHECK(hb_writer_append(run.w, src, &run.in.frames[f], err, sizeof err), HB_EXIT_RUNTIME);
             }
         }
-        frame = run.in.n_frames;
+        frame = last + 1;
         double ms;
         CHECK(b->load(b, run.input, &ms, err, sizeof err), HB_EXIT_RUNTIME);
     }
@@ -314,6 +487,15 @@ int hb_main(int argc, char **argv, hb_backend *b)
         sr->frame = frame;
         sr->stage = st;
         frame_meta(&sr->meta, st, &o.scene, b->name, o.variant);
+        sr->meta.step = frame;
+        if (st == HB_STAGE_SIMULATE) {
+            status = run_simulate(&run, sr, frame, times, err, sizeof err);
+            if (status != HB_EXIT_OK) {
+                run_free(&run);
+                return die(status, err);
+            }
+            break; /* simulate is the last stage */
+        }
         if (st == HB_STAGE_WIND && o.scene.wind_strength == 0.0) {
             /* a stage whose effect is nil is not launched (DESIGN §8) */
             sr->meta.skipped = 1;
@@ -344,6 +526,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
             sc->frame = frame + 1;
             sc->stage = o.stages[i + 1];
             frame_meta(&sc->meta, sc->stage, &o.scene, b->name, o.variant);
+            sc->meta.step = frame + 1;
             snprintf(sc->meta.fused, sizeof sc->meta.fused, "into-previous");
             sc->meta.moved_points = r.moved_points;
             if (run.w) {
@@ -366,7 +549,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
     /* ---- one whole pass, transfers included, timed apart from the stages ---- */
     if (o.end_to_end) {
         if (b->keep_intermediate) b->keep_intermediate(b, 0);
-        double t0 = now_ms(), h2d = 0, d2h = 0;
+        double t0 = hb_now_ms(), h2d = 0, d2h = 0;
         if (o.input) CHECK(b->load(b, run.input, &h2d, err, sizeof err), HB_EXIT_RUNTIME);
         for (int i = 0; i < o.n_stages;) {
             if (o.stages[i] == HB_STAGE_WIND && o.scene.wind_strength == 0.0) {
@@ -378,7 +561,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
             i += r.consumed;
         }
         CHECK(b->fetch(b, run.host, &d2h, err, sizeof err), HB_EXIT_RUNTIME);
-        rec.end_to_end_ms = now_ms() - t0;
+        rec.end_to_end_ms = hb_now_ms() - t0;
         if (strcmp(b->name, "cpu") != 0) {
             rec.h2d_ms = o.input ? h2d : NAN;
             rec.d2h_ms = d2h;
@@ -387,12 +570,14 @@ int hb_main(int argc, char **argv, hb_backend *b)
 
     if (run.w) {
         hb_run_meta rm = {b->name, o.variant, rec.git_revision, rec.compiler, b->flags, rec.device, rec.driver,
-                          rec.threads, rec.block_size, o.repeat, o.warmup, rec.end_to_end_ms, 0};
-        double t0 = now_ms(), before = 1e3 * hb_writer_seconds(run.w);
+                          rec.threads, rec.block_size, o.repeat, o.warmup, rec.end_to_end_ms, 0,
+                          run.sim.dynamic, run.sim.paper_frames, run.sim.last_frame, (int)o.output_every,
+                          run.sim.features};
+        double t0 = hb_now_ms(), before = 1e3 * hb_writer_seconds(run.w);
         hb_writer *w = run.w;
         run.w = NULL;
         CHECK(hb_writer_close(w, &rm, err, sizeof err), HB_EXIT_RUNTIME);
-        rec.hdf5_write_ms = before + (now_ms() - t0);
+        rec.hdf5_write_ms = before + (hb_now_ms() - t0);
     }
     if (o.json) hb_record_json(stdout, &rec);
     if (!o.quiet) hb_record_summary(stderr, &rec);

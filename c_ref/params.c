@@ -12,6 +12,7 @@ const char *hb_stage_name(hb_stage s)
     case HB_STAGE_INIT: return "init";
     case HB_STAGE_WIND: return "wind";
     case HB_STAGE_COLLIDE: return "collide";
+    case HB_STAGE_SIMULATE: return "simulate";
     }
     return "?";
 }
@@ -74,5 +75,76 @@ int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
                  s->precision == HB_FP32 ? " (use --precision fp64)" : "");
     }
     if (hb_state_bytes(s) == 0) FAIL("--strands x --points is too large to address");
+    return 0;
+}
+
+/* ---- the dynamic model (docs/model.md §3) ----------------------------------------------- */
+
+const char *hb_solver_name(hb_solver s) { return s == HB_SOLVER_FTL ? "ftl" : "xpbd"; }
+
+const char *hb_motion_name(hb_motion m)
+{
+    switch (m) {
+    case HB_MOTION_STILL: return "still";
+    case HB_MOTION_NOD: return "nod";
+    case HB_MOTION_SHAKE: return "shake";
+    case HB_MOTION_TILT: return "tilt";
+    }
+    return "?";
+}
+
+/* Defaults (docs/decisions.md, "dynamic defaults"): what a flag left out means. */
+void hb_dynamics_defaults(hb_dynamics *d)
+{
+    memset(d, 0, sizeof *d);
+    d->frame_dt = 1.0 / 60.0;
+    d->substeps = 1;
+    d->iterations = 1;
+    d->solver = HB_SOLVER_XPBD;
+    d->gravity = 981.0;
+    d->shape_range = 1.0;
+    d->ftl_damping = 0.9;
+    d->collider = 1;
+    d->gust_frequency = 1.0;
+    d->gust_wavelength = 100.0;
+    d->motion_amplitude = 0.25;
+    d->motion_frequency = 1.0;
+}
+
+int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
+{
+    const struct { const char *flag; double v; int positive; } nonneg[] = {
+        {"--frame-dt", d->frame_dt, 1},
+        {"--gravity", d->gravity, 0},
+        {"--drag", d->drag, 0},
+        {"--damping", d->damping, 0},
+        {"--stretch-compliance", d->stretch_compliance, 0},
+        {"--bend-compliance", d->bend_compliance, 0},
+        {"--shape-compliance", d->shape_compliance, 0},
+        {"--collision-margin", d->collision_margin, 0},
+        {"--wind-speed", d->wind_speed, 0},
+        {"--gust-amplitude", d->gust_amplitude, 0},
+        {"--gust-frequency", d->gust_frequency, 0},
+        {"--gust-wavelength", d->gust_wavelength, 1},
+        {"--motion-amplitude", d->motion_amplitude, 0},
+        {"--motion-frequency", d->motion_frequency, 0},
+    };
+    for (size_t i = 0; i < sizeof nonneg / sizeof nonneg[0]; i++) {
+        double v = nonneg[i].v;
+        if (!isfinite(v) || v < 0.0 || (nonneg[i].positive && v == 0.0))
+            FAIL("%s must be a finite number %s 0 (got %g)", nonneg[i].flag, nonneg[i].positive ? ">" : ">=", v);
+    }
+    if (d->substeps < 1) FAIL("--substeps must be at least 1 (got %lld)", (long long)d->substeps);
+    if (d->iterations < 1) FAIL("--iterations must be at least 1 (got %lld)", (long long)d->iterations);
+    if (d->substeps > 1000000) FAIL("--substeps must be at most 1000000 (got %lld)", (long long)d->substeps);
+    if (d->iterations > 1000000) FAIL("--iterations must be at most 1000000 (got %lld)", (long long)d->iterations);
+    if (!(d->shape_range > 0.0 && d->shape_range <= 1.0))
+        FAIL("--shape-range must be in (0, 1] (got %g)", d->shape_range);
+    if (!(d->ftl_damping >= 0.0 && d->ftl_damping <= 1.0))
+        FAIL("--ftl-damping must be in [0, 1] (got %g)", d->ftl_damping);
+    /* h = Δt/S and α/h² must stay normal numbers in double */
+    const double h = d->frame_dt / (double)d->substeps;
+    if (!(h >= 1e-12 && h <= 1e3))
+        FAIL("--frame-dt / --substeps = %g s is outside the substep lengths this model takes [1e-12, 1e3]", h);
     return 0;
 }

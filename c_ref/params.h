@@ -18,7 +18,36 @@ extern "C" {
 enum { HB_EXIT_OK = 0, HB_EXIT_USAGE = 2, HB_EXIT_MEMORY = 3, HB_EXIT_RUNTIME = 4 };
 
 typedef enum { HB_FP32 = 0, HB_FP64 = 1 } hb_precision;
-typedef enum { HB_STAGE_INIT = 0, HB_STAGE_WIND = 1, HB_STAGE_COLLIDE = 2 } hb_stage;
+typedef enum { HB_STAGE_INIT = 0, HB_STAGE_WIND = 1, HB_STAGE_COLLIDE = 2, HB_STAGE_SIMULATE = 3 } hb_stage;
+typedef enum { HB_SOLVER_XPBD = 0, HB_SOLVER_FTL = 1 } hb_solver;
+typedef enum { HB_MOTION_STILL = 0, HB_MOTION_NOD = 1, HB_MOTION_SHAKE = 2, HB_MOTION_TILT = 3 } hb_motion;
+
+/* The dynamic model's physics (docs/model.md §3): everything that decides the bits of a
+ * simulated frame. Units: cm, s. Bend and shape exist only when declared (their
+ * compliance given); the wind only when U > 0 and c_d > 0 (§3.9). */
+typedef struct {
+    double frame_dt;            /* Δt, s */
+    int64_t substeps;           /* S */
+    int64_t iterations;         /* I */
+    hb_solver solver;
+    double gravity;             /* g0, cm/s² */
+    double drag, damping;       /* c_d, β, 1/s */
+    int drag_declared;          /* --drag or --damping given: the implicit divide runs (§3.9) */
+    double stretch_compliance;  /* α_s */
+    int bend;                   /* declared */
+    double bend_compliance;     /* α_b */
+    int shape;                  /* declared */
+    double shape_compliance;    /* α_g */
+    double shape_range;         /* ρ_g in (0, 1] */
+    double ftl_damping;         /* s */
+    int collider;
+    double collision_margin;    /* c_m */
+    double wind_speed;          /* U, cm/s; direction ψ is hb_scene.wind_angle */
+    double gust_amplitude, gust_frequency, gust_wavelength; /* A_g, f_g (Hz), λ_g (cm) */
+    hb_motion motion;
+    double motion_amplitude;    /* A, radians */
+    double motion_frequency;    /* f, Hz */
+} hb_dynamics;
 
 /* The scene: everything that decides the bits of a state. */
 typedef struct {
@@ -32,6 +61,7 @@ typedef struct {
     double wind_strength;    /* w in [0, 1] */
     double wind_angle;       /* psi, radians from +z toward +y */
     hb_precision precision;
+    hb_dynamics dyn;         /* used by the simulate stage only */
 } hb_scene;
 
 /* How a run is carried out: which stages, how timed, where written. */
@@ -53,6 +83,11 @@ typedef struct {
     int measure_bandwidth;   /* only measure the copy bandwidth */
     const char *self_test;   /* "rng": print the known-answer checks */
     int list_variants;       /* print the backend's variants as JSON and exit */
+    int input_frame;         /* --input-frame: resume after this frame of --input; −1 = its last */
+    int64_t frames;          /* simulate: frames to advance (F) */
+    int64_t output_every;    /* simulate: write every K-th frame (the last always) */
+    int all_velocities;      /* simulate: write the velocities of every written frame */
+    uint64_t dyn_given;      /* which dynamic flags were given: bit i = entry i of cli.c's table */
     /* which scene flags the user gave explicitly (for --input consistency checks) */
     unsigned given;
 } hb_options;
@@ -61,7 +96,7 @@ typedef struct {
 enum {
     HB_GIVEN_STRANDS = 1u << 0, HB_GIVEN_POINTS = 1u << 1, HB_GIVEN_SEED = 1u << 2,
     HB_GIVEN_RADIUS = 1u << 3, HB_GIVEN_OFFSET = 1u << 4, HB_GIVEN_LENGTH = 1u << 5,
-    HB_GIVEN_MARGIN = 1u << 6, HB_GIVEN_PRECISION = 1u << 7,
+    HB_GIVEN_MARGIN = 1u << 6, HB_GIVEN_PRECISION = 1u << 7, HB_GIVEN_ANGLE = 1u << 8,
 };
 
 /* Derived values, computed once in double on the host and rounded once to the working
@@ -78,6 +113,11 @@ const char *hb_precision_name(hb_precision p);
 
 /* Checks a scene against DESIGN §3/§8; on failure writes one line naming the flag. */
 int hb_scene_validate(const hb_scene *s, char *err, size_t errlen);
+/* Checks the dynamic parameters (docs/model.md §3); one line naming the flag on failure. */
+int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen);
+void hb_dynamics_defaults(hb_dynamics *d);
+const char *hb_solver_name(hb_solver s);
+const char *hb_motion_name(hb_motion m);
 
 /* Bytes of one state [N·P][3] in the scene's precision; 0 on overflow. */
 uint64_t hb_state_bytes(const hb_scene *s);

@@ -128,6 +128,22 @@ void hb_record_json(FILE *f, const hb_record *r)
         fputs("], \"moved_points\": ", f);
         if (st->meta.moved_points >= 0) fprintf(f, "%lld", (long long)st->meta.moved_points);
         else fputs("null", f);
+        if (st->stage == HB_STAGE_SIMULATE) {
+            const hb_dynamics *d = &s->dyn;
+            fprintf(f, ", \"frames\": %lld, \"substeps\": %lld, \"iterations\": %lld, \"solver\": \"%s\"",
+                    (long long)st->frames, (long long)d->substeps, (long long)d->iterations, hb_solver_name(d->solver));
+            fputs(", \"features\": ", f); json_str(f, st->features);
+            fputs(", \"frame_dt\": ", f); json_num(f, d->frame_dt);
+            /* point-substeps per second of the median frame */
+            fputs(", \"point_substeps_per_s\": ", f);
+            json_num(f, (double)s->n_strands * (double)s->points * (double)d->substeps / (1e-3 * st->meta.median_ms));
+            fputs(", \"observe_ms\": ", f); json_num(f, st->observe_ms);
+            fputs(", \"last_observables\": {\"stretch_max\": ", f); json_num(f, st->last.stretch_max);
+            fputs(", \"penetration_max\": ", f); json_num(f, st->last.penetration_max);
+            fputs(", \"kinetic_energy\": ", f); json_num(f, st->last.kinetic_energy);
+            fprintf(f, ", \"blown_up_strands\": %lld}, \"blown_up_frames\": %lld", (long long)st->last.blown_up_strands,
+                    (long long)st->blown_frames);
+        }
         fputc('}', f);
     }
     fputs("]", f);
@@ -161,6 +177,13 @@ void hb_record_summary(FILE *f, const hb_record *r)
         else fprintf(f, " median %.3f ms (min %.3f, max %.3f, %d runs)", st->meta.median_ms, st->meta.min_ms,
                      st->meta.max_ms, st->n_times);
         if (st->meta.moved_points >= 0) fprintf(f, ", %lld points moved", (long long)st->meta.moved_points);
+        if (st->stage == HB_STAGE_SIMULATE) {
+            fprintf(f, " per frame over %lld frames (%s, S=%lld, I=%lld, %s)", (long long)st->frames,
+                    hb_solver_name(s->dyn.solver), (long long)s->dyn.substeps, (long long)s->dyn.iterations, st->features);
+            fprintf(f, "\n    last frame: stretch_max %.3g, penetration_max %.3g cm, kinetic energy %.6g cm2/s2",
+                    st->last.stretch_max, st->last.penetration_max, st->last.kinetic_energy);
+            if (st->blown_frames) fprintf(f, "; BLOWN UP in %lld frames", (long long)st->blown_frames);
+        }
         fputc('\n', f);
     }
     if (isfinite(r->end_to_end_ms)) fprintf(f, "  end-to-end %.3f ms\n", r->end_to_end_ms);

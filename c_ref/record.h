@@ -18,6 +18,13 @@ typedef struct {
     hb_frame_meta meta;  /* stage, skipped, fused, moved points, median/min/max */
     double *times_ms;    /* repeat entries (NULL when skipped or fused into the previous) */
     int n_times;
+    /* simulate: frames advanced (the times are per frame), the features compiled in, the
+     * last frame's observables and the frames that blew up */
+    int64_t frames;
+    char features[96];
+    hb_observables last;
+    int64_t blown_frames;
+    double observe_ms;   /* computing the observables, all frames, apart from the frame times */
 } hb_stage_record;
 
 typedef struct {

@@ -92,6 +92,15 @@ struct hb_writer {
     int n_frames, cap;
     hb_frame_meta *frames;
     double seconds;
+    /* the dynamic model */
+    hid_t velocity;           /* velocity/value, created by the first velocity frame */
+    int n_vel, vel_cap;
+    int64_t *vel_step;
+    double *vel_time;
+    int n_obs, obs_cap;
+    hb_observables *obs;
+    int64_t *obs_step;
+    double *obs_time;
 };
 
 double hb_writer_seconds(const hb_writer *w) { return w->seconds; }
@@ -102,12 +111,18 @@ static void writer_free(hb_writer *w)
     free(w->path);
     free(w->tmp);
     free(w->frames);
+    free(w->vel_step);
+    free(w->vel_time);
+    free(w->obs);
+    free(w->obs_step);
+    free(w->obs_time);
     free(w);
 }
 
 void hb_writer_abort(hb_writer *w)
 {
     if (!w) return;
+    if (w->velocity >= 0) H5Dclose(w->velocity);
     if (w->value >= 0) H5Dclose(w->value);
     if (w->file >= 0) H5Fclose(w->file);
     if (w->tmp) unlink(w->tmp);
@@ -120,7 +135,7 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     double t0 = now_s();
     hb_writer *w = calloc(1, sizeof *w);
     if (!w) { snprintf(err, errlen, "out of host memory"); return NULL; }
-    w->file = w->value = -1;
+    w->file = w->value = w->velocity = -1;
     w->scene = *scene;
     w->rows = (uint64_t)scene->n_strands * (uint64_t)scene->points;
     if (!force && access(path, F_OK) == 0)
@@ -189,6 +204,126 @@ fail:
     return NULL;
 }
 
+/* Resizes *a to `cap` entries of `size` bytes; −1 (and *a unchanged) when out of memory. */
+static int resize(void **a, int cap, size_t size)
+{
+    void *p = realloc(*a, (size_t)cap * size);
+    if (!p) return -1;
+    *a = p;
+    return 0;
+}
+
+/* An extendible [frames][rows][3] dataset, one chunk row per frame (or 2^20 rows). */
+static hid_t create_frames_ds(hid_t loc, const char *name, uint64_t rows, hb_precision prec)
+{
+    hsize_t dims[3] = {0, rows, 3}, maxdims[3] = {H5S_UNLIMITED, rows, 3};
+    hsize_t chunk[3] = {1, rows < (1u << 20) ? rows : (1u << 20), 3};
+    hid_t space = H5Screate_simple(3, dims, maxdims);
+    hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(dcpl, 3, chunk);
+    hid_t d = H5Dcreate2(loc, name, prec == HB_FP64 ? H5T_IEEE_F64LE : H5T_IEEE_F32LE, space, H5P_DEFAULT, dcpl,
+                         H5P_DEFAULT);
+    H5Pclose(dcpl);
+    H5Sclose(space);
+    return d;
+}
+
+/* Writes frame `index` of a [frames][rows][3] dataset, extending it by one. */
+static herr_t write_frame_row(hid_t ds, int index, uint64_t rows, hb_precision prec, const void *frame)
+{
+    hsize_t dims[3] = {(hsize_t)index + 1, rows, 3};
+    if (H5Dset_extent(ds, dims) < 0) return -1;
+    hid_t fs = H5Dget_space(ds);
+    hsize_t start[3] = {(hsize_t)index, 0, 0}, count[3] = {1, rows, 3};
+    H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
+    hid_t ms = H5Screate_simple(3, count, NULL);
+    herr_t rc = H5Dwrite(ds, prec == HB_FP64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT, ms, fs, H5P_DEFAULT, frame);
+    H5Sclose(ms);
+    H5Sclose(fs);
+    return rc;
+}
+
+int hb_writer_rest(hb_writer *w, const void *rest, char *err, size_t errlen)
+{
+    double t0 = now_s();
+    hsize_t dims[2] = {w->rows, 3};
+    hid_t hair = H5Gopen2(w->file, "particles/hair", H5P_DEFAULT);
+    hid_t sp = H5Screate_simple(2, dims, NULL);
+    const int f64 = w->scene.precision == HB_FP64;
+    hid_t d = H5Dcreate2(hair, "rest_position", f64 ? H5T_IEEE_F64LE : H5T_IEEE_F32LE, sp, H5P_DEFAULT, H5P_DEFAULT,
+                         H5P_DEFAULT);
+    herr_t rc = d < 0 ? -1 : H5Dwrite(d, f64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, rest);
+    if (rc >= 0 && attr_str(d, "unit", "cm") < 0) rc = -1;
+    if (d >= 0) H5Dclose(d);
+    H5Sclose(sp);
+    H5Gclose(hair);
+    w->seconds += now_s() - t0;
+    if (rc < 0) {
+        snprintf(err, errlen, "--output %s: HDF5 could not write the rest shape (disk full?)", w->path);
+        return -1;
+    }
+    return 0;
+}
+
+int hb_writer_velocity(hb_writer *w, const void *v, int64_t step, double time, char *err, size_t errlen)
+{
+    double t0 = now_s();
+    if (w->velocity < 0) {
+        hid_t hair = H5Gopen2(w->file, "particles/hair", H5P_DEFAULT);
+        hid_t g = make_group(hair, "velocity");
+        w->velocity = g < 0 ? -1 : create_frames_ds(g, "value", w->rows, w->scene.precision);
+        if (w->velocity >= 0 && attr_str(w->velocity, "unit", "cm s-1") < 0) {
+            H5Dclose(w->velocity);
+            w->velocity = -1;
+        }
+        if (g >= 0) H5Gclose(g);
+        H5Gclose(hair);
+        if (w->velocity < 0) {
+            snprintf(err, errlen, "--output %s: HDF5 could not create the velocity dataset", w->path);
+            return -1;
+        }
+    }
+    if (w->n_vel == w->vel_cap) {
+        int cap = w->vel_cap ? 2 * w->vel_cap : 8;
+        if (resize((void **)&w->vel_step, cap, sizeof *w->vel_step) < 0 ||
+            resize((void **)&w->vel_time, cap, sizeof *w->vel_time) < 0)
+            goto oom;
+        w->vel_cap = cap;
+    }
+    if (write_frame_row(w->velocity, w->n_vel, w->rows, w->scene.precision, v) < 0) {
+        snprintf(err, errlen, "--output %s: HDF5 write of velocity frame %d failed (disk full?)", w->path, w->n_vel);
+        return -1;
+    }
+    w->vel_step[w->n_vel] = step;
+    w->vel_time[w->n_vel] = time;
+    w->n_vel++;
+    w->seconds += now_s() - t0;
+    return 0;
+oom:
+    snprintf(err, errlen, "out of host memory");
+    return -1;
+}
+
+int hb_writer_observables(hb_writer *w, const hb_observables *o, int64_t step, double time, char *err,
+                          size_t errlen)
+{
+    if (w->n_obs == w->obs_cap) {
+        int cap = w->obs_cap ? 2 * w->obs_cap : 8;
+        if (resize((void **)&w->obs, cap, sizeof *w->obs) < 0 || resize((void **)&w->obs_step, cap, sizeof *w->obs_step) < 0 ||
+            resize((void **)&w->obs_time, cap, sizeof *w->obs_time) < 0)
+            goto oom;
+        w->obs_cap = cap;
+    }
+    w->obs[w->n_obs] = *o;
+    w->obs_step[w->n_obs] = step;
+    w->obs_time[w->n_obs] = time;
+    w->n_obs++;
+    return 0;
+oom:
+    snprintf(err, errlen, "out of host memory");
+    return -1;
+}
+
 int hb_writer_append(hb_writer *w, const void *frame, const hb_frame_meta *fm, char *err, size_t errlen)
 {
     double t0 = now_s();
@@ -221,6 +356,94 @@ int hb_writer_append(hb_writer *w, const void *frame, const hb_frame_meta *fm, c
     return 0;
 }
 
+/* One observable's series: /observables/NAME/{value, step, time} (H5MD observables). */
+static int write_series(hid_t obs, const char *name, hid_t ftype, hid_t mtype, const void *value, const hb_writer *w,
+                        const char *unit)
+{
+    hid_t g = make_group(obs, name);
+    if (g < 0) return -1;
+    hsize_t n = (hsize_t)w->n_obs;
+    int bad = ds_1d(g, "value", ftype, mtype, n, value) < 0;
+    bad |= ds_1d(g, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, n, w->obs_step) < 0;
+    bad |= ds_1d(g, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, w->obs_time) < 0;
+    if (!bad && unit) {
+        hid_t d = H5Dopen2(g, "value", H5P_DEFAULT);
+        bad |= d < 0 || attr_str(d, "unit", unit) < 0;
+        if (d >= 0) H5Dclose(d);
+    }
+    if (!bad) {
+        hid_t d = H5Dopen2(g, "time", H5P_DEFAULT);
+        bad |= d < 0 || attr_str(d, "unit", "s") < 0;
+        if (d >= 0) H5Dclose(d);
+    }
+    H5Gclose(g);
+    return bad ? -1 : 0;
+}
+
+/* The dynamic model's datasets and parameters (docs/interfaces.md, "dynamic files"). */
+static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
+{
+    const hb_dynamics *d = &w->scene.dyn;
+    int bad = 0;
+    bad |= attr_str(p, "model", "dynamic") < 0;
+    bad |= attr_str(p, "solver", hb_solver_name(d->solver)) < 0;
+    bad |= attr_str(p, "head_motion", hb_motion_name(d->motion)) < 0;
+    bad |= attr_str(p, "features", rm->features) < 0;
+    bad |= attr_i64(p, "paper_frames", rm->paper_frames) < 0;
+    bad |= attr_i64(p, "simulated_frames", rm->simulated_frames) < 0;
+    bad |= attr_i64(p, "output_every", rm->output_every) < 0;
+    bad |= attr_i64(p, "substeps", d->substeps) < 0;
+    bad |= attr_i64(p, "iterations", d->iterations) < 0;
+    bad |= attr_i64(p, "bend", d->bend) < 0;
+    bad |= attr_i64(p, "shape", d->shape) < 0;
+    bad |= attr_i64(p, "collider", d->collider) < 0;
+    bad |= attr_i64(p, "drag_declared", d->drag_declared) < 0;
+    const struct { const char *name; double v; } num[] = {
+        {"frame_dt", d->frame_dt}, {"gravity", d->gravity}, {"drag", d->drag}, {"damping", d->damping},
+        {"stretch_compliance", d->stretch_compliance}, {"bend_compliance", d->bend_compliance},
+        {"shape_compliance", d->shape_compliance}, {"shape_range", d->shape_range}, {"ftl_damping", d->ftl_damping},
+        {"collision_margin", d->collision_margin}, {"wind_speed", d->wind_speed},
+        {"gust_amplitude", d->gust_amplitude}, {"gust_frequency", d->gust_frequency},
+        {"gust_wavelength", d->gust_wavelength}, {"motion_amplitude", d->motion_amplitude},
+        {"motion_frequency", d->motion_frequency},
+    };
+    for (size_t i = 0; i < sizeof num / sizeof num[0]; i++) bad |= attr_f64(p, num[i].name, num[i].v) < 0;
+
+    if (w->velocity >= 0) {
+        hid_t g = H5Gopen2(w->file, "particles/hair/velocity", H5P_DEFAULT);
+        bad |= g < 0;
+        if (g >= 0) {
+            bad |= ds_1d(g, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, (hsize_t)w->n_vel, w->vel_step) < 0;
+            bad |= ds_1d(g, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)w->n_vel, w->vel_time) < 0;
+            H5Gclose(g);
+        }
+    }
+    hid_t obs = make_group(w->file, "observables");
+    if (obs < 0) return -1;
+    const int n = w->n_obs;
+    double *v = calloc((size_t)n + 1, sizeof *v);
+    int64_t *c = calloc((size_t)n + 1, sizeof *c);
+    int8_t *b = calloc((size_t)n + 1, sizeof *b);
+    if (!v || !c || !b) bad = 1;
+    else {
+        for (int i = 0; i < n; i++) v[i] = w->obs[i].stretch_max;
+        bad |= write_series(obs, "stretch_max", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v, w, NULL) < 0;
+        for (int i = 0; i < n; i++) v[i] = w->obs[i].penetration_max;
+        bad |= write_series(obs, "penetration_max", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v, w, "cm") < 0;
+        for (int i = 0; i < n; i++) v[i] = w->obs[i].kinetic_energy;
+        bad |= write_series(obs, "kinetic_energy", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v, w, "cm+2 s-2") < 0;
+        for (int i = 0; i < n; i++) c[i] = w->obs[i].blown_up_strands;
+        bad |= write_series(obs, "blown_up_strands", H5T_STD_I64LE, H5T_NATIVE_INT64, c, w, NULL) < 0;
+        for (int i = 0; i < n; i++) b[i] = (int8_t)hb_obs_blown_up(&w->obs[i]);
+        bad |= write_series(obs, "blown_up", H5T_STD_I8LE, H5T_NATIVE_INT8, b, w, NULL) < 0;
+    }
+    free(v);
+    free(c);
+    free(b);
+    H5Gclose(obs);
+    return bad ? -1 : 0;
+}
+
 int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errlen)
 {
     double t0 = now_s();
@@ -234,7 +457,7 @@ int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errle
 
     {
         hid_t pos = H5Gopen2(w->file, "particles/hair/position", H5P_DEFAULT);
-        for (int f = 0; f < F; f++) { i64[f] = f; f64[f] = f; }
+        for (int f = 0; f < F; f++) { i64[f] = w->frames[f].step; f64[f] = w->frames[f].time; }
         bad |= ds_1d(pos, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, (hsize_t)F, i64) < 0;
         bad |= ds_1d(pos, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
         H5Gclose(pos);
@@ -289,6 +512,7 @@ int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errle
     bad |= ds_1d(p, "stage_min_ms", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
     for (int f = 0; f < F; f++) f64[f] = w->frames[f].max_ms;
     bad |= ds_1d(p, "stage_max_ms", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
+    if (rm->dynamic) bad |= write_dynamic(w, p, rm) < 0;
     /* the write time so far, frames included; the closing itself is not counted */
     bad |= attr_f64(p, "hdf5_write_ms", 1e3 * (w->seconds + now_s() - t0)) < 0;
     if (p >= 0) H5Gclose(p);
@@ -304,6 +528,8 @@ out:
     }
     H5Dclose(w->value);
     w->value = -1;
+    if (w->velocity >= 0) H5Dclose(w->velocity);
+    w->velocity = -1;
     herr_t rc = H5Fclose(w->file);
     w->file = -1;
     if (rc < 0) {
@@ -415,7 +641,190 @@ void hb_input_close(hb_input *in)
     if (in->hid > 0) H5Fclose((hid_t)in->hid);
     in->hid = 0;
     free(in->frames);
+    free(in->vel_step);
+    free(in->vel_time);
+    free(in->obs);
+    free(in->obs_step);
+    free(in->obs_time);
     in->frames = NULL;
+    in->vel_step = in->obs_step = NULL;
+    in->vel_time = in->obs_time = NULL;
+    in->obs = NULL;
+}
+
+/* Reads a 1-D dataset at `path` of any length into a new array; its length in *n. */
+static void *read_1d(hid_t f, const char *path, hid_t mem_type, size_t size, hsize_t *n)
+{
+    *n = 0;
+    if (!has_path(f, path)) return NULL;
+    hid_t d = H5Dopen2(f, path, H5P_DEFAULT);
+    if (d < 0) return NULL;
+    hid_t sp = H5Dget_space(d);
+    void *v = NULL;
+    if (H5Sget_simple_extent_ndims(sp) == 1 && H5Sget_simple_extent_dims(sp, n, NULL) == 1) {
+        v = calloc(*n ? *n : 1, size);
+        if (v && H5Dread(d, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0) {
+            free(v);
+            v = NULL;
+        }
+    }
+    H5Sclose(sp);
+    H5Dclose(d);
+    return v;
+}
+
+/* Checks a [frames?][rows][3] float dataset of the file's precision; its frame count in *frames. */
+static int check_rows(hid_t f, const char *path, int rank, uint64_t rows, hb_precision prec, hsize_t *frames)
+{
+    hid_t d = H5Dopen2(f, path, H5P_DEFAULT);
+    if (d < 0) return -1;
+    hid_t sp = H5Dget_space(d), t = H5Dget_type(d);
+    hsize_t dims[3] = {0, 0, 0};
+    int ok = H5Sget_simple_extent_ndims(sp) == rank && H5Sget_simple_extent_dims(sp, dims, NULL) == rank;
+    ok = ok && H5Tget_class(t) == H5T_FLOAT && H5Tget_size(t) == hb_real_size(prec);
+    if (ok && rank == 3) ok = dims[1] == rows && dims[2] == 3;
+    if (ok && rank == 2) ok = dims[0] == rows && dims[1] == 3;
+    if (frames) *frames = rank == 3 ? dims[0] : 1;
+    H5Tclose(t);
+    H5Sclose(sp);
+    H5Dclose(d);
+    return ok ? 0 : -1;
+}
+
+/* The dynamic part of an --input file (docs/interfaces.md, "dynamic files"). */
+static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, size_t errlen)
+{
+    hid_t f = (hid_t)in->hid;
+    hb_dynamics *d = &in->scene.dyn;
+    char model[32] = "", solver[16] = "", motion[16] = "";
+    if (read_attr_str(p, "model", model, sizeof model) < 0 || strcmp(model, "dynamic") != 0) {
+        if (has_path(f, "particles/hair/rest_position") || has_path(f, "particles/hair/velocity"))
+            return snprintf(err, errlen, "--input %s holds a rest shape or velocities but /parameters/model is not "
+                            "'dynamic'", path), -1;
+        return 0;
+    }
+    in->dynamic = 1;
+    const char *missing = NULL;
+    int64_t bend = 0, shape = 0, collider = 1, drag_declared = 0;
+#define NEED(call, name) if (!missing && (call) < 0) missing = name
+    NEED(read_attr_str(p, "solver", solver, sizeof solver), "solver");
+    NEED(read_attr_str(p, "head_motion", motion, sizeof motion), "head_motion");
+    NEED(read_attr(p, "paper_frames", H5T_NATIVE_INT64, &in->paper_frames), "paper_frames");
+    NEED(read_attr(p, "substeps", H5T_NATIVE_INT64, &d->substeps), "substeps");
+    NEED(read_attr(p, "iterations", H5T_NATIVE_INT64, &d->iterations), "iterations");
+    NEED(read_attr(p, "bend", H5T_NATIVE_INT64, &bend), "bend");
+    NEED(read_attr(p, "shape", H5T_NATIVE_INT64, &shape), "shape");
+    NEED(read_attr(p, "collider", H5T_NATIVE_INT64, &collider), "collider");
+    NEED(read_attr(p, "drag_declared", H5T_NATIVE_INT64, &drag_declared), "drag_declared");
+    const struct { const char *name; double *v; } num[] = {
+        {"frame_dt", &d->frame_dt}, {"gravity", &d->gravity}, {"drag", &d->drag}, {"damping", &d->damping},
+        {"stretch_compliance", &d->stretch_compliance}, {"bend_compliance", &d->bend_compliance},
+        {"shape_compliance", &d->shape_compliance}, {"shape_range", &d->shape_range},
+        {"ftl_damping", &d->ftl_damping}, {"collision_margin", &d->collision_margin},
+        {"wind_speed", &d->wind_speed}, {"gust_amplitude", &d->gust_amplitude},
+        {"gust_frequency", &d->gust_frequency}, {"gust_wavelength", &d->gust_wavelength},
+        {"motion_amplitude", &d->motion_amplitude}, {"motion_frequency", &d->motion_frequency},
+    };
+    for (size_t i = 0; i < sizeof num / sizeof num[0]; i++) NEED(read_attr(p, num[i].name, H5T_NATIVE_DOUBLE, num[i].v), num[i].name);
+#undef NEED
+    if (missing) return snprintf(err, errlen, "--input %s: /parameters lacks the attribute '%s'", path, missing), -1;
+    d->bend = bend != 0;
+    d->shape = shape != 0;
+    d->collider = collider != 0;
+    d->drag_declared = drag_declared != 0;
+    if (strcmp(solver, "xpbd") == 0) d->solver = HB_SOLVER_XPBD;
+    else if (strcmp(solver, "ftl") == 0) d->solver = HB_SOLVER_FTL;
+    else return snprintf(err, errlen, "--input %s: unknown solver '%s'", path, solver), -1;
+    if (strcmp(motion, "still") == 0) d->motion = HB_MOTION_STILL;
+    else if (strcmp(motion, "nod") == 0) d->motion = HB_MOTION_NOD;
+    else if (strcmp(motion, "shake") == 0) d->motion = HB_MOTION_SHAKE;
+    else if (strcmp(motion, "tilt") == 0) d->motion = HB_MOTION_TILT;
+    else return snprintf(err, errlen, "--input %s: unknown head motion '%s'", path, motion), -1;
+    char why[HB_ERRLEN];
+    if (hb_dynamics_validate(d, why, sizeof why) != 0)
+        return snprintf(err, errlen, "--input %s holds invalid dynamic parameters: %s", path, why), -1;
+    if (in->paper_frames < 1 || in->paper_frames > in->n_frames)
+        return snprintf(err, errlen, "--input %s: paper_frames = %lld does not fit its %d frames", path,
+                        (long long)in->paper_frames, in->n_frames), -1;
+
+    const uint64_t rows = (uint64_t)in->scene.n_strands * (uint64_t)in->scene.points;
+    if (!has_path(f, "particles/hair/rest_position") ||
+        check_rows(f, "particles/hair/rest_position", 2, rows, in->scene.precision, NULL) < 0)
+        return snprintf(err, errlen, "--input %s: a dynamic file needs /particles/hair/rest_position [%llu][3] in %s",
+                        path, (unsigned long long)rows, hb_precision_name(in->scene.precision)), -1;
+    hsize_t nv = 0, ns = 0, nt = 0;
+    if (has_path(f, "particles/hair/velocity/value")) {
+        if (check_rows(f, "particles/hair/velocity/value", 3, rows, in->scene.precision, &nv) < 0)
+            return snprintf(err, errlen, "--input %s: velocity/value must be [frames][%llu][3] in %s", path,
+                            (unsigned long long)rows, hb_precision_name(in->scene.precision)), -1;
+        in->vel_step = read_1d(f, "particles/hair/velocity/step", H5T_NATIVE_INT64, sizeof(int64_t), &ns);
+        in->vel_time = read_1d(f, "particles/hair/velocity/time", H5T_NATIVE_DOUBLE, sizeof(double), &nt);
+        if (!in->vel_step || !in->vel_time || ns != nv || nt != nv)
+            return snprintf(err, errlen, "--input %s: velocity/step and velocity/time need one entry per velocity "
+                            "frame (%llu)", path, (unsigned long long)nv), -1;
+        in->n_vel = (int)nv;
+    }
+    /* observables: copied into the output when present and consistent */
+    hsize_t n1 = 0, n2 = 0, n3 = 0, n4 = 0, n5 = 0;
+    double *sm = read_1d(f, "observables/stretch_max/value", H5T_NATIVE_DOUBLE, sizeof(double), &n1);
+    double *pm = read_1d(f, "observables/penetration_max/value", H5T_NATIVE_DOUBLE, sizeof(double), &n2);
+    double *ke = read_1d(f, "observables/kinetic_energy/value", H5T_NATIVE_DOUBLE, sizeof(double), &n3);
+    int64_t *bs = read_1d(f, "observables/blown_up_strands/value", H5T_NATIVE_INT64, sizeof(int64_t), &n4);
+    in->obs_step = read_1d(f, "observables/stretch_max/step", H5T_NATIVE_INT64, sizeof(int64_t), &n5);
+    in->obs_time = read_1d(f, "observables/stretch_max/time", H5T_NATIVE_DOUBLE, sizeof(double), &ns);
+    int ok = sm && pm && ke && bs && in->obs_step && in->obs_time && n2 == n1 && n3 == n1 && n4 == n1 && n5 == n1 &&
+             ns == n1;
+    if (ok) {
+        in->obs = calloc(n1 ? n1 : 1, sizeof *in->obs);
+        ok = in->obs != NULL;
+        for (hsize_t i = 0; ok && i < n1; i++)
+            in->obs[i] = (hb_observables){sm[i], pm[i], ke[i], bs[i]};
+        in->n_obs = (int)n1;
+    }
+    free(sm);
+    free(pm);
+    free(ke);
+    free(bs);
+    if (!ok)
+        return snprintf(err, errlen, "--input %s: /observables must hold stretch_max, penetration_max, kinetic_energy "
+                        "and blown_up_strands with one value, step and time each", path), -1;
+    return 0;
+}
+
+int hb_input_read_rest(hb_input *in, void *buf, char *err, size_t errlen)
+{
+    hid_t d = H5Dopen2((hid_t)in->hid, "particles/hair/rest_position", H5P_DEFAULT);
+    herr_t rc = d < 0 ? -1 : H5Dread(d, in->scene.precision == HB_FP64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT,
+                                      H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+    if (d >= 0) H5Dclose(d);
+    if (rc < 0) {
+        snprintf(err, errlen, "--input: HDF5 could not read the rest shape (truncated file?)");
+        return -1;
+    }
+    return 0;
+}
+
+int hb_input_read_velocity(hb_input *in, int index, void *buf, char *err, size_t errlen)
+{
+    const uint64_t rows = (uint64_t)in->scene.n_strands * (uint64_t)in->scene.points;
+    hid_t d = H5Dopen2((hid_t)in->hid, "particles/hair/velocity/value", H5P_DEFAULT);
+    if (d < 0) {
+        snprintf(err, errlen, "--input: HDF5 could not open the velocities");
+        return -1;
+    }
+    hid_t fs = H5Dget_space(d);
+    hsize_t start[3] = {(hsize_t)index, 0, 0}, count[3] = {1, rows, 3};
+    H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
+    hid_t ms = H5Screate_simple(3, count, NULL);
+    herr_t rc = H5Dread(d, in->scene.precision == HB_FP64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT, ms, fs, H5P_DEFAULT, buf);
+    H5Sclose(ms);
+    H5Sclose(fs);
+    H5Dclose(d);
+    if (rc < 0) {
+        snprintf(err, errlen, "--input: HDF5 could not read velocity frame %d (truncated file?)", index);
+        return -1;
+    }
+    return 0;
 }
 
 #undef FAIL
@@ -527,6 +936,22 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
         free(sk);
         free(mv);
         free(v);
+    }
+    {
+        hsize_t ns = 0, nt = 0;
+        int64_t *st = read_1d(f, "particles/hair/position/step", H5T_NATIVE_INT64, sizeof(int64_t), &ns);
+        double *tm = read_1d(f, "particles/hair/position/time", H5T_NATIVE_DOUBLE, sizeof(double), &nt);
+        for (hsize_t i = 0; i < F; i++) {
+            in->frames[i].step = st && ns == F ? st[i] : (int64_t)i;
+            in->frames[i].time = tm && nt == F ? tm[i] : 0.0;
+        }
+        free(st);
+        free(tm);
+    }
+    if (input_dynamic(in, path, p, err, errlen) < 0) {
+        H5Gclose(p);
+        hb_input_close(in);
+        return -1;
     }
     H5Gclose(p);
     return 0;

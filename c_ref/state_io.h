@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "dynamics.h"
 #include "params.h"
 
 #ifdef __cplusplus
@@ -23,6 +24,8 @@ typedef struct {
     double wind_strength;  /* NaN where not a wind frame */
     double wind_angle;
     double median_ms, min_ms, max_ms;
+    int64_t step;          /* /particles/hair/position/step (docs/interfaces.md) */
+    double time;           /* s: 0 for the paper stages' frames, f·Δt for simulated frame f */
 } hb_frame_meta;
 
 /* Run-wide metadata written as attributes of /parameters. */
@@ -30,6 +33,12 @@ typedef struct {
     const char *backend, *variant, *git_revision, *compiler, *flags, *device, *driver;
     int threads, block_size, repeat, warmup;
     double end_to_end_ms, hdf5_write_ms;
+    /* the dynamic model (docs/model.md §3): 0 for a paper-model run */
+    int dynamic;
+    int64_t paper_frames;     /* frames of the paper stages before the simulation */
+    int64_t simulated_frames; /* simulated frames from the start of the simulation to the last */
+    int output_every;
+    const char *features;
 } hb_run_meta;
 
 typedef struct hb_writer hb_writer;
@@ -42,13 +51,29 @@ int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errle
 /* Closes and deletes the temporary file. Frees w. */
 void hb_writer_abort(hb_writer *w);
 double hb_writer_seconds(const hb_writer *w); /* time spent writing so far */
+/* The dynamic model's datasets: the rest shape (once), velocities (per written frame) and
+ * the per-frame observables (kept in memory, written at close). */
+int hb_writer_rest(hb_writer *w, const void *rest, char *err, size_t errlen);
+int hb_writer_velocity(hb_writer *w, const void *v, int64_t step, double time, char *err, size_t errlen);
+int hb_writer_observables(hb_writer *w, const hb_observables *o, int64_t step, double time, char *err,
+                          size_t errlen);
 
 /* An --input file, validated. */
 typedef struct {
     hb_scene scene;
     int n_frames;
-    hb_frame_meta *frames; /* n_frames entries */
+    hb_frame_meta *frames; /* n_frames entries (step and time included) */
     int64_t hid;           /* the open file */
+    /* a dynamic file: the rest shape, velocity frames and observables */
+    int dynamic;
+    int64_t paper_frames;
+    int n_vel;
+    int64_t *vel_step;
+    double *vel_time;
+    int n_obs;
+    hb_observables *obs;
+    int64_t *obs_step;
+    double *obs_time;
 } hb_input;
 
 /* Opens and checks the layout and the scene; one line in err on failure. */
@@ -56,6 +81,8 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen);
 /* Reads frame f into buf (canonical, the file's precision); checks for NaN/Inf. */
 int hb_input_read_frame(hb_input *in, int f, void *buf, char *err, size_t errlen);
 void hb_input_close(hb_input *in);
+int hb_input_read_rest(hb_input *in, void *buf, char *err, size_t errlen);
+int hb_input_read_velocity(hb_input *in, int index, void *buf, char *err, size_t errlen);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,274 @@
+/* dynamics_impl.h — the dynamic model (docs/model.md §3), written once for a floating
+ * type REAL; dynamics.c includes it for float and for double (SFX, DMODEL, SQRT, SIN).
+ *
+ * One call advances one strand by one frame of S substeps. The feature set F is a
+ * compile-time constant in every instantiation of frame_body (see the dispatch at the
+ * end), so an undeclared feature leaves no code in the loop (§3.9). Every expression is
+ * evaluated in the order written here; §3.10 states that order for the other backends.
+ *
+ * Layout: point k of a strand at s[3k + 0..2] = (x, y, z).
+ */
+
+#define HB_ALWAYS_INLINE static inline __attribute__((always_inline))
+
+/* r = Q·a, row-major Q, each row summed left to right. */
+HB_ALWAYS_INLINE void SFX(rotate)(const REAL *q, const REAL *a, REAL *r)
+{
+    r[0] = q[0] * a[0] + q[1] * a[1] + q[2] * a[2];
+    r[1] = q[3] * a[0] + q[4] * a[1] + q[5] * a[2];
+    r[2] = q[6] * a[0] + q[7] * a[1] + q[8] * a[2];
+}
+
+/* §3.5 distance constraint between a = p[3ia] and b = p[3ib] with rest length r and
+ * α̃ = at. `move_a` is 0 when a is the root (inverse mass 0), else 1; b is never the root. */
+HB_ALWAYS_INLINE void SFX(distance)(REAL *pa, REAL *pb, int move_a, REAL r, REAL at, REAL *lambda)
+{
+    const REAL ex = pb[0] - pa[0], ey = pb[1] - pa[1], ez = pb[2] - pa[2];
+    const REAL len = SQRT(ex * ex + ey * ey + ez * ez);
+    if (len == (REAL)0) return; /* no direction: nothing moves */
+    const REAL c = len - r;
+    const REAL wsum = move_a ? (REAL)2 : (REAL)1;
+    const REAL dl = (-c - at * *lambda) / (wsum + at);
+    *lambda = *lambda + dl;
+    const REAL nx = ex / len, ny = ey / len, nz = ez / len;
+    if (move_a) {
+        pa[0] = pa[0] - dl * nx;
+        pa[1] = pa[1] - dl * ny;
+        pa[2] = pa[2] - dl * nz;
+    }
+    pb[0] = pb[0] + dl * nx;
+    pb[1] = pb[1] + dl * ny;
+    pb[2] = pb[2] + dl * nz;
+}
+
+/* §3.5 shape: a zero-length spring from p to the target t. */
+HB_ALWAYS_INLINE void SFX(shape_pull)(REAL *p, const REAL *t, REAL at, REAL *lambda)
+{
+    const REAL ex = p[0] - t[0], ey = p[1] - t[1], ez = p[2] - t[2];
+    const REAL c = SQRT(ex * ex + ey * ey + ez * ez);
+    if (c == (REAL)0) return;
+    const REAL dl = (-c - at * *lambda) / ((REAL)1 + at);
+    *lambda = *lambda + dl;
+    p[0] = p[0] + dl * (ex / c);
+    p[1] = p[1] + dl * (ey / c);
+    p[2] = p[2] + dl * (ez / c);
+}
+
+/* §3.5 head collision: a point inside the sphere R_c goes to its surface along the ray
+ * from the centre; the centre itself goes to (0, R_c, 0). */
+HB_ALWAYS_INLINE void SFX(collide_sphere)(REAL *p, REAL rc)
+{
+    const REAL len = SQRT(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    if (!(len < rc)) return;
+    if (len == (REAL)0) {
+        p[0] = (REAL)0;
+        p[1] = rc;
+        p[2] = (REAL)0;
+        return;
+    }
+    const REAL sc = rc / len;
+    p[0] = p[0] * sc;
+    p[1] = p[1] * sc;
+    p[2] = p[2] * sc;
+}
+
+/* §3.6 bend constraints (k−1, k+1), k = 1…P−2, of one parity group: ⌊(k−1)/2⌋ even
+ * (parity 0) or odd (parity 1). */
+HB_ALWAYS_INLINE void SFX(bend_group)(const DMODEL *m, REAL *p, const REAL *bend_rest, REAL *lam, int parity)
+{
+    const int64_t P = m->points;
+    for (int64_t k = 1; k + 1 < P; k++)
+        if ((((k - 1) / 2) & 1) == parity)
+            SFX(distance)(p + 3 * (k - 1), p + 3 * (k + 1), k - 1 != 0, bend_rest[k - 1], m->bend_at, &lam[k - 1]);
+}
+
+/* §3.5 shape targets T_k = Q(t+h)·X̄_k (X̄_k itself when the head does not move). */
+HB_ALWAYS_INLINE void SFX(shape_all)(const DMODEL *m, REAL *p, const REAL *rest, const REAL *q, REAL *lam,
+                                     const unsigned F)
+{
+    for (int64_t k = 1; k <= m->shape_count; k++) {
+        REAL t[3];
+        if (F & HB_F_MOTION) SFX(rotate)(q, rest + 3 * k, t);
+        else { t[0] = rest[3 * k]; t[1] = rest[3 * k + 1]; t[2] = rest[3 * k + 2]; }
+        SFX(shape_pull)(p + 3 * k, t, m->shape_at, &lam[k - 1]);
+    }
+}
+
+/* One frame of one strand: S substeps of §3.4, the solver of §3.6 or §3.7. */
+HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, REAL *x, REAL *v, const REAL *rest,
+                                      const REAL *bend_rest, REAL *scratch, const unsigned F)
+{
+    const int64_t P = m->points;
+    const REAL h = m->h;
+    REAL *p = scratch;               /* predicted positions, 3P */
+    REAL *lam = scratch + 3 * P;     /* multipliers: stretch P−1 | bend P−2 | shape K */
+    REAL *lam_s = lam, *lam_b = lam + P, *lam_g = lam + 2 * P;
+    REAL *d = scratch + 6 * P;       /* ftl corrections d_k, 3P */
+
+    for (int64_t j = 0; j < m->substeps; j++) {
+        const REAL *q = QTABLE(fr) + 9 * j;    /* Q(t + h) */
+        const REAL phase = PHASE(fr)[j];      /* φ(t) */
+        (void)q; (void)phase;
+
+        /* 1. root on the head: x0 ← Q(t+h)·X̄0, v0 ← (x0_new − x0_old)/h */
+        if (F & HB_F_MOTION) {
+            REAL r[3];
+            SFX(rotate)(q, rest, r);
+            for (int c = 0; c < 3; c++) {
+                v[c] = (r[c] - x[c]) / h;
+                x[c] = r[c];
+            }
+        }
+        p[0] = x[0];
+        p[1] = x[1];
+        p[2] = x[2];
+
+        /* 2. velocities, implicit in drag and damping, then the prediction */
+        for (int64_t k = 1; k < P; k++) {
+            REAL *vk = v + 3 * k;
+            const REAL *xk = x + 3 * k;
+            REAL vx = vk[0], vy = vk[1], vz = vk[2];
+            if (F & HB_F_WIND) {
+                REAL gam = (REAL)1;
+                if (F & HB_F_GUST) gam = (REAL)1 + m->gust * SIN(phase - m->kappa * (m->dir_y * xk[1] + m->dir_z * xk[2]));
+                vy = vy + h * (m->gravity_y + m->wind_y * gam);
+                vz = vz + h * (m->wind_z * gam);
+            } else {
+                vy = vy + h * m->gravity_y;
+            }
+            if (F & HB_F_DRAG) {
+                vx = vx / m->den;
+                vy = vy / m->den;
+                vz = vz / m->den;
+            }
+            vk[0] = vx;
+            vk[1] = vy;
+            vk[2] = vz;
+            p[3 * k + 0] = xk[0] + h * vx;
+            p[3 * k + 1] = xk[1] + h * vy;
+            p[3 * k + 2] = xk[2] + h * vz;
+        }
+
+        /* 3. constraints; every multiplier starts the substep at 0 */
+        for (int64_t i = 0; i < 3 * P; i++) lam[i] = (REAL)0;
+        if (m->solver == HB_SOLVER_XPBD) {
+            for (int64_t it = 0; it < m->iterations; it++) {
+                for (int64_t k = 1; k < P; k += 2) /* stretch, k odd */
+                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, k - 1 != 0, m->seg_len, m->stretch_at, &lam_s[k - 1]);
+                for (int64_t k = 2; k < P; k += 2) /* stretch, k even */
+                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, 1, m->seg_len, m->stretch_at, &lam_s[k - 1]);
+                if (F & HB_F_BEND) {
+                    SFX(bend_group)(m, p, bend_rest, lam_b, 0);
+                    SFX(bend_group)(m, p, bend_rest, lam_b, 1);
+                }
+                if (F & HB_F_SHAPE) SFX(shape_all)(m, p, rest, q, lam_g, F);
+                if (F & HB_F_COLLIDE)
+                    for (int64_t k = 1; k < P; k++) SFX(collide_sphere)(p + 3 * k, m->collide_r);
+            }
+        } else {
+            for (int64_t it = 0; it < m->iterations; it++) {
+                if (F & HB_F_BEND) {
+                    SFX(bend_group)(m, p, bend_rest, lam_b, 0);
+                    SFX(bend_group)(m, p, bend_rest, lam_b, 1);
+                }
+                if (F & HB_F_SHAPE) SFX(shape_all)(m, p, rest, q, lam_g, F);
+            }
+            /* §3.7 follow the leader: q = p_{k−1} + ℓ·(p_k − p_{k−1})/|p_k − p_{k−1}| */
+            for (int64_t k = 1; k < P; k++) {
+                REAL *pk = p + 3 * k;
+                const REAL *pp = p + 3 * (k - 1);
+                const REAL ex = pk[0] - pp[0], ey = pk[1] - pp[1], ez = pk[2] - pp[2];
+                const REAL len = SQRT(ex * ex + ey * ey + ez * ez);
+                REAL nq[3];
+                if (len > (REAL)0) {
+                    nq[0] = pp[0] + m->seg_len * (ex / len);
+                    nq[1] = pp[1] + m->seg_len * (ey / len);
+                    nq[2] = pp[2] + m->seg_len * (ez / len);
+                } else {
+                    nq[0] = pp[0];
+                    nq[1] = pp[1] - m->seg_len;
+                    nq[2] = pp[2];
+                }
+                for (int c = 0; c < 3; c++) d[3 * k + c] = nq[c] - pk[c];
+                if (F & HB_F_COLLIDE) SFX(collide_sphere)(nq, m->collide_r);
+                for (int c = 0; c < 3; c++) pk[c] = nq[c];
+            }
+        }
+
+        /* 4. velocities from the motion (ftl: less s·d_{k+1}/h), then the positions */
+        for (int64_t k = 1; k < P; k++)
+            for (int c = 0; c < 3; c++) v[3 * k + c] = (p[3 * k + c] - x[3 * k + c]) / h;
+        if (m->solver == HB_SOLVER_FTL)
+            for (int64_t k = 1; k + 1 < P; k++)
+                for (int c = 0; c < 3; c++) v[3 * k + c] = v[3 * k + c] - (m->ftl_s * d[3 * (k + 1) + c]) / h;
+        for (int64_t i = 3; i < 3 * P; i++) x[i] = p[i];
+    }
+}
+
+/* One function per feature set: the switch's constant F specialises frame_body. */
+void SFX(hb_dyn_frame_strand)(const DMODEL *m, const hb_dyn_frame *fr, REAL *x, REAL *v, const REAL *rest,
+                              const REAL *bend_rest, REAL *scratch)
+{
+#define HB_F_CASE(n)                                                                         \
+    case (n):                                                                                \
+        if (((n) & HB_F_GUST) && !((n) & HB_F_WIND)) break; /* no gusts without wind */     \
+        SFX(frame_body)(m, fr, x, v, rest, bend_rest, scratch, (n));                         \
+        break;
+#define HB_F_CASE8(n) HB_F_CASE(n) HB_F_CASE(n + 1) HB_F_CASE(n + 2) HB_F_CASE(n + 3) HB_F_CASE(n + 4) \
+    HB_F_CASE(n + 5) HB_F_CASE(n + 6) HB_F_CASE(n + 7)
+    switch (m->features) {
+        HB_F_CASE8(0) HB_F_CASE8(8) HB_F_CASE8(16) HB_F_CASE8(24) HB_F_CASE8(32) HB_F_CASE8(40)
+        HB_F_CASE8(48) HB_F_CASE8(56) HB_F_CASE8(64) HB_F_CASE8(72) HB_F_CASE8(80) HB_F_CASE8(88)
+        HB_F_CASE8(96) HB_F_CASE8(104) HB_F_CASE8(112) HB_F_CASE8(120)
+    default: break;
+    }
+#undef HB_F_CASE8
+#undef HB_F_CASE
+}
+
+/* §3.5 bend rest lengths |X̄_{k+1} − X̄_{k−1}|, once per run in the working precision. */
+void SFX(hb_dyn_bend_rest)(const DMODEL *m, const REAL *rest, REAL *bend_rest)
+{
+    for (int64_t k = 1; k + 1 < m->points; k++) {
+        const REAL *a = rest + 3 * (k - 1), *b = rest + 3 * (k + 1);
+        const REAL ex = b[0] - a[0], ey = b[1] - a[1], ez = b[2] - a[2];
+        bend_rest[k - 1] = SQRT(ex * ex + ey * ey + ez * ez);
+    }
+}
+
+/* §3.8 observables of one strand, in double. */
+void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v, hb_obs_partial *o)
+{
+    const int64_t P = s->points;
+    const double ell = hb_segment_length(s), far2 = 4.0 * s->hair_length * s->hair_length;
+    const double rc = s->head_radius + s->dyn.collision_margin;
+    double smax = 0.0, pmax = 0.0, v2 = 0.0;
+    int64_t blown = 0;
+    for (int64_t k = 0; k < P; k++)
+        for (int c = 0; c < 3; c++) blown |= !isfinite((double)x[3 * k + c]) || !isfinite((double)v[3 * k + c]);
+    for (int64_t k = 1; k < P; k++) {
+        double e[3], r[3], r2 = 0.0, l2 = 0.0, n2 = 0.0, w2 = 0.0;
+        for (int c = 0; c < 3; c++) {
+            e[c] = (double)x[3 * k + c] - (double)x[3 * (k - 1) + c];
+            r[c] = (double)x[3 * k + c] - (double)x[c];
+            l2 += e[c] * e[c];
+            r2 += r[c] * r[c];
+            n2 += (double)x[3 * k + c] * (double)x[3 * k + c];
+            w2 += (double)v[3 * k + c] * (double)v[3 * k + c];
+        }
+        const double st = fabs(sqrt(l2) / ell - 1.0);
+        if (st > smax) smax = st;
+        if (s->dyn.collider) {
+            const double pen = rc - sqrt(n2);
+            if (pen > pmax) pmax = pen;
+        }
+        v2 += w2;
+        if (r2 > far2) blown = 1;
+    }
+    o->stretch_max = smax;
+    o->penetration_max = pmax;
+    o->v2_sum = v2;
+    o->blown = blown;
+}
+
+#undef HB_ALWAYS_INLINE
