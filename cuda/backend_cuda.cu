@@ -9,6 +9,8 @@
  *          separate kernels; wind and collide never touch X.
  *   fused  (default) point-major; a wind immediately followed by collide in the stage list
  *          runs as one kernel (run_stage returns consumed = 2).
+ *   strand, warp  the variants that also run simulate (the dynamic model; backend_dyn.cuh):
+ *          strand point-major as soa, warp strand-major as paper for the other stages.
  *
  * Memory on the device: the state (one state's bytes; point-major: X|Y|Z in one
  * allocation), for soa and fused a canonical staging buffer of the same size (load/fetch
@@ -32,6 +34,7 @@
 
 #include "backend.h"
 #include "check.cuh"
+#include "dyn_kernels.cuh"
 #include "kernels.cuh"
 #include "model.h"
 
@@ -41,7 +44,8 @@ using hb::StrandMajor;
 
 namespace {
 
-enum Variant { V_PAPER = 0, V_SOA = 1, V_FUSED = 2 };
+enum Variant { V_PAPER = 0, V_SOA = 1, V_FUSED = 2, V_STRAND = 3, V_WARP = 4 }; /* strand, warp: backend_dyn.cuh */
+struct DynState;
 
 struct cuda_impl {
     hb_scene scene;
@@ -60,6 +64,7 @@ struct cuda_impl {
     int keep;            /* keep_intermediate(1): fused calls write the wind frame to staging */
     int inter_valid;     /* staging holds the last fused call's wind frame */
     char device[256];
+    DynState *dyn;       /* simulate (backend_dyn.cuh); NULL when the run does not simulate */
 };
 
 double now_ms()
@@ -144,6 +149,8 @@ int device_alloc(void **p, uint64_t bytes, const cuda_impl *c, const char *what,
     return 0;
 }
 
+#include "backend_dyn.cuh"
+
 int setup_inner(hb_backend *b, cuda_impl *c, const hb_options *o, int need_save, uint64_t driver_bytes, char *err,
                 size_t errlen)
 {
@@ -152,7 +159,8 @@ int setup_inner(hb_backend *b, cuda_impl *c, const hb_options *o, int need_save,
     c->P = o->scene.points;
     c->bytes = hb_state_bytes(&o->scene);
     const char *v = o->variant ? o->variant : "fused";
-    c->variant = strcmp(v, "paper") == 0 ? V_PAPER : strcmp(v, "soa") == 0 ? V_SOA : V_FUSED;
+    c->variant = strcmp(v, "paper") == 0 ? V_PAPER : strcmp(v, "soa") == 0 ? V_SOA : strcmp(v, "strand") == 0 ? V_STRAND
+                 : strcmp(v, "warp") == 0 ? V_WARP : V_FUSED;
     c->block = o->block_size;
     b->block_size = c->block;
     b->threads = 0;
@@ -161,18 +169,23 @@ int setup_inner(hb_backend *b, cuda_impl *c, const hb_options *o, int need_save,
     if (pick_device(c->device, sizeof c->device, err, errlen)) return -1;
 
     /* ---- memory: refuse before allocating anything ---- */
-    const int point_major = c->variant != V_PAPER;
+    int rc;
+    const int point_major = !dyn_is_strand_major(c);
     uint64_t need = c->bytes;
     if (point_major) need = sat_add(need, c->bytes); /* staging / intermediate */
     if (need_save) need = sat_add(need, c->bytes);
+    uint64_t dyn_bytes = 0;
+    if ((rc = dyn_plan(c, o, need_save, &dyn_bytes, err, errlen))) return rc;
+    need = sat_add(need, dyn_bytes);
     size_t free_b = 0, total_b = 0;
     HB_CUDA(cudaMemGetInfo(&free_b, &total_b));
     if (need > (uint64_t)free_b) {
         snprintf(err, errlen,
-                 "the state needs %.2f GB of GPU memory (%lld strands x %lld points, %s: state%s%s) but only %.2f GB is "
-                 "free on %s",
+                 "the state needs %.2f GB of GPU memory (%lld strands x %lld points, %s: state%s%s%s) but only %.2f GB "
+                 "is free on %s",
                  1e-9 * (double)need, (long long)c->N, (long long)c->P, hb_precision_name(o->scene.precision),
-                 point_major ? " + staging" : "", need_save ? " + saved copy" : "", 1e-9 * (double)free_b, c->device);
+                 point_major ? " + staging" : "", need_save ? " + saved copy" : "",
+                 dyn_bytes ? " + simulate (velocities, rest shape, scratch)" : "", 1e-9 * (double)free_b, c->device);
         return HB_EXIT_MEMORY;
     }
     const uint64_t avail = hb_host_memory_available();
@@ -184,11 +197,11 @@ int setup_inner(hb_backend *b, cuda_impl *c, const hb_options *o, int need_save,
         return HB_EXIT_MEMORY;
     }
 
-    int rc;
     if ((rc = device_alloc(&c->state, c->bytes, c, "state", err, errlen))) return rc;
     if (point_major && (rc = device_alloc(&c->staging, c->bytes, c, "staging buffer", err, errlen))) return rc;
     if (need_save && (rc = device_alloc(&c->saved, c->bytes, c, "saved copy", err, errlen))) return rc;
     if ((rc = device_alloc((void **)&c->d_count, sizeof *c->d_count, c, "collide counter", err, errlen))) return rc;
+    if ((rc = dyn_alloc(c, need_save, err, errlen))) return rc;
     HB_CUDA(cudaEventCreate(&c->ev0));
     HB_CUDA(cudaEventCreate(&c->ev1));
     c->have_events = 1;
@@ -211,7 +224,7 @@ int cuda_load(hb_backend *b, const void *canonical, double *ms, char *err, size_
 {
     cuda_impl *c = (cuda_impl *)b->impl;
     const double t0 = now_ms();
-    if (c->variant == V_PAPER) {
+    if (dyn_is_strand_major(c)) {
         HB_CUDA(cudaMemcpy(c->state, canonical, (size_t)c->bytes, cudaMemcpyHostToDevice));
     } else {
         c->inter_valid = 0;
@@ -234,7 +247,7 @@ int cuda_fetch(hb_backend *b, void *canonical, double *ms, char *err, size_t err
 {
     cuda_impl *c = (cuda_impl *)b->impl;
     const double t0 = now_ms();
-    if (c->variant == V_PAPER) {
+    if (dyn_is_strand_major(c)) {
         HB_CUDA(cudaMemcpy(canonical, c->state, (size_t)c->bytes, cudaMemcpyDeviceToHost));
     } else {
         c->inter_valid = 0; /* the staging buffer is about to be overwritten */
@@ -278,7 +291,7 @@ int cuda_save(hb_backend *b, char *err, size_t errlen)
         return -1;
     }
     HB_CUDA(cudaMemcpy(c->saved, c->state, (size_t)c->bytes, cudaMemcpyDeviceToDevice));
-    return 0;
+    return dyn_save(c, err, errlen);
 }
 
 int cuda_restore(hb_backend *b, char *err, size_t errlen)
@@ -289,7 +302,7 @@ int cuda_restore(hb_backend *b, char *err, size_t errlen)
         return -1;
     }
     HB_CUDA(cudaMemcpy(c->state, c->saved, (size_t)c->bytes, cudaMemcpyDeviceToDevice));
-    return 0;
+    return dyn_restore(c, err, errlen);
 }
 
 /* Enqueues the kernel(s) of one stage call; *what names the launch for an error. */
@@ -298,7 +311,7 @@ cudaError_t launch_stage(cuda_impl *c, const Model<T> &m, hb_stage st, int fuse,
 {
     const int64_t N = c->N;
     const int B = c->block;
-    if (c->variant == V_PAPER) {
+    if (dyn_is_strand_major(c)) {
         const StrandMajor<T> lay = strand_major<T>(c, c->state);
         switch (st) {
         case HB_STAGE_INIT: *what = "the init kernel launch (paper)"; return hb::launch_init<T>(m, lay, N, B, 0);
@@ -463,6 +476,7 @@ void cuda_teardown(hb_backend *b)
     if (c->staging) cudaFree(c->staging);
     if (c->saved) cudaFree(c->saved);
     if (c->d_count) cudaFree(c->d_count);
+    dyn_free(c);
     if (c->have_events) {
         cudaEventDestroy(c->ev0);
         cudaEventDestroy(c->ev1);
@@ -476,6 +490,10 @@ const hb_variant cuda_variants[] = {
     {"paper", CUDA_PAPER_STAGES, "the paper's scheme: strand-major, one thread per strand, one kernel per stage"},
     {"soa", CUDA_PAPER_STAGES, "point-major structure of arrays, one thread per strand, one kernel per stage"},
     {"fused", CUDA_PAPER_STAGES, "point-major, wind and the collide after it in one kernel"},
+    {"strand", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
+     "point-major like soa; simulate: one thread per strand, a frame's substeps in one launch"},
+    {"warp", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
+     "strand-major like paper; simulate: one warp per strand, a lane per point, the frame in shared memory"},
     {NULL, 0, NULL},
 };
 
@@ -518,5 +536,9 @@ int main(int argc, char **argv)
     b.measure_bandwidth = cuda_measure_bandwidth;
     b.describe = cuda_describe;
     b.teardown = cuda_teardown;
+    b.dyn_load = cuda_dyn_load;
+    b.dyn_frame = cuda_dyn_frame;
+    b.dyn_observe = cuda_dyn_observe;
+    b.dyn_fetch_velocity = cuda_dyn_fetch_velocity;
     return hb_main(argc, argv, &b);
 }

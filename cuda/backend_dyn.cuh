@@ -1,0 +1,325 @@
+/* backend_dyn.cuh — the simulate stage of the CUDA backend (the hb_backend hooks dyn_load,
+ * dyn_frame, dyn_observe, dyn_fetch_velocity; docs/cuda.md "The dynamic model"). Included by
+ * backend_cuda.cu inside its anonymous namespace, after cuda_impl (it is not a translation
+ * unit of its own, hence .cuh).
+ *
+ * Variants that run simulate:
+ *   strand  one thread per strand; the state, velocities and rest shape point-major
+ *           X|Y|Z [P][N] (as soa/fused), bend rest lengths [P−2][N]; p, λ, d in a thread's
+ *           interleaved scratch (9·P reals per resident thread; the grid is capped at the
+ *           threads the device holds at once, each thread takes strands grid-strided).
+ *   warp    one warp per strand; the state, velocities and rest shape canonical [N][P][3]
+ *           (as paper: a strand's 3P reals are contiguous, so the warp's loads coalesce),
+ *           bend rest lengths [N][P−2]; x, v, p, λ, d of the frame in shared memory.
+ *
+ * Device memory of simulate: velocities, rest shape, bend rest lengths, a saved copy of the
+ * velocities for repeats, the strand variant's scratch, the frame's tables ([S][9] + [S])
+ * and the observables' per-chunk partials. Counted in setup's cudaMemGetInfo check.
+ *
+ * Timing: dyn_frame uploads the frame's rotation and phase tables (cudaMemcpyAsync on the
+ * stream, before the start event: not part of r->ms, but of the end-to-end cost of a frame),
+ * then records the events immediately around the one kernel launch.
+ */
+
+namespace hbd = hb::dyn;
+
+struct DynState {
+    int64_t S;
+    void *vel, *vel_saved, *rest, *bend_rest, *scratch, *q, *ph;
+    hbd::ObsPartial *d_obs;
+    hbd::ObsPartial *h_obs;
+    hb_obs_partial *h_part;
+    int64_t nchunks;
+    int grid;
+    hbd::DModel<float> m32;
+    hbd::DModel<double> m64;
+    hbd::ObsScene obs;
+};
+
+int dyn_is_strand_major(const cuda_impl *c) { return c->variant == V_PAPER || c->variant == V_WARP; }
+
+/* The variant's layouts of the state (and of velocities and rest shape). */
+hbd::Layout dyn_layout(const cuda_impl *c)
+{
+    if (c->variant == V_WARP) return hbd::Layout{3 * c->P, 3, 1};
+    return hbd::Layout{1, c->N, c->N * c->P};
+}
+hbd::Layout1 dyn_bend_layout(const cuda_impl *c)
+{
+    if (c->variant == V_WARP) return hbd::Layout1{c->P - 2 > 0 ? c->P - 2 : 0, 1};
+    return hbd::Layout1{1, c->N};
+}
+
+/* Grid of the strand variant: one thread a strand, at most as many threads as the device
+ * holds at once (the scratch is sized for them). */
+int dyn_strand_grid(int64_t N, int block, int64_t resident)
+{
+    int64_t g = (N + block - 1) / block;
+    const int64_t cap = resident / block > 0 ? resident / block : 1;
+    if (g > cap) g = cap;
+    return (int)(g < 1 ? 1 : g);
+}
+
+/* Bytes of device memory simulate adds (0 when it is not in the stage list); refuses a
+ * warp-variant block that does not fit in shared memory. */
+int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, char *err, size_t errlen)
+{
+    *bytes = 0;
+    int on = 0;
+    for (int i = 0; i < o->n_stages; i++) on |= o->stages[i] == HB_STAGE_SIMULATE;
+    if (!on) return 0;
+    if (c->variant != V_STRAND && c->variant != V_WARP) {
+        snprintf(err, errlen, "internal error: variant without simulate reached the simulate setup");
+        return -1;
+    }
+    DynState *d = (DynState *)calloc(1, sizeof *d);
+    if (!d) {
+        snprintf(err, errlen, "out of host memory");
+        return HB_EXIT_MEMORY;
+    }
+    c->dyn = d;
+    const hb_scene *s = &o->scene;
+    hb_dyn_model_f32 m32;
+    hb_dyn_model_f64 m64;
+    hb_dyn_round(s, &m32, &m64);
+    d->m32 = hbd::dmodel_from<float>(m32);
+    d->m64 = hbd::dmodel_from<double>(m64);
+    d->obs = hbd::obs_scene(s);
+    d->S = s->dyn.substeps;
+    if (!hbd::valid_features(m64.features)) {
+        snprintf(err, errlen, "internal error: feature set %u has no kernel", m64.features);
+        return -1;
+    }
+    const uint64_t rs = hb_real_size(s->precision);
+    const int64_t N = c->N, P = c->P;
+    cudaDeviceProp prop;
+    HB_CUDA(cudaGetDeviceProperties(&prop, 0));
+    uint64_t need = sat_add(c->bytes, c->bytes); /* velocities, rest shape */
+    if (need_save) need = sat_add(need, c->bytes);
+    need = sat_add(need, (uint64_t)N * (uint64_t)(P - 2 > 0 ? P - 2 : 1) * rs);
+    need = sat_add(need, (uint64_t)d->S * 10u * rs);
+    d->nchunks = (N + hbd::kObsChunk - 1) / hbd::kObsChunk;
+    need = sat_add(need, (uint64_t)d->nchunks * sizeof(hbd::ObsPartial));
+    if (c->variant == V_STRAND) {
+        const int64_t resident = (int64_t)prop.multiProcessorCount * prop.maxThreadsPerMultiProcessor;
+        d->grid = dyn_strand_grid(N, c->block, resident);
+        need = sat_add(need, (uint64_t)d->grid * (uint64_t)c->block * 9u * (uint64_t)P * rs);
+    } else {
+        const int wpb = c->block / 32;
+        const int64_t g = (N + wpb - 1) / wpb;
+        d->grid = (int)(g > 2147483647 ? 2147483647 : g);
+        const size_t smem = (s->precision == HB_FP32 ? hbd::warp_smem_bytes<float>(P) : hbd::warp_smem_bytes<double>(P)) *
+                            (size_t)wpb;
+        if (smem > prop.sharedMemPerBlockOptin) {
+            snprintf(err, errlen,
+                     "--variant warp keeps each strand in shared memory: %lld points x %d strands a block (--block-size "
+                     "%d) need %.1f KB, more than the %.1f KB a block may have on %s; use a smaller --block-size or "
+                     "--variant strand",
+                     (long long)P, wpb, c->block, (double)smem / 1024.0, (double)prop.sharedMemPerBlockOptin / 1024.0,
+                     c->device);
+            return HB_EXIT_USAGE;
+        }
+    }
+    *bytes = need;
+    return 0;
+}
+
+int dyn_alloc(cuda_impl *c, int need_save, char *err, size_t errlen)
+{
+    DynState *d = c->dyn;
+    if (!d) return 0;
+    const uint64_t rs = hb_real_size(c->scene.precision);
+    const int64_t P = c->P;
+    int rc;
+    if ((rc = device_alloc(&d->vel, c->bytes, c, "velocities", err, errlen))) return rc;
+    if ((rc = device_alloc(&d->rest, c->bytes, c, "rest shape", err, errlen))) return rc;
+    if (need_save && (rc = device_alloc(&d->vel_saved, c->bytes, c, "saved velocities", err, errlen))) return rc;
+    if ((rc = device_alloc(&d->bend_rest, (uint64_t)c->N * (uint64_t)(P - 2 > 0 ? P - 2 : 1) * rs, c,
+                           "bend rest lengths", err, errlen)))
+        return rc;
+    if ((rc = device_alloc(&d->q, (uint64_t)d->S * 9u * rs, c, "rotation table", err, errlen))) return rc;
+    if ((rc = device_alloc(&d->ph, (uint64_t)d->S * rs, c, "phase table", err, errlen))) return rc;
+    if ((rc = device_alloc((void **)&d->d_obs, (uint64_t)d->nchunks * sizeof(hbd::ObsPartial), c, "observables",
+                           err, errlen)))
+        return rc;
+    if (c->variant == V_STRAND &&
+        (rc = device_alloc(&d->scratch, (uint64_t)d->grid * (uint64_t)c->block * 9u * (uint64_t)P * rs, c,
+                           "per-thread scratch", err, errlen)))
+        return rc;
+    d->h_obs = (hbd::ObsPartial *)malloc((size_t)d->nchunks * sizeof *d->h_obs);
+    d->h_part = (hb_obs_partial *)malloc((size_t)d->nchunks * sizeof *d->h_part);
+    if (!d->h_obs || !d->h_part) {
+        snprintf(err, errlen, "out of host memory for the observables");
+        return HB_EXIT_MEMORY;
+    }
+    return 0;
+}
+
+void dyn_free(cuda_impl *c)
+{
+    DynState *d = c->dyn;
+    if (!d) return;
+    void *ptrs[] = {d->vel, d->vel_saved, d->rest, d->bend_rest, d->scratch, d->q, d->ph, d->d_obs};
+    for (void *p : ptrs)
+        if (p) cudaFree(p);
+    free(d->h_obs);
+    free(d->h_part);
+    free(d);
+    c->dyn = NULL;
+}
+
+int dyn_save(cuda_impl *c, char *err, size_t errlen)
+{
+    DynState *d = c->dyn;
+    if (!d) return 0;
+    if (!d->vel_saved) {
+        snprintf(err, errlen, "internal error: save without a saved-velocity buffer");
+        return -1;
+    }
+    HB_CUDA(cudaMemcpy(d->vel_saved, d->vel, (size_t)c->bytes, cudaMemcpyDeviceToDevice));
+    return 0;
+}
+
+int dyn_restore(cuda_impl *c, char *err, size_t errlen)
+{
+    DynState *d = c->dyn;
+    if (!d) return 0;
+    if (!d->vel_saved) {
+        snprintf(err, errlen, "internal error: restore without saved velocities");
+        return -1;
+    }
+    HB_CUDA(cudaMemcpy(d->vel, d->vel_saved, (size_t)c->bytes, cudaMemcpyDeviceToDevice));
+    return 0;
+}
+
+/* canonical host array -> the variant's layout in `dst` (through the staging buffer for
+ * the point-major strand variant) */
+template <typename T>
+int dyn_upload(cuda_impl *c, void *dst, const void *canonical, const char *what, char *err, size_t errlen)
+{
+    if (c->variant == V_WARP) {
+        HB_CUDA_AS(cudaMemcpy(dst, canonical, (size_t)c->bytes, cudaMemcpyHostToDevice), what);
+        return 0;
+    }
+    c->inter_valid = 0;
+    HB_CUDA_AS(cudaMemcpy(c->staging, canonical, (size_t)c->bytes, cudaMemcpyHostToDevice), what);
+    HB_CUDA_AS(hb::launch_to_point_major<T>((const T *)c->staging, point_major<T>(c, dst), c->N, c->P, 0),
+               "the canonical-to-point-major kernel launch (simulate)");
+    HB_CUDA_AS(cudaDeviceSynchronize(), what);
+    return 0;
+}
+
+template <typename T>
+int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char *err, size_t errlen)
+{
+    DynState *d = c->dyn;
+    if (velocity) {
+        if (dyn_upload<T>(c, d->vel, velocity, "uploading the velocities", err, errlen)) return -1;
+    } else {
+        HB_CUDA(cudaMemset(d->vel, 0, (size_t)c->bytes));
+    }
+    if (dyn_upload<T>(c, d->rest, rest, "uploading the rest shape", err, errlen)) return -1;
+    HB_CUDA_AS(hbd::launch_bend_rest<T>((const T *)d->rest, dyn_layout(c), (T *)d->bend_rest, dyn_bend_layout(c), c->N,
+                                        c->P, 0),
+               "the bend-rest-length kernel launch");
+    if (c->variant == V_WARP) {
+        const size_t smem = hbd::warp_smem_bytes<T>(c->P) * (size_t)(c->block / 32);
+        HB_CUDA_AS(hbd::prepare_warp<T>(d->m64.features, smem), "raising the warp kernel's shared-memory limit");
+    }
+    HB_CUDA_AS(cudaDeviceSynchronize(), "dyn_load (cudaDeviceSynchronize)");
+    return 0;
+}
+
+int cuda_dyn_load(hb_backend *b, const void *velocity, const void *rest, char *err, size_t errlen)
+{
+    cuda_impl *c = (cuda_impl *)b->impl;
+    if (!c->dyn) {
+        snprintf(err, errlen, "internal error: simulate was not set up");
+        return -1;
+    }
+    return c->scene.precision == HB_FP32 ? dyn_load_t<float>(c, velocity, rest, err, errlen)
+                                         : dyn_load_t<double>(c, velocity, rest, err, errlen);
+}
+
+template <typename T>
+cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m)
+{
+    DynState *d = c->dyn;
+    if (c->variant == V_STRAND)
+        return hbd::launch_frame_strand<T>(m, (const T *)d->q, (const T *)d->ph, (T *)c->state, (T *)d->vel,
+                                           (const T *)d->rest, (const T *)d->bend_rest, (T *)d->scratch, c->N, d->grid,
+                                           c->block, 0);
+    return hbd::launch_frame_warp<T>(m, (const T *)d->q, (const T *)d->ph, (T *)c->state, (T *)d->vel,
+                                     (const T *)d->rest, (const T *)d->bend_rest, c->N, d->grid, c->block, 0);
+}
+
+int cuda_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen)
+{
+    cuda_impl *c = (cuda_impl *)b->impl;
+    DynState *d = c->dyn;
+    const int fp32 = c->scene.precision == HB_FP32;
+    const size_t rs = fp32 ? sizeof(float) : sizeof(double);
+    if (f->substeps != d->S) {
+        snprintf(err, errlen, "internal error: a frame of %lld substeps for a run of %lld", (long long)f->substeps,
+                 (long long)d->S);
+        return -1;
+    }
+    /* the frame's tables: enqueued before the start event, so not in r->ms */
+    HB_CUDA(cudaMemcpyAsync(d->q, fp32 ? (const void *)f->q32 : (const void *)f->q64, (size_t)d->S * 9u * rs,
+                            cudaMemcpyHostToDevice, 0));
+    HB_CUDA(cudaMemcpyAsync(d->ph, fp32 ? (const void *)f->phase32 : (const void *)f->phase64, (size_t)d->S * rs,
+                            cudaMemcpyHostToDevice, 0));
+    HB_CUDA(cudaEventRecord(c->ev0, 0));
+    const cudaError_t e = fp32 ? dyn_launch<float>(c, d->m32) : dyn_launch<double>(c, d->m64);
+    HB_CUDA_AS(e, c->variant == V_STRAND ? "the simulate kernel launch (strand)" : "the simulate kernel launch (warp)");
+    HB_CUDA(cudaEventRecord(c->ev1, 0));
+    HB_CUDA_AS(cudaEventSynchronize(c->ev1), "the simulate kernel (cudaEventSynchronize)");
+    float ms = 0.0f;
+    HB_CUDA(cudaEventElapsedTime(&ms, c->ev0, c->ev1));
+    r->ms = (double)ms;
+    r->moved_points = -1;
+    r->consumed = 1;
+    return 0;
+}
+
+int cuda_dyn_observe(hb_backend *b, hb_observables *obs, char *err, size_t errlen)
+{
+    cuda_impl *c = (cuda_impl *)b->impl;
+    DynState *d = c->dyn;
+    if (c->scene.precision == HB_FP32)
+        HB_CUDA_AS(hbd::launch_observe<float>(d->obs, (const float *)c->state, (const float *)d->vel, dyn_layout(c),
+                                              c->N, d->d_obs, 0),
+                   "the observables kernel launch");
+    else
+        HB_CUDA_AS(hbd::launch_observe<double>(d->obs, (const double *)c->state, (const double *)d->vel,
+                                               dyn_layout(c), c->N, d->d_obs, 0),
+                   "the observables kernel launch");
+    HB_CUDA(cudaMemcpy(d->h_obs, d->d_obs, (size_t)d->nchunks * sizeof *d->h_obs, cudaMemcpyDeviceToHost));
+    for (int64_t i = 0; i < d->nchunks; i++) {
+        d->h_part[i].stretch_max = d->h_obs[i].stretch_max;
+        d->h_part[i].penetration_max = d->h_obs[i].penetration_max;
+        d->h_part[i].v2_sum = d->h_obs[i].v2_sum;
+        d->h_part[i].blown = (int64_t)d->h_obs[i].blown;
+    }
+    hb_dyn_reduce(d->h_part, d->nchunks, c->P, c->N, obs); /* chunks in index order */
+    return 0;
+}
+
+int cuda_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, size_t errlen)
+{
+    cuda_impl *c = (cuda_impl *)b->impl;
+    DynState *d = c->dyn;
+    if (c->variant == V_WARP) {
+        HB_CUDA(cudaMemcpy(canonical, d->vel, (size_t)c->bytes, cudaMemcpyDeviceToHost));
+        return 0;
+    }
+    c->inter_valid = 0;
+    if (c->scene.precision == HB_FP32)
+        HB_CUDA_AS(hb::launch_to_canonical<float>(point_major<float>(c, d->vel), (float *)c->staging, c->N, c->P, 0),
+                   "the point-major-to-canonical kernel launch (velocities)");
+    else
+        HB_CUDA_AS(hb::launch_to_canonical<double>(point_major<double>(c, d->vel), (double *)c->staging, c->N, c->P, 0),
+                   "the point-major-to-canonical kernel launch (velocities)");
+    HB_CUDA(cudaMemcpy(canonical, c->staging, (size_t)c->bytes, cudaMemcpyDeviceToHost));
+    return 0;
+}

@@ -1,0 +1,105 @@
+/* dyn_kernels.cuh — the launchers of the dynamic model's kernels (cuda/dyn_kernels.cu; the
+ * math is cuda/dyn_model.cuh, the design docs/cuda.md "The dynamic model").
+ *
+ * Every launcher enqueues its kernel on `stream` and returns cudaGetLastError() right after
+ * the launch, so the caller checks each launch (cuda/check.cuh). Instantiated for T = float
+ * and T = double.
+ */
+#ifndef HB_DYN_KERNELS_CUH
+#define HB_DYN_KERNELS_CUH
+
+#include <cuda_runtime.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dyn_model.cuh"
+
+namespace hb {
+namespace dyn {
+
+/* Where strand i's point k, coordinate c lies in an array: base[i·is + k·ks + c·cs].
+ *   point-major X|Y|Z [P][N] (the strand variant): is = 1, ks = N, cs = N·P
+ *   canonical [N][P][3] (the warp variant):        is = 3P, ks = 3, cs = 1 */
+struct Layout {
+    int64_t is, ks, cs;
+};
+/* A per-strand array of P − 2 bend rest lengths: entry j of strand i at base[i·is + j·s]. */
+struct Layout1 {
+    int64_t is, s;
+};
+
+/* Strands per observe block: per-strand partials are combined in strand order within a
+ * chunk of this many strands, and the chunks in order on the host, exactly as
+ * backend_cpu.c's cpu_dyn_observe does (its OBS_CHUNK), so the sums do not depend on the
+ * block size, and equal the CPU's where the states are equal. */
+constexpr int64_t kObsChunk = 1024;
+
+/* A feature mask that a run can have: not a gust without wind. */
+constexpr bool valid_mask(unsigned f) { return !((f & HB_F_GUST) && !(f & HB_F_WIND)) && f < HB_F_COUNT; }
+inline bool valid_features(unsigned f) { return valid_mask(f); }
+
+/* The feature sets with kernels of their own: the scenes of the analytic checks and the
+ * common runs (xpbd/ftl with or without bend, shape, wind, gusts, motion, the collider,
+ * drag). Masks: BEND 1, SHAPE 2, WIND 4, GUST 8, MOTION 16, COLLIDE 32, DRAG 64. */
+constexpr bool specialised_mask(unsigned f)
+{
+#if defined(HB_DYN_SPECIALISE_ALL)
+    return true;
+#else
+    switch (f) {
+    case 0:                           /* gravity only (pendulum, chain) */
+    case HB_F_DRAG:                   /* pendulum with damping */
+    case HB_F_WIND | HB_F_DRAG:       /* hanging particle in a wind */
+    case HB_F_COLLIDE:                /* the default scene: collider on */
+    case HB_F_COLLIDE | HB_F_DRAG:
+    case HB_F_BEND | HB_F_COLLIDE | HB_F_DRAG:
+    case HB_F_BEND | HB_F_SHAPE | HB_F_COLLIDE | HB_F_DRAG:
+    case HB_F_BEND | HB_F_WIND | HB_F_COLLIDE | HB_F_DRAG:
+    case HB_F_BEND | HB_F_WIND | HB_F_GUST | HB_F_COLLIDE | HB_F_DRAG:
+    case HB_F_BEND | HB_F_SHAPE | HB_F_WIND | HB_F_GUST | HB_F_COLLIDE | HB_F_DRAG:
+    case HB_F_BEND | HB_F_SHAPE | HB_F_MOTION | HB_F_COLLIDE | HB_F_DRAG:
+    case HB_F_BEND | HB_F_SHAPE | HB_F_WIND | HB_F_GUST | HB_F_MOTION | HB_F_COLLIDE | HB_F_DRAG: /* everything */
+        return true;
+    default:
+        return false;
+    }
+#endif
+}
+
+
+/* The strand variant: one thread per strand, all S substeps of the frame in one launch.
+ * x, v, rest: point-major X|Y|Z [P][N]; bend_rest [P−2][N]; scratch: 9·P·threads reals
+ * (p, λ, d of each thread, interleaved so that a warp's accesses coalesce), threads =
+ * grid·block. q, phase: the frame's tables on the device ([S][9], [S]). */
+template <typename T>
+cudaError_t launch_frame_strand(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
+                                const T *bend_rest, T *scratch, int64_t N, int grid, int block, cudaStream_t stream);
+
+/* The warp variant: one warp per strand (block/32 strands per block), the strand's x, v, p,
+ * λ and d in shared memory (warp_smem_bytes per warp). x, v, rest canonical [N][P][3];
+ * bend_rest [N][P−2]. */
+template <typename T>
+cudaError_t launch_frame_warp(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
+                              const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream);
+template <typename T>
+size_t warp_smem_bytes(int64_t P);
+/* Allows the warp kernel of this feature set `bytes` of dynamic shared memory a block (the
+ * opt-in above 48 KB). */
+template <typename T>
+cudaError_t prepare_warp(unsigned features, size_t bytes);
+
+/* Bend rest lengths |X̄_{k+1} − X̄_{k−1}| of every strand, on the device (one thread a strand). */
+template <typename T>
+cudaError_t launch_bend_rest(const T *rest, Layout rl, T *bend_rest, Layout1 bl, int64_t N, int64_t P,
+                             cudaStream_t stream);
+
+/* Observables: out[b] = the partials of strands b·kObsChunk … (b+1)·kObsChunk − 1, combined
+ * in strand order; ceil(N / kObsChunk) blocks. */
+template <typename T>
+cudaError_t launch_observe(const ObsScene &sc, const T *x, const T *v, Layout lay, int64_t N, ObsPartial *out,
+                           cudaStream_t stream);
+
+} /* namespace dyn */
+} /* namespace hb */
+
+#endif

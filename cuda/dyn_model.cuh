@@ -1,0 +1,442 @@
+/* dyn_model.cuh — the dynamic model (docs/model.md §3) for the CUDA port: c_ref/dynamics_impl.h
+ * written as `__host__ __device__` templates over the floating type T, the feature set, the
+ * memory layout of the strand and the way a loop over points or constraints is executed.
+ *
+ * This file follows c_ref/dynamics_impl.h operation by operation: the same expressions in
+ * the same order (no reassociation, the same divisions, the same branches). A build without
+ * FMA contraction and with IEEE division and square root (hairsim-cuda-strict) therefore
+ * differs from the C reference only where CUDA's sinf/sin differ from glibc's (gusts only;
+ * the rest uses +, −, ×, ÷ and sqrt, all correctly rounded). Compiled for the host
+ * (cuda/hostcheck/dyn_hostcheck.cu) the same templates call glibc and must reproduce
+ * c_ref/dynamics_f32.c / dynamics_f64.c bit for bit. The normal build contracts a·b + c into
+ * FMAs and the fast-math build uses approximate sinf, division and square root: both differ.
+ *
+ * The three policies:
+ *   Feat  the feature set (docs/model.md §3.9): StaticF<F> folds every `has(bit)` at compile
+ *         time, so an undeclared feature leaves no code; DynF keeps the set as a run-time mask
+ *         (the generic fallback of cuda/dyn_kernels.cu).
+ *   Arr   where coordinate c of point k of the strand is: base[k·ks + c·cs]. One type covers
+ *         the canonical array (ks = 3, cs = 1), the point-major planes X|Y|Z [P][N]
+ *         (ks = N, cs = N·P), a warp's shared-memory planes [3][P] (ks = 1, cs = P) and a
+ *         thread's interleaved scratch (ks = T, cs = P·T for T threads).
+ *   Exec  how a loop runs: Seq runs it in order on one thread (the strand variant, and the
+ *         C reference's order); Lanes (cuda/dyn_kernels.cu) spreads its iterations over
+ *         the 32 lanes of a warp and ends with __syncwarp(). Only loops whose iterations
+ *         touch disjoint data are handed to Exec::each (a group of §3.6, the per-point
+ *         velocity and position steps, the multiplier reset); the follow-the-leader chain
+ *         and the root step run through Exec::one (one lane). So every point sees the same
+ *         operations on the same inputs in any Exec, and the bits are the same.
+ */
+#ifndef HB_DYN_MODEL_CUH
+#define HB_DYN_MODEL_CUH
+
+#include <math.h>
+#include <stdint.h>
+
+#include "dynamics.h" /* HB_F_*, hb_dyn_model_f32/f64 */
+#include "params.h"   /* HB_SOLVER_* */
+
+#if defined(__CUDACC__)
+#define HB_DHD __host__ __device__ __forceinline__
+#else
+#define HB_DHD inline
+#endif
+
+namespace hb {
+namespace dyn {
+
+/* The run's constants in T: the fields of hb_dyn_model_f32/f64 (hb_dyn_round made them). */
+template <typename T>
+struct DModel {
+    int64_t points, substeps, iterations, shape_count;
+    int solver;
+    unsigned features;
+    T h, seg_len, gravity_y, wind_y, wind_z, dir_y, dir_z, kappa, gust, den, stretch_at, bend_at, shape_at,
+        collide_r, ftl_s;
+};
+
+template <typename T, typename M>
+inline DModel<T> dmodel_from(const M &m)
+{
+    DModel<T> r;
+    r.points = m.points;
+    r.substeps = m.substeps;
+    r.iterations = m.iterations;
+    r.shape_count = m.shape_count;
+    r.solver = m.solver;
+    r.features = m.features;
+    r.h = m.h;
+    r.seg_len = m.seg_len;
+    r.gravity_y = m.gravity_y;
+    r.wind_y = m.wind_y;
+    r.wind_z = m.wind_z;
+    r.dir_y = m.dir_y;
+    r.dir_z = m.dir_z;
+    r.kappa = m.kappa;
+    r.gust = m.gust;
+    r.den = m.den;
+    r.stretch_at = m.stretch_at;
+    r.bend_at = m.bend_at;
+    r.shape_at = m.shape_at;
+    r.collide_r = m.collide_r;
+    r.ftl_s = m.ftl_s;
+    return r;
+}
+
+/* The observables' scene numbers, in double, as hb_dyn_observe_strand computes them. */
+struct ObsScene {
+    int64_t points;
+    double ell, far2, rc;
+    int collider;
+};
+
+inline ObsScene obs_scene(const hb_scene *s)
+{
+    ObsScene o;
+    o.points = s->points;
+    o.ell = hb_segment_length(s);
+    o.far2 = 4.0 * s->hair_length * s->hair_length;
+    o.rc = s->head_radius + s->dyn.collision_margin;
+    o.collider = s->dyn.collider;
+    return o;
+}
+
+/* ---- math: the float functions for float, the double ones for double ---- */
+HB_DHD float d_sqrt(float x) { return sqrtf(x); }
+HB_DHD double d_sqrt(double x) { return sqrt(x); }
+HB_DHD float d_sin(float x) { return sinf(x); }
+HB_DHD double d_sin(double x) { return sin(x); }
+
+/* ---- policies ---- */
+template <unsigned F>
+struct StaticF {
+    HB_DHD constexpr bool operator()(unsigned bit) const { return (F & bit) != 0u; }
+};
+struct DynF {
+    unsigned f;
+    HB_DHD bool operator()(unsigned bit) const { return (f & bit) != 0u; }
+};
+
+template <typename T>
+struct Arr {
+    T *b;
+    int64_t ks, cs;
+    HB_DHD T &operator()(int64_t k, int c) const { return b[k * ks + (int64_t)c * cs]; }
+};
+template <typename T>
+struct Arr1 {
+    T *b;
+    int64_t s;
+    HB_DHD T &operator()(int64_t i) const { return b[i * s]; }
+};
+
+/* One strand: x, v (state), rest X̄, bend rest lengths, and the frame's working arrays:
+ * predicted positions p, multipliers λ (stretch P−1 | bend P−2 | shape K at 0, P, 2P) and
+ * the ftl corrections d. */
+template <typename T>
+struct Strand {
+    Arr<T> x, v;
+    Arr<const T> rest;
+    Arr1<const T> bend_rest;
+    Arr<T> p, d;
+    Arr1<T> lam;
+};
+
+struct Seq {
+    template <class Fn>
+    HB_DHD void each(int64_t b, int64_t e, int64_t step, Fn f) const
+    {
+        for (int64_t k = b; k < e; k += step) f(k);
+    }
+    template <class Fn>
+    HB_DHD void one(Fn f) const
+    {
+        f();
+    }
+};
+
+/* ---- the constraints (§3.5) on scalars ---- */
+
+/* r = Q·a, row-major Q, each row summed left to right. */
+template <typename T>
+HB_DHD void rotate(const T *q, T a0, T a1, T a2, T *r)
+{
+    r[0] = q[0] * a0 + q[1] * a1 + q[2] * a2;
+    r[1] = q[3] * a0 + q[4] * a1 + q[5] * a2;
+    r[2] = q[6] * a0 + q[7] * a1 + q[8] * a2;
+}
+
+/* distance constraint between point a and point b of `p` (dynamics_impl.h distance) */
+template <typename T>
+HB_DHD void distance(const Arr<T> &p, int64_t ia, int64_t ib, int move_a, T r, T at, T &lambda)
+{
+    const T ex = p(ib, 0) - p(ia, 0), ey = p(ib, 1) - p(ia, 1), ez = p(ib, 2) - p(ia, 2);
+    const T len = d_sqrt(ex * ex + ey * ey + ez * ez);
+    if (len == (T)0) return;
+    const T c = len - r;
+    const T wsum = move_a ? (T)2 : (T)1;
+    const T dl = (-c - at * lambda) / (wsum + at);
+    lambda = lambda + dl;
+    const T nx = ex / len, ny = ey / len, nz = ez / len;
+    if (move_a) {
+        p(ia, 0) = p(ia, 0) - dl * nx;
+        p(ia, 1) = p(ia, 1) - dl * ny;
+        p(ia, 2) = p(ia, 2) - dl * nz;
+    }
+    p(ib, 0) = p(ib, 0) + dl * nx;
+    p(ib, 1) = p(ib, 1) + dl * ny;
+    p(ib, 2) = p(ib, 2) + dl * nz;
+}
+
+template <typename T>
+HB_DHD void shape_pull(const Arr<T> &p, int64_t k, const T *t, T at, T &lambda)
+{
+    const T ex = p(k, 0) - t[0], ey = p(k, 1) - t[1], ez = p(k, 2) - t[2];
+    const T c = d_sqrt(ex * ex + ey * ey + ez * ez);
+    if (c == (T)0) return;
+    const T dl = (-c - at * lambda) / ((T)1 + at);
+    lambda = lambda + dl;
+    p(k, 0) = p(k, 0) + dl * (ex / c);
+    p(k, 1) = p(k, 1) + dl * (ey / c);
+    p(k, 2) = p(k, 2) + dl * (ez / c);
+}
+
+/* head collision on a point held in three scalars */
+template <typename T>
+HB_DHD void collide_sphere(T &p0, T &p1, T &p2, T rc)
+{
+    const T len = d_sqrt(p0 * p0 + p1 * p1 + p2 * p2);
+    if (!(len < rc)) return;
+    if (len == (T)0) {
+        p0 = (T)0;
+        p1 = rc;
+        p2 = (T)0;
+        return;
+    }
+    const T sc = rc / len;
+    p0 = p0 * sc;
+    p1 = p1 * sc;
+    p2 = p2 * sc;
+}
+
+/* k of the g-th member of bend group `parity`: ⌊(k−1)/2⌋ ≡ parity (mod 2), k ascending. */
+HB_DHD int64_t bend_k(int64_t g, int parity) { return 1 + 4 * (g >> 1) + (g & 1) + 2 * parity; }
+
+template <typename T, class Exec>
+HB_DHD void bend_group(const DModel<T> &m, const Strand<T> &s, const Exec &ex, int parity)
+{
+    const int64_t P = m.points;
+    const Arr<T> p = s.p;
+    const Arr1<const T> br = s.bend_rest;
+    const Arr1<T> lam = s.lam;
+    const T at = m.bend_at;
+    /* members g = 0, 1, …: at most P/2 + 2 of them; k + 1 < P bounds the group */
+    ex.each(0, P / 2 + 2, 1, [&](int64_t g) {
+        const int64_t k = bend_k(g, parity);
+        if (k + 1 < P) distance(p, k - 1, k + 1, k - 1 != 0, br(k - 1), at, lam(P + k - 1));
+    });
+}
+
+template <typename T, class Feat, class Exec>
+HB_DHD void shape_all(const DModel<T> &m, const Strand<T> &s, const T *q, const Exec &ex, Feat has)
+{
+    const int64_t P = m.points;
+    const Arr<T> p = s.p;
+    const Arr<const T> rest = s.rest;
+    const Arr1<T> lam = s.lam;
+    const T at = m.shape_at;
+    ex.each(1, m.shape_count + 1, 1, [&](int64_t k) {
+        T t[3];
+        if (has(HB_F_MOTION)) rotate(q, rest(k, 0), rest(k, 1), rest(k, 2), t);
+        else {
+            t[0] = rest(k, 0);
+            t[1] = rest(k, 1);
+            t[2] = rest(k, 2);
+        }
+        shape_pull(p, k, t, at, lam(2 * P + k - 1));
+    });
+}
+
+/* One frame of one strand: S substeps of §3.4 with the solver of §3.6 or §3.7.
+ * qtab: [S][9] rotations Q(t+h); phtab: [S] gust phases φ(t) (hb_dyn_frame_plan). */
+template <typename T, class Feat, class Exec>
+HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const Strand<T> &s, const Exec &ex,
+                       Feat has)
+{
+    const int64_t P = m.points;
+    const T h = m.h;
+    const Arr<T> x = s.x, v = s.v, p = s.p, d = s.d;
+    const Arr<const T> rest = s.rest;
+    const Arr1<T> lam = s.lam;
+
+    for (int64_t j = 0; j < m.substeps; j++) {
+        const T *q = qtab + 9 * j;
+        const T phase = phtab[j];
+
+        /* 1. root on the head, then p0 = x0 */
+        ex.one([&]() {
+            if (has(HB_F_MOTION)) {
+                T r[3];
+                rotate(q, rest(0, 0), rest(0, 1), rest(0, 2), r);
+                for (int c = 0; c < 3; c++) {
+                    v(0, c) = (r[c] - x(0, c)) / h;
+                    x(0, c) = r[c];
+                }
+            }
+            p(0, 0) = x(0, 0);
+            p(0, 1) = x(0, 1);
+            p(0, 2) = x(0, 2);
+        });
+
+        /* 2. velocities, implicit in drag and damping, then the prediction */
+        ex.each(1, P, 1, [&](int64_t k) {
+            T vx = v(k, 0), vy = v(k, 1), vz = v(k, 2);
+            if (has(HB_F_WIND)) {
+                T gam = (T)1;
+                if (has(HB_F_GUST)) gam = (T)1 + m.gust * d_sin(phase - m.kappa * (m.dir_y * x(k, 1) + m.dir_z * x(k, 2)));
+                vy = vy + h * (m.gravity_y + m.wind_y * gam);
+                vz = vz + h * (m.wind_z * gam);
+            } else {
+                vy = vy + h * m.gravity_y;
+            }
+            if (has(HB_F_DRAG)) {
+                vx = vx / m.den;
+                vy = vy / m.den;
+                vz = vz / m.den;
+            }
+            v(k, 0) = vx;
+            v(k, 1) = vy;
+            v(k, 2) = vz;
+            p(k, 0) = x(k, 0) + h * vx;
+            p(k, 1) = x(k, 1) + h * vy;
+            p(k, 2) = x(k, 2) + h * vz;
+        });
+
+        /* 3. constraints; every multiplier starts the substep at 0 */
+        ex.each(0, 3 * P, 1, [&](int64_t i) { lam(i) = (T)0; });
+        if (m.solver == HB_SOLVER_XPBD) {
+            for (int64_t it = 0; it < m.iterations; it++) {
+                ex.each(1, P, 2, [&](int64_t k) { /* stretch, k odd */
+                    distance(p, k - 1, k, k - 1 != 0, m.seg_len, m.stretch_at, lam(k - 1));
+                });
+                ex.each(2, P, 2, [&](int64_t k) { /* stretch, k even */
+                    distance(p, k - 1, k, 1, m.seg_len, m.stretch_at, lam(k - 1));
+                });
+                if (has(HB_F_BEND)) {
+                    bend_group(m, s, ex, 0);
+                    bend_group(m, s, ex, 1);
+                }
+                if (has(HB_F_SHAPE)) shape_all(m, s, q, ex, has);
+                if (has(HB_F_COLLIDE))
+                    ex.each(1, P, 1, [&](int64_t k) { collide_sphere(p(k, 0), p(k, 1), p(k, 2), m.collide_r); });
+            }
+        } else {
+            for (int64_t it = 0; it < m.iterations; it++) {
+                if (has(HB_F_BEND)) {
+                    bend_group(m, s, ex, 0);
+                    bend_group(m, s, ex, 1);
+                }
+                if (has(HB_F_SHAPE)) shape_all(m, s, q, ex, has);
+            }
+            /* §3.7 follow the leader, k ascending: each point follows its corrected predecessor */
+            ex.one([&]() {
+                for (int64_t k = 1; k < P; k++) {
+                    const T ex_ = p(k, 0) - p(k - 1, 0), ey = p(k, 1) - p(k - 1, 1), ez = p(k, 2) - p(k - 1, 2);
+                    const T len = d_sqrt(ex_ * ex_ + ey * ey + ez * ez);
+                    T nq[3];
+                    if (len > (T)0) {
+                        nq[0] = p(k - 1, 0) + m.seg_len * (ex_ / len);
+                        nq[1] = p(k - 1, 1) + m.seg_len * (ey / len);
+                        nq[2] = p(k - 1, 2) + m.seg_len * (ez / len);
+                    } else {
+                        nq[0] = p(k - 1, 0);
+                        nq[1] = p(k - 1, 1) - m.seg_len;
+                        nq[2] = p(k - 1, 2);
+                    }
+                    for (int c = 0; c < 3; c++) d(k, c) = nq[c] - p(k, c);
+                    if (has(HB_F_COLLIDE)) collide_sphere(nq[0], nq[1], nq[2], m.collide_r);
+                    for (int c = 0; c < 3; c++) p(k, c) = nq[c];
+                }
+            });
+        }
+
+        /* 4. velocities from the motion (ftl: less s·d_{k+1}/h), then the positions. Per
+         * point the same operations as the reference's three loops, in the same order. */
+        const int ftl = m.solver == HB_SOLVER_FTL;
+        ex.each(1, P, 1, [&](int64_t k) {
+            for (int c = 0; c < 3; c++) {
+                T vk = (p(k, c) - x(k, c)) / h;
+                if (ftl && k + 1 < P) vk = vk - (m.ftl_s * d(k + 1, c)) / h;
+                v(k, c) = vk;
+                x(k, c) = p(k, c);
+            }
+        });
+    }
+}
+
+/* §3.5 bend rest lengths |X̄_{k+1} − X̄_{k−1}| (dynamics_impl.h hb_dyn_bend_rest). */
+template <typename T>
+HB_DHD void bend_rest(int64_t P, const Arr<const T> &rest, const Arr1<T> &out)
+{
+    for (int64_t k = 1; k + 1 < P; k++) {
+        const T ex = rest(k + 1, 0) - rest(k - 1, 0), ey = rest(k + 1, 1) - rest(k - 1, 1),
+                ez = rest(k + 1, 2) - rest(k - 1, 2);
+        out(k - 1) = d_sqrt(ex * ex + ey * ey + ez * ez);
+    }
+}
+
+/* Per-strand partial observables (§3.8), in double: hb_obs_partial's fields. */
+struct ObsPartial {
+    double stretch_max, penetration_max, v2_sum;
+    long long blown;
+};
+
+HB_DHD int finite_d(double a) { return isfinite(a) ? 1 : 0; }
+
+template <typename T>
+HB_DHD void observe_strand(const ObsScene &sc, const Arr<const T> &x, const Arr<const T> &v, ObsPartial *o)
+{
+    const int64_t P = sc.points;
+    const double ell = sc.ell, far2 = sc.far2, rc = sc.rc;
+    double smax = 0.0, pmax = 0.0, v2 = 0.0;
+    long long blown = 0;
+    for (int64_t k = 0; k < P; k++)
+        for (int c = 0; c < 3; c++) blown |= !finite_d((double)x(k, c)) || !finite_d((double)v(k, c));
+    for (int64_t k = 1; k < P; k++) {
+        double e[3], r[3], r2 = 0.0, l2 = 0.0, n2 = 0.0, w2 = 0.0;
+        for (int c = 0; c < 3; c++) {
+            e[c] = (double)x(k, c) - (double)x(k - 1, c);
+            r[c] = (double)x(k, c) - (double)x(0, c);
+            l2 += e[c] * e[c];
+            r2 += r[c] * r[c];
+            n2 += (double)x(k, c) * (double)x(k, c);
+            w2 += (double)v(k, c) * (double)v(k, c);
+        }
+        const double st = fabs(sqrt(l2) / ell - 1.0);
+        if (st > smax) smax = st;
+        if (sc.collider) {
+            const double pen = rc - sqrt(n2);
+            if (pen > pmax) pmax = pen;
+        }
+        v2 += w2;
+        if (r2 > far2) blown = 1;
+    }
+    o->stretch_max = smax;
+    o->penetration_max = pmax;
+    o->v2_sum = v2;
+    o->blown = blown;
+}
+
+/* acc ← acc combined with o (hb_dyn_reduce_into). */
+HB_DHD void reduce_into(ObsPartial *acc, const ObsPartial *o)
+{
+    if (o->stretch_max > acc->stretch_max) acc->stretch_max = o->stretch_max;
+    if (o->penetration_max > acc->penetration_max) acc->penetration_max = o->penetration_max;
+    acc->v2_sum += o->v2_sum;
+    acc->blown += o->blown;
+}
+
+} /* namespace dyn */
+} /* namespace hb */
+
+#endif
