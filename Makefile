@@ -135,8 +135,13 @@ sanitize: check-python check-hdf5
 	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(PYTHON) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume"
 
 # compute-sanitizer (memcheck, racecheck) over every CUDA variant on a small run that also
-# exercises the output, resume and end-to-end paths. Needs a GPU.
+# exercises the output, resume and end-to-end paths, and simulate on the strand and warp
+# variants (both solvers and precisions, a resume from a middle frame). Needs a GPU.
 SAN_RUN := --strands 1000 --points 16 --hair-length 10 --repeat 2 --end-to-end --quiet
+# simulate (strand, warp): every feature, P = 45 (the warp's lanes take one or two points), 3 frames
+SAN_SIM := --strands 300 --points 45 --hair-length 10 --stages init,simulate --frames 3 --velocities all --repeat 2 \
+  --substeps 2 --iterations 2 --bend-compliance 1e-6 --shape-compliance 1e-5 --wind-speed 300 --drag 2 \
+  --gust-amplitude 0.5 --head-motion nod --quiet
 sanitize-gpu: cuda
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
 	@set -e; for v in paper soa fused; do for p in fp32 fp64; do \
@@ -148,6 +153,17 @@ sanitize-gpu: cuda
 	  done; \
 	  echo "racecheck $$v"; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_RUN) --variant $$v; \
+	done; \
+	for v in strand warp; do for p in fp32 fp64; do for s in xpbd ftl; do \
+	  echo "memcheck simulate $$v $$p $$s"; \
+	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) \
+	    --variant $$v --precision $$p --solver $$s --output $(BUILD)/san-sim-$$v-$$p-$$s.h5 --force; \
+	  compute-sanitizer --tool memcheck --error-exitcode 9 $(BUILD)/hairsim-cuda --input $(BUILD)/san-sim-$$v-$$p-$$s.h5 \
+	    --input-frame 2 --stages simulate --frames 1 --variant $$v --quiet --output $(BUILD)/san-sim-$$v-$$p-$$s-r.h5 --force; \
+	  done; done; \
+	  echo "racecheck simulate $$v"; \
+	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --variant $$v --frames 1; \
+	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --variant $$v --frames 1 --solver ftl; \
 	done; rm -f $(BUILD)/san-*.h5; echo "compute-sanitizer: memcheck and racecheck found no errors in any variant"
 
 clean:

@@ -22,6 +22,7 @@ import subprocess
 
 import pytest
 
+from conftest import CUDA_BIN
 from test_cuda_port_host import C_FLAGS, _run, _tool
 
 NVCC_FLAGS = ["-std=c++17", "-O1", "-Xcompiler", "-ffp-contract=off,-fno-fast-math"]
@@ -58,3 +59,14 @@ def test_cuda_dynamic_model_matches_c_reference_bit_for_bit(dyn_hostcheck):
     # rest lengths, the observables and 3 modes x (run-time mask, + compiled where specialised)
     cases = int(summary.split()[3])
     assert cases >= 96 * 2 * 2 * 6 * (2 + 3), summary
+
+
+@pytest.mark.parametrize("variant", ("paper", "soa", "fused"))
+def test_paper_variants_refuse_simulate(variant):
+    """The driver refuses before any device is touched, so this runs without a GPU."""
+    if not CUDA_BIN.exists():
+        pytest.skip(f"{CUDA_BIN} is not built (nvcc missing or `make` not run)")
+    p = subprocess.run([str(CUDA_BIN), "--strands", "10", "--stages", "init,simulate", "--variant", variant, "--quiet"],
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 2, (p.returncode, p.stderr)
+    assert f"variant {variant} does not run 'simulate'" in p.stderr, p.stderr

@@ -1,0 +1,243 @@
+"""GPU tests of the dynamic model's CUDA port (the simulate stage; cuda/dyn_kernels.cu,
+docs/cuda.md "The dynamic model"). Every test is marked `gpu`; conftest.py skips them, with
+the reason, where there is no usable GPU.
+
+One frame on the GPU from the CPU's state: the CPU runs `init,simulate` for K frames with
+--velocities all; each GPU build resumes from the CPU's frame k (`--input cpu.h5
+--input-frame k --stages simulate --frames 1`) and its frame is compared with the CPU's
+frame k+1, positions, velocities and observables. For each variant (strand, warp) x solver
+(xpbd, ftl) x precision x block size x build, on scenes with the feature set compiled in
+(cuda/dyn_kernels.cuh specialised_mask) and one that runs the generic kernel.
+
+Rules (harness/tolerances.py GPU_DYN_*): the strict build equals the CPU bit for bit
+without gusts, and is within GPU_DYN_POS / GPU_DYN_VEL with them; the normal and fast-math
+builds are within their bounds. Every build: bit-identical across block sizes and repeats.
+Strict build: strand and warp bit-identical. The measured worst errors go to
+build/gpu_dyn_test_errors.json (for recalibrating the tolerances).
+"""
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import BUILD, CPU_BIN, CUDA_BIN, CUDA_FASTMATH_BIN, CUDA_STRICT_BIN
+from harness import dynstate
+from harness.states import open_state
+from harness.tolerances import (GPU_DYN_MAX_OVER_FRACTION, GPU_DYN_OBS_ABS, GPU_DYN_OBS_REL, GPU_DYN_POS,
+                                GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS, GPU_DYN_VEL)
+
+pytestmark = pytest.mark.gpu
+
+VARIANTS = ("strand", "warp")
+SOLVERS = ("xpbd", "ftl")
+PRECISIONS = ("fp32", "fp64")
+BLOCKS = (32, 96, 256, 1024)
+BUILDS = {"normal": CUDA_BIN, "strict": CUDA_STRICT_BIN, "fastmath": CUDA_FASTMATH_BIN}
+
+# N not a multiple of any block; P = 32 (a lane a point) and P = 45 (lanes take two points)
+N, SEED, L = 1500, 20260101, 30.0
+SUBSTEPS, ITERATIONS, FRAME_IN = 8, 4, 2  # the CPU writes frames 1..FRAME_IN+1; the GPU resumes at FRAME_IN
+SCENES = {
+    # the default scene: gravity, stretch, the collider (a specialised kernel)
+    "collide": ("--points", 32),
+    # every feature (specialised): bend, shape, wind with gusts, a nodding head, drag
+    "all": ("--points", 32, "--bend-compliance", "1e-6", "--shape-compliance", "1e-5", "--shape-range", "0.5",
+            "--wind-speed", "400", "--drag", "2", "--damping", "0.5", "--gust-amplitude", "0.5",
+            "--gust-frequency", "2", "--gust-wavelength", "25", "--head-motion", "nod", "--motion-amplitude", "0.3",
+            "--motion-frequency", "1.5"),
+    # shape with a shaking head and no collider: the generic kernel (features as run-time flags), P > 32
+    "generic": ("--points", 45, "--shape-compliance", "1e-5", "--head-motion", "shake", "--no-collider"),
+}
+GUSTS = {"collide": False, "all": True, "generic": False}
+
+ERRORS = {}
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _write_measurements():
+    yield
+    if ERRORS:
+        try:
+            (BUILD / "gpu_dyn_test_errors.json").write_text(json.dumps(ERRORS, indent=1, sort_keys=True) + "\n")
+        except OSError:
+            pass
+
+
+def record(key, value):
+    ERRORS[key] = max(float(value), ERRORS.get(key, 0.0))
+
+
+def run(binary, *args, check=True, timeout=300):
+    cmd = [str(binary), *[str(a) for a in args]]
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    if check and p.returncode != 0:
+        raise AssertionError(f"{' '.join(cmd)} exited {p.returncode}: {p.stderr.strip()}")
+    return p
+
+
+def dyn_args(scene, solver):
+    return ["--substeps", SUBSTEPS, "--iterations", ITERATIONS, "--solver", solver, *SCENES[scene]]
+
+
+class Frame:
+    """The last simulated frame of a file: positions, velocities, observables."""
+
+    def __init__(self, path, step=None):
+        with open_state(path) as s:
+            steps = dynstate.position_steps(path)
+            idx = len(steps) - 1 if step is None else steps.index(step)
+            self.step = steps[idx]
+            self.n, self.p = s.n_strands, s.points
+            self.x = s.frame(idx)
+            self.flags = s.flags
+        self.v = dynstate.velocity(path, self.n, self.p, self.step)
+        self.obs = dynstate.observables(path, self.step)
+
+
+_CACHE = {}
+
+
+@pytest.fixture(scope="session")
+def work(tmp_path_factory):
+    return tmp_path_factory.mktemp("gpu_dyn")
+
+
+@pytest.fixture(scope="session")
+def cpu_run(work):
+    """(scene, solver, precision) -> the CPU's file (frames 0..FRAME_IN+1, velocities all)."""
+    def get(scene, solver, precision):
+        key = ("cpu", scene, solver, precision)
+        if key not in _CACHE:
+            out = work / f"cpu_{scene}_{solver}_{precision}.h5"
+            run(CPU_BIN, "--strands", N, "--seed", SEED, "--hair-length", L, "--precision", precision,
+                "--stages", "init,simulate", "--frames", FRAME_IN + 1, "--velocities", "all", "--quiet",
+                *dyn_args(scene, solver), "--output", out, "--force")
+            _CACHE[key] = out
+        return _CACHE[key]
+    return get
+
+
+@pytest.fixture(scope="session")
+def gpu_frame(work, cpu_run):
+    """(build, variant, scene, solver, precision, block, tag) -> the GPU's frame from the CPU's frame FRAME_IN."""
+    def get(build, variant, scene, solver, precision, block, tag="", extra=()):
+        key = ("gpu", build, variant, scene, solver, precision, block, tag)
+        if key not in _CACHE:
+            src = cpu_run(scene, solver, precision)
+            out = work / f"gpu_{build}_{variant}_{scene}_{solver}_{precision}_{block}{tag}.h5"
+            run(BUILDS[build], "--input", src, "--input-frame", FRAME_IN, "--stages", "simulate", "--frames", 1,
+                "--variant", variant, "--block-size", block, "--quiet", *dyn_args(scene, solver), *extra,
+                "--output", out, "--force")
+            _CACHE[key] = Frame(out)
+        return _CACHE[key]
+    return get
+
+
+def cpu_next(cpu_run, scene, solver, precision):
+    key = ("cpu-next", scene, solver, precision)
+    if key not in _CACHE:
+        path = cpu_run(scene, solver, precision)
+        _CACHE[key] = Frame(path, dynstate.position_steps(path)[FRAME_IN + 1])
+    return _CACHE[key]
+
+
+def point_errors(a, b):
+    return np.linalg.norm(a.astype(np.float64) - b.astype(np.float64), axis=-1)
+
+
+def assert_close(gpu, cpu, build, precision, what):
+    h = (1.0 / 60.0) / SUBSTEPS
+    for name, ga, ca, tol, scale in (("positions", gpu.x, cpu.x, GPU_DYN_POS, 1.0 / L),
+                                     ("velocities", gpu.v, cpu.v, GPU_DYN_VEL, h / L)):
+        assert ga.shape == ca.shape, f"{what} {name}: shapes {ga.shape} vs {ca.shape}"
+        assert np.isfinite(ga).all(), f"{what} {name}: NaN or Inf in the GPU state"
+        d = point_errors(ga, ca) * scale
+        t = tol[build][precision]
+        over = int((d > t).sum())
+        allowed = int(GPU_DYN_MAX_OVER_FRACTION[precision] * d.size)
+        worst = float(d.max())
+        record(f"{name} {build} {precision}", worst)
+        assert over <= allowed, (f"{what} {name}: {over} of {d.size} points more than {t:g} apart (allowed "
+                                 f"{allowed}); worst {worst:.3g} at {np.unravel_index(d.argmax(), d.shape)}")
+    for k in ("stretch_max", "penetration_max", "kinetic_energy"):
+        g, c = float(gpu.obs[k]), float(cpu.obs[k])
+        assert abs(g - c) <= GPU_DYN_OBS_REL[precision] * abs(c) + GPU_DYN_OBS_ABS[precision], \
+            f"{what}: {k} {g!r} on the GPU, {c!r} on the CPU"
+    assert gpu.obs["blown_up_strands"] == cpu.obs["blown_up_strands"] == 0, f"{what}: blown-up strands"
+
+
+def same_bits(a, b):
+    return (a.x.dtype == b.x.dtype and a.x.tobytes() == b.x.tobytes() and a.v.tobytes() == b.v.tobytes()
+            and a.obs == b.obs)
+
+
+# ---- against the CPU ------------------------------------------------------------------------
+@pytest.mark.parametrize("precision", PRECISIONS)
+@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("scene", tuple(SCENES))
+@pytest.mark.parametrize("variant", VARIANTS)
+@pytest.mark.parametrize("build", tuple(BUILDS))
+def test_frame_matches_cpu(cpu_run, gpu_frame, build, variant, scene, solver, precision):
+    cpu = cpu_next(cpu_run, scene, solver, precision)
+    gpu = gpu_frame(build, variant, scene, solver, precision, 256)
+    assert gpu.step == cpu.step
+    what = f"{build} {variant} {scene} {solver} {precision}"
+    if build == "strict" and GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS and not GUSTS[scene]:
+        assert gpu.x.tobytes() == cpu.x.tobytes(), f"{what}: positions differ from the CPU's (must be bit-identical)"
+        assert gpu.v.tobytes() == cpu.v.tobytes(), f"{what}: velocities differ from the CPU's (must be bit-identical)"
+        assert gpu.obs == cpu.obs, f"{what}: observables {gpu.obs} vs the CPU's {cpu.obs}"
+    else:
+        assert_close(gpu, cpu, build, precision, what)
+
+
+# ---- determinism ------------------------------------------------------------------------------
+@pytest.mark.parametrize("precision", PRECISIONS)
+@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("variant", VARIANTS)
+@pytest.mark.parametrize("build", tuple(BUILDS))
+def test_bits_do_not_depend_on_block_size_or_repeats(gpu_frame, build, variant, solver, precision):
+    ref = gpu_frame(build, variant, "all", solver, precision, BLOCKS[0])
+    for b in BLOCKS[1:]:  # the warp variant at 1024, P = 32, fp64: 32 strands x 3.75 KB = 120 KB of shared memory
+        other = gpu_frame(build, variant, "all", solver, precision, b)
+        assert same_bits(ref, other), f"{build} {variant} {solver} {precision}: block {b} differs from block {BLOCKS[0]}"
+    again = gpu_frame(build, variant, "all", solver, precision, BLOCKS[0], tag="-again")
+    assert same_bits(ref, again), f"{build} {variant} {solver} {precision}: a second run differs"
+    # --repeat 3: the frame is run three times from the saved state (positions and velocities)
+    rep = gpu_frame(build, variant, "all", solver, precision, BLOCKS[0], tag="-repeat", extra=("--repeat", 3))
+    assert same_bits(ref, rep), f"{build} {variant} {solver} {precision}: --repeat 3 differs (save/restore)"
+
+
+@pytest.mark.parametrize("precision", PRECISIONS)
+@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("scene", tuple(SCENES))
+def test_strict_strand_and_warp_identical(gpu_frame, scene, solver, precision):
+    a = gpu_frame("strict", "strand", scene, solver, precision, 256)
+    b = gpu_frame("strict", "warp", scene, solver, precision, 256)
+    assert same_bits(a, b), f"strict {scene} {solver} {precision}: strand and warp differ"
+
+
+# ---- refusals ---------------------------------------------------------------------------------
+def test_warp_block_too_large_for_shared_memory_is_refused(tmp_path):
+    # 512 points x 32 strands a block x 15 reals x 8 bytes = 1.9 MB: more than any GPU gives a block
+    p = run(CUDA_BIN, "--strands", 100, "--points", 512, "--hair-length", 60, "--precision", "fp64", "--stages",
+            "init,simulate", "--frames", 1, "--variant", "warp", "--block-size", 1024, "--quiet",
+            "--output", tmp_path / "o.h5", check=False)
+    assert p.returncode == 2, p.stderr
+    assert "shared memory" in p.stderr and "--block-size" in p.stderr, p.stderr
+    assert not (tmp_path / "o.h5").exists()
+
+
+def test_state_too_large_for_simulate_is_refused(tmp_path):
+    # a state of a third of the free GPU memory: the state and its staging copy fit, but not
+    # with the velocities, the rest shape and the strand variant's scratch on top
+    smi = subprocess.run(["nvidia-smi", "--query-gpu=memory.free", "--format=csv,noheader,nounits", "-i", "0"],
+                         capture_output=True, text=True, timeout=60)
+    free = int(smi.stdout.split()[0]) * 2 ** 20
+    strands = free // 3 // (32 * 3 * 8)
+    out = tmp_path / "big.h5"
+    p = run(CUDA_BIN, "--strands", strands, "--points", 32, "--precision", "fp64", "--stages", "init,simulate",
+            "--frames", 1, "--variant", "strand", "--quiet", "--output", out, check=False)
+    assert p.returncode == 3, (p.returncode, p.stderr)
+    assert "GPU memory" in p.stderr and "simulate" in p.stderr, p.stderr
+    assert list(tmp_path.iterdir()) == [], "a refused run must leave no file"
