@@ -319,6 +319,7 @@ cudaError_t launch_stage(cuda_impl *c, const Model<T> &m, hb_stage st, int fuse,
         case HB_STAGE_COLLIDE:
             *what = "the collide kernel launch (paper)";
             return hb::launch_collide<T>(m, lay, N, c->d_count, B, 0);
+        default: break; /* simulate runs through dyn_frame */
         }
     } else {
         const PointMajor<T> lay = point_major<T>(c, c->state);
@@ -332,6 +333,7 @@ cudaError_t launch_stage(cuda_impl *c, const Model<T> &m, hb_stage st, int fuse,
         case HB_STAGE_COLLIDE:
             *what = "the collide kernel launch (point-major)";
             return hb::launch_collide<T>(m, lay, N, c->d_count, B, 0);
+        default: break; /* simulate runs through dyn_frame */
         }
     }
     *what = "an unknown stage";

@@ -217,6 +217,20 @@ def test_strict_strand_and_warp_identical(gpu_frame, scene, solver, precision):
     assert same_bits(a, b), f"strict {scene} {solver} {precision}: strand and warp differ"
 
 
+# ---- the paper-model stages on the new variants: the kernels of their layout --------------------
+@pytest.mark.parametrize("precision", PRECISIONS)
+@pytest.mark.parametrize("variant, same_as", (("strand", "soa"), ("warp", "paper")))
+def test_paper_stages_as_their_layouts_variant(tmp_path, variant, same_as, precision):
+    args = ["--strands", N, "--points", 32, "--seed", SEED, "--precision", precision, "--wind-strength", "0.6",
+            "--stages", "init,collide,wind,collide", "--quiet"]
+    run(CUDA_STRICT_BIN, *args, "--variant", variant, "--output", tmp_path / "a.h5")
+    run(CUDA_STRICT_BIN, *args, "--variant", same_as, "--output", tmp_path / "b.h5")
+    with open_state(tmp_path / "a.h5") as a, open_state(tmp_path / "b.h5") as b:
+        assert a.n_frames == b.n_frames == 4
+        for f in range(4):
+            assert a.frame(f).tobytes() == b.frame(f).tobytes(), f"{variant} vs {same_as}: frame {f} differs"
+
+
 # ---- refusals ---------------------------------------------------------------------------------
 def test_warp_block_too_large_for_shared_memory_is_refused(tmp_path):
     # 512 points x 32 strands a block x 15 reals x 8 bytes = 1.9 MB: more than any GPU gives a block
