@@ -3,13 +3,14 @@
  * per-strand math is cuda/dyn_model.cuh; this file maps threads to strands and points.
  *
  * Feature dispatch (docs/model.md §3.9): a table of kernel pointers indexed by the run's
- * feature mask. A mask in HB_DYN_SPECIALISED (below) has kernels of its own, compiled with
- * the mask as a constant (StaticF), so an undeclared feature leaves no code; any other
- * valid mask runs the generic kernel (DynF), which tests the same bits at run time: the tests are uniform branches around the same expressions, so the bits are
- * the same either way (the host check runs both). Building all
- * 96 valid masks as kernels of their own (-DHB_DYN_SPECIALISE_ALL) multiplies the build
- * time (docs/cuda.md gives the numbers), so the default build specialises only the sets
- * listed there. The solver is a run-time branch per substep in both (outside the inner loops).
+ * feature mask. A mask for which specialised_mask() (cuda/dyn_kernels.cuh) is true has
+ * kernels of its own, compiled with the mask as a constant (StaticF), so an undeclared
+ * feature leaves no code; any other valid mask runs the generic kernel (DynF), which tests
+ * the same bits at run time: uniform branches around the same expressions, so the bits are
+ * the same either way (the host check runs both). Building all 96 valid masks as kernels
+ * of their own (-DHB_DYN_SPECIALISE_ALL) multiplies the build time (docs/cuda.md gives the
+ * numbers), so the default build specialises the listed sets only. The solver is a
+ * run-time branch once per substep in both, outside the inner loops.
  */
 #include <utility>
 
@@ -21,7 +22,6 @@ namespace dyn {
 namespace {
 
 constexpr int kMaxThreads = 1024;
-
 
 template <class Feat> struct MakeFeat;
 template <unsigned F> struct MakeFeat<StaticF<F>> {
