@@ -19,10 +19,8 @@
 namespace hb {
 namespace dyn {
 
-namespace {
-
-constexpr int kMaxThreads = 1024;
-
+/* the kernel's feature policy from the run's mask (outside the anonymous namespace: with
+ * every mask specialised the generic one is never referenced) */
 template <class Feat> struct MakeFeat;
 template <unsigned F> struct MakeFeat<StaticF<F>> {
     __device__ static StaticF<F> make(unsigned) { return StaticF<F>(); }
@@ -30,6 +28,11 @@ template <unsigned F> struct MakeFeat<StaticF<F>> {
 template <> struct MakeFeat<DynF> {
     __device__ static DynF make(unsigned f) { return DynF{f}; }
 };
+
+namespace {
+
+constexpr int kMaxThreads = 1024;
+
 
 /* A loop over a warp's lanes: iteration k runs on lane (k − b)/step mod 32; the warp
  * synchronises after the loop, so the next group sees every write (shared memory). */
