@@ -595,7 +595,7 @@ static void cpu_teardown(hb_backend *b)
 
 #define CPU_PAPER_STAGES ((1u << HB_STAGE_INIT) | (1u << HB_STAGE_COLLIDE) | (1u << HB_STAGE_WIND))
 static const hb_variant cpu_variants[] = {
-    {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE), "the oracle: model_impl.h one strand at a time, OpenMP over strands"},
+    {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE), "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands"},
     {"simd", CPU_PAPER_STAGES, "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks"},
     {NULL, 0, NULL},
 };

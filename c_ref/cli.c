@@ -194,9 +194,23 @@ static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err
     char *base = (char *)&o->scene.dyn;
     int64_t iv;
     switch (df->kind) {
-    case DF_REAL:
-        if (parse_f64(df->flag, v, (double *)(base + df->offset), err, errlen)) return -1;
+    case DF_REAL: {
+        /* a ratio "a/b" is taken as a / b in double (e.g. --frame-dt 1/60) */
+        const char *slash = strchr(v, '/');
+        if (slash && slash != v) {
+            char num[64];
+            double a, b2;
+            if ((size_t)(slash - v) >= sizeof num) FAIL("%s needs a number (got '%s')", df->flag, v);
+            memcpy(num, v, (size_t)(slash - v));
+            num[slash - v] = '\0';
+            if (parse_f64(df->flag, num, &a, err, errlen) || parse_f64(df->flag, slash + 1, &b2, err, errlen)) return -1;
+            if (b2 == 0.0) FAIL("%s: division by zero in '%s'", df->flag, v);
+            *(double *)(base + df->offset) = a / b2;
+        } else if (parse_f64(df->flag, v, (double *)(base + df->offset), err, errlen)) {
+            return -1;
+        }
         break;
+    }
     case DF_COUNT:
         if (parse_i64(df->flag, v, 1, &iv, err, errlen)) return -1;
         *(int64_t *)(base + df->offset) = iv;
