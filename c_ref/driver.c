@@ -237,7 +237,7 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         if (r->w) {
             char *hv = r->host;
             for (int i = 0; i < r->in.n_vel; i++)
-                if (r->in.vel_step[i] <= step && (o->all_velocities || 0)) {
+                if (o->all_velocities && r->in.vel_step[i] <= step) {
                     FAIL_IF(hb_input_read_velocity(&r->in, i, hv, err, errlen), HB_EXIT_USAGE);
                     FAIL_IF(hb_writer_velocity(r->w, hv, r->in.vel_step[i], r->in.vel_time[i], err, errlen),
                             HB_EXIT_RUNTIME);
