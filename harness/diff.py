@@ -131,10 +131,11 @@ def frame_pairs(a, b, frames="all", align_last=False):
         return [(Fa - n + i, Fb - n + i) for i in range(n)]
     pairs = []
     for k in frames:
-        for path, count in ((a.path, Fa), (b.path, Fb)):
-            if not -count <= k < count:
-                raise StateError(f"{path}: has no frame {k} (it has {count})")
-        pairs.append((k % Fa, k % Fb))
+        ka, kb = k if isinstance(k, tuple) else (k, k)  # (frame in A, frame in B), or one for both
+        for path, count, kk in ((a.path, Fa, ka), (b.path, Fb, kb)):
+            if not -count <= kk < count:
+                raise StateError(f"{path}: has no frame {kk} (it has {count})")
+        pairs.append((ka % Fa, kb % Fb))
     return pairs
 
 
@@ -214,17 +215,22 @@ def compare_frame(a, b, fa, fb, tol, eps, ulp_dtype):
     return fd
 
 
-def compare(path_a, path_b, frames="all", align_last=False, exact=False):
-    """Compare two files; return a DiffResult. StateError (exit 2) if they cannot be."""
+def compare(path_a, path_b, frames="all", align_last=False, exact=False, tolerance=None):
+    """Compare two files; return a DiffResult. StateError (exit 2) if they cannot be.
+
+    `frames`: "all", "last", or a list of frame numbers or (frame in A, frame in B) pairs.
+    `tolerance`: a PairTolerance to use instead of the one of the files' precision kinds
+    (tolerances.named_pair: a tighter rule for a pair the precisions do not tell apart)."""
     with open_state(path_a) as a, open_state(path_b) as b:
         check_comparable(a, b)
         pairs = frame_pairs(a, b, frames, align_last)
         kind_a = tolerances.kind_of(a.precision, a.fast_math)
         kind_b = tolerances.kind_of(b.precision, b.fast_math)
-        tol = tolerances.EXACT if exact else tolerances.pair_tolerance(kind_a, kind_b)
+        tol = tolerances.EXACT if exact else (tolerance or tolerances.pair_tolerance(kind_a, kind_b))
         eps = max(tolerances.EPS[kind_a], tolerances.EPS[kind_b])
         result = DiffResult(path_a=str(path_a), path_b=str(path_b), label_a=a.label, label_b=b.label,
-                            pair=f"{kind_a}↔{kind_b}" + (" (exact)" if exact else ""),
+                            pair=f"{kind_a}↔{kind_b}" + (" (exact)" if exact else
+                                                          f" ({tolerance.name})" if tolerance else ""),
                             tolerance=tol, hair_length=a.hair_length)
         R, h = float(a.params["head_radius"]), float(a.params["hair_offset"])
         # the unit's range: a root with |x0| = R (smallest) to one with x0 = y0 = 0 (largest)

@@ -56,6 +56,7 @@ class State:
     stages: list                    # stage name of each frame
     skipped: list                   # bool per frame
     fused: list                     # "" | "wind+collide" | "into-previous" per frame
+    moved: list = field(default_factory=list)  # points each collide changed, -1 where not recorded
     _file: object = field(repr=False, default=None)
     _dset: object = field(repr=False, default=None)
 
@@ -97,6 +98,14 @@ class State:
         except Exception as e:  # h5py raises many kinds for corrupt chunks
             raise StateError(f"{self.path}: cannot read frame {f}: {e}") from None
         return flat.reshape(self.n_strands, self.points, 3)
+
+    def frames(self):
+        """Every frame as one [F][N][P][3] array of the file's dtype (small states only)."""
+        try:
+            flat = self._dset[()]
+        except Exception as e:  # h5py raises many kinds for corrupt chunks
+            raise StateError(f"{self.path}: cannot read frames: {e}") from None
+        return flat.reshape(self.n_frames, self.n_strands, self.points, 3)
 
     def close(self):
         if self._file is not None:
@@ -184,5 +193,42 @@ def _checked_state(f, path):
     if len(skipped) != n_frames:
         raise StateError(f"{path}: /{PARAMETERS}/skipped has {len(skipped)} entries for {n_frames} frames")
     fused = _string_list(group, "fused", n_frames, "", path)
+    moved = [int(v) for v in group["moved_points"][()]] if "moved_points" in group else [-1] * n_frames
+    if len(moved) != n_frames:
+        raise StateError(f"{path}: /{PARAMETERS}/moved_points has {len(moved)} entries for {n_frames} frames")
     return State(path=path, n_strands=n, points=p, n_frames=n_frames, precision=precision,
-                 params=params, stages=stages, skipped=skipped, fused=fused, _file=f, _dset=dset)
+                 params=params, stages=stages, skipped=skipped, fused=fused, moved=moved,
+                 _file=f, _dset=dset)
+
+
+@dataclass
+class LoadedState:
+    """A whole state read into memory: what the tests assert on."""
+    path: str
+    params: dict
+    precision: str
+    fast_math: bool
+    flags: str
+    stages: list
+    skipped: np.ndarray             # 0/1 per frame
+    fused: list
+    moved: np.ndarray               # points each collide changed, -1 where not recorded
+    frames: np.ndarray              # [F][N][P][3], the file's dtype
+
+    @property
+    def dtype(self):
+        return self.frames.dtype
+
+    @property
+    def segment_length(self):
+        """ℓ = L/(P−1), in double."""
+        return float(self.params["hair_length"]) / (self.frames.shape[2] - 1)
+
+
+def load_state(path):
+    """Open, check and read a whole (small) state file into a LoadedState."""
+    with open_state(path) as s:
+        return LoadedState(path=s.path, params=s.params, precision=s.precision,
+                           fast_math=s.fast_math, flags=s.flags, stages=list(s.stages),
+                           skipped=np.array([int(v) for v in s.skipped]), fused=list(s.fused),
+                           moved=np.array(s.moved, dtype=np.int64), frames=s.frames())

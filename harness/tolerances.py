@@ -91,6 +91,7 @@ class PairTolerance:
     point_k: float              # a point is over when |a − b| > point_k · u (point_unit)
     max_over_fraction: float    # fraction of the points of a frame allowed over
     why: str                    # the measurement behind it (shown by `harness diff --json`)
+    name: str = ""              # a named pair (named_pair), "" for a precision pair
 
 
 @dataclass(frozen=True)
@@ -147,13 +148,65 @@ INVARIANTS = {
         why="measured segment ≤ 1.60·ε·E, shell depth ≤ 16.5·ε·rc (cuda-fastmath on an H200)"),
 }
 
+# A drawn root lies on the head sphere: | |p0| − R | ≤ ROOT_ON_SPHERE_K · ε · R (the draw
+# is a few roundings of R; docs/decisions.md).
+ROOT_ON_SPHERE_K = 8
+
 # `harness diff --exact`: bit-identical, for runs that must not differ at all (thread
 # count, block size, strand order, the same build twice).
 EXACT = PairTolerance(point_k=0.0, max_over_fraction=0.0, why="bit-identical required (--exact)")
 
 
+# Pairs that the precision kinds do not tell apart: a variant or build against the oracle
+# of the same precision. A named pair may be tighter than its precisions' rule, never looser.
+NAMED_PAIRS = {
+    # simd vs ref, same precision: ref's arithmetic operation for operation, only sin, cos,
+    # asin and atan2 from libmvec (≤ 4 ulp); the roots are bit-identical, so u = ε·P·E.
+    ("simd", "fp32"): PairTolerance(
+        point_k=4.0, max_over_fraction=0.0, name="simd",
+        why="measured ≤ 1.40·u (simd vs ref, P = 2, wind; P ≥ 16 ≤ 0.19·u; 284 stability scenes ≤ 1.01·u; "
+            "docs/cpu_simd.md); 4 = margin 2.9×; same roots and decisions, so no point may be over"),
+    ("simd", "fp64"): PairTolerance(
+        point_k=4.0, max_over_fraction=0.0, name="simd",
+        why="measured ≤ 1.00·u (simd vs ref, P = 2; docs/cpu_simd.md); 4 = margin 4×"),
+    # cuda-strict vs c_ref, same precision: differs only where CUDA's sinf/cosf/asinf/atan2f
+    # differ from glibc's; the precision pair's rule (docs/cuda.md, docs/harness.md).
+    ("strict", "fp32"): PairTolerance(
+        point_k=6.0, max_over_fraction=1e-5, name="strict",
+        why="measured ≤ 1.50·u (cuda-strict vs c_ref fp32, H200); 6 = margin 4×; as fp32↔fp32"),
+    ("strict", "fp64"): PairTolerance(
+        point_k=4.0, max_over_fraction=0.0, name="strict",
+        why="measured ≤ 1.00·u (cuda-strict vs c_ref fp64, H200); 4 = margin 4×; as fp64↔fp64"),
+    # cuda-fastmath fp32 vs an fp32 state (c_ref, strict or normal build)
+    ("fast-math", "fp32"): PairTolerance(
+        point_k=8.0, max_over_fraction=1e-5, name="fast-math",
+        why="measured ≤ 1.84·u (cuda-fastmath vs c_ref fp32, H200); 8 = margin 4.3×; as fast-math↔fp32"),
+}
+
+# The two regressions of docs/decisions.md (short segments, P = 251): after the fixes the
+# segment error stays within 2·ε·E (measured ≤ 0.71, 24 before); the shell bound is the
+# precisions' own.
+SHORT_SEGMENTS = InvariantTolerance(
+    segment_k=2, shell_k=32,
+    why="measured segment ≤ 0.71·ε·E at P = 251 after the half-angle and (rc − a)(rc + a) forms")
+# Hand-made points inside the shell at the slice poles: collide lifts each onto its shell
+# circle (the stability tests' bound was 1e-6·rc, about 8 ε·rc in fp32).
+SLICE_POLES = InvariantTolerance(
+    segment_k=2, shell_k=8,
+    why="points lifted out by collide land on the shell; segments keep ℓ to a few roundings")
+
+
 def pair_tolerance(kind_a, kind_b):
     return PAIRS[_key(kind_a, kind_b)]
+
+
+def named_pair(name, precision):
+    """The tolerance of a named pair ("simd", "strict", "fast-math") at `precision`."""
+    try:
+        return NAMED_PAIRS[(name, precision)]
+    except KeyError:
+        known = sorted({n for n, _ in NAMED_PAIRS})
+        raise KeyError(f"no named pair '{name}' at {precision} (known: {', '.join(known)})") from None
 
 
 def invariant_tolerance(kind):

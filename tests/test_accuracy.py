@@ -48,7 +48,7 @@ def test_a_fused_wind_frame_is_not_checked_for_penetration(tmp_path):
     state after the wind half, inside the shell by design; accuracy once counted it as a
     collide frame and reported 6% penetration."""
     from harness.states import open_state
-    from harness.synthetic import write_state
+    from support.synthetic import write_state
 
     inside = np.zeros((1, 1, 3, 3))
     inside[0, 0, :, 2] = [10.0, 9.0, 8.0]      # root on the head, then two points inside

@@ -4,7 +4,7 @@ import h5py
 import numpy as np
 import pytest
 
-from statecheck import run, tmp_leftovers
+from support.statecheck import run, tmp_leftovers
 
 SMALL = ["--strands", "50", "--points", "8", "--hair-length", "5"]
 

@@ -2,7 +2,7 @@
 
 The CPU test needs build/hairsim-cpu (skipped with the reason without it; `make test`
 builds it first); the GPU test is marked `gpu`. The failure paths use the stand-in
-backend harness.fakebackend."""
+backend support.fakebackend."""
 import csv
 import json
 import os
@@ -11,7 +11,7 @@ import sys
 
 import pytest
 
-from harness.fakebackend import install
+from support.fakebackend import install
 
 from conftest import CPU_BIN, ROOT
 

@@ -1,6 +1,6 @@
 """`harness diff`: exit codes on planted cases, frame selection, ULP distance, tolerances.
 
-Most files are written with harness.synthetic (the documented layout, no backend needed);
+Most files are written with support.synthetic (the documented layout, no backend needed);
 the last tests use the real build/hairsim-cpu and are skipped, with the reason, without it.
 """
 import json
@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from harness import tolerances
 from harness.__main__ import main
 from harness.diff import compare
-from harness.synthetic import radial_strands, write_state
+from support.synthetic import radial_strands, write_state
 from harness.ulp import ulp_distance
 
 from conftest import CPU_BIN, ROOT

@@ -7,7 +7,7 @@ import pytest
 
 from harness import invariants
 from harness.states import open_state
-from harness.synthetic import radial_strands, write_state
+from support.synthetic import radial_strands, write_state
 
 from conftest import CPU_BIN
 

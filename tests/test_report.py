@@ -8,7 +8,7 @@ import pytest
 from harness import report, runlog
 from harness.__main__ import main
 from harness.plots import FIGURE_STATE
-from harness.synthetic import radial_strands, write_state
+from support.synthetic import radial_strands, write_state
 
 STAGES = ["init", "collide", "wind", "collide"]
 

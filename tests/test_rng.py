@@ -3,7 +3,7 @@ independent Python Philox4x32-10 that must reproduce the C roots bit for bit."""
 import numpy as np
 import pytest
 
-from statecheck import State, run
+from support.statecheck import State, run
 
 M0, M1, W0, W1 = 0xD2511F53, 0xCD9E8D57, 0x9E3779B9, 0xBB67AE85
 MASK = 0xFFFFFFFF

@@ -1,7 +1,7 @@
 """`harness sweep`: tidy rows, IQR from times_ms, roofline bytes, skipped cases said aloud,
 and resume after a kill with no lost or duplicated rows.
 
-The backend is harness.fakebackend (installed as build/hairsim-* in a temporary build dir
+The backend is support.fakebackend (installed as build/hairsim-* in a temporary build dir
 through HAIRBENCH_BUILD_DIR), so these tests need no build and take seconds."""
 import csv
 import os
@@ -13,7 +13,7 @@ import time
 import pytest
 
 from harness import roofline, runlog
-from harness.fakebackend import install
+from support.fakebackend import install
 from harness.sweep import quartiles, run_sweep
 from harness.sweepfile import load_sweep
 

@@ -1,4 +1,5 @@
-"""A stand-in backend for the harness's own tests: `python -m harness.fakebackend FLAGS`.
+"""A stand-in backend for the harness's own tests: `python -m support.fakebackend FLAGS`
+(from tests/).
 
 It speaks the interface of docs/interfaces.md (the flags the harness passes, the JSON
 record, HDF5 states via synthetic.py) without simulating anything, so the sweep, resume,
@@ -20,7 +21,9 @@ import numpy as np
 NAMES = ("strands", "points", "seed", "head-radius", "hair-offset", "hair-length",
          "face-margin", "wind-strength", "wind-angle", "stages", "precision", "variant",
          "threads", "block-size", "input", "output", "repeat", "warmup")
-SWITCHES = ("force", "json", "quiet", "end-to-end", "measure-bandwidth")
+SWITCHES = ("force", "json", "quiet", "end-to-end", "measure-bandwidth", "list-variants")
+# what --list-variants prints, per backend (the binaries declare theirs the same way)
+VARIANTS = {"cpu": ("ref", ["ref", "simd"]), "cuda": ("fused", ["paper", "soa", "fused"])}
 
 
 def parse(argv):
@@ -48,6 +51,14 @@ def main(argv=None):
     prog = os.path.basename(os.environ.get("FAKE_PROG", "hairsim-cpu"))
     backend = os.environ.get("FAKE_BACKEND") or ("cuda" if "cuda" in prog else "cpu")
     o = parse(argv)
+    if o.get("list-variants"):
+        default, names = VARIANTS[backend]
+        build = next((b for b in ("strict", "fastmath") if prog.endswith(b)), "default")
+        print(json.dumps({"backend": backend, "build": build, "default_variant": default,
+                          "precisions": ["fp32", "fp64"],
+                          "variants": [{"name": n, "stages": ["init", "collide", "wind"], "summary": "fake"}
+                                       for n in names]}))
+        return 0
     time.sleep(float(os.environ.get("FAKE_SLEEP", "0")))
     if o.get("measure-bandwidth"):
         if os.environ.get("FAKE_NO_BANDWIDTH"):
@@ -71,7 +82,7 @@ def main(argv=None):
                         "max_ms": max(times), "times_ms": times,
                         "moved_points": 0 if st == "collide" else None})
     if o.get("output"):
-        from .synthetic import radial_strands, write_state
+        from support.synthetic import radial_strands, write_state
         dtype = np.float64 if precision == "fp64" else np.float32
         pos = radial_strands(strands, points, stages, dtype=np.float64, seed=int(o.get("seed", 1)))
         shift = float(os.environ.get("FAKE_SHIFT_FP32", "0"))
@@ -97,13 +108,14 @@ def install(directory, names=("hairsim-cpu",)):
     """Write executable stand-ins named `names` into `directory` (for HAIRBENCH_BUILD_DIR)."""
     from pathlib import Path
 
-    root = Path(__file__).resolve().parent.parent
+    tests = Path(__file__).resolve().parent.parent
+    root = tests.parent
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     for name in names:
         path = directory / name
-        path.write_text(f'#!/bin/sh\nFAKE_PROG="$0" PYTHONPATH="{root}${{PYTHONPATH:+:$PYTHONPATH}}" '
-                        f'exec "{sys.executable}" -m harness.fakebackend "$@"\n')
+        path.write_text(f'#!/bin/sh\nFAKE_PROG="$0" PYTHONPATH="{tests}:{root}${{PYTHONPATH:+:$PYTHONPATH}}" '
+                        f'exec "{sys.executable}" -m support.fakebackend "$@"\n')
         path.chmod(0o755)
     return directory
 
