@@ -5,6 +5,7 @@ use. One job: turn tidy rows into per-case numbers.
 plus the median of the collide right after it (for the fused variant the wind row carries
 the pair and the collide row is 0). `total_ms` is the sum of every stage's median.
 Medians are added, not the medians of sums: each stage is timed on its own."""
+
 import json
 from pathlib import Path
 
@@ -13,8 +14,18 @@ import pandas as pd
 
 from . import HarnessError, runlog
 
-CASE_KEYS = ["case_id", "scene", "backend", "build", "variant", "precision", "block_size",
-             "threads", "strands", "points"]
+CASE_KEYS = [
+    "case_id",
+    "scene",
+    "backend",
+    "build",
+    "variant",
+    "precision",
+    "block_size",
+    "threads",
+    "strands",
+    "points",
+]
 
 
 def load(results_dir):
@@ -58,11 +69,15 @@ def per_case(rows):
                 pair_iqr += iqr[i + 1]
         first = g.iloc[0]
         rec = {k: first[k] for k in CASE_KEYS}
-        rec.update(pair_ms=pair, pair_iqr_ms=pair_iqr, total_ms=float(np.sum(med)),
-                   stages=",".join(stages),
-                   skipped_stages=",".join(s for s, k in zip(stages, g["skipped"]) if int(k)),
-                   fused=",".join(f for f in g["fused"] if f),
-                   end_to_end_ms=first.get("end_to_end_ms"))
+        rec.update(
+            pair_ms=pair,
+            pair_iqr_ms=pair_iqr,
+            total_ms=float(np.sum(med)),
+            stages=",".join(stages),
+            skipped_stages=",".join(s for s, k in zip(stages, g["skipped"]) if int(k)),
+            fused=",".join(f for f in g["fused"] if f),
+            end_to_end_ms=first.get("end_to_end_ms"),
+        )
         out.append(rec)
     cases = pd.DataFrame(out)
     if not cases.empty:

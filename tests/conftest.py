@@ -3,6 +3,7 @@
 GPU tests are marked `@pytest.mark.gpu`; they are skipped, with the reason, where no
 usable NVIDIA GPU (or no built CUDA binary) is present.
 """
+
 import os
 import shutil
 import subprocess

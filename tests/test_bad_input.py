@@ -1,5 +1,6 @@
 """Bad input to the C reference (DESIGN §8, issue #2): one clear line naming the flag or
 file, a non-zero exit, and no output file (nor a temporary one) left behind."""
+
 import h5py
 import numpy as np
 import pytest
@@ -28,8 +29,12 @@ CLI_CASES = [
     ("block_size_on_cpu", ["--block-size", "64"], 2, "--block-size is a flag of hairsim-cuda"),
     ("unknown_variant", ["--variant", "turbo"], 2, "--variant turbo is not a cpu variant"),
     ("missing_value", ["--seed"], 2, "--seed needs a value"),
-    ("state_too_big_for_memory", ["--strands", "1000000000000", "--points", "100", "--hair-length", "50"], 3,
-     "host memory"),
+    (
+        "state_too_big_for_memory",
+        ["--strands", "1000000000000", "--points", "100", "--hair-length", "50"],
+        3,
+        "host memory",
+    ),
 ]
 
 

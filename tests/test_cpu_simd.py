@@ -14,6 +14,7 @@ an input that differs by rounding (the init/collide before it) can turn a near-o
 segment the other way (measured: 15 of 20,000 strands at P = 24, w = 1, ψ = π/2). Those runs
 are checked for the invariants, and the wind stage itself from the same input is compared.
 """
+
 import json
 import math
 import os
@@ -25,12 +26,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
+from test_stability import scene_args, scenes
 
 from harness import tolerances
 from support import synthetic
 from support.invariants_check import assert_invariants
 from support.statecheck import State, assert_equivalent, run, run_json, tmp_leftovers
-from test_stability import scene_args, scenes
 
 SEEDS = [1, 7, 123456789]
 PAPER = ["init", "collide", "wind", "collide"]
@@ -63,8 +64,9 @@ needs_simd = pytest.mark.skipif(NO_SIMD is not None, reason=f"simd test skipped:
 
 def assert_close(ref_path, simd_path, precision, frames, what):
     """harness diff of simd against ref under the "simd" pair (tolerances.named_pair)."""
-    return assert_equivalent(ref_path, simd_path, frames=frames,
-                             tolerance=tolerances.named_pair("simd", precision), what=what)
+    return assert_equivalent(
+        ref_path, simd_path, frames=frames, tolerance=tolerances.named_pair("simd", precision), what=what
+    )
 
 
 def moved_from_frames(before, after):
@@ -80,6 +82,7 @@ def scene(points, seed, precision, strands=1000):
 
 
 # ---- equivalence with ref ---------------------------------------------------------------
+
 
 @needs_simd
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
@@ -144,8 +147,18 @@ def test_strong_wind_at_other_angles(cpu_bin, tmp_path, precision):
         run(cpu_bin, "--input", prefix, *w, "--stages", "wind", "--output", ref, "--quiet")
         run(cpu_bin, "--input", prefix, *w, "--stages", "wind", "--variant", "simd", "--output", one, "--quiet")
         assert_close(ref, one, precision, [2], f"wind at psi={angle}")
-        run(cpu_bin, *base, *w, "--variant", "simd", "--stages", "init,collide,wind,collide,wind,collide",
-            "--output", whole, "--quiet")
+        run(
+            cpu_bin,
+            *base,
+            *w,
+            "--variant",
+            "simd",
+            "--stages",
+            "init,collide,wind,collide,wind,collide",
+            "--output",
+            whole,
+            "--quiet",
+        )
         assert_invariants(State(whole))
 
 
@@ -175,8 +188,12 @@ def test_fp32_simd_agrees_with_fp64_ref(cpu_bin, tmp_path):
 
 
 @needs_simd
-@settings(max_examples=40, deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(
+    max_examples=40,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 @given(s=scenes())
 def test_each_stage_matches_ref_across_the_scene_space(cpu_bin, tmp_path_factory, s):
     """The stability suite's scene space (tests/test_stability.py): every stage from the
@@ -208,11 +225,17 @@ def test_each_stage_matches_ref_across_the_scene_space(cpu_bin, tmp_path_factory
 
 # ---- edge states made by hand (the stability suite's), through --input -------------------
 
+
 def _crafted(tmp_path, strands, precision, L):
     pos = np.asarray([strands], dtype=np.float64 if precision == "fp64" else np.float32)
     path = tmp_path / "crafted.h5"
-    synthetic.write_state(path, pos, ["init"], precision=precision,
-                          params={"hair_length": L, "head_radius": 10.0, "hair_offset": 0.1, "face_margin": 1.0})
+    synthetic.write_state(
+        path,
+        pos,
+        ["init"],
+        precision=precision,
+        params={"hair_length": L, "head_radius": 10.0, "hair_offset": 0.1, "face_margin": 1.0},
+    )
     return path
 
 
@@ -220,7 +243,7 @@ def _crafted(tmp_path, strands, precision, L):
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_exactly_opposite_segments_turn_through_plus_y(cpu_bin, tmp_path, precision):
     P, ell = 4, 1.0
-    toward_face = [(0.0, 0.0, 10.0 + k * ell) for k in range(P)]              # φ = 0, wind ψ = π
+    toward_face = [(0.0, 0.0, 10.0 + k * ell) for k in range(P)]  # φ = 0, wind ψ = π
     toward_back = [(1.0, 0.0, -math.sqrt(99.0) - k * ell) for k in range(P)]  # φ = π, wind ψ = 0
     src = _crafted(tmp_path, [toward_face, toward_back], precision, L=(P - 1) * ell)
     for strand, angle in ((0, math.pi), (1, 0.0)):
@@ -254,14 +277,29 @@ def test_collide_at_the_slice_poles_is_refs_bits(cpu_bin, tmp_path, precision):
 
 # ---- bits that must not change -------------------------------------------------------------
 
+
 @needs_simd
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_thread_count_does_not_change_a_bit(cpu_bin, tmp_path, precision):
     states = []
     for threads in (1, 2, 3):
         out = tmp_path / f"t{threads}.h5"
-        run(cpu_bin, "--strands", 3001, "--points", 20, "--threads", threads, "--precision", precision,
-            "--variant", "simd", "--output", out, "--quiet")
+        run(
+            cpu_bin,
+            "--strands",
+            3001,
+            "--points",
+            20,
+            "--threads",
+            threads,
+            "--precision",
+            precision,
+            "--variant",
+            "simd",
+            "--output",
+            out,
+            "--quiet",
+        )
         states.append(State(out))
     for s in states[1:]:
         assert np.array_equal(s.frames, states[0].frames)
@@ -286,16 +324,32 @@ def test_resume_gives_the_same_bits_as_one_run(cpu_bin, tmp_path):
     args = ["--strands", 1100, "--points", 32, "--variant", "simd"]
     run(cpu_bin, *args, "--output", whole, "--quiet")
     run(cpu_bin, *args, "--stages", "init", "--output", first, "--quiet")
-    run(cpu_bin, "--input", first, "--variant", "simd", "--stages", "collide,wind,collide", "--output", rest,
-        "--quiet")
+    run(cpu_bin, "--input", first, "--variant", "simd", "--stages", "collide,wind,collide", "--output", rest, "--quiet")
     assert np.array_equal(State(whole).frames, State(rest).frames)
 
 
 @needs_simd
 def test_wind_zero_is_not_run_and_changes_nothing(cpu_bin, tmp_path):
     out = tmp_path / "s.h5"
-    rec = json.loads(run(cpu_bin, "--strands", 300, "--points", 16, "--hair-length", 10, "--wind-strength", 0,
-                         "--variant", "simd", "--output", out, "--json", "--quiet").stdout)
+    rec = json.loads(
+        run(
+            cpu_bin,
+            "--strands",
+            300,
+            "--points",
+            16,
+            "--hair-length",
+            10,
+            "--wind-strength",
+            0,
+            "--variant",
+            "simd",
+            "--output",
+            out,
+            "--json",
+            "--quiet",
+        ).stdout
+    )
     wind = rec["stages"][2]
     assert wind["stage"] == "wind" and wind["skipped"] is True and wind["times_ms"] == []
     s = State(out)
@@ -307,11 +361,25 @@ def test_wind_zero_is_not_run_and_changes_nothing(cpu_bin, tmp_path):
 
 # ---- what the variant records and how it is built ------------------------------------------
 
+
 @needs_simd
 def test_records_say_simd_and_its_flags(cpu_bin, tmp_path):
     out = tmp_path / "s.h5"
-    rec = run_json(cpu_bin, "--strands", 500, "--points", 16, "--hair-length", 10, "--variant", "simd",
-                   "--repeat", 2, "--output", out)
+    rec = run_json(
+        cpu_bin,
+        "--strands",
+        500,
+        "--points",
+        16,
+        "--hair-length",
+        10,
+        "--variant",
+        "simd",
+        "--repeat",
+        2,
+        "--output",
+        out,
+    )
     assert rec["backend"] == "cpu" and rec["variant"] == "simd"
     for flag in ("-ffp-contract=off", "-march=x86-64-v3", "-fno-math-errno", "-fno-trapping-math"):
         assert flag in rec["flags"], flag

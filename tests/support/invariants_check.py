@@ -5,6 +5,7 @@ collide, skipped stages unchanged) is checked by harness/invariants.py with the 
 of harness/tolerances.py. The tests add two facts of the root draw (DESIGN §3 init): roots
 lie on the head sphere, and none sits on the lower face.
 """
+
 import numpy as np
 
 from harness import invariants, tolerances

@@ -3,6 +3,7 @@
 States are read by harness.states (the one reader), compared by harness.diff and checked
 by harness.invariants, with the tolerances of harness/tolerances.py.
 """
+
 import json
 import subprocess
 from pathlib import Path
