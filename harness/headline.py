@@ -1,4 +1,4 @@
-"""`python -m harness headline`: the numbers the issues quote, measured in one run.
+"""`python -m harness headline`: the headline numbers, measured in one run.
 
 At one size (default 4M strands x 32 points, the paper scene) and on this node:
   - the device copy bandwidth (hairsim-cuda --measure-bandwidth) and the CPU's STREAM-style

@@ -272,7 +272,7 @@ def timing_table(cases):
 
 
 def headline_section(path):
-    """The issues' headline numbers (python -m harness headline), when they were measured."""
+    """The headline numbers (python -m harness headline), when they were measured."""
     if not path.exists():
         return []
     from .headline import table
@@ -337,7 +337,7 @@ def build(results_dir="results/default", report_dir=None):
         "the limit is the memory's copy bandwidth, and a state that small beats it.",
         "",
     ]
-    # the accuracy study of the same machine (`python -m harness accuracy`, issue #5): its CSV
+    # the accuracy study of the same machine (`python -m harness accuracy`): its CSV
     # beside this results directory, rendered again here so the report never mixes machines
     accuracy_csv = Path(results_dir).parent / "accuracy" / "accuracy.csv"
     if accuracy_csv.exists():

@@ -22,8 +22,8 @@ A scene file:
 Every key is optional except `stages`; missing ones take the backends' defaults (the
 values above). Anything else is refused before any work, naming the key: unknown keys,
 counts that are not whole numbers ≥ 1 (≥ 2 for points), NaN or infinite numbers, stages
-that do not exist or a list not starting with init, ℓ < h, and a state that would not fit
-in this machine's memory.
+that do not exist or a list not starting with init, ℓ < h, and a state whose frame (times
+the copies a backend holds) would not fit in this machine's memory.
 """
 
 import math
@@ -184,6 +184,11 @@ def parse_stages(value, where="scene", key="stages"):
     return tuple(value)
 
 
+# copies of one frame a backend holds: the state, its saved copy for --repeat/--warmup, and
+# the host frame written to the file (c_ref/driver.c)
+FRAME_COPIES = 3
+
+
 def memory_bytes():
     try:
         return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
@@ -201,13 +206,14 @@ def _check_values(scene, where):
             f"{where}: hair.length/(hair.points − 1) = {scene.segment_length:g} is "
             f"below hair.offset = {scene.hair_offset:g} (ℓ ≥ h is required)"
         )
-    # the backends hold every frame of the state in memory (docs/interfaces.md)
-    need = scene.state_bytes() * (len(scene.stages) + 1)
+    # frames are streamed to the file one at a time: a backend holds a few copies of one
+    # frame (FRAME_COPIES), never all of them
+    need = scene.state_bytes() * FRAME_COPIES
     have = memory_bytes()
     if have and need > have:
         raise SceneError(
-            f"{where}: {scene.strands} strands × {scene.points} points × "
-            f"{len(scene.stages)} frames need {need / 2**30:.1f} GiB, more than this "
+            f"{where}: {scene.strands} strands × {scene.points} points need "
+            f"{need / 2**30:.1f} GiB ({FRAME_COPIES} copies of one frame), more than this "
             f"machine's {have / 2**30:.1f} GiB (hair.strands too large)"
         )
 

@@ -31,32 +31,10 @@ collide no non-root point inside its shell circle by more than shell_k · ε·rc
 binaries' own collide test leaves points up to 16 ε·rc inside alone (HB_SHELL_ULPS in
 c_ref/model.h), so shell_k must be above 16.
 
-MEASUREMENTS, worst over all runs. (1) `python -m harness calibrate --strands 20000
---points 2 8 32 128 256 --seeds 1 2 --other /tmp/hbfma/hairsim-cpu` (and --points 2 8 32
-251) on the 2-core dev machine, "other" = c_ref rebuilt with `make BUILD=/tmp/hbfma
-CFLAGS_REF="-std=c11 -D_DEFAULT_SOURCE -O3 -march=native -ffp-contract=fast -Wall"` (FMA
-contraction); (2) `python -m harness calibrate --strands 20000 --points 2 8 32 251 --seeds
-1 --other build/hairsim-cuda[-strict|-fastmath]` on an NVIDIA H200 (CUDA 13.0, sm_90);
-paper scene w = 0.5 and gale w = 1, every frame, 0.5–1.4e8 point comparisons per pair:
-  pair                      c_ref (1)   FMA c_ref (1)  cuda-strict  cuda    cuda-fastmath
-  fp64↔fp64                     —         0.83·u        1.00·u     1.08·u   1.08·u
-  fp32↔fp64                  0.88·u       0.88·u        0.88·u     0.88·u   1.05·u
-  fp32↔fp32                     —         1.22·u        1.50·u     1.50·u   1.84·u (fast-math↔fp32)
-  max error, any pair: 4.7e-6·L (fp32), 1.4e-14·L (fp64); 0 points beyond 1e-3·L anywhere
-  segment error:   fp32 ≤ 0.80·ε·E, fast-math ≤ 1.60·ε·E, fp64 ≤ 0.80·ε·E
-  shell depth:     fp32 ≤ 17.0·ε·rc, fast-math ≤ 16.5·ε·rc, fp64 ≤ 3.0·ε·rc
-                   (the binary leaves up to 16 ε·rc alone)
-  `harness bench` on the H200: 167 comparisons (every build × variant × block size ×
-  precision, and every stage resumed from the cpu state) at 2000 × 32, all equivalent,
-  worst 0.17·u.
-So point_k = 4 for fp64↔fp64 and fp32↔fp64 (margin ≥ 3.7×), 6 for fp32↔fp32 (4× over
-1.50·u), 8 for fast-math pairs (4.3× over 1.84·u). For the paper scene at P = 32, 4u is
-2.1e-5·L … 9.4e-4·L in fp32 (the large end only for a root with x0 ≈ 0 that differs
-between the files) and 3.9e-14·L … 4.0e-8·L in fp64. segment_k = 16 is ≥ 10× the worst
-measured and the bound tests/invariants_check.py uses (16·ε·(R + L), docs/decisions.md),
-so the harness and the test suite agree: 7.9e-5·ℓ in fp32 and 1.5e-13·ℓ in fp64 for the
-paper scene at P = 32. shell_k = 32 is the binary's 16 plus a margin of 16 over the
-measured excess of ≤ 1 ε·rc, again the tests' bound.
+The measurements behind every number (`python -m harness calibrate` on the dev machine and
+on an H200, `harness bench`, the simd and GPU test runs) are in docs/harness.md
+("Tolerances, and the measurements behind them"), docs/decisions.md and docs/cpu_simd.md;
+each tolerance's `why` names its worst measured value and margin.
 """
 
 import math

@@ -1,4 +1,4 @@
-"""`python -m harness accuracy` (issue #5): the speed/accuracy table, the Pareto plot and the
+"""`python -m harness accuracy`: the speed/accuracy table, the Pareto plot and the
 recommendation, on the modes this machine can run."""
 
 import csv
