@@ -11,8 +11,8 @@ function, so there simd must give ref's bits, as asserted below.
 Not compared point for point: whole runs with strong wind at angles other than the default,
 where the shorter-arc rule of the wind is discontinuous at an exactly opposite segment and
 an input that differs by rounding (the init/collide before it) can turn a near-opposite
-segment the other way (measured: 15 of 20,000 strands at P = 24, w = 1, ψ = π/2). Those runs
-are checked for the invariants, and the wind stage itself from the same input is compared.
+segment the other way (docs/cpu_simd.md, "A discontinuity, not an error"). Those runs are
+checked for the invariants, and the wind stage itself from the same input is compared.
 """
 
 import json
@@ -198,7 +198,7 @@ def test_fp32_simd_agrees_with_fp64_ref(cpu_bin, tmp_path):
 def test_each_stage_matches_ref_across_the_scene_space(cpu_bin, tmp_path_factory, s):
     """The stability suite's scene space (tests/test_stability.py): every stage from the
     ref state matches ref, and whole simd runs keep the invariants. (Measured over 284 of
-    its scenes: ≤ 1.01 u stage by stage, collide bit for bit.)"""
+    its scenes: docs/cpu_simd.md.)"""
     d = tmp_path_factory.mktemp("space")
     args = scene_args(s)
     p = run(cpu_bin, *args, "--output", d / "ref.h5", "--quiet", check=False)
