@@ -141,7 +141,7 @@ sanitize: check-python check-hdf5
 SAN_RUN := --strands 1000 --points 16 --hair-length 10 --repeat 2 --end-to-end --quiet
 sanitize-gpu: cuda
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
-	@set -e; for v in paper soa fused; do for p in fp32 fp64; do \
+	@set -e; for v in $$($(PYTHON) -c "from harness import variants; print(*variants.names('cuda'))"); do for p in fp32 fp64; do \
 	  echo "memcheck $$v $$p"; \
 	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_RUN) \
 	    --variant $$v --precision $$p --output $(BUILD)/san-$$v-$$p.h5 --force; \

@@ -1,4 +1,5 @@
 """report/report.md: what ran, how it was checked, how fast, and the paper beside it.
+Rendering only: the numbers come from results_data.py.
 
 Sections: environment; scenes and the stages that ran (skipped and fused ones named);
 validation (results/<name>/validation.json, written by `harness bench`); the paper's
@@ -15,6 +16,7 @@ from pathlib import Path
 from . import results_data
 from .paths import REPORT, display
 from .plots import make_all
+from .results_data import curve_of, interp_time, strands_at_time
 
 # The paper's Fig. 3 (release) and Fig. 4 (debug), milliseconds of "applying wind".
 PAPER = {
@@ -23,49 +25,12 @@ PAPER = {
 }
 
 
-def strands_at_time(curve, target_ms):
-    """Strand count at which a (strands → ms) curve reaches target_ms.
-
-    Log-log interpolation between measured points; beyond the largest, linear in N from
-    it (the work is linear in N), marked extrapolated. (None, note) if it cannot."""
-    pts = sorted((int(n), float(t)) for n, t in curve.items() if t and t > 0)
-    if not pts:
-        return None, "no data"
-    for (n0, t0), (n1, t1) in zip(pts, pts[1:]):
-        if t0 <= target_ms <= t1 and t1 > t0:
-            f = (math.log(target_ms) - math.log(t0)) / (math.log(t1) - math.log(t0))
-            return math.exp(math.log(n0) + f * (math.log(n1) - math.log(n0))), "interpolated"
-    n_max, t_max = pts[-1]
-    if target_ms > t_max:
-        return n_max * target_ms / t_max, f"extrapolated linearly from N = {n_max:,}"
-    n_min, t_min = pts[0]
-    return n_min * target_ms / t_min, f"below our smallest N = {n_min:,}: extrapolated"
-
-
-def interp_time(curve, n):
-    """Our time at strand count n (log-log interpolation, linear extrapolation)."""
-    pts = sorted((int(k), float(t)) for k, t in curve.items() if t and t > 0)
-    if not pts or n is None:
-        return None
-    for (n0, t0), (n1, t1) in zip(pts, pts[1:]):
-        if n0 <= n <= n1:
-            f = (math.log(n) - math.log(n0)) / (math.log(n1) - math.log(n0))
-            return math.exp(math.log(t0) + f * (math.log(t1) - math.log(t0)))
-    n_edge, t_edge = pts[-1] if n > pts[-1][0] else pts[0]
-    return t_edge * n / n_edge
-
-
 def fmt_n(n):
     return "—" if n is None else f"{n:,.0f}"
 
 
 def fmt_ms(t):
     return "—" if t is None or (isinstance(t, float) and math.isnan(t)) else f"{t:.3f}"
-
-
-def curve_of(cases, mask):
-    c = cases[mask].dropna(subset=["pair_ms"])
-    return dict(zip(c["strands"], c["pair_ms"]))
 
 
 def environment_section(env):

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from harness import report, runlog
+from harness import results_data, runlog
 from harness.__main__ import main
 from harness.plots import FIGURE_STATE
 from support.synthetic import radial_strands, write_state
@@ -146,12 +146,12 @@ def test_report_builds_with_plots(tmp_path, gpu, capsys):
 
 def test_strand_count_at_a_time():
     curve = {1000: 1.0, 10000: 10.0, 100000: 100.0}
-    n, how = report.strands_at_time(curve, 50.0)
+    n, how = results_data.strands_at_time(curve, 50.0)
     assert n == pytest.approx(50000, rel=1e-9) and how == "interpolated"
-    n, how = report.strands_at_time(curve, 400.0)
+    n, how = results_data.strands_at_time(curve, 400.0)
     assert n == pytest.approx(400000) and how.startswith("extrapolated")
-    assert report.strands_at_time({}, 5.0) == (None, "no data")
-    assert report.interp_time(curve, 30000) == pytest.approx(30.0)
+    assert results_data.strands_at_time({}, 5.0) == (None, "no data")
+    assert results_data.interp_time(curve, 30000) == pytest.approx(30.0)
 
 
 def test_report_without_results_is_one_clear_error(tmp_path, capsys):
