@@ -255,3 +255,28 @@ def load_state(path: str | Path) -> LoadedState:
             moved=np.array(s.moved, dtype=np.int64),
             frames=s.frames(),
         )
+
+
+def h5md_layout(path: str | Path) -> dict[str, Any]:
+    """The H5MD metadata of a state file (docs/interfaces.md), for checking the writer:
+    h5md version, author and creator attributes, box dimension, the position dataset's
+    shape, dtype and chunks, its step list, and the /parameters attributes and datasets."""
+    import h5py
+
+    with open_state(path):  # the layout of the positions and parameters first
+        pass
+    with h5py.File(str(path), "r") as f:
+        value = f[POSITION]
+        group = f[PARAMETERS]
+        return {
+            "version": [int(v) for v in f["h5md"].attrs["version"]],
+            "author": {k: as_python(v) for k, v in f["h5md/author"].attrs.items()},
+            "creator": {k: as_python(v) for k, v in f["h5md/creator"].attrs.items()},
+            "dimension": int(f["particles/hair/box"].attrs["dimension"]),
+            "shape": tuple(value.shape),
+            "dtype": value.dtype,
+            "chunks": value.chunks,
+            "step": [int(v) for v in f["particles/hair/position/step"][()]],
+            "parameters": {k: as_python(v) for k, v in group.attrs.items()},
+            "parameter_datasets": {k: len(group[k]) for k in group},
+        }

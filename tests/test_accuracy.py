@@ -5,7 +5,7 @@ import csv
 
 import numpy as np
 
-from harness import accuracy
+from harness import accuracy, scenes, tolerances
 
 
 def test_along_curve_error_is_zero_on_a_straight_strand_and_sees_a_bend():
@@ -37,7 +37,12 @@ def test_accuracy_study_writes_table_plot_and_recommendation(cpu_bin, tmp_path):
     assert {"cpu fp64 ref", "cpu fp32 ref"} <= modes
     fp32 = [r for r in rows if r["mode"] == "cpu fp32 ref"]
     assert len(fp32) == 4  # one row per frame of the paper scene
-    assert all(0 < r["max_err_L"] < 1e-4 for r in fp32)  # fp32 rounding, not a bug
+    # fp32 rounding, not a bug: within harness diff's fp32↔fp64 limit at its largest
+    scene = scenes.load_scene("paper")
+    R, h, L = scene.head_radius, scene.hair_offset, scene.hair_length
+    largest_u = tolerances.point_unit(np.zeros(1), np.zeros(1), R, h, L, 16, tolerances.EPS["fp32"])[0]
+    limit_L = tolerances.pair_tolerance("fp32", "fp64").point_k * largest_u / L
+    assert all(0 < r["max_err_L"] < limit_L for r in fp32)
     assert all(r["time_ms"] > 0 for r in rows)
     ref = [r for r in rows if r["mode"] == "cpu fp64 ref"]
     assert all(r["max_err_L"] == 0 for r in ref)
