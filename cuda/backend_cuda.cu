@@ -301,6 +301,7 @@ cudaError_t launch_stage(cuda_impl *c, const Model<T> &m, hb_stage st, int fuse,
         {"the init kernel launch (paper)", "the wind kernel launch (paper)", "the collide kernel launch (paper)"},
         {"the init kernel launch (point-major)", "the wind kernel launch (point-major)",
          "the collide kernel launch (point-major)"}};
+    static_assert(HB_STAGE_INIT == 0 && HB_STAGE_WIND == 1 && HB_STAGE_COLLIDE == 2, "kLaunch is indexed by hb_stage");
     const int64_t N = c->N;
     const int B = c->block;
     const int paper = c->variant == V_PAPER;
