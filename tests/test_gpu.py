@@ -354,8 +354,7 @@ def test_json_record(variant, cpu_ref):
         assert rec["stages"][3]["median_ms"] == 0
     else:
         assert "wind+collide" not in fused
-    # a point may take the other side of a discrete decision only as often as diff allows
-    allowed = strict("fp32").max_over_fraction * N * P
+    allowed = tolerances.MOVED_COUNT_FRACTION * N * P
     for f in (1, 3):
         assert abs(rec["stages"][f]["moved_points"] - int(cpu.moved[f])) <= allowed
     for s in rec["stages"]:
