@@ -65,7 +65,7 @@ NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
 
-.PHONY: all cpu cuda test bench report help clean check-python check-hdf5 sanitize sanitize-gpu
+.PHONY: all cpu cuda test bench report help clean check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt
 
 all: cpu cuda
 
@@ -78,6 +78,8 @@ help:
 	@echo "make report   rebuild report/ from results/default (REPORT_FROM=results/reference-h200/sweep for the committed H200 run)"
 	@echo "make sanitize build the C reference with ASan+UBSan and run the CPU tests under it"
 	@echo "make sanitize-gpu  compute-sanitizer memcheck + racecheck over every CUDA variant (GPU node)"
+	@echo "make lint     ruff check, ruff format --check, mypy (lint-py) and clang-format --dry-run (lint-c)"
+	@echo "make fmt      ruff format the Python and clang-format -i the C and CUDA sources"
 	@echo "make clean    remove build/"
 
 check-hdf5:
@@ -139,7 +141,7 @@ sanitize: check-python check-hdf5
 SAN_RUN := --strands 1000 --points 16 --hair-length 10 --repeat 2 --end-to-end --quiet
 sanitize-gpu: cuda
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
-	@set -e; for v in paper soa fused; do for p in fp32 fp64; do \
+	@set -e; for v in $$($(PYTHON) -c "from harness import variants; print(*variants.names('cuda'))"); do for p in fp32 fp64; do \
 	  echo "memcheck $$v $$p"; \
 	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_RUN) \
 	    --variant $$v --precision $$p --output $(BUILD)/san-$$v-$$p.h5 --force; \
@@ -149,6 +151,25 @@ sanitize-gpu: cuda
 	  echo "racecheck $$v"; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_RUN) --variant $$v; \
 	done; rm -f $(BUILD)/san-*.h5; echo "compute-sanitizer: memcheck and racecheck found no errors in any variant"
+
+# ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----
+PY_SRC     := harness tests
+C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*.h cuda/*.cu cuda/*.cuh)
+CLANG_FORMAT ?= clang-format
+
+lint: lint-py lint-c
+
+lint-py:
+	$(PYTHON) -m ruff check $(PY_SRC)
+	$(PYTHON) -m ruff format --check $(PY_SRC)
+	$(PYTHON) -m mypy
+
+lint-c:
+	$(CLANG_FORMAT) --dry-run --Werror $(C_FMT_SRC)
+
+fmt:
+	$(PYTHON) -m ruff format $(PY_SRC)
+	$(CLANG_FORMAT) -i $(C_FMT_SRC)
 
 clean:
 	rm -rf $(BUILD)

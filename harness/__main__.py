@@ -2,6 +2,7 @@
 
 Commands: run, diff, sweep, plot, report, bench, accuracy, headline, calibrate (`--help` on each). User
 errors print one line `harness: error: …` and exit non-zero, never a traceback."""
+
 import argparse
 import json
 import sys
@@ -14,12 +15,23 @@ def cmd_run(args):
     from .paths import binary_path
 
     scene = scenes.load_scene(args.scene).with_overrides(
-        strands=args.strands, points=args.points, precision=args.precision,
-        stages=scenes.parse_stages(args.stages, "--stages", "--stages") if args.stages else None)
+        strands=args.strands,
+        points=args.points,
+        precision=args.precision,
+        stages=scenes.parse_stages(args.stages, "--stages", "--stages") if args.stages else None,
+    )
     binary = binary_path(args.backend, args.build)
-    flags = runner.run_flags(scene, args.backend, variant=args.variant, block_size=args.block_size,
-                             threads=args.threads, repeat=args.repeat, warmup=args.warmup,
-                             output=args.output, force=args.force)
+    flags = runner.run_flags(
+        scene,
+        args.backend,
+        variant=args.variant,
+        block_size=args.block_size,
+        threads=args.threads,
+        repeat=args.repeat,
+        warmup=args.warmup,
+        output=args.output,
+        force=args.force,
+    )
     record = runner.run_binary(binary, flags, timeout=args.timeout)
     print(json.dumps(record, indent=1) if args.json else runner.summary(record))
     return 0
@@ -29,8 +41,7 @@ def cmd_diff(args):
     from . import diff
 
     frames = ",".join(str(k) for k in args.frame) if args.frame else args.frames
-    return diff.run(args.a, args.b, frames=frames, align_last=args.align_last,
-                    exact=args.exact, as_json=args.json)
+    return diff.run(args.a, args.b, frames=frames, align_last=args.align_last, exact=args.exact, as_json=args.json)
 
 
 def cmd_sweep(args):
@@ -63,47 +74,72 @@ def cmd_bench(args):
 
 
 def cmd_accuracy(args):
-    from . import accuracy
+    from . import accuracy, accuracy_report
 
     if args.from_csv:
-        accuracy.report_from_csv(args.from_csv, report_dir=args.report_dir)
+        accuracy_report.report_from_csv(args.from_csv, report_dir=args.report_dir)
         return 0
-    accuracy.run_study(args.scene, strands=args.strands, points=args.points, repeat=args.repeat,
-                       resolution=tuple(args.resolution), res_strands=args.resolution_strands,
-                       out_dir=args.out, report_dir=args.report_dir)
+    accuracy.run_study(
+        args.scene,
+        strands=args.strands,
+        points=args.points,
+        repeat=args.repeat,
+        resolution=tuple(args.resolution),
+        res_strands=args.resolution_strands,
+        out_dir=args.out,
+        report_dir=args.report_dir,
+    )
     return 0
 
 
 def cmd_headline(args):
     from . import headline
 
-    headline.run(strands=args.strands, points=args.points, repeat=args.repeat, cpu_repeat=args.cpu_repeat,
-                 block_size=args.block_size, out_dir=args.out)
+    headline.run(
+        strands=args.strands,
+        points=args.points,
+        repeat=args.repeat,
+        cpu_repeat=args.cpu_repeat,
+        block_size=args.block_size,
+        out_dir=args.out,
+    )
     return 0
 
 
 def cmd_calibrate(args):
     from . import calibrate
 
-    return calibrate.run(strands=args.strands, points=args.points, seeds=args.seeds,
-                         other=args.other, as_json=args.json)
+    return calibrate.run(
+        strands=args.strands, points=args.points, seeds=args.seeds, other=args.other, as_json=args.json
+    )
 
 
 def parser():
-    p = argparse.ArgumentParser(prog="python -m harness",
-                                description="hairbench harness: run, diff, sweep, plot and report "
-                                            "the hair-strand backends (docs/harness.md)")
+    p = argparse.ArgumentParser(
+        prog="python -m harness",
+        description="hairbench harness: run, diff, sweep, plot and report the hair-strand backends (docs/harness.md)",
+    )
     p.add_argument("--version", action="version", version=f"hairbench harness {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
-    r = sub.add_parser("run", help="run one scene on a backend and print its record",
-                       description="Run a scene (configs/NAME.toml or a path) on a backend binary "
-                                   "with --json; print a summary, or the JSON record with --json.")
-    r.add_argument("scene", help="scene name in configs/ (e.g. paper) or a .toml path")
+    r = sub.add_parser(
+        "run",
+        help="run one scene on a backend and print its record",
+        description="Run a scene (configs/scenes/NAME.toml or a path) on a backend binary "
+        "with --json; print a summary, or the JSON record with --json.",
+    )
+    r.add_argument("scene", help="scene name in configs/scenes/ (e.g. paper) or a .toml path")
     r.add_argument("--backend", choices=("cpu", "cuda"), default="cpu")
-    r.add_argument("--build", choices=("default", "strict", "fastmath"), default="default",
-                   help="cuda build: hairsim-cuda, -strict or -fastmath (default: default)")
-    r.add_argument("--variant", help="cpu: ref; cuda: paper, soa, fused (default: the backend's)")
+    r.add_argument(
+        "--build",
+        choices=("default", "strict", "fastmath"),
+        default="default",
+        help="cuda build: hairsim-cuda, -strict or -fastmath (default: default)",
+    )
+    r.add_argument(
+        "--variant",
+        help="a variant the binary declares (`hairsim-* --list-variants`; default: the binary's default variant)",
+    )
     r.add_argument("--precision", choices=("fp32", "fp64"), help="override the scene's precision")
     r.add_argument("--block-size", type=int, help="cuda threads per block (32…1024)")
     r.add_argument("--strands", type=int, help="override the scene's strand count")
@@ -118,71 +154,109 @@ def parser():
     r.add_argument("--json", action="store_true", help="print the binary's JSON record")
     r.set_defaults(func=cmd_run)
 
-    d = sub.add_parser("diff", help="compare two state files frame by frame (exit 0/1/2)",
-                       description="Compare two HDF5 states frame by frame (DESIGN §6). Exit 0 = "
-                                   "equivalent, 1 = not equivalent, 2 = could not compare.")
+    d = sub.add_parser(
+        "diff",
+        help="compare two state files frame by frame (exit 0/1/2)",
+        description="Compare two HDF5 states frame by frame (DESIGN §6). Exit 0 = "
+        "equivalent, 1 = not equivalent, 2 = could not compare.",
+    )
     d.add_argument("a", help="first state file (e.g. the CPU reference)")
     d.add_argument("b", help="second state file")
-    d.add_argument("--frames", default="all",
-                   help="'all' (default; frame counts must match), 'last' (the last frame of "
-                        "each), or frame numbers like '3' or '1,3'")
-    d.add_argument("--frame", type=int, action="append",
-                   help="compare only frame K (repeatable; negative counts from the end)")
-    d.add_argument("--align-last", action="store_true",
-                   help="with different frame counts, compare the last min(F_A, F_B) frames")
+    d.add_argument(
+        "--frames",
+        default="all",
+        help="'all' (default; frame counts must match), 'last' (the last frame of "
+        "each), or frame numbers like '3' or '1,3'",
+    )
+    d.add_argument(
+        "--frame", type=int, action="append", help="compare only frame K (repeatable; negative counts from the end)"
+    )
+    d.add_argument(
+        "--align-last", action="store_true", help="with different frame counts, compare the last min(F_A, F_B) frames"
+    )
     d.add_argument("--exact", action="store_true", help="require bit-identical positions")
     d.add_argument("--json", action="store_true", help="print the comparison as JSON")
     d.set_defaults(func=cmd_diff)
 
-    s = sub.add_parser("sweep", help="run a sweep file, appending rows to results/NAME/runs.csv",
-                       description="Run every case of a sweep (configs/NAME.toml), one row per "
-                                   "(case, stage) in results/NAME/runs.csv; a killed sweep resumes.")
-    s.add_argument("sweep", help="sweep name in configs/ (e.g. quick) or a .toml path")
+    s = sub.add_parser(
+        "sweep",
+        help="run a sweep file, appending rows to results/NAME/runs.csv",
+        description="Run every case of a sweep (configs/sweeps/NAME.toml), one row per "
+        "(case, stage) in results/NAME/runs.csv; a killed sweep resumes.",
+    )
+    s.add_argument("sweep", help="sweep name in configs/sweeps/ (e.g. quick) or a .toml path")
     s.add_argument("--out", help="results directory (default results/<sweep name>)")
-    s.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto",
-                   help="run cuda cases: auto (if a GPU is usable), yes (fail without), no")
+    s.add_argument(
+        "--gpu",
+        choices=("auto", "yes", "no"),
+        default="auto",
+        help="run cuda cases: auto (if a GPU is usable), yes (fail without), no",
+    )
     s.set_defaults(func=cmd_sweep)
 
-    for name, helptext, fn in (("plot", "draw the PNG plots of a results directory", cmd_plot),
-                               ("report", "write report/report.md (and its plots)", cmd_report)):
+    for name, helptext, fn in (
+        ("plot", "draw the PNG plots of a results directory", cmd_plot),
+        ("report", "write report/report.md (and its plots)", cmd_report),
+    ):
         q = sub.add_parser(name, help=helptext, description=helptext[0].upper() + helptext[1:] + ".")
-        q.add_argument("results", nargs="?", default="results/default",
-                       help="results directory with runs.csv and env.json (default results/default)")
+        q.add_argument(
+            "results",
+            nargs="?",
+            default="results/default",
+            help="results directory with runs.csv and env.json (default results/default)",
+        )
         q.add_argument("--report-dir", default=None, help="where to write (default report/)")
         q.set_defaults(func=fn)
 
-    b = sub.add_parser("bench", help="the make bench pipeline: check, validate, sweep, report",
-                       description="Check the binaries, validate every GPU variant against the CPU "
-                                   "(fail before timing), run the sweep, then plot and report.")
-    b.add_argument("--sweep", default="configs/default.toml", help="sweep file (default configs/default.toml)")
+    b = sub.add_parser(
+        "bench",
+        help="the make bench pipeline: check, validate, sweep, report",
+        description="Check the binaries, validate every GPU variant against the CPU "
+        "(fail before timing), run the sweep, then plot and report.",
+    )
+    b.add_argument("--sweep", default="default", help="sweep name in configs/sweeps/ or a path (default: default)")
     b.add_argument("--out", help="results directory (default results/<sweep name>)")
     b.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto")
     b.add_argument("--report-dir", default=None, help="where to write the report (default report/)")
     b.set_defaults(func=cmd_bench)
 
-    a = sub.add_parser("accuracy", help="speed against accuracy: every mode against the fp64 reference",
-                       description="Run the scene in every precision/build mode available here and in "
-                                   "several model resolutions, compare with hairsim-cpu --precision "
-                                   "fp64, time each mode apart, and write results/accuracy/ and "
-                                   "report/accuracy.md with a Pareto plot (issue #5).")
+    a = sub.add_parser(
+        "accuracy",
+        help="speed against accuracy: every mode against the fp64 reference",
+        description="Run the scene in every precision/build mode available here and in "
+        "several model resolutions, compare with hairsim-cpu --precision "
+        "fp64, time each mode apart, and write results/accuracy/ and "
+        "report/accuracy.md with a Pareto plot.",
+    )
     a.add_argument("--scene", default="paper", help="scene name or .toml path (default paper)")
     a.add_argument("--strands", type=int, default=100_000)
     a.add_argument("--points", type=int, default=32)
     a.add_argument("--repeat", type=int, default=9, help="timed repetitions per stage (default 9)")
-    a.add_argument("--resolution", type=int, nargs="+", default=[4, 8, 16, 32, 64, 128, 256],
-                   help="points per strand of the resolution study (the largest is the reference)")
+    a.add_argument(
+        "--resolution",
+        type=int,
+        nargs="+",
+        default=[4, 8, 16, 32, 64, 128, 256],
+        help="points per strand of the resolution study (the largest is the reference)",
+    )
     a.add_argument("--resolution-strands", type=int, default=20_000)
     a.add_argument("--out", default=None, help="results directory (default results/accuracy)")
     a.add_argument("--report-dir", default=None, help="where to write (default report/)")
-    a.add_argument("--from-csv", default=None, help="only rewrite the table and plot from an existing "
-                                                      "accuracy.csv (e.g. results/accuracy/accuracy.csv)")
+    a.add_argument(
+        "--from-csv",
+        default=None,
+        help="only rewrite the table and plot from an existing accuracy.csv (e.g. results/accuracy/accuracy.csv)",
+    )
     a.set_defaults(func=cmd_accuracy)
 
-    h = sub.add_parser("headline", help="the issues' headline numbers: bandwidth fractions and speedups",
-                       description="At one size, measure the copy bandwidths, every CUDA variant's init and "
-                                   "wind+collide time and bandwidth fraction, and three CPU baselines "
-                                   "(ref 1 thread, ref all cores, simd all cores); write "
-                                   "results/headline/headline.json.")
+    h = sub.add_parser(
+        "headline",
+        help="the headline numbers: bandwidth fractions and speedups",
+        description="At one size, measure the copy bandwidths, every CUDA variant's init and "
+        "wind+collide time and bandwidth fraction, and three CPU baselines "
+        "(ref 1 thread, ref all cores, simd all cores); write "
+        "results/headline/headline.json.",
+    )
     h.add_argument("--strands", type=int, default=4 * 1024 * 1024)
     h.add_argument("--points", type=int, default=32)
     h.add_argument("--repeat", type=int, default=9, help="GPU repetitions per stage (default 9)")
@@ -191,14 +265,20 @@ def parser():
     h.add_argument("--out", default=None, help="results directory (default results/headline)")
     h.set_defaults(func=cmd_headline)
 
-    c = sub.add_parser("calibrate", help="measure fp32-vs-fp64 errors behind tolerances.py",
-                       description="Run the cpu binary at fp32 and fp64 on the paper scene and print "
-                                   "the errors and invariant residuals that tolerances.py is set from.")
+    c = sub.add_parser(
+        "calibrate",
+        help="measure fp32-vs-fp64 errors behind tolerances.py",
+        description="Run the cpu binary at fp32 and fp64 on the paper scene and print "
+        "the errors and invariant residuals that tolerances.py is set from.",
+    )
     c.add_argument("--strands", type=int, default=20000)
     c.add_argument("--points", type=int, nargs="+", default=[8, 32, 128])
     c.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
-    c.add_argument("--other", help="a second binary to compare with the cpu reference at each "
-                                   "precision (e.g. build/hairsim-cuda on a GPU node)")
+    c.add_argument(
+        "--other",
+        help="a second binary to compare with the cpu reference at each "
+        "precision (e.g. build/hairsim-cuda on a GPU node)",
+    )
     c.add_argument("--json", action="store_true")
     c.set_defaults(func=cmd_calibrate)
     return p
