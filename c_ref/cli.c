@@ -96,7 +96,7 @@ static int parse_u64(const char *flag, const char *v, uint64_t *out, char *err, 
     char *end;
     errno = 0;
     if (v[0] == '-') FAIL("%s needs a non-negative whole number (got '%s')", flag, v);
-    unsigned long long x = strtoull(v, &end, 0);
+    unsigned long long x = strtoull(v, &end, 10); /* base 10: 010 is ten */
     if (end == v || *end != '\0') FAIL("%s needs a whole number (got '%s')", flag, v);
     if (errno == ERANGE) FAIL("%s is out of range (got '%s')", flag, v);
     *out = x;
@@ -119,6 +119,7 @@ static int parse_stages(const char *v, hb_options *o, char *err, size_t errlen)
     char buf[1024];
     if (strlen(v) >= sizeof buf) FAIL("--stages is too long");
     strcpy(buf, v);
+    if (hb_stage_list_has_empty_item(v)) FAIL("--stages: empty item in '%s' (write e.g. init,collide,wind)", v);
     o->n_stages = 0;
     char *save = NULL;
     for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
@@ -128,6 +129,7 @@ static int parse_stages(const char *v, hb_options *o, char *err, size_t errlen)
         else if (strcmp(tok, "collide") == 0) s = HB_STAGE_COLLIDE;
         else FAIL("--stages: unknown stage '%s' (known: init, collide, wind)", tok);
         if (o->n_stages == HB_MAX_STAGES) FAIL("--stages: at most %d stages", HB_MAX_STAGES);
+        if (s == HB_STAGE_INIT && o->n_stages > 0) FAIL("--stages: init may only come first (it would replace the state)");
         o->stages[o->n_stages++] = s;
     }
     if (o->n_stages == 0) FAIL("--stages needs at least one stage");
@@ -240,4 +242,12 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
     }
     if (o->warmup < 0) o->warmup = o->repeat > 1 ? 1 : 0;
     return 0;
+}
+
+/* The stage-list rule shared with the harness (harness/scenes.py parse_stages): no empty
+ * item, so "init,,wind", ",init" and "init," are refused instead of skipped. */
+int hb_stage_list_has_empty_item(const char *v)
+{
+    size_t n = strlen(v);
+    return n == 0 || v[0] == ',' || v[n - 1] == ',' || strstr(v, ",,") != NULL;
 }

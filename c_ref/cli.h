@@ -19,4 +19,6 @@ void hb_default_options(hb_options *o);
 #ifdef __cplusplus
 }
 #endif
+int hb_stage_list_has_empty_item(const char *v);
+
 #endif

@@ -1,5 +1,6 @@
 /* state_io.c — HDF5 states, H5MD 1.1 shaped (DESIGN §4; layout in docs/interfaces.md). */
 #include "state_io.h"
+#include "safe_write.h"
 
 #include <errno.h>
 #include <stddef.h>
@@ -111,6 +112,7 @@ void hb_writer_abort(hb_writer *w)
     if (w->value >= 0) H5Dclose(w->value);
     if (w->file >= 0) H5Fclose(w->file);
     if (w->tmp) unlink(w->tmp);
+    hb_safe_forget();
     writer_free(w);
 }
 
@@ -123,14 +125,14 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     w->file = w->value = -1;
     w->scene = *scene;
     w->rows = (uint64_t)scene->n_strands * (uint64_t)scene->points;
-    if (!force && access(path, F_OK) == 0)
-        FAIL("--output %s exists; choose another name or pass --force to replace it", path);
+    if (hb_safe_output_check(path, force, err, errlen)) goto fail;
     w->path = strdup(path);
     size_t n = strlen(path) + 32;
     w->tmp = malloc(n);
     if (!w->path || !w->tmp) FAIL("out of host memory");
     snprintf(w->tmp, n, "%s.tmp.%ld", path, (long)getpid());
-    w->file = H5Fcreate(w->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    hb_safe_track(w->tmp); /* removed on a signal or exit() from here on */
+    w->file = H5Fcreate(w->tmp, H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT);
     if (w->file < 0) FAIL("--output %s: cannot create %s (%s)", path, w->tmp, strerror(errno));
 
     /* /h5md: version, author, creator (H5MD 1.1 §"H5MD metadata") */
@@ -311,8 +313,7 @@ out:
         hb_writer_abort(w);
         return -1;
     }
-    if (rename(w->tmp, w->path) != 0) {
-        snprintf(err, errlen, "--output %s: cannot rename %s into place (%s)", w->path, w->tmp, strerror(errno));
+    if (hb_safe_commit(w->tmp, w->path, err, errlen) != 0) {
         hb_writer_abort(w);
         return -1;
     }
