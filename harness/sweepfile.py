@@ -25,6 +25,7 @@ default build but one for the fast-math build. The cases are the product of the 
 each group; a case that two groups both produce runs once.
 """
 import itertools
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -126,6 +127,15 @@ def _check_axis(where, label, values, backend):
     return values
 
 
+def _results_name(where, name):
+    """A sweep's name is a directory under results/: one plain path component."""
+    if (not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", name)
+            or ".." in name):
+        raise SweepError(f"{where}: name must be letters, digits, '.', '_' or '-' (a directory "
+                         f"under results/), got {name!r}")
+    return name
+
+
 def find_sweep_file(ref):
     found = config_file(ref)
     if found:
@@ -183,6 +193,6 @@ def load_sweep(ref):
     for backend, b in axes:
         for p in b["points"]:
             scene.with_overrides(points=p)  # ℓ ≥ h for every point count
-    return Sweep(name=data.get("name", path.stem), path=path, scene=scene, repeat=repeat,
+    return Sweep(name=_results_name(where, data.get("name", path.stem)), path=path, scene=scene, repeat=repeat,
                  warmup=warmup, timeout_s=int(timeout), axes=axes,
                  description=data.get("description", ""))
