@@ -1,6 +1,7 @@
 /* state_io.c — HDF5 states, H5MD 1.1 shaped (DESIGN §4; layout in docs/interfaces.md). */
 #include "state_io.h"
 #include "safe_write.h"
+#include "h5md_meta.h"
 
 #include <errno.h>
 #include <stddef.h>
@@ -145,10 +146,10 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     if (av >= 0) H5Aclose(av);
     H5Sclose(sp2);
     hid_t author = make_group(h5md, "author");
-    bad |= attr_str(author, "name", "hairbench") < 0;
+    bad |= hb_h5md_str_attr(author, "name", "hairbench") < 0;
     hid_t creator = make_group(h5md, "creator");
-    bad |= attr_str(creator, "name", "hairbench") < 0;
-    bad |= attr_str(creator, "version", HB_VERSION) < 0;
+    bad |= hb_h5md_str_attr(creator, "name", "hairbench") < 0;
+    bad |= hb_h5md_str_attr(creator, "version", HB_VERSION) < 0;
     H5Gclose(creator);
     H5Gclose(author);
     H5Gclose(h5md);
@@ -160,14 +161,8 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     int32_t dim = 3;
     bad |= attr_num(box, "dimension", H5T_STD_I32LE, H5T_NATIVE_INT32, &dim) < 0;
     {
-        hsize_t three = 3;
         const char *boundary[3] = {"none", "none", "none"};
-        hid_t t = str_type(), sp = H5Screate_simple(1, &three, NULL);
-        hid_t a = H5Acreate2(box, "boundary", t, sp, H5P_DEFAULT, H5P_DEFAULT);
-        bad |= a < 0 || H5Awrite(a, t, boundary) < 0;
-        if (a >= 0) H5Aclose(a);
-        H5Sclose(sp);
-        H5Tclose(t);
+        bad |= hb_h5md_str_array_attr(box, "boundary", boundary, 3) < 0;
     }
     H5Gclose(box);
     hid_t position = make_group(hair, "position");
@@ -236,10 +231,12 @@ int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errle
 
     {
         hid_t pos = H5Gopen2(w->file, "particles/hair/position", H5P_DEFAULT);
-        for (int f = 0; f < F; f++) { i64[f] = f; f64[f] = f; }
+        /* step = frame index; time in seconds: the paper model's frames are all at t = 0 */
+        for (int f = 0; f < F; f++) { i64[f] = f; f64[f] = 0.0; }
         bad |= ds_1d(pos, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, (hsize_t)F, i64) < 0;
         bad |= ds_1d(pos, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
         H5Gclose(pos);
+        bad |= hb_h5md_finish(w->file, s) < 0; /* units, strand ids (h5md_meta.c) */
     }
 
     hid_t p = make_group(w->file, "parameters");
