@@ -1,6 +1,6 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
-Commands: run, diff, sweep, plot, report, bench, accuracy, headline, calibrate (`--help` on each). User
+Commands: run, diff, sweep, plot, report, bench, accuracy, headline, export, calibrate (`--help` on each). User
 errors print one line `harness: error: …` and exit non-zero, never a traceback."""
 import argparse
 import json
@@ -119,6 +119,14 @@ def cmd_headline(args):
     return 0
 
 
+def cmd_export(args):
+    from . import export
+
+    for path in export.run(args.state, xdmf=not args.usd_only, usd=args.usd or args.usd_only, out=args.out):
+        print(f"wrote {path}")
+    return 0
+
+
 def cmd_calibrate(args):
     from . import calibrate
 
@@ -227,6 +235,16 @@ def parser():
     h.add_argument("--block-size", type=whole(32), default=256)
     h.add_argument("--out", default=None, help="results directory (default results/headline)")
     h.set_defaults(func=cmd_headline)
+
+    e = sub.add_parser("export", help="sidecars that ParaView/VisIt (XDMF) and Blender/Houdini/usdview (USD) open",
+                       description="Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions "
+                                   "referenced in STATE) and, with --usd, STATE.usdc (BasisCurves, one "
+                                   "time sample per frame; needs usd-core).")
+    e.add_argument("state", help="an HDF5 state written by a hairsim binary")
+    e.add_argument("--usd", action="store_true", help="also write the USD file")
+    e.add_argument("--usd-only", action="store_true", help="write only the USD file")
+    e.add_argument("--out", help="output prefix (default: the state's path)")
+    e.set_defaults(func=cmd_export)
 
     c = sub.add_parser("calibrate", help="measure fp32-vs-fp64 errors behind tolerances.py",
                        description="Run the cpu binary at fp32 and fp64 on the paper scene and print "
