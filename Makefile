@@ -65,7 +65,12 @@ NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
 
-.PHONY: all cpu cuda test bench report help clean check-python check-hdf5 sanitize sanitize-gpu
+.PHONY: all cpu cuda test bench report help clean setup check-python check-hdf5 sanitize sanitize-gpu
+
+# The Python that runs the tests and the harness: tools/setup.sh picks it (PYTHON when it has
+# the packages, else ./.venv) after installing what is missing, and writes its path here.
+PY_FILE := $(BUILD)/python
+RUN_PY   = "$$(cat $(PY_FILE))"
 
 all: cpu cuda
 
@@ -78,17 +83,19 @@ help:
 	@echo "make report   rebuild report/ from results/default (REPORT_FROM=results/reference-h200/sweep for the committed H200 run)"
 	@echo "make sanitize build the C reference with ASan+UBSan and run the CPU tests under it"
 	@echo "make sanitize-gpu  compute-sanitizer memcheck + racecheck over every CUDA variant (GPU node)"
+	@echo "make setup    install what is missing (apt as root/sudo, pip into .venv under PEP 668); nothing when all is there"
 	@echo "make clean    remove build/"
 
 check-hdf5:
 	@echo '#include <hdf5.h>' | $(CC) $(HDF5_CFLAGS) -E -x c - >/dev/null 2>&1 || { \
 	  echo "error: the HDF5 C library is missing (hdf5.h not found): install it, e.g. 'sudo apt-get install libhdf5-dev hdf5-tools'"; exit 1; }
 
-check-python:
-	@for m in h5py numpy pandas matplotlib pytest hypothesis; do \
-	  $(PYTHON) -c "import $$m" 2>/dev/null || { \
-	    echo "error: the Python package '$$m' is missing for $(PYTHON): run '$(PYTHON) -m pip install -r requirements.txt'"; exit 1; }; \
-	done
+# Set-up: system packages (apt, as root or with sudo) and the Python packages (pip, into
+# .venv under PEP 668) when missing; nothing is installed when all are there.
+setup:
+	@PYTHON="$(PYTHON)" CC="$(CC)" tools/setup.sh $(PY_FILE)
+
+check-python: setup
 
 $(OBJ)/%.o: c_ref/%.c $(C_HEADERS) | check-hdf5
 	@mkdir -p $(OBJ)
@@ -117,22 +124,25 @@ cuda:
 	@echo "note: nvcc not found: CUDA binaries not built (install the CUDA toolkit to build them)"
 endif
 
-test: check-python all
-	$(PYTHON) -m pytest tests -q -ra
+# setup runs first, then the build (a recursive make, so that -j cannot build before it)
+test: setup
+	@$(MAKE) --no-print-directory all
+	$(RUN_PY) -m pytest tests -q -ra
 
-bench: check-python all
-	$(PYTHON) -m harness bench $(if $(OUT),--out $(OUT))
+bench: setup
+	@$(MAKE) --no-print-directory all
+	$(RUN_PY) -m harness bench $(if $(OUT),--out $(OUT))
 
 # REPORT_FROM: the results to render (default results/default; the committed reference run
 # from an H200 is results/reference-h200/sweep)
-report: check-python
-	$(PYTHON) -m harness report $(REPORT_FROM)
+report: setup
+	$(RUN_PY) -m harness report $(REPORT_FROM)
 
 # ASan + UBSan over the C reference: a separate build in build/asan, the C tests run on it.
-sanitize: check-python check-hdf5
+sanitize: setup check-hdf5
 	$(MAKE) BUILD=build/asan COPT="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" \
 	  CC="$(CC) -fsanitize=address,undefined" build/asan/hairsim-cpu
-	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(PYTHON) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume"
+	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(RUN_PY) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume"
 
 # compute-sanitizer (memcheck, racecheck) over every CUDA variant on a small run that also
 # exercises the output, resume and end-to-end paths. Needs a GPU.
