@@ -62,7 +62,7 @@ fi
 
 imports() { "$1" -c "import $(echo "$MODULES" | tr ' ' ',')" >/dev/null 2>&1; }
 done_with() {
-  if [ "${HAIRBENCH_READERS:-}" = 1 ]; then
+  if [ "${HAIRBENCH_READERS:-}" = 1 ] && ! "$1" -c "import MDAnalysis, vtkmodules.vtkIOXdmf2, pxr" >/dev/null 2>&1; then
     say "installing the optional readers (requirements-readers.lock) into $1"
     "$1" -m pip install -q --disable-pip-version-check --retries 1 --timeout 30 -r requirements-readers.lock >>"$LOG" 2>&1 ||
       die "pip could not install requirements-readers.lock into $1 (see $LOG)"
