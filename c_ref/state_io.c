@@ -134,7 +134,13 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     snprintf(w->tmp, n, "%s.tmp.%ld", path, (long)getpid());
     hb_safe_track(w->tmp); /* removed on a signal or exit() from here on */
     w->file = H5Fcreate(w->tmp, H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT);
-    if (w->file < 0) FAIL("--output %s: cannot create %s (%s)", path, w->tmp, strerror(errno));
+    if (w->file < 0) {
+        hb_safe_forget(); /* not ours to remove: it may exist already */
+        snprintf(err, errlen, "--output %s: cannot create %s (%s)", path, w->tmp, strerror(errno));
+        free(w->tmp);
+        w->tmp = NULL;
+        goto fail;
+    }
 
     /* /h5md: version, author, creator (H5MD 1.1 §"H5MD metadata") */
     hid_t h5md = make_group(w->file, "h5md");
