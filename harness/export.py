@@ -20,6 +20,20 @@ POSITION = "particles/hair/position"
 BLOCK_ROWS = 1 << 20  # rows written or read at a time
 
 
+def _writable(path):
+    """Refuse, as the binaries do for --output, a target that is a symlink or exists and is
+    not a regular file; the caller writes PATH.tmp.<pid> and renames it over PATH."""
+    path = Path(path)
+    if path.is_symlink() or (path.exists() and not path.is_file()):
+        raise HarnessError(f"export: {path} is a symbolic link or not a regular file; refusing to replace it")
+    return path.with_name(f"{path.name}.tmp.{os.getpid()}")
+
+
+def _replace(tmp, path):
+    os.replace(tmp, path)
+    return Path(path)
+
+
 def _open_state(path):
     import h5py
 
@@ -114,13 +128,17 @@ def export_xdmf(state, out_prefix=None):
         frames, float_bytes = value.shape[0], value.dtype.itemsize
         times = frame_times(f)
         has_strand = "particles/hair/strand" in f
-    int_bytes = np.dtype(write_connectivity(topo_path, n, p)).itemsize
+    tmp_topo, tmp_xdmf = _writable(topo_path), _writable(xdmf_path)
+    try:
+        int_bytes = np.dtype(write_connectivity(tmp_topo, n, p)).itemsize
+    except BaseException:
+        tmp_topo.unlink(missing_ok=True)
+        raise
     here = xdmf_path.parent.resolve()
     state_ref = escape(os.path.relpath(state.resolve(), here))
     topo_ref = escape(os.path.relpath(topo_path.resolve(), here))
-    xdmf_path.write_text(_xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes,
-                               has_strand))
-    return xdmf_path, topo_path
+    tmp_xdmf.write_text(_xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_strand))
+    return _replace(tmp_xdmf, xdmf_path), _replace(tmp_topo, topo_path)
 
 
 def export_usd(state, out_prefix=None):
@@ -139,9 +157,10 @@ def export_usd(state, out_prefix=None):
         value = f[f"{POSITION}/value"]
         frames = value.shape[0]
         times = frame_times(f)
-        if usd_path.exists():
-            usd_path.unlink()
-        stage = Usd.Stage.CreateNew(str(usd_path))
+        _writable(usd_path)
+        tmp = usd_path.with_name(f"{usd_path.stem}.tmp{os.getpid()}.usdc")  # USD picks the format by suffix
+        tmp.unlink(missing_ok=True)
+        stage = Usd.Stage.CreateNew(str(tmp))
         UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)    # column 1 is up
         UsdGeom.SetStageMetersPerUnit(stage, 0.01)          # positions are in cm
         stage.SetStartTimeCode(0)
@@ -161,8 +180,13 @@ def export_usd(state, out_prefix=None):
         prim = curves.GetPrim()
         prim.CreateAttribute("hairbench:frameTime", Sdf.ValueTypeNames.DoubleArray).Set(
             Vt.DoubleArray.FromNumpy(times))
-        stage.GetRootLayer().Save()
-    return usd_path
+        try:
+            stage.GetRootLayer().Save()
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+    del stage
+    return _replace(tmp, usd_path)
 
 
 def run(state, xdmf=True, usd=False, out=None):

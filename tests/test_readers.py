@@ -150,3 +150,18 @@ def test_export_refuses_what_is_not_a_state(tmp_path):
     p = subprocess.run([sys.executable, "-m", "harness", "export", str(bad)], cwd=ROOT_DIR,
                        capture_output=True, text=True)
     assert p.returncode == 2 and p.stderr.count("\n") == 1 and p.stderr.startswith("harness: error: export:")
+
+
+def test_export_refuses_a_symlinked_target(state, tmp_path):
+    target = tmp_path / "elsewhere.txt"
+    target.write_text("keep")
+    link = Path(f"{state}.xdmf")
+    link.unlink(missing_ok=True)
+    link.symlink_to(target)
+    try:
+        p = subprocess.run([sys.executable, "-m", "harness", "export", str(state)], cwd=ROOT_DIR,
+                           capture_output=True, text=True)
+        assert p.returncode == 2 and "symbolic link" in p.stderr and target.read_text() == "keep"
+        assert not [q for q in Path(state).parent.iterdir() if ".tmp" in q.name]
+    finally:
+        link.unlink()
