@@ -1,6 +1,6 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
-Commands: run, diff, sweep, plot, report, bench, accuracy, headline, calibrate (`--help` on each). User
+Commands: run, diff, sweep, plot, report, bench, accuracy, headline, export, calibrate (`--help` on each). User
 errors print one line `harness: error: …` and exit non-zero, never a traceback."""
 
 import argparse
@@ -10,16 +10,50 @@ import sys
 from . import HarnessError, __version__
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """Usage errors as the binaries print them: one line, exit 2."""
+
+    def error(self, message):
+        command = self.prog.split()[3:]  # "python -m harness run" → ["run"]
+        self.exit(2, f"harness: error: {' '.join(command + [''])[:-1] + ': ' if command else ''}{message}\n")
+
+
+def whole(low):
+    """An argparse type: a whole number ≥ low, refused in one line otherwise."""
+    def parse(text):
+        try:
+            value = int(text, 10)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"needs a whole number (got '{text}')") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"must be at least {low} (got {value})")
+        return value
+    return parse
+
+
+def seconds(text):
+    """An argparse type: a finite number of seconds > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs a number of seconds (got '{text}')") from None
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a finite number of seconds > 0 (got '{text}')")
+    return value
+
+
 def cmd_run(args):
     from . import runner, scenes
     from .paths import binary_path
 
+    if args.backend == "cpu" and args.block_size is not None:
+        raise HarnessError("run: --block-size is a cuda flag; the cpu backend takes --threads")
+    if args.backend == "cuda" and args.threads is not None:
+        raise HarnessError("run: --threads is a cpu flag; the cuda backend takes --block-size")
+
     scene = scenes.load_scene(args.scene).with_overrides(
-        strands=args.strands,
-        points=args.points,
-        precision=args.precision,
-        stages=scenes.parse_stages(args.stages, "--stages", "--stages") if args.stages else None,
-    )
+        strands=args.strands, points=args.points, precision=args.precision,
+        stages=scenes.parse_stages(args.stages, "run", "--stages") if args.stages else None)
     binary = binary_path(args.backend, args.build)
     flags = runner.run_flags(
         scene,
@@ -106,6 +140,14 @@ def cmd_headline(args):
     return 0
 
 
+def cmd_export(args):
+    from . import export
+
+    for path in export.run(args.state, xdmf=not args.usd_only, usd=args.usd or args.usd_only, out=args.out):
+        print(f"wrote {path}")
+    return 0
+
+
 def cmd_calibrate(args):
     from . import calibrate
 
@@ -115,10 +157,9 @@ def cmd_calibrate(args):
 
 
 def parser():
-    p = argparse.ArgumentParser(
-        prog="python -m harness",
-        description="hairbench harness: run, diff, sweep, plot and report the hair-strand backends (docs/harness.md)",
-    )
+    p = OneLineParser(prog="python -m harness",
+                                description="hairbench harness: run, diff, sweep, plot and report "
+                                            "the hair-strand backends (docs/harness.md)")
     p.add_argument("--version", action="version", version=f"hairbench harness {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
@@ -141,16 +182,16 @@ def parser():
         help="a variant the binary declares (`hairsim-* --list-variants`; default: the binary's default variant)",
     )
     r.add_argument("--precision", choices=("fp32", "fp64"), help="override the scene's precision")
-    r.add_argument("--block-size", type=int, help="cuda threads per block (32…1024)")
-    r.add_argument("--strands", type=int, help="override the scene's strand count")
-    r.add_argument("--points", type=int, help="override the scene's points per strand")
+    r.add_argument("--block-size", type=whole(32), help="cuda threads per block (32…1024)")
+    r.add_argument("--strands", type=whole(1), help="override the scene's strand count")
+    r.add_argument("--points", type=whole(2), help="override the scene's points per strand")
     r.add_argument("--stages", help="override the scene's stages (comma-separated)")
-    r.add_argument("--threads", type=int, help="cpu OpenMP threads (default: all cores)")
-    r.add_argument("--repeat", type=int, help="timed repetitions per stage")
-    r.add_argument("--warmup", type=int, help="untimed runs per stage before the timed ones")
+    r.add_argument("--threads", type=whole(1), help="cpu OpenMP threads (default: all cores)")
+    r.add_argument("--repeat", type=whole(1), help="timed repetitions per stage")
+    r.add_argument("--warmup", type=whole(0), help="untimed runs per stage before the timed ones")
     r.add_argument("--output", help="write the HDF5 state here (refused if it exists, unless --force)")
     r.add_argument("--force", action="store_true", help="allow replacing --output")
-    r.add_argument("--timeout", type=float, default=None, help="seconds before giving up")
+    r.add_argument("--timeout", type=seconds, default=None, help="seconds before giving up")
     r.add_argument("--json", action="store_true", help="print the binary's JSON record")
     r.set_defaults(func=cmd_run)
 
@@ -229,17 +270,12 @@ def parser():
         "report/accuracy.md with a Pareto plot.",
     )
     a.add_argument("--scene", default="paper", help="scene name or .toml path (default paper)")
-    a.add_argument("--strands", type=int, default=100_000)
-    a.add_argument("--points", type=int, default=32)
-    a.add_argument("--repeat", type=int, default=9, help="timed repetitions per stage (default 9)")
-    a.add_argument(
-        "--resolution",
-        type=int,
-        nargs="+",
-        default=[4, 8, 16, 32, 64, 128, 256],
-        help="points per strand of the resolution study (the largest is the reference)",
-    )
-    a.add_argument("--resolution-strands", type=int, default=20_000)
+    a.add_argument("--strands", type=whole(1), default=100_000)
+    a.add_argument("--points", type=whole(2), default=32)
+    a.add_argument("--repeat", type=whole(1), default=9, help="timed repetitions per stage (default 9)")
+    a.add_argument("--resolution", type=whole(2), nargs="+", default=[4, 8, 16, 32, 64, 128, 256],
+                   help="points per strand of the resolution study (the largest is the reference)")
+    a.add_argument("--resolution-strands", type=whole(1), default=20_000)
     a.add_argument("--out", default=None, help="results directory (default results/accuracy)")
     a.add_argument("--report-dir", default=None, help="where to write (default report/)")
     a.add_argument(
@@ -249,36 +285,37 @@ def parser():
     )
     a.set_defaults(func=cmd_accuracy)
 
-    h = sub.add_parser(
-        "headline",
-        help="the headline numbers: bandwidth fractions and speedups",
-        description="At one size, measure the copy bandwidths, every CUDA variant's init and "
-        "wind+collide time and bandwidth fraction, and three CPU baselines "
-        "(ref 1 thread, ref all cores, simd all cores); write "
-        "results/headline/headline.json.",
-    )
-    h.add_argument("--strands", type=int, default=4 * 1024 * 1024)
-    h.add_argument("--points", type=int, default=32)
-    h.add_argument("--repeat", type=int, default=9, help="GPU repetitions per stage (default 9)")
-    h.add_argument("--cpu-repeat", type=int, default=3, help="CPU repetitions per stage (default 3)")
-    h.add_argument("--block-size", type=int, default=256)
+    h = sub.add_parser("headline", help="the issues' headline numbers: bandwidth fractions and speedups",
+                       description="At one size, measure the copy bandwidths, every CUDA variant's init and "
+                                   "wind+collide time and bandwidth fraction, and three CPU baselines "
+                                   "(ref 1 thread, ref all cores, simd all cores); write "
+                                   "results/headline/headline.json.")
+    h.add_argument("--strands", type=whole(1), default=4 * 1024 * 1024)
+    h.add_argument("--points", type=whole(2), default=32)
+    h.add_argument("--repeat", type=whole(1), default=9, help="GPU repetitions per stage (default 9)")
+    h.add_argument("--cpu-repeat", type=whole(1), default=3, help="CPU repetitions per stage (default 3)")
+    h.add_argument("--block-size", type=whole(32), default=256)
     h.add_argument("--out", default=None, help="results directory (default results/headline)")
     h.set_defaults(func=cmd_headline)
 
-    c = sub.add_parser(
-        "calibrate",
-        help="measure fp32-vs-fp64 errors behind tolerances.py",
-        description="Run the cpu binary at fp32 and fp64 on the paper scene and print "
-        "the errors and invariant residuals that tolerances.py is set from.",
-    )
-    c.add_argument("--strands", type=int, default=20000)
-    c.add_argument("--points", type=int, nargs="+", default=[8, 32, 128])
-    c.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
-    c.add_argument(
-        "--other",
-        help="a second binary to compare with the cpu reference at each "
-        "precision (e.g. build/hairsim-cuda on a GPU node)",
-    )
+    e = sub.add_parser("export", help="sidecars that ParaView/VisIt (XDMF) and Blender/Houdini/usdview (USD) open",
+                       description="Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions "
+                                   "referenced in STATE) and, with --usd, STATE.usdc (BasisCurves, one "
+                                   "time sample per frame; needs usd-core).")
+    e.add_argument("state", help="an HDF5 state written by a hairsim binary")
+    e.add_argument("--usd", action="store_true", help="also write the USD file")
+    e.add_argument("--usd-only", action="store_true", help="write only the USD file")
+    e.add_argument("--out", help="output prefix (default: the state's path)")
+    e.set_defaults(func=cmd_export)
+
+    c = sub.add_parser("calibrate", help="measure fp32-vs-fp64 errors behind tolerances.py",
+                       description="Run the cpu binary at fp32 and fp64 on the paper scene and print "
+                                   "the errors and invariant residuals that tolerances.py is set from.")
+    c.add_argument("--strands", type=whole(1), default=20000)
+    c.add_argument("--points", type=whole(2), nargs="+", default=[8, 32, 128])
+    c.add_argument("--seeds", type=whole(0), nargs="+", default=[1, 2, 3])
+    c.add_argument("--other", help="a second binary to compare with the cpu reference at each "
+                                   "precision (e.g. build/hairsim-cuda on a GPU node)")
     c.add_argument("--json", action="store_true")
     c.set_defaults(func=cmd_calibrate)
     return p

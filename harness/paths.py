@@ -71,5 +71,7 @@ def read_toml(path, where, error):
             return tomllib.load(f)
     except tomllib.TOMLDecodeError as e:
         raise error(f"{where}: not valid TOML: {e}") from None
+    except UnicodeDecodeError as e:
+        raise error(f"{where}: not UTF-8 text (byte {e.start}); TOML files are UTF-8") from None
     except OSError as e:
         raise error(f"{where}: cannot read: {e.strerror}") from None

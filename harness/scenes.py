@@ -60,6 +60,10 @@ SCHEMA = {
     "wind": {"strength": ("wind_strength", "unit"), "angle": ("wind_angle", "real")},
 }
 
+# field name → kind, for overrides given on the command line
+FIELD_KINDS = {spec[0]: spec[1] for table in SCHEMA.values() for spec in table.values()
+               if spec and spec[1] not in ("stages", "text")}
+
 
 class SceneError(HarnessError):
     """A scene that is refused; the message names the file and the key."""
@@ -97,6 +101,9 @@ class Scene:
     def with_overrides(self, **overrides):
         """A copy with the given fields replaced (None = keep), validated again."""
         changes = {k: v for k, v in overrides.items() if v is not None}
+        for k, v in changes.items():
+            if k in FIELD_KINDS:
+                _convert(f"scene {self.name}", k, FIELD_KINDS[k], v)
         scene = replace(self, **changes)
         _check_values(scene, f"scene {self.name}")
         return scene
@@ -173,14 +180,25 @@ def _convert(where, key, kind, value):
     return x
 
 
+MAX_STAGES = 64  # HB_MAX_STAGES in c_ref/params.h
+
+
 def parse_stages(value, where="scene", key="stages"):
+    """The stage-list rules of the binaries' --stages (c_ref/cli.c): known names, no empty
+    item (\"init,,wind\" is refused, not skipped), at most MAX_STAGES, init only first."""
     if isinstance(value, str):
-        value = [s.strip() for s in value.split(",")]
+        if value == "" or value.startswith(",") or value.endswith(",") or ",," in value:
+            raise SceneError(f"{where}: {key}: empty item in '{value}' (write e.g. init,collide,wind)")
+        value = value.split(",")
     if not isinstance(value, list) or not value:
         raise SceneError(f"{where}: {key} must be a non-empty list of stage names")
+    if len(value) > MAX_STAGES:
+        raise SceneError(f"{where}: {key}: at most {MAX_STAGES} stages")
     for i, s in enumerate(value):
-        if s not in STAGES:
-            raise SceneError(f"{where}: {key}[{i}] '{s}' is not a stage (known: {', '.join(STAGES)})")
+        if not isinstance(s, str) or s not in STAGES:
+            raise SceneError(f"{where}: {key}[{i}] {s!r} is not a stage (known: {', '.join(STAGES)})")
+        if s == "init" and i > 0:
+            raise SceneError(f"{where}: {key}: init may only come first (it would replace the state)")
     return tuple(value)
 
 
@@ -255,7 +273,7 @@ def is_scene_file(path):
     try:
         with open(path, "rb") as f:
             return "stages" in tomllib.load(f)
-    except (OSError, tomllib.TOMLDecodeError):
+    except (OSError, ValueError):  # TOMLDecodeError and UnicodeDecodeError are ValueErrors
         return False
 
 

@@ -26,6 +26,7 @@ each group; a case that two groups both produce runs once.
 """
 
 import itertools
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -153,6 +154,15 @@ def known_variants(backend):
     return tuple(known)
 
 
+def _results_name(where, name):
+    """A sweep's name is a directory under results/: one plain path component."""
+    if (not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", name)
+            or ".." in name):
+        raise SweepError(f"{where}: name must be letters, digits, '.', '_' or '-' (a directory "
+                         f"under results/), got {name!r}")
+    return name
+
+
 def find_sweep_file(ref):
     found = config_file(ref, SWEEPS)
     if found and is_scene_file(found):
@@ -212,13 +222,6 @@ def load_sweep(ref):
     for backend, b in axes:
         for p in b["points"]:
             scene.with_overrides(points=p)  # ℓ ≥ h for every point count
-    return Sweep(
-        name=data.get("name", path.stem),
-        path=path,
-        scene=scene,
-        repeat=repeat,
-        warmup=warmup,
-        timeout_s=int(timeout),
-        axes=axes,
-        description=data.get("description", ""),
-    )
+    return Sweep(name=_results_name(where, data.get("name", path.stem)), path=path, scene=scene, repeat=repeat,
+                 warmup=warmup, timeout_s=int(timeout), axes=axes,
+                 description=data.get("description", ""))
