@@ -33,7 +33,7 @@ import numpy as np
 
 from . import invariants, tolerances
 from .invariants import Violation
-from .states import State
+from .states import State, as_text
 
 
 @dataclass
@@ -134,6 +134,11 @@ def _paper_view(traj):
     kw.update(n_frames=traj.paper_frames, stages=traj.stages[:traj.paper_frames],
               skipped=traj.skipped[:traj.paper_frames], fused=traj.fused[:traj.paper_frames])
     return State(**kw)
+
+
+def is_reference_build(traj):
+    """The C reference built as the oracle (no FMA contraction): its roots must be bit-exact."""
+    return as_text(traj.params.get("backend", "")) == "cpu" and "-ffp-contract=off" in traj.flags
 
 
 def check(traj, exact=True, frames=None, paper=True):
