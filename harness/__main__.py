@@ -21,7 +21,12 @@ def cmd_run(args):
                              threads=args.threads, repeat=args.repeat, warmup=args.warmup,
                              output=args.output, force=args.force)
     if scene.model == "dynamic":  # per-frame observables (harness/dynrun.py)
-        from . import dynrun
+        from . import dynrun, dynscene
+        if args.frames:
+            scene = dynscene.with_frames(scene, args.frames)
+            flags = runner.run_flags(scene, args.backend, variant=args.variant, block_size=args.block_size,
+                                     threads=args.threads, repeat=args.repeat, warmup=args.warmup,
+                                     output=args.output, force=args.force)
         return dynrun.run(binary, flags, args.output, timeout=args.timeout, as_json=args.json,
                           every=args.every)
     record = runner.run_binary(binary, flags, timeout=args.timeout)
@@ -129,6 +134,7 @@ def parser():
     r.add_argument("--force", action="store_true", help="allow replacing --output")
     r.add_argument("--timeout", type=float, default=None, help="seconds before giving up")
     r.add_argument("--json", action="store_true", help="print the binary's JSON record")
+    r.add_argument("--frames", type=int, default=None, help="dynamic scenes: override dynamics.frames")
     r.add_argument("--every", type=int, default=None,
                    help="dynamic scenes: print every K-th frame's observables (default: about 30 lines)")
     r.set_defaults(func=cmd_run)

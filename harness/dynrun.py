@@ -23,7 +23,7 @@ def table(obs, every=None):
         lines.append(f"{row.step:>6} {row.time:9.4f} {row.stretch_max:12.4g} {row.penetration_max:12.4g} "
                      f"{row.kinetic_energy:12.4g} {row.blown_up_strands:>9}")
     if k > 1:
-        lines.append(f"(every {k}th frame and the last; --every 1 prints all {n})")
+        lines.append(f"(one frame in {k} and the last; --every 1 prints all {n})")
     return lines
 
 

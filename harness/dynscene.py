@@ -166,3 +166,13 @@ def flags(scene):
 
 def frames(scene):
     return int(scene.dynamic.get("--frames", 1))
+
+
+def with_frames(scene, n):
+    """A copy of a dynamic scene simulating n frames."""
+    from dataclasses import replace
+
+    from .scenes import SceneError
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise SceneError(f"--frames must be a whole number ≥ 1, got {n!r}")
+    return replace(scene, dynamic={**scene.dynamic, "--frames": n})

@@ -333,3 +333,35 @@ def test_stepdiff_catches_a_wrong_frame(cpu_bin, reference, tmp_path, capsys):
     code = harness_main(["stepdiff", "--reference", str(bad), "--binary", str(cpu_bin), "--frames", "3"])
     assert code == 1, capsys.readouterr().out
     assert harness_main(["stepdiff", "--reference", str(bad), "--binary", str(cpu_bin), "--frames", "2"]) == 0
+
+
+# ---- dynamic scenes and `harness run` ----------------------------------------------------------
+
+def test_shipped_dynamic_scenes_load():
+    from harness import scenes
+
+    d = scenes.load_scene("dynamic")
+    assert d.model == "dynamic" and d.stages[-1] == "simulate"
+    flags = d.flags()
+    for flag in ("--solver", "--substeps", "--bend-compliance", "--shape-compliance", "--wind-speed",
+                 "--gust-amplitude", "--head-motion", "--drag", "--damping"):
+        assert flag in flags, flag
+    assert "--no-collider" not in flags
+    s = scenes.load_scene("still-dynamic").flags()
+    for flag in ("--bend-compliance", "--shape-compliance", "--wind-speed", "--no-collider"):
+        assert flag not in s, flag
+    assert s[s.index("--head-motion") + 1] == "still"
+    # a paper scene has no dynamic flags
+    assert "--frames" not in scenes.load_scene("paper").flags()
+
+
+def test_harness_run_prints_observables(cpu_bin, tmp_path, capsys):
+    out = tmp_path / "d.h5"
+    code = harness_main(["run", "dynamic", "--strands", "64", "--points", "16", "--frames", "40",
+                         "--output", str(out)])
+    text = capsys.readouterr().out
+    assert code == 0
+    assert "stretch_max" in text and "(one frame in 2 and the last" in text
+    assert "blown up: no; invariants: all hold" in text
+    with open_trajectory(out) as t:
+        assert len(t.observables) == 40 and t.features == "bend+shape+wind+gust+motion+collide+drag"
