@@ -32,11 +32,12 @@ import tomllib
 from dataclasses import dataclass, field, replace
 
 from . import HarnessError
+from . import dynscene
 from .paths import SCENES, config_file, read_toml
 
-STAGES = ("init", "collide", "wind")
+STAGES = ("init", "collide", "wind", "simulate")
 PRECISIONS = ("fp32", "fp64")
-MODELS = ("paper",)
+MODELS = ("paper", "dynamic")
 
 # table → key → (field name, kind); kinds: int_count, seed, pos, nonneg, unit, real
 SCHEMA = {
@@ -85,6 +86,9 @@ class Scene:
     hair_offset: float = 0.1
     wind_strength: float = 0.5
     wind_angle: float = math.pi
+    # model = "dynamic": the binary flags of [dynamics], [constraints], [wind] and [head]
+    # (harness/dynscene.py), flag → value text, in the order they were declared
+    dynamic: dict = field(default_factory=dict)
     source: str = field(default="", compare=False)
 
     @property
@@ -133,6 +137,7 @@ class Scene:
             ",".join(self.stages),
             "--precision",
             self.precision,
+            *dynscene.flags(self),
         ]
 
 
@@ -215,6 +220,7 @@ def memory_bytes():
 
 
 def _check_values(scene, where):
+    dynscene.check(scene, where, SceneError)
     if scene.stages[0] != "init":
         raise SceneError(f"{where}: stages must start with init (got '{scene.stages[0]}')")
     if "init" in scene.stages[1:]:
@@ -225,8 +231,8 @@ def _check_values(scene, where):
             f"below hair.offset = {scene.hair_offset:g} (ℓ ≥ h is required)"
         )
     # frames are streamed to the file one at a time: a backend holds a few copies of one
-    # frame (FRAME_COPIES), never all of them
-    need = scene.state_bytes() * FRAME_COPIES
+    # frame (FRAME_COPIES), never all of them; simulate adds velocities, rest shape and saved copies
+    need = scene.state_bytes() * (FRAME_COPIES + (3 if scene.model == "dynamic" else 0))
     have = memory_bytes()
     if have and need > have:
         raise SceneError(
@@ -238,6 +244,11 @@ def _check_values(scene, where):
 
 def scene_from_dict(data, name, where):
     values = {}
+    data, values["dynamic"] = dynscene.split(data, where, SceneError)
+    if "stages" not in data and values["dynamic"] is not None:
+        data = dict(data, stages=list(dynscene.DEFAULT_STAGES))
+    if values["dynamic"] is None:
+        values["dynamic"] = {}
     for key, value in data.items():
         if key not in SCHEMA[""]:
             raise SceneError(f"{where}: unknown key '{key}' (known: {', '.join(SCHEMA[''])})")
@@ -272,7 +283,8 @@ def is_scene_file(path):
     """A file with a `stages` key: a scene, not a sweep (a check; the directory is the rule)."""
     try:
         with open(path, "rb") as f:
-            return "stages" in tomllib.load(f)
+            data = tomllib.load(f)
+        return "stages" in data or data.get("model") == "dynamic"
     except (OSError, ValueError):  # TOMLDecodeError and UnicodeDecodeError are ValueErrors
         return False
 

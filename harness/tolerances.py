@@ -235,3 +235,56 @@ def named_pair(name: str, precision: str) -> PairTolerance:
 
 def invariant_tolerance(kind: str) -> InvariantTolerance:
     return INVARIANTS[kind]
+
+
+
+# ---- the dynamic model (docs/model.md §3): harness/dynamic_checks.py, harness/dyndiff.py ----
+# Measured on the 2-core dev machine with build/hairsim-cpu and with "other" = c_ref built
+# with FMA contraction (`make BUILD=/tmp/hbfma CFLAGS_REF="-std=c11 -D_DEFAULT_SOURCE -O2
+# -march=native -ffp-contract=fast -fno-fast-math -Wall" /tmp/hbfma/hairsim-cpu`), the
+# stand-in for a port that rounds differently. Scenes: 1000 strands × 32 points, 30–60
+# frames, xpbd and ftl, fp32 and fp64, each of: defaults (S = I = 1, gravity only); the
+# dynamic default scene (S = 8, I = 2, bend 1e-6, shape 1e-4 range 0.5, drag 0.5, damping
+# 0.5, wind 150 with gusts, nod); shake A = 0.5 S = 4; tilt + wind 300 without collider;
+# collision margin 0.5 with I = 3 (and 5000 strands for the kinetic energy's sum order).
+#
+# Roots: the reference puts every root bit-exactly at Q(t)·X̄0 in all 40 runs (0 ULP). The
+# FMA build contracts the rotation's products: ≤ 0.8·ε·R off (nod, shake and tilt,
+# A = 0.5 rad, fp32 and fp64) (coordinates near 0 make that
+# up to 1e4 ULP, hence a unit of ε·R, not ULPs). DYN_ROOT_K = 4 for non-reference builds.
+DYN_ROOT_K = 4.0
+# Collider: after a frame no non-root point lies inside R_c by more than 1.63·ε·R_c (fp32)
+# and 1.60·ε·R_c (fp64), reference and FMA build alike; 8 is a 4.9× margin.
+DYN_PENETRATION_K = 8.0
+# FTL segments the collider did not move: |len − ℓ| ≤ 0.45·ε·E in every run (fp32 0.44,
+# fp64 0.45, with and without the collider, FMA build 0.42); 4 is a 8.9× margin.
+DYN_FTL_SEGMENT_K = 4.0
+# Kinetic energy recomputed by the harness (strand by strand in order) against the file's
+# (the binary sums in chunks of 1024 strands): bit-equal up to 1000 strands, ≤ 9.9e-15
+# relative at 5000 strands (1.55e5 terms), ≤ 3.9e-16 for the FMA build. Rounding errors of
+# a sum grow like √n·ε: at 1e6 strands × 31 that extrapolates to ≈ 1.4e-13, so 1e-11 keeps
+# a 70× margin there (and 1000× at the sizes measured).
+DYN_KINETIC_REL = 1e-11
+# stretch_max and penetration_max (computed in double, §3.8) recomputed by the harness: bit
+# for bit against the reference in every run (the checks require it there); the FMA build
+# contracts the sums of squares: ≤ 1.0·ε64 of 1 + stretch or of R_c (8 runs: nod and
+# shake, xpbd and ftl, fp32 and fp64, 30 frames); 8 is an 8× margin.
+DYN_OBSERVABLE_K = 8.0
+# One frame advanced from the same input (`harness stepdiff`): a point is over when the
+# two results differ by more than DYN_STEP_K·ε·E·S·I. FMA build against the reference,
+# P = 32, frames 1…38 of 40 of the dynamic default scene: worst 12.7·ε·E at S·I = 16
+# (0.79 per substep-iteration; fp32 12.3, fp64 12.7; xpbd 12.7, ftl 10.7); xpbd fp64 at
+# S = 2, I = 1: 0.89·ε·E (0.45 per); S = 16, I = 4: 30.3·ε·E (0.47 per); S = I = 1: 0.82.
+# So ≤ 0.82·ε·E·S·I everywhere; DYN_STEP_K = 4 is a 4.9× margin. Measured at P = 32 only.
+# Over many frames two correct builds drift apart (collisions, the solvers): this rule is
+# for one frame from one input, not for whole trajectories.
+DYN_STEP_K = {("fp64", "fp64"): 4.0, ("fp32", "fp64"): 4.0, ("fp32", "fp32"): 4.0}
+DYN_STEP_WHY = ("one frame from the same input: FMA-contracted c_ref against c_ref ≤ 0.82·ε·E·S·I "
+                "(xpbd and ftl, fp32 and fp64, S·I = 1 … 64, P = 32); 4 = margin 4.9×")
+# fp32 against fp64 of the same scene over a short horizon (tests/test_dynamic.py): 64
+# strands × 16 points, S = I = 2, bend, shape, drag, damping, gusty wind, nod, seeds 1–3,
+# xpbd and ftl, collider on and off: max |x32 − x64| ≤ 1.43e-6·L over frames 1–10 (the
+# drift grows: up to 1.1e-5·L by frame 20, where a contact went the other way in fp32).
+# 1e-5·L over at most 10 frames is a 7× margin.
+DYN_FP32_VS_FP64_FRAMES = 10
+DYN_FP32_VS_FP64_REL_L = 1e-5
