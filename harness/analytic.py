@@ -46,9 +46,12 @@ def pendulum_period(length, g, theta0):
     return 4.0 * math.sqrt(length / g) * ellipk(math.sin(0.5 * theta0) ** 2)
 
 
-def wind_angle(drag, speed, g):
-    """Steady angle from the downward vertical, tan θ = c_d·U/g0 (docs/model.md §4.2)."""
-    return math.atan2(drag * speed, g)
+def wind_angle(drag, speed, g, psi=0.0):
+    """Steady angle from the downward vertical (−y), positive toward +z (docs/model.md §4.2):
+    the rod lines up with the net acceleration (0, −g + c_d·U·sin ψ, c_d·U·cos ψ); for a
+    horizontal wind (ψ = 0) tan θ = c_d·U/g0. ψ = π gives −atan(c_d·U/g0) up to the 1.2e-16
+    of sin π in double."""
+    return math.atan2(drag * speed * math.cos(psi), g - drag * speed * math.sin(psi))
 
 
 def j0(x):

@@ -89,10 +89,12 @@ def test_pendulum_ftl_is_xpbd_at_two_points(cpu_bin, tmp_path):
 @pytest.mark.parametrize("solver", SOLVERS)
 @pytest.mark.parametrize("substeps", (1, 8))
 def test_steady_wind_angle(cpu_bin, tmp_path, solver, substeps):
-    for speed in (250.0, 981.0, 3000.0):
-        r = run_wind(cpu_bin, tmp_path, solver, substeps, speed)
+    # horizontal wind toward +z at three speeds; toward −z (ψ = π); and tilted up (ψ = 0.5),
+    # where the net acceleration (0, −g0 + c_d·U·sin ψ, c_d·U·cos ψ) sets the angle
+    for speed, psi in ((250.0, 0.0), (981.0, 0.0), (3000.0, 0.0), (981.0, math.pi), (981.0, 0.5)):
+        r = run_wind(cpu_bin, tmp_path, solver, substeps, speed, wind_angle=psi)
         assert abs(r["measured"] - r["expected"]) <= tol.ANALYTIC_WIND_ANGLE_ABS, \
-            f"U={speed}: θ={r['measured']!r}, atan(c_d·U/g0)={r['expected']!r}"
+            f"U={speed}, ψ={psi}: θ={r['measured']!r}, expected {r['expected']!r}"
         assert r["change_last_second"] <= tol.ANALYTIC_WIND_ANGLE_ABS
 
 

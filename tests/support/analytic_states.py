@@ -140,13 +140,14 @@ def run_pendulum(binary, workdir, solver, substeps, theta0, length=30.0, periods
             "amplitude_end": float(np.max(np.abs(theta[last]))), "frames": frames}
 
 
-def run_wind(binary, workdir, solver, substeps, speed, drag=1.0, damping=10.0, seconds=6.0, length=30.0,
+def run_wind(binary, workdir, solver, substeps, speed, drag=1.0, damping=10.0, seconds=8.0, length=30.0,
              wind_angle=0.0, precision="fp64"):
-    """§4.2: P = 2 hanging straight down, steady wind along ψ = 0 (toward +z), no gusts; the
-    angle of the segment at the last frame against atan(c_d·U/g0)."""
+    """§4.2: P = 2 hanging straight down, steady wind along ψ (0: toward +z), no gusts; the
+    angle of the segment at the last frame against the net acceleration's,
+    atan(c_d·U/g0) for ψ = 0."""
     an = _analytic()
     frames = int(math.ceil(seconds / FRAME_DT))
-    tag = f"wind_{solver}_{substeps}_{speed:g}_{precision}"
+    tag = f"wind_{solver}_{substeps}_{speed:g}_{wind_angle:g}_{precision}"
     inp = write_paper_state(os.path.join(workdir, f"{tag}_in.h5"), pendulum_positions(length, 0.0), length,
                             precision=precision)
     out = simulate(binary, inp, os.path.join(workdir, f"{tag}.h5"), frames, substeps, solver,
@@ -155,7 +156,7 @@ def run_wind(binary, workdir, solver, substeps, speed, drag=1.0, damping=10.0, s
                           repr(float(damping)), "--wind-angle", repr(float(wind_angle)), "--gust-amplitude", "0"))
     t, x = an.read_series(out)
     theta = an.segment_angle(x[:, 0, 0], x[:, 0, 1])
-    return {"measured": float(theta[-1]), "expected": an.wind_angle(drag, speed, G0),
+    return {"measured": float(theta[-1]), "expected": an.wind_angle(drag, speed, G0, wind_angle),
             "change_last_second": float(np.max(np.abs(theta[t >= t[-1] - 1.0] - theta[-1]))), "frames": frames}
 
 
