@@ -113,3 +113,18 @@ def test_hanging_chain_first_mode_converges_in_substeps(cpu_bin, tmp_path, point
     r = runs[-1]
     gap = an.relative_error(r["expected"], r["continuum"])
     assert an.relative_error(r["measured"], r["continuum"]) <= gap + tol.ANALYTIC_CHAIN_REL
+
+
+# ---------------------------------------------------------------- fp32
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_fp32_holds_the_analytic_answers_at_moderate_substeps(cpu_bin, tmp_path, solver):
+    """fp32 stops converging once h²·|a| nears the ulp of a coordinate (docs/analytic.md);
+    at S = 8 it still matches the closed forms."""
+    r = run_pendulum(cpu_bin, tmp_path, solver, 8, 0.1, precision="fp32")
+    assert an.relative_error(r["measured"], r["expected"]) <= tol.ANALYTIC_FP32_PENDULUM_REL
+    for substeps in (1, 8):
+        for speed, psi in ((250.0, 0.0), (981.0, 0.0), (3000.0, 0.0), (981.0, math.pi), (981.0, 0.5)):
+            r = run_wind(cpu_bin, tmp_path, solver, substeps, speed, wind_angle=psi, precision="fp32")
+            assert abs(r["measured"] - r["expected"]) <= tol.ANALYTIC_FP32_WIND_ANGLE_ABS, \
+                f"fp32 S={substeps} U={speed} ψ={psi}: θ={r['measured']!r}, expected {r['expected']!r}"
