@@ -42,7 +42,7 @@ def pendulum_tables(binary, work, sa, s_values):
     for theta0 in (0.1, 2.0):
         out.append(f"### Pendulum, θ0 = {theta0} rad (P = 2, ℓ = 30 cm, 3 periods)\n")
         out.append("| solver | S | T measured (s) | T expected (s) | rel. error | rel. error vs 2π√(ℓ/g) "
-                   "| amplitude in the 3rd period (rad) |")
+                   "| amplitude in the 4th (last) period (rad) |")
         out.append("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
         orders = []
         for solver in ("xpbd", "ftl"):

@@ -172,7 +172,7 @@ def invariant_tolerance(kind):
 # are the same scheme (the periods agree to ≤ 1.0e-12 relative over S = 1…128: rounding).
 #   θ0 = 0.1: S = 2, 8, 32 → 5.1e-4, 2.9e-5, 1.69e-5 (both solvers)
 #   θ0 = 2.0: S = 2, 8, 32 → 0.184, 0.104, 0.0400   (both solvers; mostly the amplitude
-#             the position-based step loses: 2.0 rad decays to 1.75 rad in 3 periods at S = 32)
+#             the position-based step loses: 2.0 rad decays to 1.75 rad by the 4th period at S = 32)
 ANALYTIC_PENDULUM_SMALL_REL = 5e-5     # θ0 = 0.1 at S = 32 (measured 1.69e-5; margin 3×)
 ANALYTIC_PENDULUM_LARGE_REL = 0.05     # θ0 = 2.0 at S = 32 (measured 0.0400; margin 1.25×:
                                        # the error is a smooth, deterministic ~1/S decay)
