@@ -1,6 +1,6 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
-Commands: run, diff, sweep, plot, report, bench, accuracy, headline, calibrate (`--help` on each). User
+Commands: run, diff, stepdiff, sweep, plot, report, bench, accuracy, headline, calibrate (`--help` on each). User
 errors print one line `harness: error: …` and exit non-zero, never a traceback."""
 import argparse
 import json
@@ -20,6 +20,10 @@ def cmd_run(args):
     flags = runner.run_flags(scene, args.backend, variant=args.variant, block_size=args.block_size,
                              threads=args.threads, repeat=args.repeat, warmup=args.warmup,
                              output=args.output, force=args.force)
+    if scene.model == "dynamic":  # per-frame observables (harness/dynrun.py)
+        from . import dynrun
+        return dynrun.run(binary, flags, args.output, timeout=args.timeout, as_json=args.json,
+                          every=args.every)
     record = runner.run_binary(binary, flags, timeout=args.timeout)
     print(json.dumps(record, indent=1) if args.json else runner.summary(record))
     return 0
@@ -29,8 +33,17 @@ def cmd_diff(args):
     from . import diff
 
     frames = ",".join(str(k) for k in args.frame) if args.frame else args.frames
+    # dynamic files (harness/dyndiff.py) pair frames by step: --frame K names step K
     return diff.run(args.a, args.b, frames=frames, align_last=args.align_last,
                     exact=args.exact, as_json=args.json)
+
+
+def cmd_stepdiff(args):
+    from . import dyndiff
+
+    flags = args.flags[1:] if args.flags[:1] == ["--"] else args.flags
+    return dyndiff.stepdiff(args.reference, args.binary, flags=flags, frames=args.frames,
+                            exact=args.exact, keep=args.keep, timeout=args.timeout)
 
 
 def cmd_sweep(args):
@@ -116,7 +129,25 @@ def parser():
     r.add_argument("--force", action="store_true", help="allow replacing --output")
     r.add_argument("--timeout", type=float, default=None, help="seconds before giving up")
     r.add_argument("--json", action="store_true", help="print the binary's JSON record")
+    r.add_argument("--every", type=int, default=None,
+                   help="dynamic scenes: print every K-th frame's observables (default: about 30 lines)")
     r.set_defaults(func=cmd_run)
+
+    sd = sub.add_parser("stepdiff", help="validate a dynamic backend one frame at a time (exit 0/1/2)",
+                        description="For each chosen simulated frame k of a reference written with "
+                                    "--velocities all, run BINARY --input REF --input-frame k --stages "
+                                    "simulate --frames 1 and compare its new frame with the reference's "
+                                    "frame k+1 by the dynamic per-frame tolerance (harness/dyndiff.py). "
+                                    "Exit 0 = equivalent, 1 = not, 2 = could not compare.")
+    sd.add_argument("--reference", required=True, help="dynamic state file (A)")
+    sd.add_argument("--binary", required=True, help="the binary to validate (e.g. build/hairsim-cuda)")
+    sd.add_argument("--frames", default="all", help="frame indices of A: all (default), K, K..L, K.., ..L")
+    sd.add_argument("--exact", action="store_true", help="require bit-identical frames")
+    sd.add_argument("--keep", help="keep the binary's outputs in this directory")
+    sd.add_argument("--timeout", type=float, default=None, help="seconds per binary run")
+    sd.add_argument("flags", nargs=argparse.REMAINDER,
+                    help="further flags for the binary (after the options, e.g. -- --threads 1)")
+    sd.set_defaults(func=cmd_stepdiff)
 
     d = sub.add_parser("diff", help="compare two state files frame by frame (exit 0/1/2)",
                        description="Compare two HDF5 states frame by frame (DESIGN §6). Exit 0 = "

@@ -277,6 +277,9 @@ def format_result(r):
 
 def run(path_a, path_b, frames="all", align_last=False, exact=False, as_json=False, out=print):
     """The `harness diff` command; returns the exit status."""
+    from . import dyndiff  # dynamic files: frames paired by step (harness/dyndiff.py)
+    if dyndiff.is_dynamic_file(path_a) or dyndiff.is_dynamic_file(path_b):
+        return dyndiff.run(path_a, path_b, frames=frames, exact=exact, as_json=as_json, out=out)
     try:
         result = compare(path_a, path_b, parse_frames(frames) if isinstance(frames, str) else frames,
                          align_last, exact)

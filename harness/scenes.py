@@ -32,11 +32,12 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from . import HarnessError
+from . import dynscene
 from .paths import CONFIGS, config_file, read_toml
 
-STAGES = ("init", "collide", "wind")
+STAGES = ("init", "collide", "wind", "simulate")
 PRECISIONS = ("fp32", "fp64")
-MODELS = ("paper",)
+MODELS = ("paper", "dynamic")
 
 # table → key → (field name, kind); kinds: int_count, seed, pos, nonneg, unit, real
 SCHEMA = {
@@ -70,6 +71,9 @@ class Scene:
     hair_offset: float = 0.1
     wind_strength: float = 0.5
     wind_angle: float = math.pi
+    # model = "dynamic": the binary flags of [dynamics], [constraints], [wind] and [head]
+    # (harness/dynscene.py), flag → value text, in the order they were declared
+    dynamic: dict = field(default_factory=dict)
     source: str = field(default="", compare=False)
 
     @property
@@ -97,7 +101,8 @@ class Scene:
                 "--hair-offset", repr(self.hair_offset), "--hair-length", repr(self.hair_length),
                 "--face-margin", repr(self.face_margin),
                 "--wind-strength", repr(self.wind_strength), "--wind-angle", repr(self.wind_angle),
-                "--stages", ",".join(self.stages), "--precision", self.precision]
+                "--stages", ",".join(self.stages), "--precision", self.precision,
+                *dynscene.flags(self)]
 
 
 def _number(where, key, value):
@@ -163,6 +168,7 @@ def memory_bytes():
 
 
 def _check_values(scene, where):
+    dynscene.check(scene, where, SceneError)
     if scene.stages[0] != "init":
         raise SceneError(f"{where}: stages must start with init (got '{scene.stages[0]}')")
     if "init" in scene.stages[1:]:
@@ -171,7 +177,7 @@ def _check_values(scene, where):
         raise SceneError(f"{where}: hair.length/(hair.points − 1) = {scene.segment_length:g} is "
                          f"below hair.offset = {scene.hair_offset:g} (ℓ ≥ h is required)")
     # the backends hold every frame of the state in memory (docs/interfaces.md)
-    need = scene.state_bytes() * (len(scene.stages) + 1)
+    need = scene.state_bytes() * (len(scene.stages) + (4 if scene.model == "dynamic" else 1))
     have = memory_bytes()
     if have and need > have:
         raise SceneError(f"{where}: {scene.strands} strands × {scene.points} points × "
@@ -181,6 +187,11 @@ def _check_values(scene, where):
 
 def scene_from_dict(data, name, where):
     values = {}
+    data, values["dynamic"] = dynscene.split(data, where, SceneError)
+    if "stages" not in data and values["dynamic"] is not None:
+        data = dict(data, stages=list(dynscene.DEFAULT_STAGES))
+    if values["dynamic"] is None:
+        values["dynamic"] = {}
     for key, value in data.items():
         if key not in SCHEMA[""]:
             raise SceneError(f"{where}: unknown key '{key}' (known: {', '.join(SCHEMA[''])})")
@@ -215,7 +226,8 @@ def find_scene_file(ref):
 def is_scene_file(path):
     try:
         with open(path, "rb") as f:
-            return "stages" in tomllib.load(f)
+            data = tomllib.load(f)
+        return "stages" in data or data.get("model") == "dynamic"
     except (OSError, tomllib.TOMLDecodeError):
         return False
 
