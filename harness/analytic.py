@@ -7,7 +7,7 @@ angle; and from a time series: zero crossings with linear interpolation, the per
 give, the dominant frequency of a signal (FFT with zero padding and parabolic peak
 interpolation), the steady angle of a segment.
 
-`read_series(path)` gives (time, positions [F][N][P][3]) of a dynamic state file.
+`read_series(path)` gives (time, positions [F][N][P][3]) of a state file (harness.trajectory).
 """
 import math
 
@@ -178,11 +178,11 @@ def convergence_order(s_values, errors):
 # ---------------------------------------------------------------- reading runs
 
 def read_series(path):
-    """(time [F], positions [F][N][P][3] float64) of every frame of a state file; time from
-    /particles/hair/position/time (0 for paper frames, f·Δt for simulated frame f)."""
-    from .states import open_state
+    """(time [F], positions [F][N][P][3] float64) of every written frame of a state file,
+    through harness.trajectory (time: 0 for paper frames, f·Δt for simulated frame f)."""
+    from .trajectory import open_trajectory
 
-    with open_state(path) as s:
-        frames = np.stack([s.frame(f).astype(np.float64) for f in range(s.n_frames)])
-        time = np.asarray(s._file["particles/hair/position/time"][()], dtype=np.float64)
+    with open_trajectory(path) as t:
+        frames = np.stack([t.frame(f).astype(np.float64) for f in range(t.n_frames)])
+        time = np.asarray(t.time, dtype=np.float64)
     return time, frames

@@ -1,7 +1,7 @@
 """Hand-made input states for the analytic checks (docs/model.md §4), and the runs on them.
 
-Self-contained on purpose: it writes a paper-model state file (the layout of
-docs/interfaces.md: /h5md, /particles/hair/position/value [1][N·P][3], /parameters with the
+Self-contained on purpose (it needs only h5py, numpy and harness.analytic): it writes a
+paper-model state file (the layout of docs/interfaces.md: /h5md, /particles/hair/position/value [1][N·P][3], /parameters with the
 scene attributes and /parameters/stage = ["init"]) with h5py, and runs the simulate stage of
 a hairsim binary on it. With `--input` of a paper-model file the binary starts a new
 simulation whose rest shape is that frame, with zero velocities (docs/model.md §3.1).
@@ -15,8 +15,6 @@ import os
 import subprocess
 
 import numpy as np
-
-J01 = 2.404825557695773
 
 
 def write_paper_state(path, positions, hair_length, precision="fp64", hair_offset=0.1, head_radius=10.0):
@@ -56,19 +54,6 @@ def pendulum_positions(length, theta0):
                       [0.0, -length * math.cos(theta0), length * math.sin(theta0)]]])
 
 
-def j0(x):
-    """Bessel J0 by its power series Σ (−x²/4)^k / (k!)²; 40 terms are exact to rounding
-    for |x| ≤ 6 (the largest term there is 9²ᵏ/(k!)² ≈ 1e2 at k = 3)."""
-    x = np.asarray(x, dtype=np.float64)
-    q = -(x * x) / 4.0
-    term = np.ones_like(x)
-    total = np.ones_like(x)
-    for k in range(1, 40):
-        term = term * q / (k * k)
-        total = total + term
-    return total
-
-
 def chain_positions(points, length, amplitude, shape="continuum"):
     """A chain of P points hanging from the origin with rigid links ℓ = L/(P−1), displaced
     along z by amplitude × the first-mode shape with the tip at `amplitude`.
@@ -79,7 +64,7 @@ def chain_positions(points, length, amplitude, shape="continuum"):
     ell = length / (points - 1)
     if isinstance(shape, str):
         s = length - ell * np.arange(points)
-        u = j0(J01 * np.sqrt(np.maximum(s, 0.0) / length))
+        u = _analytic().chain_mode_shape(np.maximum(s, 0.0), length)
     else:
         u = np.asarray(shape, dtype=np.float64)
     u = amplitude * u / u[-1]
