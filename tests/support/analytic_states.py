@@ -1,9 +1,10 @@
 """Hand-made input states for the analytic checks (docs/model.md §4), and the runs on them.
 
 Self-contained on purpose (it needs only h5py, numpy and harness.analytic): it writes a
-paper-model state file (the layout of docs/interfaces.md: /h5md, /particles/hair/position/value [1][N·P][3], /parameters with the
-scene attributes and /parameters/stage = ["init"]) with h5py, and runs the simulate stage of
-a hairsim binary on it. With `--input` of a paper-model file the binary starts a new
+paper-model state file (the layout of docs/interfaces.md: /h5md,
+/particles/hair/position/value [1][N·P][3], /parameters with the scene attributes and
+/parameters/stage = ["init"]) with h5py, and runs the simulate stage of a hairsim binary
+on it. With `--input` of a paper-model file the binary starts a new
 simulation whose rest shape is that frame, with zero velocities (docs/model.md §3.1).
 
 Geometry (docs/model.md §1.1: y up): every strand hangs from a root at the origin; the
