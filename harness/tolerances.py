@@ -158,3 +158,24 @@ def pair_tolerance(kind_a, kind_b):
 
 def invariant_tolerance(kind):
     return INVARIANTS[kind]
+
+
+# ---- the simd CPU variant's simulate stage against ref (docs/cpu_simd.md, "The dynamic
+# model"; tests/test_cpu_simd_dynamic.py) ----
+# Without gusts simd is ref's bits (positions, velocities, observables): no tolerance, the
+# tests compare with np.array_equal. With gusts the sine is libmvec's (≤ 4 ulp) and the
+# runs drift by roundings: each quantity within k units, ε the precision's epsilon,
+# E = R + h + L, h = Δt/S the substep, ℓ the segment length.
+@dataclass(frozen=True)
+class SimdDynTolerance:
+    position_k: float       # |Δx| ≤ k·ε·E at every point of every frame
+    velocity_k: float       # |Δv| ≤ k·ε·E/h (v = Δp/h: a position rounding over h)
+    kinetic_energy_k: float  # |ΔKE| ≤ k·ε·KE, every frame
+    stretch_k: float        # |Δ stretch_max| ≤ k·ε·E/ℓ
+    penetration_k: float    # |Δ penetration_max| ≤ k·ε·E
+    why: str
+
+
+SIMD_DYN_GUST = SimdDynTolerance(
+    position_k=8.0, velocity_k=16.0, kinetic_energy_k=400.0, stretch_k=1.0, penetration_k=8.0,
+    why="provisional")
