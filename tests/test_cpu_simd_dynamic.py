@@ -24,7 +24,7 @@ import pytest
 
 from harness.dynstates import observables, velocities
 from harness.states import open_state
-from harness.tolerances import SIMD_DYN_GUST
+from harness.tolerances import SIMD_DYN_GUST, SIMD_DYN_GUST_MAX_FRAMES
 from statecheck import run
 from test_cpu_simd import NO_SIMD, needs_simd
 
@@ -129,6 +129,7 @@ def test_short_strands_bit_for_bit(cpu_bin, inputs, tmp_path, precision, points)
 @pytest.mark.parametrize("solver", ["xpbd", "ftl"])
 @pytest.mark.parametrize("features", ["gust", "all"])
 def test_with_gusts_simd_is_within_the_tolerance(cpu_bin, inputs, tmp_path, precision, solver, features):
+    assert FRAMES <= SIMD_DYN_GUST_MAX_FRAMES  # the tolerance's horizon
     inp = inputs(precision, 33)
     args = ["--solver", solver, *(GUST if features == "gust" else ALL), "--velocities", "all"]
     pa, va, oa, extent, h, ell = read(simulate(cpu_bin, inp, tmp_path / "ref.h5", "ref", *args))
