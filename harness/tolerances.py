@@ -185,7 +185,7 @@ class SimdDynTolerance:
 # that the dynamics carries on, and a freely swinging strand (wind and gusts, no shape)
 # amplifies it: after 60 frames of the same runs positions differed by up to 149 / 189 ε·E,
 # velocities 47 / 38 ε·E/h, kinetic energy 6.4 / 19 ε·KE (2,000 strands × 32 points, S = 8,
-# I = 2, 30 frames, the same gusts: up to 246 ε·E). With every feature on (shape holds the
+# I = 2, 30 frames, the same gusts, fp32: up to 253 ε·E). With every feature on (shape holds the
 # strands; 2,000 × 32, S = 8, I = 2, 60 frames) positions stayed ≤ 2.4 ε·E at every 10th
 # frame, but the kinetic energy, small there, differed by up to 101 ε·KE.
 # Margins over the 10-frame worst: 2.5× (positions), 4.4×, 5.3×, 5×, 20×.
