@@ -47,12 +47,12 @@ CFLAGS_REF := $(CSTD) $(COPT) -ffp-contract=off -fno-fast-math $(CWARN)
 # The simd variant's file only (docs/cpu_simd.md): AVX2 code checked for at run time, glibc's
 # vector math, and of -ffast-math's flags only the two that change no value.
 SIMD_CFLAGS := -O3 -march=x86-64-v3 -fopenmp-simd -fno-math-errno -fno-trapping-math
-CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (model_simd.c) adds: $(SIMD_CFLAGS)
+CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (model_simd.c, dynamics_simd.c) adds: $(SIMD_CFLAGS)
 
 SHARED_SRC := c_ref/params.c c_ref/cli.c c_ref/state_io.c c_ref/safe_write.c c_ref/h5md_meta.c c_ref/record.c \
               c_ref/driver.c c_ref/dynamics_host.c c_ref/host.c
 SHARED_OBJ := $(SHARED_SRC:c_ref/%.c=$(OBJ)/%.o)
-CPU_SRC    := c_ref/model.c c_ref/model_simd.c c_ref/dynamics_f32.c c_ref/dynamics_f64.c c_ref/backend_cpu.c
+CPU_SRC    := c_ref/model.c c_ref/model_simd.c c_ref/dynamics_simd.c c_ref/dynamics_f32.c c_ref/dynamics_f64.c c_ref/backend_cpu.c
 CPU_OBJ    := $(CPU_SRC:c_ref/%.c=$(OBJ)/%.o)
 C_HEADERS  := $(wildcard c_ref/*.h)
 
@@ -105,6 +105,7 @@ $(OBJ)/%.o: c_ref/%.c $(C_HEADERS) | check-hdf5
 	$(CC) $(CFLAGS_REF) -fopenmp $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' -DHB_FLAGS='"$(CPU_FLAGS_STR)"' -c $< -o $@
 
 $(OBJ)/model_simd.o: CFLAGS_REF += $(SIMD_CFLAGS)
+$(OBJ)/dynamics_simd.o: CFLAGS_REF += $(SIMD_CFLAGS)
 $(OBJ)/record.o: $(REV_STAMP)
 
 $(BUILD)/hairsim-cpu: $(SHARED_OBJ) $(CPU_OBJ)
