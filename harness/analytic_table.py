@@ -3,7 +3,7 @@
     python -m harness.analytic_table [--binary build/hairsim-cpu] [--quick]
 
 Runs the C reference (fp64, one thread) on the hand-made states of
-tests/support/analytic_states.py (the same runs tests/test_analytic.py makes, over more S)
+harness/analytic_runs.py (the same runs tests/test_analytic.py makes, over more S)
 and prints one table per check: solver, S, measured, expected, relative error, and what
 shows the damping. docs/analytic.md holds its output. About 30 s on 2 cores.
 """
@@ -19,10 +19,8 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def _support():
-    # the state writers live with the tests (tests/support/); this script is their other user
-    sys.path.insert(0, str(ROOT / "tests"))
-    from support import analytic_states
-    return analytic_states
+    from . import analytic_runs
+    return analytic_runs
 
 
 def _fmt(x, digits=7):

@@ -1,6 +1,6 @@
 """Analytic checks of the dynamic model (docs/model.md §4) on the C reference, fp64.
 
-Hand-made input states (tests/support/analytic_states.py) run through
+Hand-made input states (harness/analytic_runs.py) run through
 `hairsim-cpu --input IN --stages simulate --no-collider …`; the closed forms and the
 measurements are in harness/analytic.py, the tolerances (with the measurements behind
 them) in harness/tolerances.py (ANALYTIC_*). Only 2–3 substep counts S per check run here;
@@ -13,7 +13,7 @@ import pytest
 
 from harness import analytic as an
 from harness import tolerances as tol
-from support.analytic_states import G0, run_chain, run_pendulum, run_wind
+from harness.analytic_runs import G0, run_chain, run_pendulum, run_wind
 
 SOLVERS = ("xpbd", "ftl")
 

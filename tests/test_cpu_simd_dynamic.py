@@ -22,10 +22,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness.dynstates import observables, velocities
-from harness.states import open_state
+from harness.trajectory import open_trajectory
 from harness.tolerances import SIMD_DYN_GUST, SIMD_DYN_GUST_MAX_FRAMES
-from statecheck import run
+from support.statecheck import run
 from test_cpu_simd import NO_SIMD, needs_simd
 
 STRANDS = 300
@@ -74,10 +73,10 @@ def simulate(cpu_bin, inp, out, variant, *args, frames=FRAMES):
 
 def read(path):
     """positions [F][N][P][3], velocities, observables, the scene's E = R + h + L and h."""
-    with open_state(path) as s:
+    with open_trajectory(path) as s:
         pos = np.stack([s.frame(f) for f in range(s.n_frames)])
-        _, vel = velocities(s)
-        obs = observables(s)
+        vel = np.stack([s.velocity(i) for i in range(len(s.velocity_steps))])
+        obs = {k: s.observables[k].to_numpy() for k in s.observables.columns if k not in ("step", "time")}
         p = s.params
         extent = float(p["head_radius"]) + float(p["hair_offset"]) + float(p["hair_length"])
         h = float(p["frame_dt"]) / float(p["substeps"])

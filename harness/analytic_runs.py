@@ -31,7 +31,7 @@ def write_paper_state(path, positions, hair_length, precision="fp64", hair_offse
         h.attrs["version"] = np.array([1, 1], dtype=np.int32)
         h.create_group("author").attrs["name"] = "hairbench analytic tests"
         c = h.create_group("creator")
-        c.attrs["name"] = "tests/support/analytic_states.py"
+        c.attrs["name"] = "harness/analytic_runs.py"
         c.attrs["version"] = "1"
         pos = f.create_group("particles/hair/position")
         pos.create_dataset("value", data=positions.reshape(1, n * p, 3).astype(dtype))
@@ -101,7 +101,7 @@ G0 = 981.0
 
 
 def _analytic():
-    from harness import analytic
+    from . import analytic
     return analytic
 
 
