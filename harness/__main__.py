@@ -1,7 +1,7 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
-Commands: run, diff, stepdiff, sweep, plot, report, bench, accuracy, headline, export, calibrate (`--help` on each). User
-errors print one line `harness: error: …` and exit non-zero, never a traceback."""
+Commands: run, diff, stepdiff, sweep, plot, report, bench, accuracy, headline, export, calibrate
+(`--help` on each). User errors print one line `harness: error: …` and exit non-zero, never a traceback."""
 
 import argparse
 import json
@@ -20,6 +20,7 @@ class OneLineParser(argparse.ArgumentParser):
 
 def whole(low):
     """An argparse type: a whole number ≥ low, refused in one line otherwise."""
+
     def parse(text):
         try:
             value = int(text, 10)
@@ -28,6 +29,7 @@ def whole(low):
         if value < low:
             raise argparse.ArgumentTypeError(f"must be at least {low} (got {value})")
         return value
+
     return parse
 
 
@@ -52,21 +54,40 @@ def cmd_run(args):
         raise HarnessError("run: --threads is a cpu flag; the cuda backend takes --block-size")
 
     scene = scenes.load_scene(args.scene).with_overrides(
-        strands=args.strands, points=args.points, precision=args.precision,
-        stages=scenes.parse_stages(args.stages, "run", "--stages") if args.stages else None)
+        strands=args.strands,
+        points=args.points,
+        precision=args.precision,
+        stages=scenes.parse_stages(args.stages, "run", "--stages") if args.stages else None,
+    )
     binary = binary_path(args.backend, args.build)
-    flags = runner.run_flags(scene, args.backend, variant=args.variant, block_size=args.block_size,
-                             threads=args.threads, repeat=args.repeat, warmup=args.warmup,
-                             output=args.output, force=args.force)
+    flags = runner.run_flags(
+        scene,
+        args.backend,
+        variant=args.variant,
+        block_size=args.block_size,
+        threads=args.threads,
+        repeat=args.repeat,
+        warmup=args.warmup,
+        output=args.output,
+        force=args.force,
+    )
     if scene.model == "dynamic":  # per-frame observables (harness/dynrun.py)
         from . import dynrun, dynscene
+
         if args.frames:
             scene = dynscene.with_frames(scene, args.frames)
-            flags = runner.run_flags(scene, args.backend, variant=args.variant, block_size=args.block_size,
-                                     threads=args.threads, repeat=args.repeat, warmup=args.warmup,
-                                     output=args.output, force=args.force)
-        return dynrun.run(binary, flags, args.output, timeout=args.timeout, as_json=args.json,
-                          every=args.every)
+            flags = runner.run_flags(
+                scene,
+                args.backend,
+                variant=args.variant,
+                block_size=args.block_size,
+                threads=args.threads,
+                repeat=args.repeat,
+                warmup=args.warmup,
+                output=args.output,
+                force=args.force,
+            )
+        return dynrun.run(binary, flags, args.output, timeout=args.timeout, as_json=args.json, every=args.every)
     record = runner.run_binary(binary, flags, timeout=args.timeout)
     print(json.dumps(record, indent=1) if args.json else runner.summary(record))
     return 0
@@ -77,16 +98,22 @@ def cmd_diff(args):
 
     frames = ",".join(str(k) for k in args.frame) if args.frame else args.frames
     # dynamic files (harness/dyndiff.py) pair frames by step: --frame K names step K
-    return diff.run(args.a, args.b, frames=frames, align_last=args.align_last,
-                    exact=args.exact, as_json=args.json)
+    return diff.run(args.a, args.b, frames=frames, align_last=args.align_last, exact=args.exact, as_json=args.json)
 
 
 def cmd_stepdiff(args):
     from . import dyndiff
 
     flags = args.flags[1:] if args.flags[:1] == ["--"] else args.flags
-    return dyndiff.stepdiff(args.reference, args.binary, flags=flags, frames=args.frames,
-                            exact=args.exact, keep=args.keep, timeout=args.timeout)
+    return dyndiff.stepdiff(
+        args.reference,
+        args.binary,
+        flags=flags,
+        frames=args.frames,
+        exact=args.exact,
+        keep=args.keep,
+        timeout=args.timeout,
+    )
 
 
 def cmd_sweep(args):
@@ -168,9 +195,10 @@ def cmd_calibrate(args):
 
 
 def parser():
-    p = OneLineParser(prog="python -m harness",
-                                description="hairbench harness: run, diff, sweep, plot and report "
-                                            "the hair-strand backends (docs/harness.md)")
+    p = OneLineParser(
+        prog="python -m harness",
+        description="hairbench harness: run, diff, sweep, plot and report the hair-strand backends (docs/harness.md)",
+    )
     p.add_argument("--version", action="version", version=f"hairbench harness {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
@@ -205,29 +233,40 @@ def parser():
     r.add_argument("--timeout", type=seconds, default=None, help="seconds before giving up")
     r.add_argument("--json", action="store_true", help="print the binary's JSON record")
     r.add_argument("--frames", type=int, default=None, help="dynamic scenes: override dynamics.frames")
-    r.add_argument("--every", type=int, default=None,
-                   help="dynamic scenes: print every K-th frame's observables (default: about 30 lines)")
+    r.add_argument(
+        "--every",
+        type=int,
+        default=None,
+        help="dynamic scenes: print every K-th frame's observables (default: about 30 lines)",
+    )
     r.set_defaults(func=cmd_run)
 
-    sd = sub.add_parser("stepdiff", help="validate a dynamic backend one frame at a time (exit 0/1/2)",
-                        description="For each chosen simulated frame k of a reference written with "
-                                    "--velocities all, run BINARY --input REF --input-frame k --stages "
-                                    "simulate --frames 1 and compare its new frame with the reference's "
-                                    "frame k+1 by the dynamic per-frame tolerance (harness/dyndiff.py). "
-                                    "Exit 0 = equivalent, 1 = not, 2 = could not compare.")
+    sd = sub.add_parser(
+        "stepdiff",
+        help="validate a dynamic backend one frame at a time (exit 0/1/2)",
+        description="For each chosen simulated frame k of a reference written with "
+        "--velocities all, run BINARY --input REF --input-frame k --stages "
+        "simulate --frames 1 and compare its new frame with the reference's "
+        "frame k+1 by the dynamic per-frame tolerance (harness/dyndiff.py). "
+        "Exit 0 = equivalent, 1 = not, 2 = could not compare.",
+    )
     sd.add_argument("--reference", required=True, help="dynamic state file (A)")
     sd.add_argument("--binary", required=True, help="the binary to validate (e.g. build/hairsim-cuda)")
     sd.add_argument("--frames", default="all", help="frame indices of A: all (default), K, K..L, K.., ..L")
     sd.add_argument("--exact", action="store_true", help="require bit-identical frames")
     sd.add_argument("--keep", help="keep the binary's outputs in this directory")
     sd.add_argument("--timeout", type=float, default=None, help="seconds per binary run")
-    sd.add_argument("flags", nargs=argparse.REMAINDER,
-                    help="further flags for the binary (after the options, e.g. -- --threads 1)")
+    sd.add_argument(
+        "flags", nargs=argparse.REMAINDER, help="further flags for the binary (after the options, e.g. -- --threads 1)"
+    )
     sd.set_defaults(func=cmd_stepdiff)
 
-    d = sub.add_parser("diff", help="compare two state files frame by frame (exit 0/1/2)",
-                       description="Compare two HDF5 states frame by frame (DESIGN §6). Exit 0 = "
-                                   "equivalent, 1 = not equivalent, 2 = could not compare.")
+    d = sub.add_parser(
+        "diff",
+        help="compare two state files frame by frame (exit 0/1/2)",
+        description="Compare two HDF5 states frame by frame (DESIGN §6). Exit 0 = "
+        "equivalent, 1 = not equivalent, 2 = could not compare.",
+    )
     d.add_argument("a", help="first state file (e.g. the CPU reference)")
     d.add_argument("b", help="second state file")
     d.add_argument(
@@ -300,8 +339,13 @@ def parser():
     a.add_argument("--strands", type=whole(1), default=100_000)
     a.add_argument("--points", type=whole(2), default=32)
     a.add_argument("--repeat", type=whole(1), default=9, help="timed repetitions per stage (default 9)")
-    a.add_argument("--resolution", type=whole(2), nargs="+", default=[4, 8, 16, 32, 64, 128, 256],
-                   help="points per strand of the resolution study (the largest is the reference)")
+    a.add_argument(
+        "--resolution",
+        type=whole(2),
+        nargs="+",
+        default=[4, 8, 16, 32, 64, 128, 256],
+        help="points per strand of the resolution study (the largest is the reference)",
+    )
     a.add_argument("--resolution-strands", type=whole(1), default=20_000)
     a.add_argument("--out", default=None, help="results directory (default results/accuracy)")
     a.add_argument("--report-dir", default=None, help="where to write (default report/)")
@@ -312,11 +356,14 @@ def parser():
     )
     a.set_defaults(func=cmd_accuracy)
 
-    h = sub.add_parser("headline", help="the issues' headline numbers: bandwidth fractions and speedups",
-                       description="At one size, measure the copy bandwidths, every CUDA variant's init and "
-                                   "wind+collide time and bandwidth fraction, and three CPU baselines "
-                                   "(ref 1 thread, ref all cores, simd all cores); write "
-                                   "results/headline/headline.json.")
+    h = sub.add_parser(
+        "headline",
+        help="the issues' headline numbers: bandwidth fractions and speedups",
+        description="At one size, measure the copy bandwidths, every CUDA variant's init and "
+        "wind+collide time and bandwidth fraction, and three CPU baselines "
+        "(ref 1 thread, ref all cores, simd all cores); write "
+        "results/headline/headline.json.",
+    )
     h.add_argument("--strands", type=whole(1), default=4 * 1024 * 1024)
     h.add_argument("--points", type=whole(2), default=32)
     h.add_argument("--repeat", type=whole(1), default=9, help="GPU repetitions per stage (default 9)")
@@ -325,24 +372,33 @@ def parser():
     h.add_argument("--out", default=None, help="results directory (default results/headline)")
     h.set_defaults(func=cmd_headline)
 
-    e = sub.add_parser("export", help="sidecars that ParaView/VisIt (XDMF) and Blender/Houdini/usdview (USD) open",
-                       description="Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions "
-                                   "referenced in STATE) and, with --usd, STATE.usdc (BasisCurves, one "
-                                   "time sample per frame; needs usd-core).")
+    e = sub.add_parser(
+        "export",
+        help="sidecars that ParaView/VisIt (XDMF) and Blender/Houdini/usdview (USD) open",
+        description="Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions "
+        "referenced in STATE) and, with --usd, STATE.usdc (BasisCurves, one "
+        "time sample per frame; needs usd-core).",
+    )
     e.add_argument("state", help="an HDF5 state written by a hairsim binary")
     e.add_argument("--usd", action="store_true", help="also write the USD file")
     e.add_argument("--usd-only", action="store_true", help="write only the USD file")
     e.add_argument("--out", help="output prefix (default: the state's path)")
     e.set_defaults(func=cmd_export)
 
-    c = sub.add_parser("calibrate", help="measure fp32-vs-fp64 errors behind tolerances.py",
-                       description="Run the cpu binary at fp32 and fp64 on the paper scene and print "
-                                   "the errors and invariant residuals that tolerances.py is set from.")
+    c = sub.add_parser(
+        "calibrate",
+        help="measure fp32-vs-fp64 errors behind tolerances.py",
+        description="Run the cpu binary at fp32 and fp64 on the paper scene and print "
+        "the errors and invariant residuals that tolerances.py is set from.",
+    )
     c.add_argument("--strands", type=whole(1), default=20000)
     c.add_argument("--points", type=whole(2), nargs="+", default=[8, 32, 128])
     c.add_argument("--seeds", type=whole(0), nargs="+", default=[1, 2, 3])
-    c.add_argument("--other", help="a second binary to compare with the cpu reference at each "
-                                   "precision (e.g. build/hairsim-cuda on a GPU node)")
+    c.add_argument(
+        "--other",
+        help="a second binary to compare with the cpu reference at each "
+        "precision (e.g. build/hairsim-cuda on a GPU node)",
+    )
     c.add_argument("--json", action="store_true")
     c.set_defaults(func=cmd_calibrate)
     return p

@@ -9,6 +9,7 @@ interpolation), the steady angle of a segment.
 
 `read_series(path)` gives (time, positions [F][N][P][3]) of a state file (harness.trajectory).
 """
+
 import math
 
 import numpy as np
@@ -17,6 +18,7 @@ J01 = 2.404825557695773  # first positive zero of J0 (NIST DLMF §10.21)
 
 
 # ---------------------------------------------------------------- closed forms
+
 
 def agm(a, b, tol=1e-16):
     """Arithmetic–geometric mean of a, b > 0."""
@@ -86,7 +88,7 @@ def discrete_chain_matrix(points, length, g):
     ell = length / n
     t = g * (points - np.arange(1, points + 1, dtype=np.float64))  # T_1 … T_P (T_P = 0)
     a = np.zeros((n, n))
-    for i in range(n):           # row i is point k = i + 1
+    for i in range(n):  # row i is point k = i + 1
         a[i, i] = (t[i] + t[i + 1]) / ell
         if i > 0:
             a[i, i - 1] = -t[i] / ell
@@ -111,6 +113,7 @@ def discrete_chain_omega1(points, length, g):
 
 # ---------------------------------------------------------------- measurements
 
+
 def zero_crossings(t, y):
     """Times where y changes sign, by linear interpolation between samples (a sample that
     is exactly 0 counts once)."""
@@ -133,7 +136,7 @@ def period_from_crossings(t, y, periods=None):
     NaN when fewer than 3 crossings."""
     c = zero_crossings(t, y)
     if periods is not None:
-        c = c[:2 * periods + 1]
+        c = c[: 2 * periods + 1]
     if len(c) < 3:
         return float("nan")
     return 2.0 * (c[-1] - c[0]) / (len(c) - 1)
@@ -151,7 +154,7 @@ def dominant_frequency(t, y, pad=16):
     mag = np.abs(np.fft.rfft(y, n))
     k = int(np.argmax(mag[1:])) + 1
     if 0 < k < len(mag) - 1:
-        a, b, c = np.log(mag[k - 1:k + 2] + 1e-300)
+        a, b, c = np.log(mag[k - 1 : k + 2] + 1e-300)
         den = a - 2 * b + c
         k = k + (0.5 * (a - c) / den if den != 0 else 0.0)
     return 2.0 * math.pi * k / (n * dt)
@@ -176,6 +179,7 @@ def convergence_order(s_values, errors):
 
 
 # ---------------------------------------------------------------- reading runs
+
 
 def read_series(path):
     """(time [F], positions [F][N][P][3] float64) of every written frame of a state file,

@@ -11,6 +11,7 @@ Geometry (docs/model.md §1.1: y up): every strand hangs from a root at the orig
 horizontal displacement is along z. `--no-collider` is always passed, so the head sphere
 plays no part and the root need not lie on it.
 """
+
 import math
 import os
 import subprocess
@@ -38,10 +39,18 @@ def write_paper_state(path, positions, hair_length, precision="fp64", hair_offse
         pos.create_dataset("step", data=np.zeros(1, dtype=np.int64))
         pos.create_dataset("time", data=np.zeros(1, dtype=np.float64))
         g = f.create_group("parameters")
-        for key, value in (("n_strands", n), ("points_per_strand", p), ("seed", 1),
-                           ("head_radius", float(head_radius)), ("hair_offset", float(hair_offset)),
-                           ("hair_length", float(hair_length)), ("face_margin", 1.0),
-                           ("wind_strength", 0.0), ("wind_angle", math.pi), ("precision", precision)):
+        for key, value in (
+            ("n_strands", n),
+            ("points_per_strand", p),
+            ("seed", 1),
+            ("head_radius", float(head_radius)),
+            ("hair_offset", float(hair_offset)),
+            ("hair_length", float(hair_length)),
+            ("face_margin", 1.0),
+            ("wind_strength", 0.0),
+            ("wind_angle", math.pi),
+            ("precision", precision),
+        ):
             g.attrs[key] = value
         g.create_dataset("stage", data=np.array(["init"], dtype=h5py.string_dtype()))
     os.replace(tmp, path)
@@ -51,8 +60,7 @@ def write_paper_state(path, positions, hair_length, precision="fp64", hair_offse
 def pendulum_positions(length, theta0):
     """P = 2: the root at the origin, the particle at angle θ0 from the downward vertical,
     displaced toward +z."""
-    return np.array([[[0.0, 0.0, 0.0],
-                      [0.0, -length * math.cos(theta0), length * math.sin(theta0)]]])
+    return np.array([[[0.0, 0.0, 0.0], [0.0, -length * math.cos(theta0), length * math.sin(theta0)]]])
 
 
 def chain_positions(points, length, amplitude, shape="continuum"):
@@ -78,13 +86,49 @@ def chain_positions(points, length, amplitude, shape="continuum"):
     return pos
 
 
-def simulate(binary, input_path, output_path, frames, substeps, solver, *, gravity=981.0,
-             iterations=1, precision="fp64", extra=(), timeout=600):
+def simulate(
+    binary,
+    input_path,
+    output_path,
+    frames,
+    substeps,
+    solver,
+    *,
+    gravity=981.0,
+    iterations=1,
+    precision="fp64",
+    extra=(),
+    timeout=600,
+):
     """Run `binary --input IN --stages simulate --no-collider … --output OUT` and return OUT."""
-    cmd = [str(binary), "--input", str(input_path), "--stages", "simulate", "--no-collider",
-           "--frames", str(frames), "--substeps", str(substeps), "--iterations", str(iterations),
-           "--solver", solver, "--gravity", repr(float(gravity)), "--precision", precision,
-           "--threads", "1", "--velocities", "last", "--output", str(output_path), "--force", "--quiet"]
+    cmd = [
+        str(binary),
+        "--input",
+        str(input_path),
+        "--stages",
+        "simulate",
+        "--no-collider",
+        "--frames",
+        str(frames),
+        "--substeps",
+        str(substeps),
+        "--iterations",
+        str(iterations),
+        "--solver",
+        solver,
+        "--gravity",
+        repr(float(gravity)),
+        "--precision",
+        precision,
+        "--threads",
+        "1",
+        "--velocities",
+        "last",
+        "--output",
+        str(output_path),
+        "--force",
+        "--quiet",
+    ]
     cmd += [str(a) for a in extra]
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     if r.returncode != 0:
@@ -102,6 +146,7 @@ G0 = 981.0
 
 def _analytic():
     from . import analytic
+
     return analytic
 
 
@@ -112,42 +157,91 @@ def run_pendulum(binary, workdir, solver, substeps, theta0, length=30.0, periods
     expected = an.pendulum_period(length, G0, theta0)
     frames = int(math.ceil((periods + 1) * expected / FRAME_DT))
     tag = f"pend_{solver}_{substeps}_{theta0:g}_{precision}"
-    inp = write_paper_state(os.path.join(workdir, f"{tag}_in.h5"), pendulum_positions(length, theta0), length,
-                            precision=precision)
-    out = simulate(binary, inp, os.path.join(workdir, f"{tag}.h5"), frames, substeps, solver,
-                   precision=precision)
+    inp = write_paper_state(
+        os.path.join(workdir, f"{tag}_in.h5"), pendulum_positions(length, theta0), length, precision=precision
+    )
+    out = simulate(binary, inp, os.path.join(workdir, f"{tag}.h5"), frames, substeps, solver, precision=precision)
     t, x = an.read_series(out)
     z = x[:, 0, 1, 2]
     measured = an.period_from_crossings(t, z, periods=periods)
     # amplitude decay: the largest |θ| in the last full period against θ0 (energy loss)
     theta = an.segment_angle(x[:, 0, 0], x[:, 0, 1])
     last = t >= t[-1] - expected
-    return {"measured": measured, "expected": expected, "small_angle": an.pendulum_period_small(length, G0),
-            "amplitude_end": float(np.max(np.abs(theta[last]))), "frames": frames}
+    return {
+        "measured": measured,
+        "expected": expected,
+        "small_angle": an.pendulum_period_small(length, G0),
+        "amplitude_end": float(np.max(np.abs(theta[last]))),
+        "frames": frames,
+    }
 
 
-def run_wind(binary, workdir, solver, substeps, speed, drag=1.0, damping=10.0, seconds=8.0, length=30.0,
-             wind_angle=0.0, precision="fp64"):
+def run_wind(
+    binary,
+    workdir,
+    solver,
+    substeps,
+    speed,
+    drag=1.0,
+    damping=10.0,
+    seconds=8.0,
+    length=30.0,
+    wind_angle=0.0,
+    precision="fp64",
+):
     """§4.2: P = 2 hanging straight down, steady wind along ψ (0: toward +z), no gusts; the
     angle of the segment at the last frame against the net acceleration's,
     atan(c_d·U/g0) for ψ = 0."""
     an = _analytic()
     frames = int(math.ceil(seconds / FRAME_DT))
     tag = f"wind_{solver}_{substeps}_{speed:g}_{wind_angle:g}_{precision}"
-    inp = write_paper_state(os.path.join(workdir, f"{tag}_in.h5"), pendulum_positions(length, 0.0), length,
-                            precision=precision)
-    out = simulate(binary, inp, os.path.join(workdir, f"{tag}.h5"), frames, substeps, solver,
-                   precision=precision,
-                   extra=("--wind-speed", repr(float(speed)), "--drag", repr(float(drag)), "--damping",
-                          repr(float(damping)), "--wind-angle", repr(float(wind_angle)), "--gust-amplitude", "0"))
+    inp = write_paper_state(
+        os.path.join(workdir, f"{tag}_in.h5"), pendulum_positions(length, 0.0), length, precision=precision
+    )
+    out = simulate(
+        binary,
+        inp,
+        os.path.join(workdir, f"{tag}.h5"),
+        frames,
+        substeps,
+        solver,
+        precision=precision,
+        extra=(
+            "--wind-speed",
+            repr(float(speed)),
+            "--drag",
+            repr(float(drag)),
+            "--damping",
+            repr(float(damping)),
+            "--wind-angle",
+            repr(float(wind_angle)),
+            "--gust-amplitude",
+            "0",
+        ),
+    )
     t, x = an.read_series(out)
     theta = an.segment_angle(x[:, 0, 0], x[:, 0, 1])
-    return {"measured": float(theta[-1]), "expected": an.wind_angle(drag, speed, G0, wind_angle),
-            "change_last_second": float(np.max(np.abs(theta[t >= t[-1] - 1.0] - theta[-1]))), "frames": frames}
+    return {
+        "measured": float(theta[-1]),
+        "expected": an.wind_angle(drag, speed, G0, wind_angle),
+        "change_last_second": float(np.max(np.abs(theta[t >= t[-1] - 1.0] - theta[-1]))),
+        "frames": frames,
+    }
 
 
-def run_chain(binary, workdir, solver, substeps, points, length=30.0, amplitude=0.3, periods=4, iterations=1,
-              ftl_damping=None, precision="fp64"):
+def run_chain(
+    binary,
+    workdir,
+    solver,
+    substeps,
+    points,
+    length=30.0,
+    amplitude=0.3,
+    periods=4,
+    iterations=1,
+    ftl_damping=None,
+    precision="fp64",
+):
     """§4.3: P points hanging from a fixed root, rigid links, no bend, displaced along z by
     amplitude × the continuum first mode J0(j01·√(s/L)) (tip at `amplitude`).
 
@@ -163,18 +257,33 @@ def run_chain(binary, workdir, solver, substeps, points, length=30.0, amplitude=
     w_disc = float(omegas[0])
     frames = int(math.ceil((periods + 1) * 2 * math.pi / w_disc / FRAME_DT))
     tag = f"chain_{solver}_{substeps}_{points}_{iterations}_{ftl_damping}_{precision}"
-    inp = write_paper_state(os.path.join(workdir, f"{tag}_in.h5"), chain_positions(points, length, amplitude),
-                            length, precision=precision)
+    inp = write_paper_state(
+        os.path.join(workdir, f"{tag}_in.h5"), chain_positions(points, length, amplitude), length, precision=precision
+    )
     extra = ("--ftl-damping", repr(float(ftl_damping))) if ftl_damping is not None else ()
-    out = simulate(binary, inp, os.path.join(workdir, f"{tag}.h5"), frames, substeps, solver,
-                   iterations=iterations, precision=precision, extra=extra)
+    out = simulate(
+        binary,
+        inp,
+        os.path.join(workdir, f"{tag}.h5"),
+        frames,
+        substeps,
+        solver,
+        iterations=iterations,
+        precision=precision,
+        extra=extra,
+    )
     t, x = an.read_series(out)
     q1 = x[:, 0, :, 2] @ shapes[:, 0]
     period = an.period_from_crossings(t, q1, periods=periods)
     tip = x[:, 0, -1, 2]
     last = t >= t[-1] - 2 * math.pi / w_disc
     stretch = np.linalg.norm(np.diff(x[:, 0], axis=1), axis=-1).sum(axis=1) / length - 1.0
-    return {"measured": 2 * math.pi / period, "expected": w_disc, "continuum": w_cont,
-            "tip_fft": an.dominant_frequency(t, tip),
-            "amplitude_end": float(np.max(np.abs(tip[last]))) / amplitude,
-            "stretch_max": float(np.max(np.abs(stretch))), "frames": frames}
+    return {
+        "measured": 2 * math.pi / period,
+        "expected": w_disc,
+        "continuum": w_cont,
+        "tip_fft": an.dominant_frequency(t, tip),
+        "amplitude_end": float(np.max(np.abs(tip[last]))) / amplitude,
+        "stretch_max": float(np.max(np.abs(stretch))),
+        "frames": frames,
+    }

@@ -340,6 +340,7 @@ def run(
 ) -> int:
     """The `harness diff` command; returns the exit status."""
     from . import dyndiff  # dynamic files: frames paired by step (harness/dyndiff.py)
+
     if dyndiff.is_dynamic_file(path_a) or dyndiff.is_dynamic_file(path_b):
         return dyndiff.run(path_a, path_b, frames=frames, exact=exact, as_json=as_json, out=out)
     try:

@@ -27,6 +27,7 @@ frame f (at step s, simulated frame number g = s − paper_frames + 1) is checke
 
 `check(traj)` returns a DynamicReport (same interface as invariants.InvariantReport).
 """
+
 import math
 from dataclasses import dataclass, field, fields
 
@@ -44,11 +45,11 @@ class DynamicReport:
     exact_roots: bool = True
     violations: list = field(default_factory=list)
     worst_root: float = 0.0
-    worst_penetration_k: float = float("-inf")   # (R_c − |x|)/(ε·R_c), positive = inside
-    worst_ftl_segment_k: float = 0.0             # |len − ℓ|/(ε·E)
+    worst_penetration_k: float = float("-inf")  # (R_c − |x|)/(ε·R_c), positive = inside
+    worst_ftl_segment_k: float = 0.0  # |len − ℓ|/(ε·E)
     worst_kinetic_rel: float = 0.0
-    worst_observable_k: float = 0.0              # stretch, penetration: |Δ|/(ε64·scale)
-    paper: object = None                         # InvariantReport of the paper frames
+    worst_observable_k: float = 0.0  # stretch, penetration: |Δ|/(ε64·scale)
+    paper: object = None  # InvariantReport of the paper frames
 
     @property
     def ok(self):
@@ -58,13 +59,18 @@ class DynamicReport:
         return (self.paper.violations if self.paper else []) + self.violations
 
     def as_dict(self):
-        return {"path": self.path, "kind": self.kind, "ok": self.ok, "exact_roots": self.exact_roots,
-                "worst_root": self.worst_root,
-                "worst_penetration_k": None if self.worst_penetration_k == float("-inf") else self.worst_penetration_k,
-                "worst_ftl_segment_k": self.worst_ftl_segment_k,
-                "worst_kinetic_rel": self.worst_kinetic_rel,
-                "worst_observable_k": self.worst_observable_k,
-                "violations": [v.as_dict() for v in self.all_violations()]}
+        return {
+            "path": self.path,
+            "kind": self.kind,
+            "ok": self.ok,
+            "exact_roots": self.exact_roots,
+            "worst_root": self.worst_root,
+            "worst_penetration_k": None if self.worst_penetration_k == float("-inf") else self.worst_penetration_k,
+            "worst_ftl_segment_k": self.worst_ftl_segment_k,
+            "worst_kinetic_rel": self.worst_kinetic_rel,
+            "worst_observable_k": self.worst_observable_k,
+            "violations": [v.as_dict() for v in self.all_violations()],
+        }
 
 
 def head_rotation(motion, amplitude, frequency, t):
@@ -93,8 +99,15 @@ def expected_roots(traj, f, rest_roots):
     if traj.head_motion == "still":
         return rest_roots.copy()
     dt = rest_roots.dtype.type
-    q = [dt(v) for v in head_rotation(traj.head_motion, float(traj.dynamic_params["motion_amplitude"]),
-                                      float(traj.dynamic_params["motion_frequency"]), frame_end_time(traj, f))]
+    q = [
+        dt(v)
+        for v in head_rotation(
+            traj.head_motion,
+            float(traj.dynamic_params["motion_amplitude"]),
+            float(traj.dynamic_params["motion_frequency"]),
+            frame_end_time(traj, f),
+        )
+    ]
     a0, a1, a2 = rest_roots[:, 0], rest_roots[:, 1], rest_roots[:, 2]
     out = np.empty_like(rest_roots)
     for row in range(3):
@@ -134,8 +147,12 @@ def observe(traj, x, v=None):
 def _paper_view(traj):
     """The paper frames of a dynamic file as a plain State (for invariants.check)."""
     kw = {f.name: getattr(traj, f.name) for f in fields(State)}
-    kw.update(n_frames=traj.paper_frames, stages=traj.stages[:traj.paper_frames],
-              skipped=traj.skipped[:traj.paper_frames], fused=traj.fused[:traj.paper_frames])
+    kw.update(
+        n_frames=traj.paper_frames,
+        stages=traj.stages[: traj.paper_frames],
+        skipped=traj.skipped[: traj.paper_frames],
+        fused=traj.fused[: traj.paper_frames],
+    )
     return State(**kw)
 
 
@@ -165,14 +182,29 @@ def check(traj, exact=True, frames=None, paper=True):
 
     want_steps = np.arange(traj.paper_frames, int(traj.step[-1]) + 1) if traj.simulated else np.zeros(0)
     if frames is None and not np.array_equal(np.asarray(obs.index), want_steps):
-        rep.violations.append(Violation(-1, "simulate", "observables", 1, 0.0,
-                                        "the observables do not have one row per simulated step "
-                                        f"{traj.paper_frames} … {int(traj.step[-1])}"))
+        rep.violations.append(
+            Violation(
+                -1,
+                "simulate",
+                "observables",
+                1,
+                0.0,
+                f"the observables do not have one row per simulated step {traj.paper_frames} … {int(traj.step[-1])}",
+            )
+        )
 
     def add(f, name, count, worst, message):
         if count:
-            rep.violations.append(Violation(f, "simulate", name, int(count), float(worst),
-                                            f"frame {f} (simulate, step {int(traj.step[f])}): {message}"))
+            rep.violations.append(
+                Violation(
+                    f,
+                    "simulate",
+                    name,
+                    int(count),
+                    float(worst),
+                    f"frame {f} (simulate, step {int(traj.step[f])}): {message}",
+                )
+            )
 
     for f in sim:
         x = traj.frame(f)
@@ -188,9 +220,15 @@ def check(traj, exact=True, frames=None, paper=True):
             moved = np.any(bits(got) != bits(want), axis=1)
             if moved.any():
                 from .ulp import ulp_distance
+
                 rep.worst_root = max(rep.worst_root, float(ulp_distance(got, want, got.dtype).max()))
-            add(f, "roots", moved.sum(), rep.worst_root,
-                f"{int(moved.sum())} root(s) not bit-identical to Q(t)·X̄0 (worst {rep.worst_root:g} ULP)")
+            add(
+                f,
+                "roots",
+                moved.sum(),
+                rep.worst_root,
+                f"{int(moved.sum())} root(s) not bit-identical to Q(t)·X̄0 (worst {rep.worst_root:g} ULP)",
+            )
         else:
             R = float(traj.params["head_radius"])
             with np.errstate(invalid="ignore"):
@@ -198,8 +236,14 @@ def check(traj, exact=True, frames=None, paper=True):
             worst = float(np.nanmax(d)) if d.size else 0.0
             rep.worst_root = max(rep.worst_root, worst)
             off = ~(d <= tolerances.DYN_ROOT_K)
-            add(f, "roots", off.sum(), worst, f"{int(off.sum())} root(s) farther than "
-                f"{tolerances.DYN_ROOT_K:g}·ε·R from Q(t)·X̄0 (worst {worst:.3g}·ε·R)")
+            add(
+                f,
+                "roots",
+                off.sum(),
+                worst,
+                f"{int(off.sum())} root(s) farther than "
+                f"{tolerances.DYN_ROOT_K:g}·ε·R from Q(t)·X̄0 (worst {worst:.3g}·ε·R)",
+            )
 
         xd = x.astype(np.float64)
         with np.errstate(invalid="ignore", over="ignore"):
@@ -209,9 +253,14 @@ def check(traj, exact=True, frames=None, paper=True):
                 if depth.size:
                     rep.worst_penetration_k = max(rep.worst_penetration_k, float(np.nanmax(depth)))
                 inside = depth > tolerances.DYN_PENETRATION_K
-                add(f, "collider", inside.sum(), np.nanmax(depth),
+                add(
+                    f,
+                    "collider",
+                    inside.sum(),
+                    np.nanmax(depth),
                     f"{int(inside.sum())} point(s) inside the collider R_c = {rc:g} by more than "
-                    f"{tolerances.DYN_PENETRATION_K:g}·ε·R_c (worst {np.nanmax(depth):.3g}·ε·R_c)")
+                    f"{tolerances.DYN_PENETRATION_K:g}·ε·R_c (worst {np.nanmax(depth):.3g}·ε·R_c)",
+                )
             if traj.solver == "ftl":
                 seg = np.sqrt(np.sum(np.diff(xd, axis=1) ** 2, axis=2))
                 err = np.abs(seg - ell) / (eps * E)
@@ -222,9 +271,14 @@ def check(traj, exact=True, frames=None, paper=True):
                 worst = float(np.nanmax(err)) if err.size else 0.0
                 rep.worst_ftl_segment_k = max(rep.worst_ftl_segment_k, worst)
                 over = ~(err <= tolerances.DYN_FTL_SEGMENT_K)
-                add(f, "ftl_segments", over.sum(), worst,
+                add(
+                    f,
+                    "ftl_segments",
+                    over.sum(),
+                    worst,
                     f"{int(over.sum())} segment(s) not moved by the collider differ from ℓ by more than "
-                    f"{tolerances.DYN_FTL_SEGMENT_K:g}·ε·E (worst {worst:.3g}·ε·E)")
+                    f"{tolerances.DYN_FTL_SEGMENT_K:g}·ε·E (worst {worst:.3g}·ε·E)",
+                )
 
         if step not in obs.index:
             add(f, "observables", 1, 0, "no observables row for this step")
@@ -251,8 +305,9 @@ def check(traj, exact=True, frames=None, paper=True):
                 msgs.append(f"kinetic_energy {k:.17g} but the velocities give {ke:.17g}")
         stored = int(row["blown_up_strands"])
         if (v is not None and blown != stored) or (v is None and blown > stored):
-            msgs.append(f"blown_up_strands {stored} but positions{' and velocities' if v is not None else ''} "
-                        f"give {blown}")
+            msgs.append(
+                f"blown_up_strands {stored} but positions{' and velocities' if v is not None else ''} give {blown}"
+            )
         if bool(row["blown_up"]) != (stored > 0):
             msgs.append(f"blown_up {bool(row['blown_up'])} disagrees with blown_up_strands {stored}")
         add(f, "observables", len(msgs), 0, "; ".join(msgs))

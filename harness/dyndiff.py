@@ -18,6 +18,7 @@ directory and compare BIN's new frame with A's frame k + 1 by the rule above.
 
 Exit status as for diff: 0 equivalent, 1 not, 2 could not compare.
 """
+
 import json
 import math
 import shutil
@@ -30,7 +31,7 @@ import numpy as np
 
 from . import HarnessError, diff, dynamic_checks, tolerances
 from .states import StateError, as_text
-from .trajectory import OBSERVABLES, open_trajectory
+from .trajectory import open_trajectory
 from .ulp import coarser, ulp_distance
 
 OBS_SHOWN = ("stretch_max", "penetration_max", "kinetic_energy", "blown_up_strands")
@@ -39,6 +40,7 @@ OBS_SHOWN = ("stretch_max", "penetration_max", "kinetic_energy", "blown_up_stran
 def is_dynamic_file(path):
     try:
         import h5py
+
         with h5py.File(path, "r") as f:
             return "parameters" in f and as_text(f["parameters"].attrs.get("model", "paper")) == "dynamic"
     except Exception:
@@ -48,8 +50,9 @@ def is_dynamic_file(path):
 def step_tolerance(kind_a, kind_b, exact=False):
     if exact:
         return tolerances.EXACT
-    return tolerances.PairTolerance(point_k=tolerances.DYN_STEP_K[diff_key(kind_a, kind_b)],
-                                    max_over_fraction=0.0, why=tolerances.DYN_STEP_WHY)
+    return tolerances.PairTolerance(
+        point_k=tolerances.DYN_STEP_K[diff_key(kind_a, kind_b)], max_over_fraction=0.0, why=tolerances.DYN_STEP_WHY
+    )
 
 
 def diff_key(kind_a, kind_b):
@@ -69,16 +72,20 @@ class DynDiffResult:
     paper_tolerance: object
     unit: float
     hair_length: float
-    frames: list = field(default_factory=list)          # diff.FrameDiff, with .step set
-    observables: list = field(default_factory=list)     # per compared simulated frame: dict
+    frames: list = field(default_factory=list)  # diff.FrameDiff, with .step set
+    observables: list = field(default_factory=list)  # per compared simulated frame: dict
     invariants_a: object = None
     invariants_b: object = None
     notes: list = field(default_factory=list)
 
     @property
     def equivalent(self):
-        return (all(f.ok for f in self.frames) and self.invariants_a.ok and self.invariants_b.ok
-                and any(f.compared for f in self.frames))
+        return (
+            all(f.ok for f in self.frames)
+            and self.invariants_a.ok
+            and self.invariants_b.ok
+            and any(f.compared for f in self.frames)
+        )
 
     @property
     def exit_code(self):
@@ -88,8 +95,11 @@ class DynDiffResult:
         out = []
         for f in self.frames:
             if not f.ok:
-                why = (f"{f.nonfinite} non-finite point(s)" if f.nonfinite
-                       else f"{f.over} point(s) over tolerance (allowed {f.allowed_over})")
+                why = (
+                    f"{f.nonfinite} non-finite point(s)"
+                    if f.nonfinite
+                    else f"{f.over} point(s) over tolerance (allowed {f.allowed_over})"
+                )
                 out.append(f"step {f.step} ({f.stage}): {why}, max error {f.max_abs:.3g}")
         for label, rep in (("A", self.invariants_a), ("B", self.invariants_b)):
             out += [f"{label} {v.message}" for v in rep.all_violations()]
@@ -103,13 +113,27 @@ class DynDiffResult:
             d = f.as_dict()
             d["step"] = f.step
             frames.append(d)
-        return {"a": self.path_a, "b": self.path_b, "label_a": self.label_a, "label_b": self.label_b,
-                "pair": self.pair, "equivalent": self.equivalent, "exit_code": self.exit_code,
-                "tolerance": {"point_k": self.tolerance.point_k, "unit": self.unit,
-                              "point_limit": self.tolerance.point_k * self.unit, "why": self.tolerance.why},
-                "frames": frames, "observables": self.observables, "notes": self.notes,
-                "invariants_a": self.invariants_a.as_dict(), "invariants_b": self.invariants_b.as_dict(),
-                "failures": self.failures()}
+        return {
+            "a": self.path_a,
+            "b": self.path_b,
+            "label_a": self.label_a,
+            "label_b": self.label_b,
+            "pair": self.pair,
+            "equivalent": self.equivalent,
+            "exit_code": self.exit_code,
+            "tolerance": {
+                "point_k": self.tolerance.point_k,
+                "unit": self.unit,
+                "point_limit": self.tolerance.point_k * self.unit,
+                "why": self.tolerance.why,
+            },
+            "frames": frames,
+            "observables": self.observables,
+            "notes": self.notes,
+            "invariants_a": self.invariants_a.as_dict(),
+            "invariants_b": self.invariants_b.as_dict(),
+            "failures": self.failures(),
+        }
 
 
 def compare_sim_frame(a, b, fa, fb, tol, unit, ulp_dtype):
@@ -147,8 +171,7 @@ def _pick_steps(a, b, frames):
         return [common[-1]]
     missing = [s for s in frames if s not in common]
     if missing:
-        raise StateError(f"step(s) {missing} are not written in both files (common steps: "
-                         f"{common[0]} … {common[-1]})")
+        raise StateError(f"step(s) {missing} are not written in both files (common steps: {common[0]} … {common[-1]})")
     return list(frames)
 
 
@@ -167,8 +190,17 @@ def compare(path_a, path_b, frames="all", exact=False, check_paper=True):
         unit = eps * tolerances.extent(R, h, a.hair_length) * SI
         tol = step_tolerance(kind_a, kind_b, exact)
         ptol = tolerances.EXACT if exact else tolerances.pair_tolerance(kind_a, kind_b)
-        res = DynDiffResult(str(path_a), str(path_b), a.label, b.label,
-                            f"{kind_a}↔{kind_b}" + (" (exact)" if exact else ""), tol, ptol, unit, a.hair_length)
+        res = DynDiffResult(
+            str(path_a),
+            str(path_b),
+            a.label,
+            b.label,
+            f"{kind_a}↔{kind_b}" + (" (exact)" if exact else ""),
+            tol,
+            ptol,
+            unit,
+            a.hair_length,
+        )
         for key in sorted(set(a.dynamic_params) | set(b.dynamic_params)):
             va, vb = a.dynamic_params.get(key), b.dynamic_params.get(key)
             if as_text(va) != as_text(vb) and key not in ("simulated_frames", "output_every"):
@@ -195,10 +227,12 @@ def compare(path_a, path_b, frames="all", exact=False, check_paper=True):
             used_a.append(fa)
             used_b.append(fb)
         # roots bit-exact for the reference build, within DYN_ROOT_K·ε·R for any other
-        res.invariants_a = dynamic_checks.check(a, exact=dynamic_checks.is_reference_build(a), frames=used_a,
-                                                paper=check_paper)
-        res.invariants_b = dynamic_checks.check(b, exact=dynamic_checks.is_reference_build(b), frames=used_b,
-                                                paper=check_paper)
+        res.invariants_a = dynamic_checks.check(
+            a, exact=dynamic_checks.is_reference_build(a), frames=used_a, paper=check_paper
+        )
+        res.invariants_b = dynamic_checks.check(
+            b, exact=dynamic_checks.is_reference_build(b), frames=used_b, paper=check_paper
+        )
     return res
 
 
@@ -209,20 +243,26 @@ def _g(x):
 def format_result(r):
     lines = [f"A: {r.path_a} ({r.label_a})", f"B: {r.path_b} ({r.label_b})"]
     if r.tolerance.point_k:
-        lines.append(f"tolerance {r.pair}: a simulated point is over when A and B differ by more than "
-                     f"{r.tolerance.point_k:g}·ε·E·S·I = {r.tolerance.point_k * r.unit:.3g} "
-                     f"({r.tolerance.point_k * r.unit / r.hair_length:.1e}·L), for one frame from the same "
-                     f"input (stepdiff); paper frames: the paper rule")
+        lines.append(
+            f"tolerance {r.pair}: a simulated point is over when A and B differ by more than "
+            f"{r.tolerance.point_k:g}·ε·E·S·I = {r.tolerance.point_k * r.unit:.3g} "
+            f"({r.tolerance.point_k * r.unit / r.hair_length:.1e}·L), for one frame from the same "
+            f"input (stepdiff); paper frames: the paper rule"
+        )
     else:
         lines.append(f"tolerance {r.pair}: {r.tolerance.why}")
     for n in r.notes:
         lines.append(f"note: parameters differ: {n}")
-    lines.append(f"{'step':>5} {'stage':8} {'max abs':>10} {'rms':>10} {'max/L':>10} {'max/u':>9} "
-                 f"{'ulp p50':>8} {'ulp p99':>8} {'ulp max':>10} {'over':>7} {'nan/inf':>7}  verdict")
+    lines.append(
+        f"{'step':>5} {'stage':8} {'max abs':>10} {'rms':>10} {'max/L':>10} {'max/u':>9} "
+        f"{'ulp p50':>8} {'ulp p99':>8} {'ulp max':>10} {'over':>7} {'nan/inf':>7}  verdict"
+    )
     for f in r.frames:
-        lines.append(f"{f.step:>5} {f.stage:8} {f.max_abs:10.3e} {f.rms_abs:10.3e} {f.max_rel_L:10.3e} "
-                     f"{f.max_k:9.3g} {f.ulp_p50:8.0f} {f.ulp_p99:8.0f} {f.ulp_max:10.3g} {f.over:7d} "
-                     f"{f.nonfinite:7d}  {'ok' if f.ok else 'FAIL'}")
+        lines.append(
+            f"{f.step:>5} {f.stage:8} {f.max_abs:10.3e} {f.rms_abs:10.3e} {f.max_rel_L:10.3e} "
+            f"{f.max_k:9.3g} {f.ulp_p50:8.0f} {f.ulp_p99:8.0f} {f.ulp_max:10.3g} {f.over:7d} "
+            f"{f.nonfinite:7d}  {'ok' if f.ok else 'FAIL'}"
+        )
     if r.observables:
         lines.append("observables (A, B, B − A):")
         lines.append(f"{'step':>5} {'time':>8} " + " ".join(f"{n:>35}" for n in OBS_SHOWN))
@@ -233,8 +273,7 @@ def format_result(r):
         vs = rep.all_violations()
         lines.append(f"invariants {label} ({rep.kind}): " + ("all hold" if not vs else f"{len(vs)} violated"))
         lines += [f"  {v.message}" for v in vs[:10]]
-    lines.append("verdict: EQUIVALENT" if r.equivalent
-                 else "verdict: NOT EQUIVALENT: " + "; ".join(r.failures()[:3]))
+    lines.append("verdict: EQUIVALENT" if r.equivalent else "verdict: NOT EQUIVALENT: " + "; ".join(r.failures()[:3]))
     return "\n".join(lines)
 
 
@@ -244,14 +283,16 @@ def run(path_a, path_b, frames="all", exact=False, as_json=False, out=print):
         res = compare(path_a, path_b, diff.parse_frames(frames) if isinstance(frames, str) else frames, exact)
     except StateError as e:
         if as_json:
-            out(json.dumps({"a": str(path_a), "b": str(path_b), "exit_code": diff.EXIT_CANNOT_COMPARE,
-                            "error": str(e)}))
+            out(
+                json.dumps({"a": str(path_a), "b": str(path_b), "exit_code": diff.EXIT_CANNOT_COMPARE, "error": str(e)})
+            )
         raise HarnessError(f"cannot compare: {e}", code=diff.EXIT_CANNOT_COMPARE) from None
     out(json.dumps(res.as_dict(), indent=1, ensure_ascii=False) if as_json else format_result(res))
     return res.exit_code
 
 
 # ---- stepdiff ----------------------------------------------------------------------------
+
 
 def parse_frame_range(spec, candidates):
     """'all' | 'K' | 'K..' | 'K..L' | '..L' | comma list of those; numbers are frame indices
@@ -271,9 +312,11 @@ def parse_frame_range(spec, candidates):
             else:
                 k = int(part)
                 if k not in candidates:
-                    raise HarnessError(f"--frames: frame {k} of the reference cannot be stepped from (it must be a "
-                                       f"simulated frame with stored velocities whose next frame is written; "
-                                       f"candidates: {_span(candidates)})")
+                    raise HarnessError(
+                        f"--frames: frame {k} of the reference cannot be stepped from (it must be a "
+                        f"simulated frame with stored velocities whose next frame is written; "
+                        f"candidates: {_span(candidates)})"
+                    )
                 chosen.add(k)
         except ValueError:
             raise HarnessError(f"--frames must be 'all', K, K..L, K.. or ..L (frame indices), not '{spec}'") from None
@@ -307,12 +350,17 @@ def stepdiff(reference, binary, flags=(), frames="all", exact=False, keep=None, 
     binary = require_binary(binary)
     with open_trajectory(reference) as ref:
         if not ref.is_dynamic:
-            raise HarnessError(f"cannot compare: {reference}: not a dynamic file (model attribute is not "
-                               f"'dynamic')", code=diff.EXIT_CANNOT_COMPARE)
+            raise HarnessError(
+                f"cannot compare: {reference}: not a dynamic file (model attribute is not 'dynamic')",
+                code=diff.EXIT_CANNOT_COMPARE,
+            )
         cand = step_candidates(ref)
         if not cand:
-            raise HarnessError(f"cannot compare: {reference}: no frame to step from (write the reference with "
-                               f"--velocities all and --output-every 1)", code=diff.EXIT_CANNOT_COMPARE)
+            raise HarnessError(
+                f"cannot compare: {reference}: no frame to step from (write the reference with "
+                f"--velocities all and --output-every 1)",
+                code=diff.EXIT_CANNOT_COMPARE,
+            )
         chosen = parse_frame_range(frames, cand)
         steps = {k: int(ref.step[k + 1]) for k in chosen}
     tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="hb-stepdiff-"))
@@ -323,16 +371,32 @@ def stepdiff(reference, binary, flags=(), frames="all", exact=False, keep=None, 
     try:
         for k in chosen:
             o = tmp / f"step{k}.h5"
-            cmd = [str(binary), "--input", str(reference), "--input-frame", str(k), "--stages", "simulate",
-                   "--frames", "1", *flags, "--output", str(o), "--force", "--quiet"]
+            cmd = [
+                str(binary),
+                "--input",
+                str(reference),
+                "--input-frame",
+                str(k),
+                "--stages",
+                "simulate",
+                "--frames",
+                "1",
+                *flags,
+                "--output",
+                str(o),
+                "--force",
+                "--quiet",
+            ]
             try:
                 p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
             except subprocess.TimeoutExpired:
                 raise HarnessError(f"{binary.name} did not finish within {timeout} s", code=2) from None
             if p.returncode != 0:
                 msg = (p.stderr.strip().splitlines() or ["no message"])[-1]
-                raise HarnessError(f"cannot compare: {binary.name} exited with status {p.returncode} on frame "
-                                   f"{k}: {msg}", code=diff.EXIT_CANNOT_COMPARE)
+                raise HarnessError(
+                    f"cannot compare: {binary.name} exited with status {p.returncode} on frame {k}: {msg}",
+                    code=diff.EXIT_CANNOT_COMPARE,
+                )
             try:
                 res = compare(reference, o, [steps[k]], exact, check_paper=False)
             except StateError as e:
@@ -340,12 +404,17 @@ def stepdiff(reference, binary, flags=(), frames="all", exact=False, keep=None, 
             f = res.frames[0]
             ok = res.equivalent
             worst = max(worst, 0 if ok else 1)
-            lines.append(f"{k:>5} {steps[k]:>5} {f.max_abs:10.3e} {f.max_k:9.3g} {f.ulp_max:10.3g} {f.over:6d}  "
-                         f"{'ok' if ok else 'FAIL: ' + '; '.join(res.failures()[:2])}")
+            lines.append(
+                f"{k:>5} {steps[k]:>5} {f.max_abs:10.3e} {f.max_k:9.3g} {f.ulp_max:10.3g} {f.over:6d}  "
+                f"{'ok' if ok else 'FAIL: ' + '; '.join(res.failures()[:2])}"
+            )
     finally:
         if not keep:
             shutil.rmtree(tmp, ignore_errors=True)
-    lines.append("verdict: " + ("EQUIVALENT" if worst == 0 else "NOT EQUIVALENT") +
-                 (" (exact)" if exact else f" (one frame from the same input; rule DYN_STEP_K·ε·E·S·I)"))
+    lines.append(
+        "verdict: "
+        + ("EQUIVALENT" if worst == 0 else "NOT EQUIVALENT")
+        + (" (exact)" if exact else " (one frame from the same input; rule DYN_STEP_K·ε·E·S·I)")
+    )
     out("\n".join(lines))
     return worst

@@ -2,6 +2,7 @@
 (docs/model.md §3.8) read back from the state file (harness/trajectory.py), every K-th
 frame for long runs (the first and the last always), and the run's verdict: blown up or
 not, and whether the file's dynamic invariants hold (harness/dynamic_checks.py)."""
+
 import json
 import shutil
 import tempfile
@@ -20,8 +21,10 @@ def table(obs, every=None):
     for i, row in enumerate(obs.itertuples(index=False)):
         if i % k and i != n - 1:
             continue
-        lines.append(f"{row.step:>6} {row.time:9.4f} {row.stretch_max:12.4g} {row.penetration_max:12.4g} "
-                     f"{row.kinetic_energy:12.4g} {row.blown_up_strands:>9}")
+        lines.append(
+            f"{row.step:>6} {row.time:9.4f} {row.stretch_max:12.4g} {row.penetration_max:12.4g} "
+            f"{row.kinetic_energy:12.4g} {row.blown_up_strands:>9}"
+        )
     if k > 1:
         lines.append(f"(one frame in {k} and the last; --every 1 prints all {n})")
     return lines
@@ -47,8 +50,10 @@ def run(binary, flags, output=None, timeout=None, as_json=False, every=None, out
             else:
                 lines = [runner.summary(record), *table(obs, every)]
                 blown = int(obs["blown_up_strands"].max()) if len(obs) else 0
-                lines.append(f"blown up: {'YES, up to ' + str(blown) + ' strand(s)' if blown else 'no'}; "
-                             f"invariants: {'all hold' if rep.ok else str(len(rep.all_violations())) + ' violated'}")
+                lines.append(
+                    f"blown up: {'YES, up to ' + str(blown) + ' strand(s)' if blown else 'no'}; "
+                    f"invariants: {'all hold' if rep.ok else str(len(rep.all_violations())) + ' violated'}"
+                )
                 lines += [f"  {v.message}" for v in rep.all_violations()[:5]]
                 out("\n".join(lines))
     finally:

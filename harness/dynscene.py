@@ -36,6 +36,7 @@ A key left out is not passed, so the binary's default (docs/model.md §3) applie
 keys, wrong types, NaN/∞ and values out of range are refused naming the key; the dynamic
 keys in a scene whose model is not "dynamic" are refused too.
 """
+
 import math
 
 DEFAULT_STAGES = ("init", "collide", "simulate")
@@ -45,11 +46,16 @@ MOTIONS = ("still", "nod", "shake", "tilt")
 # table → key → (flag, kind)
 TABLES = {
     "dynamics": {
-        "frames": ("--frames", "count"), "frame_dt": ("--frame-dt", "pos"),
-        "substeps": ("--substeps", "count"), "iterations": ("--iterations", "count"),
-        "solver": ("--solver", SOLVERS), "gravity": ("--gravity", "nonneg"),
-        "drag": ("--drag", "nonneg"), "damping": ("--damping", "nonneg"),
-        "ftl_damping": ("--ftl-damping", "unit"), "output_every": ("--output-every", "count"),
+        "frames": ("--frames", "count"),
+        "frame_dt": ("--frame-dt", "pos"),
+        "substeps": ("--substeps", "count"),
+        "iterations": ("--iterations", "count"),
+        "solver": ("--solver", SOLVERS),
+        "gravity": ("--gravity", "nonneg"),
+        "drag": ("--drag", "nonneg"),
+        "damping": ("--damping", "nonneg"),
+        "ftl_damping": ("--ftl-damping", "unit"),
+        "output_every": ("--output-every", "count"),
     },
     "constraints": {
         "stretch_compliance": ("--stretch-compliance", "nonneg"),
@@ -62,13 +68,19 @@ TABLES = {
 }
 # dynamic keys inside the paper model's [wind] and [head] tables
 SHARED = {
-    "wind": {"speed": ("--wind-speed", "nonneg"), "gust_amplitude": ("--gust-amplitude", "nonneg"),
-             "gust_frequency": ("--gust-frequency", "nonneg"),
-             "gust_wavelength": ("--gust-wavelength", "pos")},
-    "head": {"motion": ("--head-motion", MOTIONS), "motion_amplitude": ("--motion-amplitude", "nonneg"),
-             "motion_frequency": ("--motion-frequency", "nonneg")},
+    "wind": {
+        "speed": ("--wind-speed", "nonneg"),
+        "gust_amplitude": ("--gust-amplitude", "nonneg"),
+        "gust_frequency": ("--gust-frequency", "nonneg"),
+        "gust_wavelength": ("--gust-wavelength", "pos"),
+    },
+    "head": {
+        "motion": ("--head-motion", MOTIONS),
+        "motion_amplitude": ("--motion-amplitude", "nonneg"),
+        "motion_frequency": ("--motion-frequency", "nonneg"),
+    },
 }
-MAX_COUNT = 10 ** 6  # the binaries' bound on S and I (docs/model.md §3)
+MAX_COUNT = 10**6  # the binaries' bound on S and I (docs/model.md §3)
 
 
 def _value(where, key, kind, value, error):
@@ -111,7 +123,7 @@ def split(data, where, error):
                 raise error(f"{where}: '{key}' must be a table [{key}]")
         if key in TABLES:
             if not dynamic:
-                raise error(f"{where}: table [{key}] belongs to model = \"dynamic\"")
+                raise error(f'{where}: table [{key}] belongs to model = "dynamic"')
             for sub, v in value.items():
                 if sub not in TABLES[key]:
                     raise error(f"{where}: unknown key '{key}.{sub}' (known in [{key}]: {', '.join(TABLES[key])})")
@@ -146,8 +158,9 @@ def check(scene, where, error):
     """The stage list rules of the dynamic model (called for every scene)."""
     if scene.model == "dynamic":
         if scene.stages[-1] != "simulate" or "simulate" in scene.stages[:-1]:
-            raise error(f"{where}: stages of a dynamic scene must end with simulate, once (got "
-                        f"{', '.join(scene.stages)})")
+            raise error(
+                f"{where}: stages of a dynamic scene must end with simulate, once (got {', '.join(scene.stages)})"
+            )
     elif "simulate" in scene.stages:
         raise error(f"{where}: stage 'simulate' needs model = \"dynamic\"")
 
@@ -173,6 +186,7 @@ def with_frames(scene, n):
     from dataclasses import replace
 
     from .scenes import SceneError
+
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise SceneError(f"--frames must be a whole number ≥ 1, got {n!r}")
     return replace(scene, dynamic={**scene.dynamic, "--frames": n})

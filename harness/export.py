@@ -8,6 +8,7 @@
 - USD (`STATE.usdc`, needs PyPI `usd-core`): one `BasisCurves` prim, linear, with one time
   sample per frame, for Blender, Houdini and usdview.
 """
+
 import os
 from pathlib import Path
 from xml.sax.saxutils import escape
@@ -47,12 +48,12 @@ def _open_state(path):
         p = int(f["parameters"].attrs["points_per_strand"])
     except (KeyError, TypeError, ValueError):
         f.close()
-        raise HarnessError(f"export: {path} is not a hairbench state (no {POSITION}/value or "
-                           f"/parameters n_strands, points_per_strand)") from None
+        raise HarnessError(
+            f"export: {path} is not a hairbench state (no {POSITION}/value or /parameters n_strands, points_per_strand)"
+        ) from None
     if value.ndim != 3 or value.shape[1] != n * p or value.shape[2] != 3:
         f.close()
-        raise HarnessError(f"export: {path}: {POSITION}/value has shape {value.shape}, "
-                           f"not [F][{n}·{p}][3]")
+        raise HarnessError(f"export: {path}: {POSITION}/value has shape {value.shape}, not [F][{n}·{p}][3]")
     return f, n, p
 
 
@@ -71,12 +72,18 @@ def write_connectivity(path, n, p):
     """[N][P] point indices of each strand's polyline, compressed, written in blocks."""
     import h5py
 
-    dtype = np.int32 if n * p < 2 ** 31 else np.int64
+    dtype = np.int32 if n * p < 2**31 else np.int64
     strands_per_block = max(1, BLOCK_ROWS // p)
     with h5py.File(path, "w") as f:
-        d = f.create_dataset("connectivity", shape=(n, p), dtype=dtype,
-                             chunks=(min(n, strands_per_block), p), compression="gzip",
-                             compression_opts=1, shuffle=True)
+        d = f.create_dataset(
+            "connectivity",
+            shape=(n, p),
+            dtype=dtype,
+            chunks=(min(n, strands_per_block), p),
+            compression="gzip",
+            compression_opts=1,
+            shuffle=True,
+        )
         d.attrs["description"] = "row i: the point indices i*P … i*P + P-1 of strand i"
         for start in range(0, n, strands_per_block):
             stop = min(n, start + strands_per_block)
@@ -88,9 +95,15 @@ def _xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_
     rows = n * p
     grids = []
     for k in range(frames):
-        strand = (f'\n     <Attribute Name="strand" AttributeType="Scalar" Center="Node">\n'
-                  f'      <DataItem Dimensions="{rows}" NumberType="Int" Precision="4" Format="HDF">'
-                  f'{state_ref}:/particles/hair/strand</DataItem>\n     </Attribute>') if has_strand else ""
+        strand = (
+            (
+                f'\n     <Attribute Name="strand" AttributeType="Scalar" Center="Node">\n'
+                f'      <DataItem Dimensions="{rows}" NumberType="Int" Precision="4" Format="HDF">'
+                f"{state_ref}:/particles/hair/strand</DataItem>\n     </Attribute>"
+            )
+            if has_strand
+            else ""
+        )
         grids.append(f"""    <Grid Name="frame {k}" GridType="Uniform">
      <Time Value="{float(times[k])!r}"/>
      <Topology TopologyType="Polyline" NumberOfElements="{n}" NodesPerElement="{p}">
@@ -147,8 +160,7 @@ def export_usd(state, out_prefix=None):
     try:
         from pxr import Sdf, Usd, UsdGeom, Vt
     except ImportError:
-        raise HarnessError("export --usd needs the USD Python bindings: "
-                           "python3 -m pip install usd-core") from None
+        raise HarnessError("export --usd needs the USD Python bindings: python3 -m pip install usd-core") from None
     state = Path(state)
     prefix = Path(out_prefix) if out_prefix else state
     usd_path = prefix.with_name(prefix.name + ".usdc")
@@ -161,8 +173,8 @@ def export_usd(state, out_prefix=None):
         tmp = usd_path.with_name(f"{usd_path.stem}.tmp{os.getpid()}.usdc")  # USD picks the format by suffix
         tmp.unlink(missing_ok=True)
         stage = Usd.Stage.CreateNew(str(tmp))
-        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)    # column 1 is up
-        UsdGeom.SetStageMetersPerUnit(stage, 0.01)          # positions are in cm
+        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)  # column 1 is up
+        UsdGeom.SetStageMetersPerUnit(stage, 0.01)  # positions are in cm
         stage.SetStartTimeCode(0)
         stage.SetEndTimeCode(frames - 1)
         stage.SetTimeCodesPerSecond(24)
@@ -178,8 +190,7 @@ def export_usd(state, out_prefix=None):
             frame = np.ascontiguousarray(value[k], dtype=np.float32)
             points.Set(Vt.Vec3fArray.FromNumpy(frame), Usd.TimeCode(k))
         prim = curves.GetPrim()
-        prim.CreateAttribute("hairbench:frameTime", Sdf.ValueTypeNames.DoubleArray).Set(
-            Vt.DoubleArray.FromNumpy(times))
+        prim.CreateAttribute("hairbench:frameTime", Sdf.ValueTypeNames.DoubleArray).Set(Vt.DoubleArray.FromNumpy(times))
         try:
             stage.GetRootLayer().Save()
         except BaseException:

@@ -31,8 +31,7 @@ import os
 import tomllib
 from dataclasses import dataclass, field, replace
 
-from . import HarnessError
-from . import dynscene
+from . import HarnessError, dynscene
 from .paths import SCENES, config_file, read_toml
 
 STAGES = ("init", "collide", "wind", "simulate")
@@ -62,8 +61,12 @@ SCHEMA = {
 }
 
 # field name → kind, for overrides given on the command line
-FIELD_KINDS = {spec[0]: spec[1] for table in SCHEMA.values() for spec in table.values()
-               if spec and spec[1] not in ("stages", "text")}
+FIELD_KINDS = {
+    spec[0]: spec[1]
+    for table in SCHEMA.values()
+    for spec in table.values()
+    if spec and spec[1] not in ("stages", "text")
+}
 
 
 class SceneError(HarnessError):

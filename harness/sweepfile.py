@@ -156,10 +156,10 @@ def known_variants(backend):
 
 def _results_name(where, name):
     """A sweep's name is a directory under results/: one plain path component."""
-    if (not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", name)
-            or ".." in name):
-        raise SweepError(f"{where}: name must be letters, digits, '.', '_' or '-' (a directory "
-                         f"under results/), got {name!r}")
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", name) or ".." in name:
+        raise SweepError(
+            f"{where}: name must be letters, digits, '.', '_' or '-' (a directory under results/), got {name!r}"
+        )
     return name
 
 
@@ -222,6 +222,13 @@ def load_sweep(ref):
     for backend, b in axes:
         for p in b["points"]:
             scene.with_overrides(points=p)  # ℓ ≥ h for every point count
-    return Sweep(name=_results_name(where, data.get("name", path.stem)), path=path, scene=scene, repeat=repeat,
-                 warmup=warmup, timeout_s=int(timeout), axes=axes,
-                 description=data.get("description", ""))
+    return Sweep(
+        name=_results_name(where, data.get("name", path.stem)),
+        path=path,
+        scene=scene,
+        repeat=repeat,
+        warmup=warmup,
+        timeout_s=int(timeout),
+        axes=axes,
+        description=data.get("description", ""),
+    )

@@ -237,7 +237,6 @@ def invariant_tolerance(kind: str) -> InvariantTolerance:
     return INVARIANTS[kind]
 
 
-
 # ---- the dynamic model (docs/model.md §3): harness/dynamic_checks.py, harness/dyndiff.py ----
 # Measured on the 2-core dev machine with build/hairsim-cpu and with "other" = c_ref built
 # with FMA contraction (`make BUILD=/tmp/hbfma CFLAGS_REF="-std=c11 -D_DEFAULT_SOURCE -O2
@@ -279,8 +278,10 @@ DYN_OBSERVABLE_K = 8.0
 # Over many frames two correct builds drift apart (collisions, the solvers): this rule is
 # for one frame from one input, not for whole trajectories.
 DYN_STEP_K = {("fp64", "fp64"): 4.0, ("fp32", "fp64"): 4.0, ("fp32", "fp32"): 4.0}
-DYN_STEP_WHY = ("one frame from the same input: FMA-contracted c_ref against c_ref ≤ 0.82·ε·E·S·I "
-                "(xpbd and ftl, fp32 and fp64, S·I = 1 … 64, P = 32); 4 = margin 4.9×")
+DYN_STEP_WHY = (
+    "one frame from the same input: FMA-contracted c_ref against c_ref ≤ 0.82·ε·E·S·I "
+    "(xpbd and ftl, fp32 and fp64, S·I = 1 … 64, P = 32); 4 = margin 4.9×"
+)
 # fp32 against fp64 of the same scene over a short horizon (tests/test_dynamic.py): 64
 # strands × 16 points, S = I = 2, bend, shape, drag, damping, gusty wind, nod, seeds 1–3,
 # xpbd and ftl, collider on and off: max |x32 − x64| ≤ 1.43e-6·L over frames 1–10 (the
@@ -302,12 +303,12 @@ DYN_FP32_VS_FP64_REL_L = 1e-5
 #   θ0 = 0.1: S = 2, 8, 32 → 5.1e-4, 2.9e-5, 1.69e-5 (both solvers)
 #   θ0 = 2.0: S = 2, 8, 32 → 0.184, 0.104, 0.0400   (both solvers; mostly the amplitude
 #             the position-based step loses: 2.0 rad decays to 1.75 rad by the 4th period at S = 32)
-ANALYTIC_PENDULUM_SMALL_REL = 5e-5     # θ0 = 0.1 at S = 32 (measured 1.69e-5; margin 3×)
-ANALYTIC_PENDULUM_LARGE_REL = 0.05     # θ0 = 2.0 at S = 32 (measured 0.0400; margin 1.25×:
-                                       # the error is a smooth, deterministic ~1/S decay)
-ANALYTIC_TREND_SLACK = 0.10            # error(S_next) ≤ (1 + slack)·error(S) along the test's S
-                                       # (measured ratios ≤ 0.59 for the pendulum, ≤ 0.10 chain)
-ANALYTIC_FTL_XPBD_P2_REL = 1e-11       # |T_ftl − T_xpbd|/T at P = 2 (measured ≤ 1.0e-12 over S = 1…128)
+ANALYTIC_PENDULUM_SMALL_REL = 5e-5  # θ0 = 0.1 at S = 32 (measured 1.69e-5; margin 3×)
+ANALYTIC_PENDULUM_LARGE_REL = 0.05  # θ0 = 2.0 at S = 32 (measured 0.0400; margin 1.25×:
+# the error is a smooth, deterministic ~1/S decay)
+ANALYTIC_TREND_SLACK = 0.10  # error(S_next) ≤ (1 + slack)·error(S) along the test's S
+# (measured ratios ≤ 0.59 for the pendulum, ≤ 0.10 chain)
+ANALYTIC_FTL_XPBD_P2_REL = 1e-11  # |T_ftl − T_xpbd|/T at P = 2 (measured ≤ 1.0e-12 over S = 1…128)
 # Wind (§4.2): P = 2 hanging straight down, c_d = 1/s, β = 10/s, no gusts, 8 s (480 frames);
 # (U, ψ) = (250, 0), (981, 0), (3000, 0), (981, π), (981, 0.5); S = 1 and 8; both solvers:
 # |θ − θ_expected| ≤ 2.2e-13 rad and θ changed by ≤ 1.6e-13 rad over the last second. The
@@ -316,7 +317,7 @@ ANALYTIC_FTL_XPBD_P2_REL = 1e-11       # |T_ftl − T_xpbd|/T at P = 2 (measured
 # h²·|a|·δθ, rounds away once it is below the ulp of a coordinate, so the particle can rest
 # anywhere within δθ ≈ u·ℓ/(h²·|a|) (u the unit roundoff) of the equilibrium: at S = 64 the
 # angle is up to 1.6e-11 rad off (docs/analytic.md), so the test stays at S ≤ 8.
-ANALYTIC_WIND_ANGLE_ABS = 2e-12        # rad (9× the worst measured at S ≤ 8)
+ANALYTIC_WIND_ANGLE_ABS = 2e-12  # rad (9× the worst measured at S ≤ 8)
 # Hanging chain (§4.3): L = 30 cm, rigid links, no bend, displaced by 0.3 cm × the continuum
 # first mode; ω from the zero crossings of the first-mode coordinate over 4 periods, against
 # the linearised discrete chain's ω1 (harness.analytic.discrete_chain_omega1). ftl runs with
@@ -324,7 +325,7 @@ ANALYTIC_WIND_ANGLE_ABS = 2e-12        # rad (9× the worst measured at S ≤ 8)
 # 13% (P = 32) and 33% (P = 64) above the chain's (docs/analytic.md).
 #   xpbd      P = 32: S = 64, 256 → 6.0e-4, 4.2e-5;  P = 64: 2.4e-3, 1.6e-4
 #   ftl, s=1  P = 32: S = 64, 256 → 1.2e-4, 1.2e-5;  P = 64: 4.7e-4, 3.4e-5
-ANALYTIC_CHAIN_REL = 5e-4              # at S = 256 against the discrete chain (worst 1.6e-4; 3×)
+ANALYTIC_CHAIN_REL = 5e-4  # at S = 256 against the discrete chain (worst 1.6e-4; 3×)
 # Against the continuum ω1 = (j01/2)√(g/L) the allowance is the discretisation gap
 # |ω1_discrete/ω1_continuum − 1| (computed: 7.93e-3 at P = 32, 3.94e-3 at P = 64, ≈ 0.25/P)
 # plus ANALYTIC_CHAIN_REL.
@@ -334,8 +335,9 @@ ANALYTIC_CHAIN_REL = 5e-4              # at S = 256 against the discrete chain (
 # S = 256 the wind angle 0.13 rad off). The tests check fp32 at S = 8 only:
 #   pendulum θ0 = 0.1, S = 8: 4.1e-5 (xpbd), 4.8e-5 (ftl)
 #   wind, the five (U, ψ) above, S = 1 and 8: ≤ 8.7e-5 rad (estimate u·ℓ/(h²·|a|) = 3e-4 at S = 8)
-ANALYTIC_FP32_PENDULUM_REL = 1.5e-4    # θ0 = 0.1 at S = 8 (worst 4.8e-5; margin 3×)
-ANALYTIC_FP32_WIND_ANGLE_ABS = 5e-4    # rad at S ≤ 8 (worst 8.7e-5; below the 3e-4 rounding estimate ×1.7)
+ANALYTIC_FP32_PENDULUM_REL = 1.5e-4  # θ0 = 0.1 at S = 8 (worst 4.8e-5; margin 3×)
+ANALYTIC_FP32_WIND_ANGLE_ABS = 5e-4  # rad at S ≤ 8 (worst 8.7e-5; below the 3e-4 rounding estimate ×1.7)
+
 
 # ---- the simd CPU variant's simulate stage against ref (docs/cpu_simd.md, "The dynamic
 # model"; tests/test_cpu_simd_dynamic.py) ----
@@ -345,11 +347,11 @@ ANALYTIC_FP32_WIND_ANGLE_ABS = 5e-4    # rad at S ≤ 8 (worst 8.7e-5; below the
 # E = R + h + L, h = Δt/S the substep, ℓ the segment length.
 @dataclass(frozen=True)
 class SimdDynTolerance:
-    position_k: float       # |Δx| ≤ k·ε·E at every point of every frame
-    velocity_k: float       # |Δv| ≤ k·ε·E/h (v = Δp/h: a position rounding over h)
+    position_k: float  # |Δx| ≤ k·ε·E at every point of every frame
+    velocity_k: float  # |Δv| ≤ k·ε·E/h (v = Δp/h: a position rounding over h)
     kinetic_energy_k: float  # |ΔKE| ≤ k·ε·KE, every frame
-    stretch_k: float        # |Δ stretch_max| ≤ k·ε·E/ℓ
-    penetration_k: float    # |Δ penetration_max| ≤ k·ε·E
+    stretch_k: float  # |Δ stretch_max| ≤ k·ε·E/ℓ
+    penetration_k: float  # |Δ penetration_max| ≤ k·ε·E
     why: str
 
 
@@ -367,6 +369,11 @@ class SimdDynTolerance:
 # frame, but the kinetic energy, small there, differed by up to 101 ε·KE.
 # Margins over the 10-frame worst: 2.5× (positions), 4.4×, 5.3×, 5×, 20×.
 SIMD_DYN_GUST = SimdDynTolerance(
-    position_k=16.0, velocity_k=8.0, kinetic_energy_k=8.0, stretch_k=1.0, penetration_k=1.0,
-    why="runs of ≤ 10 frames: measured ≤ 6.38 ε·E, 1.8 ε·E/h, 1.52 ε·KE, 0.19 ε·E/ℓ, 0.05 ε·E")
+    position_k=16.0,
+    velocity_k=8.0,
+    kinetic_energy_k=8.0,
+    stretch_k=1.0,
+    penetration_k=1.0,
+    why="runs of ≤ 10 frames: measured ≤ 6.38 ε·E, 1.8 ε·E/h, 1.52 ε·KE, 0.19 ε·E/ℓ, 0.05 ε·E",
+)
 SIMD_DYN_GUST_MAX_FRAMES = 10  # the horizon the bounds were measured for

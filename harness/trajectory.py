@@ -19,6 +19,7 @@ A paper-model file opens too (`is_dynamic` False, no rest, no velocities, empty
 observables), so callers can take either. Any departure from the layout (a missing
 dataset, a shape or dtype that does not fit, steps that do not match) is a StateError.
 """
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,19 +30,54 @@ HAIR = "particles/hair"
 REST = f"{HAIR}/rest_position"
 VELOCITY = f"{HAIR}/velocity"
 OBSERVABLES = ("stretch_max", "penetration_max", "kinetic_energy", "blown_up", "blown_up_strands")
-DYNAMIC_ATTRS = ("paper_frames", "simulated_frames", "output_every", "solver", "head_motion", "features",
-                 "substeps", "iterations", "bend", "shape", "collider", "drag_declared", "frame_dt",
-                 "gravity", "drag", "damping", "stretch_compliance", "bend_compliance", "shape_compliance",
-                 "shape_range", "ftl_damping", "collision_margin", "wind_speed", "wind_angle",
-                 "gust_amplitude", "gust_frequency", "gust_wavelength", "motion_amplitude",
-                 "motion_frequency")
-REQUIRED_DYNAMIC = ("paper_frames", "substeps", "frame_dt", "solver", "head_motion", "collider",
-                    "motion_amplitude", "motion_frequency", "collision_margin")
+DYNAMIC_ATTRS = (
+    "paper_frames",
+    "simulated_frames",
+    "output_every",
+    "solver",
+    "head_motion",
+    "features",
+    "substeps",
+    "iterations",
+    "bend",
+    "shape",
+    "collider",
+    "drag_declared",
+    "frame_dt",
+    "gravity",
+    "drag",
+    "damping",
+    "stretch_compliance",
+    "bend_compliance",
+    "shape_compliance",
+    "shape_range",
+    "ftl_damping",
+    "collision_margin",
+    "wind_speed",
+    "wind_angle",
+    "gust_amplitude",
+    "gust_frequency",
+    "gust_wavelength",
+    "motion_amplitude",
+    "motion_frequency",
+)
+REQUIRED_DYNAMIC = (
+    "paper_frames",
+    "substeps",
+    "frame_dt",
+    "solver",
+    "head_motion",
+    "collider",
+    "motion_amplitude",
+    "motion_frequency",
+    "collision_margin",
+)
 
 
 @dataclass
 class Trajectory(State):
     """A State plus the dynamic model's time series (see the module docstring)."""
+
     is_dynamic: bool = False
     paper_frames: int = 0
     step: np.ndarray = None
@@ -163,20 +199,22 @@ def _check_dynamic(t, f):
     for fr in range(t.n_frames):
         want = "simulate" if fr >= t.paper_frames else None
         if want and t.stages[fr] != want:
-            raise StateError(f"{path}: frame {fr} is '{t.stages[fr]}', expected 'simulate' after "
-                             f"{t.paper_frames} paper frame(s)")
+            raise StateError(
+                f"{path}: frame {fr} is '{t.stages[fr]}', expected 'simulate' after {t.paper_frames} paper frame(s)"
+            )
         if not want and t.stages[fr] == "simulate":
             raise StateError(f"{path}: frame {fr} is 'simulate' but lies among the paper frames")
     if not np.all(np.diff(t.step) > 0):
         raise StateError(f"{path}: /{HAIR}/position/step is not increasing")
-    if not np.array_equal(t.step[:t.paper_frames], np.arange(t.paper_frames)):
+    if not np.array_equal(t.step[: t.paper_frames], np.arange(t.paper_frames)):
         raise StateError(f"{path}: the paper frames' steps are not 0 … {t.paper_frames - 1}")
     if REST not in f:
         raise StateError(f"{path}: no /{REST} dataset (a dynamic file has its rest shape)")
     rest = f[REST]
     if not hasattr(rest, "shape") or rest.shape != (t.n_strands * t.points, 3):
-        raise StateError(f"{path}: /{REST} has shape {getattr(rest, 'shape', None)}, "
-                         f"expected ({t.n_strands * t.points}, 3)")
+        raise StateError(
+            f"{path}: /{REST} has shape {getattr(rest, 'shape', None)}, expected ({t.n_strands * t.points}, 3)"
+        )
     if rest.dtype != t.dtype:
         raise StateError(f"{path}: /{REST} is {rest.dtype} but positions are {t.dtype}")
     t._rest = rest
@@ -184,8 +222,10 @@ def _check_dynamic(t, f):
         raise StateError(f"{path}: no /{VELOCITY}/value dataset (a dynamic file stores velocities)")
     vel = f[f"{VELOCITY}/value"]
     if not hasattr(vel, "shape") or vel.ndim != 3 or vel.shape[1:] != (t.n_strands * t.points, 3):
-        raise StateError(f"{path}: /{VELOCITY}/value has shape {getattr(vel, 'shape', None)}, "
-                         f"expected [Fv][{t.n_strands * t.points}][3]")
+        raise StateError(
+            f"{path}: /{VELOCITY}/value has shape {getattr(vel, 'shape', None)}, "
+            f"expected [Fv][{t.n_strands * t.points}][3]"
+        )
     if vel.dtype != t.dtype:
         raise StateError(f"{path}: /{VELOCITY}/value is {vel.dtype} but positions are {t.dtype}")
     t._vel = vel
@@ -208,10 +248,12 @@ def open_trajectory(path):
         t = Trajectory(**{k: getattr(state, k) for k in State.__dataclass_fields__})
         F = t.n_frames
         base = f"{HAIR}/position"
-        t.step = (_series(f, f"{base}/step", t.path, F, "iu").astype(np.int64) if f"{base}/step" in f
-                  else np.arange(F, dtype=np.int64))
-        t.time = (_series(f, f"{base}/time", t.path, F, "f").astype(np.float64) if f"{base}/time" in f
-                  else np.zeros(F))
+        t.step = (
+            _series(f, f"{base}/step", t.path, F, "iu").astype(np.int64)
+            if f"{base}/step" in f
+            else np.arange(F, dtype=np.int64)
+        )
+        t.time = _series(f, f"{base}/time", t.path, F, "f").astype(np.float64) if f"{base}/time" in f else np.zeros(F)
         t.is_dynamic = as_text(t.params.get("model", "paper")) == "dynamic"
         if t.is_dynamic:
             _check_dynamic(t, f)

@@ -6,6 +6,7 @@ measurements are in harness/analytic.py, the tolerances (with the measurements b
 them) in harness/tolerances.py (ANALYTIC_*). Only 2–3 substep counts S per check run here;
 the full sweeps are in docs/analytic.md (`python -m harness.analytic_table`).
 """
+
 import math
 
 import numpy as np
@@ -30,20 +31,21 @@ def assert_converges(s_values, errors, final_tol, what):
 
 # ---------------------------------------------------------------- closed forms (no binary)
 
+
 def test_elliptic_k_and_pendulum_period_closed_forms():
     assert an.ellipk(0.0) == pytest.approx(math.pi / 2, rel=1e-15)
-    assert an.ellipk(0.5) == pytest.approx(1.854074677301372, rel=1e-14)     # DLMF §19.2
+    assert an.ellipk(0.5) == pytest.approx(1.854074677301372, rel=1e-14)  # DLMF §19.2
     assert an.ellipk(0.99) == pytest.approx(3.695637362989875, rel=1e-14)
     t0 = an.pendulum_period_small(30.0, G0)
-    for theta in (1e-4, 0.1, 0.3):   # T ≈ T0·(1 + θ²/16 + 11θ⁴/3072), next term O(θ⁶)
-        series = t0 * (1 + theta ** 2 / 16 + 11 * theta ** 4 / 3072)
-        assert an.pendulum_period(30.0, G0, theta) == pytest.approx(series, rel=2e-3 * theta ** 6 + 1e-15)
+    for theta in (1e-4, 0.1, 0.3):  # T ≈ T0·(1 + θ²/16 + 11θ⁴/3072), next term O(θ⁶)
+        series = t0 * (1 + theta**2 / 16 + 11 * theta**4 / 3072)
+        assert an.pendulum_period(30.0, G0, theta) == pytest.approx(series, rel=2e-3 * theta**6 + 1e-15)
 
 
 def test_bessel_and_chain_closed_forms():
     assert abs(an.j0(an.J01)) < 1e-15
     assert an.j0(1.0) == pytest.approx(0.7651976865579666, rel=1e-15)
-    assert abs(an.j0(5.520078110286311)) < 1e-14                                # j0,2 (DLMF §10.21)
+    assert abs(an.j0(5.520078110286311)) < 1e-14  # j0,2 (DLMF §10.21)
     # one mass on one link is the pendulum; the discrete chain tends to the continuum ≈ 0.25/P
     assert an.discrete_chain_omega1(2, 30.0, G0) == pytest.approx(math.sqrt(G0 / 30.0), rel=1e-14)
     w = an.chain_omega1(30.0, G0)
@@ -66,8 +68,9 @@ PENDULUM_S = (2, 8, 32)
 
 
 @pytest.mark.parametrize("solver", SOLVERS)
-@pytest.mark.parametrize("theta0, final_tol", [(0.1, tol.ANALYTIC_PENDULUM_SMALL_REL),
-                                               (2.0, tol.ANALYTIC_PENDULUM_LARGE_REL)])
+@pytest.mark.parametrize(
+    "theta0, final_tol", [(0.1, tol.ANALYTIC_PENDULUM_SMALL_REL), (2.0, tol.ANALYTIC_PENDULUM_LARGE_REL)]
+)
 def test_pendulum_period_converges_in_substeps(cpu_bin, tmp_path, solver, theta0, final_tol):
     runs = [run_pendulum(cpu_bin, tmp_path, solver, s, theta0) for s in PENDULUM_S]
     errors = [an.relative_error(r["measured"], r["expected"]) for r in runs]
@@ -86,6 +89,7 @@ def test_pendulum_ftl_is_xpbd_at_two_points(cpu_bin, tmp_path):
 
 # ---------------------------------------------------------------- §4.2 wind
 
+
 @pytest.mark.parametrize("solver", SOLVERS)
 @pytest.mark.parametrize("substeps", (1, 8))
 def test_steady_wind_angle(cpu_bin, tmp_path, solver, substeps):
@@ -93,8 +97,9 @@ def test_steady_wind_angle(cpu_bin, tmp_path, solver, substeps):
     # where the net acceleration (0, −g0 + c_d·U·sin ψ, c_d·U·cos ψ) sets the angle
     for speed, psi in ((250.0, 0.0), (981.0, 0.0), (3000.0, 0.0), (981.0, math.pi), (981.0, 0.5)):
         r = run_wind(cpu_bin, tmp_path, solver, substeps, speed, wind_angle=psi)
-        assert abs(r["measured"] - r["expected"]) <= tol.ANALYTIC_WIND_ANGLE_ABS, \
+        assert abs(r["measured"] - r["expected"]) <= tol.ANALYTIC_WIND_ANGLE_ABS, (
             f"U={speed}, ψ={psi}: θ={r['measured']!r}, expected {r['expected']!r}"
+        )
         assert r["change_last_second"] <= tol.ANALYTIC_WIND_ANGLE_ABS
 
 
@@ -117,6 +122,7 @@ def test_hanging_chain_first_mode_converges_in_substeps(cpu_bin, tmp_path, point
 
 # ---------------------------------------------------------------- fp32
 
+
 @pytest.mark.parametrize("solver", SOLVERS)
 def test_fp32_holds_the_analytic_answers_at_moderate_substeps(cpu_bin, tmp_path, solver):
     """fp32 stops converging once h²·|a| nears the ulp of a coordinate (docs/analytic.md);
@@ -126,5 +132,6 @@ def test_fp32_holds_the_analytic_answers_at_moderate_substeps(cpu_bin, tmp_path,
     for substeps in (1, 8):
         for speed, psi in ((250.0, 0.0), (981.0, 0.0), (3000.0, 0.0), (981.0, math.pi), (981.0, 0.5)):
             r = run_wind(cpu_bin, tmp_path, solver, substeps, speed, wind_angle=psi, precision="fp32")
-            assert abs(r["measured"] - r["expected"]) <= tol.ANALYTIC_FP32_WIND_ANGLE_ABS, \
+            assert abs(r["measured"] - r["expected"]) <= tol.ANALYTIC_FP32_WIND_ANGLE_ABS, (
                 f"fp32 S={substeps} U={speed} ψ={psi}: θ={r['measured']!r}, expected {r['expected']!r}"
+            )

@@ -13,7 +13,7 @@ Both variants start from the same ref `init,collide` state (--input): simd's own
 stages differ from ref's by their libmvec rounding (tests/test_cpu_simd.py covers those).
 N = 300 and 1000 are not multiples of the blocks (512/256 strands, 64 per dynamic block).
 """
-import os
+
 import platform
 import shutil
 import subprocess
@@ -21,11 +21,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from harness.trajectory import open_trajectory
-from harness.tolerances import SIMD_DYN_GUST, SIMD_DYN_GUST_MAX_FRAMES
-from support.statecheck import run
 from test_cpu_simd import NO_SIMD, needs_simd
+
+from harness.tolerances import SIMD_DYN_GUST, SIMD_DYN_GUST_MAX_FRAMES
+from harness.trajectory import open_trajectory
+from support.statecheck import run
 
 STRANDS = 300
 FRAMES = 10
@@ -40,8 +40,20 @@ FEATURES = {
     "motion": ["--no-collider", "--head-motion", "nod", "--motion-amplitude", 0.5],
     "collide": ["--collision-margin", 0.3],
     "drag": ["--no-collider", "--damping", 2],
-    "all-but-gust": ["--bend-compliance", 1e-6, "--shape-compliance", 1e-5, "--wind-speed", 300, "--drag", 1,
-                     "--damping", 0.5, "--head-motion", "shake"],
+    "all-but-gust": [
+        "--bend-compliance",
+        1e-6,
+        "--shape-compliance",
+        1e-5,
+        "--wind-speed",
+        300,
+        "--drag",
+        1,
+        "--damping",
+        0.5,
+        "--head-motion",
+        "shake",
+    ],
 }
 ALL = FEATURES["all-but-gust"] + ["--gust-amplitude", 0.8, "--gust-frequency", 3, "--gust-wavelength", 20]
 SOLVE = ["--substeps", 3, "--iterations", 2]
@@ -57,8 +69,22 @@ def inputs(cpu_bin, tmp_path_factory):
         key = (precision, points, strands)
         if key not in made:
             path = d / f"in_{precision}_{points}_{strands}.h5"
-            run(cpu_bin, "--stages", "init,collide", "--strands", strands, "--points", points, "--precision",
-                precision, "--seed", 7, "--output", path, "--quiet")
+            run(
+                cpu_bin,
+                "--stages",
+                "init,collide",
+                "--strands",
+                strands,
+                "--points",
+                points,
+                "--precision",
+                precision,
+                "--seed",
+                7,
+                "--output",
+                path,
+                "--quiet",
+            )
             made[key] = path
         return made[key]
 
@@ -66,8 +92,23 @@ def inputs(cpu_bin, tmp_path_factory):
 
 
 def simulate(cpu_bin, inp, out, variant, *args, frames=FRAMES):
-    run(cpu_bin, "--input", inp, "--stages", "simulate", "--frames", frames, "--variant", variant, *SOLVE, *args,
-        "--output", out, "--force", "--quiet")
+    run(
+        cpu_bin,
+        "--input",
+        inp,
+        "--stages",
+        "simulate",
+        "--frames",
+        frames,
+        "--variant",
+        variant,
+        *SOLVE,
+        *args,
+        "--output",
+        out,
+        "--force",
+        "--quiet",
+    )
     return out
 
 
@@ -179,8 +220,25 @@ def test_resume_gives_the_same_bits(cpu_bin, inputs, tmp_path, solver):
     assert np.array_equal(ow["kinetic_energy"][-5:], orr["kinetic_energy"][-5:])
     # from simulated frame 3 of the whole run (file frame paper_frames − 1 + 3 = 4)
     mid = tmp_path / "mid.h5"
-    run(cpu_bin, "--input", whole, "--input-frame", 4, "--stages", "simulate", "--frames", 7, "--variant", "simd",
-        *SOLVE, *args, "--output", mid, "--force", "--quiet")
+    run(
+        cpu_bin,
+        "--input",
+        whole,
+        "--input-frame",
+        4,
+        "--stages",
+        "simulate",
+        "--frames",
+        7,
+        "--variant",
+        "simd",
+        *SOLVE,
+        *args,
+        "--output",
+        mid,
+        "--force",
+        "--quiet",
+    )
     pm, vm = read(mid)[:2]
     assert np.array_equal(pw[-1], pm[-1]) and np.array_equal(vw[-1], vm[-1])
 
@@ -196,8 +254,11 @@ def test_dynamics_simd_object_calls_only_the_vector_sine(cpu_bin):
     if shutil.which("objdump") is None:
         pytest.skip("objdump not found (binutils)")
     text = subprocess.run(["objdump", "-dr", str(obj)], capture_output=True, text=True, check=True).stdout
-    called = {line.split()[-1].split("-")[0].split("+")[0] for line in text.splitlines()
-              if "R_X86_64_PLT32" in line or "R_X86_64_PC32" in line}
+    called = {
+        line.split()[-1].split("-")[0].split("+")[0]
+        for line in text.splitlines()
+        if "R_X86_64_PLT32" in line or "R_X86_64_PC32" in line
+    }
     if "__asan_init" in called or any(c.startswith("__ubsan_") for c in called):
         pytest.skip("a sanitizer build (make sanitize): its instrumentation keeps the loops scalar")
     assert not {"sinf", "sin", "sqrtf", "sqrt", "sincosf", "sincos"} & called, sorted(called)
@@ -208,6 +269,7 @@ def test_dynamics_simd_object_calls_only_the_vector_sine(cpu_bin):
 @needs_simd
 def test_simd_lists_simulate(cpu_bin):
     import json
+
     listing = json.loads(run(cpu_bin, "--list-variants").stdout)
     simd = [v for v in listing["variants"] if v["name"] == "simd"][0]
     assert "simulate" in simd["stages"]

@@ -3,6 +3,7 @@ features at zero strength, determinism (threads, resume, frame split), fp32 agai
 --output-every, observables, and `harness stepdiff`. Files are read only through the
 harness (harness/trajectory.py, dynamic_checks.py, dyndiff.py); every tolerance comes from
 harness/tolerances.py. Small sizes: 64 strands × 16 points, ≤ 20 frames."""
+
 import numpy as np
 import pytest
 
@@ -14,9 +15,30 @@ from support.statecheck import run
 SMALL = ["--strands", "64", "--points", "16"]
 SIM = ["--stages", "init,collide,simulate"]
 # every feature on (S = I = 2 keeps the runs short)
-FULL = ["--substeps", "2", "--iterations", "2", "--bend-compliance", "1e-6", "--shape-compliance", "1e-4",
-        "--shape-range", "0.5", "--drag", "0.5", "--damping", "0.5", "--wind-speed", "150",
-        "--gust-amplitude", "0.5", "--gust-wavelength", "60", "--head-motion", "nod"]
+FULL = [
+    "--substeps",
+    "2",
+    "--iterations",
+    "2",
+    "--bend-compliance",
+    "1e-6",
+    "--shape-compliance",
+    "1e-4",
+    "--shape-range",
+    "0.5",
+    "--drag",
+    "0.5",
+    "--damping",
+    "0.5",
+    "--wind-speed",
+    "150",
+    "--gust-amplitude",
+    "0.5",
+    "--gust-wavelength",
+    "60",
+    "--head-motion",
+    "nod",
+]
 SOLVERS = ["xpbd", "ftl"]
 PRECISIONS = ["fp32", "fp64"]
 
@@ -52,6 +74,7 @@ def check_ok(path):
 
 # ---- invariants ---------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("precision", PRECISIONS)
 @pytest.mark.parametrize("solver", SOLVERS)
 @pytest.mark.parametrize("collider", [True, False], ids=["collider", "no-collider"])
@@ -59,8 +82,18 @@ def test_invariants_on_every_frame(cpu_bin, tmp_path, solver, precision, collide
     """No NaN/Inf; roots bit-exactly at Q(t)·X̄0; no point inside the collider after a
     frame (collider on); ftl segments of length ℓ to rounding where the collider did not
     move them (every segment without the collider); observables agree with the positions."""
-    out = simulate(cpu_bin, tmp_path / "s.h5", *FULL, "--solver", solver, "--precision", precision,
-                   "--velocities", "all", *([] if collider else ["--no-collider"]))
+    out = simulate(
+        cpu_bin,
+        tmp_path / "s.h5",
+        *FULL,
+        "--solver",
+        solver,
+        "--precision",
+        precision,
+        "--velocities",
+        "all",
+        *([] if collider else ["--no-collider"]),
+    )
     rep = check_ok(out)
     assert rep.worst_root == 0
     with open_trajectory(out) as t:
@@ -72,8 +105,19 @@ def test_invariants_on_every_frame(cpu_bin, tmp_path, solver, precision, collide
 
 @pytest.mark.parametrize("motion", ["shake", "tilt"])
 def test_roots_follow_every_motion(cpu_bin, tmp_path, motion):
-    out = simulate(cpu_bin, tmp_path / "s.h5", "--head-motion", motion, "--motion-amplitude", "0.7",
-                   "--solver", "ftl", "--precision", "fp64", frames=8)
+    out = simulate(
+        cpu_bin,
+        tmp_path / "s.h5",
+        "--head-motion",
+        motion,
+        "--motion-amplitude",
+        "0.7",
+        "--solver",
+        "ftl",
+        "--precision",
+        "fp64",
+        frames=8,
+    )
     check_ok(out)
 
 
@@ -82,11 +126,15 @@ def test_the_checks_can_fail(cpu_bin, tmp_path):
     disagrees with the positions are each reported (hand-damaged copies of a good file)."""
     import h5py
 
-    good = simulate(cpu_bin, tmp_path / "good.h5", *FULL, "--solver", "ftl", "--precision", "fp64",
-                    "--no-collider", frames=4)
+    good = simulate(
+        cpu_bin, tmp_path / "good.h5", *FULL, "--solver", "ftl", "--precision", "fp64", "--no-collider", frames=4
+    )
     check_ok(good)
-    cases = {"roots": lambda f: _nudge(f, 0, 0), "ftl_segments": lambda f: _nudge(f, 5, 2, 1e-6),
-             "observables": lambda f: f["observables/stretch_max/value"].__setitem__(1, 0.5)}
+    cases = {
+        "roots": lambda f: _nudge(f, 0, 0),
+        "ftl_segments": lambda f: _nudge(f, 5, 2, 1e-6),
+        "observables": lambda f: f["observables/stretch_max/value"].__setitem__(1, 0.5),
+    }
     for name, damage in cases.items():
         bad = tmp_path / f"{name}.h5"
         bad.write_bytes(good.read_bytes())
@@ -125,8 +173,21 @@ def test_blown_up_run_is_detected_and_matches_the_observables(cpu_bin, tmp_path)
     """xpbd with S = I = 1 and no damping at 32 points blows up (measured: every strand by
     frame 60); the harness's own count from positions and velocities equals the file's."""
     out = tmp_path / "b.h5"
-    run(cpu_bin, *SIM, "--strands", "64", "--points", "32", "--frames", "30", "--velocities", "all",
-        "--output", out, "--quiet")
+    run(
+        cpu_bin,
+        *SIM,
+        "--strands",
+        "64",
+        "--points",
+        "32",
+        "--frames",
+        "30",
+        "--velocities",
+        "all",
+        "--output",
+        out,
+        "--quiet",
+    )
     with open_trajectory(out) as t:
         assert t.observables["blown_up"].any()
         rep = dynamic_checks.check(t)
@@ -139,23 +200,35 @@ def test_blown_up_run_is_detected_and_matches_the_observables(cpu_bin, tmp_path)
 
 ZERO_CASES = [
     # (name, zero-strength flags, undeclared flags, features differ?, a non-zero variant)
-    ("wind_speed_0", ["--drag", "0.5", "--wind-speed", "0"], ["--drag", "0.5"], False,
-     ["--drag", "0.5", "--wind-speed", "150"]),
-    ("gust_amplitude_0", ["--drag", "0.5", "--wind-speed", "150", "--gust-amplitude", "0"],
-     ["--drag", "0.5", "--wind-speed", "150"], False,
-     ["--drag", "0.5", "--wind-speed", "150", "--gust-amplitude", "0.5"]),
-    ("motion_amplitude_0", ["--head-motion", "nod", "--motion-amplitude", "0"], [], True,
-     ["--head-motion", "nod"]),
+    (
+        "wind_speed_0",
+        ["--drag", "0.5", "--wind-speed", "0"],
+        ["--drag", "0.5"],
+        False,
+        ["--drag", "0.5", "--wind-speed", "150"],
+    ),
+    (
+        "gust_amplitude_0",
+        ["--drag", "0.5", "--wind-speed", "150", "--gust-amplitude", "0"],
+        ["--drag", "0.5", "--wind-speed", "150"],
+        False,
+        ["--drag", "0.5", "--wind-speed", "150", "--gust-amplitude", "0.5"],
+    ),
+    ("motion_amplitude_0", ["--head-motion", "nod", "--motion-amplitude", "0"], [], True, ["--head-motion", "nod"]),
     ("damping_0", ["--damping", "0"], [], True, ["--damping", "0.5"]),
-    ("shape_range_K0", ["--shape-compliance", "1e-4", "--shape-range", "0.01"], [], True,
-     ["--shape-compliance", "1e-4"]),
+    (
+        "shape_range_K0",
+        ["--shape-compliance", "1e-4", "--shape-range", "0.01"],
+        [],
+        True,
+        ["--shape-compliance", "1e-4"],
+    ),
 ]
 
 
 @pytest.mark.parametrize("solver", SOLVERS)
 @pytest.mark.parametrize("name,zero,undeclared,declared,live", ZERO_CASES, ids=[c[0] for c in ZERO_CASES])
-def test_zero_strength_gives_the_bits_of_undeclared(cpu_bin, tmp_path, solver, name, zero, undeclared,
-                                                    declared, live):
+def test_zero_strength_gives_the_bits_of_undeclared(cpu_bin, tmp_path, solver, name, zero, undeclared, declared, live):
     """wind U = 0 and gust A_g = 0: the rule (§3.9) evaluates no wind / no sine, so the two
     runs execute the same code (the features attribute is the same, asserted): the test is
     that the switch really leaves it out. nod with A = 0, --damping 0 and a shape range
@@ -174,11 +247,25 @@ def test_zero_strength_gives_the_bits_of_undeclared(cpu_bin, tmp_path, solver, n
 
 # ---- determinism ---------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("precision", PRECISIONS)
 @pytest.mark.parametrize("solver", SOLVERS)
 def test_thread_count_does_not_change_a_bit(cpu_bin, tmp_path, solver, precision):
-    paths = [simulate(cpu_bin, tmp_path / f"t{n}.h5", *FULL, "--solver", solver, "--precision", precision,
-                      "--threads", n, frames=10) for n in (1, 2, 3)]
+    paths = [
+        simulate(
+            cpu_bin,
+            tmp_path / f"t{n}.h5",
+            *FULL,
+            "--solver",
+            solver,
+            "--precision",
+            precision,
+            "--threads",
+            n,
+            frames=10,
+        )
+        for n in (1, 2, 3)
+    ]
     for p in paths[1:]:
         assert same_bits(paths[0], p)
         with open_trajectory(paths[0]) as a, open_trajectory(p) as b:
@@ -198,8 +285,9 @@ def test_resume_gives_the_bits_of_one_run(cpu_bin, tmp_path, solver):
     with open_trajectory(whole) as t:
         k = t.frame_at_step(t.paper_frames - 1 + 6)
     mid = tmp_path / "mid.h5"
-    run(cpu_bin, "--input", whole, "--input-frame", k, "--stages", "simulate", "--frames", 4, "--output", mid,
-        "--quiet")
+    run(
+        cpu_bin, "--input", whole, "--input-frame", k, "--stages", "simulate", "--frames", 4, "--output", mid, "--quiet"
+    )
     assert same_bits(whole, mid)
     with open_trajectory(whole) as a, open_trajectory(rest) as b:
         assert np.array_equal(a.step, b.step) and np.array_equal(a.time, b.time)
@@ -210,8 +298,22 @@ def test_resume_gives_the_bits_of_one_run(cpu_bin, tmp_path, solver):
 def test_frame_split_does_not_change_a_bit(cpu_bin, tmp_path, solver):
     """Δt = 1/30 with S = 2 and Δt = 1/60 with S = 1 run the same substeps (times come from
     the global substep index, §3.4): equal bits at the common times t = k/30."""
-    args = ["--solver", solver, "--precision", "fp32", "--head-motion", "shake", "--drag", "0.5",
-            "--wind-speed", "150", "--gust-amplitude", "0.5", "--bend-compliance", "1e-6"]
+    args = [
+        "--solver",
+        solver,
+        "--precision",
+        "fp32",
+        "--head-motion",
+        "shake",
+        "--drag",
+        "0.5",
+        "--wind-speed",
+        "150",
+        "--gust-amplitude",
+        "0.5",
+        "--bend-compliance",
+        "1e-6",
+    ]
     a = simulate(cpu_bin, tmp_path / "a.h5", *args, "--frame-dt", repr(1 / 30), "--substeps", 2, frames=6)
     b = simulate(cpu_bin, tmp_path / "b.h5", *args, "--frame-dt", repr(1 / 60), "--substeps", 1, frames=12)
     with open_trajectory(a) as ta, open_trajectory(b) as tb:
@@ -250,8 +352,9 @@ def test_output_every_writes_every_kth_frame_and_the_last(cpu_bin, tmp_path):
 
 @pytest.mark.parametrize("solver", SOLVERS)
 def test_observables_agree_with_positions(cpu_bin, tmp_path, solver):
-    out = simulate(cpu_bin, tmp_path / "s.h5", *FULL, "--solver", solver, "--precision", "fp32",
-                   "--velocities", "all", frames=10)
+    out = simulate(
+        cpu_bin, tmp_path / "s.h5", *FULL, "--solver", solver, "--precision", "fp32", "--velocities", "all", frames=10
+    )
     with open_trajectory(out) as t:
         obs = t.observables.set_index("step")
         for f in t.simulated:
@@ -265,14 +368,28 @@ def test_observables_agree_with_positions(cpu_bin, tmp_path, solver):
 
 # ---- harness diff and stepdiff on dynamic files -----------------------------------------------
 
+
 @pytest.fixture(scope="module")
 def reference(cpu_bin, tmp_path_factory):
     d = tmp_path_factory.mktemp("stepdiff")
     out = {}
     for precision in PRECISIONS:
         out[precision] = d / f"ref_{precision}.h5"
-        run(cpu_bin, *SIM, *SMALL, "--frames", 6, *FULL, "--precision", precision, "--velocities", "all",
-            "--output", out[precision], "--quiet")
+        run(
+            cpu_bin,
+            *SIM,
+            *SMALL,
+            "--frames",
+            6,
+            *FULL,
+            "--precision",
+            precision,
+            "--velocities",
+            "all",
+            "--output",
+            out[precision],
+            "--quiet",
+        )
     return out
 
 
@@ -282,10 +399,10 @@ def test_diff_of_dynamic_files(reference, capsys):
     assert "observables (A, B, B − A)" in text and "simulate" in text
 
 
-
 def test_diff_of_dynamic_files_with_other_physics_fails(cpu_bin, reference, tmp_path, capsys):
-    other = simulate(cpu_bin, tmp_path / "g.h5", *FULL, "--gravity", "900", "--precision", "fp64",
-                     "--velocities", "all", frames=6)
+    other = simulate(
+        cpu_bin, tmp_path / "g.h5", *FULL, "--gravity", "900", "--precision", "fp64", "--velocities", "all", frames=6
+    )
     assert harness_main(["diff", str(reference["fp64"]), str(other)]) == 1
     text = capsys.readouterr().out
     assert "note: parameters differ: gravity" in text and "NOT EQUIVALENT" in text
@@ -294,23 +411,49 @@ def test_diff_of_dynamic_files_with_other_physics_fails(cpu_bin, reference, tmp_
 
 
 def test_stepdiff_thread_counts(cpu_bin, reference, capsys):
-    code = harness_main(["stepdiff", "--reference", str(reference["fp64"]), "--binary", str(cpu_bin),
-                         "--exact", "--", "--threads", "1"])
+    code = harness_main(
+        ["stepdiff", "--reference", str(reference["fp64"]), "--binary", str(cpu_bin), "--exact", "--", "--threads", "1"]
+    )
     assert code == 0, capsys.readouterr().out
     assert "EQUIVALENT" in capsys.readouterr().out
 
 
 def test_stepdiff_fp32_with_a_tighter_rule(cpu_bin, reference, capsys):
     """fp32 against itself passes even the exact rule, one frame at a time, from frame 2 on."""
-    code = harness_main(["stepdiff", "--reference", str(reference["fp32"]), "--binary", str(cpu_bin),
-                         "--frames", "3..", "--exact", "--", "--threads", "2"])
+    code = harness_main(
+        [
+            "stepdiff",
+            "--reference",
+            str(reference["fp32"]),
+            "--binary",
+            str(cpu_bin),
+            "--frames",
+            "3..",
+            "--exact",
+            "--",
+            "--threads",
+            "2",
+        ]
+    )
     assert code == 0, capsys.readouterr().out
 
 
 def test_stepdiff_different_physics_fails(cpu_bin, reference, capsys):
     """A resumed run keeps its physics: the binary refuses the other flag (exit 2)."""
-    code = harness_main(["stepdiff", "--reference", str(reference["fp64"]), "--binary", str(cpu_bin),
-                         "--frames", "2", "--", "--gravity", "500"])
+    code = harness_main(
+        [
+            "stepdiff",
+            "--reference",
+            str(reference["fp64"]),
+            "--binary",
+            str(cpu_bin),
+            "--frames",
+            "2",
+            "--",
+            "--gravity",
+            "500",
+        ]
+    )
     assert code == 2
     assert "--gravity does not match" in capsys.readouterr().err
 
@@ -322,9 +465,9 @@ def test_stepdiff_catches_a_wrong_frame(cpu_bin, reference, tmp_path, capsys):
     bad = tmp_path / "bad.h5"
     bad.write_bytes(reference["fp64"].read_bytes())
     with open_trajectory(reference["fp64"]) as t:
-        S, I = int(t.dynamic_params["substeps"]), int(t.dynamic_params["iterations"])
+        substeps, iterations = int(t.dynamic_params["substeps"]), int(t.dynamic_params["iterations"])
         E = tolerances.extent(float(t.params["head_radius"]), float(t.params["hair_offset"]), t.hair_length)
-    limit = tolerances.DYN_STEP_K[("fp64", "fp64")] * tolerances.EPS["fp64"] * E * S * I
+    limit = tolerances.DYN_STEP_K[("fp64", "fp64")] * tolerances.EPS["fp64"] * E * substeps * iterations
     with h5py.File(bad, "r+") as f:
         v = f["particles/hair/position/value"]
         a = v[4]
@@ -337,14 +480,24 @@ def test_stepdiff_catches_a_wrong_frame(cpu_bin, reference, tmp_path, capsys):
 
 # ---- dynamic scenes and `harness run` ----------------------------------------------------------
 
+
 def test_shipped_dynamic_scenes_load():
     from harness import scenes
 
     d = scenes.load_scene("dynamic")
     assert d.model == "dynamic" and d.stages[-1] == "simulate"
     flags = d.flags()
-    for flag in ("--solver", "--substeps", "--bend-compliance", "--shape-compliance", "--wind-speed",
-                 "--gust-amplitude", "--head-motion", "--drag", "--damping"):
+    for flag in (
+        "--solver",
+        "--substeps",
+        "--bend-compliance",
+        "--shape-compliance",
+        "--wind-speed",
+        "--gust-amplitude",
+        "--head-motion",
+        "--drag",
+        "--damping",
+    ):
         assert flag in flags, flag
     assert "--no-collider" not in flags
     s = scenes.load_scene("still-dynamic").flags()
@@ -357,8 +510,7 @@ def test_shipped_dynamic_scenes_load():
 
 def test_harness_run_prints_observables(cpu_bin, tmp_path, capsys):
     out = tmp_path / "d.h5"
-    code = harness_main(["run", "dynamic", "--strands", "64", "--points", "16", "--frames", "40",
-                         "--output", str(out)])
+    code = harness_main(["run", "dynamic", "--strands", "64", "--points", "16", "--frames", "40", "--output", str(out)])
     text = capsys.readouterr().out
     assert code == 0
     assert "stretch_max" in text and "(one frame in 2 and the last" in text

@@ -2,6 +2,7 @@
 dynamic file is refused before any work with one line on stderr, exit status 2, and no
 output file (nor a temporary one) left behind; the harness reader refuses the same files in
 one line."""
+
 import h5py
 import numpy as np
 import pytest
@@ -43,8 +44,11 @@ FLAG_CASES = [
     ("motion_frequency_negative", ["--motion-frequency", "-1"], "--motion-frequency must be a finite number >= 0"),
     ("output_every_zero", ["--output-every", "0"], "--output-every must be at least 1"),
     ("velocities_unknown", ["--velocities", "some"], "--velocities must be last or all"),
-    ("flag_without_simulate", ["--stages", "init,collide", "--substeps", "2"],
-     "--substeps belongs to the simulate stage"),
+    (
+        "flag_without_simulate",
+        ["--stages", "init,collide", "--substeps", "2"],
+        "--substeps belongs to the simulate stage",
+    ),
     ("frames_without_simulate", ["--stages", "init", "--frames", "3"], "belong to the simulate stage"),
     ("motion_without_simulate", ["--stages", "init", "--head-motion", "nod"], "belongs to the simulate stage"),
     ("simulate_not_last", ["--stages", "init,simulate,collide"], "simulate may appear once, as the last stage"),
@@ -111,13 +115,17 @@ def test_damaged_dynamic_files_are_refused(cpu_bin, tmp_path, dynamic_file, kind
     assert len(err) == 1 and err[0].startswith("harness: error: cannot compare: ") and "Traceback" not in err[0]
 
 
-@pytest.mark.parametrize("args,text", [
-    (["--input-frame", "9"], "--input-frame 9"),
-    (["--input-frame", "-3"], "--input-frame must be at least 0"),
-    (["--input-frame", "3"], "has no stored velocities"),   # only the last frame has velocities
-    (["--gravity", "500"], "--gravity does not match the input file's simulation"),
-    (["--solver", "ftl"], "--solver does not match the input file's simulation"),
-], ids=["out_of_range", "negative", "no_velocities", "other_gravity", "other_solver"])
+@pytest.mark.parametrize(
+    "args,text",
+    [
+        (["--input-frame", "9"], "--input-frame 9"),
+        (["--input-frame", "-3"], "--input-frame must be at least 0"),
+        (["--input-frame", "3"], "has no stored velocities"),  # only the last frame has velocities
+        (["--gravity", "500"], "--gravity does not match the input file's simulation"),
+        (["--solver", "ftl"], "--solver does not match the input file's simulation"),
+    ],
+    ids=["out_of_range", "negative", "no_velocities", "other_gravity", "other_solver"],
+)
 def test_bad_resume_is_refused(cpu_bin, tmp_path, dynamic_file, args, text):
     out = tmp_path / "out.h5"
     p = run(cpu_bin, "--input", dynamic_file, "--stages", "simulate", *args, "--output", out, check=False)
@@ -140,38 +148,52 @@ SCENE_CASES = [
     ("frame_dt_negative", "[dynamics]\nframe_dt = -0.1", "dynamics.frame_dt must be > 0"),
     ("frame_dt_inf", "[dynamics]\nframe_dt = inf", "dynamics.frame_dt is infinite"),
     ("substep_too_short", "[dynamics]\nframe_dt = 1e-13\nsubsteps = 10", "outside [1e-12, 1e3] s"),
-    ("solver_unknown", "[dynamics]\nsolver = \"rk4\"", "dynamics.solver must be one of xpbd, ftl"),
+    ("solver_unknown", '[dynamics]\nsolver = "rk4"', "dynamics.solver must be one of xpbd, ftl"),
     ("solver_not_text", "[dynamics]\nsolver = 1", "dynamics.solver must be one of"),
     ("gravity_nan", "[dynamics]\ngravity = nan", "dynamics.gravity is NaN"),
     ("drag_negative", "[dynamics]\ndrag = -1.0", "dynamics.drag must be ≥ 0"),
-    ("damping_text", "[dynamics]\ndamping = \"lots\"", "dynamics.damping must be a number"),
+    ("damping_text", '[dynamics]\ndamping = "lots"', "dynamics.damping must be a number"),
     ("ftl_damping_above_one", "[dynamics]\nftl_damping = 1.5", "dynamics.ftl_damping must be in [0, 1]"),
     ("output_every_zero", "[dynamics]\noutput_every = 0", "dynamics.output_every must be a whole number"),
     ("dynamics_unknown", "[dynamics]\ntimestep = 1", "unknown key 'dynamics.timestep'"),
     ("bend_negative", "[constraints]\nbend_compliance = -1e-6", "constraints.bend_compliance must be ≥ 0"),
-    ("shape_range_zero", "[constraints]\nshape_compliance = 1e-4\nshape_range = 0.0",
-     "constraints.shape_range must be in (0, 1]"),
+    (
+        "shape_range_zero",
+        "[constraints]\nshape_compliance = 1e-4\nshape_range = 0.0",
+        "constraints.shape_range must be in (0, 1]",
+    ),
     ("shape_range_alone", "[constraints]\nshape_range = 0.5", "constraints.shape_range needs"),
-    ("collider_text", "[constraints]\ncollider = \"yes\"", "constraints.collider must be true or false"),
+    ("collider_text", '[constraints]\ncollider = "yes"', "constraints.collider must be true or false"),
     ("constraints_unknown", "[constraints]\nfriction = 0.1", "unknown key 'constraints.friction'"),
     ("wind_speed_negative", "[wind]\nspeed = -1.0", "wind.speed must be ≥ 0"),
     ("gust_wavelength_zero", "[wind]\ngust_wavelength = 0.0", "wind.gust_wavelength must be > 0"),
     ("gust_amplitude_inf", "[wind]\ngust_amplitude = inf", "wind.gust_amplitude is infinite"),
     ("wind_unknown", "[wind]\ngusts = 1.0", "unknown key 'wind.gusts'"),
-    ("motion_unknown", "[head]\nmotion = \"spin\"", "head.motion must be one of still, nod, shake, tilt"),
+    ("motion_unknown", '[head]\nmotion = "spin"', "head.motion must be one of still, nod, shake, tilt"),
     ("motion_amplitude_negative", "[head]\nmotion_amplitude = -0.1", "head.motion_amplitude must be ≥ 0"),
     ("dynamics_not_a_table", "dynamics = 3", "'dynamics' must be a table"),
-    ("simulate_not_last", "stages = [\"init\", \"simulate\", \"collide\"]", "must end with simulate"),
-    ("paper_with_dynamics", "model = \"paper\"\nstages = [\"init\"]\n[dynamics]\nframes = 3",
-     "table [dynamics] belongs to model = \"dynamic\""),
-    ("paper_with_wind_speed", "model = \"paper\"\nstages = [\"init\"]\n[wind]\nspeed = 1.0", "'wind.speed' belongs to model"),
-    ("paper_with_simulate", "model = \"paper\"\nstages = [\"init\", \"simulate\"]", "stage 'simulate' needs model = \"dynamic\""),
+    ("simulate_not_last", 'stages = ["init", "simulate", "collide"]', "must end with simulate"),
+    (
+        "paper_with_dynamics",
+        'model = "paper"\nstages = ["init"]\n[dynamics]\nframes = 3',
+        'table [dynamics] belongs to model = "dynamic"',
+    ),
+    (
+        "paper_with_wind_speed",
+        'model = "paper"\nstages = ["init"]\n[wind]\nspeed = 1.0',
+        "'wind.speed' belongs to model",
+    ),
+    (
+        "paper_with_simulate",
+        'model = "paper"\nstages = ["init", "simulate"]',
+        "stage 'simulate' needs model = \"dynamic\"",
+    ),
 ]
 
 
 @pytest.mark.parametrize("name,text,words", SCENE_CASES, ids=[c[0] for c in SCENE_CASES])
 def test_bad_dynamic_scene_keys_are_refused(tmp_path, capsys, name, text, words):
-    head = "" if "model =" in text else "model = \"dynamic\"\n"
+    head = "" if "model =" in text else 'model = "dynamic"\n'
     # top-level keys first, then tables (TOML puts keys after a table header inside it)
     scene = tmp_path / "s.toml"
     scene.write_text(head + text + "\n")

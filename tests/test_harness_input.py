@@ -2,15 +2,15 @@
 in one line `harness: error: …` with exit status 2, never a traceback; the binary and the
 harness agree on the stage-list rules; --seed is read in base 10; a sweep's name stays
 under results/."""
+
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
 from harness import scenes, sweepfile
 from harness.scenes import SceneError
-
-from pathlib import Path
 
 ROOT_DIR = Path(__file__).resolve().parent.parent
 
@@ -45,8 +45,9 @@ SCENES = {
 
 
 def harness(*args):
-    return subprocess.run([sys.executable, "-m", "harness", *map(str, args)], cwd=ROOT_DIR,
-                          capture_output=True, text=True, timeout=120)
+    return subprocess.run(
+        [sys.executable, "-m", "harness", *map(str, args)], cwd=ROOT_DIR, capture_output=True, text=True, timeout=120
+    )
 
 
 def one_line_refusal(p):
@@ -89,15 +90,39 @@ def test_bad_command_is_one_line():
     one_line_refusal(harness())
 
 
-STAGE_LISTS = ["init", "init,collide,wind,collide", "init,,wind", ",init", "init,", "",
-               "init,wind,init", "init,blow", "init, wind", "init,wind,wind", ",".join(["init"] + ["wind"] * 63),
-               ",".join(["init"] + ["wind"] * 64)]
+STAGE_LISTS = [
+    "init",
+    "init,collide,wind,collide",
+    "init,,wind",
+    ",init",
+    "init,",
+    "",
+    "init,wind,init",
+    "init,blow",
+    "init, wind",
+    "init,wind,wind",
+    ",".join(["init"] + ["wind"] * 63),
+    ",".join(["init"] + ["wind"] * 64),
+]
 
 
 @pytest.mark.parametrize("stages", STAGE_LISTS)
 def test_binary_and_harness_agree_on_stage_lists(cpu_bin, stages):
-    p = run(cpu_bin, "--strands", "2", "--points", "4", "--hair-length", "3", "--stages", stages,
-            "--wind-strength", "0", "--quiet", check=False)
+    p = run(
+        cpu_bin,
+        "--strands",
+        "2",
+        "--points",
+        "4",
+        "--hair-length",
+        "3",
+        "--stages",
+        stages,
+        "--wind-strength",
+        "0",
+        "--quiet",
+        check=False,
+    )
     try:
         scenes.parse_stages(stages, "test", "--stages")
         harness_ok = True
@@ -107,8 +132,21 @@ def test_binary_and_harness_agree_on_stage_lists(cpu_bin, stages):
 
 
 def test_seed_is_base_ten(cpu_bin):
-    p = run(cpu_bin, "--strands", "2", "--points", "4", "--hair-length", "3", "--stages", "init",
-            "--seed", "010", "--json", "--quiet")
+    p = run(
+        cpu_bin,
+        "--strands",
+        "2",
+        "--points",
+        "4",
+        "--hair-length",
+        "3",
+        "--stages",
+        "init",
+        "--seed",
+        "010",
+        "--json",
+        "--quiet",
+    )
     assert '"seed": 10' in p.stdout
     p = run(cpu_bin, "--seed", "0x10", check=False)
     assert p.returncode == 2 and "--seed needs a whole number" in p.stderr

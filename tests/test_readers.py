@@ -2,6 +2,7 @@
 H5MD reader, and the `harness export` sidecars read back by VTK's XDMF reader (ParaView,
 VisIt) and by pxr (USD: Blender, Houdini, usdview), compared bit for bit. The readers are
 optional: each test skips, with the reason, where its package is absent."""
+
 import subprocess
 import sys
 import warnings
@@ -77,9 +78,11 @@ def test_mdanalysis_without_centimetres_names_the_unit(state):
     """Documents the upstream gap: until MDAnalysis knows 'cm', it names the unit and stops
     (a fresh interpreter: the test above taught this one)."""
     pytest.importorskip("MDAnalysis", reason="MDAnalysis not installed (pip install MDAnalysis)")
-    code = ("import sys, warnings; warnings.simplefilter('ignore')\n"
-            "from MDAnalysis.coordinates.H5MD import H5MDReader\n"
-            "try:\n    H5MDReader(sys.argv[1])\nexcept RuntimeError as e:\n    print(e); sys.exit(3)\n")
+    code = (
+        "import sys, warnings; warnings.simplefilter('ignore')\n"
+        "from MDAnalysis.coordinates.H5MD import H5MDReader\n"
+        "try:\n    H5MDReader(sys.argv[1])\nexcept RuntimeError as e:\n    print(e); sys.exit(3)\n"
+    )
     p = subprocess.run([sys.executable, "-c", code, str(state)], capture_output=True, text=True)
     if p.returncode == 0:
         pytest.skip("this MDAnalysis reads 'cm' with its defaults: drop the shim in the test above")
@@ -87,8 +90,9 @@ def test_mdanalysis_without_centimetres_names_the_unit(state):
 
 
 def export(state, *args):
-    p = subprocess.run([sys.executable, "-m", "harness", "export", str(state), *args], cwd=ROOT_DIR,
-                       capture_output=True, text=True)
+    p = subprocess.run(
+        [sys.executable, "-m", "harness", "export", str(state), *args], cwd=ROOT_DIR, capture_output=True, text=True
+    )
     assert p.returncode == 0, p.stderr
     return p
 
@@ -117,8 +121,10 @@ def test_xdmf_opens_in_vtk_as_polylines_over_time(state):
         r.UpdateTimeStep(t)
         grid = r.GetOutputDataObject(0)
         assert grid.GetNumberOfCells() == n_rows // p
-        assert all(grid.GetCellType(c) == 4 and grid.GetCell(c).GetNumberOfPoints() == p  # VTK_POLY_LINE
-                   for c in range(grid.GetNumberOfCells()))
+        assert all(
+            grid.GetCellType(c) == 4 and grid.GetCell(c).GetNumberOfPoints() == p  # VTK_POLY_LINE
+            for c in range(grid.GetNumberOfCells())
+        )
         pts = vtk_to_numpy(grid.GetPoints().GetData())
         assert pts.dtype == ref.dtype and pts.tobytes() == ref[k].tobytes(), k
         strand = vtk_to_numpy(grid.GetPointData().GetArray("strand"))
@@ -147,8 +153,9 @@ def test_usd_basis_curves_one_sample_per_frame(state):
 def test_export_refuses_what_is_not_a_state(tmp_path):
     bad = tmp_path / "x.h5"
     bad.write_text("not hdf5")
-    p = subprocess.run([sys.executable, "-m", "harness", "export", str(bad)], cwd=ROOT_DIR,
-                       capture_output=True, text=True)
+    p = subprocess.run(
+        [sys.executable, "-m", "harness", "export", str(bad)], cwd=ROOT_DIR, capture_output=True, text=True
+    )
     assert p.returncode == 2 and p.stderr.count("\n") == 1 and p.stderr.startswith("harness: error: export:")
 
 
@@ -159,8 +166,9 @@ def test_export_refuses_a_symlinked_target(state, tmp_path):
     link.unlink(missing_ok=True)
     link.symlink_to(target)
     try:
-        p = subprocess.run([sys.executable, "-m", "harness", "export", str(state)], cwd=ROOT_DIR,
-                           capture_output=True, text=True)
+        p = subprocess.run(
+            [sys.executable, "-m", "harness", "export", str(state)], cwd=ROOT_DIR, capture_output=True, text=True
+        )
         assert p.returncode == 2 and "symbolic link" in p.stderr and target.read_text() == "keep"
         assert not [q for q in Path(state).parent.iterdir() if ".tmp" in q.name]
     finally:

@@ -1,14 +1,14 @@
 """Writes that cannot hurt (docs/interfaces.md, "Writing the output"): an --output that is
 not a regular file is refused even with --force, a signalled run leaves no temporary file
 and exits non-zero, and the next run into a directory removes the temporaries of dead runs."""
+
 import os
 import signal
 import subprocess
 import time
+from pathlib import Path
 
 import pytest
-
-from pathlib import Path
 
 ROOT_DIR = Path(__file__).resolve().parent.parent
 
@@ -21,7 +21,6 @@ def run(binary, *args, check=True):
 
 def tmp_leftovers(directory):
     return sorted(p.name for p in Path(directory).iterdir() if ".tmp." in p.name)
-
 
 
 SMALL = ["--strands", "20", "--points", "8", "--hair-length", "5", "--quiet"]
@@ -77,9 +76,23 @@ def _wait_for_tmp(directory, proc, timeout=60):
 def test_signal_removes_the_temporary(cpu_bin, tmp_path, sig):
     out = tmp_path / "big.h5"
     # large enough that the run is still writing frames when the signal comes
-    proc = subprocess.Popen([str(cpu_bin), "--strands", "2000000", "--points", "32", "--threads", "1",
-                             "--stages", "init,collide,wind,collide,wind,collide,wind,collide",
-                             "--output", str(out), "--quiet"], stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        [
+            str(cpu_bin),
+            "--strands",
+            "2000000",
+            "--points",
+            "32",
+            "--threads",
+            "1",
+            "--stages",
+            "init,collide,wind,collide,wind,collide,wind,collide",
+            "--output",
+            str(out),
+            "--quiet",
+        ],
+        stderr=subprocess.PIPE,
+    )
     try:
         assert _wait_for_tmp(tmp_path, proc), "the run ended before its temporary file appeared"
         proc.send_signal(sig)
@@ -100,7 +113,7 @@ def test_stale_temporaries_of_dead_runs_are_removed(cpu_bin, tmp_path):
     pid = p.pid
     (tmp_path / f"old.h5.tmp.{pid}").write_bytes(HDF5_SIGNATURE + b"rest")
     (tmp_path / f"empty.h5.tmp.{pid}").write_bytes(b"")
-    (tmp_path / f"notes.txt.tmp.{pid}").write_text("not ours")          # not HDF5: kept
+    (tmp_path / f"notes.txt.tmp.{pid}").write_text("not ours")  # not HDF5: kept
     (tmp_path / f"alive.h5.tmp.{os.getpid()}").write_bytes(HDF5_SIGNATURE)  # live pid: kept
     r = run(cpu_bin, *SMALL, "--output", tmp_path / "new.h5")
     notes = [line for line in r.stderr.splitlines() if "stale temporary" in line]

@@ -2,6 +2,7 @@
 packages importable it installs nothing (machines without a network), and with them
 missing it installs requirements.lock — here into a throw-away copy, against a PyPI that
 cannot be reached, so it must stop with one line saying what to run."""
+
 import os
 import shutil
 import subprocess
@@ -11,8 +12,12 @@ from pathlib import Path
 import pytest
 
 ROOT_DIR = Path(__file__).resolve().parent.parent
-NO_NETWORK = {"PIP_INDEX_URL": "http://127.0.0.1:9/simple", "http_proxy": "http://127.0.0.1:9",
-              "https_proxy": "http://127.0.0.1:9", "PIP_CONFIG_FILE": os.devnull}
+NO_NETWORK = {
+    "PIP_INDEX_URL": "http://127.0.0.1:9/simple",
+    "http_proxy": "http://127.0.0.1:9",
+    "https_proxy": "http://127.0.0.1:9",
+    "PIP_CONFIG_FILE": os.devnull,
+}
 
 
 def copy_of_repo(tmp_path):
@@ -27,8 +32,14 @@ def copy_of_repo(tmp_path):
 def setup(root, python, **env):
     e = {k: v for k, v in os.environ.items() if k != "HAIRBENCH_READERS"}
     e.update(NO_NETWORK, PYTHON=str(python), **env)
-    return subprocess.run(["bash", str(root / "tools" / "setup.sh"), "build/python"], cwd=root, env=e,
-                          capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        ["bash", str(root / "tools" / "setup.sh"), "build/python"],
+        cwd=root,
+        env=e,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 def test_lock_pins_exact_versions():
