@@ -186,6 +186,27 @@ def cmd_export(args):
     return 0
 
 
+def cmd_featurecost(args):
+    from . import featurecost, featurecost_report
+
+    rows = featurecost.measure(
+        scene_ref=args.scene,
+        backend=args.backend,
+        build=args.build,
+        variant=args.variant,
+        strands=args.strands,
+        points=args.points,
+        frames=args.frames,
+        repeat=args.repeat,
+        threads=args.threads,
+        block_size=args.block_size,
+        out=args.out,
+        timeout=args.timeout,
+    )
+    print(featurecost_report.markdown(rows), end="")
+    return 0
+
+
 def cmd_calibrate(args):
     from . import calibrate
 
@@ -401,6 +422,27 @@ def parser():
     )
     c.add_argument("--json", action="store_true")
     c.set_defaults(func=cmd_calibrate)
+
+    fc = sub.add_parser(
+        "featurecost",
+        help="the dynamic model's time per frame with each feature undeclared, alone, and the full scene",
+        description="Run a dynamic scene with every feature undeclared, each alone, the full scene "
+        "less each, and the full scene (features are removed by their flags, so the binary compiles "
+        "them out); print a Markdown table and, with --out, write the rows as CSV.",
+    )
+    fc.add_argument("--scene", default="dynamic", help="a dynamic scene (default dynamic)")
+    fc.add_argument("--backend", choices=("cpu", "cuda"), default="cpu")
+    fc.add_argument("--build", default="default", help="cuda build: default | strict | fastmath")
+    fc.add_argument("--variant", default=None)
+    fc.add_argument("--strands", type=whole(1), default=100_000)
+    fc.add_argument("--points", type=whole(2), default=None)
+    fc.add_argument("--frames", type=whole(1), default=3, help="frames per case (default 3)")
+    fc.add_argument("--repeat", type=whole(1), default=3, help="timed repeats of each frame (default 3)")
+    fc.add_argument("--threads", type=whole(1), default=None, help="cpu threads (default: all cores)")
+    fc.add_argument("--block-size", type=whole(32), default=None)
+    fc.add_argument("--timeout", type=seconds, default=None)
+    fc.add_argument("--out", default=None, help="CSV file to write")
+    fc.set_defaults(func=cmd_featurecost)
     return p
 
 
