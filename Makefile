@@ -47,11 +47,12 @@ CFLAGS_REF := $(CSTD) $(COPT) -ffp-contract=off -fno-fast-math $(CWARN)
 # The simd variant's file only (docs/cpu_simd.md): AVX2 code checked for at run time, glibc's
 # vector math, and of -ffast-math's flags only the two that change no value.
 SIMD_CFLAGS := -O3 -march=x86-64-v3 -fopenmp-simd -fno-math-errno -fno-trapping-math
-CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (model_simd.c) adds: $(SIMD_CFLAGS)
+CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (model_simd.c, dynamics_simd.c) adds: $(SIMD_CFLAGS)
 
-SHARED_SRC := c_ref/params.c c_ref/cli.c c_ref/state_io.c c_ref/record.c c_ref/driver.c c_ref/dynamics_host.c c_ref/host.c
+SHARED_SRC := c_ref/params.c c_ref/cli.c c_ref/state_io.c c_ref/safe_write.c c_ref/h5md_meta.c c_ref/record.c \
+              c_ref/driver.c c_ref/dynamics_host.c c_ref/host.c
 SHARED_OBJ := $(SHARED_SRC:c_ref/%.c=$(OBJ)/%.o)
-CPU_SRC    := c_ref/model.c c_ref/model_simd.c c_ref/dynamics_f32.c c_ref/dynamics_f64.c c_ref/backend_cpu.c
+CPU_SRC    := c_ref/model.c c_ref/model_simd.c c_ref/dynamics_simd.c c_ref/dynamics_f32.c c_ref/dynamics_f64.c c_ref/backend_cpu.c
 CPU_OBJ    := $(CPU_SRC:c_ref/%.c=$(OBJ)/%.o)
 C_HEADERS  := $(wildcard c_ref/*.h)
 
@@ -65,7 +66,12 @@ NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
 
-.PHONY: all cpu cuda test bench report help clean check-python check-hdf5 sanitize sanitize-gpu
+.PHONY: all cpu cuda test bench report help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt
+
+# The Python that runs the tests and the harness: harness/setup.sh picks it (PYTHON when it has
+# the packages, else ./.venv) after installing what is missing, and writes its path here.
+PY_FILE := $(BUILD)/python
+RUN_PY   = "$$(cat $(PY_FILE))"
 
 all: cpu cuda
 
@@ -78,23 +84,28 @@ help:
 	@echo "make report   rebuild report/ from results/default (REPORT_FROM=results/reference-h200/sweep for the committed H200 run)"
 	@echo "make sanitize build the C reference with ASan+UBSan and run the CPU tests under it"
 	@echo "make sanitize-gpu  compute-sanitizer memcheck + racecheck over every CUDA variant (GPU node)"
+	@echo "make lint     ruff check, ruff format --check, mypy (lint-py) and clang-format --dry-run (lint-c)"
+	@echo "make fmt      ruff format the Python and clang-format -i the C and CUDA sources"
+	@echo "make setup    install what is missing (apt as root/sudo, pip into .venv under PEP 668); nothing when all is there"
 	@echo "make clean    remove build/"
 
 check-hdf5:
 	@echo '#include <hdf5.h>' | $(CC) $(HDF5_CFLAGS) -E -x c - >/dev/null 2>&1 || { \
 	  echo "error: the HDF5 C library is missing (hdf5.h not found): install it, e.g. 'sudo apt-get install libhdf5-dev hdf5-tools'"; exit 1; }
 
-check-python:
-	@for m in h5py numpy pandas matplotlib pytest hypothesis; do \
-	  $(PYTHON) -c "import $$m" 2>/dev/null || { \
-	    echo "error: the Python package '$$m' is missing for $(PYTHON): run '$(PYTHON) -m pip install -r requirements.txt'"; exit 1; }; \
-	done
+# Set-up: system packages (apt, as root or with sudo) and the Python packages (pip, into
+# .venv under PEP 668) when missing; nothing is installed when all are there.
+setup:
+	@PYTHON="$(PYTHON)" CC="$(CC)" harness/setup.sh $(PY_FILE)
+
+check-python: setup
 
 $(OBJ)/%.o: c_ref/%.c $(C_HEADERS) | check-hdf5
 	@mkdir -p $(OBJ)
 	$(CC) $(CFLAGS_REF) -fopenmp $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' -DHB_FLAGS='"$(CPU_FLAGS_STR)"' -c $< -o $@
 
 $(OBJ)/model_simd.o: CFLAGS_REF += $(SIMD_CFLAGS)
+$(OBJ)/dynamics_simd.o: CFLAGS_REF += $(SIMD_CFLAGS)
 $(OBJ)/record.o: $(REV_STAMP)
 
 $(BUILD)/hairsim-cpu: $(SHARED_OBJ) $(CPU_OBJ)
@@ -117,22 +128,25 @@ cuda:
 	@echo "note: nvcc not found: CUDA binaries not built (install the CUDA toolkit to build them)"
 endif
 
-test: check-python all
-	$(PYTHON) -m pytest tests -q -ra
+# setup runs first, then the build (a recursive make, so that -j cannot build before it)
+test: setup
+	@$(MAKE) --no-print-directory all
+	$(RUN_PY) -m pytest tests -q -ra
 
-bench: check-python all
-	$(PYTHON) -m harness bench $(if $(OUT),--out $(OUT))
+bench: setup
+	@$(MAKE) --no-print-directory all
+	$(RUN_PY) -m harness bench $(if $(OUT),--out $(OUT))
 
 # REPORT_FROM: the results to render (default results/default; the committed reference run
 # from an H200 is results/reference-h200/sweep)
-report: check-python
-	$(PYTHON) -m harness report $(REPORT_FROM)
+report: setup
+	$(RUN_PY) -m harness report $(REPORT_FROM)
 
 # ASan + UBSan over the C reference: a separate build in build/asan, the C tests run on it.
-sanitize: check-python check-hdf5
+sanitize: setup check-hdf5
 	$(MAKE) BUILD=build/asan COPT="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" \
 	  CC="$(CC) -fsanitize=address,undefined" build/asan/hairsim-cpu
-	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(PYTHON) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume"
+	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(RUN_PY) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume"
 
 # compute-sanitizer (memcheck, racecheck) over every CUDA variant on a small run that also
 # exercises the output, resume and end-to-end paths, and simulate on the strand and warp
@@ -144,7 +158,7 @@ SAN_SIM := --strands 300 --points 45 --hair-length 10 --stages init,simulate --f
   --gust-amplitude 0.5 --head-motion nod --quiet
 sanitize-gpu: cuda
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
-	@set -e; for v in paper soa fused; do for p in fp32 fp64; do \
+	@set -e; for v in $$($(PYTHON) -c "from harness import variants; print(*variants.names('cuda'))"); do for p in fp32 fp64; do \
 	  echo "memcheck $$v $$p"; \
 	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_RUN) \
 	    --variant $$v --precision $$p --output $(BUILD)/san-$$v-$$p.h5 --force; \
@@ -165,6 +179,26 @@ sanitize-gpu: cuda
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --variant $$v --frames 1; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --variant $$v --frames 1 --solver ftl; \
 	done; rm -f $(BUILD)/san-*.h5; echo "compute-sanitizer: memcheck and racecheck found no errors in any variant"
+
+# ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----
+PY_SRC     := harness tests
+C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*.h cuda/*.cu cuda/*.cuh)
+CLANG_FORMAT ?= clang-format
+
+lint: lint-py lint-c
+
+lint-py: setup
+	@$(RUN_PY) -c "import ruff, mypy" 2>/dev/null || $(RUN_PY) -m pip install -q --disable-pip-version-check -r requirements-dev.txt
+	$(RUN_PY) -m ruff check $(PY_SRC)
+	$(RUN_PY) -m ruff format --check $(PY_SRC)
+	$(RUN_PY) -m mypy
+
+lint-c:
+	$(CLANG_FORMAT) --dry-run --Werror $(C_FMT_SRC)
+
+fmt:
+	$(PYTHON) -m ruff format $(PY_SRC)
+	$(CLANG_FORMAT) -i $(C_FMT_SRC)
 
 clean:
 	rm -rf $(BUILD)

@@ -19,6 +19,7 @@
 #include "backend.h"
 #include "cli.h"
 #include "dynamics.h"
+#include "dynamics_simd.h"
 #include "host.h"
 #include "model.h"
 #include "model_simd.h"
@@ -42,6 +43,8 @@ typedef struct {
     void *vel, *vel_saved, *rest, *bend_rest;
     hb_dyn_model_f32 d32;
     hb_dyn_model_f64 d64;
+    /* simulate (simd): velocities, saved velocities, rest shape as [P][stride], bend rest [P−2][stride] */
+    void *pv[3], *pv_saved[3], *pr[3], *pb;
 } cpu_impl;
 
 
@@ -162,6 +165,9 @@ static void pm_copy(cpu_impl *c, void *const dst[3], void *const src[3])
             }
 }
 
+static uint64_t simd_dyn_bytes(const cpu_impl *c, uint64_t one, int need_save);
+static int simd_dyn_setup(cpu_impl *c, int need_save, uint64_t need, char *err, size_t errlen);
+
 static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t driver_bytes, char *err,
                       size_t errlen)
 {
@@ -184,10 +190,12 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
     /* 3 arrays of P × stride reals; no overflow: stride < N + block and the canonical
      * state of N strands fits in uint64 (hb_state_bytes) */
     const uint64_t one = (uint64_t)s->points * (uint64_t)c->stride * rs;
-    uint64_t need = 3u * one * (need_save ? 2u : 1u) + driver_bytes;
+    for (int i = 0; i < o->n_stages; i++) c->dynamic |= o->stages[i] == HB_STAGE_SIMULATE;
+    const uint64_t dyn = c->dynamic ? simd_dyn_bytes(c, one, need_save) : 0;
+    uint64_t need = 3u * one * (need_save ? 2u : 1u) + dyn + driver_bytes;
     uint64_t avail = hb_host_memory_available();
     if ((avail && need > avail) || one > SIZE_MAX / 4) {
-        hb_memory_message(err, errlen, s, "host", need, avail, ", simd", NULL);
+        hb_memory_message(err, errlen, s, "host", need, avail, c->dynamic ? ", simd, simulate" : ", simd", NULL);
         return HB_EXIT_MEMORY;
     }
     c->pm_bytes = (size_t)one;
@@ -201,6 +209,7 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
     }
     pm_first_touch(c, c->pm);
     if (need_save) pm_first_touch(c, c->pm_saved);
+    if (c->dynamic) return simd_dyn_setup(c, need_save, need, err, errlen);
     return HB_EXIT_OK;
 }
 
@@ -288,6 +297,177 @@ static int64_t simd_run_stage(cpu_impl *c, hb_stage st)
     return moved;
 }
 
+/* ---- the simd variant: the dynamic model (docs/cpu_simd.md, "The dynamic model") ------ */
+
+/* Bytes simulate adds: velocities (and their saved copy), the rest shape, bend rest lengths. */
+static uint64_t simd_dyn_bytes(const cpu_impl *c, uint64_t one, int need_save)
+{
+    const int64_t rows = c->scene.points - 2 > 0 ? c->scene.points - 2 : 1;
+    return 3u * one * (need_save ? 3u : 2u) + (uint64_t)rows * (uint64_t)c->stride * hb_real_size(c->scene.precision);
+}
+
+static int simd_dyn_setup(cpu_impl *c, int need_save, uint64_t need, char *err, size_t errlen)
+{
+    const int64_t rows = c->scene.points - 2 > 0 ? c->scene.points - 2 : 1;
+    int bad = 0;
+    for (int d = 0; d < 3; d++) {
+        c->pv[d] = pm_alloc(c->pm_bytes);
+        c->pr[d] = pm_alloc(c->pm_bytes);
+        if (need_save) c->pv_saved[d] = pm_alloc(c->pm_bytes);
+        bad |= !c->pv[d] || !c->pr[d] || (need_save && !c->pv_saved[d]);
+    }
+    c->pb = pm_alloc((size_t)rows * (size_t)c->stride * hb_real_size(c->scene.precision));
+    if (bad || !c->pb) {
+        snprintf(err, errlen, "cannot allocate %.2f GB of host memory for the state", 1e-9 * (double)need);
+        return HB_EXIT_MEMORY;
+    }
+    pm_first_touch(c, c->pv);
+    pm_first_touch(c, c->pr);
+    if (need_save) pm_first_touch(c, c->pv_saved);
+    hb_dyn_round(&c->scene, &c->d32, &c->d64);
+    return HB_EXIT_OK;
+}
+
+/* canonical [N][P][3] ↔ a[0..2] as [P][stride] (simd_convert for any three arrays) */
+#define PM_CONVERT_ARRAYS(T, TO_PM)                                                            \
+    do {                                                                                       \
+        T *X = a[0], *Y = a[1], *Z = a[2];                                                     \
+        T *cs = (T *)canonical;                                                                \
+        _Pragma("omp parallel for schedule(static)")                                           \
+        for (int64_t blk = 0; blk < c->nblocks; blk++) {                                       \
+            const int64_t i1 = (blk + 1) * c->block < N ? (blk + 1) * c->block : N;            \
+            for (int64_t i = blk * c->block; i < i1; i++) {                                    \
+                T *q = cs + (size_t)i * (size_t)P * 3u;                                        \
+                for (int64_t k = 0; k < P; k++) {                                              \
+                    const size_t e = (size_t)k * (size_t)S + (size_t)i;                       \
+                    if (TO_PM) {                                                               \
+                        X[e] = q[3 * k + 0];                                                   \
+                        Y[e] = q[3 * k + 1];                                                   \
+                        Z[e] = q[3 * k + 2];                                                   \
+                    } else {                                                                   \
+                        q[3 * k + 0] = X[e];                                                   \
+                        q[3 * k + 1] = Y[e];                                                   \
+                        q[3 * k + 2] = Z[e];                                                   \
+                    }                                                                          \
+                }                                                                              \
+            }                                                                                  \
+        }                                                                                      \
+    } while (0)
+
+static void simd_dyn_convert(cpu_impl *c, void *const a[3], void *canonical, int to_pm)
+{
+    const int64_t N = c->scene.n_strands, P = c->scene.points, S = c->stride;
+    if (c->scene.precision == HB_FP32) {
+        if (to_pm) PM_CONVERT_ARRAYS(float, 1);
+        else PM_CONVERT_ARRAYS(float, 0);
+    } else {
+        if (to_pm) PM_CONVERT_ARRAYS(double, 1);
+        else PM_CONVERT_ARRAYS(double, 0);
+    }
+}
+#undef PM_CONVERT_ARRAYS
+
+/* Velocities (zero without) and the rest shape to point-major, then the bend rest lengths:
+ * outside the timed frames, as positions are in load. Padding lanes keep their zeros. */
+static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
+{
+    if (velocity) simd_dyn_convert(c, c->pv, (void *)velocity, 1);
+    else pm_first_touch(c, c->pv);
+    simd_dyn_convert(c, c->pr, (void *)rest, 1);
+    const int64_t DB = HB_SIMD_DYN_BLOCK, nb = c->stride / HB_SIMD_DYN_BLOCK, S = c->stride;
+    if (c->scene.precision == HB_FP32) {
+        const float *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2];
+        float *BR = c->pb;
+#pragma omp parallel for schedule(static)
+        for (int64_t b = 0; b < nb; b++)
+            hb_simd_dyn_bend_rest_block_f32(&c->d32, RX + b * DB, RY + b * DB, RZ + b * DB, BR + b * DB, S);
+    } else {
+        const double *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2];
+        double *BR = c->pb;
+#pragma omp parallel for schedule(static)
+        for (int64_t b = 0; b < nb; b++)
+            hb_simd_dyn_bend_rest_block_f64(&c->d64, RX + b * DB, RY + b * DB, RZ + b * DB, BR + b * DB, S);
+    }
+    return 0;
+}
+
+/* Dynamic blocks over threads (static schedule: the bits do not depend on it); each
+ * thread's block scratch (hb_simd_dyn_scratch_reals) is its own. */
+#define SIMD_DYN_FRAME(T, SFX, M)                                                               \
+    do {                                                                                        \
+        T *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2], *VX = c->pv[0], *VY = c->pv[1], *VZ = c->pv[2]; \
+        const T *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2], *BR = c->pb;                    \
+        _Pragma("omp parallel")                                                                 \
+        {                                                                                       \
+            T *scratch = aligned_alloc(64, ((size_t)hb_simd_dyn_scratch_reals(P) * sizeof(T) + 63) / 64 * 64); \
+            if (!scratch) {                                                                     \
+                _Pragma("omp atomic write") failed = 1;                                         \
+            } else {                                                                            \
+                _Pragma("omp for schedule(static)")                                             \
+                for (int64_t b = 0; b < nb; b++) {                                              \
+                    const int64_t o = b * DB;                                                   \
+                    hb_simd_dyn_frame_block_##SFX(M, f, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, \
+                                                  RY + o, RZ + o, BR + o, S, scratch);          \
+                }                                                                               \
+                free(scratch);                                                                  \
+            }                                                                                   \
+        }                                                                                       \
+    } while (0)
+
+static int simd_dyn_frame(cpu_impl *c, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen)
+{
+    const int64_t P = c->scene.points, DB = HB_SIMD_DYN_BLOCK, nb = c->stride / HB_SIMD_DYN_BLOCK, S = c->stride;
+    int failed = 0;
+    const double t0 = hb_now_ms();
+    if (c->scene.precision == HB_FP32) SIMD_DYN_FRAME(float, f32, &c->d32);
+    else SIMD_DYN_FRAME(double, f64, &c->d64);
+    r->ms = hb_now_ms() - t0;
+    r->moved_points = -1;
+    r->consumed = 1;
+    if (failed) {
+        snprintf(err, errlen, "out of host memory for the per-thread block scratch (%lld points)", (long long)P);
+        return -1;
+    }
+    return 0;
+}
+#undef SIMD_DYN_FRAME
+
+/* Per-strand partials, the same bits as ref's, combined over the same fixed chunks of
+ * SIMD_OBS_CHUNK (= OBS_CHUNK below) strands in the same order: ref's observables. */
+#define SIMD_OBS_CHUNK 1024
+
+static int simd_dyn_observe(cpu_impl *c, hb_observables *obs, char *err, size_t errlen)
+{
+    const int64_t N = c->scene.n_strands, P = c->scene.points, S = c->stride;
+    const int64_t nchunks = (N + SIMD_OBS_CHUNK - 1) / SIMD_OBS_CHUNK;
+    hb_obs_partial *part = calloc((size_t)nchunks, sizeof *part);
+    hb_obs_partial *strand = malloc((size_t)N * sizeof *strand);
+    if (!part || !strand) {
+        free(part);
+        free(strand);
+        snprintf(err, errlen, "out of host memory for the observables");
+        return -1;
+    }
+#pragma omp parallel for schedule(static)
+    for (int64_t ch = 0; ch < nchunks; ch++) {
+        const int64_t i0 = ch * SIMD_OBS_CHUNK, i1 = i0 + SIMD_OBS_CHUNK < N ? i0 + SIMD_OBS_CHUNK : N;
+        if (c->scene.precision == HB_FP32)
+            hb_simd_dyn_observe_f32(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0,
+                                    i1 - i0, strand + i0);
+        else
+            hb_simd_dyn_observe_f64(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0,
+                                    i1 - i0, strand + i0);
+        hb_obs_partial acc = {0, 0, 0, 0};
+        for (int64_t i = i0; i < i1; i++) hb_dyn_reduce_into(&acc, &strand[i]);
+        part[ch] = acc;
+    }
+    hb_dyn_reduce(part, nchunks, P, N, obs);
+    free(part);
+    free(strand);
+    return 0;
+}
+#undef SIMD_OBS_CHUNK
+
 /* ---- the backend interface ----------------------------------------------------------- */
 
 static int cpu_load(hb_backend *b, const void *canonical, double *ms, char *err, size_t errlen)
@@ -326,6 +506,7 @@ static int cpu_save(hb_backend *b, char *err, size_t errlen)
     cpu_impl *c = b->impl;
     if (c->simd) pm_copy(c, c->pm_saved, c->pm);
     else memcpy(c->saved, c->state, c->bytes);
+    if (c->pv_saved[0]) pm_copy(c, c->pv_saved, c->pv);
     if (c->vel_saved) memcpy(c->vel_saved, c->vel, c->bytes);
     return 0;
 }
@@ -336,6 +517,7 @@ static int cpu_restore(hb_backend *b, char *err, size_t errlen)
     cpu_impl *c = b->impl;
     if (c->simd) pm_copy(c, c->pm, c->pm_saved);
     else memcpy(c->state, c->saved, c->bytes);
+    if (c->pv_saved[0]) pm_copy(c, c->pv, c->pv_saved);
     if (c->vel_saved) memcpy(c->vel, c->vel_saved, c->bytes);
     return 0;
 }
@@ -392,6 +574,7 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
 {
     (void)err; (void)errlen;
     cpu_impl *c = b->impl;
+    if (c->simd) return simd_dyn_load(c, velocity, rest);
     const int64_t N = c->scene.n_strands, P = c->scene.points;
     const size_t stride = (size_t)P * 3u, bstride = (size_t)(P - 2 > 0 ? P - 2 : 0);
     if (velocity) memcpy(c->vel, velocity, c->bytes);
@@ -429,6 +612,7 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
 static int cpu_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen)
 {
     cpu_impl *c = b->impl;
+    if (c->simd) return simd_dyn_frame(c, f, r, err, errlen);
     const int64_t N = c->scene.n_strands, P = c->scene.points;
     const size_t stride = (size_t)P * 3u, bstride = (size_t)(P - 2 > 0 ? P - 2 : 0);
     int failed = 0;
@@ -453,6 +637,7 @@ static int cpu_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *
 static int cpu_dyn_observe(hb_backend *b, hb_observables *obs, char *err, size_t errlen)
 {
     cpu_impl *c = b->impl;
+    if (c->simd) return simd_dyn_observe(c, obs, err, errlen);
     const int64_t N = c->scene.n_strands, P = c->scene.points;
     const size_t stride = (size_t)P * 3u;
     const int64_t nchunks = (N + OBS_CHUNK - 1) / OBS_CHUNK;
@@ -486,6 +671,10 @@ static int cpu_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, siz
 {
     (void)err; (void)errlen;
     cpu_impl *c = b->impl;
+    if (c->simd) {
+        simd_dyn_convert(c, c->pv, canonical, 0);
+        return 0;
+    }
     memcpy(canonical, c->vel, c->bytes);
     return 0;
 }
@@ -588,15 +777,19 @@ static void cpu_teardown(hb_backend *b)
     for (int d = 0; d < 3; d++) {
         free(c->pm[d]);
         free(c->pm_saved[d]);
+        free(c->pv[d]);
+        free(c->pv_saved[d]);
+        free(c->pr[d]);
     }
+    free(c->pb);
     free(c);
     b->impl = NULL;
 }
 
 #define CPU_PAPER_STAGES ((1u << HB_STAGE_INIT) | (1u << HB_STAGE_COLLIDE) | (1u << HB_STAGE_WIND))
 static const hb_variant cpu_variants[] = {
-    {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE), "the oracle: model_impl.h one strand at a time, OpenMP over strands"},
-    {"simd", CPU_PAPER_STAGES, "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks"},
+    {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE), "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands"},
+    {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE), "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks"},
     {NULL, 0, NULL},
 };
 

@@ -171,7 +171,7 @@ static int parse_u64(const char *flag, const char *v, uint64_t *out, char *err, 
     char *end;
     errno = 0;
     if (v[0] == '-') FAIL("%s needs a non-negative whole number (got '%s')", flag, v);
-    unsigned long long x = strtoull(v, &end, 0);
+    unsigned long long x = strtoull(v, &end, 10); /* base 10: 010 is ten */
     if (end == v || *end != '\0') FAIL("%s needs a whole number (got '%s')", flag, v);
     if (errno == ERANGE) FAIL("%s is out of range (got '%s')", flag, v);
     *out = x;
@@ -194,9 +194,23 @@ static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err
     char *base = (char *)&o->scene.dyn;
     int64_t iv;
     switch (df->kind) {
-    case DF_REAL:
-        if (parse_f64(df->flag, v, (double *)(base + df->offset), err, errlen)) return -1;
+    case DF_REAL: {
+        /* a ratio "a/b" is taken as a / b in double (e.g. --frame-dt 1/60) */
+        const char *slash = strchr(v, '/');
+        if (slash && slash != v) {
+            char num[64];
+            double a, b2;
+            if ((size_t)(slash - v) >= sizeof num) FAIL("%s needs a number (got '%s')", df->flag, v);
+            memcpy(num, v, (size_t)(slash - v));
+            num[slash - v] = '\0';
+            if (parse_f64(df->flag, num, &a, err, errlen) || parse_f64(df->flag, slash + 1, &b2, err, errlen)) return -1;
+            if (b2 == 0.0) FAIL("%s: division by zero in '%s'", df->flag, v);
+            *(double *)(base + df->offset) = a / b2;
+        } else if (parse_f64(df->flag, v, (double *)(base + df->offset), err, errlen)) {
+            return -1;
+        }
         break;
+    }
     case DF_COUNT:
         if (parse_i64(df->flag, v, 1, &iv, err, errlen)) return -1;
         *(int64_t *)(base + df->offset) = iv;
@@ -226,6 +240,7 @@ static int parse_stages(const char *v, hb_options *o, char *err, size_t errlen)
     char buf[1024];
     if (strlen(v) >= sizeof buf) FAIL("--stages is too long");
     strcpy(buf, v);
+    if (hb_stage_list_has_empty_item(v)) FAIL("--stages: empty item in '%s' (write e.g. init,collide,wind)", v);
     o->n_stages = 0;
     char *save = NULL;
     for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
@@ -236,6 +251,7 @@ static int parse_stages(const char *v, hb_options *o, char *err, size_t errlen)
         else if (strcmp(tok, "simulate") == 0) s = HB_STAGE_SIMULATE;
         else FAIL("--stages: unknown stage '%s' (known: init, collide, wind, simulate)", tok);
         if (o->n_stages == HB_MAX_STAGES) FAIL("--stages: at most %d stages", HB_MAX_STAGES);
+        if (s == HB_STAGE_INIT && o->n_stages > 0) FAIL("--stages: init may only come first (it would replace the state)");
         o->stages[o->n_stages++] = s;
     }
     if (o->n_stages == 0) FAIL("--stages needs at least one stage");
@@ -392,4 +408,12 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
     if (o->scene.dyn.shape == 0 && (o->dyn_given & (1ull << hb_dyn_flag_index("--shape-range"))))
         FAIL("--shape-range needs --shape-compliance (shape is off unless its compliance is given)");
     return 0;
+}
+
+/* The stage-list rule shared with the harness (harness/scenes.py parse_stages): no empty
+ * item, so "init,,wind", ",init" and "init," are refused instead of skipped. */
+int hb_stage_list_has_empty_item(const char *v)
+{
+    size_t n = strlen(v);
+    return n == 0 || v[0] == ',' || v[n - 1] == ',' || strstr(v, ",,") != NULL;
 }

@@ -27,4 +27,6 @@ int hb_dyn_flag_differs(int i, const hb_dynamics *a, const hb_dynamics *b);
 #ifdef __cplusplus
 }
 #endif
+int hb_stage_list_has_empty_item(const char *v);
+
 #endif

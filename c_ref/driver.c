@@ -68,7 +68,7 @@ static int self_test_rng(void)
  * object (docs/interfaces.md); the harness reads it instead of spelling the names. */
 static int list_variants(const hb_backend *b)
 {
-    static const hb_stage all[] = {HB_STAGE_INIT, HB_STAGE_COLLIDE, HB_STAGE_WIND};
+    static const hb_stage all[] = {HB_STAGE_INIT, HB_STAGE_COLLIDE, HB_STAGE_WIND, HB_STAGE_SIMULATE};
     printf("{\"backend\": \"%s\", \"build\": \"%s\", \"default_variant\": \"%s\", "
            "\"precisions\": [\"fp32\", \"fp64\"], \"variants\": [", b->name, b->build, b->default_variant);
     for (const hb_variant *v = b->variants; v->name; v++) {
@@ -80,6 +80,12 @@ static int list_variants(const hb_backend *b)
                 first = 0;
             }
         printf("], \"summary\": \"%s\"}", v->summary);
+    }
+    printf("], \"solvers\": [\"xpbd\", \"ftl\"], \"features\": [");
+    for (unsigned i = 0; (1u << i) < HB_F_COUNT; i++) {
+        char name[32];
+        hb_dyn_feature_names(1u << i, name, sizeof name);
+        printf("%s\"%s\"", i ? ", " : "", name);
     }
     printf("]}\n");
     return HB_EXIT_OK;
@@ -231,7 +237,7 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         if (r->w) {
             char *hv = r->host;
             for (int i = 0; i < r->in.n_vel; i++)
-                if (r->in.vel_step[i] <= step && (o->all_velocities || 0)) {
+                if (o->all_velocities && r->in.vel_step[i] <= step) {
                     FAIL_IF(hb_input_read_velocity(&r->in, i, hv, err, errlen), HB_EXIT_USAGE);
                     FAIL_IF(hb_writer_velocity(r->w, hv, r->in.vel_step[i], r->in.vel_time[i], err, errlen),
                             HB_EXIT_RUNTIME);

@@ -1,5 +1,7 @@
 /* state_io.c — HDF5 states, H5MD 1.1 shaped (DESIGN §4; layout in docs/interfaces.md). */
 #include "state_io.h"
+#include "safe_write.h"
+#include "h5md_meta.h"
 
 #include <errno.h>
 #include <stddef.h>
@@ -126,6 +128,7 @@ void hb_writer_abort(hb_writer *w)
     if (w->value >= 0) H5Dclose(w->value);
     if (w->file >= 0) H5Fclose(w->file);
     if (w->tmp) unlink(w->tmp);
+    hb_safe_forget();
     writer_free(w);
 }
 
@@ -138,15 +141,21 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     w->file = w->value = w->velocity = -1;
     w->scene = *scene;
     w->rows = (uint64_t)scene->n_strands * (uint64_t)scene->points;
-    if (!force && access(path, F_OK) == 0)
-        FAIL("--output %s exists; choose another name or pass --force to replace it", path);
+    if (hb_safe_output_check(path, force, err, errlen)) goto fail;
     w->path = strdup(path);
     size_t n = strlen(path) + 32;
     w->tmp = malloc(n);
     if (!w->path || !w->tmp) FAIL("out of host memory");
     snprintf(w->tmp, n, "%s.tmp.%ld", path, (long)getpid());
-    w->file = H5Fcreate(w->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-    if (w->file < 0) FAIL("--output %s: cannot create %s (%s)", path, w->tmp, strerror(errno));
+    hb_safe_track(w->tmp); /* removed on a signal or exit() from here on */
+    w->file = H5Fcreate(w->tmp, H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT);
+    if (w->file < 0) {
+        hb_safe_forget(); /* not ours to remove: it may exist already */
+        snprintf(err, errlen, "--output %s: cannot create %s (%s)", path, w->tmp, strerror(errno));
+        free(w->tmp);
+        w->tmp = NULL;
+        goto fail;
+    }
 
     /* /h5md: version, author, creator (H5MD 1.1 §"H5MD metadata") */
     hid_t h5md = make_group(w->file, "h5md");
@@ -158,10 +167,10 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     if (av >= 0) H5Aclose(av);
     H5Sclose(sp2);
     hid_t author = make_group(h5md, "author");
-    bad |= attr_str(author, "name", "hairbench") < 0;
+    bad |= hb_h5md_str_attr(author, "name", "hairbench") < 0;
     hid_t creator = make_group(h5md, "creator");
-    bad |= attr_str(creator, "name", "hairbench") < 0;
-    bad |= attr_str(creator, "version", HB_VERSION) < 0;
+    bad |= hb_h5md_str_attr(creator, "name", "hairbench") < 0;
+    bad |= hb_h5md_str_attr(creator, "version", HB_VERSION) < 0;
     H5Gclose(creator);
     H5Gclose(author);
     H5Gclose(h5md);
@@ -173,14 +182,8 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     int32_t dim = 3;
     bad |= attr_num(box, "dimension", H5T_STD_I32LE, H5T_NATIVE_INT32, &dim) < 0;
     {
-        hsize_t three = 3;
         const char *boundary[3] = {"none", "none", "none"};
-        hid_t t = str_type(), sp = H5Screate_simple(1, &three, NULL);
-        hid_t a = H5Acreate2(box, "boundary", t, sp, H5P_DEFAULT, H5P_DEFAULT);
-        bad |= a < 0 || H5Awrite(a, t, boundary) < 0;
-        if (a >= 0) H5Aclose(a);
-        H5Sclose(sp);
-        H5Tclose(t);
+        bad |= hb_h5md_str_array_attr(box, "boundary", boundary, 3) < 0;
     }
     H5Gclose(box);
     hid_t position = make_group(hair, "position");
@@ -457,10 +460,12 @@ int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errle
 
     {
         hid_t pos = H5Gopen2(w->file, "particles/hair/position", H5P_DEFAULT);
+        /* step and time from each frame's record: paper frames at t = 0 (docs/interfaces.md) */
         for (int f = 0; f < F; f++) { i64[f] = w->frames[f].step; f64[f] = w->frames[f].time; }
         bad |= ds_1d(pos, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, (hsize_t)F, i64) < 0;
         bad |= ds_1d(pos, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
         H5Gclose(pos);
+        bad |= hb_h5md_finish(w->file, s) < 0; /* units, strand ids (h5md_meta.c) */
     }
 
     hid_t p = make_group(w->file, "parameters");
@@ -537,8 +542,7 @@ out:
         hb_writer_abort(w);
         return -1;
     }
-    if (rename(w->tmp, w->path) != 0) {
-        snprintf(err, errlen, "--output %s: cannot rename %s into place (%s)", w->path, w->tmp, strerror(errno));
+    if (hb_safe_commit(w->tmp, w->path, err, errlen) != 0) {
         hb_writer_abort(w);
         return -1;
     }

@@ -309,35 +309,27 @@ int cuda_restore(hb_backend *b, char *err, size_t errlen)
 template <typename T>
 cudaError_t launch_stage(cuda_impl *c, const Model<T> &m, hb_stage st, int fuse, const char **what)
 {
+    /* what each launch is called in an error: [strand-major, point-major][stage] */
+    static const char *const kLaunch[2][3] = {
+        {"the init kernel launch (paper)", "the wind kernel launch (paper)", "the collide kernel launch (paper)"},
+        {"the init kernel launch (point-major)", "the wind kernel launch (point-major)",
+         "the collide kernel launch (point-major)"}};
+    static_assert(HB_STAGE_INIT == 0 && HB_STAGE_WIND == 1 && HB_STAGE_COLLIDE == 2, "kLaunch is indexed by hb_stage");
     const int64_t N = c->N;
     const int B = c->block;
-    if (dyn_is_strand_major(c)) {
-        const StrandMajor<T> lay = strand_major<T>(c, c->state);
-        switch (st) {
-        case HB_STAGE_INIT: *what = "the init kernel launch (paper)"; return hb::launch_init<T>(m, lay, N, B, 0);
-        case HB_STAGE_WIND: *what = "the wind kernel launch (paper)"; return hb::launch_wind<T>(m, lay, N, B, 0);
-        case HB_STAGE_COLLIDE:
-            *what = "the collide kernel launch (paper)";
-            return hb::launch_collide<T>(m, lay, N, c->d_count, B, 0);
-        default: break; /* simulate runs through dyn_frame */
-        }
-    } else {
-        const PointMajor<T> lay = point_major<T>(c, c->state);
-        if (fuse) {
-            *what = "the fused wind+collide kernel launch";
-            return hb::launch_wind_collide<T>(m, lay, N, c->keep ? (T *)c->staging : (T *)NULL, c->d_count, B, 0);
-        }
-        switch (st) {
-        case HB_STAGE_INIT: *what = "the init kernel launch (point-major)"; return hb::launch_init<T>(m, lay, N, B, 0);
-        case HB_STAGE_WIND: *what = "the wind kernel launch (point-major)"; return hb::launch_wind<T>(m, lay, N, B, 0);
-        case HB_STAGE_COLLIDE:
-            *what = "the collide kernel launch (point-major)";
-            return hb::launch_collide<T>(m, lay, N, c->d_count, B, 0);
-        default: break; /* simulate runs through dyn_frame */
-        }
+    const int paper = dyn_is_strand_major(c); /* paper and warp: the canonical layout */
+    if (!paper && fuse) {
+        *what = "the fused wind+collide kernel launch";
+        return hb::launch_wind_collide<T>(m, point_major<T>(c, c->state), N, c->keep ? (T *)c->staging : (T *)NULL,
+                                          c->d_count, B, 0);
     }
-    *what = "an unknown stage";
-    return cudaErrorInvalidValue;
+    if ((unsigned)st > HB_STAGE_COLLIDE) {
+        *what = "an unknown stage";
+        return cudaErrorInvalidValue;
+    }
+    *what = kLaunch[paper ? 0 : 1][st];
+    return paper ? hb::launch_stage<T>(st, m, strand_major<T>(c, c->state), N, c->d_count, B, 0)
+                 : hb::launch_stage<T>(st, m, point_major<T>(c, c->state), N, c->d_count, B, 0);
 }
 
 int cuda_run_stage(hb_backend *b, const hb_stage *stages, int i, int n, hb_stage_result *r, char *err, size_t errlen)

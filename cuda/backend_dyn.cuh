@@ -36,7 +36,10 @@ struct DynState {
     hbd::ObsScene obs;
 };
 
-int dyn_is_strand_major(const cuda_impl *c) { return c->variant == V_PAPER || c->variant == V_WARP; }
+int dyn_is_strand_major(const cuda_impl *c)
+{
+    return c->variant == V_PAPER || c->variant == V_WARP;
+}
 
 /* The variant's layouts of the state (and of velocities and rest shape). */
 hbd::Layout dyn_layout(const cuda_impl *c)
@@ -108,15 +111,16 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
         const int wpb = c->block / 32;
         const int64_t g = (N + wpb - 1) / wpb;
         d->grid = (int)(g > 2147483647 ? 2147483647 : g);
-        const size_t smem = (s->precision == HB_FP32 ? hbd::warp_smem_bytes<float>(P) : hbd::warp_smem_bytes<double>(P)) *
-                            (size_t)wpb;
+        const size_t smem =
+            (s->precision == HB_FP32 ? hbd::warp_smem_bytes<float>(P) : hbd::warp_smem_bytes<double>(P)) * (size_t)wpb;
         if (smem > prop.sharedMemPerBlockOptin) {
-            snprintf(err, errlen,
-                     "--variant warp keeps each strand in shared memory: %lld points x %d strands a block (--block-size "
-                     "%d) need %.1f KB, more than the %.1f KB a block may have on %s; use a smaller --block-size or "
-                     "--variant strand",
-                     (long long)P, wpb, c->block, (double)smem / 1024.0, (double)prop.sharedMemPerBlockOptin / 1024.0,
-                     c->device);
+            snprintf(
+                err, errlen,
+                "--variant warp keeps each strand in shared memory: %lld points x %d strands a block (--block-size "
+                "%d) need %.1f KB, more than the %.1f KB a block may have on %s; use a smaller --block-size or "
+                "--variant strand",
+                (long long)P, wpb, c->block, (double)smem / 1024.0, (double)prop.sharedMemPerBlockOptin / 1024.0,
+                c->device);
             return HB_EXIT_USAGE;
         }
     }
@@ -139,8 +143,8 @@ int dyn_alloc(cuda_impl *c, int need_save, char *err, size_t errlen)
         return rc;
     if ((rc = device_alloc(&d->q, (uint64_t)d->S * 9u * rs, c, "rotation table", err, errlen))) return rc;
     if ((rc = device_alloc(&d->ph, (uint64_t)d->S * rs, c, "phase table", err, errlen))) return rc;
-    if ((rc = device_alloc((void **)&d->d_obs, (uint64_t)d->nchunks * sizeof(hbd::ObsPartial), c, "observables",
-                           err, errlen)))
+    if ((rc = device_alloc((void **)&d->d_obs, (uint64_t)d->nchunks * sizeof(hbd::ObsPartial), c, "observables", err,
+                           errlen)))
         return rc;
     if (c->variant == V_STRAND &&
         (rc = device_alloc(&d->scratch, (uint64_t)d->grid * (uint64_t)c->block * 9u * (uint64_t)P * rs, c,
@@ -209,8 +213,7 @@ int dyn_upload(cuda_impl *c, void *dst, const void *canonical, const char *what,
     return 0;
 }
 
-template <typename T>
-int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char *err, size_t errlen)
+template <typename T> int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char *err, size_t errlen)
 {
     DynState *d = c->dyn;
     if (velocity) {
@@ -241,8 +244,7 @@ int cuda_dyn_load(hb_backend *b, const void *velocity, const void *rest, char *e
                                          : dyn_load_t<double>(c, velocity, rest, err, errlen);
 }
 
-template <typename T>
-cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m)
+template <typename T> cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m)
 {
     DynState *d = c->dyn;
     if (c->variant == V_STRAND)
@@ -291,8 +293,8 @@ int cuda_dyn_observe(hb_backend *b, hb_observables *obs, char *err, size_t errle
                                               c->N, d->d_obs, 0),
                    "the observables kernel launch");
     else
-        HB_CUDA_AS(hbd::launch_observe<double>(d->obs, (const double *)c->state, (const double *)d->vel,
-                                               dyn_layout(c), c->N, d->d_obs, 0),
+        HB_CUDA_AS(hbd::launch_observe<double>(d->obs, (const double *)c->state, (const double *)d->vel, dyn_layout(c),
+                                               c->N, d->d_obs, 0),
                    "the observables kernel launch");
     HB_CUDA(cudaMemcpy(d->h_obs, d->d_obs, (size_t)d->nchunks * sizeof *d->h_obs, cudaMemcpyDeviceToHost));
     for (int64_t i = 0; i < d->nchunks; i++) {

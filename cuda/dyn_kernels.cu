@@ -38,14 +38,12 @@ constexpr int kMaxThreads = 1024;
  * synchronises after the loop, so the next group sees every write (shared memory). */
 struct Lanes {
     int lane;
-    template <class Fn>
-    __device__ __forceinline__ void each(int64_t b, int64_t e, int64_t step, Fn f) const
+    template <class Fn> __device__ __forceinline__ void each(int64_t b, int64_t e, int64_t step, Fn f) const
     {
         for (int64_t k = b + (int64_t)lane * step; k < e; k += 32 * step) f(k);
         __syncwarp();
     }
-    template <class Fn>
-    __device__ __forceinline__ void one(Fn f) const
+    template <class Fn> __device__ __forceinline__ void one(Fn f) const
     {
         if (lane == 0) f();
         __syncwarp();
@@ -76,13 +74,14 @@ __global__ void __launch_bounds__(kMaxThreads)
 }
 
 /* ---- the warp variant: one warp per strand, a lane per point ---- */
-template <typename T>
-__host__ __device__ constexpr int64_t warp_reals(int64_t P) { return 15 * P; } /* x, v, p, d [3][P]; λ [3P] */
+template <typename T> __host__ __device__ constexpr int64_t warp_reals(int64_t P)
+{
+    return 15 * P;
+} /* x, v, p, d [3][P]; λ [3P] */
 
 template <typename T, class Feat>
-__global__ void __launch_bounds__(kMaxThreads)
-    k_warp(DModel<T> m, const T *__restrict__ q, const T *__restrict__ ph, T *x, T *v, const T *rest,
-           const T *bend_rest, int64_t N)
+__global__ void __launch_bounds__(kMaxThreads) k_warp(DModel<T> m, const T *__restrict__ q, const T *__restrict__ ph,
+                                                      T *x, T *v, const T *rest, const T *bend_rest, int64_t N)
 {
     extern __shared__ __align__(16) unsigned char hb_dyn_smem[];
     const Feat has = MakeFeat<Feat>::make(m.features);
@@ -118,36 +117,29 @@ __global__ void __launch_bounds__(kMaxThreads)
 /* ---- the dispatch tables ---- */
 template <typename T>
 using StrandFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, const T *, T *, int64_t);
-template <typename T>
-using WarpFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, const T *, int64_t);
+template <typename T> using WarpFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, const T *, int64_t);
 
-template <typename T, unsigned F>
-constexpr StrandFn<T> strand_entry()
+template <typename T, unsigned F> constexpr StrandFn<T> strand_entry()
 {
     if constexpr (!valid_mask(F)) return nullptr;
     else if constexpr (specialised_mask(F)) return &k_strand<T, StaticF<F>>;
     else return &k_strand<T, DynF>;
 }
-template <typename T, unsigned F>
-constexpr WarpFn<T> warp_entry()
+template <typename T, unsigned F> constexpr WarpFn<T> warp_entry()
 {
     if constexpr (!valid_mask(F)) return nullptr;
     else if constexpr (specialised_mask(F)) return &k_warp<T, StaticF<F>>;
     else return &k_warp<T, DynF>;
 }
 
-template <typename T, unsigned... Fs>
-struct Tables {
+template <typename T, unsigned... Fs> struct Tables {
     static constexpr StrandFn<T> strand[sizeof...(Fs)] = {strand_entry<T, Fs>()...};
     static constexpr WarpFn<T> warp[sizeof...(Fs)] = {warp_entry<T, Fs>()...};
 };
-template <typename T, unsigned... Fs>
-Tables<T, Fs...> tables_of(std::integer_sequence<unsigned, Fs...>);
-template <typename T>
-using TablesT = decltype(tables_of<T>(std::make_integer_sequence<unsigned, HB_F_COUNT>()));
+template <typename T, unsigned... Fs> Tables<T, Fs...> tables_of(std::integer_sequence<unsigned, Fs...>);
+template <typename T> using TablesT = decltype(tables_of<T>(std::make_integer_sequence<unsigned, HB_F_COUNT>()));
 
-template <typename T>
-__global__ void k_bend_rest(const T *rest, Layout rl, T *out, Layout1 bl, int64_t N, int64_t P)
+template <typename T> __global__ void k_bend_rest(const T *rest, Layout rl, T *out, Layout1 bl, int64_t N, int64_t P)
 {
     for (int64_t i = (int64_t)blockIdx.x * blockDim.x + threadIdx.x; i < N; i += (int64_t)gridDim.x * blockDim.x)
         bend_rest(P, Arr<const T>{rest + i * rl.is, rl.ks, rl.cs}, Arr1<T>{out + i * bl.is, bl.s});
@@ -193,14 +185,12 @@ cudaError_t launch_frame_strand(const DModel<T> &m, const T *q, const T *phase, 
     return cudaGetLastError();
 }
 
-template <typename T>
-size_t warp_smem_bytes(int64_t P)
+template <typename T> size_t warp_smem_bytes(int64_t P)
 {
     return (size_t)warp_reals<T>(P) * sizeof(T);
 }
 
-template <typename T>
-cudaError_t prepare_warp(unsigned features, size_t bytes)
+template <typename T> cudaError_t prepare_warp(unsigned features, size_t bytes)
 {
     if (!valid_mask(features)) return cudaErrorInvalidValue;
     return cudaFuncSetAttribute(TablesT<T>::warp[features], cudaFuncAttributeMaxDynamicSharedMemorySize, (int)bytes);
@@ -232,15 +222,15 @@ cudaError_t launch_observe(const ObsScene &sc, const T *x, const T *v, Layout la
     return cudaGetLastError();
 }
 
-#define HB_DYN_INSTANTIATE(T)                                                                                     \
-    template cudaError_t launch_frame_strand<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,      \
-                                                const T *, T *, int64_t, int, int, cudaStream_t);                 \
-    template cudaError_t launch_frame_warp<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,        \
-                                              const T *, int64_t, int, int, cudaStream_t);                        \
-    template size_t warp_smem_bytes<T>(int64_t);                                                                   \
-    template cudaError_t prepare_warp<T>(unsigned, size_t);                                                        \
-    template cudaError_t launch_bend_rest<T>(const T *, Layout, T *, Layout1, int64_t, int64_t, cudaStream_t);     \
-    template cudaError_t launch_observe<T>(const ObsScene &, const T *, const T *, Layout, int64_t, ObsPartial *,   \
+#define HB_DYN_INSTANTIATE(T)                                                                                          \
+    template cudaError_t launch_frame_strand<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,          \
+                                                const T *, T *, int64_t, int, int, cudaStream_t);                      \
+    template cudaError_t launch_frame_warp<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *, const T *, \
+                                              int64_t, int, int, cudaStream_t);                                        \
+    template size_t warp_smem_bytes<T>(int64_t);                                                                       \
+    template cudaError_t prepare_warp<T>(unsigned, size_t);                                                            \
+    template cudaError_t launch_bend_rest<T>(const T *, Layout, T *, Layout1, int64_t, int64_t, cudaStream_t);         \
+    template cudaError_t launch_observe<T>(const ObsScene &, const T *, const T *, Layout, int64_t, ObsPartial *,      \
                                            cudaStream_t);
 HB_DYN_INSTANTIATE(float)
 HB_DYN_INSTANTIATE(double)

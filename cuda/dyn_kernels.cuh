@@ -35,33 +35,49 @@ struct Layout1 {
 constexpr int64_t kObsChunk = 1024;
 
 /* A feature mask that a run can have: not a gust without wind. */
-constexpr bool valid_mask(unsigned f) { return !((f & HB_F_GUST) && !(f & HB_F_WIND)) && f < HB_F_COUNT; }
-inline bool valid_features(unsigned f) { return valid_mask(f); }
+constexpr bool valid_mask(unsigned f)
+{
+    return !((f & HB_F_GUST) && !(f & HB_F_WIND)) && f < HB_F_COUNT;
+}
+inline bool valid_features(unsigned f)
+{
+    return valid_mask(f);
+}
 
-/* The feature sets with kernels of their own: the scenes of the analytic checks and the
- * common runs (xpbd/ftl with or without bend, shape, wind, gusts, motion, the collider,
- * drag). Masks: BEND 1, SHAPE 2, WIND 4, GUST 8, MOTION 16, COLLIDE 32, DRAG 64. */
+/* The feature sets with kernels of their own: the configured scenes (configs/scenes/
+ * dynamic.toml: every feature; still-dynamic.toml: the collider), the analytic checks
+ * (gravity only, drag, wind), the masks harness/featurecost.py times (none, each feature
+ * alone, each removed from the full scene; a wind needs drag, gusts need the wind) and a
+ * few common runs. Masks: BEND 1, SHAPE 2, WIND 4, GUST 8, MOTION 16, COLLIDE 32, DRAG 64;
+ * ALL = 127. */
 constexpr bool specialised_mask(unsigned f)
 {
 #if defined(HB_DYN_SPECIALISE_ALL)
     return true;
 #else
     switch (f) {
-    case 0:                           /* gravity only (pendulum, chain) */
-    case HB_F_DRAG:                   /* pendulum with damping */
-    case HB_F_WIND | HB_F_DRAG:       /* hanging particle in a wind */
-    case HB_F_COLLIDE:                /* the default scene: collider on */
-    case HB_F_COLLIDE | HB_F_DRAG:
+    case 0:         /* nothing: gravity and stretch only */
+    case HB_F_BEND: /* each feature alone … */
+    case HB_F_SHAPE:
+    case HB_F_WIND | HB_F_DRAG:
+    case HB_F_WIND | HB_F_GUST | HB_F_DRAG:
+    case HB_F_MOTION:
+    case HB_F_COLLIDE: /* … the default scene's collider */
+    case HB_F_DRAG:
+    case 127 & ~HB_F_BEND: /* each removed from all … */
+    case 127 & ~HB_F_SHAPE:
+    case 127 & ~(HB_F_WIND | HB_F_GUST):
+    case 127 & ~HB_F_GUST:
+    case 127 & ~HB_F_MOTION:
+    case 127 & ~HB_F_COLLIDE:
+    case 127 & ~(HB_F_DRAG | HB_F_WIND | HB_F_GUST):
+    case 127:                      /* … and all (dynamic.toml) */
+    case HB_F_COLLIDE | HB_F_DRAG: /* common runs */
     case HB_F_BEND | HB_F_COLLIDE | HB_F_DRAG:
     case HB_F_BEND | HB_F_SHAPE | HB_F_COLLIDE | HB_F_DRAG:
     case HB_F_BEND | HB_F_WIND | HB_F_COLLIDE | HB_F_DRAG:
-    case HB_F_BEND | HB_F_WIND | HB_F_GUST | HB_F_COLLIDE | HB_F_DRAG:
-    case HB_F_BEND | HB_F_SHAPE | HB_F_WIND | HB_F_GUST | HB_F_COLLIDE | HB_F_DRAG:
-    case HB_F_BEND | HB_F_SHAPE | HB_F_MOTION | HB_F_COLLIDE | HB_F_DRAG:
-    case HB_F_BEND | HB_F_SHAPE | HB_F_WIND | HB_F_GUST | HB_F_MOTION | HB_F_COLLIDE | HB_F_DRAG: /* everything */
-        return true;
-    default:
-        return false;
+    case HB_F_BEND | HB_F_WIND | HB_F_GUST | HB_F_COLLIDE | HB_F_DRAG: return true;
+    default: return false;
     }
 #endif
 }
@@ -81,12 +97,10 @@ cudaError_t launch_frame_strand(const DModel<T> &m, const T *q, const T *phase, 
 template <typename T>
 cudaError_t launch_frame_warp(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                               const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream);
-template <typename T>
-size_t warp_smem_bytes(int64_t P);
+template <typename T> size_t warp_smem_bytes(int64_t P);
 /* Allows the warp kernel of this feature set `bytes` of dynamic shared memory a block (the
  * opt-in above 48 KB). */
-template <typename T>
-cudaError_t prepare_warp(unsigned features, size_t bytes);
+template <typename T> cudaError_t prepare_warp(unsigned features, size_t bytes);
 
 /* Bend rest lengths |X̄_{k+1} − X̄_{k−1}| of every strand, on the device (one thread a strand). */
 template <typename T>

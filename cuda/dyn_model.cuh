@@ -46,17 +46,15 @@ namespace hb {
 namespace dyn {
 
 /* The run's constants in T: the fields of hb_dyn_model_f32/f64 (hb_dyn_round made them). */
-template <typename T>
-struct DModel {
+template <typename T> struct DModel {
     int64_t points, substeps, iterations, shape_count;
     int solver;
     unsigned features;
-    T h, seg_len, gravity_y, wind_y, wind_z, dir_y, dir_z, kappa, gust, den, stretch_at, bend_at, shape_at,
-        collide_r, ftl_s;
+    T h, seg_len, gravity_y, wind_y, wind_z, dir_y, dir_z, kappa, gust, den, stretch_at, bend_at, shape_at, collide_r,
+        ftl_s;
 };
 
-template <typename T, typename M>
-inline DModel<T> dmodel_from(const M &m)
+template <typename T, typename M> inline DModel<T> dmodel_from(const M &m)
 {
     DModel<T> r;
     r.points = m.points;
@@ -102,14 +100,25 @@ inline ObsScene obs_scene(const hb_scene *s)
 }
 
 /* ---- math: the float functions for float, the double ones for double ---- */
-HB_DHD float d_sqrt(float x) { return sqrtf(x); }
-HB_DHD double d_sqrt(double x) { return sqrt(x); }
-HB_DHD float d_sin(float x) { return sinf(x); }
-HB_DHD double d_sin(double x) { return sin(x); }
+HB_DHD float d_sqrt(float x)
+{
+    return sqrtf(x);
+}
+HB_DHD double d_sqrt(double x)
+{
+    return sqrt(x);
+}
+HB_DHD float d_sin(float x)
+{
+    return sinf(x);
+}
+HB_DHD double d_sin(double x)
+{
+    return sin(x);
+}
 
 /* ---- policies ---- */
-template <unsigned F>
-struct StaticF {
+template <unsigned F> struct StaticF {
     HB_DHD constexpr bool operator()(unsigned bit) const { return (F & bit) != 0u; }
 };
 struct DynF {
@@ -117,14 +126,12 @@ struct DynF {
     HB_DHD bool operator()(unsigned bit) const { return (f & bit) != 0u; }
 };
 
-template <typename T>
-struct Arr {
+template <typename T> struct Arr {
     T *b;
     int64_t ks, cs;
     HB_DHD T &operator()(int64_t k, int c) const { return b[k * ks + (int64_t)c * cs]; }
 };
-template <typename T>
-struct Arr1 {
+template <typename T> struct Arr1 {
     T *b;
     int64_t s;
     HB_DHD T &operator()(int64_t i) const { return b[i * s]; }
@@ -133,8 +140,7 @@ struct Arr1 {
 /* One strand: x, v (state), rest X̄, bend rest lengths, and the frame's working arrays:
  * predicted positions p, multipliers λ (stretch P−1 | bend P−2 | shape K at 0, P, 2P) and
  * the ftl corrections d. */
-template <typename T>
-struct Strand {
+template <typename T> struct Strand {
     Arr<T> x, v;
     Arr<const T> rest;
     Arr1<const T> bend_rest;
@@ -143,23 +149,17 @@ struct Strand {
 };
 
 struct Seq {
-    template <class Fn>
-    HB_DHD void each(int64_t b, int64_t e, int64_t step, Fn f) const
+    template <class Fn> HB_DHD void each(int64_t b, int64_t e, int64_t step, Fn f) const
     {
         for (int64_t k = b; k < e; k += step) f(k);
     }
-    template <class Fn>
-    HB_DHD void one(Fn f) const
-    {
-        f();
-    }
+    template <class Fn> HB_DHD void one(Fn f) const { f(); }
 };
 
 /* ---- the constraints (§3.5) on scalars ---- */
 
 /* r = Q·a, row-major Q, each row summed left to right. */
-template <typename T>
-HB_DHD void rotate(const T *q, T a0, T a1, T a2, T *r)
+template <typename T> HB_DHD void rotate(const T *q, T a0, T a1, T a2, T *r)
 {
     r[0] = q[0] * a0 + q[1] * a1 + q[2] * a2;
     r[1] = q[3] * a0 + q[4] * a1 + q[5] * a2;
@@ -167,8 +167,7 @@ HB_DHD void rotate(const T *q, T a0, T a1, T a2, T *r)
 }
 
 /* distance constraint between point a and point b of `p` (dynamics_impl.h distance) */
-template <typename T>
-HB_DHD void distance(const Arr<T> &p, int64_t ia, int64_t ib, int move_a, T r, T at, T &lambda)
+template <typename T> HB_DHD void distance(const Arr<T> &p, int64_t ia, int64_t ib, int move_a, T r, T at, T &lambda)
 {
     const T ex = p(ib, 0) - p(ia, 0), ey = p(ib, 1) - p(ia, 1), ez = p(ib, 2) - p(ia, 2);
     const T len = d_sqrt(ex * ex + ey * ey + ez * ez);
@@ -188,8 +187,7 @@ HB_DHD void distance(const Arr<T> &p, int64_t ia, int64_t ib, int move_a, T r, T
     p(ib, 2) = p(ib, 2) + dl * nz;
 }
 
-template <typename T>
-HB_DHD void shape_pull(const Arr<T> &p, int64_t k, const T *t, T at, T &lambda)
+template <typename T> HB_DHD void shape_pull(const Arr<T> &p, int64_t k, const T *t, T at, T &lambda)
 {
     const T ex = p(k, 0) - t[0], ey = p(k, 1) - t[1], ez = p(k, 2) - t[2];
     const T c = d_sqrt(ex * ex + ey * ey + ez * ez);
@@ -202,8 +200,7 @@ HB_DHD void shape_pull(const Arr<T> &p, int64_t k, const T *t, T at, T &lambda)
 }
 
 /* head collision on a point held in three scalars */
-template <typename T>
-HB_DHD void collide_sphere(T &p0, T &p1, T &p2, T rc)
+template <typename T> HB_DHD void collide_sphere(T &p0, T &p1, T &p2, T rc)
 {
     const T len = d_sqrt(p0 * p0 + p1 * p1 + p2 * p2);
     if (!(len < rc)) return;
@@ -220,7 +217,10 @@ HB_DHD void collide_sphere(T &p0, T &p1, T &p2, T rc)
 }
 
 /* k of the g-th member of bend group `parity`: ⌊(k−1)/2⌋ ≡ parity (mod 2), k ascending. */
-HB_DHD int64_t bend_k(int64_t g, int parity) { return 1 + 4 * (g >> 1) + (g & 1) + 2 * parity; }
+HB_DHD int64_t bend_k(int64_t g, int parity)
+{
+    return 1 + 4 * (g >> 1) + (g & 1) + 2 * parity;
+}
 
 template <typename T, class Exec>
 HB_DHD void bend_group(const DModel<T> &m, const Strand<T> &s, const Exec &ex, int parity)
@@ -260,8 +260,7 @@ HB_DHD void shape_all(const DModel<T> &m, const Strand<T> &s, const T *q, const 
 /* One frame of one strand: S substeps of §3.4 with the solver of §3.6 or §3.7.
  * qtab: [S][9] rotations Q(t+h); phtab: [S] gust phases φ(t) (hb_dyn_frame_plan). */
 template <typename T, class Feat, class Exec>
-HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const Strand<T> &s, const Exec &ex,
-                       Feat has)
+HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const Strand<T> &s, const Exec &ex, Feat has)
 {
     const int64_t P = m.points;
     const T h = m.h;
@@ -293,7 +292,8 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
             T vx = v(k, 0), vy = v(k, 1), vz = v(k, 2);
             if (has(HB_F_WIND)) {
                 T gam = (T)1;
-                if (has(HB_F_GUST)) gam = (T)1 + m.gust * d_sin(phase - m.kappa * (m.dir_y * x(k, 1) + m.dir_z * x(k, 2)));
+                if (has(HB_F_GUST))
+                    gam = (T)1 + m.gust * d_sin(phase - m.kappa * (m.dir_y * x(k, 1) + m.dir_z * x(k, 2)));
                 vy = vy + h * (m.gravity_y + m.wind_y * gam);
                 vz = vz + h * (m.wind_z * gam);
             } else {
@@ -317,10 +317,11 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
         if (m.solver == HB_SOLVER_XPBD) {
             for (int64_t it = 0; it < m.iterations; it++) {
                 ex.each(1, P, 2, [&](int64_t k) { /* stretch, k odd */
-                    distance(p, k - 1, k, k - 1 != 0, m.seg_len, m.stretch_at, lam(k - 1));
+                                                  distance(p, k - 1, k, k - 1 != 0, m.seg_len, m.stretch_at,
+                                                           lam(k - 1));
                 });
                 ex.each(2, P, 2, [&](int64_t k) { /* stretch, k even */
-                    distance(p, k - 1, k, 1, m.seg_len, m.stretch_at, lam(k - 1));
+                                                  distance(p, k - 1, k, 1, m.seg_len, m.stretch_at, lam(k - 1));
                 });
                 if (has(HB_F_BEND)) {
                     bend_group(m, s, ex, 0);
@@ -375,8 +376,7 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
 }
 
 /* §3.5 bend rest lengths |X̄_{k+1} − X̄_{k−1}| (dynamics_impl.h hb_dyn_bend_rest). */
-template <typename T>
-HB_DHD void bend_rest(int64_t P, const Arr<const T> &rest, const Arr1<T> &out)
+template <typename T> HB_DHD void bend_rest(int64_t P, const Arr<const T> &rest, const Arr1<T> &out)
 {
     for (int64_t k = 1; k + 1 < P; k++) {
         const T ex = rest(k + 1, 0) - rest(k - 1, 0), ey = rest(k + 1, 1) - rest(k - 1, 1),
@@ -391,7 +391,10 @@ struct ObsPartial {
     long long blown;
 };
 
-HB_DHD int finite_d(double a) { return isfinite(a) ? 1 : 0; }
+HB_DHD int finite_d(double a)
+{
+    return isfinite(a) ? 1 : 0;
+}
 
 template <typename T>
 HB_DHD void observe_strand(const ObsScene &sc, const Arr<const T> &x, const Arr<const T> &v, ObsPartial *o)

@@ -134,47 +134,34 @@ __global__ void HB_STAGE_BOUNDS
 }
 
 /* ---- the launchers ---------------------------------------------------------------------- */
+/* The three arrays a stage kernel takes: strand-major passes its one array first. */
 template <typename T>
-cudaError_t launch_init(const Model<T> &m, const StrandMajor<T> &lay, int64_t N, int block, cudaStream_t stream)
+struct Arrays {
+    T *a, *b, *c;
+};
+template <typename T>
+Arrays<T> arrays_of(const StrandMajor<T> &lay)
 {
-    k_init<T, StrandMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.s, nullptr, nullptr, N);
-    return cudaGetLastError();
+    return {lay.s, nullptr, nullptr};
+}
+template <typename T>
+Arrays<T> arrays_of(const PointMajor<T> &lay)
+{
+    return {lay.X, lay.Y, lay.Z};
 }
 
-template <typename T>
-cudaError_t launch_init(const Model<T> &m, const PointMajor<T> &lay, int64_t N, int block, cudaStream_t stream)
+template <typename T, class Layout>
+cudaError_t launch_stage(hb_stage st, const Model<T> &m, const Layout &lay, int64_t N, unsigned long long *count,
+                         int block, cudaStream_t stream)
 {
-    k_init<T, PointMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N);
-    return cudaGetLastError();
-}
-
-template <typename T>
-cudaError_t launch_wind(const Model<T> &m, const StrandMajor<T> &lay, int64_t N, int block, cudaStream_t stream)
-{
-    k_wind<T, StrandMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.s, nullptr, nullptr, N);
-    return cudaGetLastError();
-}
-
-template <typename T>
-cudaError_t launch_wind(const Model<T> &m, const PointMajor<T> &lay, int64_t N, int block, cudaStream_t stream)
-{
-    k_wind<T, PointMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N);
-    return cudaGetLastError();
-}
-
-template <typename T>
-cudaError_t launch_collide(const Model<T> &m, const StrandMajor<T> &lay, int64_t N, unsigned long long *count,
-                           int block, cudaStream_t stream)
-{
-    k_collide<T, StrandMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.s, nullptr, nullptr, N, count);
-    return cudaGetLastError();
-}
-
-template <typename T>
-cudaError_t launch_collide(const Model<T> &m, const PointMajor<T> &lay, int64_t N, unsigned long long *count,
-                           int block, cudaStream_t stream)
-{
-    k_collide<T, PointMajor<T>><<<grid_for(N, block), block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, count);
+    const Arrays<T> p = arrays_of(lay);
+    const unsigned grid = grid_for(N, block);
+    switch (st) {
+    case HB_STAGE_INIT: k_init<T, Layout><<<grid, block, 0, stream>>>(m, p.a, p.b, p.c, N); break;
+    case HB_STAGE_WIND: k_wind<T, Layout><<<grid, block, 0, stream>>>(m, p.a, p.b, p.c, N); break;
+    case HB_STAGE_COLLIDE: k_collide<T, Layout><<<grid, block, 0, stream>>>(m, p.a, p.b, p.c, N, count); break;
+    default: return cudaErrorInvalidValue;
+    }
     return cudaGetLastError();
 }
 
@@ -190,16 +177,12 @@ cudaError_t launch_wind_collide(const Model<T> &m, const PointMajor<T> &lay, int
     return cudaGetLastError();
 }
 
-#define HB_INSTANTIATE(T)                                                                                  \
-    template cudaError_t launch_init<T>(const Model<T> &, const StrandMajor<T> &, int64_t, int, cudaStream_t); \
-    template cudaError_t launch_init<T>(const Model<T> &, const PointMajor<T> &, int64_t, int, cudaStream_t);  \
-    template cudaError_t launch_wind<T>(const Model<T> &, const StrandMajor<T> &, int64_t, int, cudaStream_t); \
-    template cudaError_t launch_wind<T>(const Model<T> &, const PointMajor<T> &, int64_t, int, cudaStream_t);  \
-    template cudaError_t launch_collide<T>(const Model<T> &, const StrandMajor<T> &, int64_t,                 \
-                                           unsigned long long *, int, cudaStream_t);                          \
-    template cudaError_t launch_collide<T>(const Model<T> &, const PointMajor<T> &, int64_t,                  \
-                                           unsigned long long *, int, cudaStream_t);                          \
-    template cudaError_t launch_wind_collide<T>(const Model<T> &, const PointMajor<T> &, int64_t, T *,        \
+#define HB_INSTANTIATE(T)                                                                                      \
+    template cudaError_t launch_stage<T, StrandMajor<T>>(hb_stage, const Model<T> &, const StrandMajor<T> &, int64_t, \
+                                                         unsigned long long *, int, cudaStream_t);                \
+    template cudaError_t launch_stage<T, PointMajor<T>>(hb_stage, const Model<T> &, const PointMajor<T> &, int64_t,   \
+                                                        unsigned long long *, int, cudaStream_t);                 \
+    template cudaError_t launch_wind_collide<T>(const Model<T> &, const PointMajor<T> &, int64_t, T *,            \
                                                 unsigned long long *, int, cudaStream_t);
 
 HB_INSTANTIATE(float)

@@ -14,29 +14,19 @@
 #include <stdint.h>
 
 #include "model.cuh"
+#include "params.h" /* hb_stage */
 
 namespace hb {
 
-/* Stage init: roots and drape, writing x, y and z of every point. */
-template <typename T>
-cudaError_t launch_init(const Model<T> &m, const StrandMajor<T> &lay, int64_t N, int block, cudaStream_t stream);
-template <typename T>
-cudaError_t launch_init(const Model<T> &m, const PointMajor<T> &lay, int64_t N, int block, cudaStream_t stream);
-
-/* Stage wind (in place). Point-major: reads and writes y and z only. */
-template <typename T>
-cudaError_t launch_wind(const Model<T> &m, const StrandMajor<T> &lay, int64_t N, int block, cudaStream_t stream);
-template <typename T>
-cudaError_t launch_wind(const Model<T> &m, const PointMajor<T> &lay, int64_t N, int block, cudaStream_t stream);
-
-/* Stage collide (in place); adds the number of points changed to *count (exactly: a
- * per-block reduction, then one 64-bit atomicAdd per block). Point-major: y and z only. */
-template <typename T>
-cudaError_t launch_collide(const Model<T> &m, const StrandMajor<T> &lay, int64_t N, unsigned long long *count,
-                           int block, cudaStream_t stream);
-template <typename T>
-cudaError_t launch_collide(const Model<T> &m, const PointMajor<T> &lay, int64_t N, unsigned long long *count,
-                           int block, cudaStream_t stream);
+/* One stage kernel on either layout (StrandMajor: the paper's scheme; PointMajor: soa):
+ *   init     roots and drape, writing x, y and z of every point;
+ *   wind     in place; point-major reads and writes y and z only;
+ *   collide  in place; adds the number of points changed to *count (exactly: a per-block
+ *            reduction, then one 64-bit atomicAdd per block); point-major: y and z only.
+ * `count` is used by collide only. An unknown stage returns cudaErrorInvalidValue. */
+template <typename T, class Layout>
+cudaError_t launch_stage(hb_stage st, const Model<T> &m, const Layout &lay, int64_t N, unsigned long long *count,
+                         int block, cudaStream_t stream);
 
 /* Wind immediately followed by collide, one kernel, point-major. With `inter` non-null the
  * post-wind state is also written there (canonical [N][P][3]; x is then read as well);

@@ -14,16 +14,17 @@
   4. plots and report/report.md.
 Without a GPU it runs the CPU rows and prints one line saying why the GPU rows are skipped.
 """
+
 import json
 import shutil
 import tempfile
 from pathlib import Path
 
-from . import HarnessError, diff, env, report, runner
+from . import HarnessError, diff, env, report, runner, variants
 from .paths import CUDA_BUILDS, RESULTS, binary_path, display
 from .plots import ensure_figure_state
 from .sweep import run_sweep, write_json
-from .sweepfile import VARIANTS, load_sweep
+from .sweepfile import load_sweep
 
 VALIDATION_STRANDS = 2000
 VALIDATION_POINTS = 32
@@ -64,8 +65,7 @@ class Validator:
         self.count += 1
         path = self.scratch / f"s{self.count}-{backend}-{build}-{precision}.h5"
         scene = self.scene.with_overrides(precision=precision) if not input_file else self.scene
-        flags = runner.run_flags(scene, backend, stages=stages, input_file=input_file,
-                                 output=path, **opts)
+        flags = runner.run_flags(scene, backend, stages=stages, input_file=input_file, output=path, **opts)
         runner.run_binary(binary_path(backend, build), flags, timeout=300)
         return path
 
@@ -76,15 +76,20 @@ class Validator:
             entry = {"what": what, "equivalent": False, "error": str(e)}
         else:
             compared = [f for f in r.frames if f.compared]
-            entry = {"what": what, "pair": r.pair, "equivalent": r.equivalent,
-                     "max_abs": max((f.max_abs for f in compared), default=0.0),
-                     "max_k": max((f.max_k for f in compared), default=0.0),
-                     "over": sum(f.over for f in compared),
-                     "failures": r.failures()[:5]}
+            entry = {
+                "what": what,
+                "pair": r.pair,
+                "equivalent": r.equivalent,
+                "max_abs": max((f.max_abs for f in compared), default=0.0),
+                "max_k": max((f.max_k for f in compared), default=0.0),
+                "over": sum(f.over for f in compared),
+                "failures": r.failures()[:5],
+            }
         self.checks.append(entry)
         if not entry["equivalent"]:
-            self.say(f"harness: NOT EQUIVALENT: {what}: "
-                     + (entry.get("error") or "; ".join(entry.get("failures", []))))
+            self.say(
+                f"harness: NOT EQUIVALENT: {what}: " + (entry.get("error") or "; ".join(entry.get("failures", [])))
+            )
         return entry["equivalent"]
 
     def cpu_checks(self):
@@ -96,15 +101,20 @@ class Validator:
         for k in range(1, len(stages)):  # the resume path itself, on the oracle
             prefix = self.state("cpu", precision="fp64", stages=stages[:k])
             resumed = self.state("cpu", precision="fp64", input_file=prefix, stages=[stages[k]])
-            self.compare(f"cpu fp64: stage {k} ({stages[k]}) resumed from frame {k - 1} (bit-identical)",
-                         ref["fp64"], resumed, frames=[k], exact=True)
+            self.compare(
+                f"cpu fp64: stage {k} ({stages[k]}) resumed from frame {k - 1} (bit-identical)",
+                ref["fp64"],
+                resumed,
+                frames=[k],
+                exact=True,
+            )
         return ref
 
     def gpu_checks(self, builds, ref):
         stages = list(self.scene.stages)
         prefixes = {}
         for build in builds:
-            for variant in VARIANTS["cuda"]:
+            for variant in variants.names("cuda", build):
                 for precision in PRECISIONS:
                     for block in BLOCK_SIZES:
                         g = self.state("cuda", build, precision, variant=variant, block_size=block)
@@ -113,10 +123,22 @@ class Validator:
                         key = (precision, k)
                         if key not in prefixes:
                             prefixes[key] = self.state("cpu", precision=precision, stages=stages[:k])
-                        g = self.state("cuda", build, precision, variant=variant, block_size=RESUME_BLOCK,
-                                       input_file=prefixes[key], stages=[stages[k]])
-                        self.compare(f"cuda {build} {variant} b{RESUME_BLOCK} {precision}: stage {k} "
-                                     f"({stages[k]}) from the cpu state", ref[precision], g, frames=[k])
+                        g = self.state(
+                            "cuda",
+                            build,
+                            precision,
+                            variant=variant,
+                            block_size=RESUME_BLOCK,
+                            input_file=prefixes[key],
+                            stages=[stages[k]],
+                        )
+                        self.compare(
+                            f"cuda {build} {variant} b{RESUME_BLOCK} {precision}: stage {k} "
+                            f"({stages[k]}) from the cpu state",
+                            ref[precision],
+                            g,
+                            frames=[k],
+                        )
 
 
 def validate(sweep, out_dir, builds, gpu_note, say):
@@ -128,19 +150,30 @@ def validate(sweep, out_dir, builds, gpu_note, say):
     if builds:
         v.gpu_checks(builds, ref)
     failed = [c for c in v.checks if not c["equivalent"]]
-    write_json(out_dir / "validation.json", {
-        "date": env.now(), "strands": VALIDATION_STRANDS, "points": VALIDATION_POINTS,
-        "scene": sweep.scene.name, "gpu_builds": builds,
-        "gpu_note": f"GPU not validated: {gpu_note}." if gpu_note else "", "checks": v.checks})
+    write_json(
+        out_dir / "validation.json",
+        {
+            "date": env.now(),
+            "strands": VALIDATION_STRANDS,
+            "points": VALIDATION_POINTS,
+            "scene": sweep.scene.name,
+            "gpu_builds": builds,
+            "gpu_note": f"GPU not validated: {gpu_note}." if gpu_note else "",
+            "checks": v.checks,
+        },
+    )
     if failed:
-        raise HarnessError(f"validation failed: {len(failed)} of {len(v.checks)} comparisons not "
-                           f"equivalent (details in {display(out_dir / 'validation.json')}, states kept "
-                           f"in {display(scratch)}); nothing was timed", code=1)
+        raise HarnessError(
+            f"validation failed: {len(failed)} of {len(v.checks)} comparisons not "
+            f"equivalent (details in {display(out_dir / 'validation.json')}, states kept "
+            f"in {display(scratch)}); nothing was timed",
+            code=1,
+        )
     shutil.rmtree(scratch, ignore_errors=True)
     say(f"harness: validation: all {len(v.checks)} comparisons equivalent")
 
 
-def run(sweep_ref="configs/default.toml", out=None, gpu="auto", report_dir=None, log=None):
+def run(sweep_ref="default", out=None, gpu="auto", report_dir=None, log=None):
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
     sweep = load_sweep(sweep_ref)
@@ -150,8 +183,7 @@ def run(sweep_ref="configs/default.toml", out=None, gpu="auto", report_dir=None,
     if gpu_note:
         say(f"harness: GPU rows skipped: {gpu_note}")
     validate(sweep, out_dir, builds, gpu_note, say)
-    _, failed = run_sweep(sweep_ref, out=out_dir, gpu="no" if gpu_note else gpu, log=say,
-                          announce_skips=False)
+    _, failed = run_sweep(sweep_ref, out=out_dir, gpu="no" if gpu_note else gpu, log=say, announce_skips=False)
     if gpu_note:  # the sweep's record says why, for the report
         _note_gpu_skip(out_dir / "env.json", gpu_note)
     ensure_figure_state(out_dir)

@@ -11,6 +11,7 @@ units: segment-length error over ε·E and depth inside the shell over ε·rc.
 With --other BINARY a second build is compared with the cpu reference at each precision
 (e.g. build/hairsim-cuda-strict on a GPU node, or c_ref rebuilt with FMA contraction).
 """
+
 import json
 import tempfile
 from pathlib import Path
@@ -23,7 +24,7 @@ from .runner import run_binary
 from .states import open_state
 
 SCENES = {"paper": 0.5, "gale": 1.0}
-FLIP = 1e-3   # a point farther than this · L took the other side of a decision
+FLIP = 1e-3  # a point farther than this · L took the other side of a decision
 
 
 def point_errors(path_a, path_b):
@@ -45,9 +46,24 @@ def invariant_residuals(path):
 
 def produce(binary, tmp, name, strands, points, seed, wind, precision):
     path = Path(tmp) / f"{name}-{precision}-P{points}-s{seed}.h5"
-    run_binary(binary, ["--strands", strands, "--points", points, "--seed", seed,
-                        "--wind-strength", wind, "--precision", precision, "--output", path,
-                        "--force"])
+    run_binary(
+        binary,
+        [
+            "--strands",
+            strands,
+            "--points",
+            points,
+            "--seed",
+            seed,
+            "--wind-strength",
+            wind,
+            "--precision",
+            precision,
+            "--output",
+            path,
+            "--force",
+        ],
+    )
     return path
 
 
@@ -60,30 +76,52 @@ def measure(strands, points_list, seeds, other=None, on_row=None):
         for scene, wind in SCENES.items():
             for points in points_list:
                 for seed in seeds:
-                    files = {p: produce(ref, tmp, "cpu-" + scene, strands, points, seed, wind, p)
-                             for p in ("fp32", "fp64")}
+                    files = {
+                        p: produce(ref, tmp, "cpu-" + scene, strands, points, seed, wind, p) for p in ("fp32", "fp64")
+                    }
                     pairs = [("fp32↔fp64 (cpu)", files["fp32"], files["fp64"])]
                     if other:
-                        o = {p: produce(Path(other), tmp, "other-" + scene, strands, points, seed,
-                                        wind, p) for p in ("fp32", "fp64")}
-                        pairs += [("fp64↔fp64 (other vs cpu)", o["fp64"], files["fp64"]),
-                                  ("fp32↔fp32 (other vs cpu)", o["fp32"], files["fp32"]),
-                                  ("fp32↔fp64 (other vs cpu)", o["fp32"], files["fp64"])]
+                        o = {
+                            p: produce(Path(other), tmp, "other-" + scene, strands, points, seed, wind, p)
+                            for p in ("fp32", "fp64")
+                        }
+                        pairs += [
+                            ("fp64↔fp64 (other vs cpu)", o["fp64"], files["fp64"]),
+                            ("fp32↔fp32 (other vs cpu)", o["fp32"], files["fp32"]),
+                            ("fp32↔fp64 (other vs cpu)", o["fp32"], files["fp64"]),
+                        ]
                         files.update({"other-" + k: v for k, v in o.items()})
                     for label, a, b in pairs:
                         e = point_errors(a, b)
                         d = diff.compare(a, b)
-                        rows.append({"kind": "pair", "pair": label, "scene": scene, "points": points,
-                                     "seed": seed, "strands": strands,
-                                     "p99_rel_L": float(np.percentile(e, 99)),
-                                     "p9999_rel_L": float(np.percentile(e, 99.99)),
-                                     "max_rel_L": float(e.max()),
-                                     "max_k": max(f.max_k for f in d.frames),
-                                     "flipped_points": int((e > FLIP).sum()), "points_total": e.size})
+                        rows.append(
+                            {
+                                "kind": "pair",
+                                "pair": label,
+                                "scene": scene,
+                                "points": points,
+                                "seed": seed,
+                                "strands": strands,
+                                "p99_rel_L": float(np.percentile(e, 99)),
+                                "p9999_rel_L": float(np.percentile(e, 99.99)),
+                                "max_rel_L": float(e.max()),
+                                "max_k": max(f.max_k for f in d.frames),
+                                "flipped_points": int((e > FLIP).sum()),
+                                "points_total": e.size,
+                            }
+                        )
                         on_row(rows[-1])
                     for label, path in files.items():
-                        rows.append({"kind": "invariants", "file": label, "scene": scene,
-                                     "points": points, "seed": seed, **invariant_residuals(path)})
+                        rows.append(
+                            {
+                                "kind": "invariants",
+                                "file": label,
+                                "scene": scene,
+                                "points": points,
+                                "seed": seed,
+                                **invariant_residuals(path),
+                            }
+                        )
                         on_row(rows[-1])
     return rows
 
@@ -92,8 +130,7 @@ def summarize(rows):
     pairs, files = {}, {}
     for r in rows:
         if r["kind"] == "pair":
-            p = pairs.setdefault(r["pair"], {"max_rel_L": 0, "p9999_rel_L": 0, "max_k": 0,
-                                             "flipped": 0, "total": 0})
+            p = pairs.setdefault(r["pair"], {"max_rel_L": 0, "p9999_rel_L": 0, "max_k": 0, "flipped": 0, "total": 0})
             p["max_rel_L"] = max(p["max_rel_L"], r["max_rel_L"])
             p["p9999_rel_L"] = max(p["p9999_rel_L"], r["p9999_rel_L"])
             p["max_k"] = max(p["max_k"], r["max_k"])
@@ -108,11 +145,15 @@ def summarize(rows):
 
 def format_row(r):
     if r["kind"] == "pair":
-        return (f"{r['pair']:26} {r['scene']:6} P={r['points']:<4d} seed={r['seed']:<3d} "
-                f"p99 {r['p99_rel_L']:8.2e}·L  p99.99 {r['p9999_rel_L']:8.2e}·L  max {r['max_rel_L']:8.2e}·L "
-                f"= {r['max_k']:6.3f}·u  beyond 1e-3·L: {r['flipped_points']}")
-    return (f"{r['file']:26} {r['scene']:6} P={r['points']:<4d} seed={r['seed']:<3d} "
-            f"segment {r['segment_k']:6.3f}·ε·E  shell {r['shell_k']:7.2f}·ε·rc")
+        return (
+            f"{r['pair']:26} {r['scene']:6} P={r['points']:<4d} seed={r['seed']:<3d} "
+            f"p99 {r['p99_rel_L']:8.2e}·L  p99.99 {r['p9999_rel_L']:8.2e}·L  max {r['max_rel_L']:8.2e}·L "
+            f"= {r['max_k']:6.3f}·u  beyond 1e-3·L: {r['flipped_points']}"
+        )
+    return (
+        f"{r['file']:26} {r['scene']:6} P={r['points']:<4d} seed={r['seed']:<3d} "
+        f"segment {r['segment_k']:6.3f}·ε·E  shell {r['shell_k']:7.2f}·ε·rc"
+    )
 
 
 def run(strands=20000, points=(8, 32, 128), seeds=(1, 2, 3), other=None, as_json=False):
@@ -124,9 +165,10 @@ def run(strands=20000, points=(8, 32, 128), seeds=(1, 2, 3), other=None, as_json
         return 0
     print("\nworst over all runs:")
     for label, p in pairs.items():
-        print(f"  {label}: max {p['max_rel_L']:.2e}·L = {p['max_k']:.3f}·u, p99.99 {p['p9999_rel_L']:.2e}·L, "
-              f"{p['flipped']} of {p['total']} points beyond {FLIP:g}·L")
+        print(
+            f"  {label}: max {p['max_rel_L']:.2e}·L = {p['max_k']:.3f}·u, p99.99 {p['p9999_rel_L']:.2e}·L, "
+            f"{p['flipped']} of {p['total']} points beyond {FLIP:g}·L"
+        )
     for label, k in files.items():
-        print(f"  {label}: segment error up to {k['segment_k']:.3f}·ε·E, "
-              f"shell depth up to {k['shell_k']:.2f}·ε·rc")
+        print(f"  {label}: segment error up to {k['segment_k']:.3f}·ε·E, shell depth up to {k['shell_k']:.2f}·ε·rc")
     return 0

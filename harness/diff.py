@@ -11,17 +11,23 @@ Exit status: 0 equivalent, 1 not equivalent (a frame over tolerance, any NaN/Inf
 invariant violated), 2 could not compare (unreadable file, layout mismatch, different N,
 P or scene, missing frames, different stages).
 """
+
 import json
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from . import HarnessError, invariants, tolerances
-from .states import StateError, as_text, open_state
+from .states import State, StateError, as_text, open_state
 from .ulp import coarser, ulp_distance
 
 EXIT_EQUIVALENT, EXIT_DIFFERENT, EXIT_CANNOT_COMPARE = 0, 1, 2
+# "all", "last", or frame numbers / (frame in A, frame in B) pairs
+Frames = str | Sequence[int | tuple[int, int]]
 # scene attributes that must agree for a comparison to mean anything
 SCENE_ATTRS = ("head_radius", "hair_offset", "hair_length", "face_margin", "seed")
 
@@ -36,7 +42,7 @@ class FrameDiff:
     max_abs: float = 0.0
     rms_abs: float = 0.0
     max_rel_L: float = 0.0
-    max_k: float = 0.0          # max of error / u (tolerances.point_unit): over when > point_k
+    max_k: float = 0.0  # max of error / u (tolerances.point_unit): over when > point_k
     ulp_p50: float = 0.0
     ulp_p99: float = 0.0
     ulp_max: float = 0.0
@@ -45,10 +51,10 @@ class FrameDiff:
     nonfinite: int = 0
 
     @property
-    def ok(self):
+    def ok(self) -> bool:
         return not self.compared or (self.nonfinite == 0 and self.over <= self.allowed_over)
 
-    def as_dict(self):
+    def as_dict(self) -> dict[str, Any]:
         d = dict(self.__dict__)
         d["ok"] = self.ok
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
@@ -63,26 +69,33 @@ class DiffResult:
     pair: str
     tolerance: tolerances.PairTolerance
     hair_length: float
-    limit_range: tuple = (0.0, 0.0)   # smallest and largest point tolerance (scene units)
+    limit_range: tuple = (0.0, 0.0)  # smallest and largest point tolerance (scene units)
     frames: list = field(default_factory=list)
-    invariants_a: object = None
-    invariants_b: object = None
+    invariants_a: Any = None
+    invariants_b: Any = None
 
     @property
-    def equivalent(self):
-        return (all(f.ok for f in self.frames) and self.invariants_a.ok and self.invariants_b.ok
-                and any(f.compared for f in self.frames))
+    def equivalent(self) -> bool:
+        return (
+            all(f.ok for f in self.frames)
+            and self.invariants_a.ok
+            and self.invariants_b.ok
+            and any(f.compared for f in self.frames)
+        )
 
     @property
-    def exit_code(self):
+    def exit_code(self) -> int:
         return EXIT_EQUIVALENT if self.equivalent else EXIT_DIFFERENT
 
-    def failures(self):
+    def failures(self) -> list[str]:
         out = []
         for f in self.frames:
             if not f.ok:
-                why = (f"{f.nonfinite} non-finite point(s)" if f.nonfinite
-                       else f"{f.over} point(s) over tolerance (allowed {f.allowed_over})")
+                why = (
+                    f"{f.nonfinite} non-finite point(s)"
+                    if f.nonfinite
+                    else f"{f.over} point(s) over tolerance (allowed {f.allowed_over})"
+                )
                 out.append(f"frame {f.frame_b} ({f.stage}): {why}, max error {f.max_abs:.3g}")
         for label, rep in (("A", self.invariants_a), ("B", self.invariants_b)):
             out += [f"{label} {v.message}" for v in rep.violations]
@@ -90,15 +103,22 @@ class DiffResult:
             out.append("no frame could be compared")
         return out
 
-    def as_dict(self):
+    def as_dict(self) -> dict[str, Any]:
         return {
-            "a": self.path_a, "b": self.path_b, "label_a": self.label_a, "label_b": self.label_b,
-            "pair": self.pair, "equivalent": self.equivalent, "exit_code": self.exit_code,
-            "tolerance": {"point_k": self.tolerance.point_k,
-                          "point_limit_min": self.limit_range[0],
-                          "point_limit_max": self.limit_range[1],
-                          "max_over_fraction": self.tolerance.max_over_fraction,
-                          "why": self.tolerance.why},
+            "a": self.path_a,
+            "b": self.path_b,
+            "label_a": self.label_a,
+            "label_b": self.label_b,
+            "pair": self.pair,
+            "equivalent": self.equivalent,
+            "exit_code": self.exit_code,
+            "tolerance": {
+                "point_k": self.tolerance.point_k,
+                "point_limit_min": self.limit_range[0],
+                "point_limit_max": self.limit_range[1],
+                "max_over_fraction": self.tolerance.max_over_fraction,
+                "why": self.tolerance.why,
+            },
             "frames": [f.as_dict() for f in self.frames],
             "invariants_a": self.invariants_a.as_dict(),
             "invariants_b": self.invariants_b.as_dict(),
@@ -106,7 +126,7 @@ class DiffResult:
         }
 
 
-def parse_frames(spec):
+def parse_frames(spec: str | None) -> str | list[int]:
     """'all' | 'last' | comma-separated frame indices (negative from the end)."""
     spec = (spec or "all").strip()
     if spec in ("all", "last"):
@@ -114,35 +134,40 @@ def parse_frames(spec):
     try:
         return [int(s) for s in spec.split(",") if s.strip()]
     except ValueError:
-        raise HarnessError(f"--frames must be 'all', 'last' or frame numbers like '3' or '1,3', "
-                           f"not '{spec}'") from None
+        raise HarnessError(f"--frames must be 'all', 'last' or frame numbers like '3' or '1,3', not '{spec}'") from None
 
 
-def frame_pairs(a, b, frames="all", align_last=False):
+def frame_pairs(a: State, b: State, frames: Frames = "all", align_last: bool = False) -> list[tuple[int, int]]:
     """The (frame in A, frame in B) pairs to compare; StateError if they do not exist."""
     Fa, Fb = a.n_frames, b.n_frames
     if frames == "last":
         return [(Fa - 1, Fb - 1)]
     if frames == "all":
         if Fa != Fb and not align_last:
-            raise StateError(f"frame counts differ: A has {Fa}, B has {Fb} (missing frames; "
-                             f"use --align-last, --frames last or --frame K to compare a part)")
+            raise StateError(
+                f"frame counts differ: A has {Fa}, B has {Fb} (missing frames; "
+                f"use --align-last, --frames last or --frame K to compare a part)"
+            )
         n = min(Fa, Fb)
         return [(Fa - n + i, Fb - n + i) for i in range(n)]
     pairs = []
+    if isinstance(frames, str):
+        raise StateError(f"frames must be 'all', 'last' or frame numbers, not '{frames}'")
     for k in frames:
-        for path, count in ((a.path, Fa), (b.path, Fb)):
-            if not -count <= k < count:
-                raise StateError(f"{path}: has no frame {k} (it has {count})")
-        pairs.append((k % Fa, k % Fb))
+        ka, kb = k if isinstance(k, tuple) else (k, k)  # (frame in A, frame in B), or one for both
+        for path, count, kk in ((a.path, Fa, ka), (b.path, Fb, kb)):
+            if not -count <= kk < count:
+                raise StateError(f"{path}: has no frame {kk} (it has {count})")
+        pairs.append((ka % Fa, kb % Fb))
     return pairs
 
 
-def check_comparable(a, b):
+def check_comparable(a: State, b: State) -> None:
     """Raise StateError when A and B are not states of the same scene."""
     if (a.n_strands, a.points) != (b.n_strands, b.points):
-        raise StateError(f"different sizes: A has {a.n_strands} strands × {a.points} points, "
-                         f"B has {b.n_strands} × {b.points}")
+        raise StateError(
+            f"different sizes: A has {a.n_strands} strands × {a.points} points, B has {b.n_strands} × {b.points}"
+        )
     for key in SCENE_ATTRS:
         va, vb = a.params.get(key), b.params.get(key)
         if va is None or vb is None:
@@ -155,26 +180,32 @@ def check_comparable(a, b):
             raise StateError(f"different scenes: {key} is {va} in A and {vb} in B")
 
 
-def strand_units(a, b, i0, i1, eps):
+def strand_units(a: State, b: State, i0: int, i1: int, eps: float) -> np.ndarray:
     """The error unit u of strands [i0, i1) (tolerances.point_unit), from both files'
     roots: the larger of the two (the smaller |x0| gives the larger unit), with the root
     terms only where the roots differ."""
     R, h = float(a.params["head_radius"]), float(a.params["hair_offset"])
     ra = invariants.read_strands(a, 0, i0, i1)[:, 0, :]
     rb = invariants.read_strands(b, 0, i0, i1)[:, 0, :]
-    differs = np.any(ra.astype(np.float64) != rb.astype(np.float64), axis=1) | \
-        ~np.all(np.isfinite(ra) & np.isfinite(rb), axis=1)
-    units = [tolerances.point_unit(r[:, 0].astype(np.float64), r[:, 1].astype(np.float64), R, h,
-                                   a.hair_length, a.points, eps, differs) for r in (ra, rb)]
+    differs = np.any(ra.astype(np.float64) != rb.astype(np.float64), axis=1) | ~np.all(
+        np.isfinite(ra) & np.isfinite(rb), axis=1
+    )
+    units = [
+        tolerances.point_unit(
+            r[:, 0].astype(np.float64), r[:, 1].astype(np.float64), R, h, a.hair_length, a.points, eps, differs
+        )
+        for r in (ra, rb)
+    ]
     with np.errstate(invalid="ignore"):
         return np.fmax(units[0], units[1])
 
 
-def compare_frame(a, b, fa, fb, tol, eps, ulp_dtype):
+def compare_frame(
+    a: State, b: State, fa: int, fb: int, tol: tolerances.PairTolerance, eps: float, ulp_dtype: Any
+) -> FrameDiff:
     stage_a, stage_b = a.stages[fa], b.stages[fb]
     if stage_a != stage_b:
-        raise StateError(f"frame {fa} of A is '{stage_a}' but frame {fb} of B is '{stage_b}' "
-                         f"(different stage lists)")
+        raise StateError(f"frame {fa} of A is '{stage_a}' but frame {fb} of B is '{stage_b}' (different stage lists)")
     # a fused wind frame holds the state after the wind half (the cuda backend keeps it,
     # docs/interfaces.md), so it is compared like any wind frame
     fd = FrameDiff(fa, fb, stage_a)
@@ -198,7 +229,7 @@ def compare_frame(a, b, fa, fb, tol, eps, ulp_dtype):
             fd.max_k = max(fd.max_k, float(k[good].max()))
             sum_sq += float(np.sum(dist[good] ** 2))
             n_finite += int(good.sum())
-        if tol.point_k == 0.0:   # exact: any difference is over
+        if tol.point_k == 0.0:  # exact: any difference is over
             over = (dist > 0) | ~finite
         else:
             over = ~(k <= tol.point_k) | ~finite
@@ -214,24 +245,41 @@ def compare_frame(a, b, fa, fb, tol, eps, ulp_dtype):
     return fd
 
 
-def compare(path_a, path_b, frames="all", align_last=False, exact=False):
-    """Compare two files; return a DiffResult. StateError (exit 2) if they cannot be."""
+def compare(
+    path_a: str | Path,
+    path_b: str | Path,
+    frames: Frames = "all",
+    align_last: bool = False,
+    exact: bool = False,
+    tolerance: tolerances.PairTolerance | None = None,
+) -> DiffResult:
+    """Compare two files; return a DiffResult. StateError (exit 2) if they cannot be.
+
+    `frames`: "all", "last", or a list of frame numbers or (frame in A, frame in B) pairs.
+    `tolerance`: a PairTolerance to use instead of the one of the files' precision kinds
+    (tolerances.named_pair: a tighter rule for a pair the precisions do not tell apart)."""
     with open_state(path_a) as a, open_state(path_b) as b:
         check_comparable(a, b)
         pairs = frame_pairs(a, b, frames, align_last)
         kind_a = tolerances.kind_of(a.precision, a.fast_math)
         kind_b = tolerances.kind_of(b.precision, b.fast_math)
-        tol = tolerances.EXACT if exact else tolerances.pair_tolerance(kind_a, kind_b)
+        tol = tolerances.EXACT if exact else (tolerance or tolerances.pair_tolerance(kind_a, kind_b))
         eps = max(tolerances.EPS[kind_a], tolerances.EPS[kind_b])
-        result = DiffResult(path_a=str(path_a), path_b=str(path_b), label_a=a.label, label_b=b.label,
-                            pair=f"{kind_a}↔{kind_b}" + (" (exact)" if exact else ""),
-                            tolerance=tol, hair_length=a.hair_length)
+        result = DiffResult(
+            path_a=str(path_a),
+            path_b=str(path_b),
+            label_a=a.label,
+            label_b=b.label,
+            pair=f"{kind_a}↔{kind_b}" + (" (exact)" if exact else f" ({tolerance.name})" if tolerance else ""),
+            tolerance=tol,
+            hair_length=a.hair_length,
+        )
         R, h = float(a.params["head_radius"]), float(a.params["hair_offset"])
         # the unit's range: a root with |x0| = R (smallest) to one with x0 = y0 = 0 (largest)
-        lo = tol.point_k * tolerances.point_unit(np.array([R]), np.array([0.0]), R, h,
-                                                 a.hair_length, a.points, eps)[0]
-        hi = tol.point_k * tolerances.point_unit(np.array([0.0]), np.array([0.0]), R, h,
-                                                 a.hair_length, a.points, eps)[0]
+        lo = tol.point_k * tolerances.point_unit(np.array([R]), np.array([0.0]), R, h, a.hair_length, a.points, eps)[0]
+        hi = (
+            tol.point_k * tolerances.point_unit(np.array([0.0]), np.array([0.0]), R, h, a.hair_length, a.points, eps)[0]
+        )
         result.limit_range = (float(lo), float(hi))
         for fa, fb in pairs:
             result.frames.append(compare_frame(a, b, fa, fb, tol, eps, coarser(a.dtype, b.dtype)))
@@ -240,28 +288,34 @@ def compare(path_a, path_b, frames="all", align_last=False, exact=False):
     return result
 
 
-def format_result(r):
+def format_result(r: DiffResult) -> str:
     t = r.tolerance
     lines = [f"A: {r.path_a} ({r.label_a})", f"B: {r.path_b} ({r.label_b})"]
     if t.point_k:
         lo, hi = r.limit_range
-        lines.append(f"tolerance {r.pair}: a point is over when it differs by more than "
-                     f"{t.point_k:g}·u, u = ε·(P·E + R²/|x0| + R²/|(x0,y0)|) per strand "
-                     f"({lo:.2g} … {hi:.2g}, i.e. {lo / r.hair_length:.1e}·L … "
-                     f"{hi / r.hair_length:.1e}·L); at most {t.max_over_fraction:.4%} of points may be over")
+        lines.append(
+            f"tolerance {r.pair}: a point is over when it differs by more than "
+            f"{t.point_k:g}·u, u = ε·(P·E + R²/|x0| + R²/|(x0,y0)|) per strand "
+            f"({lo:.2g} … {hi:.2g}, i.e. {lo / r.hair_length:.1e}·L … "
+            f"{hi / r.hair_length:.1e}·L); at most {t.max_over_fraction:.4%} of points may be over"
+        )
     else:
         lines.append(f"tolerance {r.pair}: {t.why}")
-    head = f"{'frame':>5} {'stage':8} {'max abs':>10} {'rms':>10} {'max/L':>10} {'max/u':>8} " \
-           f"{'ulp p50':>8} {'ulp p99':>8} {'ulp max':>10} {'over':>7} {'nan/inf':>7}  verdict"
+    head = (
+        f"{'frame':>5} {'stage':8} {'max abs':>10} {'rms':>10} {'max/L':>10} {'max/u':>8} "
+        f"{'ulp p50':>8} {'ulp p99':>8} {'ulp max':>10} {'over':>7} {'nan/inf':>7}  verdict"
+    )
     lines.append(head)
     for f in r.frames:
         frame = f"{f.frame_a}" if f.frame_a == f.frame_b else f"{f.frame_a}/{f.frame_b}"
         if not f.compared:
             lines.append(f"{frame:>5} {f.stage:8} {f.note}")
             continue
-        lines.append(f"{frame:>5} {f.stage:8} {f.max_abs:10.3e} {f.rms_abs:10.3e} {f.max_rel_L:10.3e} {f.max_k:8.3g} "
-                     f"{f.ulp_p50:8.0f} {f.ulp_p99:8.0f} {f.ulp_max:10.3g} {f.over:7d} {f.nonfinite:7d}  "
-                     f"{'ok' if f.ok else 'FAIL'}")
+        lines.append(
+            f"{frame:>5} {f.stage:8} {f.max_abs:10.3e} {f.rms_abs:10.3e} {f.max_rel_L:10.3e} {f.max_k:8.3g} "
+            f"{f.ulp_p50:8.0f} {f.ulp_p99:8.0f} {f.ulp_max:10.3g} {f.over:7d} {f.nonfinite:7d}  "
+            f"{'ok' if f.ok else 'FAIL'}"
+        )
     for label, rep in (("A", r.invariants_a), ("B", r.invariants_b)):
         if rep.ok:
             lines.append(f"invariants {label} ({rep.kind}): all hold")
@@ -275,15 +329,25 @@ def format_result(r):
     return "\n".join(lines)
 
 
-def run(path_a, path_b, frames="all", align_last=False, exact=False, as_json=False, out=print):
+def run(
+    path_a: str | Path,
+    path_b: str | Path,
+    frames: Frames = "all",
+    align_last: bool = False,
+    exact: bool = False,
+    as_json: bool = False,
+    out: Callable[[str], Any] = print,
+) -> int:
     """The `harness diff` command; returns the exit status."""
+    from . import dyndiff  # dynamic files: frames paired by step (harness/dyndiff.py)
+
+    if dyndiff.is_dynamic_file(path_a) or dyndiff.is_dynamic_file(path_b):
+        return dyndiff.run(path_a, path_b, frames=frames, exact=exact, as_json=as_json, out=out)
     try:
-        result = compare(path_a, path_b, parse_frames(frames) if isinstance(frames, str) else frames,
-                         align_last, exact)
+        result = compare(path_a, path_b, parse_frames(frames) if isinstance(frames, str) else frames, align_last, exact)
     except StateError as e:
         if as_json:
-            out(json.dumps({"a": str(path_a), "b": str(path_b), "exit_code": EXIT_CANNOT_COMPARE,
-                            "error": str(e)}))
+            out(json.dumps({"a": str(path_a), "b": str(path_b), "exit_code": EXIT_CANNOT_COMPARE, "error": str(e)}))
         raise HarnessError(f"cannot compare: {e}", code=EXIT_CANNOT_COMPARE) from None
     out(json.dumps(result.as_dict(), indent=1, ensure_ascii=False) if as_json else format_result(result))
     return result.exit_code

@@ -1,6 +1,7 @@
 """The environment record of a sweep (results/<name>/env.json) and GPU detection.
 
 Every probe is best effort: a tool that is missing gives null, never an error."""
+
 import datetime
 import os
 import platform
@@ -44,8 +45,11 @@ def cpu_model():
 
 
 def gpu_info():
-    out = _cmd(["nvidia-smi", "--query-gpu=name,driver_version,memory.total",
-                "--format=csv,noheader"]) if shutil.which("nvidia-smi") else None
+    out = (
+        _cmd(["nvidia-smi", "--query-gpu=name,driver_version,memory.total", "--format=csv,noheader"])
+        if shutil.which("nvidia-smi")
+        else None
+    )
     if not out:
         return None
     gpus = []

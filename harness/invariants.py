@@ -6,12 +6,14 @@
   x_constant  x is bit-identical along each strand and through every frame (a strand
               lives in its slice plane x = x0)
   segments    every segment length equals ℓ = L/(P−1) within the precision's tolerance
-  shell       after a collide frame no non-root point is inside its shell circle, radius rc = |(y0, z0)| + h, beyond the tolerance
+  shell       after a collide frame no non-root point is inside its shell circle, radius
+              rc = |(y0, z0)| + h, beyond the tolerance
   skipped     a skipped stage (wind with w = 0) left its frame bit-identical to the last
 
 The tolerances are those of tolerances.py for the file's precision kind. `check` returns
 the violations and the worst values seen (which `harness calibrate` reports).
 """
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -31,8 +33,14 @@ class Violation:
     message: str
 
     def as_dict(self):
-        return {"frame": self.frame, "stage": self.stage, "invariant": self.invariant,
-                "count": self.count, "worst": self.worst, "message": self.message}
+        return {
+            "frame": self.frame,
+            "stage": self.stage,
+            "invariant": self.invariant,
+            "count": self.count,
+            "worst": self.worst,
+            "message": self.message,
+        }
 
 
 @dataclass
@@ -51,13 +59,15 @@ class InvariantReport:
         return not self.violations
 
     def as_dict(self):
-        return {"path": self.path, "kind": self.kind, "ok": self.ok,
-                "tolerance": {"segment_k": self.tolerance.segment_k,
-                              "shell_k": self.tolerance.shell_k},
-                "worst_segment_k": self.worst_segment_k,
-                "worst_shell_k": (None if self.worst_shell_k == float("-inf")
-                                  else self.worst_shell_k),
-                "violations": [v.as_dict() for v in self.violations]}
+        return {
+            "path": self.path,
+            "kind": self.kind,
+            "ok": self.ok,
+            "tolerance": {"segment_k": self.tolerance.segment_k, "shell_k": self.tolerance.shell_k},
+            "worst_segment_k": self.worst_segment_k,
+            "worst_shell_k": (None if self.worst_shell_k == float("-inf") else self.worst_shell_k),
+            "violations": [v.as_dict() for v in self.violations],
+        }
 
 
 def _bits(a):
@@ -72,7 +82,7 @@ def is_collide_frame(state, f):
 
 def read_strands(state, f, i0, i1):
     """Strands [i0, i1) of frame f as [n][P][3] in the file's dtype."""
-    rows = state._dset[f, i0 * state.points:i1 * state.points]
+    rows = state._dset[f, i0 * state.points : i1 * state.points]
     return rows.reshape(i1 - i0, state.points, 3)
 
 
@@ -98,12 +108,10 @@ def check(state, tol=None):
     h = float(state.params["hair_offset"])
     eps = tolerances.EPS[kind]
     seg_unit = eps * tolerances.extent(float(state.params["head_radius"]), h, state.hair_length)
-    seg_allow = tol.segment_k * seg_unit
     N, P = state.n_strands, state.points
 
     for f in range(state.n_frames):
-        tallies = {name: _Tally() for name in
-                   ("finite", "roots", "x_constant", "segments", "shell", "skipped")}
+        tallies = {name: _Tally() for name in ("finite", "roots", "x_constant", "segments", "shell", "skipped")}
         collide = is_collide_frame(state, f)
         for i0 in range(0, N, STRAND_CHUNK):
             i1 = min(N, i0 + STRAND_CHUNK)
@@ -148,15 +156,20 @@ def check(state, tol=None):
             "finite": lambda t: f"{t.count} coordinate(s) are NaN or Inf",
             "roots": lambda t: f"{t.count} root(s) moved since frame 0",
             "x_constant": lambda t: f"{t.count} point(s) left their strand's slice plane x = x0",
-            "segments": lambda t: (f"{t.count} of {N * (P - 1)} segment length(s) differ from ℓ by more "
-                                   f"than {tol.segment_k:g}·ε·E = {tol.segment_k * seg_unit / ell:.2e}·ℓ "
-                                   f"(worst {t.worst:.3g}·ε·E)"),
-            "shell": lambda t: (f"{t.count} of {total_points} point(s) inside the shell circle by more "
-                                f"than {tol.shell_k:g}·ε·rc (worst {t.worst:.3g}·ε·rc)"),
+            "segments": lambda t: (
+                f"{t.count} of {N * (P - 1)} segment length(s) differ from ℓ by more "
+                f"than {tol.segment_k:g}·ε·E = {tol.segment_k * seg_unit / ell:.2e}·ℓ "
+                f"(worst {t.worst:.3g}·ε·E)"
+            ),
+            "shell": lambda t: (
+                f"{t.count} of {total_points} point(s) inside the shell circle by more "
+                f"than {tol.shell_k:g}·ε·rc (worst {t.worst:.3g}·ε·rc)"
+            ),
             "skipped": lambda t: f"skipped stage changed {t.count} coordinate(s)",
         }
         for name, t in tallies.items():
             if t.count:
-                report.violations.append(Violation(f, stage, name, t.count, t.worst,
-                                                   f"frame {f} ({stage}): {messages[name](t)}"))
+                report.violations.append(
+                    Violation(f, stage, name, t.count, t.worst, f"frame {f} ({stage}): {messages[name](t)}")
+                )
     return report

@@ -1,12 +1,16 @@
-"""Where things live: the repository root, the built binaries, configs/, results/, report/.
+"""Where things live: the repository root, the built binaries, configs/scenes/,
+configs/sweeps/, results/, report/.
 
 HAIRBENCH_BUILD_DIR overrides the build directory (the tests use it to point the harness
 at stand-in binaries)."""
+
 import os
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 CONFIGS = ROOT / "configs"
+SCENES = CONFIGS / "scenes"  # scene files (DESIGN §8)
+SWEEPS = CONFIGS / "sweeps"  # sweep files
 RESULTS = ROOT / "results"
 REPORT = ROOT / "report"
 
@@ -29,9 +33,11 @@ def binary_path(backend, build="default"):
     if backend == "cuda":
         if build not in CUDA_BUILDS:
             from . import HarnessError
+
             raise HarnessError(f"unknown cuda build '{build}' (known: {', '.join(CUDA_BUILDS)})")
         return build_dir() / CUDA_BUILDS[build]
     from . import HarnessError
+
     raise HarnessError(f"unknown backend '{backend}' (known: cpu, cuda)")
 
 
@@ -44,12 +50,13 @@ def display(path):
         return str(p)
 
 
-def config_file(ref):
-    """A config path as given, or a bare name looked up as configs/<name>.toml; None if neither."""
+def config_file(ref, directory):
+    """A config path as given, or a bare name looked up as `directory`/<name>.toml (SCENES
+    or SWEEPS); None if neither."""
     p = Path(ref)
     if p.is_file():
         return p
-    candidate = CONFIGS / f"{ref}.toml"
+    candidate = Path(directory) / f"{ref}.toml"
     if p.suffix == "" and candidate.is_file():
         return candidate
     return None
@@ -64,5 +71,7 @@ def read_toml(path, where, error):
             return tomllib.load(f)
     except tomllib.TOMLDecodeError as e:
         raise error(f"{where}: not valid TOML: {e}") from None
+    except UnicodeDecodeError as e:
+        raise error(f"{where}: not UTF-8 text (byte {e.start}); TOML files are UTF-8") from None
     except OSError as e:
         raise error(f"{where}: cannot read: {e.strerror}") from None

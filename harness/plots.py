@@ -11,6 +11,7 @@
   fig2_after_wind.png          the paper's Fig. 2 (after wind + collide), same view
 Without GPU rows the GPU panels say so instead of staying blank.
 """
+
 import os
 from pathlib import Path
 
@@ -23,8 +24,8 @@ import numpy as np  # noqa: E402
 from . import results_data  # noqa: E402
 from .paths import REPORT, binary_path  # noqa: E402
 
-FIGURE_STRANDS = 400        # strands in the Fig. 1/2 state
-FIGURE_DRAWN = 160          # strands drawn of them
+FIGURE_STRANDS = 400  # strands in the Fig. 1/2 state
+FIGURE_DRAWN = 160  # strands drawn of them
 FIGURE_STATE = "states/figure-cpu-fp32.h5"
 
 
@@ -38,8 +39,7 @@ def _save(fig, path):
 
 
 def _note(ax, text):
-    ax.text(0.5, 0.5, text, ha="center", va="center", wrap=True, transform=ax.transAxes,
-            fontsize=9, color="0.3")
+    ax.text(0.5, 0.5, text, ha="center", va="center", wrap=True, transform=ax.transAxes, fontsize=9, color="0.3")
 
 
 def speedup_plot(cases, precision, points, out_dir, gpu_note):
@@ -47,15 +47,14 @@ def speedup_plot(cases, precision, points, out_dir, gpu_note):
     gpu = c[c["backend"] == "cuda"]
     cpu = c[c["backend"] == "cpu"]
     variants = sorted(gpu["variant"].unique()) or ["(no GPU rows)"]
-    fig, axes = plt.subplots(2, len(variants), figsize=(5.2 * len(variants), 7.5), squeeze=False,
-                             sharex=True)
+    fig, axes = plt.subplots(2, len(variants), figsize=(5.2 * len(variants), 7.5), squeeze=False, sharex=True)
     for row, which in enumerate(("single", "all")):
         base = results_data.cpu_baseline(c, which)
         bname = results_data.BASELINES[which]
         for col, variant in enumerate(variants):
             ax = axes[row][col]
             ax.set_xscale("log")
-            ax.set_yscale("log")   # speedups span orders of magnitude, and < 1 at small N
+            ax.set_yscale("log")  # speedups span orders of magnitude, and < 1 at small N
             ax.axhline(1.0, color="0.6", lw=0.8)
             lines = []
             if which == "single":  # the other CPU configurations, as dashed lines
@@ -88,8 +87,12 @@ def speedup_plot(cases, precision, points, out_dir, gpu_note):
 def block_size_plot(cases, precision, points, out_dir, gpu_note):
     """One panel per GPU variant (default build): time against block size at the two
     largest strand counts, IQR as error bars, 32 and 64 marked (the paper's finding)."""
-    c = cases[(cases["precision"] == precision) & (cases["points"] == points)
-              & (cases["backend"] == "cuda") & cases["build"].isin(["", "default"])].dropna(subset=["pair_ms"])
+    c = cases[
+        (cases["precision"] == precision)
+        & (cases["points"] == points)
+        & (cases["backend"] == "cuda")
+        & cases["build"].isin(["", "default"])
+    ].dropna(subset=["pair_ms"])
     variants = sorted(c["variant"].unique()) or [None]
     fig, axes = plt.subplots(1, len(variants), figsize=(4.6 * len(variants), 4.2), squeeze=False)
     for ax, variant in zip(axes[0], variants):
@@ -99,10 +102,17 @@ def block_size_plot(cases, precision, points, out_dir, gpu_note):
             _note(ax, f"no GPU rows: the paper's block-size finding (32 vs 64) needs a GPU.\n{gpu_note}")
         else:
             g = c[c["variant"] == variant]
-            for n in sorted(g["strands"].unique())[-2:]:   # the two largest strand counts
+            for n in sorted(g["strands"].unique())[-2:]:  # the two largest strand counts
                 gg = g[g["strands"] == n].sort_values("block_size")
-                ax.errorbar(gg["block_size"], gg["pair_ms"], yerr=gg["pair_iqr_ms"] / 2, marker="o",
-                            ms=3, capsize=2, label=f"N = {n:,}")
+                ax.errorbar(
+                    gg["block_size"],
+                    gg["pair_ms"],
+                    yerr=gg["pair_iqr_ms"] / 2,
+                    marker="o",
+                    ms=3,
+                    capsize=2,
+                    label=f"N = {n:,}",
+                )
             for b in (32, 64):
                 ax.axvline(b, color="0.8", lw=0.8, zorder=0)
             ax.legend(fontsize=7)
@@ -116,8 +126,9 @@ def block_size_plot(cases, precision, points, out_dir, gpu_note):
 
 
 def bandwidth_plot(rows, precision, points, out_dir, gpu_note):
-    r = rows[(rows["precision"] == precision) & (rows["points"] == points)
-             & rows["stage"].isin(["wind", "collide"])].copy()
+    r = rows[
+        (rows["precision"] == precision) & (rows["points"] == points) & rows["stage"].isin(["wind", "collide"])
+    ].copy()
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), squeeze=False)
     r = r[(r["backend"] == "cpu") | r["build"].isin(["", "default"])]
     best = best_blocks(r)
@@ -143,8 +154,16 @@ def bandwidth_plot(rows, precision, points, out_dir, gpu_note):
         if not drawn:
             _note(ax, "no bandwidth fractions: the copy bandwidth was not measured")
         elif not (rows["backend"] == "cuda").any():
-            ax.text(0.02, 0.97, f"GPU rows absent: {gpu_note}", transform=ax.transAxes, va="top",
-                    fontsize=7, color="0.3", wrap=True)
+            ax.text(
+                0.02,
+                0.97,
+                f"GPU rows absent: {gpu_note}",
+                transform=ax.transAxes,
+                va="top",
+                fontsize=7,
+                color="0.3",
+                wrap=True,
+            )
         ax.set_xscale("log")
         ax.set_xlabel("strands")
         ax.set_ylabel("fraction of measured copy bandwidth")
@@ -152,8 +171,10 @@ def bandwidth_plot(rows, precision, points, out_dir, gpu_note):
         ax.grid(True, which="both", alpha=0.3)
         if drawn:
             ax.legend(fontsize=6)
-    fig.suptitle(f"roofline: bytes the stage must move / time, over the device's copy bandwidth "
-                 f"({precision}, {points} points)", fontsize=10)
+    fig.suptitle(
+        f"roofline: bytes the stage must move / time, over the device's copy bandwidth ({precision}, {points} points)",
+        fontsize=10,
+    )
     return _save(fig, out_dir / f"bandwidth_{precision}.png")
 
 
@@ -197,8 +218,10 @@ def hair_figures(state_path, out_dir):
         R = float(s.params["head_radius"])
         rng = np.random.default_rng(0)
         pick = np.sort(rng.choice(s.n_strands, size=min(FIGURE_DRAWN, s.n_strands), replace=False))
-        for name, frame, title in (("fig1_initialized.png", after_init, "Fig. 1: hair initialized"),
-                                   ("fig2_after_wind.png", after_wind, "Fig. 2: hair after wind")):
+        for name, frame, title in (
+            ("fig1_initialized.png", after_init, "Fig. 1: hair initialized"),
+            ("fig2_after_wind.png", after_wind, "Fig. 2: hair after wind"),
+        ):
             fig, ax = plt.subplots(figsize=(5.5, 6))
             if frame is None:
                 _note(ax, "this state has no wind stage")
@@ -208,8 +231,11 @@ def hair_figures(state_path, out_dir):
                     ax.plot(strand[:, 2], strand[:, 1], lw=0.6, color="saddlebrown", alpha=0.6)
                 ax.add_patch(plt.Circle((0, 0), R, fill=False, color="k", lw=1.2))
                 ax.annotate("face →", (R * 0.55, -R * 0.1), fontsize=8, color="0.3")
-                ax.set_title(f"{title} (frame {frame}: after {' + '.join(stages[:frame + 1])})\n"
-                             f"{len(pick)} of {s.n_strands} strands, side view", fontsize=9)
+                ax.set_title(
+                    f"{title} (frame {frame}: after {' + '.join(stages[: frame + 1])})\n"
+                    f"{len(pick)} of {s.n_strands} strands, side view",
+                    fontsize=9,
+                )
             ax.set_aspect("equal")
             ax.set_xlabel("z (toward the face)")
             ax.set_ylabel("y (up)")

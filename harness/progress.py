@@ -1,4 +1,5 @@
 """A progress bar (tqdm) that falls back silently to none when tqdm is missing."""
+
 import sys
 
 try:
@@ -11,8 +12,9 @@ class Progress:
     def __init__(self, total, desc):
         self.bar = None
         if _tqdm is not None and total:
-            self.bar = _tqdm(total=total, desc=desc, unit="case", file=sys.stderr,
-                             dynamic_ncols=True, leave=True, disable=None)  # no bar off a terminal
+            self.bar = _tqdm(
+                total=total, desc=desc, unit="case", file=sys.stderr, dynamic_ncols=True, leave=True, disable=None
+            )  # no bar off a terminal
 
     def update(self, n=1):
         if self.bar is not None:

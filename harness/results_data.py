@@ -5,7 +5,9 @@ use. One job: turn tidy rows into per-case numbers.
 plus the median of the collide right after it (for the fused variant the wind row carries
 the pair and the collide row is 0). `total_ms` is the sum of every stage's median.
 Medians are added, not the medians of sums: each stage is timed on its own."""
+
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -13,8 +15,18 @@ import pandas as pd
 
 from . import HarnessError, runlog
 
-CASE_KEYS = ["case_id", "scene", "backend", "build", "variant", "precision", "block_size",
-             "threads", "strands", "points"]
+CASE_KEYS = [
+    "case_id",
+    "scene",
+    "backend",
+    "build",
+    "variant",
+    "precision",
+    "block_size",
+    "threads",
+    "strands",
+    "points",
+]
 
 
 def load(results_dir):
@@ -58,11 +70,15 @@ def per_case(rows):
                 pair_iqr += iqr[i + 1]
         first = g.iloc[0]
         rec = {k: first[k] for k in CASE_KEYS}
-        rec.update(pair_ms=pair, pair_iqr_ms=pair_iqr, total_ms=float(np.sum(med)),
-                   stages=",".join(stages),
-                   skipped_stages=",".join(s for s, k in zip(stages, g["skipped"]) if int(k)),
-                   fused=",".join(f for f in g["fused"] if f),
-                   end_to_end_ms=first.get("end_to_end_ms"))
+        rec.update(
+            pair_ms=pair,
+            pair_iqr_ms=pair_iqr,
+            total_ms=float(np.sum(med)),
+            stages=",".join(stages),
+            skipped_stages=",".join(s for s, k in zip(stages, g["skipped"]) if int(k)),
+            fused=",".join(f for f in g["fused"] if f),
+            end_to_end_ms=first.get("end_to_end_ms"),
+        )
         out.append(rec)
     cases = pd.DataFrame(out)
     if not cases.empty:
@@ -109,3 +125,40 @@ def gpu_absent_reason(env):
     if reasons:
         return reasons[-1]
     return "the sweep has no cuda cases"
+
+
+def strands_at_time(curve, target_ms):
+    """Strand count at which a (strands → ms) curve reaches target_ms.
+
+    Log-log interpolation between measured points; beyond the largest, linear in N from
+    it (the work is linear in N), marked extrapolated. (None, note) if it cannot."""
+    pts = sorted((int(n), float(t)) for n, t in curve.items() if t and t > 0)
+    if not pts:
+        return None, "no data"
+    for (n0, t0), (n1, t1) in zip(pts, pts[1:]):
+        if t0 <= target_ms <= t1 and t1 > t0:
+            f = (math.log(target_ms) - math.log(t0)) / (math.log(t1) - math.log(t0))
+            return math.exp(math.log(n0) + f * (math.log(n1) - math.log(n0))), "interpolated"
+    n_max, t_max = pts[-1]
+    if target_ms > t_max:
+        return n_max * target_ms / t_max, f"extrapolated linearly from N = {n_max:,}"
+    n_min, t_min = pts[0]
+    return n_min * target_ms / t_min, f"below our smallest N = {n_min:,}: extrapolated"
+
+
+def interp_time(curve, n):
+    """Our time at strand count n (log-log interpolation, linear extrapolation)."""
+    pts = sorted((int(k), float(t)) for k, t in curve.items() if t and t > 0)
+    if not pts or n is None:
+        return None
+    for (n0, t0), (n1, t1) in zip(pts, pts[1:]):
+        if n0 <= n <= n1:
+            f = (math.log(n) - math.log(n0)) / (math.log(n1) - math.log(n0))
+            return math.exp(math.log(t0) + f * (math.log(t1) - math.log(t0)))
+    n_edge, t_edge = pts[-1] if n > pts[-1][0] else pts[0]
+    return t_edge * n / n_edge
+
+
+def curve_of(cases, mask):
+    c = cases[mask].dropna(subset=["pair_ms"])
+    return dict(zip(c["strands"], c["pair_ms"]))

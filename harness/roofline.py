@@ -19,6 +19,7 @@ The limit is the device's measured copy bandwidth, `copy_gbps` = (bytes read + b
 written) / time of a large device-to-device copy (GPU) or of a STREAM-style copy over all
 cores (CPU), as printed by `hairsim-* --measure-bandwidth --json`.
 """
+
 from .runner import BackendError, run_binary
 
 
@@ -53,8 +54,7 @@ def measure_copy_bandwidth(binary, timeout=300):
     try:
         rec = run_binary(binary, ["--measure-bandwidth"], timeout=timeout, expect_keys=("copy_gbps",))
     except BackendError as e:
-        return None, (f"{binary.name} --measure-bandwidth failed ({e}); "
-                      f"bandwidth fractions are left empty")
+        return None, (f"{binary.name} --measure-bandwidth failed ({e}); bandwidth fractions are left empty")
     gbps = rec.get("copy_gbps")
     if not isinstance(gbps, (int, float)) or gbps <= 0:
         return None, f"{binary.name} --measure-bandwidth gave copy_gbps = {gbps!r}; fractions left empty"

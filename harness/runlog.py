@@ -7,6 +7,7 @@ file, keeps every complete case, and cuts off the trailing partial line or parti
 row is lost or duplicated. The file is never truncated otherwise, and a file with other
 columns is refused rather than mixed.
 """
+
 import csv
 import io
 import os
@@ -14,11 +15,42 @@ import os
 from . import HarnessError
 
 COLUMNS = [
-    "case_id", "stage_index", "n_stages", "stage", "scene", "backend", "build", "variant",
-    "precision", "block_size", "threads", "strands", "points", "repeat", "warmup",
-    "skipped", "fused", "n_times", "median_ms", "min_ms", "max_ms", "q1_ms", "q3_ms", "iqr_ms",
-    "moved_points", "bytes_moved", "achieved_gbps", "copy_gbps", "bandwidth_fraction",
-    "end_to_end_ms", "h2d_ms", "d2h_ms", "state_bytes", "device", "binary", "session",
+    "case_id",
+    "stage_index",
+    "n_stages",
+    "stage",
+    "scene",
+    "backend",
+    "build",
+    "variant",
+    "precision",
+    "block_size",
+    "threads",
+    "strands",
+    "points",
+    "repeat",
+    "warmup",
+    "skipped",
+    "fused",
+    "n_times",
+    "median_ms",
+    "min_ms",
+    "max_ms",
+    "q1_ms",
+    "q3_ms",
+    "iqr_ms",
+    "moved_points",
+    "bytes_moved",
+    "achieved_gbps",
+    "copy_gbps",
+    "bandwidth_fraction",
+    "end_to_end_ms",
+    "h2d_ms",
+    "d2h_ms",
+    "state_bytes",
+    "device",
+    "binary",
+    "session",
     "finished_at",
 ]
 HEADER = ",".join(COLUMNS) + "\n"
@@ -53,11 +85,12 @@ def resume(path):
             _truncate(path, 0, header)
             return set(), len(data)
         first = data.split(b"\n", 1)[0].decode("utf-8", "replace")
-        raise HarnessError(f"{path}: has other columns than this harness writes "
-                           f"(first line '{first[:60]}…'); use another --out")
-    lines = data[len(header):].splitlines(keepends=True)
+        raise HarnessError(
+            f"{path}: has other columns than this harness writes (first line '{first[:60]}…'); use another --out"
+        )
+    lines = data[len(header) :].splitlines(keepends=True)
     complete = set()
-    keep = len(header)          # end of the last complete case
+    keep = len(header)  # end of the last complete case
     offset = keep
     group_id, group_seen, group_n = None, set(), 0
     for i, raw in enumerate(lines):
@@ -67,8 +100,10 @@ def resume(path):
         if fields is None:
             if last:
                 break  # a partial trailing line: cut below
-            raise HarnessError(f"{path}: line {i + 2} is damaged (not {len(COLUMNS)} fields); "
-                               f"fix or move the file, the harness will not cut it")
+            raise HarnessError(
+                f"{path}: line {i + 2} is damaged (not {len(COLUMNS)} fields); "
+                f"fix or move the file, the harness will not cut it"
+            )
         row = dict(zip(COLUMNS, fields))
         if row["case_id"] != group_id:
             group_id, group_seen, group_n = row["case_id"], set(), int(row["n_stages"])
@@ -93,7 +128,7 @@ def _fields(raw):
 
 
 def _truncate(path, size, then_write=b""):
-    with open(path, "ab") as f:   # never truncates on open
+    with open(path, "ab") as f:  # never truncates on open
         f.truncate(size)
         f.write(then_write)
         f.flush()

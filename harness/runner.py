@@ -4,9 +4,12 @@ A failure is one HarnessError line naming the binary, its exit status and the la
 it wrote on stderr; exit status 3 (state does not fit in memory) is a `DoesNotFit`, so a
 sweep can skip the case and go on.
 """
+
 import json
 import subprocess
+from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import Any
 
 from . import HarnessError
 from .paths import display
@@ -26,19 +29,21 @@ class MissingBinary(HarnessError):
     pass
 
 
-def require_binary(path):
+def require_binary(path: str | Path) -> Path:
     path = Path(path)
     if not path.exists():
         raise MissingBinary(f"{display(path)} not found: run make")
     return path
 
 
-def last_line(text):
+def last_line(text: str) -> str:
     lines = [ln for ln in (text or "").strip().splitlines() if ln.strip()]
     return lines[-1].strip() if lines else ""
 
 
-def run_binary(binary, args, timeout=None, expect_keys=RECORD_KEYS):
+def run_binary(
+    binary: str | Path, args: Sequence[Any], timeout: float | None = None, expect_keys: Iterable[str] = RECORD_KEYS
+) -> dict[str, Any]:
     """Run `binary args… --json --quiet`; return the JSON object it prints."""
     binary = require_binary(binary)
     cmd = [str(binary), *map(str, args), "--json", "--quiet"]
@@ -55,8 +60,9 @@ def run_binary(binary, args, timeout=None, expect_keys=RECORD_KEYS):
     try:
         record = json.loads(proc.stdout)
     except json.JSONDecodeError:
-        raise BackendError(f"{binary.name} printed no JSON record on stdout "
-                           f"(got: {last_line(proc.stdout)[:120]!r})") from None
+        raise BackendError(
+            f"{binary.name} printed no JSON record on stdout (got: {last_line(proc.stdout)[:120]!r})"
+        ) from None
     if not isinstance(record, dict):
         raise BackendError(f"{binary.name} printed JSON that is not an object")
     missing = [k for k in expect_keys if k not in record]
@@ -65,13 +71,30 @@ def run_binary(binary, args, timeout=None, expect_keys=RECORD_KEYS):
     return record
 
 
-def run_flags(scene, backend, variant=None, block_size=None, threads=None, repeat=None,
-              warmup=None, output=None, force=False, input_file=None, stages=None):
+def run_flags(
+    scene: Any,
+    backend: str,
+    variant: str | None = None,
+    block_size: int | None = None,
+    threads: int | str | None = None,
+    repeat: int | None = None,
+    warmup: int | None = None,
+    output: str | Path | None = None,
+    force: bool = False,
+    input_file: str | Path | None = None,
+    stages: Sequence[str] | None = None,
+) -> list[str]:
     """Backend flags for a scene and run options. With input_file, the geometry comes
     from the file and only the wind flags and the stages are passed."""
     if input_file:
-        flags = ["--input", str(input_file), "--wind-strength", repr(scene.wind_strength),
-                 "--wind-angle", repr(scene.wind_angle)]
+        flags = [
+            "--input",
+            str(input_file),
+            "--wind-strength",
+            repr(scene.wind_strength),
+            "--wind-angle",
+            repr(scene.wind_angle),
+        ]
         flags += ["--stages", ",".join(stages or scene.stages)]
     else:
         flags = scene.flags()
@@ -95,20 +118,27 @@ def run_flags(scene, backend, variant=None, block_size=None, threads=None, repea
     return flags
 
 
-def summary(record):
+def summary(record: dict[str, Any]) -> str:
     """A short human table of a record's stage times."""
-    where = (f"block size {record.get('block_size')}" if record.get("backend") == "cuda"
-             else f"{record.get('threads')} thread(s)")
-    lines = [f"{record.get('backend')}/{record.get('variant')} {record.get('precision')}: "
-             f"{record.get('strands')} strands × {record.get('points')} points, {where}, "
-             f"repeat {record.get('repeat')}, on {record.get('device')}"]
+    where = (
+        f"block size {record.get('block_size')}"
+        if record.get("backend") == "cuda"
+        else f"{record.get('threads')} thread(s)"
+    )
+    lines = [
+        f"{record.get('backend')}/{record.get('variant')} {record.get('precision')}: "
+        f"{record.get('strands')} strands × {record.get('points')} points, {where}, "
+        f"repeat {record.get('repeat')}, on {record.get('device')}"
+    ]
     lines.append(f"{'frame':>5} {'stage':8} {'median ms':>10} {'min ms':>10} {'max ms':>10} {'moved':>8}  note")
     for s in record.get("stages", []):
         note = "skipped (nil effect)" if s.get("skipped") else (s.get("fused") or "")
         moved = s.get("moved_points")
-        lines.append(f"{s.get('frame', ''):>5} {s.get('stage', ''):8} {s.get('median_ms', 0):10.3f} "
-                     f"{s.get('min_ms', 0):10.3f} {s.get('max_ms', 0):10.3f} "
-                     f"{'' if moved is None else moved:>8}  {note}")
+        lines.append(
+            f"{s.get('frame', ''):>5} {s.get('stage', ''):8} {s.get('median_ms', 0):10.3f} "
+            f"{s.get('min_ms', 0):10.3f} {s.get('max_ms', 0):10.3f} "
+            f"{'' if moved is None else moved:>8}  {note}"
+        )
     for key in ("end_to_end_ms", "h2d_ms", "d2h_ms", "hdf5_write_ms"):
         if record.get(key) is not None:
             lines.append(f"{key}: {record[key]:.3f}")

@@ -1,4 +1,4 @@
-"""Scene files (configs/*.toml, DESIGN §8) → validated Scene → backend flags.
+"""Scene files (configs/scenes/*.toml, DESIGN §8) → validated Scene → backend flags.
 
 A scene file:
 
@@ -22,31 +22,50 @@ A scene file:
 Every key is optional except `stages`; missing ones take the backends' defaults (the
 values above). Anything else is refused before any work, naming the key: unknown keys,
 counts that are not whole numbers ≥ 1 (≥ 2 for points), NaN or infinite numbers, stages
-that do not exist or a list not starting with init, ℓ < h, and a state that would not fit
-in this machine's memory.
+that do not exist or a list not starting with init, ℓ < h, and a state whose frame (times
+the copies a backend holds) would not fit in this machine's memory.
 """
+
 import math
 import os
 import tomllib
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
-from . import HarnessError
-from .paths import CONFIGS, config_file, read_toml
+from . import HarnessError, dynscene
+from .paths import SCENES, config_file, read_toml
 
-STAGES = ("init", "collide", "wind")
+STAGES = ("init", "collide", "wind", "simulate")
 PRECISIONS = ("fp32", "fp64")
-MODELS = ("paper",)
+MODELS = ("paper", "dynamic")
 
 # table → key → (field name, kind); kinds: int_count, seed, pos, nonneg, unit, real
 SCHEMA = {
-    "": {"description": ("description", "text"), "model": ("model", "model"),
-         "stages": ("stages", "stages"), "precision": ("precision", "precision"),
-         "seed": ("seed", "seed"), "head": None, "hair": None, "wind": None},
+    "": {
+        "description": ("description", "text"),
+        "model": ("model", "model"),
+        "stages": ("stages", "stages"),
+        "precision": ("precision", "precision"),
+        "seed": ("seed", "seed"),
+        "head": None,
+        "hair": None,
+        "wind": None,
+    },
     "head": {"radius": ("head_radius", "pos"), "face_margin": ("face_margin", "nonneg")},
-    "hair": {"strands": ("strands", "count1"), "points": ("points", "count2"),
-             "length": ("hair_length", "pos"), "offset": ("hair_offset", "pos")},
+    "hair": {
+        "strands": ("strands", "count1"),
+        "points": ("points", "count2"),
+        "length": ("hair_length", "pos"),
+        "offset": ("hair_offset", "pos"),
+    },
     "wind": {"strength": ("wind_strength", "unit"), "angle": ("wind_angle", "real")},
+}
+
+# field name → kind, for overrides given on the command line
+FIELD_KINDS = {
+    spec[0]: spec[1]
+    for table in SCHEMA.values()
+    for spec in table.values()
+    if spec and spec[1] not in ("stages", "text")
 }
 
 
@@ -70,6 +89,9 @@ class Scene:
     hair_offset: float = 0.1
     wind_strength: float = 0.5
     wind_angle: float = math.pi
+    # model = "dynamic": the binary flags of [dynamics], [constraints], [wind] and [head]
+    # (harness/dynscene.py), flag → value text, in the order they were declared
+    dynamic: dict = field(default_factory=dict)
     source: str = field(default="", compare=False)
 
     @property
@@ -86,18 +108,40 @@ class Scene:
     def with_overrides(self, **overrides):
         """A copy with the given fields replaced (None = keep), validated again."""
         changes = {k: v for k, v in overrides.items() if v is not None}
+        for k, v in changes.items():
+            if k in FIELD_KINDS:
+                _convert(f"scene {self.name}", k, FIELD_KINDS[k], v)
         scene = replace(self, **changes)
         _check_values(scene, f"scene {self.name}")
         return scene
 
     def flags(self):
         """The backend flags that run this scene (docs/interfaces.md)."""
-        return ["--strands", str(self.strands), "--points", str(self.points),
-                "--seed", str(self.seed), "--head-radius", repr(self.head_radius),
-                "--hair-offset", repr(self.hair_offset), "--hair-length", repr(self.hair_length),
-                "--face-margin", repr(self.face_margin),
-                "--wind-strength", repr(self.wind_strength), "--wind-angle", repr(self.wind_angle),
-                "--stages", ",".join(self.stages), "--precision", self.precision]
+        return [
+            "--strands",
+            str(self.strands),
+            "--points",
+            str(self.points),
+            "--seed",
+            str(self.seed),
+            "--head-radius",
+            repr(self.head_radius),
+            "--hair-offset",
+            repr(self.hair_offset),
+            "--hair-length",
+            repr(self.hair_length),
+            "--face-margin",
+            repr(self.face_margin),
+            "--wind-strength",
+            repr(self.wind_strength),
+            "--wind-angle",
+            repr(self.wind_angle),
+            "--stages",
+            ",".join(self.stages),
+            "--precision",
+            self.precision,
+            *dynscene.flags(self),
+        ]
 
 
 def _number(where, key, value):
@@ -131,7 +175,7 @@ def _convert(where, key, kind, value):
         low = {"count1": 1, "count2": 2, "seed": 0}[kind]
         if isinstance(value, bool) or not isinstance(value, int) or value < low:
             raise SceneError(f"{where}: {key} must be a whole number ≥ {low}, got {value!r}")
-        if kind == "seed" and value >= 2 ** 64:
+        if kind == "seed" and value >= 2**64:
             raise SceneError(f"{where}: {key} must fit in 64 bits, got {value}")
         return value
     x = _number(where, key, value)
@@ -144,15 +188,31 @@ def _convert(where, key, kind, value):
     return x
 
 
+MAX_STAGES = 64  # HB_MAX_STAGES in c_ref/params.h
+
+
 def parse_stages(value, where="scene", key="stages"):
+    """The stage-list rules of the binaries' --stages (c_ref/cli.c): known names, no empty
+    item (\"init,,wind\" is refused, not skipped), at most MAX_STAGES, init only first."""
     if isinstance(value, str):
-        value = [s.strip() for s in value.split(",")]
+        if value == "" or value.startswith(",") or value.endswith(",") or ",," in value:
+            raise SceneError(f"{where}: {key}: empty item in '{value}' (write e.g. init,collide,wind)")
+        value = value.split(",")
     if not isinstance(value, list) or not value:
         raise SceneError(f"{where}: {key} must be a non-empty list of stage names")
+    if len(value) > MAX_STAGES:
+        raise SceneError(f"{where}: {key}: at most {MAX_STAGES} stages")
     for i, s in enumerate(value):
-        if s not in STAGES:
-            raise SceneError(f"{where}: {key}[{i}] '{s}' is not a stage (known: {', '.join(STAGES)})")
+        if not isinstance(s, str) or s not in STAGES:
+            raise SceneError(f"{where}: {key}[{i}] {s!r} is not a stage (known: {', '.join(STAGES)})")
+        if s == "init" and i > 0:
+            raise SceneError(f"{where}: {key}: init may only come first (it would replace the state)")
     return tuple(value)
+
+
+# copies of one frame a backend holds: the state, its saved copy for --repeat/--warmup, and
+# the host frame written to the file (c_ref/driver.c)
+FRAME_COPIES = 3
 
 
 def memory_bytes():
@@ -163,24 +223,35 @@ def memory_bytes():
 
 
 def _check_values(scene, where):
+    dynscene.check(scene, where, SceneError)
     if scene.stages[0] != "init":
         raise SceneError(f"{where}: stages must start with init (got '{scene.stages[0]}')")
     if "init" in scene.stages[1:]:
         raise SceneError(f"{where}: stages may contain init only first")
     if scene.segment_length < scene.hair_offset:
-        raise SceneError(f"{where}: hair.length/(hair.points − 1) = {scene.segment_length:g} is "
-                         f"below hair.offset = {scene.hair_offset:g} (ℓ ≥ h is required)")
-    # the backends hold every frame of the state in memory (docs/interfaces.md)
-    need = scene.state_bytes() * (len(scene.stages) + 1)
+        raise SceneError(
+            f"{where}: hair.length/(hair.points − 1) = {scene.segment_length:g} is "
+            f"below hair.offset = {scene.hair_offset:g} (ℓ ≥ h is required)"
+        )
+    # frames are streamed to the file one at a time: a backend holds a few copies of one
+    # frame (FRAME_COPIES), never all of them; simulate adds velocities, rest shape and saved copies
+    need = scene.state_bytes() * (FRAME_COPIES + (3 if scene.model == "dynamic" else 0))
     have = memory_bytes()
     if have and need > have:
-        raise SceneError(f"{where}: {scene.strands} strands × {scene.points} points × "
-                         f"{len(scene.stages)} frames need {need / 2**30:.1f} GiB, more than this "
-                         f"machine's {have / 2**30:.1f} GiB (hair.strands too large)")
+        raise SceneError(
+            f"{where}: {scene.strands} strands × {scene.points} points need "
+            f"{need / 2**30:.1f} GiB ({FRAME_COPIES} copies of one frame), more than this "
+            f"machine's {have / 2**30:.1f} GiB (hair.strands too large)"
+        )
 
 
 def scene_from_dict(data, name, where):
     values = {}
+    data, values["dynamic"] = dynscene.split(data, where, SceneError)
+    if "stages" not in data and values["dynamic"] is not None:
+        data = dict(data, stages=list(dynscene.DEFAULT_STAGES))
+    if values["dynamic"] is None:
+        values["dynamic"] = {}
     for key, value in data.items():
         if key not in SCHEMA[""]:
             raise SceneError(f"{where}: unknown key '{key}' (known: {', '.join(SCHEMA[''])})")
@@ -189,8 +260,7 @@ def scene_from_dict(data, name, where):
                 raise SceneError(f"{where}: '{key}' must be a table [{key}]")
             for sub, subvalue in value.items():
                 if sub not in SCHEMA[key]:
-                    raise SceneError(f"{where}: unknown key '{key}.{sub}' "
-                                     f"(known in [{key}]: {', '.join(SCHEMA[key])})")
+                    raise SceneError(f"{where}: unknown key '{key}.{sub}' (known in [{key}]: {', '.join(SCHEMA[key])})")
                 name_, kind = SCHEMA[key][sub]
                 values[name_] = _convert(where, f"{key}.{sub}", kind, subvalue)
         else:
@@ -204,19 +274,21 @@ def scene_from_dict(data, name, where):
 
 
 def find_scene_file(ref):
-    """A scene path, or a name looked up as configs/<name>.toml."""
-    found = config_file(ref)
+    """A scene path, or a name looked up as configs/scenes/<name>.toml."""
+    found = config_file(ref, SCENES)
     if found:
         return found
-    known = sorted(q.stem for q in CONFIGS.glob("*.toml") if is_scene_file(q))
-    raise SceneError(f"no scene '{ref}' (not a file; scenes in configs/: {', '.join(known) or 'none'})")
+    known = sorted(q.stem for q in SCENES.glob("*.toml"))
+    raise SceneError(f"no scene '{ref}' (not a file; scenes in configs/scenes/: {', '.join(known) or 'none'})")
 
 
 def is_scene_file(path):
+    """A file with a `stages` key: a scene, not a sweep (a check; the directory is the rule)."""
     try:
         with open(path, "rb") as f:
-            return "stages" in tomllib.load(f)
-    except (OSError, tomllib.TOMLDecodeError):
+            data = tomllib.load(f)
+        return "stages" in data or data.get("model") == "dynamic"
+    except (OSError, ValueError):  # TOMLDecodeError and UnicodeDecodeError are ValueErrors
         return False
 
 

@@ -7,6 +7,7 @@ bytes the stage must move (roofline.py), the achieved GB/s and its fraction of t
 bandwidth measured on the same device at the start of this run. The environment goes to
 results/<name>/env.json, one entry per session (a resumed run adds one).
 """
+
 import json
 import os
 from pathlib import Path
@@ -36,37 +37,72 @@ def rows_of_record(case, record, copy_gbps, session, binary):
         times = st.get("times_ms") or []
         q1, q3 = quartiles(times)
         fused = st.get("fused") or ""
-        nbytes = roofline.stage_bytes(st["stage"], case.strands, case.points, case.precision,
-                                      fused=fused, skipped=bool(st.get("skipped")),
-                                      moved=st.get("moved_points"))
+        nbytes = roofline.stage_bytes(
+            st["stage"],
+            case.strands,
+            case.points,
+            case.precision,
+            fused=fused,
+            skipped=bool(st.get("skipped")),
+            moved=st.get("moved_points"),
+        )
         gbps = roofline.achieved_gbps(nbytes, st.get("median_ms"))
-        rows.append({
-            "case_id": case.case_id, "stage_index": i, "n_stages": len(stages), "stage": st["stage"],
-            "scene": case.scene, "backend": case.backend, "build": case.build, "variant": case.variant,
-            "precision": case.precision,
-            "block_size": case.block_size or "", "threads": case.threads or "",
-            "strands": case.strands, "points": case.points, "repeat": case.repeat,
-            "warmup": case.warmup, "skipped": int(bool(st.get("skipped"))), "fused": fused,
-            "n_times": len(times), "median_ms": st.get("median_ms"), "min_ms": st.get("min_ms"),
-            "max_ms": st.get("max_ms"), "q1_ms": q1, "q3_ms": q3,
-            "iqr_ms": (q3 - q1) if q1 is not None else None,
-            "moved_points": st.get("moved_points"), "bytes_moved": nbytes, "achieved_gbps": gbps,
-            "copy_gbps": copy_gbps,
-            "bandwidth_fraction": (gbps / copy_gbps) if (gbps and copy_gbps) else None,
-            "end_to_end_ms": record.get("end_to_end_ms"), "h2d_ms": record.get("h2d_ms"),
-            "d2h_ms": record.get("d2h_ms"), "state_bytes": record.get("state_bytes"),
-            "device": record.get("device"), "binary": binary.name, "session": session,
-            "finished_at": env.now(),
-        })
+        rows.append(
+            {
+                "case_id": case.case_id,
+                "stage_index": i,
+                "n_stages": len(stages),
+                "stage": st["stage"],
+                "scene": case.scene,
+                "backend": case.backend,
+                "build": case.build,
+                "variant": case.variant,
+                "precision": case.precision,
+                "block_size": case.block_size or "",
+                "threads": case.threads or "",
+                "strands": case.strands,
+                "points": case.points,
+                "repeat": case.repeat,
+                "warmup": case.warmup,
+                "skipped": int(bool(st.get("skipped"))),
+                "fused": fused,
+                "n_times": len(times),
+                "median_ms": st.get("median_ms"),
+                "min_ms": st.get("min_ms"),
+                "max_ms": st.get("max_ms"),
+                "q1_ms": q1,
+                "q3_ms": q3,
+                "iqr_ms": (q3 - q1) if q1 is not None else None,
+                "moved_points": st.get("moved_points"),
+                "bytes_moved": nbytes,
+                "achieved_gbps": gbps,
+                "copy_gbps": copy_gbps,
+                "bandwidth_fraction": (gbps / copy_gbps) if (gbps and copy_gbps) else None,
+                "end_to_end_ms": record.get("end_to_end_ms"),
+                "h2d_ms": record.get("h2d_ms"),
+                "d2h_ms": record.get("d2h_ms"),
+                "state_bytes": record.get("state_bytes"),
+                "device": record.get("device"),
+                "binary": binary.name,
+                "session": session,
+                "finished_at": env.now(),
+            }
+        )
     return rows
 
 
 def case_flags(sweep, case):
-    scene = sweep.scene.with_overrides(strands=case.strands, points=case.points,
-                                       precision=case.precision)
+    scene = sweep.scene.with_overrides(strands=case.strands, points=case.points, precision=case.precision)
     threads = None if case.threads in ("", "all") else case.threads
-    flags = run_flags(scene, case.backend, variant=case.variant, block_size=case.block_size,
-                      threads=threads, repeat=case.repeat, warmup=case.warmup)
+    flags = run_flags(
+        scene,
+        case.backend,
+        variant=case.variant,
+        block_size=case.block_size,
+        threads=threads,
+        repeat=case.repeat,
+        warmup=case.warmup,
+    )
     return flags + ["--end-to-end"]  # end_to_end_ms (and h2d/d2h on cuda) in the record
 
 
@@ -121,12 +157,16 @@ def check_same_machine(before, now, out_dir):
     """A resumed sweep must run where its rows were measured: rows of two machines in one
     runs.csv would make curves that no machine produced."""
     if machine_of(before) != machine_of(now):
+
         def describe(h):
             cpu, cores, gpus = machine_of(h)
             return f"{cpu}, {cores} cores, {', '.join(gpus) if gpus else 'no GPU'}"
-        raise HarnessError(f"{display(out_dir)} holds rows measured on another machine ({describe(before)}); "
-                           f"this one is {describe(now)}: give another --out (make bench OUT=results/NAME) "
-                           f"or move it away")
+
+        raise HarnessError(
+            f"{display(out_dir)} holds rows measured on another machine ({describe(before)}); "
+            f"this one is {describe(now)}: give another --out (make bench OUT=results/NAME) "
+            f"or move it away"
+        )
 
 
 def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
@@ -138,10 +178,12 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
     env_path = out_dir / "env.json"
     say = log or (lambda m: print(m, flush=True))
 
-    record = load_env(env_path) or {"sweep": sweep.name, "sweep_file": display(sweep.path),
-                                    "scene": {k: v for k, v in sweep.scene.__dict__.items()
-                                              if k != "source"},
-                                    "sessions": []}
+    record = load_env(env_path) or {
+        "sweep": sweep.name,
+        "sweep_file": display(sweep.path),
+        "scene": {k: v for k, v in sweep.scene.__dict__.items() if k != "source"},
+        "sessions": [],
+    }
     done, dropped = runlog.resume(csv_path)
     if done and record.get("sessions"):
         check_same_machine(record["sessions"][-1].get("host") or {}, env.collect(), out_dir)
@@ -157,16 +199,25 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
         skipped.append({"backends": backends, "builds": builds, "cases": n, "reason": why})
         if announce_skips:
             say(f"harness: skipping {n} {label} case(s): {why}")
-    todo = [c for c in cases if (c.backend, c.build or "default") not in reasons
-            and c.case_id not in done]
+    todo = [c for c in cases if (c.backend, c.build or "default") not in reasons and c.case_id not in done]
     if done or dropped:
-        say(f"harness: resuming {display(csv_path)}: {len(done)} case(s) already complete"
-            + (f", dropped {dropped} byte(s) of a partial case" if dropped else ""))
+        say(
+            f"harness: resuming {display(csv_path)}: {len(done)} case(s) already complete"
+            + (f", dropped {dropped} byte(s) of a partial case" if dropped else "")
+        )
 
     session_index = len(record["sessions"])
-    session = {"started_at": env.now(), "host": env.collect(), "bandwidth": {},
-               "binaries": {}, "skipped": skipped, "failed": [], "done_before": len(done),
-               "cases_total": len(cases), "cases_run": 0}
+    session = {
+        "started_at": env.now(),
+        "host": env.collect(),
+        "bandwidth": {},
+        "binaries": {},
+        "skipped": skipped,
+        "failed": [],
+        "done_before": len(done),
+        "cases_total": len(cases),
+        "cases_run": 0,
+    }
     record["sessions"].append(session)
     bandwidth = {}
     for key in sorted({(c.backend, c.build or "default") for c in todo}):
@@ -193,17 +244,19 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
                 session["failed"].append({"case": case.case_id, "error": str(e)})
                 progress.write(f"harness: case {case.case_id} failed: {e}")
             else:
-                runlog.append_case(csv_path, rows_of_record(case, rec, bandwidth.get(key),
-                                                            session_index, binary))
+                runlog.append_case(csv_path, rows_of_record(case, rec, bandwidth.get(key), session_index, binary))
                 session["cases_run"] += 1
-                session["binaries"].setdefault(binary.name, {
-                    k: rec.get(k) for k in ("version", "git_revision", "compiler", "flags",
-                                            "device", "driver")})
+                session["binaries"].setdefault(
+                    binary.name,
+                    {k: rec.get(k) for k in ("version", "git_revision", "compiler", "flags", "device", "driver")},
+                )
             progress.update()
             session["finished_at"] = env.now()
             write_json(env_path, record)
     finally:
         progress.close()
-    say(f"harness: sweep {sweep.name}: {session['cases_run']} case(s) run, {len(done)} resumed, "
-        f"{failed} failed; rows in {display(csv_path)}")
+    say(
+        f"harness: sweep {sweep.name}: {session['cases_run']} case(s) run, {len(done)} resumed, "
+        f"{failed} failed; rows in {display(csv_path)}"
+    )
     return out_dir, failed

@@ -1,8 +1,8 @@
-"""Sweep files (configs/<sweep>.toml) → the list of cases to run.
+"""Sweep files (configs/sweeps/<sweep>.toml) → the list of cases to run.
 
     name = "default"          # results/<name>/ (optional; defaults to the file's stem)
     description = "…"
-    scene = "paper"           # a scene name in configs/ or a path
+    scene = "paper"           # a scene name in configs/scenes/ or a path
     repeat = 9                # timed repetitions per stage (≥ 9: median and IQR)
     warmup = 1                # untimed runs per stage before them
     timeout_s = 600           # per case
@@ -24,21 +24,25 @@ that backend (e.g. fewer strands for the single-thread CPU). Write [[cpu]] / [[c
 default build but one for the fast-math build. The cases are the product of the axes of
 each group; a case that two groups both produce runs once.
 """
+
 import itertools
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 from . import HarnessError
-from .paths import CONFIGS, CUDA_BUILDS, config_file, read_toml
-from .scenes import PRECISIONS, load_scene
+from .paths import CUDA_BUILDS, SWEEPS, config_file, read_toml
+from .scenes import PRECISIONS, is_scene_file, load_scene
+from .variants import names as declared_variants
 
 MIN_REPEAT = 9
 SHARED_AXES = ("strands", "points", "precision")
 BACKEND_AXES = {"cpu": ("variant", "threads"), "cuda": ("build", "variant", "block_size")}
-DEFAULTS = {"cpu": {"variant": ["ref"], "threads": ["all"]},
-            "cuda": {"build": ["default"], "variant": ["fused"], "block_size": [256]}}
+DEFAULTS = {
+    "cpu": {"variant": ["ref"], "threads": ["all"]},
+    "cuda": {"build": ["default"], "variant": ["fused"], "block_size": [256]},
+}
 TOP_KEYS = ("name", "description", "scene", "repeat", "warmup", "timeout_s", "axes", "cpu", "cuda")
-VARIANTS = {"cpu": ("ref", "simd"), "cuda": ("paper", "soa", "fused")}
 
 
 class SweepError(HarnessError):
@@ -49,11 +53,11 @@ class SweepError(HarnessError):
 class Case:
     scene: str
     backend: str
-    build: str          # cuda build, "" for cpu
+    build: str  # cuda build, "" for cpu
     variant: str
     precision: str
-    block_size: int     # 0 for cpu
-    threads: str        # "1", "2", … or "all"; "" for cuda
+    block_size: int  # 0 for cpu
+    threads: str  # "1", "2", … or "all"; "" for cuda
     strands: int
     points: int
     repeat: int
@@ -61,9 +65,11 @@ class Case:
 
     @property
     def case_id(self):
-        where = (f"t{self.threads}" if self.backend == "cpu" else f"{self.build}:b{self.block_size}")
-        return (f"{self.scene}:{self.backend}:{self.variant}:{where}:{self.precision}:"
-                f"N{self.strands}:P{self.points}:r{self.repeat}w{self.warmup}")
+        where = f"t{self.threads}" if self.backend == "cpu" else f"{self.build}:b{self.block_size}"
+        return (
+            f"{self.scene}:{self.backend}:{self.variant}:{where}:{self.precision}:"
+            f"N{self.strands}:P{self.points}:r{self.repeat}w{self.warmup}"
+        )
 
 
 @dataclass
@@ -74,7 +80,7 @@ class Sweep:
     repeat: int
     warmup: int
     timeout_s: int
-    axes: list          # (backend, {axis: values}) per group; the cases are each group's product
+    axes: list  # (backend, {axis: values}) per group; the cases are each group's product
     description: str = ""
 
     def cases(self):
@@ -83,11 +89,21 @@ class Sweep:
             names = list(axes)
             for values in itertools.product(*(axes[n] for n in names)):
                 v = dict(zip(names, values))
-                out.append(Case(scene=self.scene.name, backend=backend,
-                                build=v.get("build", ""), variant=v["variant"],
-                                precision=v["precision"], block_size=int(v.get("block_size", 0)),
-                                threads=str(v.get("threads", "")), strands=int(v["strands"]),
-                                points=int(v["points"]), repeat=self.repeat, warmup=self.warmup))
+                out.append(
+                    Case(
+                        scene=self.scene.name,
+                        backend=backend,
+                        build=v.get("build", ""),
+                        variant=v["variant"],
+                        precision=v["precision"],
+                        block_size=int(v.get("block_size", 0)),
+                        threads=str(v.get("threads", "")),
+                        strands=int(v["strands"]),
+                        points=int(v["points"]),
+                        repeat=self.repeat,
+                        warmup=self.warmup,
+                    )
+                )
                 if out[-1].case_id in seen:
                     out.pop()  # the same case from two groups runs once
                 else:
@@ -118,16 +134,39 @@ def _check_axis(where, label, values, backend):
         elif key == "precision" and v not in PRECISIONS:
             raise SweepError(f"{where}: {label} '{v}' is not fp32 or fp64")
         elif key == "threads" and not (v == "all" or (isinstance(v, int) and not isinstance(v, bool) and v >= 1)):
-            raise SweepError(f"{where}: {label} values must be whole numbers ≥ 1 or \"all\", got {v!r}")
+            raise SweepError(f'{where}: {label} values must be whole numbers ≥ 1 or "all", got {v!r}')
         elif key == "build" and v not in CUDA_BUILDS:
             raise SweepError(f"{where}: {label} '{v}' is not one of {', '.join(CUDA_BUILDS)}")
-        elif key == "variant" and v not in VARIANTS[backend]:
-            raise SweepError(f"{where}: {label} '{v}' is not one of {', '.join(VARIANTS[backend])}")
+        elif key == "variant":
+            known = known_variants(backend)
+            if known and v not in known:
+                raise SweepError(f"{where}: {label} '{v}' is not one of {', '.join(known)}")
     return values
 
 
+def known_variants(backend):
+    """The variants the backend's binaries declare (every cuda build's); () when none is
+    built here, so the cases are kept and later skipped as "not built"."""
+    builds = CUDA_BUILDS if backend == "cuda" else ("default",)
+    known = []
+    for build in builds:
+        known += [n for n in declared_variants(backend, build) if n not in known]
+    return tuple(known)
+
+
+def _results_name(where, name):
+    """A sweep's name is a directory under results/: one plain path component."""
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", name) or ".." in name:
+        raise SweepError(
+            f"{where}: name must be letters, digits, '.', '_' or '-' (a directory under results/), got {name!r}"
+        )
+    return name
+
+
 def find_sweep_file(ref):
-    found = config_file(ref)
+    found = config_file(ref, SWEEPS)
+    if found and is_scene_file(found):
+        raise SweepError(f"{ref} is a scene file (it has `stages`), not a sweep: sweeps live in configs/sweeps/")
     if found:
         return found
     raise SweepError(f"no sweep file '{ref}'")
@@ -183,6 +222,13 @@ def load_sweep(ref):
     for backend, b in axes:
         for p in b["points"]:
             scene.with_overrides(points=p)  # ℓ ≥ h for every point count
-    return Sweep(name=data.get("name", path.stem), path=path, scene=scene, repeat=repeat,
-                 warmup=warmup, timeout_s=int(timeout), axes=axes,
-                 description=data.get("description", ""))
+    return Sweep(
+        name=_results_name(where, data.get("name", path.stem)),
+        path=path,
+        scene=scene,
+        repeat=repeat,
+        warmup=warmup,
+        timeout_s=int(timeout),
+        axes=axes,
+        description=data.get("description", ""),
+    )

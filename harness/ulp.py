@@ -9,6 +9,7 @@ split off, so the magnitude bits order the non-negative floats, and
 computed in uint64, where neither can overflow (a magnitude is below 2^63).
 NaN has no distance: the caller must treat it as a failure (`nan_mask`).
 """
+
 import numpy as np
 
 _LAYOUT = {

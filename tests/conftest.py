@@ -1,8 +1,10 @@
-"""Shared pytest fixtures: where the binaries are, and the `gpu` marker.
+"""Shared pytest fixtures: where the binaries are, and the skipping of `gpu` tests (the
+marker itself is declared in pyproject.toml).
 
 GPU tests are marked `@pytest.mark.gpu`; they are skipped, with the reason, where no
 usable NVIDIA GPU (or no built CUDA binary) is present.
 """
+
 import os
 import shutil
 import subprocess
@@ -38,10 +40,6 @@ def _gpu_reason():
 
 
 GPU_REASON = _gpu_reason()
-
-
-def pytest_configure(config):
-    config.addinivalue_line("markers", "gpu: needs an NVIDIA GPU; skipped with a reason where there is none")
 
 
 def pytest_collection_modifyitems(config, items):

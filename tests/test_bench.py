@@ -1,8 +1,9 @@
-"""`harness bench` (what `make bench` runs), end to end on the tiny configs/quick.toml.
+"""`harness bench` (what `make bench` runs), end to end on the tiny configs/sweeps/quick.toml.
 
 The CPU test needs build/hairsim-cpu (skipped with the reason without it; `make test`
 builds it first); the GPU test is marked `gpu`. The failure paths use the stand-in
-backend harness.fakebackend."""
+backend support.fakebackend."""
+
 import csv
 import json
 import os
@@ -11,18 +12,29 @@ import sys
 
 import pytest
 
-from harness.fakebackend import install
-
 from conftest import CPU_BIN, ROOT
+from support.fakebackend import install
 
 needs_cpu = pytest.mark.skipif(not CPU_BIN.exists(), reason=f"{CPU_BIN} is not built (run make)")
 
 
 def bench(tmp_path, *extra, env=None):
-    cmd = [sys.executable, "-m", "harness", "bench", "--sweep", "configs/quick.toml",
-           "--out", str(tmp_path / "results"), "--report-dir", str(tmp_path / "report"), *extra]
-    return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600,
-                          env=dict(os.environ, **(env or {})))
+    cmd = [
+        sys.executable,
+        "-m",
+        "harness",
+        "bench",
+        "--sweep",
+        "configs/sweeps/quick.toml",
+        "--out",
+        str(tmp_path / "results"),
+        "--report-dir",
+        str(tmp_path / "report"),
+        *extra,
+    ]
+    return subprocess.run(
+        cmd, cwd=ROOT, capture_output=True, text=True, timeout=600, env=dict(os.environ, **(env or {}))
+    )
 
 
 @needs_cpu
@@ -40,7 +52,7 @@ def test_bench_end_to_end_on_cpu(tmp_path):
     with open(results / "runs.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     cases = {r["case_id"] for r in rows}
-    assert len(cases) == 2 * 2 * 2 and len(rows) == 4 * len(cases)   # strands × precision × threads
+    assert len(cases) == 2 * 2 * 2 and len(rows) == 4 * len(cases)  # strands × precision × threads
     assert all(r["backend"] == "cpu" and float(r["median_ms"]) > 0 for r in rows)
     assert all(int(r["n_times"]) >= 9 and r["copy_gbps"] for r in rows)
     env = json.loads((results / "env.json").read_text())
@@ -67,8 +79,7 @@ def test_bench_without_binaries_says_run_make(tmp_path):
 
 def test_bench_fails_before_timing_when_not_equivalent(tmp_path):
     build = install(tmp_path / "build", ["hairsim-cpu"])
-    p = bench(tmp_path, env={"HAIRBENCH_BUILD_DIR": str(build), "HAIRBENCH_NO_GPU": "1",
-                             "FAKE_SHIFT_FP32": "0.01"})
+    p = bench(tmp_path, env={"HAIRBENCH_BUILD_DIR": str(build), "HAIRBENCH_NO_GPU": "1", "FAKE_SHIFT_FP32": "0.01"})
     assert p.returncode == 1, p.stdout + p.stderr
     assert "harness: error: validation failed" in p.stderr and "nothing was timed" in p.stderr
     assert "NOT EQUIVALENT: cpu fp32 vs cpu fp64" in p.stdout

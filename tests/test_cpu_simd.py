@@ -1,33 +1,20 @@
-"""The simd variant of the CPU backend (issue #6): `hairsim-cpu --variant simd` against the
+"""The simd variant of the CPU backend: `hairsim-cpu --variant simd` against the
 `ref` oracle, one stage at a time (the ref state after frame k fed through --input into
 simd for the next stage only) and whole runs; DESIGN §3 invariants on its outputs; bits
 independent of the thread count, of repeats and of resuming; nil stages; the refusal on a
 CPU without AVX2; the vector math really vectorised; the bandwidth record.
 
-TOLERANCE (one per precision, docs/cpu_simd.md): |simd − ref| ≤ 4·u at every point of every
-frame, u = ε·P·(R + h + L), ε the precision's machine epsilon. simd's arithmetic is ref's
-operation for operation (no FMA, IEEE sqrt and division); only sin, cos, asin and atan2 are
-libmvec's vector functions (≤ 4 ulp) instead of glibc's scalar ones, and the difference
-adds up along the strand (u counts one ε·E per point, as harness/tolerances.py does).
-Measured before choosing it (20,000 strands × P ∈ {2, 3, 16, 64, 251} × seeds 1, 7,
-123456789; 200,000 strands at P = 32; 100,000 at P = 64; 40,000 at P = 251 × 4 seeds; the
-paper scene, every frame, whole runs and stage by stage):
-  fp32: worst 1.40 u (P = 2, wind: ℓ·cos with ℓ = L); P ≥ 16 ≤ 0.19 u; worst absolute
-        7.2 ε·(R + L) = 3.4e-5 (P = 251)
-  fp64: worst 1.00 u (P = 2); P ≥ 16 ≤ 0.19 u; worst absolute 31.7 ε·(R + L) = 2.8e-13
-        (P = 251, one strand in 40,000 whose angle steps round the other way each step)
-  collide from the same input: bit-identical to ref (no libm call in it), as asserted below.
-  wind from the same input at w = 1 and ψ ∈ {0, 1, −2.5, 7, ±π/2, π}: ≤ 0.77 u.
-  284 scenes of the stability suite's space (R 1e-3…1e4, P 2…251, ℓ = h …, any wind),
-  stage by stage and whole runs: ≤ 1.01 u.
-So 4 u leaves a margin of 2.9× (fp32) and 4× (fp64) over the worst measured case.
+TOLERANCE: the "simd" pair of harness/tolerances.py (the measurements behind it are in
+docs/cpu_simd.md); every comparison goes through harness diff. collide calls no libm
+function, so there simd must give ref's bits, as asserted below.
 
 Not compared point for point: whole runs with strong wind at angles other than the default,
 where the shorter-arc rule of the wind is discontinuous at an exactly opposite segment and
 an input that differs by rounding (the init/collide before it) can turn a near-opposite
-segment the other way (measured: 15 of 20,000 strands at P = 24, w = 1, ψ = π/2). Those runs
-are checked for the invariants, and the wind stage itself from the same input is compared.
+segment the other way (docs/cpu_simd.md, "A discontinuity, not an error"). Those runs are
+checked for the invariants, and the wind stage itself from the same input is compared.
 """
+
 import json
 import math
 import os
@@ -39,12 +26,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
-
-from invariants_check import assert_invariants
-from statecheck import State, run, run_json, tmp_leftovers
 from test_stability import scene_args, scenes
 
-K_SIMD = {"fp32": 4.0, "fp64": 4.0}  # in units of u = ε·P·(R + h + L), see above
+from harness import tolerances
+from support import synthetic
+from support.invariants_check import assert_invariants
+from support.statecheck import State, assert_equivalent, run, run_json, tmp_leftovers
+
 SEEDS = [1, 7, 123456789]
 PAPER = ["init", "collide", "wind", "collide"]
 # x86-64-v3, as /proc/cpuinfo names it (abm = lzcnt)
@@ -74,22 +62,11 @@ NO_SIMD = _no_simd_reason()
 needs_simd = pytest.mark.skipif(NO_SIMD is not None, reason=f"simd test skipped: {NO_SIMD}")
 
 
-def unit(s):
-    """u = ε·P·(R + h + L) of a State."""
-    eps = float(np.finfo(s.dtype).eps)
-    p = s.params
-    return eps * s.p * (float(p["head_radius"]) + float(p["hair_offset"]) + float(p["hair_length"]))
-
-
-def assert_close(ref_frame, simd_frame, s, what):
-    """simd within K_SIMD·u of ref at every point; NaN or Inf never passes."""
-    assert np.isfinite(simd_frame).all(), f"{what}: NaN or Inf in the simd state"
-    assert np.isfinite(ref_frame).all(), f"{what}: NaN or Inf in the ref state"
-    err = float(np.abs(ref_frame.astype(np.float64) - simd_frame.astype(np.float64)).max())
-    u = unit(s)
-    k = K_SIMD["fp64" if s.dtype == np.float64 else "fp32"]
-    assert err <= k * u, f"{what}: simd differs from ref by {err:.3g} = {err / u:.2f} u > {k} u"
-    return err / u
+def assert_close(ref_path, simd_path, precision, frames, what):
+    """harness diff of simd against ref under the "simd" pair (tolerances.named_pair)."""
+    return assert_equivalent(
+        ref_path, simd_path, frames=frames, tolerance=tolerances.named_pair("simd", precision), what=what
+    )
 
 
 def moved_from_frames(before, after):
@@ -106,6 +83,7 @@ def scene(points, seed, precision, strands=1000):
 
 # ---- equivalence with ref ---------------------------------------------------------------
 
+
 @needs_simd
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 @pytest.mark.parametrize("points", [2, 3, 16, 64, 251])
@@ -121,8 +99,8 @@ def test_whole_run_matches_ref_and_keeps_the_invariants(cpu_bin, tmp_path, preci
     # roots (integer draws, IEEE arithmetic) and x (never changes) are ref's bits
     assert np.array_equal(b.frames[..., 0], a.frames[..., 0])
     assert np.array_equal(b.frames[:, :, 0, :], a.frames[:, :, 0, :])
+    assert_close(ref, simd, precision, "all", f"P={points}, seed={seed}")
     for f in range(len(PAPER)):
-        assert_close(a.frames[f], b.frames[f], b, f"frame {f} ({PAPER[f]}), P={points}, seed={seed}")
         if PAPER[f] == "collide":  # the count covers the real strands only, not the padding
             assert b.moved[f] == moved_from_frames(b.frames[f - 1], b.frames[f])
 
@@ -140,7 +118,7 @@ def test_each_stage_from_the_ref_state_matches_ref(cpu_bin, tmp_path, precision,
     a = State(whole)
     init = tmp_path / "init.h5"
     run(cpu_bin, *args, "--variant", "simd", "--stages", "init", "--output", init, "--quiet")
-    assert_close(a.frames[0], State(init).frames[0], a, "init")
+    assert_close(whole, init, precision, [0], "init")
     for k in range(1, len(PAPER)):
         prefix, one = tmp_path / f"prefix{k}.h5", tmp_path / f"simd{k}.h5"
         run(cpu_bin, *args, "--stages", ",".join(PAPER[:k]), "--output", prefix, "--quiet")
@@ -152,7 +130,7 @@ def test_each_stage_from_the_ref_state_matches_ref(cpu_bin, tmp_path, precision,
             assert np.array_equal(b.frames[k], a.frames[k]), f"collide (frame {k}) is not ref's bits"
             assert b.moved[k] == a.moved[k]
         else:
-            assert_close(a.frames[k], b.frames[k], a, f"{PAPER[k]} (frame {k}) from the ref state")
+            assert_close(whole, one, precision, [k], f"{PAPER[k]} (frame {k}) from the ref state")
 
 
 @needs_simd
@@ -168,10 +146,19 @@ def test_strong_wind_at_other_angles(cpu_bin, tmp_path, precision):
         run(cpu_bin, *base, *w, "--stages", "init,collide", "--output", prefix, "--quiet")
         run(cpu_bin, "--input", prefix, *w, "--stages", "wind", "--output", ref, "--quiet")
         run(cpu_bin, "--input", prefix, *w, "--stages", "wind", "--variant", "simd", "--output", one, "--quiet")
-        a, b = State(ref), State(one)
-        assert_close(a.frames[2], b.frames[2], a, f"wind at psi={angle}")
-        run(cpu_bin, *base, *w, "--variant", "simd", "--stages", "init,collide,wind,collide,wind,collide",
-            "--output", whole, "--quiet")
+        assert_close(ref, one, precision, [2], f"wind at psi={angle}")
+        run(
+            cpu_bin,
+            *base,
+            *w,
+            "--variant",
+            "simd",
+            "--stages",
+            "init,collide,wind,collide,wind,collide",
+            "--output",
+            whole,
+            "--quiet",
+        )
         assert_invariants(State(whole))
 
 
@@ -188,32 +175,30 @@ def test_partial_blocks_match_ref(cpu_bin, tmp_path, strands):
         a, b = State(ref), State(simd)
         assert b.frames.shape == a.frames.shape
         assert_invariants(b)
-        for f in range(len(PAPER)):
-            assert_close(a.frames[f], b.frames[f], a, f"{strands} strands, frame {f}")
+        assert_close(ref, simd, precision, "all", f"{strands} strands")
 
 
 @needs_simd
 def test_fp32_simd_agrees_with_fp64_ref(cpu_bin, tmp_path):
-    # The project's fp32-vs-fp64 bound (tests/test_cpu_reference.py, 5e-5·L). Measured for
-    # simd fp32 against ref fp64 at 200,000 strands × 32 points: see docs/cpu_simd.md.
-    FP32_VS_FP64_REL_L = 5e-5
+    """harness diff's fp32↔fp64 rule (measurements: docs/cpu_simd.md)."""
     a_path, b_path = tmp_path / "fp32.h5", tmp_path / "fp64.h5"
     run(cpu_bin, "--strands", 20000, "--points", 32, "--variant", "simd", "--output", a_path, "--quiet")
     run(cpu_bin, "--strands", 20000, "--points", 32, "--precision", "fp64", "--output", b_path, "--quiet")
-    a, b = State(a_path), State(b_path)
-    err = np.linalg.norm(a.frames.astype(np.float64) - b.frames, axis=-1) / 30.0
-    assert np.isfinite(err).all()
-    assert err.max() < FP32_VS_FP64_REL_L, err.max()
+    assert_equivalent(a_path, b_path, what="simd fp32 vs ref fp64")
 
 
 @needs_simd
-@settings(max_examples=40, deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(
+    max_examples=40,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 @given(s=scenes())
 def test_each_stage_matches_ref_across_the_scene_space(cpu_bin, tmp_path_factory, s):
     """The stability suite's scene space (tests/test_stability.py): every stage from the
     ref state matches ref, and whole simd runs keep the invariants. (Measured over 284 of
-    its scenes: ≤ 1.01 u stage by stage, collide bit for bit.)"""
+    its scenes: docs/cpu_simd.md.)"""
     d = tmp_path_factory.mktemp("space")
     args = scene_args(s)
     p = run(cpu_bin, *args, "--output", d / "ref.h5", "--quiet", check=False)
@@ -223,7 +208,7 @@ def test_each_stage_matches_ref_across_the_scene_space(cpu_bin, tmp_path_factory
     run(cpu_bin, *args, "--variant", "simd", "--output", d / "simd.h5", "--quiet")
     assert_invariants(State(d / "simd.h5"))
     run(cpu_bin, *args, "--variant", "simd", "--stages", "init", "--output", d / "s0.h5", "--quiet")
-    assert_close(a.frames[0], State(d / "s0.h5").frames[0], a, f"init of {s}")
+    assert_close(d / "ref.h5", d / "s0.h5", a.precision, [0], f"init of {s}")
     wind = ["--wind-strength", repr(s["w"]), "--wind-angle", repr(s["psi"])]
     for k in range(1, len(PAPER)):
         prefix, one = d / f"p{k}.h5", d / f"s{k}.h5"
@@ -235,17 +220,22 @@ def test_each_stage_matches_ref_across_the_scene_space(cpu_bin, tmp_path_factory
         elif PAPER[k] == "collide":
             assert np.array_equal(b.frames[k], a.frames[k]), f"collide of {s} is not ref's bits"
         else:
-            assert_close(a.frames[k], b.frames[k], a, f"{PAPER[k]} of {s}")
+            assert_close(d / "ref.h5", one, a.precision, [k], f"{PAPER[k]} of {s}")
 
 
 # ---- edge states made by hand (the stability suite's), through --input -------------------
 
+
 def _crafted(tmp_path, strands, precision, L):
-    synthetic = pytest.importorskip("harness.synthetic", reason="harness.synthetic writes the hand-made states")
     pos = np.asarray([strands], dtype=np.float64 if precision == "fp64" else np.float32)
     path = tmp_path / "crafted.h5"
-    synthetic.write_state(path, pos, ["init"], precision=precision,
-                          params={"hair_length": L, "head_radius": 10.0, "hair_offset": 0.1, "face_margin": 1.0})
+    synthetic.write_state(
+        path,
+        pos,
+        ["init"],
+        precision=precision,
+        params={"hair_length": L, "head_radius": 10.0, "hair_offset": 0.1, "face_margin": 1.0},
+    )
     return path
 
 
@@ -253,7 +243,7 @@ def _crafted(tmp_path, strands, precision, L):
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_exactly_opposite_segments_turn_through_plus_y(cpu_bin, tmp_path, precision):
     P, ell = 4, 1.0
-    toward_face = [(0.0, 0.0, 10.0 + k * ell) for k in range(P)]              # φ = 0, wind ψ = π
+    toward_face = [(0.0, 0.0, 10.0 + k * ell) for k in range(P)]  # φ = 0, wind ψ = π
     toward_back = [(1.0, 0.0, -math.sqrt(99.0) - k * ell) for k in range(P)]  # φ = π, wind ψ = 0
     src = _crafted(tmp_path, [toward_face, toward_back], precision, L=(P - 1) * ell)
     for strand, angle in ((0, math.pi), (1, 0.0)):
@@ -261,9 +251,9 @@ def test_exactly_opposite_segments_turn_through_plus_y(cpu_bin, tmp_path, precis
         common = ["--input", src, "--stages", "wind", "--wind-strength", 1, "--wind-angle", angle, "--quiet"]
         run(cpu_bin, *common, "--output", ref)
         run(cpu_bin, *common, "--variant", "simd", "--output", simd)
-        a, b = State(ref), State(simd)
+        b = State(simd)
         assert (b.frames[-1, strand, 1:, 1] > 0).all(), b.frames[-1, strand]  # lifted, not pushed down
-        assert_close(a.frames[-1], b.frames[-1], a, f"opposite wind, strand {strand}")
+        assert_close(ref, simd, precision, [-1], f"opposite wind, strand {strand}")
 
 
 @needs_simd
@@ -287,14 +277,29 @@ def test_collide_at_the_slice_poles_is_refs_bits(cpu_bin, tmp_path, precision):
 
 # ---- bits that must not change -------------------------------------------------------------
 
+
 @needs_simd
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_thread_count_does_not_change_a_bit(cpu_bin, tmp_path, precision):
     states = []
     for threads in (1, 2, 3):
         out = tmp_path / f"t{threads}.h5"
-        run(cpu_bin, "--strands", 3001, "--points", 20, "--threads", threads, "--precision", precision,
-            "--variant", "simd", "--output", out, "--quiet")
+        run(
+            cpu_bin,
+            "--strands",
+            3001,
+            "--points",
+            20,
+            "--threads",
+            threads,
+            "--precision",
+            precision,
+            "--variant",
+            "simd",
+            "--output",
+            out,
+            "--quiet",
+        )
         states.append(State(out))
     for s in states[1:]:
         assert np.array_equal(s.frames, states[0].frames)
@@ -319,16 +324,32 @@ def test_resume_gives_the_same_bits_as_one_run(cpu_bin, tmp_path):
     args = ["--strands", 1100, "--points", 32, "--variant", "simd"]
     run(cpu_bin, *args, "--output", whole, "--quiet")
     run(cpu_bin, *args, "--stages", "init", "--output", first, "--quiet")
-    run(cpu_bin, "--input", first, "--variant", "simd", "--stages", "collide,wind,collide", "--output", rest,
-        "--quiet")
+    run(cpu_bin, "--input", first, "--variant", "simd", "--stages", "collide,wind,collide", "--output", rest, "--quiet")
     assert np.array_equal(State(whole).frames, State(rest).frames)
 
 
 @needs_simd
 def test_wind_zero_is_not_run_and_changes_nothing(cpu_bin, tmp_path):
     out = tmp_path / "s.h5"
-    rec = json.loads(run(cpu_bin, "--strands", 300, "--points", 16, "--hair-length", 10, "--wind-strength", 0,
-                         "--variant", "simd", "--output", out, "--json", "--quiet").stdout)
+    rec = json.loads(
+        run(
+            cpu_bin,
+            "--strands",
+            300,
+            "--points",
+            16,
+            "--hair-length",
+            10,
+            "--wind-strength",
+            0,
+            "--variant",
+            "simd",
+            "--output",
+            out,
+            "--json",
+            "--quiet",
+        ).stdout
+    )
     wind = rec["stages"][2]
     assert wind["stage"] == "wind" and wind["skipped"] is True and wind["times_ms"] == []
     s = State(out)
@@ -340,11 +361,25 @@ def test_wind_zero_is_not_run_and_changes_nothing(cpu_bin, tmp_path):
 
 # ---- what the variant records and how it is built ------------------------------------------
 
+
 @needs_simd
 def test_records_say_simd_and_its_flags(cpu_bin, tmp_path):
     out = tmp_path / "s.h5"
-    rec = run_json(cpu_bin, "--strands", 500, "--points", 16, "--hair-length", 10, "--variant", "simd",
-                   "--repeat", 2, "--output", out)
+    rec = run_json(
+        cpu_bin,
+        "--strands",
+        500,
+        "--points",
+        16,
+        "--hair-length",
+        10,
+        "--variant",
+        "simd",
+        "--repeat",
+        2,
+        "--output",
+        out,
+    )
     assert rec["backend"] == "cpu" and rec["variant"] == "simd"
     for flag in ("-ffp-contract=off", "-march=x86-64-v3", "-fno-math-errno", "-fno-trapping-math"):
         assert flag in rec["flags"], flag

@@ -18,12 +18,13 @@ host check with the host compiler told the same (-O1: the many instantiations co
 about a minute; optimisation level does not change IEEE results without contraction).
 Skipped, with the reason, where nvcc or gcc is missing.
 """
+
 import subprocess
 
 import pytest
+from test_cuda_port_host import C_FLAGS, _run, _tool
 
 from conftest import CUDA_BIN
-from test_cuda_port_host import C_FLAGS, _run, _tool
 
 NVCC_FLAGS = ["-std=c++17", "-O1", "-Xcompiler", "-ffp-contract=off,-fno-fast-math"]
 
@@ -43,8 +44,10 @@ def dyn_hostcheck(tmp_path_factory):
         _run([cc, *C_FLAGS, "-Ic_ref", "-c", f"c_ref/{src}", "-o", obj])
         objs.append(obj)
     exe = d / "dyn_hostcheck"
-    _run([nvcc, *NVCC_FLAGS, "-Ic_ref", "-Icuda", "cuda/hostcheck/dyn_hostcheck.cu", *objs, "-o", exe, "-lm"],
-         timeout=1200)
+    _run(
+        [nvcc, *NVCC_FLAGS, "-Ic_ref", "-Icuda", "cuda/hostcheck/dyn_hostcheck.cu", *objs, "-o", exe, "-lm"],
+        timeout=1200,
+    )
     return exe
 
 
@@ -66,7 +69,11 @@ def test_paper_variants_refuse_simulate(variant):
     """The driver refuses before any device is touched, so this runs without a GPU."""
     if not CUDA_BIN.exists():
         pytest.skip(f"{CUDA_BIN} is not built (nvcc missing or `make` not run)")
-    p = subprocess.run([str(CUDA_BIN), "--strands", "10", "--stages", "init,simulate", "--variant", variant, "--quiet"],
-                       capture_output=True, text=True, timeout=60)
+    p = subprocess.run(
+        [str(CUDA_BIN), "--strands", "10", "--stages", "init,simulate", "--variant", variant, "--quiet"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert p.returncode == 2, (p.returncode, p.stderr)
     assert f"variant {variant} does not run 'simulate'" in p.stderr, p.stderr

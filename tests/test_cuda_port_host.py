@@ -10,6 +10,7 @@ c_ref/model.c and c_ref/params.c with the reference's flags (no FMA contraction,
 math), nvcc compiles the host check with the host compiler told the same. Skipped, with the
 reason, where nvcc or gcc is missing.
 """
+
 import os
 import shutil
 import subprocess
@@ -61,8 +62,11 @@ def hostcheck(tmp_path_factory):
 def test_cuda_model_matches_c_reference_bit_for_bit(hostcheck):
     p = subprocess.run([str(hostcheck)], capture_output=True, text=True, timeout=600)
     summary = p.stdout.strip().splitlines()[-1] if p.stdout.strip() else "(no output)"
-    assert p.returncode == 0, f"host check failed: {summary}\n" + "\n".join(
-        line for line in p.stdout.splitlines() if line.startswith("MISMATCH"))[:20000] + p.stderr
+    assert p.returncode == 0, (
+        f"host check failed: {summary}\n"
+        + "\n".join(line for line in p.stdout.splitlines() if line.startswith("MISMATCH"))[:20000]
+        + p.stderr
+    )
     assert " 0 mismatches" in summary, summary
     # every case was compared and the collide paths were exercised
     assert "identical" in p.stdout and "MISMATCH" not in p.stdout

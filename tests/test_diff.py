@@ -1,8 +1,9 @@
 """`harness diff`: exit codes on planted cases, frame selection, ULP distance, tolerances.
 
-Most files are written with harness.synthetic (the documented layout, no backend needed);
+Most files are written with support.synthetic (the documented layout, no backend needed);
 the last tests use the real build/hairsim-cpu and are skipped, with the reason, without it.
 """
+
 import json
 import subprocess
 import sys
@@ -13,13 +14,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from conftest import CPU_BIN, ROOT
 from harness import tolerances
 from harness.__main__ import main
 from harness.diff import compare
-from harness.synthetic import radial_strands, write_state
 from harness.ulp import ulp_distance
-
-from conftest import CPU_BIN, ROOT
+from support.synthetic import radial_strands, write_state
 
 STAGES = ["init", "collide", "wind", "collide"]
 needs_cpu = pytest.mark.skipif(not CPU_BIN.exists(), reason=f"{CPU_BIN} is not built (run make)")
@@ -50,7 +50,7 @@ def test_identical_files_are_equivalent(tmp_path, ref64, capsys):
 
 def test_one_moved_point_is_not_equivalent(tmp_path, ref64, capsys):
     moved = ref64.copy()
-    moved[2, 17, 5, 1] += 1e-6   # far above fp64 rounding, far below a segment
+    moved[2, 17, 5, 1] += 1e-6  # far above fp64 rounding, far below a segment
     a = write(tmp_path, "a.h5", ref64)
     b = write(tmp_path, "b.h5", moved)
     code, out, _ = run_diff(capsys, a, b, "--json")
@@ -83,18 +83,21 @@ def test_missing_frame_cannot_compare(tmp_path, ref64, capsys):
     code, _, err = run_diff(capsys, a, b)
     assert code == 2
     assert err.startswith("harness: error: cannot compare:") and "frame counts differ" in err
-    assert err.count("\n") == 1   # one line
+    assert err.count("\n") == 1  # one line
 
 
-@pytest.mark.parametrize("change, message", [
-    ("strands", "different sizes"),
-    ("points", "different sizes"),
-    ("shape", "expected [F][N·P][3]"),
-    ("no_stage", "no /parameters/stage"),
-    ("count_attr", "n_strands × points_per_strand"),
-    ("precision_attr", "precision attribute says"),
-    ("scene", "different scenes: hair_length"),
-])
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        ("strands", "different sizes"),
+        ("points", "different sizes"),
+        ("shape", "expected [F][N·P][3]"),
+        ("no_stage", "no /parameters/stage"),
+        ("count_attr", "n_strands × points_per_strand"),
+        ("precision_attr", "precision attribute says"),
+        ("scene", "different scenes: hair_length"),
+    ],
+)
 def test_layout_mismatch_cannot_compare(tmp_path, ref64, capsys, change, message):
     a = write(tmp_path, "a.h5", ref64)
     if change == "strands":
@@ -145,9 +148,10 @@ def test_cli_exit_status_and_no_traceback(tmp_path, ref64):
     """The real process: exit 2 and one line on stderr, never a traceback."""
     a = write(tmp_path, "a.h5", ref64)
     junk = tmp_path / "junk.h5"
-    junk.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 64)   # an HDF5 signature, then nothing
-    p = subprocess.run([sys.executable, "-m", "harness", "diff", a, str(junk)], cwd=ROOT,
-                       capture_output=True, text=True)
+    junk.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 64)  # an HDF5 signature, then nothing
+    p = subprocess.run(
+        [sys.executable, "-m", "harness", "diff", a, str(junk)], cwd=ROOT, capture_output=True, text=True
+    )
     assert p.returncode == 2
     assert "Traceback" not in p.stderr
     assert p.stderr.startswith("harness: error:") and p.stderr.count("\n") == 1
@@ -157,9 +161,9 @@ def test_frame_selection_for_a_resumed_file(tmp_path, ref64, capsys):
     """A GPU file resumed from a CPU state has its own frame count: compare chosen frames."""
     a = write(tmp_path, "a.h5", ref64)
     resumed = write(tmp_path, "r.h5", ref64[:3], stages=STAGES[:3])
-    assert run_diff(capsys, a, resumed, "--frames", "last")[0] == 2   # frame 3 vs 2: stages differ
+    assert run_diff(capsys, a, resumed, "--frames", "last")[0] == 2  # frame 3 vs 2: stages differ
     assert run_diff(capsys, a, resumed, "--frame", "2")[0] == 0
-    assert run_diff(capsys, a, resumed, "--frame", "3")[0] == 2       # B has no frame 3
+    assert run_diff(capsys, a, resumed, "--frame", "3")[0] == 2  # B has no frame 3
     assert run_diff(capsys, resumed, a, "--frames", "0,1")[0] == 0
     # the last frames of files with different counts line up only when asked
     tail = write(tmp_path, "t.h5", ref64[1:], stages=STAGES[1:])
@@ -185,7 +189,7 @@ def test_exact_mode_and_fast_math_pair(tmp_path, ref64, capsys):
     nudged[1, 3, 4, 2] = np.nextafter(nudged[1, 3, 4, 2], np.inf)
     a = write(tmp_path, "a.h5", ref64)
     b = write(tmp_path, "b.h5", nudged)
-    assert run_diff(capsys, a, b)[0] == 0            # one ulp is within the fp64 tolerance
+    assert run_diff(capsys, a, b)[0] == 0  # one ulp is within the fp64 tolerance
     assert run_diff(capsys, a, b, "--exact")[0] == 1
     fm = write(tmp_path, "fm.h5", ref64.astype(np.float32), params={"flags": "nvcc --use_fast_math"})
     r = compare(a, fm)
@@ -195,15 +199,16 @@ def test_exact_mode_and_fast_math_pair(tmp_path, ref64, capsys):
 
 def test_tolerance_scales_with_root_conditioning():
     """u grows where the root draw cancels (x0 → 0) and is the step term for equal roots."""
-    kw = dict(head_radius=10.0, hair_offset=0.1, hair_length=30.0, points=32, eps=2.0 ** -23)
+    kw = dict(head_radius=10.0, hair_offset=0.1, hair_length=30.0, points=32, eps=2.0**-23)
     u = tolerances.point_unit(np.array([10.0, 1.0, 1e-2, 1e-3, 0.0]), np.zeros(5), **kw)
     assert np.all(np.diff(u[:3]) > 0)
-    assert u[3] == u[4]   # below √ε·R the bound is the cancellation's worst case
+    assert u[3] == u[4]  # below √ε·R the bound is the cancellation's worst case
     same = tolerances.point_unit(np.array([0.0]), np.array([0.0]), root_differs=np.array([False]), **kw)
     assert same[0] == pytest.approx(kw["eps"] * 32 * 40.1)
 
 
 # ---- ULP distance ------------------------------------------------------------------------
+
 
 def test_ulp_distance_basics():
     f = np.float32
@@ -214,9 +219,9 @@ def test_ulp_distance_basics():
     assert ulp_distance(np.array([tiny]), np.array([-tiny]), np.float32)[0] == 2
     big = np.finfo(np.float64).max
     d = ulp_distance(np.array([big]), np.array([-big]), np.float64)[0]
-    assert d == 2 * 0x7FEFFFFFFFFFFFFF   # no overflow
+    assert d == 2 * 0x7FEFFFFFFFFFFFFF  # no overflow
     # mixed precision: counted in float32 after rounding both to it
-    assert ulp_distance(np.array([1.0 + 2.0 ** -30]), np.array([1.0], np.float32), np.float32)[0] == 0
+    assert ulp_distance(np.array([1.0 + 2.0**-30]), np.array([1.0], np.float32), np.float32)[0] == 0
 
 
 @settings(max_examples=200, deadline=None)
@@ -235,14 +240,20 @@ def test_ulp_distance_counts_steps(x, k):
 
 # ---- against the real C reference -------------------------------------------------------
 
+
 @needs_cpu
 def test_cpu_fp32_against_fp64_and_threads(tmp_path, capsys):
     files = {}
-    for name, extra in (("fp64", ["--precision", "fp64"]), ("fp32", ["--precision", "fp32"]),
-                        ("fp64t1", ["--precision", "fp64", "--threads", "1"])):
+    for name, extra in (
+        ("fp64", ["--precision", "fp64"]),
+        ("fp32", ["--precision", "fp32"]),
+        ("fp64t1", ["--precision", "fp64", "--threads", "1"]),
+    ):
         files[name] = tmp_path / f"{name}.h5"
-        subprocess.run([str(CPU_BIN), "--strands", "3000", "--points", "32", "--quiet",
-                        "--output", str(files[name]), *extra], check=True)
+        subprocess.run(
+            [str(CPU_BIN), "--strands", "3000", "--points", "32", "--quiet", "--output", str(files[name]), *extra],
+            check=True,
+        )
     code, out, _ = run_diff(capsys, files["fp32"], files["fp64"], "--json")
     r = json.loads(out)
     assert code == 0, r["failures"]

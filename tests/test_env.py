@@ -1,5 +1,6 @@
 """harness.env.git_revision: which code a result says it came from (docs/harness.md,
 "Which code a result came from")."""
+
 import subprocess
 
 import pytest

@@ -15,6 +15,7 @@ builds are within their bounds. Every build: bit-identical across block sizes an
 Strict build: strand and warp bit-identical. The measured worst errors go to
 build/gpu_dyn_test_errors.json (for recalibrating the tolerances).
 """
+
 import json
 import subprocess
 
@@ -22,10 +23,15 @@ import numpy as np
 import pytest
 
 from conftest import BUILD, CPU_BIN, CUDA_BIN, CUDA_FASTMATH_BIN, CUDA_STRICT_BIN
-from harness import dynstate
-from harness.states import open_state
-from harness.tolerances import (GPU_DYN_MAX_OVER_FRACTION, GPU_DYN_OBS_ABS, GPU_DYN_OBS_REL, GPU_DYN_POS,
-                                GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS, GPU_DYN_VEL)
+from harness.tolerances import (
+    GPU_DYN_MAX_OVER_FRACTION,
+    GPU_DYN_OBS_ABS,
+    GPU_DYN_OBS_REL,
+    GPU_DYN_POS,
+    GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS,
+    GPU_DYN_VEL,
+)
+from harness.trajectory import open_trajectory
 
 pytestmark = pytest.mark.gpu
 
@@ -42,10 +48,34 @@ SCENES = {
     # the default scene: gravity, stretch, the collider (a specialised kernel)
     "collide": ("--points", 32),
     # every feature (specialised): bend, shape, wind with gusts, a nodding head, drag
-    "all": ("--points", 32, "--bend-compliance", "1e-6", "--shape-compliance", "1e-5", "--shape-range", "0.5",
-            "--wind-speed", "400", "--drag", "2", "--damping", "0.5", "--gust-amplitude", "0.5",
-            "--gust-frequency", "2", "--gust-wavelength", "25", "--head-motion", "nod", "--motion-amplitude", "0.3",
-            "--motion-frequency", "1.5"),
+    "all": (
+        "--points",
+        32,
+        "--bend-compliance",
+        "1e-6",
+        "--shape-compliance",
+        "1e-5",
+        "--shape-range",
+        "0.5",
+        "--wind-speed",
+        "400",
+        "--drag",
+        "2",
+        "--damping",
+        "0.5",
+        "--gust-amplitude",
+        "0.5",
+        "--gust-frequency",
+        "2",
+        "--gust-wavelength",
+        "25",
+        "--head-motion",
+        "nod",
+        "--motion-amplitude",
+        "0.3",
+        "--motion-frequency",
+        "1.5",
+    ),
     # shape with a shaking head and no collider: the generic kernel (features as run-time flags), P > 32
     "generic": ("--points", 45, "--shape-compliance", "1e-5", "--head-motion", "shake", "--no-collider"),
 }
@@ -81,18 +111,22 @@ def dyn_args(scene, solver):
 
 
 class Frame:
-    """The last simulated frame of a file: positions, velocities, observables."""
+    """A simulated frame of a file (default: the last written): positions, velocities, observables."""
 
-    def __init__(self, path, step=None):
-        with open_state(path) as s:
-            steps = dynstate.position_steps(path)
-            idx = len(steps) - 1 if step is None else steps.index(step)
-            self.step = steps[idx]
-            self.n, self.p = s.n_strands, s.points
-            self.x = s.frame(idx)
-            self.flags = s.flags
-        self.v = dynstate.velocity(path, self.n, self.p, self.step)
-        self.obs = dynstate.observables(path, self.step)
+    OBSERVABLES = ("stretch_max", "penetration_max", "kinetic_energy", "blown_up_strands")
+
+    def __init__(self, path, index=-1):
+        with open_trajectory(path) as t:
+            idx = index % t.n_frames
+            self.step = int(t.step[idx])
+            self.n, self.p = t.n_strands, t.points
+            self.x = t.frame(idx)
+            self.flags = t.flags
+            self.v = t.velocity_at_step(self.step)
+            assert self.v is not None, f"{path}: no velocities stored for step {self.step}"
+            rows = t.observables[t.observables["step"] == self.step]
+            assert len(rows) == 1, f"{path}: no observables for step {self.step}"
+            self.obs = {k: rows.iloc[0][k].item() for k in self.OBSERVABLES}
 
 
 _CACHE = {}
@@ -106,39 +140,79 @@ def work(tmp_path_factory):
 @pytest.fixture(scope="session")
 def cpu_run(work):
     """(scene, solver, precision) -> the CPU's file (frames 0..FRAME_IN+1, velocities all)."""
+
     def get(scene, solver, precision):
         key = ("cpu", scene, solver, precision)
         if key not in _CACHE:
             out = work / f"cpu_{scene}_{solver}_{precision}.h5"
-            run(CPU_BIN, "--strands", N, "--seed", SEED, "--hair-length", L, "--precision", precision,
-                "--stages", "init,simulate", "--frames", FRAME_IN + 1, "--velocities", "all", "--quiet",
-                *dyn_args(scene, solver), "--output", out, "--force")
+            run(
+                CPU_BIN,
+                "--strands",
+                N,
+                "--seed",
+                SEED,
+                "--hair-length",
+                L,
+                "--precision",
+                precision,
+                "--stages",
+                "init,simulate",
+                "--frames",
+                FRAME_IN + 1,
+                "--velocities",
+                "all",
+                "--quiet",
+                *dyn_args(scene, solver),
+                "--output",
+                out,
+                "--force",
+            )
             _CACHE[key] = out
         return _CACHE[key]
+
     return get
 
 
 @pytest.fixture(scope="session")
 def gpu_frame(work, cpu_run):
     """(build, variant, scene, solver, precision, block, tag) -> the GPU's frame from the CPU's frame FRAME_IN."""
+
     def get(build, variant, scene, solver, precision, block, tag="", extra=()):
         key = ("gpu", build, variant, scene, solver, precision, block, tag)
         if key not in _CACHE:
             src = cpu_run(scene, solver, precision)
             out = work / f"gpu_{build}_{variant}_{scene}_{solver}_{precision}_{block}{tag}.h5"
-            run(BUILDS[build], "--input", src, "--input-frame", FRAME_IN, "--stages", "simulate", "--frames", 1,
-                "--variant", variant, "--block-size", block, "--quiet", *dyn_args(scene, solver), *extra,
-                "--output", out, "--force")
+            run(
+                BUILDS[build],
+                "--input",
+                src,
+                "--input-frame",
+                FRAME_IN,
+                "--stages",
+                "simulate",
+                "--frames",
+                1,
+                "--variant",
+                variant,
+                "--block-size",
+                block,
+                "--quiet",
+                *dyn_args(scene, solver),
+                *extra,
+                "--output",
+                out,
+                "--force",
+            )
             _CACHE[key] = Frame(out)
         return _CACHE[key]
+
     return get
 
 
 def cpu_next(cpu_run, scene, solver, precision):
     key = ("cpu-next", scene, solver, precision)
     if key not in _CACHE:
-        path = cpu_run(scene, solver, precision)
-        _CACHE[key] = Frame(path, dynstate.position_steps(path)[FRAME_IN + 1])
+        _CACHE[key] = Frame(cpu_run(scene, solver, precision), FRAME_IN + 1)
     return _CACHE[key]
 
 
@@ -148,8 +222,10 @@ def point_errors(a, b):
 
 def assert_close(gpu, cpu, build, precision, what):
     h = (1.0 / 60.0) / SUBSTEPS
-    for name, ga, ca, tol, scale in (("positions", gpu.x, cpu.x, GPU_DYN_POS, 1.0 / L),
-                                     ("velocities", gpu.v, cpu.v, GPU_DYN_VEL, h / L)):
+    for name, ga, ca, tol, scale in (
+        ("positions", gpu.x, cpu.x, GPU_DYN_POS, 1.0 / L),
+        ("velocities", gpu.v, cpu.v, GPU_DYN_VEL, h / L),
+    ):
         assert ga.shape == ca.shape, f"{what} {name}: shapes {ga.shape} vs {ca.shape}"
         assert np.isfinite(ga).all(), f"{what} {name}: NaN or Inf in the GPU state"
         d = point_errors(ga, ca) * scale
@@ -158,18 +234,22 @@ def assert_close(gpu, cpu, build, precision, what):
         allowed = int(GPU_DYN_MAX_OVER_FRACTION[precision] * d.size)
         worst = float(d.max())
         record(f"{name} {build} {precision}", worst)
-        assert over <= allowed, (f"{what} {name}: {over} of {d.size} points more than {t:g} apart (allowed "
-                                 f"{allowed}); worst {worst:.3g} at {np.unravel_index(d.argmax(), d.shape)}")
+        assert over <= allowed, (
+            f"{what} {name}: {over} of {d.size} points more than {t:g} apart (allowed "
+            f"{allowed}); worst {worst:.3g} at {np.unravel_index(d.argmax(), d.shape)}"
+        )
     for k in ("stretch_max", "penetration_max", "kinetic_energy"):
         g, c = float(gpu.obs[k]), float(cpu.obs[k])
-        assert abs(g - c) <= GPU_DYN_OBS_REL[precision] * abs(c) + GPU_DYN_OBS_ABS[precision], \
+        assert abs(g - c) <= GPU_DYN_OBS_REL[precision] * abs(c) + GPU_DYN_OBS_ABS[precision], (
             f"{what}: {k} {g!r} on the GPU, {c!r} on the CPU"
+        )
     assert gpu.obs["blown_up_strands"] == cpu.obs["blown_up_strands"] == 0, f"{what}: blown-up strands"
 
 
 def same_bits(a, b):
-    return (a.x.dtype == b.x.dtype and a.x.tobytes() == b.x.tobytes() and a.v.tobytes() == b.v.tobytes()
-            and a.obs == b.obs)
+    return (
+        a.x.dtype == b.x.dtype and a.x.tobytes() == b.x.tobytes() and a.v.tobytes() == b.v.tobytes() and a.obs == b.obs
+    )
 
 
 # ---- against the CPU ------------------------------------------------------------------------
@@ -200,7 +280,9 @@ def test_bits_do_not_depend_on_block_size_or_repeats(gpu_frame, build, variant, 
     ref = gpu_frame(build, variant, "all", solver, precision, BLOCKS[0])
     for b in BLOCKS[1:]:  # the warp variant at 1024, P = 32, fp64: 32 strands x 3.75 KB = 120 KB of shared memory
         other = gpu_frame(build, variant, "all", solver, precision, b)
-        assert same_bits(ref, other), f"{build} {variant} {solver} {precision}: block {b} differs from block {BLOCKS[0]}"
+        assert same_bits(ref, other), (
+            f"{build} {variant} {solver} {precision}: block {b} differs from block {BLOCKS[0]}"
+        )
     again = gpu_frame(build, variant, "all", solver, precision, BLOCKS[0], tag="-again")
     assert same_bits(ref, again), f"{build} {variant} {solver} {precision}: a second run differs"
     # --repeat 3: the frame is run three times from the saved state (positions and velocities)
@@ -217,26 +299,32 @@ def test_strict_strand_and_warp_identical(gpu_frame, scene, solver, precision):
     assert same_bits(a, b), f"strict {scene} {solver} {precision}: strand and warp differ"
 
 
-# ---- the paper-model stages on the new variants: the kernels of their layout --------------------
-@pytest.mark.parametrize("precision", PRECISIONS)
-@pytest.mark.parametrize("variant, same_as", (("strand", "soa"), ("warp", "paper")))
-def test_paper_stages_as_their_layouts_variant(tmp_path, variant, same_as, precision):
-    args = ["--strands", N, "--points", 32, "--seed", SEED, "--precision", precision, "--wind-strength", "0.6",
-            "--stages", "init,collide,wind,collide", "--quiet"]
-    run(CUDA_STRICT_BIN, *args, "--variant", variant, "--output", tmp_path / "a.h5")
-    run(CUDA_STRICT_BIN, *args, "--variant", same_as, "--output", tmp_path / "b.h5")
-    with open_state(tmp_path / "a.h5") as a, open_state(tmp_path / "b.h5") as b:
-        assert a.n_frames == b.n_frames == 4
-        for f in range(4):
-            assert a.frame(f).tobytes() == b.frame(f).tobytes(), f"{variant} vs {same_as}: frame {f} differs"
-
-
 # ---- refusals ---------------------------------------------------------------------------------
 def test_warp_block_too_large_for_shared_memory_is_refused(tmp_path):
     # 512 points x 32 strands a block x 15 reals x 8 bytes = 1.9 MB: more than any GPU gives a block
-    p = run(CUDA_BIN, "--strands", 100, "--points", 512, "--hair-length", 60, "--precision", "fp64", "--stages",
-            "init,simulate", "--frames", 1, "--variant", "warp", "--block-size", 1024, "--quiet",
-            "--output", tmp_path / "o.h5", check=False)
+    p = run(
+        CUDA_BIN,
+        "--strands",
+        100,
+        "--points",
+        512,
+        "--hair-length",
+        60,
+        "--precision",
+        "fp64",
+        "--stages",
+        "init,simulate",
+        "--frames",
+        1,
+        "--variant",
+        "warp",
+        "--block-size",
+        1024,
+        "--quiet",
+        "--output",
+        tmp_path / "o.h5",
+        check=False,
+    )
     assert p.returncode == 2, p.stderr
     assert "shared memory" in p.stderr and "--block-size" in p.stderr, p.stderr
     assert not (tmp_path / "o.h5").exists()
@@ -245,13 +333,34 @@ def test_warp_block_too_large_for_shared_memory_is_refused(tmp_path):
 def test_state_too_large_for_simulate_is_refused(tmp_path):
     # a state of a third of the free GPU memory: the state and its staging copy fit, but not
     # with the velocities, the rest shape and the strand variant's scratch on top
-    smi = subprocess.run(["nvidia-smi", "--query-gpu=memory.free", "--format=csv,noheader,nounits", "-i", "0"],
-                         capture_output=True, text=True, timeout=60)
-    free = int(smi.stdout.split()[0]) * 2 ** 20
+    smi = subprocess.run(
+        ["nvidia-smi", "--query-gpu=memory.free", "--format=csv,noheader,nounits", "-i", "0"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    free = int(smi.stdout.split()[0]) * 2**20
     strands = free // 3 // (32 * 3 * 8)
     out = tmp_path / "big.h5"
-    p = run(CUDA_BIN, "--strands", strands, "--points", 32, "--precision", "fp64", "--stages", "init,simulate",
-            "--frames", 1, "--variant", "strand", "--quiet", "--output", out, check=False)
+    p = run(
+        CUDA_BIN,
+        "--strands",
+        strands,
+        "--points",
+        32,
+        "--precision",
+        "fp64",
+        "--stages",
+        "init,simulate",
+        "--frames",
+        1,
+        "--variant",
+        "strand",
+        "--quiet",
+        "--output",
+        out,
+        check=False,
+    )
     assert p.returncode == 3, (p.returncode, p.stderr)
     assert "GPU memory" in p.stderr and "simulate" in p.stderr, p.stderr
     assert list(tmp_path.iterdir()) == [], "a refused run must leave no file"

@@ -1,15 +1,15 @@
 """The DESIGN §3 invariants as harness/invariants.py checks them: each planted violation
 is found and named, valid states pass, and the real C reference's outputs pass."""
+
 import subprocess
 
 import numpy as np
 import pytest
 
+from conftest import CPU_BIN
 from harness import invariants
 from harness.states import open_state
-from harness.synthetic import radial_strands, write_state
-
-from conftest import CPU_BIN
+from support.synthetic import radial_strands, write_state
 
 STAGES = ["init", "collide", "wind", "collide"]
 needs_cpu = pytest.mark.skipif(not CPU_BIN.exists(), reason=f"{CPU_BIN} is not built (run make)")
@@ -34,19 +34,19 @@ def test_valid_state_passes(tmp_path, dtype):
 
 def test_moved_root(tmp_path):
     x = radial_strands(10, 8, STAGES)
-    x[2, 4, :, 1] += 1e-9   # the whole strand shifts: only its root is wrong
+    x[2, 4, :, 1] += 1e-9  # the whole strand shifts: only its root is wrong
     assert names(check(tmp_path, x)) == {(2, "roots")}
 
 
 def test_strand_leaves_its_plane(tmp_path):
     x = radial_strands(10, 8, STAGES)
-    x[1, 3, 5, 0] = np.nextafter(x[1, 3, 5, 0], np.inf)   # one ulp is already a violation
+    x[1, 3, 5, 0] = np.nextafter(x[1, 3, 5, 0], np.inf)  # one ulp is already a violation
     assert names(check(tmp_path, x)) == {(1, "x_constant")}
 
 
 def test_stretched_segment(tmp_path):
     x = radial_strands(10, 8, STAGES)
-    x[3, 7, 7, 1] += 1e-6    # the last segment grows by ~1e-6 ≫ 16 ε·E in fp64
+    x[3, 7, 7, 1] += 1e-6  # the last segment grows by ~1e-6 ≫ 16 ε·E in fp64
     rep = check(tmp_path, x)
     assert names(rep) == {(3, "segments")}
     assert "segment length" in rep.violations[0].message
@@ -56,7 +56,7 @@ def test_point_inside_shell_only_matters_after_collide(tmp_path):
     x = radial_strands(10, 8, STAGES)
     root = x[0, 2, 0]
     radial = root[1:] / np.hypot(root[1], root[2])
-    turn = np.radians(150)   # the strand points into the head: its points are inside the shell
+    turn = np.radians(150)  # the strand points into the head: its points are inside the shell
     c, s = np.cos(turn), np.sin(turn)
     inward = np.array([c * radial[0] + s * radial[1], -s * radial[0] + c * radial[1]])
     ell = 30.0 / 7
@@ -64,7 +64,7 @@ def test_point_inside_shell_only_matters_after_collide(tmp_path):
         x[:, 2, k, 1:] = root[1:] + k * ell * inward
     found = names(check(tmp_path, x))
     assert (1, "shell") in found and (3, "shell") in found
-    assert (0, "shell") not in found and (2, "shell") not in found   # init and wind frames
+    assert (0, "shell") not in found and (2, "shell") not in found  # init and wind frames
     assert not any(name != "shell" for _, name in found)
 
 
@@ -87,15 +87,20 @@ def test_skipped_stage_must_be_a_copy(tmp_path):
 
 @needs_cpu
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
-@pytest.mark.parametrize("scene", [
-    ["--wind-strength", "0.5"],
-    ["--wind-strength", "1", "--points", "8"],
-    ["--wind-strength", "0", "--points", "64"],
-])
+@pytest.mark.parametrize(
+    "scene",
+    [
+        ["--wind-strength", "0.5"],
+        ["--wind-strength", "1", "--points", "8"],
+        ["--wind-strength", "0", "--points", "64"],
+    ],
+)
 def test_real_cpu_output_holds_every_invariant(tmp_path, precision, scene):
     out = tmp_path / "cpu.h5"
-    subprocess.run([str(CPU_BIN), "--strands", "2000", "--precision", precision, "--quiet",
-                    "--output", str(out), *scene], check=True)
+    subprocess.run(
+        [str(CPU_BIN), "--strands", "2000", "--precision", precision, "--quiet", "--output", str(out), *scene],
+        check=True,
+    )
     with open_state(out) as s:
         rep = invariants.check(s)
         if "0" in scene:

@@ -1,14 +1,15 @@
 """`harness plot` / `harness report` from a small runs.csv: the report builds, says what
 ran and what is absent, sets the paper's numbers beside ours, and every PNG is written."""
+
 import json
 
 import numpy as np
 import pytest
 
-from harness import report, runlog
+from harness import results_data, runlog
 from harness.__main__ import main
 from harness.plots import FIGURE_STATE
-from harness.synthetic import radial_strands, write_state
+from support.synthetic import radial_strands, write_state
 
 STAGES = ["init", "collide", "wind", "collide"]
 
@@ -23,15 +24,42 @@ def case_rows(backend, variant, threads, block, strands, pair_ms, precision="fp3
             f, ms = "wind+collide", pair_ms
         elif fused and i == 3:
             f, ms = "into-previous", 0.0
-        rows.append({"case_id": case_id, "stage_index": i, "n_stages": 4, "stage": st, "scene": "paper",
-                     "backend": backend, "build": "default" if backend == "cuda" else "",
-                     "variant": variant, "precision": precision, "block_size": block or "",
-                     "threads": threads, "strands": strands, "points": 32, "repeat": 9, "warmup": 1,
-                     "skipped": 0, "fused": f, "n_times": 9, "median_ms": ms, "min_ms": ms * 0.9,
-                     "max_ms": ms * 1.2, "q1_ms": ms * 0.95, "q3_ms": ms * 1.05, "iqr_ms": ms * 0.1,
-                     "bytes_moved": strands * 32 * 16, "achieved_gbps": strands * 32 * 16 / (ms or 1) / 1e6,
-                     "copy_gbps": 40.0, "bandwidth_fraction": 0.1, "device": "test", "binary": "x",
-                     "session": 0, "finished_at": "now"})
+        rows.append(
+            {
+                "case_id": case_id,
+                "stage_index": i,
+                "n_stages": 4,
+                "stage": st,
+                "scene": "paper",
+                "backend": backend,
+                "build": "default" if backend == "cuda" else "",
+                "variant": variant,
+                "precision": precision,
+                "block_size": block or "",
+                "threads": threads,
+                "strands": strands,
+                "points": 32,
+                "repeat": 9,
+                "warmup": 1,
+                "skipped": 0,
+                "fused": f,
+                "n_times": 9,
+                "median_ms": ms,
+                "min_ms": ms * 0.9,
+                "max_ms": ms * 1.2,
+                "q1_ms": ms * 0.95,
+                "q3_ms": ms * 1.05,
+                "iqr_ms": ms * 0.1,
+                "bytes_moved": strands * 32 * 16,
+                "achieved_gbps": strands * 32 * 16 / (ms or 1) / 1e6,
+                "copy_gbps": 40.0,
+                "bandwidth_fraction": 0.1,
+                "device": "test",
+                "binary": "x",
+                "session": 0,
+                "finished_at": "now",
+            }
+        )
     return rows
 
 
@@ -39,7 +67,7 @@ def write_results(d, gpu):
     d.mkdir(parents=True, exist_ok=True)
     rows = []
     for n in (1000, 10000, 100000, 1000000):
-        t1 = n * 6e-4                       # ref, 1 thread: 353 ms near N = 588,000
+        t1 = n * 6e-4  # ref, 1 thread: 353 ms near N = 588,000
         rows += case_rows("cpu", "ref", "1", 0, n, t1)
         rows += case_rows("cpu", "simd", "all", 0, n, t1 / 8)
         rows += case_rows("cpu", "ref", "1", 0, n, t1 * 1.3, precision="fp64")
@@ -49,13 +77,35 @@ def write_results(d, gpu):
             rows += case_rows("cuda", "fused", "", 256, n, 0.04 + n * 5e-7, fused=True)
     path = d / "runs.csv"
     path.write_text(runlog.HEADER + runlog.format_rows(rows))
-    skipped = [] if gpu else [{"backends": ["cuda"], "builds": ["default"], "cases": 12,
-                               "reason": "no nvidia-smi on PATH: this machine has no NVIDIA GPU"}]
-    (d / "env.json").write_text(json.dumps({
-        "sweep": "t", "scene": {"head_radius": 10.0, "hair_offset": 0.1, "hair_length": 30.0},
-        "sessions": [{"started_at": "now", "host": {"cpu_model": "Test CPU", "cpu_cores": 2},
-                      "binaries": {"hairsim-cpu": {"flags": "-O2"}},
-                      "bandwidth": {"hairsim-cpu": {"copy_gbps": 40.0}}, "skipped": skipped}]}))
+    skipped = (
+        []
+        if gpu
+        else [
+            {
+                "backends": ["cuda"],
+                "builds": ["default"],
+                "cases": 12,
+                "reason": "no nvidia-smi on PATH: this machine has no NVIDIA GPU",
+            }
+        ]
+    )
+    (d / "env.json").write_text(
+        json.dumps(
+            {
+                "sweep": "t",
+                "scene": {"head_radius": 10.0, "hair_offset": 0.1, "hair_length": 30.0},
+                "sessions": [
+                    {
+                        "started_at": "now",
+                        "host": {"cpu_model": "Test CPU", "cpu_cores": 2},
+                        "binaries": {"hairsim-cpu": {"flags": "-O2"}},
+                        "bandwidth": {"hairsim-cpu": {"copy_gbps": 40.0}},
+                        "skipped": skipped,
+                    }
+                ],
+            }
+        )
+    )
     (d / FIGURE_STATE).parent.mkdir()
     write_state(d / FIGURE_STATE, radial_strands(60, 16, STAGES), STAGES)
     return d
@@ -68,8 +118,14 @@ def test_report_builds_with_plots(tmp_path, gpu, capsys):
     assert main(["report", str(results), "--report-dir", str(out)]) == 0
     md = (out / "report.md").read_text()
     pngs = sorted(p.name for p in out.glob("*.png"))
-    for name in ("speedup_fp32.png", "speedup_fp64.png", "block_size_fp32.png", "bandwidth_fp32.png",
-                 "fig1_initialized.png", "fig2_after_wind.png"):
+    for name in (
+        "speedup_fp32.png",
+        "speedup_fp64.png",
+        "block_size_fp32.png",
+        "bandwidth_fp32.png",
+        "fig1_initialized.png",
+        "fig2_after_wind.png",
+    ):
         assert name in pngs
         assert (out / name).stat().st_size > 5000
         assert f"]({name})" in md
@@ -90,12 +146,12 @@ def test_report_builds_with_plots(tmp_path, gpu, capsys):
 
 def test_strand_count_at_a_time():
     curve = {1000: 1.0, 10000: 10.0, 100000: 100.0}
-    n, how = report.strands_at_time(curve, 50.0)
+    n, how = results_data.strands_at_time(curve, 50.0)
     assert n == pytest.approx(50000, rel=1e-9) and how == "interpolated"
-    n, how = report.strands_at_time(curve, 400.0)
+    n, how = results_data.strands_at_time(curve, 400.0)
     assert n == pytest.approx(400000) and how.startswith("extrapolated")
-    assert report.strands_at_time({}, 5.0) == (None, "no data")
-    assert report.interp_time(curve, 30000) == pytest.approx(30.0)
+    assert results_data.strands_at_time({}, 5.0) == (None, "no data")
+    assert results_data.interp_time(curve, 30000) == pytest.approx(30.0)
 
 
 def test_report_without_results_is_one_clear_error(tmp_path, capsys):

@@ -1,9 +1,10 @@
 """The counter-based RNG (DESIGN §3 Randomness): Random123's known-answer vectors, and an
 independent Python Philox4x32-10 that must reproduce the C roots bit for bit."""
+
 import numpy as np
 import pytest
 
-from statecheck import State, run
+from support.statecheck import State, run
 
 M0, M1, W0, W1 = 0xD2511F53, 0xCD9E8D57, 0x9E3779B9, 0xBB67AE85
 MASK = 0xFFFFFFFF
@@ -25,8 +26,11 @@ def philox4x32(ctr, key, rounds=10):
 KAT = [
     ([0, 0, 0, 0], [0, 0], [0x6627E8D5, 0xE169C58D, 0xBC57AC4C, 0x9B00DBD8]),
     ([MASK] * 4, [MASK, MASK], [0x408F276D, 0x41C83B0E, 0xA20BC7C6, 0x6D5451FD]),
-    ([0x243F6A88, 0x85A308D3, 0x13198A2E, 0x03707344], [0xA4093822, 0x299F31D0],
-     [0xD16CFE09, 0x94FDCCEB, 0x5001E420, 0x24126EA1]),
+    (
+        [0x243F6A88, 0x85A308D3, 0x13198A2E, 0x03707344],
+        [0xA4093822, 0x299F31D0],
+        [0xD16CFE09, 0x94FDCCEB, 0x5001E420, 0x24126EA1],
+    ),
 ]
 
 
@@ -63,8 +67,24 @@ def roots_from_python(seed, n, R, m):
 @pytest.mark.parametrize("seed", [1, 2**40 + 12345])
 def test_roots_match_an_independent_python_rng_bit_for_bit(cpu_bin, tmp_path, seed):
     out = tmp_path / "roots.h5"
-    run(cpu_bin, "--strands", 300, "--points", 4, "--hair-length", 3, "--seed", seed, "--precision", "fp64",
-        "--stages", "init", "--output", out, "--quiet")
+    run(
+        cpu_bin,
+        "--strands",
+        300,
+        "--points",
+        4,
+        "--hair-length",
+        3,
+        "--seed",
+        seed,
+        "--precision",
+        "fp64",
+        "--stages",
+        "init",
+        "--output",
+        out,
+        "--quiet",
+    )
     s = State(out)
     want = roots_from_python(seed, 300, 10.0, 1.0)
     np.testing.assert_array_equal(s.frames[0, :, 0, :], want)
@@ -73,8 +93,22 @@ def test_roots_match_an_independent_python_rng_bit_for_bit(cpu_bin, tmp_path, se
 def test_draws_differ_between_seeds_and_strands(cpu_bin, tmp_path):
     a, b = tmp_path / "a.h5", tmp_path / "b.h5"
     for seed, path in ((1, a), (2, b)):
-        run(cpu_bin, "--strands", 500, "--points", 2, "--hair-length", 1, "--seed", seed, "--stages", "init",
-            "--output", path, "--quiet")
+        run(
+            cpu_bin,
+            "--strands",
+            500,
+            "--points",
+            2,
+            "--hair-length",
+            1,
+            "--seed",
+            seed,
+            "--stages",
+            "init",
+            "--output",
+            path,
+            "--quiet",
+        )
     ra, rb = State(a).frames[0, :, 0], State(b).frames[0, :, 0]
     assert not np.array_equal(ra, rb)
     # strands draw distinct roots, except those whose z the DESIGN §3 clamp put at -R

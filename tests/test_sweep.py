@@ -1,8 +1,9 @@
 """`harness sweep`: tidy rows, IQR from times_ms, roofline bytes, skipped cases said aloud,
 and resume after a kill with no lost or duplicated rows.
 
-The backend is harness.fakebackend (installed as build/hairsim-* in a temporary build dir
+The backend is support.fakebackend (installed as build/hairsim-* in a temporary build dir
 through HAIRBENCH_BUILD_DIR), so these tests need no build and take seconds."""
+
 import csv
 import os
 import signal
@@ -12,12 +13,11 @@ import time
 
 import pytest
 
+from conftest import ROOT
 from harness import roofline, runlog
-from harness.fakebackend import install
 from harness.sweep import quartiles, run_sweep
 from harness.sweepfile import load_sweep
-
-from conftest import ROOT
+from support.fakebackend import install
 
 SWEEP = """
 name = "t"
@@ -67,7 +67,7 @@ def test_rows_are_tidy_with_iqr_and_roofline(fake, tmp_path, capsys):
     out = tmp_path / "res"
     run_sweep(fake, out=out)
     err = capsys.readouterr().out
-    assert "skipping 12 cuda" in err and "HAIRBENCH_NO_GPU is set" in err   # said, not silent
+    assert "skipping 12 cuda" in err and "HAIRBENCH_NO_GPU is set" in err  # said, not silent
     rows = read_csv(out / "runs.csv")
     assert_complete_once(rows, N_CPU_CASES)
     assert list(rows[0]) == runlog.COLUMNS
@@ -103,8 +103,9 @@ def test_resume_after_sigkill(fake, tmp_path):
     out = tmp_path / "res"
     env = dict(os.environ, FAKE_SLEEP="0.25", PYTHONPATH=str(ROOT))
     cmd = [sys.executable, "-m", "harness", "sweep", str(fake), "--out", str(out), "--gpu", "no"]
-    p = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                         start_new_session=True)
+    p = subprocess.Popen(
+        cmd, cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+    )
     csv_path = out / "runs.csv"
     deadline = time.time() + 60
     while time.time() < deadline:
@@ -115,7 +116,7 @@ def test_resume_after_sigkill(fake, tmp_path):
     p.wait()
     rows = read_csv(csv_path)
     assert STAGES * 3 <= len(rows) < STAGES * N_CPU_CASES, "the kill came too late to test anything"
-    with open(csv_path, "a") as f:   # what a kill inside a write leaves: a torn line
+    with open(csv_path, "a") as f:  # what a kill inside a write leaves: a torn line
         f.write("paper:cpu:ref:t1:fp32:N30:P4:r9w1,0,4,in")
     done_before = {r["case_id"] for r in rows}
 
@@ -131,8 +132,8 @@ def test_resume_drops_a_partial_case_and_keeps_the_rest(fake, tmp_path):
     run_sweep(fake, out=out, gpu="no")
     path = out / "runs.csv"
     lines = path.read_text().splitlines(keepends=True)
-    complete = lines[:1 + 5 * STAGES]
-    partial = lines[1 + 5 * STAGES:1 + 5 * STAGES + 2]   # 2 of a case's 4 rows
+    complete = lines[: 1 + 5 * STAGES]
+    partial = lines[1 + 5 * STAGES : 1 + 5 * STAGES + 2]  # 2 of a case's 4 rows
     path.write_text("".join(complete + partial))
     size_before = len("".join(complete))
     done, dropped = runlog.resume(path)
@@ -167,7 +168,7 @@ def test_missing_bandwidth_and_too_big_cases(fake, tmp_path, monkeypatch, capsys
     rows = read_csv(out / "runs.csv")
     assert {r["strands"] for r in rows} == {"10", "20"}
     assert all(r["bandwidth_fraction"] == "" and r["copy_gbps"] == "" for r in rows)
-    assert "N30" in (out / "env.json").read_text()   # the skipped cases are recorded
+    assert "N30" in (out / "env.json").read_text()  # the skipped cases are recorded
 
 
 def test_gpu_yes_without_gpu_is_an_error(fake, tmp_path):
@@ -178,8 +179,10 @@ def test_gpu_yes_without_gpu_is_an_error(fake, tmp_path):
 
 def test_groups_and_overrides(tmp_path):
     p = tmp_path / "g.toml"
-    p.write_text('scene = "paper"\n[axes]\nstrands = [1, 2]\n[[cpu]]\nthreads = [1]\n'
-                 '[[cpu]]\nthreads = [1, "all"]\nstrands = [2, 3]\n')
+    p.write_text(
+        'scene = "paper"\n[axes]\nstrands = [1, 2]\n[[cpu]]\nthreads = [1]\n'
+        '[[cpu]]\nthreads = [1, "all"]\nstrands = [2, 3]\n'
+    )
     cases = load_sweep(p).cases()
     assert sorted((c.strands, c.threads) for c in cases) == [(1, "1"), (2, "1"), (2, "all"), (3, "1"), (3, "all")]
 

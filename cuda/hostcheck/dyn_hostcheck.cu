@@ -53,14 +53,23 @@ void ref_frame(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *x, float
 {
     hb_dyn_frame_strand_f32(m, f, x, v, r, b, s);
 }
-void ref_frame(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *x, double *v, const double *r,
-               const double *b, double *s)
+void ref_frame(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *x, double *v, const double *r, const double *b,
+               double *s)
 {
     hb_dyn_frame_strand_f64(m, f, x, v, r, b, s);
 }
-void ref_bend(const hb_dyn_model_f32 *m, const float *r, float *b) { hb_dyn_bend_rest_f32(m, r, b); }
-void ref_bend(const hb_dyn_model_f64 *m, const double *r, double *b) { hb_dyn_bend_rest_f64(m, r, b); }
-void ref_obs(const hb_scene *s, const float *x, const float *v, hb_obs_partial *o) { hb_dyn_observe_strand_f32(s, x, v, o); }
+void ref_bend(const hb_dyn_model_f32 *m, const float *r, float *b)
+{
+    hb_dyn_bend_rest_f32(m, r, b);
+}
+void ref_bend(const hb_dyn_model_f64 *m, const double *r, double *b)
+{
+    hb_dyn_bend_rest_f64(m, r, b);
+}
+void ref_obs(const hb_scene *s, const float *x, const float *v, hb_obs_partial *o)
+{
+    hb_dyn_observe_strand_f32(s, x, v, o);
+}
 void ref_obs(const hb_scene *s, const double *x, const double *v, hb_obs_partial *o)
 {
     hb_dyn_observe_strand_f64(s, x, v, o);
@@ -81,17 +90,12 @@ template <> struct CM<double> {
 
 /* The warp kernel's Lanes on one host thread: lane 31 first, each lane its strided share. */
 struct HostLanes {
-    template <class Fn>
-    HB_DHD void each(int64_t b, int64_t e, int64_t step, Fn f) const
+    template <class Fn> HB_DHD void each(int64_t b, int64_t e, int64_t step, Fn f) const
     {
         for (int lane = 31; lane >= 0; lane--)
             for (int64_t k = b + (int64_t)lane * step; k < e; k += 32 * step) f(k);
     }
-    template <class Fn>
-    HB_DHD void one(Fn f) const
-    {
-        f();
-    }
+    template <class Fn> HB_DHD void one(Fn f) const { f(); }
 };
 
 /* a small deterministic generator (no libc rand: the same numbers everywhere) */
@@ -167,7 +171,8 @@ void make_state(const hb_scene &s, uint64_t seed, std::vector<T> &rest, std::vec
         for (int c = 0; c < 3; c++) p[c] = R * dir[c] / n;
         for (int64_t k = 0; k < P; k++) {
             if (k > 0) {
-                double t[3] = {dir[0] / n + 0.6 * g.sym(), dir[1] / n - 0.5 + 0.6 * g.sym(), dir[2] / n + 0.6 * g.sym()};
+                double t[3] = {dir[0] / n + 0.6 * g.sym(), dir[1] / n - 0.5 + 0.6 * g.sym(),
+                               dir[2] / n + 0.6 * g.sym()};
                 double tn = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
                 for (int c = 0; c < 3; c++) p[c] += ell * t[c] / tn;
             }
@@ -188,8 +193,7 @@ void make_state(const hb_scene &s, uint64_t seed, std::vector<T> &rest, std::vec
 
 long g_cases = 0, g_mismatch = 0;
 
-template <typename T>
-bool same_bits(const std::vector<T> &a, const std::vector<T> &b)
+template <typename T> bool same_bits(const std::vector<T> &a, const std::vector<T> &b)
 {
     return a.size() == b.size() && memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
@@ -282,8 +286,7 @@ void port_frames(Mode mode, Feat has, const DModel<T> &m, const T *q, const T *p
     }
 }
 
-template <typename T, unsigned F>
-void check_one(int solver, int64_t P, int variant)
+template <typename T, unsigned F> void check_one(int solver, int64_t P, int variant)
 {
     const int64_t N = 7;
     const int fp64 = sizeof(T) == 8;
@@ -342,8 +345,9 @@ void check_one(int solver, int64_t P, int variant)
             ref_obs(&s, xr[1].data() + i * P3, vr[1].data() + i * P3, &a);
             observe_strand<T>(os, Arr<const T>{xr[1].data() + i * P3, 3, 1}, Arr<const T>{vr[1].data() + i * P3, 3, 1},
                               &b);
-            ok &= memcmp(&a.stretch_max, &b.stretch_max, 8) == 0 && memcmp(&a.penetration_max, &b.penetration_max, 8) == 0 &&
-                  memcmp(&a.v2_sum, &b.v2_sum, 8) == 0 && a.blown == (int64_t)b.blown;
+            ok &= memcmp(&a.stretch_max, &b.stretch_max, 8) == 0 &&
+                  memcmp(&a.penetration_max, &b.penetration_max, 8) == 0 && memcmp(&a.v2_sum, &b.v2_sum, 8) == 0 &&
+                  a.blown == (int64_t)b.blown;
         }
         report(ok, "observables", F, solver, P, prec, feat);
     }

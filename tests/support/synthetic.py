@@ -6,21 +6,45 @@ angle, with segments of exactly ℓ (up to rounding) and x constant. `write_stat
 any positions array [F][N][P][3] with the /h5md, /particles and /parameters layout of
 docs/interfaces.md.
 """
+
 import os
 
 import numpy as np
 
 DEFAULT_PARAMS = {
-    "head_radius": 10.0, "hair_offset": 0.1, "hair_length": 30.0, "face_margin": 1.0,
-    "wind_strength": 0.5, "wind_angle": np.pi, "seed": 1, "backend": "synthetic",
-    "variant": "radial", "block_size": -1, "threads": 1, "repeat": 1, "warmup": 0,
-    "git_revision": "none", "compiler": "none", "flags": "", "device": "none",
-    "driver": "none", "version": "0.1.0", "end_to_end_ms": 0.0, "hdf5_write_ms": 0.0,
+    "head_radius": 10.0,
+    "hair_offset": 0.1,
+    "hair_length": 30.0,
+    "face_margin": 1.0,
+    "wind_strength": 0.5,
+    "wind_angle": np.pi,
+    "seed": 1,
+    "backend": "synthetic",
+    "variant": "radial",
+    "block_size": -1,
+    "threads": 1,
+    "repeat": 1,
+    "warmup": 0,
+    "git_revision": "none",
+    "compiler": "none",
+    "flags": "",
+    "device": "none",
+    "driver": "none",
+    "version": "0.1.0",
+    "end_to_end_ms": 0.0,
+    "hdf5_write_ms": 0.0,
 }
 
 
-def radial_strands(n_strands, points, stages=("init", "collide", "wind", "collide"),
-                   dtype=np.float64, seed=0, head_radius=10.0, hair_length=30.0):
+def radial_strands(
+    n_strands,
+    points,
+    stages=("init", "collide", "wind", "collide"),
+    dtype=np.float64,
+    seed=0,
+    head_radius=10.0,
+    hair_length=30.0,
+):
     """Positions [F][N][P][3] of strands running outward from their roots.
 
     Frame f tilts every strand by an angle of f·0.1 rad in its slice plane (still well
@@ -43,8 +67,7 @@ def radial_strands(n_strands, points, stages=("init", "collide", "wind", "collid
     return np.asarray(frames).astype(dtype)
 
 
-def write_state(path, positions, stages, precision=None, params=None, skipped=None,
-                fused=None, datasets=True):
+def write_state(path, positions, stages, precision=None, params=None, skipped=None, fused=None, datasets=True):
     """Write positions [F][N][P][3] to `path` in the documented layout (temp file, rename).
 
     `params` overrides /parameters attributes; `datasets=False` leaves out the optional
@@ -67,8 +90,7 @@ def write_state(path, positions, stages, precision=None, params=None, skipped=No
         box.attrs["dimension"] = 3
         box.attrs["boundary"] = ["none", "none", "none"]
         pos = f.create_group("particles/hair/position")
-        pos.create_dataset("value", data=positions.reshape(F, N * P, 3),
-                           chunks=(1, min(N * P, 1 << 20), 3))
+        pos.create_dataset("value", data=positions.reshape(F, N * P, 3), chunks=(1, min(N * P, 1 << 20), 3))
         pos.create_dataset("step", data=np.arange(F, dtype=np.int64))
         pos.create_dataset("time", data=np.arange(F, dtype=np.float64))
         g = f.create_group("parameters")
@@ -82,11 +104,15 @@ def write_state(path, positions, stages, precision=None, params=None, skipped=No
             g.create_dataset("moved_points", data=np.array(moved, dtype=np.int64))
             wind = [attrs["wind_strength"] if s == "wind" else np.nan for s in stages]
             g.create_dataset("wind_strength", data=np.array(wind, dtype=np.float64))
-            g.create_dataset("wind_angle", data=np.array(
-                [attrs["wind_angle"] if s == "wind" else np.nan for s in stages], dtype=np.float64))
+            g.create_dataset(
+                "wind_angle",
+                data=np.array([attrs["wind_angle"] if s == "wind" else np.nan for s in stages], dtype=np.float64),
+            )
             for name in ("stage_median_ms", "stage_min_ms", "stage_max_ms"):
                 g.create_dataset(name, data=np.zeros(F))
-            g.create_dataset("frame_backend", data=np.array(
-                [f"{attrs['backend']}/{attrs['variant']}"] * F, dtype=h5py.string_dtype()))
+            g.create_dataset(
+                "frame_backend",
+                data=np.array([f"{attrs['backend']}/{attrs['variant']}"] * F, dtype=h5py.string_dtype()),
+            )
     os.replace(tmp, path)
     return path

@@ -1,4 +1,5 @@
-"""A stand-in backend for the harness's own tests: `python -m harness.fakebackend FLAGS`.
+"""A stand-in backend for the harness's own tests: `python -m support.fakebackend FLAGS`
+(from tests/).
 
 It speaks the interface of docs/interfaces.md (the flags the harness passes, the JSON
 record, HDF5 states via synthetic.py) without simulating anything, so the sweep, resume,
@@ -10,6 +11,7 @@ environment:
   FAKE_SHIFT_FP32=d       move every fp32 point by d (a planted inequivalence)
   FAKE_BACKEND=name       the backend named in the record (default: from the program name)
 """
+
 import json
 import os
 import sys
@@ -17,10 +19,29 @@ import time
 
 import numpy as np
 
-NAMES = ("strands", "points", "seed", "head-radius", "hair-offset", "hair-length",
-         "face-margin", "wind-strength", "wind-angle", "stages", "precision", "variant",
-         "threads", "block-size", "input", "output", "repeat", "warmup")
-SWITCHES = ("force", "json", "quiet", "end-to-end", "measure-bandwidth")
+NAMES = (
+    "strands",
+    "points",
+    "seed",
+    "head-radius",
+    "hair-offset",
+    "hair-length",
+    "face-margin",
+    "wind-strength",
+    "wind-angle",
+    "stages",
+    "precision",
+    "variant",
+    "threads",
+    "block-size",
+    "input",
+    "output",
+    "repeat",
+    "warmup",
+)
+SWITCHES = ("force", "json", "quiet", "end-to-end", "measure-bandwidth", "list-variants")
+# what --list-variants prints, per backend (the binaries declare theirs the same way)
+VARIANTS = {"cpu": ("ref", ["ref", "simd"]), "cuda": ("fused", ["paper", "soa", "fused"])}
 
 
 def parse(argv):
@@ -48,6 +69,21 @@ def main(argv=None):
     prog = os.path.basename(os.environ.get("FAKE_PROG", "hairsim-cpu"))
     backend = os.environ.get("FAKE_BACKEND") or ("cuda" if "cuda" in prog else "cpu")
     o = parse(argv)
+    if o.get("list-variants"):
+        default, names = VARIANTS[backend]
+        build = next((b for b in ("strict", "fastmath") if prog.endswith(b)), "default")
+        print(
+            json.dumps(
+                {
+                    "backend": backend,
+                    "build": build,
+                    "default_variant": default,
+                    "precisions": ["fp32", "fp64"],
+                    "variants": [{"name": n, "stages": ["init", "collide", "wind"], "summary": "fake"} for n in names],
+                }
+            )
+        )
+        return 0
     time.sleep(float(os.environ.get("FAKE_SLEEP", "0")))
     if o.get("measure-bandwidth"):
         if os.environ.get("FAKE_NO_BANDWIDTH"):
@@ -66,29 +102,60 @@ def main(argv=None):
     records = []
     for i, st in enumerate(stages):
         times = [float((i + 1) * (r + 1)) for r in range(repeat)]
-        records.append({"frame": i, "stage": st, "skipped": False, "fused": None,
-                        "median_ms": float(np.median(times)), "min_ms": min(times),
-                        "max_ms": max(times), "times_ms": times,
-                        "moved_points": 0 if st == "collide" else None})
+        records.append(
+            {
+                "frame": i,
+                "stage": st,
+                "skipped": False,
+                "fused": None,
+                "median_ms": float(np.median(times)),
+                "min_ms": min(times),
+                "max_ms": max(times),
+                "times_ms": times,
+                "moved_points": 0 if st == "collide" else None,
+            }
+        )
     if o.get("output"):
-        from .synthetic import radial_strands, write_state
+        from support.synthetic import radial_strands, write_state
+
         dtype = np.float64 if precision == "fp64" else np.float32
         pos = radial_strands(strands, points, stages, dtype=np.float64, seed=int(o.get("seed", 1)))
         shift = float(os.environ.get("FAKE_SHIFT_FP32", "0"))
         if precision == "fp32" and shift:
             pos[1:, :, 1:, 1] += shift
-        write_state(o["output"], pos.astype(dtype), stages, precision=precision,
-                    params={"backend": backend, "variant": o.get("variant", "ref"),
-                            "seed": int(o.get("seed", 1))})
-    record = {"backend": backend, "variant": o.get("variant", "ref"), "precision": precision,
-              "strands": strands, "points": points, "seed": int(o.get("seed", 1)),
-              "threads": int(o.get("threads", 2)), "block_size": o.get("block-size"),
-              "repeat": repeat, "warmup": int(o.get("warmup", 0)), "input": o.get("input"),
-              "output": o.get("output"), "stages": records, "end_to_end_ms": 1.0,
-              "h2d_ms": None, "d2h_ms": None, "hdf5_write_ms": None,
-              "state_bytes": strands * points * 3 * (8 if precision == "fp64" else 4),
-              "git_revision": "fake", "compiler": "none", "flags": "fake", "device": "fake device",
-              "driver": None, "version": "0.0.0"}
+        write_state(
+            o["output"],
+            pos.astype(dtype),
+            stages,
+            precision=precision,
+            params={"backend": backend, "variant": o.get("variant", "ref"), "seed": int(o.get("seed", 1))},
+        )
+    record = {
+        "backend": backend,
+        "variant": o.get("variant", "ref"),
+        "precision": precision,
+        "strands": strands,
+        "points": points,
+        "seed": int(o.get("seed", 1)),
+        "threads": int(o.get("threads", 2)),
+        "block_size": o.get("block-size"),
+        "repeat": repeat,
+        "warmup": int(o.get("warmup", 0)),
+        "input": o.get("input"),
+        "output": o.get("output"),
+        "stages": records,
+        "end_to_end_ms": 1.0,
+        "h2d_ms": None,
+        "d2h_ms": None,
+        "hdf5_write_ms": None,
+        "state_bytes": strands * points * 3 * (8 if precision == "fp64" else 4),
+        "git_revision": "fake",
+        "compiler": "none",
+        "flags": "fake",
+        "device": "fake device",
+        "driver": None,
+        "version": "0.0.0",
+    }
     print(json.dumps(record))
     return 0
 
@@ -97,13 +164,16 @@ def install(directory, names=("hairsim-cpu",)):
     """Write executable stand-ins named `names` into `directory` (for HAIRBENCH_BUILD_DIR)."""
     from pathlib import Path
 
-    root = Path(__file__).resolve().parent.parent
+    tests = Path(__file__).resolve().parent.parent
+    root = tests.parent
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     for name in names:
         path = directory / name
-        path.write_text(f'#!/bin/sh\nFAKE_PROG="$0" PYTHONPATH="{root}${{PYTHONPATH:+:$PYTHONPATH}}" '
-                        f'exec "{sys.executable}" -m harness.fakebackend "$@"\n')
+        path.write_text(
+            f'#!/bin/sh\nFAKE_PROG="$0" PYTHONPATH="{tests}:{root}${{PYTHONPATH:+:$PYTHONPATH}}" '
+            f'exec "{sys.executable}" -m support.fakebackend "$@"\n'
+        )
         path.chmod(0o755)
     return directory
 

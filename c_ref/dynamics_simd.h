@@ -1,0 +1,68 @@
+/* dynamics_simd.h — the dynamic model (docs/model.md §3) on the point-major layout,
+ * vectorised across strands: the simulate stage of the `simd` variant of hairsim-cpu
+ * (docs/cpu_simd.md, "The dynamic model").
+ *
+ * Layout: as model_simd.h. Positions X, Y, Z, velocities VX, VY, VZ and the rest shape
+ * RX, RY, RZ are [P][stride] arrays (point k of strand i at k·stride + i); the bend rest
+ * lengths BR are [P−2][stride]. A dynamic block is HB_SIMD_DYN_BLOCK consecutive strands
+ * (it divides the layout blocks HB_SIMD_BLOCK_F32/_F64); each call below computes one
+ * whole block, one strand per SIMD lane, with the lane state of the block (the predicted
+ * positions of all P points, the multipliers) in a block-sized scratch array.
+ *
+ * The arithmetic is dynamics_impl.h's, operation for operation (docs/model.md §3.10), its
+ * branches turned into selects; only the sine of the gusts is libmvec's. Without gusts the
+ * result is bit-identical to the `ref` variant. dynamics_simd.c is compiled for x86-64-v3:
+ * call these only after the CPU check of backend_cpu.c.
+ */
+#ifndef HB_DYNAMICS_SIMD_H
+#define HB_DYNAMICS_SIMD_H
+
+#include <stdint.h>
+
+#include "dynamics.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Strands per dynamic block (a multiple of 64, dividing 256). The block's scratch is
+ * (6P + 3) reals per lane (p: 3P, multipliers: up to 3P, the ftl correction of one point:
+ * 3): at P = 32 that is 50 KiB (fp32) or 100 KiB (fp64) for 64 lanes, in L1/L2, where a
+ * block of the paper stages' 512 lanes would need 400 KiB (docs/cpu_simd.md). */
+#ifndef HB_SIMD_DYN_BLOCK
+#define HB_SIMD_DYN_BLOCK 64
+#endif
+
+/* Reals of scratch one block needs (allocate 64-byte aligned). */
+int64_t hb_simd_dyn_scratch_reals(int64_t points);
+
+/* Bend rest lengths of one block: BR[k−1][lane] = |X̄_{k+1} − X̄_{k−1}|, k = 1…P−2. */
+void hb_simd_dyn_bend_rest_block_f32(const hb_dyn_model_f32 *m, const float *RX, const float *RY, const float *RZ,
+                                     float *BR, int64_t stride);
+void hb_simd_dyn_bend_rest_block_f64(const hb_dyn_model_f64 *m, const double *RX, const double *RY,
+                                     const double *RZ, double *BR, int64_t stride);
+
+/* One frame (S substeps) of one block. All pointers point at the block's first strand in
+ * row 0 and are 64-byte aligned; scratch holds hb_simd_dyn_scratch_reals(P) reals. */
+void hb_simd_dyn_frame_block_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *X, float *Y, float *Z,
+                                 float *VX, float *VY, float *VZ, const float *RX, const float *RY,
+                                 const float *RZ, const float *BR, int64_t stride, float *scratch);
+void hb_simd_dyn_frame_block_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *X, double *Y,
+                                 double *Z, double *VX, double *VY, double *VZ, const double *RX,
+                                 const double *RY, const double *RZ, const double *BR, int64_t stride,
+                                 double *scratch);
+
+/* The per-strand observables (docs/model.md §3.8) of `count` consecutive strands starting
+ * at lane `first` (any alignment), into out[0 … count−1]: each strand's partial is the
+ * same bits as hb_dyn_observe_strand's, so a reduction in strand order gives ref's. */
+void hb_simd_dyn_observe_f32(const hb_scene *s, const float *X, const float *Y, const float *Z, const float *VX,
+                             const float *VY, const float *VZ, int64_t stride, int64_t first, int64_t count,
+                             hb_obs_partial *out);
+void hb_simd_dyn_observe_f64(const hb_scene *s, const double *X, const double *Y, const double *Z,
+                             const double *VX, const double *VY, const double *VZ, int64_t stride, int64_t first,
+                             int64_t count, hb_obs_partial *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

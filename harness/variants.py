@@ -1,0 +1,74 @@
+"""The variants each binary declares: `hairsim-* --list-variants` (one JSON object).
+
+    {"backend": "cpu", "build": "default", "default_variant": "ref",
+     "precisions": ["fp32", "fp64"], "variants": [{"name": "ref", "stages": [...], ...}]}
+
+The one place the harness and the tests learn variant names; read once per binary. Keys
+other than these are ignored, and missing optional ones get defaults, so a binary that
+declares more (solvers, stages) still reads.
+"""
+
+import json
+import subprocess
+from dataclasses import dataclass
+from functools import lru_cache
+
+from . import HarnessError
+from .paths import binary_path
+
+
+@dataclass(frozen=True)
+class Declared:
+    backend: str
+    build: str
+    default_variant: str
+    precisions: tuple
+    variants: tuple  # names, in the binary's order
+    stages: dict  # variant name -> tuple of the stages it runs
+
+
+@lru_cache(maxsize=None)
+def _read(path):
+    try:
+        p = subprocess.run([path, "--list-variants"], capture_output=True, text=True, timeout=60)
+    except OSError as e:
+        raise HarnessError(f"{path}: cannot run: {e.strerror}") from None
+    except subprocess.TimeoutExpired:
+        raise HarnessError(f"{path} --list-variants did not finish in 60 s") from None
+    if p.returncode != 0:
+        raise HarnessError(f"{path} --list-variants exited {p.returncode}: {p.stderr.strip()}")
+    try:
+        d = json.loads(p.stdout)
+        variants = [v for v in d["variants"] if isinstance(v, dict) and "name" in v]
+        names = tuple(str(v["name"]) for v in variants)
+        return Declared(
+            backend=str(d.get("backend", "")),
+            build=str(d.get("build", "default")),
+            default_variant=str(d.get("default_variant") or (names[0] if names else "")),
+            precisions=tuple(d.get("precisions", ("fp32", "fp64"))),
+            variants=names,
+            stages={str(v["name"]): tuple(v.get("stages", ())) for v in variants},
+        )
+    except (ValueError, KeyError, TypeError, AttributeError):
+        raise HarnessError(f"{path} --list-variants did not print the documented JSON object") from None
+
+
+def declared(backend, build="default"):
+    """What the binary of `backend`/`build` declares; HarnessError if it is not built."""
+    path = binary_path(backend, build)
+    if not path.exists():
+        raise HarnessError(f"{path} not found: run make")
+    return _read(str(path))
+
+
+def names(backend, build="default"):
+    """The variant names of `backend`/`build`, or () when its binary is not built."""
+    try:
+        return declared(backend, build).variants
+    except HarnessError:
+        return ()
+
+
+def clear_cache():
+    """Forget what was read (a test that swaps the build directory)."""
+    _read.cache_clear()

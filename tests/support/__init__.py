@@ -1,0 +1,1 @@
+"""Helpers shared by the tests (state writers, checkers); not tests themselves."""

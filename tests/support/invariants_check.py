@@ -1,0 +1,32 @@
+"""DESIGN §3 invariants asserted on a state (a LoadedState of support/statecheck.py).
+
+Every per-frame invariant (finite, roots fixed, x constant, segment lengths, shell after
+collide, skipped stages unchanged) is checked by harness/invariants.py with the tolerances
+of harness/tolerances.py. The tests add two facts of the root draw (DESIGN §3 init): roots
+lie on the head sphere, and none sits on the lower face.
+"""
+
+import numpy as np
+
+from harness import invariants, tolerances
+from harness.states import open_state
+
+
+def assert_invariants(s, tol=None):
+    """`tol`: an InvariantTolerance tighter than the precision's (tolerances.py), or None."""
+    eps = float(np.finfo(s.dtype).eps)
+    R = float(s.params["head_radius"])
+    root0 = s.frames[0, :, 0, :]
+    assert np.isfinite(root0).all(), "NaN or Inf in a root"
+    r3 = np.linalg.norm(root0.astype(np.float64), axis=1)
+    assert np.abs(r3 - R).max() <= tolerances.ROOT_ON_SPHERE_K * eps * R, "a root off the head sphere"
+    assert not np.any((root0[:, 2] > 0) & (root0[:, 1] < 0)), "a root on the lower face"
+    assert_frames_invariants(s.path, tol)
+
+
+def assert_frames_invariants(path, tol=None):
+    """The per-frame invariants only (for hand-made inputs whose roots are not drawn)."""
+    with open_state(path) as st:
+        report = invariants.check(st, tol)
+    assert report.ok, "; ".join(v.message for v in report.violations)
+    return report

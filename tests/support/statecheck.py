@@ -1,0 +1,44 @@
+"""Test helpers: run a hairsim binary, read its state, and judge two states.
+
+States are read by harness.states (the one reader), compared by harness.diff and checked
+by harness.invariants, with the tolerances of harness/tolerances.py.
+"""
+
+import json
+import subprocess
+from pathlib import Path
+
+from harness import diff
+from harness.states import LoadedState, load_state
+
+
+def run(binary, *args, check=True, timeout=600):
+    """Runs a hairsim binary; returns the CompletedProcess (text mode)."""
+    cmd = [str(binary), *[str(a) for a in args]]
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    if check and p.returncode != 0:
+        raise AssertionError(f"{' '.join(cmd)} exited {p.returncode}: {p.stderr.strip()}")
+    return p
+
+
+def run_json(binary, *args):
+    p = run(binary, *args, "--json", "--quiet")
+    return json.loads(p.stdout)
+
+
+def State(path) -> LoadedState:  # noqa: N802 (reads like the type it returns)
+    """The whole state at `path`, read by harness.states."""
+    return load_state(path)
+
+
+def assert_equivalent(path_a, path_b, frames="all", tolerance=None, what=""):
+    """harness diff's verdict on two files (DESIGN §6): every compared frame within the
+    tolerance and every invariant held in both; returns the DiffResult."""
+    result = diff.compare(str(path_a), str(path_b), frames=frames, tolerance=tolerance)
+    assert result.equivalent, f"{what}: " + diff.format_result(result)
+    return result
+
+
+def tmp_leftovers(directory: Path):
+    """Temporary files a writer could have left behind."""
+    return sorted(p.name for p in Path(directory).iterdir() if ".tmp." in p.name)
