@@ -22,8 +22,8 @@ NO_NETWORK = {
 
 def copy_of_repo(tmp_path):
     root = tmp_path / "repo"
-    (root / "tools").mkdir(parents=True)
-    shutil.copy(ROOT_DIR / "tools" / "setup.sh", root / "tools" / "setup.sh")
+    (root / "harness").mkdir(parents=True)
+    shutil.copy(ROOT_DIR / "harness" / "setup.sh", root / "harness" / "setup.sh")
     for name in ("requirements.lock", "requirements-readers.lock"):
         shutil.copy(ROOT_DIR / name, root / name)
     return root
@@ -33,7 +33,7 @@ def setup(root, python, **env):
     e = {k: v for k, v in os.environ.items() if k != "HAIRBENCH_READERS"}
     e.update(NO_NETWORK, PYTHON=str(python), **env)
     return subprocess.run(
-        ["bash", str(root / "tools" / "setup.sh"), "build/python"],
+        ["bash", str(root / "harness" / "setup.sh"), "build/python"],
         cwd=root,
         env=e,
         capture_output=True,
