@@ -37,25 +37,24 @@ typedef struct {
 } hb_stage_result;
 
 struct hb_backend {
-    const char *name;            /* "cpu" | "cuda" */
+    const char *name; /* "cpu" | "cuda" */
     const char *default_variant;
-    const hb_variant *variants;  /* terminated by a NULL name */
-    const char *build;           /* "default" | "strict" | "fastmath" (the math mode) */
-    const char *flags;           /* build flags, recorded in every output */
-    const char *compiler;        /* NULL: the host C compiler that built the driver */
-    void *impl;                  /* backend's private state */
-    int threads, block_size;     /* what the run uses, set by setup (0 where not used) */
+    const hb_variant *variants; /* terminated by a NULL name */
+    const char *build;          /* "default" | "strict" | "fastmath" (the math mode) */
+    const char *flags;          /* build flags, recorded in every output */
+    const char *compiler;       /* NULL: the host C compiler that built the driver */
+    void *impl;                 /* backend's private state */
+    int threads, block_size;    /* what the run uses, set by setup (0 where not used) */
 
     /* Check memory and allocate for the run (saving a copy for repeats when `need_save`;
      * the driver's own host buffers take `driver_host_bytes`). Returns HB_EXIT_OK or an
      * exit status with one line in err. */
-    int (*setup)(hb_backend *b, const hb_options *o, int need_save, uint64_t driver_host_bytes,
-                 char *err, size_t errlen);
+    int (*setup)(hb_backend *b, const hb_options *o, int need_save, uint64_t driver_host_bytes, char *err,
+                 size_t errlen);
     /* Load a canonical host state as the current state; *ms gets the transfer time (cuda). */
     int (*load)(hb_backend *b, const void *canonical, double *ms, char *err, size_t errlen);
     /* Run stages[i] (and, for a fusing variant, possibly stages[i+1]) on the current state. */
-    int (*run_stage)(hb_backend *b, const hb_stage *stages, int i, int n, hb_stage_result *r,
-                     char *err, size_t errlen);
+    int (*run_stage)(hb_backend *b, const hb_stage *stages, int i, int n, hb_stage_result *r, char *err, size_t errlen);
     /* Keep a copy of the current state / make the copy current again (for repeats). */
     int (*save)(hb_backend *b, char *err, size_t errlen);
     int (*restore)(hb_backend *b, char *err, size_t errlen);
@@ -67,11 +66,9 @@ struct hb_backend {
     /* Tell the backend whether fused calls must keep the intermediate state. */
     void (*keep_intermediate)(hb_backend *b, int keep);
     /* Measure copy bandwidth (bytes read + bytes written per second, GB/s). */
-    int (*measure_bandwidth)(hb_backend *b, const hb_options *o, double *gbps, double *bytes,
-                             char *err, size_t errlen);
+    int (*measure_bandwidth)(hb_backend *b, const hb_options *o, double *gbps, double *bytes, char *err, size_t errlen);
     /* Optional (NULL: not measured): a STREAM-style triad a = b + q·c, bytes = 2 reads + 1 write. */
-    int (*measure_triad)(hb_backend *b, const hb_options *o, double *gbps, double *bytes,
-                         char *err, size_t errlen);
+    int (*measure_triad)(hb_backend *b, const hb_options *o, double *gbps, double *bytes, char *err, size_t errlen);
     /* The dynamic model (the simulate stage; NULL where no variant runs it). The positions
      * come through load; this gives their velocities (NULL: all zero) and the rest shape,
      * canonical, and computes what the run derives from the rest shape once. */

@@ -57,26 +57,27 @@ static void first_touch(void *p, const hb_scene *s)
     for (int64_t i = 0; i < N; i++) memset((char *)p + (size_t)i * strand, 0, strand);
 }
 
-static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t driver_bytes, char *err,
-                      size_t errlen);
+static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t driver_bytes, char *err, size_t errlen);
 
-static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t driver_bytes, char *err,
-                     size_t errlen)
+static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t driver_bytes, char *err, size_t errlen)
 {
     cpu_impl *c = calloc(1, sizeof *c);
-    if (!c) { snprintf(err, errlen, "out of host memory"); return HB_EXIT_MEMORY; }
+    if (!c) {
+        snprintf(err, errlen, "out of host memory");
+        return HB_EXIT_MEMORY;
+    }
     b->impl = c;
     c->scene = o->scene;
     c->bytes = hb_state_bytes(&o->scene);
     hb_model_round(&o->scene, &c->m32, &c->m64);
     if (o->threads > 0) omp_set_num_threads(o->threads);
     b->threads = omp_get_max_threads();
-    if (o->variant && strcmp(o->variant, "simd") == 0)
-        return simd_setup(c, o, need_save, driver_bytes, err, errlen);
+    if (o->variant && strcmp(o->variant, "simd") == 0) return simd_setup(c, o, need_save, driver_bytes, err, errlen);
 
     for (int i = 0; i < o->n_stages; i++) c->dynamic |= o->stages[i] == HB_STAGE_SIMULATE;
     /* simulate adds velocities, the rest shape, bend rest lengths and a saved velocity copy */
-    const uint64_t bend_bytes = (uint64_t)o->scene.n_strands * (uint64_t)(o->scene.points - 2 > 0 ? o->scene.points - 2 : 1) *
+    const uint64_t bend_bytes = (uint64_t)o->scene.n_strands *
+                                (uint64_t)(o->scene.points - 2 > 0 ? o->scene.points - 2 : 1) *
                                 hb_real_size(o->scene.precision);
     const uint64_t dyn = c->dynamic ? c->bytes * (need_save ? 3u : 2u) + bend_bytes : 0;
     uint64_t need = c->bytes * (need_save ? 2u : 1u) + dyn + driver_bytes;
@@ -168,12 +169,12 @@ static void pm_copy(cpu_impl *c, void *const dst[3], void *const src[3])
 static uint64_t simd_dyn_bytes(const cpu_impl *c, uint64_t one, int need_save);
 static int simd_dyn_setup(cpu_impl *c, int need_save, uint64_t need, char *err, size_t errlen);
 
-static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t driver_bytes, char *err,
-                      size_t errlen)
+static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t driver_bytes, char *err, size_t errlen)
 {
     const hb_scene *s = &o->scene;
     if (!simd_cpu_ok()) {
-        snprintf(err, errlen, "--variant simd needs an x86-64-v3 CPU (AVX2 + FMA) and this CPU lacks it; "
+        snprintf(err, errlen,
+                 "--variant simd needs an x86-64-v3 CPU (AVX2 + FMA) and this CPU lacks it; "
                  "use --variant ref");
         return HB_EXIT_USAGE;
     }
@@ -215,29 +216,29 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
 
 /* canonical [N][P][3] → X, Y, Z [P][stride], parallel over blocks; padding lanes keep what
  * they hold (they are computed, never read back) */
-#define PM_CONVERT(T, TO_PM)                                                                   \
-    do {                                                                                       \
-        T *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2];                                         \
-        T *cs = (T *)canonical;                                                                \
-        _Pragma("omp parallel for schedule(static)")                                           \
-        for (int64_t blk = 0; blk < c->nblocks; blk++) {                                       \
-            const int64_t i1 = (blk + 1) * c->block < N ? (blk + 1) * c->block : N;            \
-            for (int64_t i = blk * c->block; i < i1; i++) {                                    \
-                T *q = cs + (size_t)i * (size_t)P * 3u;                                        \
-                for (int64_t k = 0; k < P; k++) {                                              \
-                    const size_t e = (size_t)k * (size_t)S + (size_t)i;                       \
-                    if (TO_PM) {                                                               \
-                        X[e] = q[3 * k + 0];                                                   \
-                        Y[e] = q[3 * k + 1];                                                   \
-                        Z[e] = q[3 * k + 2];                                                   \
-                    } else {                                                                   \
-                        q[3 * k + 0] = X[e];                                                   \
-                        q[3 * k + 1] = Y[e];                                                   \
-                        q[3 * k + 2] = Z[e];                                                   \
-                    }                                                                          \
-                }                                                                              \
-            }                                                                                  \
-        }                                                                                      \
+#define PM_CONVERT(T, TO_PM)                                                                                           \
+    do {                                                                                                               \
+        T *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2];                                                                 \
+        T *cs = (T *)canonical;                                                                                        \
+        _Pragma("omp parallel for schedule(static)") for (int64_t blk = 0; blk < c->nblocks; blk++)                    \
+        {                                                                                                              \
+            const int64_t i1 = (blk + 1) * c->block < N ? (blk + 1) * c->block : N;                                    \
+            for (int64_t i = blk * c->block; i < i1; i++) {                                                            \
+                T *q = cs + (size_t)i * (size_t)P * 3u;                                                                \
+                for (int64_t k = 0; k < P; k++) {                                                                      \
+                    const size_t e = (size_t)k * (size_t)S + (size_t)i;                                                \
+                    if (TO_PM) {                                                                                       \
+                        X[e] = q[3 * k + 0];                                                                           \
+                        Y[e] = q[3 * k + 1];                                                                           \
+                        Z[e] = q[3 * k + 2];                                                                           \
+                    } else {                                                                                           \
+                        q[3 * k + 0] = X[e];                                                                           \
+                        q[3 * k + 1] = Y[e];                                                                           \
+                        q[3 * k + 2] = Z[e];                                                                           \
+                    }                                                                                                  \
+                }                                                                                                      \
+            }                                                                                                          \
+        }                                                                                                              \
     } while (0)
 
 static void simd_convert(cpu_impl *c, void *canonical, int to_pm)
@@ -329,29 +330,29 @@ static int simd_dyn_setup(cpu_impl *c, int need_save, uint64_t need, char *err, 
 }
 
 /* canonical [N][P][3] ↔ a[0..2] as [P][stride] (simd_convert for any three arrays) */
-#define PM_CONVERT_ARRAYS(T, TO_PM)                                                            \
-    do {                                                                                       \
-        T *X = a[0], *Y = a[1], *Z = a[2];                                                     \
-        T *cs = (T *)canonical;                                                                \
-        _Pragma("omp parallel for schedule(static)")                                           \
-        for (int64_t blk = 0; blk < c->nblocks; blk++) {                                       \
-            const int64_t i1 = (blk + 1) * c->block < N ? (blk + 1) * c->block : N;            \
-            for (int64_t i = blk * c->block; i < i1; i++) {                                    \
-                T *q = cs + (size_t)i * (size_t)P * 3u;                                        \
-                for (int64_t k = 0; k < P; k++) {                                              \
-                    const size_t e = (size_t)k * (size_t)S + (size_t)i;                       \
-                    if (TO_PM) {                                                               \
-                        X[e] = q[3 * k + 0];                                                   \
-                        Y[e] = q[3 * k + 1];                                                   \
-                        Z[e] = q[3 * k + 2];                                                   \
-                    } else {                                                                   \
-                        q[3 * k + 0] = X[e];                                                   \
-                        q[3 * k + 1] = Y[e];                                                   \
-                        q[3 * k + 2] = Z[e];                                                   \
-                    }                                                                          \
-                }                                                                              \
-            }                                                                                  \
-        }                                                                                      \
+#define PM_CONVERT_ARRAYS(T, TO_PM)                                                                                    \
+    do {                                                                                                               \
+        T *X = a[0], *Y = a[1], *Z = a[2];                                                                             \
+        T *cs = (T *)canonical;                                                                                        \
+        _Pragma("omp parallel for schedule(static)") for (int64_t blk = 0; blk < c->nblocks; blk++)                    \
+        {                                                                                                              \
+            const int64_t i1 = (blk + 1) * c->block < N ? (blk + 1) * c->block : N;                                    \
+            for (int64_t i = blk * c->block; i < i1; i++) {                                                            \
+                T *q = cs + (size_t)i * (size_t)P * 3u;                                                                \
+                for (int64_t k = 0; k < P; k++) {                                                                      \
+                    const size_t e = (size_t)k * (size_t)S + (size_t)i;                                                \
+                    if (TO_PM) {                                                                                       \
+                        X[e] = q[3 * k + 0];                                                                           \
+                        Y[e] = q[3 * k + 1];                                                                           \
+                        Z[e] = q[3 * k + 2];                                                                           \
+                    } else {                                                                                           \
+                        q[3 * k + 0] = X[e];                                                                           \
+                        q[3 * k + 1] = Y[e];                                                                           \
+                        q[3 * k + 2] = Z[e];                                                                           \
+                    }                                                                                                  \
+                }                                                                                                      \
+            }                                                                                                          \
+        }                                                                                                              \
     } while (0)
 
 static void simd_dyn_convert(cpu_impl *c, void *const a[3], void *canonical, int to_pm)
@@ -393,25 +394,25 @@ static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
 
 /* Dynamic blocks over threads (static schedule: the bits do not depend on it); each
  * thread's block scratch (hb_simd_dyn_scratch_reals) is its own. */
-#define SIMD_DYN_FRAME(T, SFX, M)                                                               \
-    do {                                                                                        \
-        T *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2], *VX = c->pv[0], *VY = c->pv[1], *VZ = c->pv[2]; \
-        const T *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2], *BR = c->pb;                    \
-        _Pragma("omp parallel")                                                                 \
-        {                                                                                       \
-            T *scratch = aligned_alloc(64, ((size_t)hb_simd_dyn_scratch_reals(P) * sizeof(T) + 63) / 64 * 64); \
-            if (!scratch) {                                                                     \
-                _Pragma("omp atomic write") failed = 1;                                         \
-            } else {                                                                            \
-                _Pragma("omp for schedule(static)")                                             \
-                for (int64_t b = 0; b < nb; b++) {                                              \
-                    const int64_t o = b * DB;                                                   \
-                    hb_simd_dyn_frame_block_##SFX(M, f, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, \
-                                                  RY + o, RZ + o, BR + o, S, scratch);          \
-                }                                                                               \
-                free(scratch);                                                                  \
-            }                                                                                   \
-        }                                                                                       \
+#define SIMD_DYN_FRAME(T, SFX, M)                                                                                      \
+    do {                                                                                                               \
+        T *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2], *VX = c->pv[0], *VY = c->pv[1], *VZ = c->pv[2];                 \
+        const T *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2], *BR = c->pb;                                           \
+        _Pragma("omp parallel")                                                                                        \
+        {                                                                                                              \
+            T *scratch = aligned_alloc(64, ((size_t)hb_simd_dyn_scratch_reals(P) * sizeof(T) + 63) / 64 * 64);         \
+            if (!scratch) {                                                                                            \
+                _Pragma("omp atomic write") failed = 1;                                                                \
+            } else {                                                                                                   \
+                _Pragma("omp for schedule(static)") for (int64_t b = 0; b < nb; b++)                                   \
+                {                                                                                                      \
+                    const int64_t o = b * DB;                                                                          \
+                    hb_simd_dyn_frame_block_##SFX(M, f, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, RY + o,   \
+                                                  RZ + o, BR + o, S, scratch);                                         \
+                }                                                                                                      \
+                free(scratch);                                                                                         \
+            }                                                                                                          \
+        }                                                                                                              \
     } while (0)
 
 static int simd_dyn_frame(cpu_impl *c, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen)
@@ -472,7 +473,8 @@ static int simd_dyn_observe(cpu_impl *c, hb_observables *obs, char *err, size_t 
 
 static int cpu_load(hb_backend *b, const void *canonical, double *ms, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
+    (void)err;
+    (void)errlen;
     cpu_impl *c = b->impl;
     double t0 = hb_now_ms();
     if (c->simd) {
@@ -487,7 +489,8 @@ static int cpu_load(hb_backend *b, const void *canonical, double *ms, char *err,
 
 static int cpu_fetch(hb_backend *b, void *canonical, double *ms, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
+    (void)err;
+    (void)errlen;
     cpu_impl *c = b->impl;
     double t0 = hb_now_ms();
     if (c->simd) {
@@ -502,7 +505,8 @@ static int cpu_fetch(hb_backend *b, void *canonical, double *ms, char *err, size
 
 static int cpu_save(hb_backend *b, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
+    (void)err;
+    (void)errlen;
     cpu_impl *c = b->impl;
     if (c->simd) pm_copy(c, c->pm_saved, c->pm);
     else memcpy(c->saved, c->state, c->bytes);
@@ -513,7 +517,8 @@ static int cpu_save(hb_backend *b, char *err, size_t errlen)
 
 static int cpu_restore(hb_backend *b, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
+    (void)err;
+    (void)errlen;
     cpu_impl *c = b->impl;
     if (c->simd) pm_copy(c, c->pm, c->pm_saved);
     else memcpy(c->state, c->saved, c->bytes);
@@ -526,7 +531,9 @@ static int cpu_restore(hb_backend *b, char *err, size_t errlen)
 static int cpu_run_stage(hb_backend *b, const hb_stage *stages, int i, int n, hb_stage_result *r, char *err,
                          size_t errlen)
 {
-    (void)n; (void)err; (void)errlen;
+    (void)n;
+    (void)err;
+    (void)errlen;
     cpu_impl *c = b->impl;
     const int64_t N = c->scene.n_strands;
     const size_t stride = (size_t)c->scene.points * 3u;
@@ -572,7 +579,8 @@ static int cpu_run_stage(hb_backend *b, const hb_stage *stages, int i, int n, hb
 
 static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
+    (void)err;
+    (void)errlen;
     cpu_impl *c = b->impl;
     if (c->simd) return simd_dyn_load(c, velocity, rest);
     const int64_t N = c->scene.n_strands, P = c->scene.points;
@@ -583,30 +591,30 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
     if (c->scene.precision == HB_FP32) {
 #pragma omp parallel for schedule(static)
         for (int64_t i = 0; i < N; i++)
-            hb_dyn_bend_rest_f32(&c->d32, (const float *)c->rest + (size_t)i * stride, (float *)c->bend_rest + (size_t)i * bstride);
+            hb_dyn_bend_rest_f32(&c->d32, (const float *)c->rest + (size_t)i * stride,
+                                 (float *)c->bend_rest + (size_t)i * bstride);
     } else {
 #pragma omp parallel for schedule(static)
         for (int64_t i = 0; i < N; i++)
-            hb_dyn_bend_rest_f64(&c->d64, (const double *)c->rest + (size_t)i * stride, (double *)c->bend_rest + (size_t)i * bstride);
+            hb_dyn_bend_rest_f64(&c->d64, (const double *)c->rest + (size_t)i * stride,
+                                 (double *)c->bend_rest + (size_t)i * bstride);
     }
     return 0;
 }
 
 /* Strands over threads; each thread's scratch (9·P reals) is its own. */
-#define DYN_FRAME(T, SFX, M)                                                                    \
-    _Pragma("omp parallel")                                                                     \
-    {                                                                                           \
-        T *scratch = malloc((size_t)P * 9u * sizeof(T));                                        \
-        if (!scratch) {                                                                         \
-            _Pragma("omp atomic write") failed = 1;                                             \
-        } else {                                                                                \
-            _Pragma("omp for schedule(static)")                                                 \
-            for (int64_t i = 0; i < N; i++)                                                     \
-                hb_dyn_frame_strand_##SFX(M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride, \
-                                          (const T *)c->rest + (size_t)i * stride,              \
-                                          (const T *)c->bend_rest + (size_t)i * bstride, scratch); \
-            free(scratch);                                                                      \
-        }                                                                                       \
+#define DYN_FRAME(T, SFX, M)                                                                                           \
+    _Pragma("omp parallel")                                                                                            \
+    {                                                                                                                  \
+        T *scratch = malloc((size_t)P * 9u * sizeof(T));                                                               \
+        if (!scratch) {                                                                                                \
+            _Pragma("omp atomic write") failed = 1;                                                                    \
+        } else {                                                                                                       \
+            _Pragma("omp for schedule(static)") for (int64_t i = 0; i < N; i++) hb_dyn_frame_strand_##SFX(             \
+                M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride,                            \
+                (const T *)c->rest + (size_t)i * stride, (const T *)c->bend_rest + (size_t)i * bstride, scratch);      \
+            free(scratch);                                                                                             \
+        }                                                                                                              \
     }
 
 static int cpu_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen)
@@ -669,7 +677,8 @@ static int cpu_dyn_observe(hb_backend *b, hb_observables *obs, char *err, size_t
 
 static int cpu_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
+    (void)err;
+    (void)errlen;
     cpu_impl *c = b->impl;
     if (c->simd) {
         simd_dyn_convert(c, c->pv, canonical, 0);
@@ -747,8 +756,7 @@ static int cpu_measure_bandwidth(hb_backend *b, const hb_options *o, double *gbp
     return rc;
 }
 
-static int cpu_measure_triad(hb_backend *b, const hb_options *o, double *gbps, double *bytes, char *err,
-                             size_t errlen)
+static int cpu_measure_triad(hb_backend *b, const hb_options *o, double *gbps, double *bytes, char *err, size_t errlen)
 {
     double copy, copy_bytes;
     (void)b;
@@ -788,8 +796,10 @@ static void cpu_teardown(hb_backend *b)
 
 #define CPU_PAPER_STAGES ((1u << HB_STAGE_INIT) | (1u << HB_STAGE_COLLIDE) | (1u << HB_STAGE_WIND))
 static const hb_variant cpu_variants[] = {
-    {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE), "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands"},
-    {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE), "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks"},
+    {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
+     "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands"},
+    {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
+     "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks"},
     {NULL, 0, NULL},
 };
 

@@ -41,8 +41,8 @@ typedef enum { DF_REAL, DF_COUNT, DF_SOLVER, DF_MOTION, DF_SWITCH } dyn_kind;
 typedef struct {
     const char *flag;
     dyn_kind kind;
-    size_t offset;      /* into hb_dynamics */
-    size_t declares;    /* an int in hb_dynamics set to 1 when the flag is given (0: none) */
+    size_t offset;   /* into hb_dynamics */
+    size_t declares; /* an int in hb_dynamics set to 1 when the flag is given (0: none) */
     const char *help;
 } dyn_flag;
 
@@ -73,7 +73,10 @@ static const dyn_flag dyn_flags[] = {
 #undef DYN
 #define N_DYN_FLAGS (sizeof dyn_flags / sizeof dyn_flags[0])
 
-const char *hb_dyn_flag_name(int i) { return i >= 0 && i < (int)N_DYN_FLAGS ? dyn_flags[i].flag : NULL; }
+const char *hb_dyn_flag_name(int i)
+{
+    return i >= 0 && i < (int)N_DYN_FLAGS ? dyn_flags[i].flag : NULL;
+}
 
 int hb_dyn_flag_differs(int i, const hb_dynamics *a, const hb_dynamics *b)
 {
@@ -145,7 +148,11 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
     }
 }
 
-#define FAIL(...) do { snprintf(err, errlen, __VA_ARGS__); return -1; } while (0)
+#define FAIL(...)                                                                                                      \
+    do {                                                                                                               \
+        snprintf(err, errlen, __VA_ARGS__);                                                                            \
+        return -1;                                                                                                     \
+    } while (0)
 
 static int parse_i64(const char *flag, const char *v, int64_t lo, int64_t *out, char *err, size_t errlen)
 {
@@ -203,7 +210,8 @@ static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err
             if ((size_t)(slash - v) >= sizeof num) FAIL("%s needs a number (got '%s')", df->flag, v);
             memcpy(num, v, (size_t)(slash - v));
             num[slash - v] = '\0';
-            if (parse_f64(df->flag, num, &a, err, errlen) || parse_f64(df->flag, slash + 1, &b2, err, errlen)) return -1;
+            if (parse_f64(df->flag, num, &a, err, errlen) || parse_f64(df->flag, slash + 1, &b2, err, errlen))
+                return -1;
             if (b2 == 0.0) FAIL("%s: division by zero in '%s'", df->flag, v);
             *(double *)(base + df->offset) = a / b2;
         } else if (parse_f64(df->flag, v, (double *)(base + df->offset), err, errlen)) {
@@ -227,9 +235,7 @@ static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err
         else if (strcmp(v, "tilt") == 0) o->scene.dyn.motion = HB_MOTION_TILT;
         else FAIL("--head-motion must be still, nod, shake or tilt (got '%s')", v);
         break;
-    case DF_SWITCH:
-        *(int *)(base + df->offset) = 0;
-        break;
+    case DF_SWITCH: *(int *)(base + df->offset) = 0; break;
     }
     if (df->declares) *(int *)(base + df->declares) = 1;
     return 0;
@@ -251,7 +257,8 @@ static int parse_stages(const char *v, hb_options *o, char *err, size_t errlen)
         else if (strcmp(tok, "simulate") == 0) s = HB_STAGE_SIMULATE;
         else FAIL("--stages: unknown stage '%s' (known: init, collide, wind, simulate)", tok);
         if (o->n_stages == HB_MAX_STAGES) FAIL("--stages: at most %d stages", HB_MAX_STAGES);
-        if (s == HB_STAGE_INIT && o->n_stages > 0) FAIL("--stages: init may only come first (it would replace the state)");
+        if (s == HB_STAGE_INIT && o->n_stages > 0)
+            FAIL("--stages: init may only come first (it would replace the state)");
         o->stages[o->n_stages++] = s;
     }
     if (o->n_stages == 0) FAIL("--stages needs at least one stage");
@@ -272,12 +279,30 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
             printf("hairbench %s (%s backend)\n", HB_VERSION, backend);
             return 1;
         }
-        if (strcmp(a, "--force") == 0) { o->force = 1; continue; }
-        if (strcmp(a, "--json") == 0) { o->json = 1; continue; }
-        if (strcmp(a, "--quiet") == 0) { o->quiet = 1; continue; }
-        if (strcmp(a, "--end-to-end") == 0) { o->end_to_end = 1; continue; }
-        if (strcmp(a, "--measure-bandwidth") == 0) { o->measure_bandwidth = 1; continue; }
-        if (strcmp(a, "--list-variants") == 0) { o->list_variants = 1; continue; }
+        if (strcmp(a, "--force") == 0) {
+            o->force = 1;
+            continue;
+        }
+        if (strcmp(a, "--json") == 0) {
+            o->json = 1;
+            continue;
+        }
+        if (strcmp(a, "--quiet") == 0) {
+            o->quiet = 1;
+            continue;
+        }
+        if (strcmp(a, "--end-to-end") == 0) {
+            o->end_to_end = 1;
+            continue;
+        }
+        if (strcmp(a, "--measure-bandwidth") == 0) {
+            o->measure_bandwidth = 1;
+            continue;
+        }
+        if (strcmp(a, "--list-variants") == 0) {
+            o->list_variants = 1;
+            continue;
+        }
         {
             int di = hb_dyn_flag_index(a);
             if (di >= 0 && dyn_flags[di].kind == DF_SWITCH) {

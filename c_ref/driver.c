@@ -44,11 +44,17 @@ static int self_test_rng(void)
         uint32_t ctr[4], key[2], want[4];
     } kat[] = {
         {10, {0, 0, 0, 0}, {0, 0}, {0x6627e8d5, 0xe169c58d, 0xbc57ac4c, 0x9b00dbd8}},
-        {10, {0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff}, {0xffffffff, 0xffffffff},
+        {10,
+         {0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff},
+         {0xffffffff, 0xffffffff},
          {0x408f276d, 0x41c83b0e, 0xa20bc7c6, 0x6d5451fd}},
-        {10, {0x243f6a88, 0x85a308d3, 0x13198a2e, 0x03707344}, {0xa4093822, 0x299f31d0},
+        {10,
+         {0x243f6a88, 0x85a308d3, 0x13198a2e, 0x03707344},
+         {0xa4093822, 0x299f31d0},
          {0xd16cfe09, 0x94fdcceb, 0x5001e420, 0x24126ea1}},
-        {7, {0x243f6a88, 0x85a308d3, 0x13198a2e, 0x03707344}, {0xa4093822, 0x299f31d0},
+        {7,
+         {0x243f6a88, 0x85a308d3, 0x13198a2e, 0x03707344},
+         {0xa4093822, 0x299f31d0},
          {0x4dfccaba, 0x190a87f0, 0xc47362ba, 0xb6b5242a}},
     };
     int failed = 0;
@@ -57,9 +63,9 @@ static int self_test_rng(void)
         hb_philox4x32(kat[i].rounds, kat[i].ctr, kat[i].key, out);
         int ok = memcmp(out, kat[i].want, sizeof out) == 0;
         failed += !ok;
-        printf("philox4x32 %d %08x %08x %08x %08x %08x %08x -> %08x %08x %08x %08x %s\n", kat[i].rounds,
-               kat[i].ctr[0], kat[i].ctr[1], kat[i].ctr[2], kat[i].ctr[3], kat[i].key[0], kat[i].key[1], out[0],
-               out[1], out[2], out[3], ok ? "ok" : "MISMATCH");
+        printf("philox4x32 %d %08x %08x %08x %08x %08x %08x -> %08x %08x %08x %08x %s\n", kat[i].rounds, kat[i].ctr[0],
+               kat[i].ctr[1], kat[i].ctr[2], kat[i].ctr[3], kat[i].key[0], kat[i].key[1], out[0], out[1], out[2],
+               out[3], ok ? "ok" : "MISMATCH");
     }
     return failed ? 1 : 0;
 }
@@ -70,7 +76,8 @@ static int list_variants(const hb_backend *b)
 {
     static const hb_stage all[] = {HB_STAGE_INIT, HB_STAGE_COLLIDE, HB_STAGE_WIND, HB_STAGE_SIMULATE};
     printf("{\"backend\": \"%s\", \"build\": \"%s\", \"default_variant\": \"%s\", "
-           "\"precisions\": [\"fp32\", \"fp64\"], \"variants\": [", b->name, b->build, b->default_variant);
+           "\"precisions\": [\"fp32\", \"fp64\"], \"variants\": [",
+           b->name, b->build, b->default_variant);
     for (const hb_variant *v = b->variants; v->name; v++) {
         printf("%s{\"name\": \"%s\", \"stages\": [", v == b->variants ? "" : ", ", v->name);
         int first = 1;
@@ -95,10 +102,10 @@ static int list_variants(const hb_backend *b)
 static int adopt_input_scene(hb_options *o, const hb_scene *f, int dynamic, char *err, size_t errlen)
 {
     hb_scene *s = &o->scene;
-#define SAME(bit, field, flag, fmt, cast)                                                     \
-    if ((o->given & (bit)) && s->field != f->field) {                                        \
-        snprintf(err, errlen, flag " " fmt " does not match the input file's " fmt, cast s->field, cast f->field); \
-        return -1;                                                                           \
+#define SAME(bit, field, flag, fmt, cast)                                                                              \
+    if ((o->given & (bit)) && s->field != f->field) {                                                                  \
+        snprintf(err, errlen, flag " " fmt " does not match the input file's " fmt, cast s->field, cast f->field);     \
+        return -1;                                                                                                     \
     }
     SAME(HB_GIVEN_STRANDS, n_strands, "--strands", "%lld", (long long))
     SAME(HB_GIVEN_POINTS, points, "--points", "%lld", (long long))
@@ -130,7 +137,8 @@ static int adopt_input_scene(hb_options *o, const hb_scene *f, int dynamic, char
             return -1;
         }
     if (o->given & HB_GIVEN_ANGLE && a != f->wind_angle) {
-        snprintf(err, errlen, "--wind-angle does not match the input file's simulation (a resumed run keeps its physics)");
+        snprintf(err, errlen,
+                 "--wind-angle does not match the input file's simulation (a resumed run keeps its physics)");
         return -1;
     }
     s->wind_angle = f->wind_angle;
@@ -144,8 +152,7 @@ static int same_file(const char *a, const char *b)
     return strcmp(ra, rb) == 0;
 }
 
-static void frame_meta(hb_frame_meta *m, hb_stage st, const hb_scene *s, const char *backend,
-                       const char *variant)
+static void frame_meta(hb_frame_meta *m, hb_stage st, const hb_scene *s, const char *backend, const char *variant)
 {
     memset(m, 0, sizeof *m);
     snprintf(m->stage, sizeof m->stage, "%s", hb_stage_name(st));
@@ -160,12 +167,12 @@ typedef struct {
     hb_options *o;
     hb_record *rec;
     hb_writer *w;
-    void *host;       /* canonical host frame (output, end-to-end) */
-    void *input;      /* the input's last frame */
+    void *host;  /* canonical host frame (output, end-to-end) */
+    void *input; /* the input's last frame */
     hb_input in;
     int have_input;
-    double *times;    /* all stages' timed runs */
-    struct {          /* the simulation, for the file's /parameters */
+    double *times; /* all stages' timed runs */
+    struct {       /* the simulation, for the file's /parameters */
         int dynamic;
         int64_t paper_frames, last_frame;
         char features[96];
@@ -202,12 +209,12 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
     hb_dyn_frame plan;
     memset(&plan, 0, sizeof plan);
     int status = HB_EXIT_OK;
-#define FAIL_IF(cond, st)                                                                    \
-    do {                                                                                     \
-        if (cond) {                                                                          \
-            status = (st);                                                                   \
-            goto out;                                                                        \
-        }                                                                                    \
+#define FAIL_IF(cond, st)                                                                                              \
+    do {                                                                                                               \
+        if (cond) {                                                                                                    \
+            status = (st);                                                                                             \
+            goto out;                                                                                                  \
+        }                                                                                                              \
     } while (0)
     if (!rest || hb_dyn_frame_alloc(&plan, d->substeps) != 0) {
         snprintf(err, errlen, "out of host memory for the simulation's rest shape and substep tables");
@@ -220,9 +227,10 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         for (int i = 0; i < r->in.n_vel; i++)
             if (r->in.vel_step[i] == step) vi = i;
         if (vi < 0) {
-            snprintf(err, errlen, "--input %s: frame %d has no stored velocities, so the simulation cannot resume "
-                     "from it (write the file with --velocities all, or resume from its last frame)", o->input,
-                     o->input_frame);
+            snprintf(err, errlen,
+                     "--input %s: frame %d has no stored velocities, so the simulation cannot resume "
+                     "from it (write the file with --velocities all, or resume from its last frame)",
+                     o->input, o->input_frame);
             FAIL_IF(1, HB_EXIT_USAGE);
         }
         paper_frames = r->in.paper_frames;
@@ -244,16 +252,19 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
                 }
             for (int i = 0; i < r->in.n_obs; i++)
                 if (r->in.obs_step[i] <= step)
-                    FAIL_IF(hb_writer_observables(r->w, &r->in.obs[i], r->in.obs_step[i], r->in.obs_time[i], err, errlen),
-                            HB_EXIT_RUNTIME);
+                    FAIL_IF(
+                        hb_writer_observables(r->w, &r->in.obs[i], r->in.obs_step[i], r->in.obs_time[i], err, errlen),
+                        HB_EXIT_RUNTIME);
         }
     } else {
         double ms;
         FAIL_IF(b->fetch(b, rest, &ms, err, errlen), HB_EXIT_RUNTIME);
     }
     if (gf0 + o->frames > (INT64_C(1) << 53) / d->substeps) {
-        snprintf(err, errlen, "--frames %lld x --substeps %lld from frame %lld passes 2^53 substeps: times would "
-                 "no longer be exact", (long long)o->frames, (long long)d->substeps, (long long)gf0);
+        snprintf(err, errlen,
+                 "--frames %lld x --substeps %lld from frame %lld passes 2^53 substeps: times would "
+                 "no longer be exact",
+                 (long long)o->frames, (long long)d->substeps, (long long)gf0);
         FAIL_IF(1, HB_EXIT_USAGE);
     }
     FAIL_IF(b->dyn_load(b, vel, rest, err, errlen), HB_EXIT_RUNTIME);
@@ -313,12 +324,12 @@ out:
     return status;
 }
 
-#define CHECK(call, status)                                                                  \
-    do {                                                                                     \
-        if ((call) != 0) {                                                                   \
-            run_free(&run);                                                                  \
-            return die(status, err);                                                         \
-        }                                                                                    \
+#define CHECK(call, status)                                                                                            \
+    do {                                                                                                               \
+        if ((call) != 0) {                                                                                             \
+            run_free(&run);                                                                                            \
+            return die(status, err);                                                                                   \
+        }                                                                                                              \
     } while (0)
 
 int hb_main(int argc, char **argv, hb_backend *b)
@@ -575,9 +586,23 @@ int hb_main(int argc, char **argv, hb_backend *b)
     }
 
     if (run.w) {
-        hb_run_meta rm = {b->name, o.variant, rec.git_revision, rec.compiler, b->flags, rec.device, rec.driver,
-                          rec.threads, rec.block_size, o.repeat, o.warmup, rec.end_to_end_ms, 0,
-                          run.sim.dynamic, run.sim.paper_frames, run.sim.last_frame, (int)o.output_every,
+        hb_run_meta rm = {b->name,
+                          o.variant,
+                          rec.git_revision,
+                          rec.compiler,
+                          b->flags,
+                          rec.device,
+                          rec.driver,
+                          rec.threads,
+                          rec.block_size,
+                          o.repeat,
+                          o.warmup,
+                          rec.end_to_end_ms,
+                          0,
+                          run.sim.dynamic,
+                          run.sim.paper_frames,
+                          run.sim.last_frame,
+                          (int)o.output_every,
                           run.sim.features};
         double t0 = hb_now_ms(), before = 1e3 * hb_writer_seconds(run.w);
         hb_writer *w = run.w;

@@ -24,26 +24,26 @@ enum {
     HB_F_BEND = 1u << 0,
     HB_F_SHAPE = 1u << 1,
     HB_F_WIND = 1u << 2,
-    HB_F_GUST = 1u << 3,   /* only with HB_F_WIND */
+    HB_F_GUST = 1u << 3, /* only with HB_F_WIND */
     HB_F_MOTION = 1u << 4,
     HB_F_COLLIDE = 1u << 5,
-    HB_F_DRAG = 1u << 6,   /* the implicit divide by 1 + h(c_d + β) */
-    HB_F_COUNT = 1u << 7,  /* number of feature sets */
+    HB_F_DRAG = 1u << 6,  /* the implicit divide by 1 + h(c_d + β) */
+    HB_F_COUNT = 1u << 7, /* number of feature sets */
 };
 
 /* The run's constants in the working precision (each computed in double, rounded once). */
-#define HB_DYN_MODEL(T)                                                                      \
-    struct {                                                                                 \
-        int64_t points, substeps, iterations, shape_count; /* P, S, I, K */                 \
-        int solver;                                                                          \
-        unsigned features;                                                                   \
-        T h, seg_len, gravity_y;       /* h = Δt/S, ℓ, −g0 */                                \
-        T wind_y, wind_z;              /* c_d·U·d̂ (the drag-scaled wind velocity) */         \
-        T dir_y, dir_z, kappa, gust;   /* d̂, κ = 2π/λ_g, A_g */                              \
-        T den;                         /* 1 + h(c_d + β) */                                  \
-        T stretch_at, bend_at, shape_at; /* α̃ = α/h² */                                     \
-        T collide_r;                   /* R_c = R + c_m */                                   \
-        T ftl_s;                       /* s */                                               \
+#define HB_DYN_MODEL(T)                                                                                                \
+    struct {                                                                                                           \
+        int64_t points, substeps, iterations, shape_count; /* P, S, I, K */                                            \
+        int solver;                                                                                                    \
+        unsigned features;                                                                                             \
+        T h, seg_len, gravity_y;         /* h = Δt/S, ℓ, −g0 */                                                   \
+        T wind_y, wind_z;                /* c_d·U·d̂ (the drag-scaled wind velocity) */                             \
+        T dir_y, dir_z, kappa, gust;     /* d̂, κ = 2π/λ_g, A_g */                                                 \
+        T den;                           /* 1 + h(c_d + β) */                                                         \
+        T stretch_at, bend_at, shape_at; /* α̃ = α/h² */                                                           \
+        T collide_r;                     /* R_c = R + c_m */                                                           \
+        T ftl_s;                         /* s */                                                                       \
     }
 typedef HB_DYN_MODEL(float) hb_dyn_model_f32;
 typedef HB_DYN_MODEL(double) hb_dyn_model_f64;
@@ -82,8 +82,7 @@ void hb_dyn_frame_plan(const hb_scene *s, int64_t m0, hb_dyn_frame *f);
 /* The rotation Q(t) of §3.2 in double, row-major. */
 void hb_head_rotation(const hb_dynamics *d, double t, double q[9]);
 /* Combines partials in index order: the result does not depend on how they were made. */
-void hb_dyn_reduce(const hb_obs_partial *p, int64_t n, int64_t points_per_strand, int64_t strands,
-                   hb_observables *out);
+void hb_dyn_reduce(const hb_obs_partial *p, int64_t n, int64_t points_per_strand, int64_t strands, hb_observables *out);
 int hb_obs_blown_up(const hb_observables *o);
 /* acc ← acc combined with o (max, max, sum, sum). */
 void hb_dyn_reduce_into(hb_obs_partial *acc, const hb_obs_partial *o);
@@ -92,10 +91,10 @@ void hb_dyn_reduce_into(hb_obs_partial *acc, const hb_obs_partial *o);
  * `scratch` holds 9·P reals. `bend_rest` holds P − 2 rest lengths (hb_dyn_bend_rest). */
 void hb_dyn_bend_rest_f32(const hb_dyn_model_f32 *m, const float *rest, float *bend_rest);
 void hb_dyn_bend_rest_f64(const hb_dyn_model_f64 *m, const double *rest, double *bend_rest);
-void hb_dyn_frame_strand_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *x, float *v,
-                             const float *rest, const float *bend_rest, float *scratch);
-void hb_dyn_frame_strand_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *x, double *v,
-                             const double *rest, const double *bend_rest, double *scratch);
+void hb_dyn_frame_strand_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *x, float *v, const float *rest,
+                             const float *bend_rest, float *scratch);
+void hb_dyn_frame_strand_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *x, double *v, const double *rest,
+                             const double *bend_rest, double *scratch);
 void hb_dyn_observe_strand_f32(const hb_scene *s, const float *x, const float *v, hb_obs_partial *o);
 void hb_dyn_observe_strand_f64(const hb_scene *s, const double *x, const double *v, hb_obs_partial *o);
 

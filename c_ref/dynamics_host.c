@@ -30,35 +30,34 @@ void hb_dyn_feature_names(unsigned features, char *out, size_t n)
     static const char *const names[] = {"bend", "shape", "wind", "gust", "motion", "collide", "drag"};
     out[0] = '\0';
     for (unsigned i = 0; i < sizeof names / sizeof names[0]; i++)
-        if (features & (1u << i))
-            snprintf(out + strlen(out), n - strlen(out), "%s%s", out[0] ? "+" : "", names[i]);
+        if (features & (1u << i)) snprintf(out + strlen(out), n - strlen(out), "%s%s", out[0] ? "+" : "", names[i]);
     if (!out[0]) snprintf(out, n, "none");
 }
 
 /* §3.10: every constant is computed in double from the scene, then rounded once. */
-#define ROUND_MODEL(M, T)                                                                    \
-    do {                                                                                     \
-        (M)->points = s->points;                                                             \
-        (M)->substeps = d->substeps;                                                         \
-        (M)->iterations = d->iterations;                                                     \
-        (M)->shape_count = shape_count;                                                      \
-        (M)->solver = (int)d->solver;                                                        \
-        (M)->features = features;                                                            \
-        (M)->h = (T)h;                                                                       \
-        (M)->seg_len = (T)hb_segment_length(s);                                              \
-        (M)->gravity_y = (T)(-d->gravity);                                                   \
-        (M)->wind_y = (T)(d->drag * d->wind_speed * dir_y);                                  \
-        (M)->wind_z = (T)(d->drag * d->wind_speed * dir_z);                                  \
-        (M)->dir_y = (T)dir_y;                                                               \
-        (M)->dir_z = (T)dir_z;                                                               \
-        (M)->kappa = (T)(2.0 * M_PI / d->gust_wavelength);                                   \
-        (M)->gust = (T)d->gust_amplitude;                                                    \
-        (M)->den = (T)(1.0 + h * (d->drag + d->damping));                                    \
-        (M)->stretch_at = (T)(d->stretch_compliance / (h * h));                              \
-        (M)->bend_at = (T)(d->bend_compliance / (h * h));                                    \
-        (M)->shape_at = (T)(d->shape_compliance / (h * h));                                  \
-        (M)->collide_r = (T)(s->head_radius + d->collision_margin);                          \
-        (M)->ftl_s = (T)d->ftl_damping;                                                      \
+#define ROUND_MODEL(M, T)                                                                                              \
+    do {                                                                                                               \
+        (M)->points = s->points;                                                                                       \
+        (M)->substeps = d->substeps;                                                                                   \
+        (M)->iterations = d->iterations;                                                                               \
+        (M)->shape_count = shape_count;                                                                                \
+        (M)->solver = (int)d->solver;                                                                                  \
+        (M)->features = features;                                                                                      \
+        (M)->h = (T)h;                                                                                                 \
+        (M)->seg_len = (T)hb_segment_length(s);                                                                        \
+        (M)->gravity_y = (T)(-d->gravity);                                                                             \
+        (M)->wind_y = (T)(d->drag * d->wind_speed * dir_y);                                                            \
+        (M)->wind_z = (T)(d->drag * d->wind_speed * dir_z);                                                            \
+        (M)->dir_y = (T)dir_y;                                                                                         \
+        (M)->dir_z = (T)dir_z;                                                                                         \
+        (M)->kappa = (T)(2.0 * M_PI / d->gust_wavelength);                                                             \
+        (M)->gust = (T)d->gust_amplitude;                                                                              \
+        (M)->den = (T)(1.0 + h * (d->drag + d->damping));                                                              \
+        (M)->stretch_at = (T)(d->stretch_compliance / (h * h));                                                        \
+        (M)->bend_at = (T)(d->bend_compliance / (h * h));                                                              \
+        (M)->shape_at = (T)(d->shape_compliance / (h * h));                                                            \
+        (M)->collide_r = (T)(s->head_radius + d->collision_margin);                                                    \
+        (M)->ftl_s = (T)d->ftl_damping;                                                                                \
     } while (0)
 
 void hb_dyn_round(const hb_scene *s, hb_dyn_model_f32 *m32, hb_dyn_model_f64 *m64)
@@ -107,16 +106,24 @@ void hb_head_rotation(const hb_dynamics *d, double t, double q[9])
     memcpy(q, eye, sizeof eye);
     switch (d->motion) {
     case HB_MOTION_NOD: /* about x̂: ŷ turns toward ẑ */
-        q[4] = c; q[5] = -sn; q[7] = sn; q[8] = c;
+        q[4] = c;
+        q[5] = -sn;
+        q[7] = sn;
+        q[8] = c;
         break;
     case HB_MOTION_SHAKE: /* about ŷ: ẑ turns toward x̂ */
-        q[0] = c; q[2] = sn; q[6] = -sn; q[8] = c;
+        q[0] = c;
+        q[2] = sn;
+        q[6] = -sn;
+        q[8] = c;
         break;
     case HB_MOTION_TILT: /* about ẑ: x̂ turns toward ŷ */
-        q[0] = c; q[1] = -sn; q[3] = sn; q[4] = c;
+        q[0] = c;
+        q[1] = -sn;
+        q[3] = sn;
+        q[4] = c;
         break;
-    case HB_MOTION_STILL:
-        break;
+    case HB_MOTION_STILL: break;
     }
 }
 
@@ -147,8 +154,7 @@ void hb_dyn_reduce_into(hb_obs_partial *acc, const hb_obs_partial *o)
     acc->blown += o->blown;
 }
 
-void hb_dyn_reduce(const hb_obs_partial *p, int64_t n, int64_t points_per_strand, int64_t strands,
-                   hb_observables *out)
+void hb_dyn_reduce(const hb_obs_partial *p, int64_t n, int64_t points_per_strand, int64_t strands, hb_observables *out)
 {
     hb_obs_partial acc = {0, 0, 0, 0};
     for (int64_t i = 0; i < n; i++) hb_dyn_reduce_into(&acc, &p[i]);
@@ -158,4 +164,7 @@ void hb_dyn_reduce(const hb_obs_partial *p, int64_t n, int64_t points_per_strand
     out->blown_up_strands = acc.blown;
 }
 
-int hb_obs_blown_up(const hb_observables *o) { return o->blown_up_strands > 0; }
+int hb_obs_blown_up(const hb_observables *o)
+{
+    return o->blown_up_strands > 0;
+}

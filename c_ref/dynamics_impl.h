@@ -89,7 +89,11 @@ HB_ALWAYS_INLINE void SFX(shape_all)(const DMODEL *m, REAL *p, const REAL *rest,
     for (int64_t k = 1; k <= m->shape_count; k++) {
         REAL t[3];
         if (F & HB_F_MOTION) SFX(rotate)(q, rest + 3 * k, t);
-        else { t[0] = rest[3 * k]; t[1] = rest[3 * k + 1]; t[2] = rest[3 * k + 2]; }
+        else {
+            t[0] = rest[3 * k];
+            t[1] = rest[3 * k + 1];
+            t[2] = rest[3 * k + 2];
+        }
         SFX(shape_pull)(p + 3 * k, t, m->shape_at, &lam[k - 1]);
     }
 }
@@ -100,15 +104,16 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
 {
     const int64_t P = m->points;
     const REAL h = m->h;
-    REAL *p = scratch;               /* predicted positions, 3P */
-    REAL *lam = scratch + 3 * P;     /* multipliers: stretch P−1 | bend P−2 | shape K */
+    REAL *p = scratch;           /* predicted positions, 3P */
+    REAL *lam = scratch + 3 * P; /* multipliers: stretch P−1 | bend P−2 | shape K */
     REAL *lam_s = lam, *lam_b = lam + P, *lam_g = lam + 2 * P;
-    REAL *d = scratch + 6 * P;       /* ftl corrections d_k, 3P */
+    REAL *d = scratch + 6 * P; /* ftl corrections d_k, 3P */
 
     for (int64_t j = 0; j < m->substeps; j++) {
-        const REAL *q = QTABLE(fr) + 9 * j;    /* Q(t + h) */
-        const REAL phase = PHASE(fr)[j];      /* φ(t) */
-        (void)q; (void)phase;
+        const REAL *q = QTABLE(fr) + 9 * j; /* Q(t + h) */
+        const REAL phase = PHASE(fr)[j];    /* φ(t) */
+        (void)q;
+        (void)phase;
 
         /* 1. root on the head: x0 ← Q(t+h)·X̄0, v0 ← (x0_new − x0_old)/h */
         if (F & HB_F_MOTION) {
@@ -130,7 +135,8 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
             REAL vx = vk[0], vy = vk[1], vz = vk[2];
             if (F & HB_F_WIND) {
                 REAL gam = (REAL)1;
-                if (F & HB_F_GUST) gam = (REAL)1 + m->gust * SIN(phase - m->kappa * (m->dir_y * xk[1] + m->dir_z * xk[2]));
+                if (F & HB_F_GUST)
+                    gam = (REAL)1 + m->gust * SIN(phase - m->kappa * (m->dir_y * xk[1] + m->dir_z * xk[2]));
                 vy = vy + h * (m->gravity_y + m->wind_y * gam);
                 vz = vz + h * (m->wind_z * gam);
             } else {
@@ -209,19 +215,22 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
 void SFX(hb_dyn_frame_strand)(const DMODEL *m, const hb_dyn_frame *fr, REAL *x, REAL *v, const REAL *rest,
                               const REAL *bend_rest, REAL *scratch)
 {
+// clang-format off
 #define HB_F_CASE(n)                                                                         \
     case (n):                                                                                \
         if (((n) & HB_F_GUST) && !((n) & HB_F_WIND)) break; /* no gusts without wind */     \
         SFX(frame_body)(m, fr, x, v, rest, bend_rest, scratch, (n));                         \
         break;
-#define HB_F_CASE8(n) HB_F_CASE(n) HB_F_CASE(n + 1) HB_F_CASE(n + 2) HB_F_CASE(n + 3) HB_F_CASE(n + 4) \
-    HB_F_CASE(n + 5) HB_F_CASE(n + 6) HB_F_CASE(n + 7)
+#define HB_F_CASE8(n) HB_F_CASE(n) HB_F_CASE(n + 1) HB_F_CASE(n + 2) HB_F_CASE(n + 3)      \
+    HB_F_CASE(n + 4) HB_F_CASE(n + 5) HB_F_CASE(n + 6) HB_F_CASE(n + 7)
     switch (m->features) {
-        HB_F_CASE8(0) HB_F_CASE8(8) HB_F_CASE8(16) HB_F_CASE8(24) HB_F_CASE8(32) HB_F_CASE8(40)
-        HB_F_CASE8(48) HB_F_CASE8(56) HB_F_CASE8(64) HB_F_CASE8(72) HB_F_CASE8(80) HB_F_CASE8(88)
+        HB_F_CASE8(0) HB_F_CASE8(8) HB_F_CASE8(16) HB_F_CASE8(24)
+        HB_F_CASE8(32) HB_F_CASE8(40) HB_F_CASE8(48) HB_F_CASE8(56)
+        HB_F_CASE8(64) HB_F_CASE8(72) HB_F_CASE8(80) HB_F_CASE8(88)
         HB_F_CASE8(96) HB_F_CASE8(104) HB_F_CASE8(112) HB_F_CASE8(120)
     default: break;
     }
+// clang-format on
 #undef HB_F_CASE8
 #undef HB_F_CASE
 }

@@ -29,12 +29,15 @@ HB_SIMD_DECL double sin(double);
 
 #define HB_ASSUME_ALIGNED(p) ((__typeof__(p))__builtin_assume_aligned((p), 64))
 
-#if HB_SIMD_DYN_BLOCK % 64 != 0 || HB_SIMD_BLOCK_F32 % HB_SIMD_DYN_BLOCK != 0 || \
+#if HB_SIMD_DYN_BLOCK % 64 != 0 || HB_SIMD_BLOCK_F32 % HB_SIMD_DYN_BLOCK != 0 ||                                       \
     HB_SIMD_BLOCK_F64 % HB_SIMD_DYN_BLOCK != 0
 #error "HB_SIMD_DYN_BLOCK must be a multiple of 64 that divides HB_SIMD_BLOCK_F32 and HB_SIMD_BLOCK_F64"
 #endif
 
-int64_t hb_simd_dyn_scratch_reals(int64_t points) { return (6 * points + 3) * (int64_t)HB_SIMD_DYN_BLOCK; }
+int64_t hb_simd_dyn_scratch_reals(int64_t points)
+{
+    return (6 * points + 3) * (int64_t)HB_SIMD_DYN_BLOCK;
+}
 
 #define REAL float
 #define SFX(name) name##_f32

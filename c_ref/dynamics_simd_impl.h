@@ -23,8 +23,8 @@
 
 #define HB_ALWAYS_INLINE static inline __attribute__((always_inline))
 #define DB HB_SIMD_DYN_BLOCK
-#define ROWP(a, k) ((a) + (int64_t)(k) * stride)
-#define SROW(r) HB_ASSUME_ALIGNED(scratch + (int64_t)(r) * DB)
+#define ROWP(a, k) ((a) + (int64_t)(k)*stride)
+#define SROW(r) HB_ASSUME_ALIGNED(scratch + (int64_t)(r)*DB)
 #define AL(p) HB_ASSUME_ALIGNED(p)
 
 /* §3.5 distance constraint between rows a and b of p, lane by lane (dynamics_impl.h
@@ -33,7 +33,13 @@ HB_ALWAYS_INLINE void SFX(distance_lanes)(REAL *restrict ax, REAL *restrict ay, 
                                           REAL *restrict by, REAL *restrict bz, const int move_a, const int per_lane,
                                           const REAL *restrict rr, const REAL rs, const REAL at, REAL *restrict lam)
 {
-    ax = AL(ax); ay = AL(ay); az = AL(az); bx = AL(bx); by = AL(by); bz = AL(bz); lam = AL(lam);
+    ax = AL(ax);
+    ay = AL(ay);
+    az = AL(az);
+    bx = AL(bx);
+    by = AL(by);
+    bz = AL(bz);
+    lam = AL(lam);
     const REAL wsum = move_a ? (REAL)2 : (REAL)1;
     const REAL wa = wsum + at;
 #pragma omp simd
@@ -62,7 +68,9 @@ HB_ALWAYS_INLINE void SFX(distance_lanes)(REAL *restrict ax, REAL *restrict ay, 
 /* §3.5 head collision of row k of p (dynamics_impl.h collide_sphere). */
 HB_ALWAYS_INLINE void SFX(collide_lanes)(REAL *restrict px, REAL *restrict py, REAL *restrict pz, const REAL rc)
 {
-    px = AL(px); py = AL(py); pz = AL(pz);
+    px = AL(px);
+    py = AL(py);
+    pz = AL(pz);
 #pragma omp simd
     for (int j = 0; j < DB; j++) {
         const REAL x = px[j], y = py[j], z = pz[j];
@@ -115,7 +123,14 @@ HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const REAL *q, const REAL 
     }
     const REAL gy = m->gravity_y, wy = m->wind_y, wz = m->wind_z, den = m->den;
     const REAL gust = m->gust, kappa = m->kappa, dy = m->dir_y, dz = m->dir_z;
-    (void)wy; (void)wz; (void)den; (void)gust; (void)kappa; (void)dy; (void)dz; (void)phase;
+    (void)wy;
+    (void)wz;
+    (void)den;
+    (void)gust;
+    (void)kappa;
+    (void)dy;
+    (void)dz;
+    (void)phase;
     for (int64_t k = 1; k < P; k++) {
         const REAL *restrict x = AL(ROWP(X, k)), *restrict y = AL(ROWP(Y, k)), *restrict z = AL(ROWP(Z, k));
         REAL *restrict vxr = AL(ROWP(VX, k)), *restrict vyr = AL(ROWP(VY, k)), *restrict vzr = AL(ROWP(VZ, k));
@@ -155,9 +170,9 @@ HB_ALWAYS_INLINE void SFX(bend_lanes)(const DMODEL *m, REAL *scratch, const REAL
     for (int64_t k = 1; k + 1 < P; k++)
         if ((((k - 1) / 2) & 1) == parity) {
             const int64_t a = k - 1, b = k + 1;
-            SFX(distance_lanes)(SROW(3 * a), SROW(3 * a + 1), SROW(3 * a + 2), SROW(3 * b), SROW(3 * b + 1),
-                                SROW(3 * b + 2), a != 0, 1, ROWP(BR, k - 1), (REAL)0, m->bend_at,
-                                SROW(3 * P + P + (k - 1)));
+            SFX(distance_lanes)
+            (SROW(3 * a), SROW(3 * a + 1), SROW(3 * a + 2), SROW(3 * b), SROW(3 * b + 1), SROW(3 * b + 2), a != 0, 1,
+             ROWP(BR, k - 1), (REAL)0, m->bend_at, SROW(3 * P + P + (k - 1)));
         }
 }
 
@@ -214,6 +229,7 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const REAL *q, REAL *X, RE
     }
     if (m->solver == HB_SOLVER_XPBD) {
         for (int64_t it = 0; it < m->iterations; it++) {
+            // clang-format off
             for (int64_t k = 1; k < P; k += 2) /* stretch, k odd */
                 SFX(distance_lanes)(SROW(3 * (k - 1)), SROW(3 * (k - 1) + 1), SROW(3 * (k - 1) + 2), SROW(3 * k),
                                     SROW(3 * k + 1), SROW(3 * k + 2), k - 1 != 0, 0, NULL, ell, m->stretch_at,
@@ -222,13 +238,15 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const REAL *q, REAL *X, RE
                 SFX(distance_lanes)(SROW(3 * (k - 1)), SROW(3 * (k - 1) + 1), SROW(3 * (k - 1) + 2), SROW(3 * k),
                                     SROW(3 * k + 1), SROW(3 * k + 2), 1, 0, NULL, ell, m->stretch_at,
                                     SROW(3 * P + (k - 1)));
+            // clang-format on
             if (F & HB_F_BEND) {
                 SFX(bend_lanes)(m, scratch, BR, stride, 0);
                 SFX(bend_lanes)(m, scratch, BR, stride, 1);
             }
             if (F & HB_F_SHAPE) SFX(shape_lanes)(m, scratch, q, RX, RY, RZ, stride, F);
             if (F & HB_F_COLLIDE)
-                for (int64_t k = 1; k < P; k++) SFX(collide_lanes)(SROW(3 * k), SROW(3 * k + 1), SROW(3 * k + 2), m->collide_r);
+                for (int64_t k = 1; k < P; k++)
+                    SFX(collide_lanes)(SROW(3 * k), SROW(3 * k + 1), SROW(3 * k + 2), m->collide_r);
         }
         /* 4. v = (p − x)/h, then x = p */
         for (int64_t k = 1; k < P; k++) {
@@ -331,20 +349,22 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const REAL *q, REAL *X, RE
 }
 
 /* The two phases, one function per feature subset (the switches' constants specialise). */
-#define VEL_F(i) ((((i) & 1) ? HB_F_WIND : 0u) | (((i) & 2) ? HB_F_GUST : 0u) | (((i) & 4) ? HB_F_DRAG : 0u) | \
-                  (((i) & 8) ? HB_F_MOTION : 0u))
-#define CON_F(i) ((((i) & 1) ? HB_F_BEND : 0u) | (((i) & 2) ? HB_F_SHAPE : 0u) | (((i) & 4) ? HB_F_COLLIDE : 0u) | \
-                  (((i) & 8) ? HB_F_MOTION : 0u))
+#define VEL_F(i)                                                                                                       \
+    ((((i)&1) ? HB_F_WIND : 0u) | (((i)&2) ? HB_F_GUST : 0u) | (((i)&4) ? HB_F_DRAG : 0u) |                            \
+     (((i)&8) ? HB_F_MOTION : 0u))
+#define CON_F(i)                                                                                                       \
+    ((((i)&1) ? HB_F_BEND : 0u) | (((i)&2) ? HB_F_SHAPE : 0u) | (((i)&4) ? HB_F_COLLIDE : 0u) |                        \
+     (((i)&8) ? HB_F_MOTION : 0u))
 #define CASE16(C) C(0) C(1) C(2) C(3) C(4) C(5) C(6) C(7) C(8) C(9) C(10) C(11) C(12) C(13) C(14) C(15)
 
-static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const REAL *q, const REAL phase, REAL *X, REAL *Y,
-                              REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ,
+static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const REAL *q, const REAL phase, REAL *X, REAL *Y, REAL *Z,
+                              REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ,
                               const int64_t stride, REAL *scratch)
 {
-#define VCASE(i)                                                                                    \
-    case (i):                                                                                       \
-        if (((i) & 2) && !((i) & 1)) break; /* no gusts without wind (hb_dyn_features) */          \
-        SFX(vel_phase)(m, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, VEL_F(i));   \
+#define VCASE(i)                                                                                                       \
+    case (i):                                                                                                          \
+        if (((i)&2) && !((i)&1)) break; /* no gusts without wind (hb_dyn_features) */                                  \
+        SFX(vel_phase)(m, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, VEL_F(i));                       \
         break;
     switch (idx) {
         CASE16(VCASE)
@@ -357,10 +377,10 @@ static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const REAL *q, REAL
                               REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ, const REAL *BR,
                               const int64_t stride, REAL *scratch)
 {
-#define CCASE(i)                                                                                   \
-    case (i):                                                                                      \
-        if (((i) & 8) && !((i) & 2)) break; /* motion matters here only through shape */          \
-        SFX(con_phase)(m, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, stride, scratch, CON_F(i));     \
+#define CCASE(i)                                                                                                       \
+    case (i):                                                                                                          \
+        if (((i)&8) && !((i)&2)) break; /* motion matters here only through shape */                                   \
+        SFX(con_phase)(m, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, stride, scratch, CON_F(i));                          \
         break;
     switch (idx) {
         CASE16(CCASE)
@@ -370,8 +390,8 @@ static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const REAL *q, REAL
 }
 
 void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, REAL *X, REAL *Y, REAL *Z, REAL *VX,
-                                  REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ,
-                                  const REAL *BR, int64_t stride, REAL *scratch)
+                                  REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ, const REAL *BR,
+                                  int64_t stride, REAL *scratch)
 {
     const unsigned F = m->features;
     const unsigned vi = ((F & HB_F_WIND) ? 1u : 0u) | ((F & HB_F_WIND) && (F & HB_F_GUST) ? 2u : 0u) |
@@ -380,7 +400,7 @@ void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, REAL 
                         ((F & HB_F_SHAPE) && (F & HB_F_MOTION) ? 8u : 0u);
     for (int64_t j = 0; j < m->substeps; j++) {
         const REAL *q = QTABLE(fr) + 9 * j; /* Q(t + h) */
-        const REAL phase = PHASE(fr)[j];   /* φ(t) */
+        const REAL phase = PHASE(fr)[j];    /* φ(t) */
         SFX(vel_dispatch)(vi, m, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch);
         SFX(con_dispatch)(ci, m, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, stride, scratch);
     }
@@ -391,8 +411,10 @@ void SFX(hb_simd_dyn_bend_rest_block)(const DMODEL *m, const REAL *RX, const REA
                                       int64_t stride)
 {
     for (int64_t k = 1; k + 1 < m->points; k++) {
-        const REAL *restrict ax = AL(ROWP(RX, k - 1)), *restrict ay = AL(ROWP(RY, k - 1)), *restrict az = AL(ROWP(RZ, k - 1));
-        const REAL *restrict bx = AL(ROWP(RX, k + 1)), *restrict by = AL(ROWP(RY, k + 1)), *restrict bz = AL(ROWP(RZ, k + 1));
+        const REAL *restrict ax = AL(ROWP(RX, k - 1)), *restrict ay = AL(ROWP(RY, k - 1)),
+                             *restrict az = AL(ROWP(RZ, k - 1));
+        const REAL *restrict bx = AL(ROWP(RX, k + 1)), *restrict by = AL(ROWP(RY, k + 1)),
+                             *restrict bz = AL(ROWP(RZ, k + 1));
         REAL *restrict br = AL(ROWP(BR, k - 1));
 #pragma omp simd
         for (int j = 0; j < DB; j++) {
@@ -423,8 +445,9 @@ void SFX(hb_simd_dyn_observe)(const hb_scene *s, const REAL *X, const REAL *Y, c
             const REAL *x = X + base, *y = Y + base, *z = Z + base, *vx = VX + base, *vy = VY + base, *vz = VZ + base;
 #pragma omp simd
             for (int j = 0; j < n; j++) {
-                const int fin = (fabs((double)x[j]) <= big) & (fabs((double)y[j]) <= big) & (fabs((double)z[j]) <= big) &
-                                (fabs((double)vx[j]) <= big) & (fabs((double)vy[j]) <= big) & (fabs((double)vz[j]) <= big);
+                const int fin = (fabs((double)x[j]) <= big) & (fabs((double)y[j]) <= big) &
+                                (fabs((double)z[j]) <= big) & (fabs((double)vx[j]) <= big) &
+                                (fabs((double)vy[j]) <= big) & (fabs((double)vz[j]) <= big);
                 blown[j] = !fin;
                 smax[j] = 0.0;
                 pmax[j] = 0.0;
@@ -443,9 +466,18 @@ void SFX(hb_simd_dyn_observe)(const hb_scene *s, const REAL *X, const REAL *Y, c
                 const double e0 = a0 - (double)xp[j], e1 = a1 - (double)yp[j], e2 = a2 - (double)zp[j];
                 const double r0 = a0 - (double)x0[j], r1 = a1 - (double)y0[j], r2v = a2 - (double)z0[j];
                 double l2 = 0.0, r2 = 0.0, n2 = 0.0, w2 = 0.0;
-                l2 += e0 * e0; r2 += r0 * r0; n2 += a0 * a0; w2 += w0 * w0;
-                l2 += e1 * e1; r2 += r1 * r1; n2 += a1 * a1; w2 += w1 * w1;
-                l2 += e2 * e2; r2 += r2v * r2v; n2 += a2 * a2; w2 += w2v * w2v;
+                l2 += e0 * e0;
+                r2 += r0 * r0;
+                n2 += a0 * a0;
+                w2 += w0 * w0;
+                l2 += e1 * e1;
+                r2 += r1 * r1;
+                n2 += a1 * a1;
+                w2 += w1 * w1;
+                l2 += e2 * e2;
+                r2 += r2v * r2v;
+                n2 += a2 * a2;
+                w2 += w2v * w2v;
                 const int fin = (fabs(a0) <= big) & (fabs(a1) <= big) & (fabs(a2) <= big) & (fabs(w0) <= big) &
                                 (fabs(w1) <= big) & (fabs(w2v) <= big);
                 const double st = fabs(sqrt(l2) / ell - 1.0);

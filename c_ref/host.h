@@ -21,8 +21,8 @@ void hb_model_round(const hb_scene *s, hb_model_f32 *m32, hb_model_f64 *m64);
 
 /* The one-line "does not fit" message: "the state needs X GB of <kind> memory (N strands x
  * P points, fp32<detail>) but only Y GB is <available | free on DEVICE>". */
-void hb_memory_message(char *err, size_t errlen, const hb_scene *s, const char *kind, uint64_t need,
-                       uint64_t avail, const char *detail, const char *device);
+void hb_memory_message(char *err, size_t errlen, const hb_scene *s, const char *kind, uint64_t need, uint64_t avail,
+                       const char *detail, const char *device);
 
 #ifdef __cplusplus
 }

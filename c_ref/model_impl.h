@@ -45,10 +45,10 @@ void SFX(hb_drape_strand)(const MODEL *m, REAL *s)
     const int64_t P = m->points;
     const REAL ell = m->seg_len;
     const REAL x0 = s[0];
-    REAL py = s[1], pz = s[2];                /* the predecessor, in the slice plane */
-    const REAL r0 = SQRT(py * py + pz * pz);  /* head circle of the slice */
-    const REAL rc = r0 + m->hair_offset;      /* shell circle */
-    REAL theta = ATAN2(py, pz);               /* (−π, π] … */
+    REAL py = s[1], pz = s[2];                  /* the predecessor, in the slice plane */
+    const REAL r0 = SQRT(py * py + pz * pz);    /* head circle of the slice */
+    const REAL rc = r0 + m->hair_offset;        /* shell circle */
+    REAL theta = ATAN2(py, pz);                 /* (−π, π] … */
     if (theta <= -HALF_PI_R) theta += TWO_PI_R; /* … taken in (−π/2, 3π/2] */
     /* A root on the lower back (θ0 > π) hangs straight down from the root. */
     int hanging = theta > PI_R;

@@ -42,8 +42,7 @@ extern "C" {
 
 /* init: roots (strands first … first + block − 1) and drape; writes X, Y, Z. */
 void hb_simd_init_block_f32(const hb_model_f32 *m, uint64_t first, float *X, float *Y, float *Z, int64_t stride);
-void hb_simd_init_block_f64(const hb_model_f64 *m, uint64_t first, double *X, double *Y, double *Z,
-                            int64_t stride);
+void hb_simd_init_block_f64(const hb_model_f64 *m, uint64_t first, double *X, double *Y, double *Z, int64_t stride);
 
 /* wind (w ≠ 0): reads and writes Y, Z; X is not touched. */
 void hb_simd_wind_block_f32(const hb_model_f32 *m, float *Y, float *Z, int64_t stride);

@@ -285,7 +285,7 @@ int64_t SFX(hb_simd_collide_block)(const MODEL *m, int real, REAL *Y, REAL *Z, i
             for (int j = j0; j < j1; j++) {
                 const REAL cy = ny[j], cz = nz[j];
                 const ITYPE now = moved[j] | inside[j]; /* inside[] is now "projected" */
-                if (now) { /* a masked store: untouched points are not written */
+                if (now) {                              /* a masked store: untouched points are not written */
                     Yk[j] = cy;
                     Zk[j] = cz;
                 }

@@ -17,7 +17,10 @@ const char *hb_stage_name(hb_stage s)
     return "?";
 }
 
-const char *hb_precision_name(hb_precision p) { return p == HB_FP64 ? "fp64" : "fp32"; }
+const char *hb_precision_name(hb_precision p)
+{
+    return p == HB_FP64 ? "fp64" : "fp32";
+}
 
 uint64_t hb_state_bytes(const hb_scene *s)
 {
@@ -36,9 +39,16 @@ double hb_wind_angle_reduced(const hb_scene *s)
     return a;
 }
 
-#define FAIL(...) do { snprintf(err, errlen, __VA_ARGS__); return -1; } while (0)
+#define FAIL(...)                                                                                                      \
+    do {                                                                                                               \
+        snprintf(err, errlen, __VA_ARGS__);                                                                            \
+        return -1;                                                                                                     \
+    } while (0)
 
-static int finite_positive(double v) { return isfinite(v) && v > 0.0; }
+static int finite_positive(double v)
+{
+    return isfinite(v) && v > 0.0;
+}
 
 int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
 {
@@ -57,14 +67,18 @@ int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
      * exactly; a relative allowance of 1e-12 keeps that edge usable. */
     if (!(ell >= s->hair_offset * (1.0 - 1e-12)))
         FAIL("--hair-length/(--points - 1) = %g is shorter than --hair-offset %g: a segment could not reach the "
-             "shell (DESIGN §3 collide needs l >= h)", ell, s->hair_offset);
+             "shell (DESIGN §3 collide needs l >= h)",
+             ell, s->hair_offset);
     /* Every length must square without leaving the precision's normal range, or the
      * model's r², ℓ² and ρ·rc underflow to denormals or zero (docs/decisions.md,
      * "fp32_near_denormal_range"). */
     const double lo = s->precision == HB_FP32 ? 1e-18 : 1e-150;
     const double hi = s->precision == HB_FP32 ? 1e18 : 1e150;
-    const struct { const char *flag; double v; } len[] = {
-        {"--head-radius", s->head_radius}, {"--hair-offset", s->hair_offset}, {"--hair-length", s->hair_length},
+    const struct {
+        const char *flag;
+        double v;
+    } len[] = {
+        {"--head-radius", s->head_radius},     {"--hair-offset", s->hair_offset}, {"--hair-length", s->hair_length},
         {"--hair-length/(--points - 1)", ell}, {"--face-margin", s->face_margin},
     };
     for (size_t i = 0; i < sizeof len / sizeof len[0]; i++) {
@@ -80,7 +94,10 @@ int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
 
 /* ---- the dynamic model (docs/model.md §3) ----------------------------------------------- */
 
-const char *hb_solver_name(hb_solver s) { return s == HB_SOLVER_FTL ? "ftl" : "xpbd"; }
+const char *hb_solver_name(hb_solver s)
+{
+    return s == HB_SOLVER_FTL ? "ftl" : "xpbd";
+}
 
 const char *hb_motion_name(hb_motion m)
 {
@@ -113,7 +130,11 @@ void hb_dynamics_defaults(hb_dynamics *d)
 
 int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
 {
-    const struct { const char *flag; double v; int positive; } nonneg[] = {
+    const struct {
+        const char *flag;
+        double v;
+        int positive;
+    } nonneg[] = {
         {"--frame-dt", d->frame_dt, 1},
         {"--gravity", d->gravity, 0},
         {"--drag", d->drag, 0},

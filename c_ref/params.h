@@ -26,42 +26,42 @@ typedef enum { HB_MOTION_STILL = 0, HB_MOTION_NOD = 1, HB_MOTION_SHAKE = 2, HB_M
  * simulated frame. Units: cm, s. Bend and shape exist only when declared (their
  * compliance given); the wind only when U > 0 and c_d > 0 (§3.9). */
 typedef struct {
-    double frame_dt;            /* Δt, s */
-    int64_t substeps;           /* S */
-    int64_t iterations;         /* I */
+    double frame_dt;    /* Δt, s */
+    int64_t substeps;   /* S */
+    int64_t iterations; /* I */
     hb_solver solver;
-    double gravity;             /* g0, cm/s² */
-    double drag, damping;       /* c_d, β, 1/s */
-    int drag_declared;          /* --drag or --damping given: the implicit divide runs (§3.9) */
-    double stretch_compliance;  /* α_s */
-    int bend;                   /* declared */
-    double bend_compliance;     /* α_b */
-    int shape;                  /* declared */
-    double shape_compliance;    /* α_g */
-    double shape_range;         /* ρ_g in (0, 1] */
-    double ftl_damping;         /* s */
+    double gravity;            /* g0, cm/s² */
+    double drag, damping;      /* c_d, β, 1/s */
+    int drag_declared;         /* --drag or --damping given: the implicit divide runs (§3.9) */
+    double stretch_compliance; /* α_s */
+    int bend;                  /* declared */
+    double bend_compliance;    /* α_b */
+    int shape;                 /* declared */
+    double shape_compliance;   /* α_g */
+    double shape_range;        /* ρ_g in (0, 1] */
+    double ftl_damping;        /* s */
     int collider;
-    double collision_margin;    /* c_m */
-    double wind_speed;          /* U, cm/s; direction ψ is hb_scene.wind_angle */
+    double collision_margin;                                /* c_m */
+    double wind_speed;                                      /* U, cm/s; direction ψ is hb_scene.wind_angle */
     double gust_amplitude, gust_frequency, gust_wavelength; /* A_g, f_g (Hz), λ_g (cm) */
     hb_motion motion;
-    double motion_amplitude;    /* A, radians */
-    double motion_frequency;    /* f, Hz */
+    double motion_amplitude; /* A, radians */
+    double motion_frequency; /* f, Hz */
 } hb_dynamics;
 
 /* The scene: everything that decides the bits of a state. */
 typedef struct {
-    int64_t n_strands;       /* N */
-    int64_t points;          /* P, including the root */
+    int64_t n_strands; /* N */
+    int64_t points;    /* P, including the root */
     uint64_t seed;
-    double head_radius;      /* R */
-    double hair_offset;      /* h */
-    double hair_length;      /* L */
-    double face_margin;      /* m */
-    double wind_strength;    /* w in [0, 1] */
-    double wind_angle;       /* psi, radians from +z toward +y */
+    double head_radius;   /* R */
+    double hair_offset;   /* h */
+    double hair_length;   /* L */
+    double face_margin;   /* m */
+    double wind_strength; /* w in [0, 1] */
+    double wind_angle;    /* psi, radians from +z toward +y */
     hb_precision precision;
-    hb_dynamics dyn;         /* used by the simulate stage only */
+    hb_dynamics dyn; /* used by the simulate stage only */
 } hb_scene;
 
 /* How a run is carried out: which stages, how timed, where written. */
@@ -69,34 +69,40 @@ typedef struct {
     hb_scene scene;
     hb_stage stages[HB_MAX_STAGES];
     int n_stages;
-    const char *variant;     /* NULL: the backend's default */
-    int threads;             /* cpu: 0 = all cores */
-    int block_size;          /* cuda */
-    const char *input;       /* NULL: start with init */
-    const char *output;      /* NULL: no file */
+    const char *variant; /* NULL: the backend's default */
+    int threads;         /* cpu: 0 = all cores */
+    int block_size;      /* cuda */
+    const char *input;   /* NULL: start with init */
+    const char *output;  /* NULL: no file */
     int force;
     int repeat;
-    int warmup;              /* -1: default (1 if repeat > 1, else 0) */
+    int warmup; /* -1: default (1 if repeat > 1, else 0) */
     int json;
     int quiet;
-    int end_to_end;          /* measure one extra untimed-by-stage pass */
-    int measure_bandwidth;   /* only measure the copy bandwidth */
-    const char *self_test;   /* "rng": print the known-answer checks */
-    int list_variants;       /* print the backend's variants as JSON and exit */
-    int input_frame;         /* --input-frame: resume after this frame of --input; −1 = its last */
-    int64_t frames;          /* simulate: frames to advance (F) */
-    int64_t output_every;    /* simulate: write every K-th frame (the last always) */
-    int all_velocities;      /* simulate: write the velocities of every written frame */
-    uint64_t dyn_given;      /* which dynamic flags were given: bit i = entry i of cli.c's table */
+    int end_to_end;        /* measure one extra untimed-by-stage pass */
+    int measure_bandwidth; /* only measure the copy bandwidth */
+    const char *self_test; /* "rng": print the known-answer checks */
+    int list_variants;     /* print the backend's variants as JSON and exit */
+    int input_frame;       /* --input-frame: resume after this frame of --input; −1 = its last */
+    int64_t frames;        /* simulate: frames to advance (F) */
+    int64_t output_every;  /* simulate: write every K-th frame (the last always) */
+    int all_velocities;    /* simulate: write the velocities of every written frame */
+    uint64_t dyn_given;    /* which dynamic flags were given: bit i = entry i of cli.c's table */
     /* which scene flags the user gave explicitly (for --input consistency checks) */
     unsigned given;
 } hb_options;
 
 /* Bits of hb_options.given. */
 enum {
-    HB_GIVEN_STRANDS = 1u << 0, HB_GIVEN_POINTS = 1u << 1, HB_GIVEN_SEED = 1u << 2,
-    HB_GIVEN_RADIUS = 1u << 3, HB_GIVEN_OFFSET = 1u << 4, HB_GIVEN_LENGTH = 1u << 5,
-    HB_GIVEN_MARGIN = 1u << 6, HB_GIVEN_PRECISION = 1u << 7, HB_GIVEN_ANGLE = 1u << 8,
+    HB_GIVEN_STRANDS = 1u << 0,
+    HB_GIVEN_POINTS = 1u << 1,
+    HB_GIVEN_SEED = 1u << 2,
+    HB_GIVEN_RADIUS = 1u << 3,
+    HB_GIVEN_OFFSET = 1u << 4,
+    HB_GIVEN_LENGTH = 1u << 5,
+    HB_GIVEN_MARGIN = 1u << 6,
+    HB_GIVEN_PRECISION = 1u << 7,
+    HB_GIVEN_ANGLE = 1u << 8,
 };
 
 /* Derived values, computed once in double on the host and rounded once to the working
@@ -106,7 +112,10 @@ static inline double hb_segment_length(const hb_scene *s)
     return s->hair_length / (double)(s->points - 1);
 }
 
-static inline size_t hb_real_size(hb_precision p) { return p == HB_FP64 ? 8 : 4; }
+static inline size_t hb_real_size(hb_precision p)
+{
+    return p == HB_FP64 ? 8 : 4;
+}
 
 const char *hb_stage_name(hb_stage s);
 const char *hb_precision_name(hb_precision p);

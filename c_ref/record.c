@@ -9,7 +9,10 @@
 #define HB_GIT_REV "unknown"
 #endif
 
-const char *hb_git_revision(void) { return HB_GIT_REV; }
+const char *hb_git_revision(void)
+{
+    return HB_GIT_REV;
+}
 
 const char *hb_compiler(void)
 {
@@ -92,24 +95,35 @@ static void json_num(FILE *f, double v)
 void hb_record_json(FILE *f, const hb_record *r)
 {
     const hb_scene *s = &r->opt->scene;
-    fputs("{\"backend\": ", f); json_str(f, r->backend);
-    fputs(", \"variant\": ", f); json_str(f, r->variant);
-    fputs(", \"precision\": ", f); json_str(f, hb_precision_name(s->precision));
-    fprintf(f, ", \"strands\": %lld, \"points\": %lld, \"seed\": %llu", (long long)s->n_strands,
-            (long long)s->points, (unsigned long long)s->seed);
-    fputs(", \"head_radius\": ", f); json_num(f, s->head_radius);
-    fputs(", \"hair_offset\": ", f); json_num(f, s->hair_offset);
-    fputs(", \"hair_length\": ", f); json_num(f, s->hair_length);
-    fputs(", \"face_margin\": ", f); json_num(f, s->face_margin);
-    fputs(", \"wind_strength\": ", f); json_num(f, s->wind_strength);
-    fputs(", \"wind_angle\": ", f); json_num(f, s->wind_angle);
+    fputs("{\"backend\": ", f);
+    json_str(f, r->backend);
+    fputs(", \"variant\": ", f);
+    json_str(f, r->variant);
+    fputs(", \"precision\": ", f);
+    json_str(f, hb_precision_name(s->precision));
+    fprintf(f, ", \"strands\": %lld, \"points\": %lld, \"seed\": %llu", (long long)s->n_strands, (long long)s->points,
+            (unsigned long long)s->seed);
+    fputs(", \"head_radius\": ", f);
+    json_num(f, s->head_radius);
+    fputs(", \"hair_offset\": ", f);
+    json_num(f, s->hair_offset);
+    fputs(", \"hair_length\": ", f);
+    json_num(f, s->hair_length);
+    fputs(", \"face_margin\": ", f);
+    json_num(f, s->face_margin);
+    fputs(", \"wind_strength\": ", f);
+    json_num(f, s->wind_strength);
+    fputs(", \"wind_angle\": ", f);
+    json_num(f, s->wind_angle);
     if (r->threads > 0) fprintf(f, ", \"threads\": %d", r->threads);
     else fputs(", \"threads\": null", f);
     if (r->block_size > 0) fprintf(f, ", \"block_size\": %d", r->block_size);
     else fputs(", \"block_size\": null", f);
     fprintf(f, ", \"repeat\": %d, \"warmup\": %d", r->opt->repeat, r->opt->warmup);
-    fputs(", \"input\": ", f); json_str(f, r->opt->input);
-    fputs(", \"output\": ", f); json_str(f, r->opt->output);
+    fputs(", \"input\": ", f);
+    json_str(f, r->opt->input);
+    fputs(", \"output\": ", f);
+    json_str(f, r->opt->output);
     fputs(", \"stages\": [", f);
     for (int i = 0; i < r->n_stages; i++) {
         const hb_stage_record *st = &r->stages[i];
@@ -117,9 +131,12 @@ void hb_record_json(FILE *f, const hb_record *r)
         json_str(f, st->meta.stage);
         fprintf(f, ", \"skipped\": %s, \"fused\": ", st->meta.skipped ? "true" : "false");
         json_str(f, st->meta.fused[0] ? st->meta.fused : NULL);
-        fputs(", \"median_ms\": ", f); json_num(f, st->meta.median_ms);
-        fputs(", \"min_ms\": ", f); json_num(f, st->meta.min_ms);
-        fputs(", \"max_ms\": ", f); json_num(f, st->meta.max_ms);
+        fputs(", \"median_ms\": ", f);
+        json_num(f, st->meta.median_ms);
+        fputs(", \"min_ms\": ", f);
+        json_num(f, st->meta.min_ms);
+        fputs(", \"max_ms\": ", f);
+        json_num(f, st->meta.max_ms);
         fputs(", \"times_ms\": [", f);
         for (int k = 0; k < st->n_times; k++) {
             if (k) fputs(", ", f);
@@ -132,32 +149,48 @@ void hb_record_json(FILE *f, const hb_record *r)
             const hb_dynamics *d = &s->dyn;
             fprintf(f, ", \"frames\": %lld, \"substeps\": %lld, \"iterations\": %lld, \"solver\": \"%s\"",
                     (long long)st->frames, (long long)d->substeps, (long long)d->iterations, hb_solver_name(d->solver));
-            fputs(", \"features\": ", f); json_str(f, st->features);
-            fputs(", \"frame_dt\": ", f); json_num(f, d->frame_dt);
+            fputs(", \"features\": ", f);
+            json_str(f, st->features);
+            fputs(", \"frame_dt\": ", f);
+            json_num(f, d->frame_dt);
             /* point-substeps per second of the median frame */
             fputs(", \"point_substeps_per_s\": ", f);
             json_num(f, (double)s->n_strands * (double)s->points * (double)d->substeps / (1e-3 * st->meta.median_ms));
-            fputs(", \"observe_ms\": ", f); json_num(f, st->observe_ms);
-            fputs(", \"last_observables\": {\"stretch_max\": ", f); json_num(f, st->last.stretch_max);
-            fputs(", \"penetration_max\": ", f); json_num(f, st->last.penetration_max);
-            fputs(", \"kinetic_energy\": ", f); json_num(f, st->last.kinetic_energy);
+            fputs(", \"observe_ms\": ", f);
+            json_num(f, st->observe_ms);
+            fputs(", \"last_observables\": {\"stretch_max\": ", f);
+            json_num(f, st->last.stretch_max);
+            fputs(", \"penetration_max\": ", f);
+            json_num(f, st->last.penetration_max);
+            fputs(", \"kinetic_energy\": ", f);
+            json_num(f, st->last.kinetic_energy);
             fprintf(f, ", \"blown_up_strands\": %lld}, \"blown_up_frames\": %lld", (long long)st->last.blown_up_strands,
                     (long long)st->blown_frames);
         }
         fputc('}', f);
     }
     fputs("]", f);
-    fputs(", \"end_to_end_ms\": ", f); json_num(f, r->end_to_end_ms);
-    fputs(", \"h2d_ms\": ", f); json_num(f, r->h2d_ms);
-    fputs(", \"d2h_ms\": ", f); json_num(f, r->d2h_ms);
-    fputs(", \"hdf5_write_ms\": ", f); json_num(f, r->hdf5_write_ms);
+    fputs(", \"end_to_end_ms\": ", f);
+    json_num(f, r->end_to_end_ms);
+    fputs(", \"h2d_ms\": ", f);
+    json_num(f, r->h2d_ms);
+    fputs(", \"d2h_ms\": ", f);
+    json_num(f, r->d2h_ms);
+    fputs(", \"hdf5_write_ms\": ", f);
+    json_num(f, r->hdf5_write_ms);
     fprintf(f, ", \"state_bytes\": %llu", (unsigned long long)hb_state_bytes(s));
-    fputs(", \"git_revision\": ", f); json_str(f, r->git_revision);
-    fputs(", \"compiler\": ", f); json_str(f, r->compiler);
-    fputs(", \"flags\": ", f); json_str(f, r->flags);
-    fputs(", \"device\": ", f); json_str(f, r->device);
-    fputs(", \"driver\": ", f); json_str(f, r->driver[0] ? r->driver : NULL);
-    fputs(", \"version\": ", f); json_str(f, HB_VERSION);
+    fputs(", \"git_revision\": ", f);
+    json_str(f, r->git_revision);
+    fputs(", \"compiler\": ", f);
+    json_str(f, r->compiler);
+    fputs(", \"flags\": ", f);
+    json_str(f, r->flags);
+    fputs(", \"device\": ", f);
+    json_str(f, r->device);
+    fputs(", \"driver\": ", f);
+    json_str(f, r->driver[0] ? r->driver : NULL);
+    fputs(", \"version\": ", f);
+    json_str(f, HB_VERSION);
     fputs("}\n", f);
 }
 
@@ -174,12 +207,14 @@ void hb_record_summary(FILE *f, const hb_record *r)
         fprintf(f, "  frame %-3d %-8s", st->frame, st->meta.stage);
         if (st->meta.skipped) fprintf(f, " skipped (nil effect: wind strength 0)");
         else if (strcmp(st->meta.fused, "into-previous") == 0) fprintf(f, " fused into the previous kernel");
-        else fprintf(f, " median %.3f ms (min %.3f, max %.3f, %d runs)", st->meta.median_ms, st->meta.min_ms,
-                     st->meta.max_ms, st->n_times);
+        else
+            fprintf(f, " median %.3f ms (min %.3f, max %.3f, %d runs)", st->meta.median_ms, st->meta.min_ms,
+                    st->meta.max_ms, st->n_times);
         if (st->meta.moved_points >= 0) fprintf(f, ", %lld points moved", (long long)st->meta.moved_points);
         if (st->stage == HB_STAGE_SIMULATE) {
             fprintf(f, " per frame over %lld frames (%s, S=%lld, I=%lld, %s)", (long long)st->frames,
-                    hb_solver_name(s->dyn.solver), (long long)s->dyn.substeps, (long long)s->dyn.iterations, st->features);
+                    hb_solver_name(s->dyn.solver), (long long)s->dyn.substeps, (long long)s->dyn.iterations,
+                    st->features);
             fprintf(f, "\n    last frame: stretch_max %.3g, penetration_max %.3g cm, kinetic energy %.6g cm2/s2",
                     st->last.stretch_max, st->last.penetration_max, st->last.kinetic_energy);
             if (st->blown_frames) fprintf(f, "; BLOWN UP in %lld frames", (long long)st->blown_frames);

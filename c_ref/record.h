@@ -15,8 +15,8 @@ extern "C" {
 typedef struct {
     int frame;
     hb_stage stage;
-    hb_frame_meta meta;  /* stage, skipped, fused, moved points, median/min/max */
-    double *times_ms;    /* repeat entries (NULL when skipped or fused into the previous) */
+    hb_frame_meta meta; /* stage, skipped, fused, moved points, median/min/max */
+    double *times_ms;   /* repeat entries (NULL when skipped or fused into the previous) */
     int n_times;
     /* simulate: frames advanced (the times are per frame), the features compiled in, the
      * last frame's observables and the frames that blew up */
@@ -24,7 +24,7 @@ typedef struct {
     char features[96];
     hb_observables last;
     int64_t blown_frames;
-    double observe_ms;   /* computing the observables, all frames, apart from the frame times */
+    double observe_ms; /* computing the observables, all frames, apart from the frame times */
 } hb_stage_record;
 
 typedef struct {

@@ -47,7 +47,10 @@ void hb_safe_track(const char *tmp)
     g_armed = 1;
 }
 
-void hb_safe_forget(void) { g_armed = 0; }
+void hb_safe_forget(void)
+{
+    g_armed = 0;
+}
 
 static const char *kind_of(mode_t m)
 {

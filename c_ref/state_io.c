@@ -13,7 +13,11 @@
 #include <time.h>
 #include <unistd.h>
 
-#define FAIL(...) do { snprintf(err, errlen, __VA_ARGS__); goto fail; } while (0)
+#define FAIL(...)                                                                                                      \
+    do {                                                                                                               \
+        snprintf(err, errlen, __VA_ARGS__);                                                                            \
+        goto fail;                                                                                                     \
+    } while (0)
 
 static double now_s(void)
 {
@@ -22,7 +26,10 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void quiet_hdf5(void) { H5Eset_auto2(H5E_DEFAULT, NULL, NULL); }
+static void quiet_hdf5(void)
+{
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
 
 static hid_t str_type(void)
 {
@@ -83,7 +90,10 @@ static int ds_str(hid_t loc, const char *name, hsize_t n, const char **v)
     return rc;
 }
 
-static hid_t make_group(hid_t loc, const char *name) { return H5Gcreate2(loc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT); }
+static hid_t make_group(hid_t loc, const char *name)
+{
+    return H5Gcreate2(loc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+}
 
 /* ---- writer ------------------------------------------------------------------------- */
 struct hb_writer {
@@ -95,7 +105,7 @@ struct hb_writer {
     hb_frame_meta *frames;
     double seconds;
     /* the dynamic model */
-    hid_t velocity;           /* velocity/value, created by the first velocity frame */
+    hid_t velocity; /* velocity/value, created by the first velocity frame */
     int n_vel, vel_cap;
     int64_t *vel_step;
     double *vel_time;
@@ -105,7 +115,10 @@ struct hb_writer {
     double *obs_time;
 };
 
-double hb_writer_seconds(const hb_writer *w) { return w->seconds; }
+double hb_writer_seconds(const hb_writer *w)
+{
+    return w->seconds;
+}
 
 static void writer_free(hb_writer *w)
 {
@@ -137,7 +150,10 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     quiet_hdf5();
     double t0 = now_s();
     hb_writer *w = calloc(1, sizeof *w);
-    if (!w) { snprintf(err, errlen, "out of host memory"); return NULL; }
+    if (!w) {
+        snprintf(err, errlen, "out of host memory");
+        return NULL;
+    }
     w->file = w->value = w->velocity = -1;
     w->scene = *scene;
     w->rows = (uint64_t)scene->n_strands * (uint64_t)scene->points;
@@ -224,8 +240,8 @@ static hid_t create_frames_ds(hid_t loc, const char *name, uint64_t rows, hb_pre
     hid_t space = H5Screate_simple(3, dims, maxdims);
     hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
     H5Pset_chunk(dcpl, 3, chunk);
-    hid_t d = H5Dcreate2(loc, name, prec == HB_FP64 ? H5T_IEEE_F64LE : H5T_IEEE_F32LE, space, H5P_DEFAULT, dcpl,
-                         H5P_DEFAULT);
+    hid_t d =
+        H5Dcreate2(loc, name, prec == HB_FP64 ? H5T_IEEE_F64LE : H5T_IEEE_F32LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     H5Pclose(dcpl);
     H5Sclose(space);
     return d;
@@ -255,7 +271,8 @@ int hb_writer_rest(hb_writer *w, const void *rest, char *err, size_t errlen)
     const int f64 = w->scene.precision == HB_FP64;
     hid_t d = H5Dcreate2(hair, "rest_position", f64 ? H5T_IEEE_F64LE : H5T_IEEE_F32LE, sp, H5P_DEFAULT, H5P_DEFAULT,
                          H5P_DEFAULT);
-    herr_t rc = d < 0 ? -1 : H5Dwrite(d, f64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, rest);
+    herr_t rc =
+        d < 0 ? -1 : H5Dwrite(d, f64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, rest);
     if (rc >= 0 && attr_str(d, "unit", "cm") < 0) rc = -1;
     if (d >= 0) H5Dclose(d);
     H5Sclose(sp);
@@ -307,12 +324,12 @@ oom:
     return -1;
 }
 
-int hb_writer_observables(hb_writer *w, const hb_observables *o, int64_t step, double time, char *err,
-                          size_t errlen)
+int hb_writer_observables(hb_writer *w, const hb_observables *o, int64_t step, double time, char *err, size_t errlen)
 {
     if (w->n_obs == w->obs_cap) {
         int cap = w->obs_cap ? 2 * w->obs_cap : 8;
-        if (resize((void **)&w->obs, cap, sizeof *w->obs) < 0 || resize((void **)&w->obs_step, cap, sizeof *w->obs_step) < 0 ||
+        if (resize((void **)&w->obs, cap, sizeof *w->obs) < 0 ||
+            resize((void **)&w->obs_step, cap, sizeof *w->obs_step) < 0 ||
             resize((void **)&w->obs_time, cap, sizeof *w->obs_time) < 0)
             goto oom;
         w->obs_cap = cap;
@@ -333,7 +350,10 @@ int hb_writer_append(hb_writer *w, const void *frame, const hb_frame_meta *fm, c
     if (w->n_frames == w->cap) {
         int cap = w->cap ? 2 * w->cap : 8;
         hb_frame_meta *f = realloc(w->frames, (size_t)cap * sizeof *f);
-        if (!f) { snprintf(err, errlen, "out of host memory"); return -1; }
+        if (!f) {
+            snprintf(err, errlen, "out of host memory");
+            return -1;
+        }
         w->frames = f;
         w->cap = cap;
     }
@@ -401,13 +421,25 @@ static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
     bad |= attr_i64(p, "shape", d->shape) < 0;
     bad |= attr_i64(p, "collider", d->collider) < 0;
     bad |= attr_i64(p, "drag_declared", d->drag_declared) < 0;
-    const struct { const char *name; double v; } num[] = {
-        {"frame_dt", d->frame_dt}, {"gravity", d->gravity}, {"drag", d->drag}, {"damping", d->damping},
-        {"stretch_compliance", d->stretch_compliance}, {"bend_compliance", d->bend_compliance},
-        {"shape_compliance", d->shape_compliance}, {"shape_range", d->shape_range}, {"ftl_damping", d->ftl_damping},
-        {"collision_margin", d->collision_margin}, {"wind_speed", d->wind_speed},
-        {"gust_amplitude", d->gust_amplitude}, {"gust_frequency", d->gust_frequency},
-        {"gust_wavelength", d->gust_wavelength}, {"motion_amplitude", d->motion_amplitude},
+    const struct {
+        const char *name;
+        double v;
+    } num[] = {
+        {"frame_dt", d->frame_dt},
+        {"gravity", d->gravity},
+        {"drag", d->drag},
+        {"damping", d->damping},
+        {"stretch_compliance", d->stretch_compliance},
+        {"bend_compliance", d->bend_compliance},
+        {"shape_compliance", d->shape_compliance},
+        {"shape_range", d->shape_range},
+        {"ftl_damping", d->ftl_damping},
+        {"collision_margin", d->collision_margin},
+        {"wind_speed", d->wind_speed},
+        {"gust_amplitude", d->gust_amplitude},
+        {"gust_frequency", d->gust_frequency},
+        {"gust_wavelength", d->gust_wavelength},
+        {"motion_amplitude", d->motion_amplitude},
         {"motion_frequency", d->motion_frequency},
     };
     for (size_t i = 0; i < sizeof num / sizeof num[0]; i++) bad |= attr_f64(p, num[i].name, num[i].v) < 0;
@@ -456,12 +488,19 @@ int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errle
     double *f64 = calloc((size_t)F + 1, sizeof *f64);
     int8_t *i8 = calloc((size_t)F + 1, sizeof *i8);
     const char **str = calloc((size_t)F + 1, sizeof *str);
-    if (!i64 || !f64 || !i8 || !str) { snprintf(err, errlen, "out of host memory"); bad = 1; goto out; }
+    if (!i64 || !f64 || !i8 || !str) {
+        snprintf(err, errlen, "out of host memory");
+        bad = 1;
+        goto out;
+    }
 
     {
         hid_t pos = H5Gopen2(w->file, "particles/hair/position", H5P_DEFAULT);
         /* step and time from each frame's record: paper frames at t = 0 (docs/interfaces.md) */
-        for (int f = 0; f < F; f++) { i64[f] = w->frames[f].step; f64[f] = w->frames[f].time; }
+        for (int f = 0; f < F; f++) {
+            i64[f] = w->frames[f].step;
+            f64[f] = w->frames[f].time;
+        }
         bad |= ds_1d(pos, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, (hsize_t)F, i64) < 0;
         bad |= ds_1d(pos, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
         H5Gclose(pos);
@@ -505,8 +544,8 @@ int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errle
     bad |= ds_1d(p, "skipped", H5T_STD_I8LE, H5T_NATIVE_INT8, (hsize_t)F, i8) < 0;
     for (int f = 0; f < F; f++) i64[f] = w->frames[f].moved_points;
     bad |= ds_1d(p, "moved_points", H5T_STD_I64LE, H5T_NATIVE_INT64, (hsize_t)F, i64) < 0;
-#define FRAME_F64(field)                                                                     \
-    for (int f = 0; f < F; f++) f64[f] = w->frames[f].field;                                 \
+#define FRAME_F64(field)                                                                                               \
+    for (int f = 0; f < F; f++) f64[f] = w->frames[f].field;                                                           \
     bad |= ds_1d(p, #field, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)F, f64) < 0;
     FRAME_F64(wind_strength)
     FRAME_F64(wind_angle)
@@ -703,14 +742,18 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
     char model[32] = "", solver[16] = "", motion[16] = "";
     if (read_attr_str(p, "model", model, sizeof model) < 0 || strcmp(model, "dynamic") != 0) {
         if (has_path(f, "particles/hair/rest_position") || has_path(f, "particles/hair/velocity"))
-            return snprintf(err, errlen, "--input %s holds a rest shape or velocities but /parameters/model is not "
-                            "'dynamic'", path), -1;
+            return snprintf(err, errlen,
+                            "--input %s holds a rest shape or velocities but /parameters/model is not "
+                            "'dynamic'",
+                            path),
+                   -1;
         return 0;
     }
     in->dynamic = 1;
     const char *missing = NULL;
     int64_t bend = 0, shape = 0, collider = 1, drag_declared = 0;
-#define NEED(call, name) if (!missing && (call) < 0) missing = name
+#define NEED(call, name)                                                                                               \
+    if (!missing && (call) < 0) missing = name
     NEED(read_attr_str(p, "solver", solver, sizeof solver), "solver");
     NEED(read_attr_str(p, "head_motion", motion, sizeof motion), "head_motion");
     NEED(read_attr(p, "paper_frames", H5T_NATIVE_INT64, &in->paper_frames), "paper_frames");
@@ -720,16 +763,29 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
     NEED(read_attr(p, "shape", H5T_NATIVE_INT64, &shape), "shape");
     NEED(read_attr(p, "collider", H5T_NATIVE_INT64, &collider), "collider");
     NEED(read_attr(p, "drag_declared", H5T_NATIVE_INT64, &drag_declared), "drag_declared");
-    const struct { const char *name; double *v; } num[] = {
-        {"frame_dt", &d->frame_dt}, {"gravity", &d->gravity}, {"drag", &d->drag}, {"damping", &d->damping},
-        {"stretch_compliance", &d->stretch_compliance}, {"bend_compliance", &d->bend_compliance},
-        {"shape_compliance", &d->shape_compliance}, {"shape_range", &d->shape_range},
-        {"ftl_damping", &d->ftl_damping}, {"collision_margin", &d->collision_margin},
-        {"wind_speed", &d->wind_speed}, {"gust_amplitude", &d->gust_amplitude},
-        {"gust_frequency", &d->gust_frequency}, {"gust_wavelength", &d->gust_wavelength},
-        {"motion_amplitude", &d->motion_amplitude}, {"motion_frequency", &d->motion_frequency},
+    const struct {
+        const char *name;
+        double *v;
+    } num[] = {
+        {"frame_dt", &d->frame_dt},
+        {"gravity", &d->gravity},
+        {"drag", &d->drag},
+        {"damping", &d->damping},
+        {"stretch_compliance", &d->stretch_compliance},
+        {"bend_compliance", &d->bend_compliance},
+        {"shape_compliance", &d->shape_compliance},
+        {"shape_range", &d->shape_range},
+        {"ftl_damping", &d->ftl_damping},
+        {"collision_margin", &d->collision_margin},
+        {"wind_speed", &d->wind_speed},
+        {"gust_amplitude", &d->gust_amplitude},
+        {"gust_frequency", &d->gust_frequency},
+        {"gust_wavelength", &d->gust_wavelength},
+        {"motion_amplitude", &d->motion_amplitude},
+        {"motion_frequency", &d->motion_frequency},
     };
-    for (size_t i = 0; i < sizeof num / sizeof num[0]; i++) NEED(read_attr(p, num[i].name, H5T_NATIVE_DOUBLE, num[i].v), num[i].name);
+    for (size_t i = 0; i < sizeof num / sizeof num[0]; i++)
+        NEED(read_attr(p, num[i].name, H5T_NATIVE_DOUBLE, num[i].v), num[i].name);
 #undef NEED
     if (missing) return snprintf(err, errlen, "--input %s: /parameters lacks the attribute '%s'", path, missing), -1;
     d->bend = bend != 0;
@@ -749,23 +805,29 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
         return snprintf(err, errlen, "--input %s holds invalid dynamic parameters: %s", path, why), -1;
     if (in->paper_frames < 1 || in->paper_frames > in->n_frames)
         return snprintf(err, errlen, "--input %s: paper_frames = %lld does not fit its %d frames", path,
-                        (long long)in->paper_frames, in->n_frames), -1;
+                        (long long)in->paper_frames, in->n_frames),
+               -1;
 
     const uint64_t rows = (uint64_t)in->scene.n_strands * (uint64_t)in->scene.points;
     if (!has_path(f, "particles/hair/rest_position") ||
         check_rows(f, "particles/hair/rest_position", 2, rows, in->scene.precision, NULL) < 0)
         return snprintf(err, errlen, "--input %s: a dynamic file needs /particles/hair/rest_position [%llu][3] in %s",
-                        path, (unsigned long long)rows, hb_precision_name(in->scene.precision)), -1;
+                        path, (unsigned long long)rows, hb_precision_name(in->scene.precision)),
+               -1;
     hsize_t nv = 0, ns = 0, nt = 0;
     if (has_path(f, "particles/hair/velocity/value")) {
         if (check_rows(f, "particles/hair/velocity/value", 3, rows, in->scene.precision, &nv) < 0)
             return snprintf(err, errlen, "--input %s: velocity/value must be [frames][%llu][3] in %s", path,
-                            (unsigned long long)rows, hb_precision_name(in->scene.precision)), -1;
+                            (unsigned long long)rows, hb_precision_name(in->scene.precision)),
+                   -1;
         in->vel_step = read_1d(f, "particles/hair/velocity/step", H5T_NATIVE_INT64, sizeof(int64_t), &ns);
         in->vel_time = read_1d(f, "particles/hair/velocity/time", H5T_NATIVE_DOUBLE, sizeof(double), &nt);
         if (!in->vel_step || !in->vel_time || ns != nv || nt != nv)
-            return snprintf(err, errlen, "--input %s: velocity/step and velocity/time need one entry per velocity "
-                            "frame (%llu)", path, (unsigned long long)nv), -1;
+            return snprintf(err, errlen,
+                            "--input %s: velocity/step and velocity/time need one entry per velocity "
+                            "frame (%llu)",
+                            path, (unsigned long long)nv),
+                   -1;
         in->n_vel = (int)nv;
     }
     /* observables: copied into the output when present and consistent */
@@ -781,8 +843,7 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
     if (ok) {
         in->obs = calloc(n1 ? n1 : 1, sizeof *in->obs);
         ok = in->obs != NULL;
-        for (hsize_t i = 0; ok && i < n1; i++)
-            in->obs[i] = (hb_observables){sm[i], pm[i], ke[i], bs[i]};
+        for (hsize_t i = 0; ok && i < n1; i++) in->obs[i] = (hb_observables){sm[i], pm[i], ke[i], bs[i]};
         in->n_obs = (int)n1;
     }
     free(sm);
@@ -790,16 +851,20 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
     free(ke);
     free(bs);
     if (!ok)
-        return snprintf(err, errlen, "--input %s: /observables must hold stretch_max, penetration_max, kinetic_energy "
-                        "and blown_up_strands with one value, step and time each", path), -1;
+        return snprintf(err, errlen,
+                        "--input %s: /observables must hold stretch_max, penetration_max, kinetic_energy "
+                        "and blown_up_strands with one value, step and time each",
+                        path),
+               -1;
     return 0;
 }
 
 int hb_input_read_rest(hb_input *in, void *buf, char *err, size_t errlen)
 {
     hid_t d = H5Dopen2((hid_t)in->hid, "particles/hair/rest_position", H5P_DEFAULT);
-    herr_t rc = d < 0 ? -1 : H5Dread(d, in->scene.precision == HB_FP64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT,
-                                      H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+    herr_t rc = d < 0 ? -1
+                      : H5Dread(d, in->scene.precision == HB_FP64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT, H5S_ALL,
+                                H5S_ALL, H5P_DEFAULT, buf);
     if (d >= 0) H5Dclose(d);
     if (rc < 0) {
         snprintf(err, errlen, "--input: HDF5 could not read the rest shape (truncated file?)");
@@ -820,7 +885,8 @@ int hb_input_read_velocity(hb_input *in, int index, void *buf, char *err, size_t
     hsize_t start[3] = {(hsize_t)index, 0, 0}, count[3] = {1, rows, 3};
     H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
     hid_t ms = H5Screate_simple(3, count, NULL);
-    herr_t rc = H5Dread(d, in->scene.precision == HB_FP64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT, ms, fs, H5P_DEFAULT, buf);
+    herr_t rc =
+        H5Dread(d, in->scene.precision == HB_FP64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT, ms, fs, H5P_DEFAULT, buf);
     H5Sclose(ms);
     H5Sclose(fs);
     H5Dclose(d);
@@ -832,7 +898,12 @@ int hb_input_read_velocity(hb_input *in, int index, void *buf, char *err, size_t
 }
 
 #undef FAIL
-#define FAIL(...) do { snprintf(err, errlen, __VA_ARGS__); hb_input_close(in); return -1; } while (0)
+#define FAIL(...)                                                                                                      \
+    do {                                                                                                               \
+        snprintf(err, errlen, __VA_ARGS__);                                                                            \
+        hb_input_close(in);                                                                                            \
+        return -1;                                                                                                     \
+    } while (0)
 
 int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
 {
@@ -845,14 +916,16 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
     if (f < 0) FAIL("--input %s: HDF5 cannot open it (truncated or damaged?)", path);
     in->hid = f;
     if (!has_path(f, "h5md") || !has_path(f, "particles/hair/position/value") || !has_path(f, "parameters"))
-        FAIL("--input %s is not a hairbench state: it lacks /h5md, /particles/hair/position/value or /parameters", path);
+        FAIL("--input %s is not a hairbench state: it lacks /h5md, /particles/hair/position/value or /parameters",
+             path);
 
     hid_t p = H5Gopen2(f, "parameters", H5P_DEFAULT);
     hb_scene *s = &in->scene;
     char prec[16] = "";
     int bad = 0;
     const char *missing = NULL;
-#define NEED(call, name) if (!missing && (call) < 0) missing = name
+#define NEED(call, name)                                                                                               \
+    if (!missing && (call) < 0) missing = name
     NEED(read_attr(p, "n_strands", H5T_NATIVE_INT64, &s->n_strands), "n_strands");
     NEED(read_attr(p, "points_per_strand", H5T_NATIVE_INT64, &s->points), "points_per_strand");
     NEED(read_attr(p, "seed", H5T_NATIVE_UINT64, &s->seed), "seed");
@@ -870,7 +943,10 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
     }
     if (strcmp(prec, "fp32") == 0) s->precision = HB_FP32;
     else if (strcmp(prec, "fp64") == 0) s->precision = HB_FP64;
-    else { H5Gclose(p); FAIL("--input %s: unknown precision '%s'", path, prec); }
+    else {
+        H5Gclose(p);
+        FAIL("--input %s: unknown precision '%s'", path, prec);
+    }
     char why[HB_ERRLEN];
     if (hb_scene_validate(s, why, sizeof why) != 0) {
         H5Gclose(p);
@@ -892,12 +968,13 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
     if (rank != 3 || dims[2] != 3)
         bad = snprintf(err, errlen, "--input %s: position/value must be [frames][N*P][3] (rank %d)", path, rank);
     else if (dims[1] != rows)
-        bad = snprintf(err, errlen, "--input %s: position/value has %llu rows, but n_strands x points_per_strand = %llu",
-                       path, (unsigned long long)dims[1], (unsigned long long)rows);
+        bad =
+            snprintf(err, errlen, "--input %s: position/value has %llu rows, but n_strands x points_per_strand = %llu",
+                     path, (unsigned long long)dims[1], (unsigned long long)rows);
     else if (!is_float || tsize != hb_real_size(s->precision))
-        bad = snprintf(err, errlen, "--input %s: position/value is not %s floating point as /parameters says", path, prec);
-    else if (dims[0] < 1)
-        bad = snprintf(err, errlen, "--input %s has no frames", path);
+        bad = snprintf(err, errlen, "--input %s: position/value is not %s floating point as /parameters says", path,
+                       prec);
+    else if (dims[0] < 1) bad = snprintf(err, errlen, "--input %s has no frames", path);
     if (bad) {
         H5Gclose(p);
         hb_input_close(in);
@@ -906,7 +983,10 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
     in->n_frames = (int)dims[0];
     hsize_t F = dims[0];
     in->frames = calloc(F, sizeof *in->frames);
-    if (!in->frames) { H5Gclose(p); FAIL("out of host memory"); }
+    if (!in->frames) {
+        H5Gclose(p);
+        FAIL("out of host memory");
+    }
     for (hsize_t i = 0; i < F; i++) {
         in->frames[i].moved_points = -1;
         in->frames[i].wind_strength = in->frames[i].wind_angle = NAN;
@@ -928,8 +1008,8 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
             for (hsize_t i = 0; i < F; i++) in->frames[i].skipped = sk[i];
         if (mv && read_frames_ds(p, "moved_points", H5T_NATIVE_INT64, F, mv) == 0)
             for (hsize_t i = 0; i < F; i++) in->frames[i].moved_points = mv[i];
-#define COPY_F64(name, field)                                                                \
-    if (v && read_frames_ds(p, name, H5T_NATIVE_DOUBLE, F, v) == 0)                          \
+#define COPY_F64(name, field)                                                                                          \
+    if (v && read_frames_ds(p, name, H5T_NATIVE_DOUBLE, F, v) == 0)                                                    \
         for (hsize_t i = 0; i < F; i++) in->frames[i].field = v[i];
         COPY_F64("wind_strength", wind_strength)
         COPY_F64("wind_angle", wind_angle)

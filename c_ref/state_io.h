@@ -18,14 +18,14 @@ extern "C" {
 typedef struct {
     char stage[16];
     char fused[16];
-    char backend[48];      /* "cpu/ref", "cuda/fused", … */
+    char backend[48]; /* "cpu/ref", "cuda/fused", … */
     int skipped;
-    int64_t moved_points;  /* −1 where not a collide frame */
-    double wind_strength;  /* NaN where not a wind frame */
+    int64_t moved_points; /* −1 where not a collide frame */
+    double wind_strength; /* NaN where not a wind frame */
     double wind_angle;
     double median_ms, min_ms, max_ms;
-    int64_t step;          /* /particles/hair/position/step (docs/interfaces.md) */
-    double time;           /* s: 0 for the paper stages' frames, f·Δt for simulated frame f */
+    int64_t step; /* /particles/hair/position/step (docs/interfaces.md) */
+    double time;  /* s: 0 for the paper stages' frames, f·Δt for simulated frame f */
 } hb_frame_meta;
 
 /* Run-wide metadata written as attributes of /parameters. */
@@ -55,8 +55,7 @@ double hb_writer_seconds(const hb_writer *w); /* time spent writing so far */
  * the per-frame observables (kept in memory, written at close). */
 int hb_writer_rest(hb_writer *w, const void *rest, char *err, size_t errlen);
 int hb_writer_velocity(hb_writer *w, const void *v, int64_t step, double time, char *err, size_t errlen);
-int hb_writer_observables(hb_writer *w, const hb_observables *o, int64_t step, double time, char *err,
-                          size_t errlen);
+int hb_writer_observables(hb_writer *w, const hb_observables *o, int64_t step, double time, char *err, size_t errlen);
 
 /* An --input file, validated. */
 typedef struct {

@@ -54,17 +54,17 @@ struct cuda_impl {
     Variant variant;
     int block;
     int64_t N, P;
-    uint64_t bytes;      /* one state [N·P][3] in the run's precision */
-    void *state;         /* paper: canonical; soa, fused: X | Y | Z, each [P][N] */
-    void *saved;         /* a copy of state for repeats (need_save) */
-    void *staging;       /* soa, fused: canonical; load/fetch and the fused intermediate */
+    uint64_t bytes;              /* one state [N·P][3] in the run's precision */
+    void *state;                 /* paper: canonical; soa, fused: X | Y | Z, each [P][N] */
+    void *saved;                 /* a copy of state for repeats (need_save) */
+    void *staging;               /* soa, fused: canonical; load/fetch and the fused intermediate */
     unsigned long long *d_count; /* collide: points changed */
     cudaEvent_t ev0, ev1;
     int have_events;
-    int keep;            /* keep_intermediate(1): fused calls write the wind frame to staging */
-    int inter_valid;     /* staging holds the last fused call's wind frame */
+    int keep;        /* keep_intermediate(1): fused calls write the wind frame to staging */
+    int inter_valid; /* staging holds the last fused call's wind frame */
     char device[256];
-    DynState *dyn;       /* simulate (backend_dyn.cuh); NULL when the run does not simulate */
+    DynState *dyn; /* simulate (backend_dyn.cuh); NULL when the run does not simulate */
 };
 
 double now_ms()
@@ -74,7 +74,10 @@ double now_ms()
     return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
 }
 
-uint64_t sat_add(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
+uint64_t sat_add(uint64_t a, uint64_t b)
+{
+    return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
 
 /* The scene's numbers rounded once to the working precision, exactly as backend_cpu.c's
  * round_scene does: derived values in double, then each rounded once to float. */
@@ -102,16 +105,14 @@ void round_scene(cuda_impl *c, const hb_scene *s)
     c->m32 = hb::model_from<hb_model_f32, float>(f);
 }
 
-template <typename T>
-PointMajor<T> point_major(const cuda_impl *c, void *base)
+template <typename T> PointMajor<T> point_major(const cuda_impl *c, void *base)
 {
     T *p = (T *)base;
     const int64_t np = c->N * c->P;
     return PointMajor<T>{p, p + np, p + 2 * np, c->N};
 }
 
-template <typename T>
-StrandMajor<T> strand_major(const cuda_impl *c, void *base)
+template <typename T> StrandMajor<T> strand_major(const cuda_impl *c, void *base)
 {
     return StrandMajor<T>{(T *)base, c->P};
 }
@@ -159,8 +160,11 @@ int setup_inner(hb_backend *b, cuda_impl *c, const hb_options *o, int need_save,
     c->P = o->scene.points;
     c->bytes = hb_state_bytes(&o->scene);
     const char *v = o->variant ? o->variant : "fused";
-    c->variant = strcmp(v, "paper") == 0 ? V_PAPER : strcmp(v, "soa") == 0 ? V_SOA : strcmp(v, "strand") == 0 ? V_STRAND
-                 : strcmp(v, "warp") == 0 ? V_WARP : V_FUSED;
+    c->variant = strcmp(v, "paper") == 0    ? V_PAPER
+                 : strcmp(v, "soa") == 0    ? V_SOA
+                 : strcmp(v, "strand") == 0 ? V_STRAND
+                 : strcmp(v, "warp") == 0   ? V_WARP
+                                            : V_FUSED;
     c->block = o->block_size;
     b->block_size = c->block;
     b->threads = 0;
@@ -190,10 +194,11 @@ int setup_inner(hb_backend *b, cuda_impl *c, const hb_options *o, int need_save,
     }
     const uint64_t avail = hb_host_memory_available();
     if (avail && driver_bytes > avail) {
-        snprintf(err, errlen,
-                 "the state needs %.2f GB of host memory (%lld strands x %lld points, %s) but only %.2f GB is available",
-                 1e-9 * (double)driver_bytes, (long long)c->N, (long long)c->P, hb_precision_name(o->scene.precision),
-                 1e-9 * (double)avail);
+        snprintf(
+            err, errlen,
+            "the state needs %.2f GB of host memory (%lld strands x %lld points, %s) but only %.2f GB is available",
+            1e-9 * (double)driver_bytes, (long long)c->N, (long long)c->P, hb_precision_name(o->scene.precision),
+            1e-9 * (double)avail);
         return HB_EXIT_MEMORY;
     }
 
@@ -230,8 +235,8 @@ int cuda_load(hb_backend *b, const void *canonical, double *ms, char *err, size_
         c->inter_valid = 0;
         HB_CUDA(cudaMemcpy(c->staging, canonical, (size_t)c->bytes, cudaMemcpyHostToDevice));
         if (c->scene.precision == HB_FP32)
-            HB_CUDA_AS(hb::launch_to_point_major<float>((const float *)c->staging, point_major<float>(c, c->state), c->N,
-                                                        c->P, 0),
+            HB_CUDA_AS(hb::launch_to_point_major<float>((const float *)c->staging, point_major<float>(c, c->state),
+                                                        c->N, c->P, 0),
                        "the canonical-to-point-major kernel launch");
         else
             HB_CUDA_AS(hb::launch_to_point_major<double>((const double *)c->staging, point_major<double>(c, c->state),
@@ -252,8 +257,9 @@ int cuda_fetch(hb_backend *b, void *canonical, double *ms, char *err, size_t err
     } else {
         c->inter_valid = 0; /* the staging buffer is about to be overwritten */
         if (c->scene.precision == HB_FP32)
-            HB_CUDA_AS(hb::launch_to_canonical<float>(point_major<float>(c, c->state), (float *)c->staging, c->N, c->P, 0),
-                       "the point-major-to-canonical kernel launch");
+            HB_CUDA_AS(
+                hb::launch_to_canonical<float>(point_major<float>(c, c->state), (float *)c->staging, c->N, c->P, 0),
+                "the point-major-to-canonical kernel launch");
         else
             HB_CUDA_AS(
                 hb::launch_to_canonical<double>(point_major<double>(c, c->state), (double *)c->staging, c->N, c->P, 0),
@@ -269,8 +275,9 @@ int cuda_fetch_intermediate(hb_backend *b, void *canonical, char *err, size_t er
 {
     cuda_impl *c = (cuda_impl *)b->impl;
     if (!c->inter_valid) {
-        snprintf(err, errlen, "internal error: no intermediate state to fetch (the last stage call was not a fused "
-                              "wind+collide that kept it)");
+        snprintf(err, errlen,
+                 "internal error: no intermediate state to fetch (the last stage call was not a fused "
+                 "wind+collide that kept it)");
         return -1;
     }
     HB_CUDA(cudaMemcpy(canonical, c->staging, (size_t)c->bytes, cudaMemcpyDeviceToHost));
@@ -454,7 +461,8 @@ void cuda_describe(hb_backend *b, char *device, size_t dlen, char *driver, size_
         int count = 0;
         cudaDeviceProp p;
         if (c && c->device[0]) snprintf(device, dlen, "%s", c->device);
-        else if (cudaGetDeviceCount(&count) == cudaSuccess && count > 0 && cudaGetDeviceProperties(&p, 0) == cudaSuccess)
+        else if (cudaGetDeviceCount(&count) == cudaSuccess && count > 0 &&
+                 cudaGetDeviceProperties(&p, 0) == cudaSuccess)
             snprintf(device, dlen, "%s", p.name);
         else snprintf(device, dlen, "unknown CUDA device");
     }

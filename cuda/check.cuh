@@ -23,17 +23,16 @@
 #include <stddef.h>
 #include <stdio.h>
 
-static inline int hb_cuda_fail(cudaError_t e, const char *what, const char *file, int line, char *err,
-                               size_t errlen)
+static inline int hb_cuda_fail(cudaError_t e, const char *what, const char *file, int line, char *err, size_t errlen)
 {
     if (err && errlen) snprintf(err, errlen, "CUDA error in %s (%s:%d): %s", what, file, line, cudaGetErrorString(e));
     return -1;
 }
 
-#define HB_CUDA_AS(call, what)                                                                  \
-    do {                                                                                        \
-        cudaError_t hb_e_ = (call);                                                             \
-        if (hb_e_ != cudaSuccess) return hb_cuda_fail(hb_e_, (what), __FILE__, __LINE__, err, errlen); \
+#define HB_CUDA_AS(call, what)                                                                                         \
+    do {                                                                                                               \
+        cudaError_t hb_e_ = (call);                                                                                    \
+        if (hb_e_ != cudaSuccess) return hb_cuda_fail(hb_e_, (what), __FILE__, __LINE__, err, errlen);                 \
     } while (0)
 
 #define HB_CUDA(call) HB_CUDA_AS(call, #call)

@@ -51,15 +51,29 @@ constexpr int kMaxThreads = 1024;
 #define HB_PREFETCH_F64 1
 #endif
 template <typename T> struct Prefetch;
-template <> struct Prefetch<float> { static constexpr int value = HB_PREFETCH_F32; };
-template <> struct Prefetch<double> { static constexpr int value = HB_PREFETCH_F64; };
+template <> struct Prefetch<float> {
+    static constexpr int value = HB_PREFETCH_F32;
+};
+template <> struct Prefetch<double> {
+    static constexpr int value = HB_PREFETCH_F64;
+};
 
 template <class Layout> struct Depth;
-template <typename T> struct Depth<StrandMajor<T>> { static constexpr int value = 0; }; /* paper: untuned */
-template <typename T> struct Depth<PointMajor<T>> { static constexpr int value = Prefetch<T>::value; };
+template <typename T> struct Depth<StrandMajor<T>> {
+    static constexpr int value = 0;
+}; /* paper: untuned */
+template <typename T> struct Depth<PointMajor<T>> {
+    static constexpr int value = Prefetch<T>::value;
+};
 
-__device__ __forceinline__ int64_t first_strand() { return (int64_t)blockIdx.x * blockDim.x + threadIdx.x; }
-__device__ __forceinline__ int64_t grid_stride() { return (int64_t)gridDim.x * blockDim.x; }
+__device__ __forceinline__ int64_t first_strand()
+{
+    return (int64_t)blockIdx.x * blockDim.x + threadIdx.x;
+}
+__device__ __forceinline__ int64_t grid_stride()
+{
+    return (int64_t)gridDim.x * blockDim.x;
+}
 
 /* Adds every thread's v into *out exactly: a shuffle reduction in each warp, the warps'
  * sums through shared memory, then one 64-bit atomicAdd for the block. Every thread of
@@ -93,25 +107,24 @@ unsigned grid_for(int64_t N, int block)
 /* a, b, c: StrandMajor: the canonical array (b, c unused); PointMajor: X, Y, Z. */
 
 template <typename T, class Layout>
-__global__ void HB_STAGE_BOUNDS
-    k_init(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c, const int64_t N)
+__global__ void HB_STAGE_BOUNDS k_init(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c,
+                                       const int64_t N)
 {
     const Layout lay = Layout::make(a, b, c, N, m.points);
     for (int64_t i = first_strand(); i < N; i += grid_stride()) init_strand(m, lay, i);
 }
 
 template <typename T, class Layout>
-__global__ void HB_STAGE_BOUNDS
-    k_wind(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c, const int64_t N)
+__global__ void HB_STAGE_BOUNDS k_wind(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c,
+                                       const int64_t N)
 {
     const Layout lay = Layout::make(a, b, c, N, m.points);
     for (int64_t i = first_strand(); i < N; i += grid_stride()) wind_strand<Depth<Layout>::value>(m, lay, i);
 }
 
 template <typename T, class Layout>
-__global__ void HB_STAGE_BOUNDS
-    k_collide(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c, const int64_t N,
-              unsigned long long *__restrict__ count)
+__global__ void HB_STAGE_BOUNDS k_collide(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c,
+                                          const int64_t N, unsigned long long *__restrict__ count)
 {
     const Layout lay = Layout::make(a, b, c, N, m.points);
     unsigned long long changed = 0;
@@ -121,9 +134,9 @@ __global__ void HB_STAGE_BOUNDS
 }
 
 template <typename T, bool Keep>
-__global__ void HB_STAGE_BOUNDS
-    k_wind_collide(const Model<T> m, T *__restrict__ X, T *__restrict__ Y, T *__restrict__ Z, const int64_t N,
-                   T *__restrict__ inter, unsigned long long *__restrict__ count)
+__global__ void HB_STAGE_BOUNDS k_wind_collide(const Model<T> m, T *__restrict__ X, T *__restrict__ Y,
+                                               T *__restrict__ Z, const int64_t N, T *__restrict__ inter,
+                                               unsigned long long *__restrict__ count)
 {
     const PointMajor<T> lay = {X, Y, Z, N};
     const StrandMajor<T> keep = {inter, m.points};
@@ -135,17 +148,14 @@ __global__ void HB_STAGE_BOUNDS
 
 /* ---- the launchers ---------------------------------------------------------------------- */
 /* The three arrays a stage kernel takes: strand-major passes its one array first. */
-template <typename T>
-struct Arrays {
+template <typename T> struct Arrays {
     T *a, *b, *c;
 };
-template <typename T>
-Arrays<T> arrays_of(const StrandMajor<T> &lay)
+template <typename T> Arrays<T> arrays_of(const StrandMajor<T> &lay)
 {
     return {lay.s, nullptr, nullptr};
 }
-template <typename T>
-Arrays<T> arrays_of(const PointMajor<T> &lay)
+template <typename T> Arrays<T> arrays_of(const PointMajor<T> &lay)
 {
     return {lay.X, lay.Y, lay.Z};
 }
@@ -177,12 +187,12 @@ cudaError_t launch_wind_collide(const Model<T> &m, const PointMajor<T> &lay, int
     return cudaGetLastError();
 }
 
-#define HB_INSTANTIATE(T)                                                                                      \
-    template cudaError_t launch_stage<T, StrandMajor<T>>(hb_stage, const Model<T> &, const StrandMajor<T> &, int64_t, \
-                                                         unsigned long long *, int, cudaStream_t);                \
-    template cudaError_t launch_stage<T, PointMajor<T>>(hb_stage, const Model<T> &, const PointMajor<T> &, int64_t,   \
-                                                        unsigned long long *, int, cudaStream_t);                 \
-    template cudaError_t launch_wind_collide<T>(const Model<T> &, const PointMajor<T> &, int64_t, T *,            \
+#define HB_INSTANTIATE(T)                                                                                              \
+    template cudaError_t launch_stage<T, StrandMajor<T>>(hb_stage, const Model<T> &, const StrandMajor<T> &, int64_t,  \
+                                                         unsigned long long *, int, cudaStream_t);                     \
+    template cudaError_t launch_stage<T, PointMajor<T>>(hb_stage, const Model<T> &, const PointMajor<T> &, int64_t,    \
+                                                        unsigned long long *, int, cudaStream_t);                      \
+    template cudaError_t launch_wind_collide<T>(const Model<T> &, const PointMajor<T> &, int64_t, T *,                 \
                                                 unsigned long long *, int, cudaStream_t);
 
 HB_INSTANTIATE(float)

@@ -59,8 +59,8 @@ __global__ void __launch_bounds__(kTile *kRows)
 
 template <typename T>
 __global__ void __launch_bounds__(kTile *kRows)
-    k_to_canonical(const T *__restrict__ X, const T *__restrict__ Y, const T *__restrict__ Z,
-                   T *__restrict__ canon, const int64_t N, const int64_t P)
+    k_to_canonical(const T *__restrict__ X, const T *__restrict__ Y, const T *__restrict__ Z, T *__restrict__ canon,
+                   const int64_t N, const int64_t P)
 {
     __shared__ T tile[kTile][kTile + 1];
     const int64_t C = 3 * P;
@@ -108,7 +108,6 @@ template cudaError_t launch_to_point_major<float>(const float *, const PointMajo
 template cudaError_t launch_to_point_major<double>(const double *, const PointMajor<double> &, int64_t, int64_t,
                                                    cudaStream_t);
 template cudaError_t launch_to_canonical<float>(const PointMajor<float> &, float *, int64_t, int64_t, cudaStream_t);
-template cudaError_t launch_to_canonical<double>(const PointMajor<double> &, double *, int64_t, int64_t,
-                                                 cudaStream_t);
+template cudaError_t launch_to_canonical<double>(const PointMajor<double> &, double *, int64_t, int64_t, cudaStream_t);
 
 } /* namespace hb */

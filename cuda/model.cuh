@@ -45,15 +45,13 @@ namespace hb {
 
 /* The scene's numbers rounded once to the working precision (the fields of hb_model_f32/
  * hb_model_f64, as backend_cpu.c's round_scene makes them). Passed to kernels by value. */
-template <typename T>
-struct Model {
+template <typename T> struct Model {
     uint64_t seed;
     int64_t points;
     T head_radius, hair_offset, face_margin, seg_len, wind_strength, wind_angle;
 };
 
-template <typename M, typename T>
-inline Model<T> model_from(const M &m)
+template <typename M, typename T> inline Model<T> model_from(const M &m)
 {
     Model<T> r;
     r.seed = m.seed;
@@ -68,12 +66,30 @@ inline Model<T> model_from(const M &m)
 }
 
 /* ---- the math functions: the float overloads for float, the double ones for double ---- */
-HB_HD float m_sqrt(float x) { return sqrtf(x); }
-HB_HD double m_sqrt(double x) { return sqrt(x); }
-HB_HD float m_asin(float x) { return asinf(x); }
-HB_HD double m_asin(double x) { return asin(x); }
-HB_HD float m_atan2(float y, float x) { return atan2f(y, x); }
-HB_HD double m_atan2(double y, double x) { return atan2(y, x); }
+HB_HD float m_sqrt(float x)
+{
+    return sqrtf(x);
+}
+HB_HD double m_sqrt(double x)
+{
+    return sqrt(x);
+}
+HB_HD float m_asin(float x)
+{
+    return asinf(x);
+}
+HB_HD double m_asin(double x)
+{
+    return asin(x);
+}
+HB_HD float m_atan2(float y, float x)
+{
+    return atan2f(y, x);
+}
+HB_HD double m_atan2(double y, double x)
+{
+    return atan2(y, x);
+}
 /* sin and cos of one argument. On the device one call, sincosf/sincos, shares the range
  * reduction; on an H200 it gave exactly sinf(x) and cosf(x) for every float |x| <= 16, and
  * sin/cos for 2e8 sampled doubles, in all three builds (docs/cuda.md). On the host sinf
@@ -97,18 +113,32 @@ HB_HD void m_sincos(double x, double *s, double *c)
 #endif
 }
 /* the machine epsilon EPS of model.c: 2^-23 / 2^-52 */
-HB_HD float m_eps(float) { return 0x1p-23f; }
-HB_HD double m_eps(double) { return 0x1p-52; }
+HB_HD float m_eps(float)
+{
+    return 0x1p-23f;
+}
+HB_HD double m_eps(double)
+{
+    return 0x1p-52;
+}
 
 /* PI_R, HALF_PI_R, TWO_PI_R of model_impl.h: the double literals rounded to T */
-template <typename T> HB_HD T pi_r() { return (T)3.14159265358979323846; }
-template <typename T> HB_HD T half_pi_r() { return (T)1.57079632679489661923; }
-template <typename T> HB_HD T two_pi_r() { return (T)6.28318530717958647692; }
+template <typename T> HB_HD T pi_r()
+{
+    return (T)3.14159265358979323846;
+}
+template <typename T> HB_HD T half_pi_r()
+{
+    return (T)1.57079632679489661923;
+}
+template <typename T> HB_HD T two_pi_r()
+{
+    return (T)6.28318530717958647692;
+}
 
 /* ---- layouts ------------------------------------------------------------------------- */
 /* A layout hands out a view of one strand: x(k), y(k), z(k) are references to point k. */
-template <typename T>
-struct StrandMajor {
+template <typename T> struct StrandMajor {
     T *s;      /* [N][P][3] */
     int64_t P; /* points per strand */
     struct View {
@@ -126,8 +156,7 @@ struct StrandMajor {
     HB_HD static StrandMajor make(T *a, T *, T *, int64_t, int64_t P) { return StrandMajor{a, P}; }
 };
 
-template <typename T>
-struct PointMajor {
+template <typename T> struct PointMajor {
     T *X, *Y, *Z; /* each [P][N] */
     int64_t N;    /* strands */
     struct View {
@@ -147,14 +176,13 @@ struct PointMajor {
 
 /* ---- DESIGN §3 "Stage init — drape" (model_impl.h: hb_drape_strand) ------------------------------ */
 /* The root (x0, py, pz) is already stored; writes points 1 … P−1. */
-template <typename T, class V>
-HB_HD void drape(const Model<T> &m, const V &s, const T x0, T py, T pz)
+template <typename T, class V> HB_HD void drape(const Model<T> &m, const V &s, const T x0, T py, T pz)
 {
     const int64_t P = m.points;
     const T ell = m.seg_len;
-    const T r0 = m_sqrt(py * py + pz * pz); /* head circle of the slice */
-    const T rc = r0 + m.hair_offset;        /* shell circle */
-    T theta = m_atan2(py, pz);              /* (−π, π] … */
+    const T r0 = m_sqrt(py * py + pz * pz);               /* head circle of the slice */
+    const T rc = r0 + m.hair_offset;                      /* shell circle */
+    T theta = m_atan2(py, pz);                            /* (−π, π] … */
     if (theta <= -half_pi_r<T>()) theta += two_pi_r<T>(); /* … taken in (−π/2, 3π/2] */
     /* A root on the lower back (θ0 > π) hangs straight down from the root. */
     int hanging = theta > pi_r<T>();
@@ -209,8 +237,7 @@ HB_HD void drape(const Model<T> &m, const V &s, const T x0, T py, T pz)
 }
 
 /* ---- DESIGN §3 "Stage init": roots (model_impl.h: place_root) then the drape ----------- */
-template <typename T, class Layout>
-HB_HD void init_strand(const Model<T> &m, const Layout &lay, int64_t i)
+template <typename T, class Layout> HB_HD void init_strand(const Model<T> &m, const Layout &lay, int64_t i)
 {
     const typename Layout::View s = lay.strand(i);
     uint32_t r[4];
@@ -238,8 +265,7 @@ HB_HD void init_strand(const Model<T> &m, const Layout &lay, int64_t i)
 }
 
 /* Re-drapes strand i from its stored root (model.h: hb_drape_strand). */
-template <typename T, class Layout>
-HB_HD void drape_strand(const Model<T> &m, const Layout &lay, int64_t i)
+template <typename T, class Layout> HB_HD void drape_strand(const Model<T> &m, const Layout &lay, int64_t i)
 {
     const typename Layout::View s = lay.strand(i);
     drape(m, s, s.x(0), s.y(0), s.z(0));
@@ -247,8 +273,7 @@ HB_HD void drape_strand(const Model<T> &m, const Layout &lay, int64_t i)
 
 /* ---- DESIGN §3 "Stage wind": one step of the walk (model_impl.h: hb_wind_strand) ------- */
 /* Keeps the predecessor before the wind (oy, oz) and after it (ny, nz). */
-template <typename T>
-struct WindWalk {
+template <typename T> struct WindWalk {
     T ell, w, psi, last;
     T oy, oz; /* the predecessor before the wind */
     T ny, nz; /* the predecessor after the wind (the root never moves) */
@@ -288,8 +313,7 @@ struct WindWalk {
 };
 
 /* ---- DESIGN §3 "Stage collide": one step of the walk (model_impl.h: hb_collide_strand) -- */
-template <typename T>
-struct CollideWalk {
+template <typename T> struct CollideWalk {
     T ell, rc, inner2;
     T py, pz; /* the predecessor, after collision */
     int moved;
@@ -374,8 +398,7 @@ struct CollideWalk {
  * step's code, and the queue is indexed with constants only, so it stays in registers).
  * The addresses advance by the layout's stride instead of being recomputed from k.
  * Loading early is safe: point k + D is not written before its turn. */
-template <int D, typename T, class V, class F>
-HB_HD void walk_points(const V &s, const int64_t P, F &&f)
+template <int D, typename T, class V, class F> HB_HD void walk_points(const V &s, const int64_t P, F &&f)
 {
     if constexpr (D == 0) {
         for (int64_t k = 1; k < P; k++) {
@@ -414,8 +437,7 @@ HB_HD void walk_points(const V &s, const int64_t P, F &&f)
 /* ---- the per-strand stages ------------------------------------------------------------ */
 /* Wind on strand i, in place. The caller does not call it when w = 0 (the identity).
  * D: the prefetch depth of walk_points. */
-template <int D, typename T, class Layout>
-HB_HD void wind_strand(const Model<T> &m, const Layout &lay, int64_t i)
+template <int D, typename T, class Layout> HB_HD void wind_strand(const Model<T> &m, const Layout &lay, int64_t i)
 {
     const int64_t P = m.points;
     if (P < 2) return;
@@ -429,8 +451,7 @@ HB_HD void wind_strand(const Model<T> &m, const Layout &lay, int64_t i)
 }
 
 /* Collide on strand i, in place; returns the number of points changed. */
-template <int D, typename T, class Layout>
-HB_HD int64_t collide_strand(const Model<T> &m, const Layout &lay, int64_t i)
+template <int D, typename T, class Layout> HB_HD int64_t collide_strand(const Model<T> &m, const Layout &lay, int64_t i)
 {
     const int64_t P = m.points;
     if (P < 2) return 0;
