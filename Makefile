@@ -128,13 +128,15 @@ cuda:
 	@echo "note: nvcc not found: CUDA binaries not built (install the CUDA toolkit to build them)"
 endif
 
-# setup runs first, then the build (a recursive make, so that -j cannot build before it)
+# setup runs first, then the build (a recursive make, so that -j cannot build before it),
+# on every core: the CUDA binaries and the C reference's feature instantiations take minutes
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 test: setup
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory -j$(JOBS) all
 	$(RUN_PY) -m pytest tests -q -ra
 
 bench: setup
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory -j$(JOBS) all
 	$(RUN_PY) -m harness bench $(if $(OUT),--out $(OUT))
 
 # REPORT_FROM: the results to render (default results/default; the committed reference run

@@ -20,13 +20,15 @@ extern "C" {
 
 typedef struct hb_backend hb_backend;
 
-/* One kernel variant of a backend: its name, the stages it runs (bit 1 << hb_stage) and
- * a one-line summary. Declared once, in the backend; `--list-variants` prints the table
- * as JSON and the harness reads it from there. */
+/* One kernel variant of a backend: its name, the stages it runs (bit 1 << hb_stage), a
+ * one-line summary and the most points per strand it can simulate (0: no limit). Declared
+ * once, in the backend; `--list-variants` prints the table as JSON and the harness reads it
+ * from there. */
 typedef struct {
     const char *name;
     unsigned stages;
     const char *summary;
+    int64_t max_points;
 } hb_variant;
 
 /* The result of running one stage (or a fused group) once. */
@@ -78,6 +80,13 @@ struct hb_backend {
     /* The observables of the current state (docs/model.md §3.8). */
     int (*dyn_observe)(hb_backend *b, hb_observables *obs, char *err, size_t errlen);
     int (*dyn_fetch_velocity)(hb_backend *b, void *canonical, char *err, size_t errlen);
+    /* Optional (NULL: not measured): advance the current state by n frames back to back, as
+     * an application's frame loop would (each frame's tables uploaded and its kernel
+     * launched, no observables, no fetch); *ms = host wall time per frame after one
+     * synchronisation at the end; *graph_ms the same n frames captured once as a CUDA graph
+     * and replayed (NaN where not measured). */
+    int (*dyn_loop)(hb_backend *b, const hb_dyn_frame *plans, int n, double *ms, double *graph_ms, char *err,
+                    size_t errlen);
     /* Descriptions for the metadata. */
     void (*describe)(hb_backend *b, char *device, size_t dlen, char *driver, size_t vlen);
     void (*teardown)(hb_backend *b);

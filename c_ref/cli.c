@@ -140,7 +140,9 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
     fprintf(f, "\nthe simulate stage (docs/model.md §3; a feature left undeclared is not evaluated):\n"
                "  --frames F           frames to simulate (default 1)\n"
                "  --output-every K     write every K-th simulated frame; the last always (default 1)\n"
-               "  --velocities W       last | all: write the velocities of the last or of every written frame\n");
+               "  --velocities W       last | all: write the velocities of the last or of every written frame\n"
+               "  --frame-loop         after the run, time F more frames back to back as an application's frame\n"
+               "                       loop would (launches and the frame's tables included; cuda only)\n");
     for (size_t i = 0; i < N_DYN_FLAGS; i++) {
         char name[64];
         snprintf(name, sizeof name, "%s%s", dyn_flags[i].flag, dyn_flags[i].kind == DF_SWITCH ? "" : " V");
@@ -293,6 +295,10 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         }
         if (strcmp(a, "--end-to-end") == 0) {
             o->end_to_end = 1;
+            continue;
+        }
+        if (strcmp(a, "--frame-loop") == 0) {
+            o->frame_loop = 1;
             continue;
         }
         if (strcmp(a, "--measure-bandwidth") == 0) {

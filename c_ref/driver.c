@@ -86,7 +86,9 @@ static int list_variants(const hb_backend *b)
                 printf("%s\"%s\"", first ? "" : ", ", hb_stage_name(all[i]));
                 first = 0;
             }
-        printf("], \"summary\": \"%s\"}", v->summary);
+        printf("], \"summary\": \"%s\"", v->summary);
+        if (v->max_points > 0) printf(", \"max_points\": %lld", (long long)v->max_points);
+        printf("}");
     }
     printf("], \"solvers\": [\"xpbd\", \"ftl\"], \"features\": [");
     for (unsigned i = 0; (1u << i) < HB_F_COUNT; i++) {
@@ -206,7 +208,8 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
     const int need_save = o->repeat > 1 || o->warmup > 0;
     int64_t gf0 = 0, paper_frames = frame;
     void *rest = malloc(bytes), *vel = NULL;
-    hb_dyn_frame plan;
+    hb_dyn_frame plan, *plans = NULL;
+    int64_t n_plans = 0;
     memset(&plan, 0, sizeof plan);
     int status = HB_EXIT_OK;
 #define FAIL_IF(cond, st)                                                                                              \
@@ -316,8 +319,30 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
     }
     sr->observe_ms = observe_ms;
     hb_time_stats(sr->times_ms, sr->n_times, &sr->meta.median_ms, &sr->meta.min_ms, &sr->meta.max_ms);
+    sr->loop_ms = sr->loop_graph_ms = NAN;
+    if (o->frame_loop) {
+        /* F more frames from the final state, after everything above is written: the frames
+         * an application would run next, their tables made here as for any frame */
+        if (o->frames > INT32_MAX || gf0 + 2 * o->frames > (INT64_C(1) << 53) / d->substeps) {
+            snprintf(err, errlen, "--frame-loop: --frames %lld is too many frames to loop over", (long long)o->frames);
+            FAIL_IF(1, HB_EXIT_USAGE);
+        }
+        plans = calloc((size_t)o->frames, sizeof *plans);
+        for (int64_t j = 0; plans && j < o->frames; j++) {
+            if (hb_dyn_frame_alloc(&plans[j], d->substeps) != 0) break;
+            n_plans = j + 1;
+            hb_dyn_frame_plan(s, (gf0 + o->frames + j) * d->substeps, &plans[j]);
+        }
+        if (n_plans < o->frames) {
+            snprintf(err, errlen, "out of host memory for the frame loop's tables");
+            FAIL_IF(1, HB_EXIT_MEMORY);
+        }
+        FAIL_IF(b->dyn_loop(b, plans, (int)o->frames, &sr->loop_ms, &sr->loop_graph_ms, err, errlen), HB_EXIT_RUNTIME);
+    }
 out:
 #undef FAIL_IF
+    for (int64_t j = 0; j < n_plans; j++) hb_dyn_frame_free(&plans[j]);
+    free(plans);
     hb_dyn_frame_free(&plan);
     free(rest);
     free(vel);
@@ -422,6 +447,19 @@ int hb_main(int argc, char **argv, hb_backend *b)
             snprintf(err, sizeof err, "--end-to-end is not measured for simulate: its frames are timed one by one");
             CHECK(1, HB_EXIT_USAGE);
         }
+        if (var->max_points > 0 && o.scene.points > var->max_points) {
+            snprintf(err, sizeof err,
+                     "--points %lld: the %s variant %s simulates at most %lld points a strand (see --list-variants)",
+                     (long long)o.scene.points, b->name, var->name, (long long)var->max_points);
+            CHECK(1, HB_EXIT_USAGE);
+        }
+        if (o.frame_loop && !b->dyn_loop) {
+            snprintf(err, sizeof err, "--frame-loop is measured by the cuda backend only");
+            CHECK(1, HB_EXIT_USAGE);
+        }
+    } else if (o.frame_loop) {
+        snprintf(err, sizeof err, "--frame-loop needs simulate in --stages");
+        CHECK(1, HB_EXIT_USAGE);
     }
     if (o.input) {
         if (o.input_frame >= run.in.n_frames) {

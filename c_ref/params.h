@@ -87,6 +87,7 @@ typedef struct {
     int64_t frames;        /* simulate: frames to advance (F) */
     int64_t output_every;  /* simulate: write every K-th frame (the last always) */
     int all_velocities;    /* simulate: write the velocities of every written frame */
+    int frame_loop;        /* simulate: also time F more frames back to back (backend dyn_loop) */
     uint64_t dyn_given;    /* which dynamic flags were given: bit i = entry i of cli.c's table */
     /* which scene flags the user gave explicitly (for --input consistency checks) */
     unsigned given;

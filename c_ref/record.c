@@ -158,6 +158,10 @@ void hb_record_json(FILE *f, const hb_record *r)
             json_num(f, (double)s->n_strands * (double)s->points * (double)d->substeps / (1e-3 * st->meta.median_ms));
             fputs(", \"observe_ms\": ", f);
             json_num(f, st->observe_ms);
+            fputs(", \"frame_loop_ms\": ", f);
+            json_num(f, st->loop_ms);
+            fputs(", \"frame_loop_graph_ms\": ", f);
+            json_num(f, st->loop_graph_ms);
             fputs(", \"last_observables\": {\"stretch_max\": ", f);
             json_num(f, st->last.stretch_max);
             fputs(", \"penetration_max\": ", f);

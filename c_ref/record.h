@@ -24,7 +24,8 @@ typedef struct {
     char features[96];
     hb_observables last;
     int64_t blown_frames;
-    double observe_ms; /* computing the observables, all frames, apart from the frame times */
+    double observe_ms;             /* computing the observables, all frames, apart from the frame times */
+    double loop_ms, loop_graph_ms; /* --frame-loop: per frame, back to back / as a graph (NaN: not run) */
 } hb_stage_record;
 
 typedef struct {

@@ -9,8 +9,9 @@
  *          separate kernels; wind and collide never touch X.
  *   fused  (default) point-major; a wind immediately followed by collide in the stage list
  *          runs as one kernel (run_stage returns consumed = 2).
- *   strand, warp  the variants that also run simulate (the dynamic model; backend_dyn.cuh):
- *          strand point-major as soa, warp strand-major as paper for the other stages.
+ *   strand, warp, warpreg  the variants that also run simulate (the dynamic model;
+ *          backend_dyn.cuh): strand point-major as soa, warp and warpreg strand-major as
+ *          paper for the other stages.
  *
  * Memory on the device: the state (one state's bytes; point-major: X|Y|Z in one
  * allocation), for soa and fused a canonical staging buffer of the same size (load/fetch
@@ -44,7 +45,14 @@ using hb::StrandMajor;
 
 namespace {
 
-enum Variant { V_PAPER = 0, V_SOA = 1, V_FUSED = 2, V_STRAND = 3, V_WARP = 4 }; /* strand, warp: backend_dyn.cuh */
+enum Variant {
+    V_PAPER = 0,
+    V_SOA = 1,
+    V_FUSED = 2,
+    V_STRAND = 3,
+    V_WARP = 4,
+    V_WARPREG = 5
+}; /* strand, warp, warpreg: backend_dyn.cuh */
 struct DynState;
 
 struct cuda_impl {
@@ -160,11 +168,12 @@ int setup_inner(hb_backend *b, cuda_impl *c, const hb_options *o, int need_save,
     c->P = o->scene.points;
     c->bytes = hb_state_bytes(&o->scene);
     const char *v = o->variant ? o->variant : "fused";
-    c->variant = strcmp(v, "paper") == 0    ? V_PAPER
-                 : strcmp(v, "soa") == 0    ? V_SOA
-                 : strcmp(v, "strand") == 0 ? V_STRAND
-                 : strcmp(v, "warp") == 0   ? V_WARP
-                                            : V_FUSED;
+    c->variant = strcmp(v, "paper") == 0     ? V_PAPER
+                 : strcmp(v, "soa") == 0     ? V_SOA
+                 : strcmp(v, "strand") == 0  ? V_STRAND
+                 : strcmp(v, "warp") == 0    ? V_WARP
+                 : strcmp(v, "warpreg") == 0 ? V_WARPREG
+                                             : V_FUSED;
     c->block = o->block_size;
     b->block_size = c->block;
     b->threads = 0;
@@ -489,14 +498,18 @@ void cuda_teardown(hb_backend *b)
 
 #define CUDA_PAPER_STAGES ((1u << HB_STAGE_INIT) | (1u << HB_STAGE_COLLIDE) | (1u << HB_STAGE_WIND))
 const hb_variant cuda_variants[] = {
-    {"paper", CUDA_PAPER_STAGES, "the paper's scheme: strand-major, one thread per strand, one kernel per stage"},
-    {"soa", CUDA_PAPER_STAGES, "point-major structure of arrays, one thread per strand, one kernel per stage"},
-    {"fused", CUDA_PAPER_STAGES, "point-major, wind and the collide after it in one kernel"},
+    {"paper", CUDA_PAPER_STAGES, "the paper's scheme: strand-major, one thread per strand, one kernel per stage", 0},
+    {"soa", CUDA_PAPER_STAGES, "point-major structure of arrays, one thread per strand, one kernel per stage", 0},
+    {"fused", CUDA_PAPER_STAGES, "point-major, wind and the collide after it in one kernel", 0},
     {"strand", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
-     "point-major like soa; simulate: one thread per strand, a frame's substeps in one launch"},
+     "point-major like soa; simulate: one thread per strand, a frame's substeps in one launch", 0},
     {"warp", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
-     "strand-major like paper; simulate: one warp per strand, a lane per point, the frame in shared memory"},
-    {NULL, 0, NULL},
+     "strand-major like paper; simulate: one warp per strand, a lane per point, the frame in shared memory", 0},
+    {"warpreg", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
+     "strand-major like paper; simulate: one warp per strand, lane k holds point k in registers (at most 32 points), "
+     "neighbours through warp shuffles",
+     hb::dyn::kWarpregMaxPoints},
+    {NULL, 0, NULL, 0},
 };
 
 } /* namespace */
@@ -542,5 +555,6 @@ int main(int argc, char **argv)
     b.dyn_frame = cuda_dyn_frame;
     b.dyn_observe = cuda_dyn_observe;
     b.dyn_fetch_velocity = cuda_dyn_fetch_velocity;
+    b.dyn_loop = cuda_dyn_loop;
     return hb_main(argc, argv, &b);
 }

@@ -11,6 +11,8 @@
  *   warp    one warp per strand; the state, velocities and rest shape canonical [N][P][3]
  *           (as paper: a strand's 3P reals are contiguous, so the warp's loads coalesce),
  *           bend rest lengths [N][P−2]; x, v, p, λ, d of the frame in shared memory.
+ *   warpreg as warp in memory; lane k holds point k's x, v, p, λ, d and rest in registers
+ *           for the whole frame, neighbours exchange through shuffles (P ≤ 32).
  *
  * Device memory of simulate: velocities, rest shape, bend rest lengths, a saved copy of the
  * velocities for repeats, the strand variant's scratch, the frame's tables ([S][9] + [S])
@@ -38,18 +40,23 @@ struct DynState {
 
 int dyn_is_strand_major(const cuda_impl *c)
 {
-    return c->variant == V_PAPER || c->variant == V_WARP;
+    return c->variant == V_PAPER || c->variant == V_WARP || c->variant == V_WARPREG;
+}
+
+int dyn_is_warp(const cuda_impl *c)
+{
+    return c->variant == V_WARP || c->variant == V_WARPREG;
 }
 
 /* The variant's layouts of the state (and of velocities and rest shape). */
 hbd::Layout dyn_layout(const cuda_impl *c)
 {
-    if (c->variant == V_WARP) return hbd::Layout{3 * c->P, 3, 1};
+    if (dyn_is_warp(c)) return hbd::Layout{3 * c->P, 3, 1};
     return hbd::Layout{1, c->N, c->N * c->P};
 }
 hbd::Layout1 dyn_bend_layout(const cuda_impl *c)
 {
-    if (c->variant == V_WARP) return hbd::Layout1{c->P - 2 > 0 ? c->P - 2 : 0, 1};
+    if (dyn_is_warp(c)) return hbd::Layout1{c->P - 2 > 0 ? c->P - 2 : 0, 1};
     return hbd::Layout1{1, c->N};
 }
 
@@ -71,7 +78,7 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
     int on = 0;
     for (int i = 0; i < o->n_stages; i++) on |= o->stages[i] == HB_STAGE_SIMULATE;
     if (!on) return 0;
-    if (c->variant != V_STRAND && c->variant != V_WARP) {
+    if (c->variant != V_STRAND && !dyn_is_warp(c)) {
         snprintf(err, errlen, "internal error: variant without simulate reached the simulate setup");
         return -1;
     }
@@ -107,6 +114,14 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
         const int64_t resident = (int64_t)prop.multiProcessorCount * prop.maxThreadsPerMultiProcessor;
         d->grid = dyn_strand_grid(N, c->block, resident);
         need = sat_add(need, (uint64_t)d->grid * (uint64_t)c->block * 9u * (uint64_t)P * rs);
+    } else if (c->variant == V_WARPREG) {
+        if (P > hbd::kWarpregMaxPoints) { /* the driver refuses it first, from the variant table */
+            snprintf(err, errlen, "internal error: warpreg with %lld points", (long long)P);
+            return -1;
+        }
+        const int wpb = c->block / 32;
+        const int64_t g = (N + wpb - 1) / wpb;
+        d->grid = (int)(g > 2147483647 ? 2147483647 : g);
     } else {
         const int wpb = c->block / 32;
         const int64_t g = (N + wpb - 1) / wpb;
@@ -201,7 +216,7 @@ int dyn_restore(cuda_impl *c, char *err, size_t errlen)
 template <typename T>
 int dyn_upload(cuda_impl *c, void *dst, const void *canonical, const char *what, char *err, size_t errlen)
 {
-    if (c->variant == V_WARP) {
+    if (dyn_is_warp(c)) {
         HB_CUDA_AS(cudaMemcpy(dst, canonical, (size_t)c->bytes, cudaMemcpyHostToDevice), what);
         return 0;
     }
@@ -244,15 +259,28 @@ int cuda_dyn_load(hb_backend *b, const void *velocity, const void *rest, char *e
                                          : dyn_load_t<double>(c, velocity, rest, err, errlen);
 }
 
-template <typename T> cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m)
+/* One frame's kernel on `stream`, with the frame's tables q [S][9] and ph [S] on the device. */
+template <typename T>
+cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m, const void *q, const void *ph, cudaStream_t stream)
 {
     DynState *d = c->dyn;
     if (c->variant == V_STRAND)
-        return hbd::launch_frame_strand<T>(m, (const T *)d->q, (const T *)d->ph, (T *)c->state, (T *)d->vel,
+        return hbd::launch_frame_strand<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel,
                                            (const T *)d->rest, (const T *)d->bend_rest, (T *)d->scratch, c->N, d->grid,
-                                           c->block, 0);
-    return hbd::launch_frame_warp<T>(m, (const T *)d->q, (const T *)d->ph, (T *)c->state, (T *)d->vel,
-                                     (const T *)d->rest, (const T *)d->bend_rest, c->N, d->grid, c->block, 0);
+                                           c->block, stream);
+    if (c->variant == V_WARPREG)
+        return hbd::launch_frame_warpreg<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel,
+                                            (const T *)d->rest, (const T *)d->bend_rest, c->N, d->grid, c->block,
+                                            stream);
+    return hbd::launch_frame_warp<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, (const T *)d->rest,
+                                     (const T *)d->bend_rest, c->N, d->grid, c->block, stream);
+}
+
+const char *dyn_launch_name(const cuda_impl *c)
+{
+    return c->variant == V_STRAND    ? "the simulate kernel launch (strand)"
+           : c->variant == V_WARPREG ? "the simulate kernel launch (warpreg)"
+                                     : "the simulate kernel launch (warp)";
 }
 
 int cuda_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen)
@@ -272,8 +300,9 @@ int cuda_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, cha
     HB_CUDA(cudaMemcpyAsync(d->ph, fp32 ? (const void *)f->phase32 : (const void *)f->phase64, (size_t)d->S * rs,
                             cudaMemcpyHostToDevice, 0));
     HB_CUDA(cudaEventRecord(c->ev0, 0));
-    const cudaError_t e = fp32 ? dyn_launch<float>(c, d->m32) : dyn_launch<double>(c, d->m64);
-    HB_CUDA_AS(e, c->variant == V_STRAND ? "the simulate kernel launch (strand)" : "the simulate kernel launch (warp)");
+    const cudaError_t e =
+        fp32 ? dyn_launch<float>(c, d->m32, d->q, d->ph, 0) : dyn_launch<double>(c, d->m64, d->q, d->ph, 0);
+    HB_CUDA_AS(e, dyn_launch_name(c));
     HB_CUDA(cudaEventRecord(c->ev1, 0));
     HB_CUDA_AS(cudaEventSynchronize(c->ev1), "the simulate kernel (cudaEventSynchronize)");
     float ms = 0.0f;
@@ -311,7 +340,7 @@ int cuda_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, size_t er
 {
     cuda_impl *c = (cuda_impl *)b->impl;
     DynState *d = c->dyn;
-    if (c->variant == V_WARP) {
+    if (dyn_is_warp(c)) {
         HB_CUDA(cudaMemcpy(canonical, d->vel, (size_t)c->bytes, cudaMemcpyDeviceToHost));
         return 0;
     }
@@ -323,5 +352,83 @@ int cuda_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, size_t er
         HB_CUDA_AS(hb::launch_to_canonical<double>(point_major<double>(c, d->vel), (double *)c->staging, c->N, c->P, 0),
                    "the point-major-to-canonical kernel launch (velocities)");
     HB_CUDA(cudaMemcpy(canonical, c->staging, (size_t)c->bytes, cudaMemcpyDeviceToHost));
+    return 0;
+}
+
+/* ---- --frame-loop: frames back to back, as an application runs them ---------------------- */
+struct LoopRes {
+    void *hq = nullptr, *hp = nullptr, *dq = nullptr, *dp = nullptr;
+    cudaStream_t st = nullptr;
+    cudaGraph_t g = nullptr;
+    cudaGraphExec_t ge = nullptr;
+    ~LoopRes()
+    { /* errors ignored: after a fault the context may be unusable */
+        if (ge) cudaGraphExecDestroy(ge);
+        if (g) cudaGraphDestroy(g);
+        if (st) cudaStreamDestroy(st);
+        if (hq) cudaFreeHost(hq);
+        if (hp) cudaFreeHost(hp);
+        if (dq) cudaFree(dq);
+        if (dp) cudaFree(dp);
+    }
+};
+
+/* Enqueues n frames on r.st: each frame's tables from pinned host memory, then its kernel. */
+cudaError_t dyn_enqueue_loop(cuda_impl *c, LoopRes &r, int n, size_t tq, size_t tp)
+{
+    const int fp32 = c->scene.precision == HB_FP32;
+    for (int i = 0; i < n; i++) {
+        char *dq = (char *)r.dq + (size_t)i * tq, *dp = (char *)r.dp + (size_t)i * tp;
+        cudaError_t e = cudaMemcpyAsync(dq, (char *)r.hq + (size_t)i * tq, tq, cudaMemcpyHostToDevice, r.st);
+        if (e == cudaSuccess) e = cudaMemcpyAsync(dp, (char *)r.hp + (size_t)i * tp, tp, cudaMemcpyHostToDevice, r.st);
+        if (e == cudaSuccess)
+            e = fp32 ? dyn_launch<float>(c, c->dyn->m32, dq, dp, r.st)
+                     : dyn_launch<double>(c, c->dyn->m64, dq, dp, r.st);
+        if (e != cudaSuccess) return e;
+    }
+    return cudaSuccess;
+}
+
+int cuda_dyn_loop(hb_backend *b, const hb_dyn_frame *plans, int n, double *ms, double *graph_ms, char *err,
+                  size_t errlen)
+{
+    cuda_impl *c = (cuda_impl *)b->impl;
+    DynState *d = c->dyn;
+    const int fp32 = c->scene.precision == HB_FP32;
+    const size_t rs = fp32 ? sizeof(float) : sizeof(double);
+    const size_t tq = (size_t)d->S * 9u * rs, tp = (size_t)d->S * rs;
+    LoopRes r;
+    HB_CUDA(cudaMallocHost(&r.hq, tq * (size_t)n));
+    HB_CUDA(cudaMallocHost(&r.hp, tp * (size_t)n));
+    HB_CUDA(cudaMalloc(&r.dq, tq * (size_t)n));
+    HB_CUDA(cudaMalloc(&r.dp, tp * (size_t)n));
+    for (int i = 0; i < n; i++) {
+        memcpy((char *)r.hq + (size_t)i * tq, fp32 ? (const void *)plans[i].q32 : (const void *)plans[i].q64, tq);
+        memcpy((char *)r.hp + (size_t)i * tp, fp32 ? (const void *)plans[i].phase32 : (const void *)plans[i].phase64,
+               tp);
+    }
+    HB_CUDA(cudaStreamCreateWithFlags(&r.st, cudaStreamNonBlocking));
+    HB_CUDA(cudaDeviceSynchronize());
+    /* launched one by one: a warm-up pass, then the timed one */
+    for (int pass = 0; pass < 2; pass++) {
+        const double t0 = now_ms();
+        HB_CUDA_AS(dyn_enqueue_loop(c, r, n, tq, tp), dyn_launch_name(c));
+        HB_CUDA_AS(cudaStreamSynchronize(r.st), "the frame loop (cudaStreamSynchronize)");
+        *ms = (now_ms() - t0) / (double)n;
+    }
+    /* the same n frames captured once as a graph: a warm-up replay, then the timed one */
+    HB_CUDA(cudaStreamBeginCapture(r.st, cudaStreamCaptureModeThreadLocal));
+    const cudaError_t ce = dyn_enqueue_loop(c, r, n, tq, tp);
+    const cudaError_t ee = cudaStreamEndCapture(r.st, &r.g);
+    HB_CUDA_AS(ce, "capturing the frame loop");
+    HB_CUDA_AS(ee, "cudaStreamEndCapture (the frame loop)");
+    HB_CUDA(cudaGraphInstantiate(&r.ge, r.g, 0));
+    HB_CUDA(cudaGraphUpload(r.ge, r.st));
+    for (int pass = 0; pass < 2; pass++) {
+        const double t0 = now_ms();
+        HB_CUDA(cudaGraphLaunch(r.ge, r.st));
+        HB_CUDA_AS(cudaStreamSynchronize(r.st), "the frame loop's graph (cudaStreamSynchronize)");
+        *graph_ms = (now_ms() - t0) / (double)n;
+    }
     return 0;
 }

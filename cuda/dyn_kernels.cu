@@ -114,10 +114,191 @@ __global__ void __launch_bounds__(kMaxThreads) k_warp(DModel<T> m, const T *__re
     }
 }
 
+/* ---- the warpreg variant: one warp per strand, lane k holds point k (P ≤ 32) in registers ----
+ * The same per-point math as frame_body (dyn_model.cuh's scalar helpers), in the same
+ * order; a constraint between neighbouring points runs on the lane of its higher point,
+ * which reads the other end with a shuffle and sends it the step (dl, n) back, so the
+ * moved point computes its own p − dl·n exactly as the reference does. Within a group of
+ * §3.6 no two constraints share a point, so each lane takes at most one step per group. */
+constexpr unsigned kFull = 0xffffffffu;
+template <typename T> __device__ __forceinline__ T from_prev(T v)
+{
+    return __shfl_up_sync(kFull, v, 1);
+}
+template <typename T> __device__ __forceinline__ T from_next(T v)
+{
+    return __shfl_down_sync(kFull, v, 1);
+}
+
+/* A distance step of one lane, to be sent to a neighbour. */
+template <typename T> struct Step {
+    int on;
+    T dl, n0, n1, n2;
+};
+template <typename T> __device__ __forceinline__ Step<T> step_from_prev(const Step<T> &s)
+{
+    return Step<T>{from_prev(s.on), from_prev(s.dl), from_prev(s.n0), from_prev(s.n1), from_prev(s.n2)};
+}
+template <typename T> __device__ __forceinline__ Step<T> step_from_next(const Step<T> &s)
+{
+    return Step<T>{from_next(s.on), from_next(s.dl), from_next(s.n0), from_next(s.n1), from_next(s.n2)};
+}
+template <typename T> __device__ __forceinline__ void move_minus(const Step<T> &s, T &p0, T &p1, T &p2)
+{
+    p0 = p0 - s.dl * s.n0;
+    p1 = p1 - s.dl * s.n1;
+    p2 = p2 - s.dl * s.n2;
+}
+template <typename T> __device__ __forceinline__ void move_plus(const Step<T> &s, T &p0, T &p1, T &p2)
+{
+    p0 = p0 + s.dl * s.n0;
+    p1 = p1 + s.dl * s.n1;
+    p2 = p2 + s.dl * s.n2;
+}
+
+template <typename T, class Feat>
+__global__ void __launch_bounds__(kMaxThreads)
+    k_warpreg(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
+              const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N)
+{
+    const Feat has = MakeFeat<Feat>::make(m.features);
+    const int k = (int)(threadIdx.x & 31u), w = (int)(threadIdx.x >> 5), wpb = (int)(blockDim.x >> 5);
+    const int P = (int)m.points, K = (int)m.shape_count;
+    const bool on = k < P, inner = on && k >= 1;
+    const bool shaped = has(HB_F_SHAPE) && k >= 1 && k <= K;
+    const bool need_rest = (has(HB_F_MOTION) && k == 0) || shaped;
+    const bool bends = has(HB_F_BEND) && k >= 1 && k + 1 < P;
+    const bool xpbd = m.solver == HB_SOLVER_XPBD;
+    const T h = m.h;
+    /* the loop bound is the same for every lane of a warp: whole warps take each strand */
+    for (int64_t i = (int64_t)blockIdx.x * wpb + w; i < N; i += (int64_t)gridDim.x * wpb) {
+        const int64_t at = i * 3 * (int64_t)P + 3 * k;
+        T x0 = 0, x1 = 0, x2 = 0, v0 = 0, v1 = 0, v2 = 0, r0 = 0, r1 = 0, r2 = 0, br = 0;
+        if (on) {
+            x0 = x[at];
+            x1 = x[at + 1];
+            x2 = x[at + 2];
+            v0 = v[at];
+            v1 = v[at + 1];
+            v2 = v[at + 2];
+        }
+        if (need_rest) {
+            r0 = rest[at];
+            r1 = rest[at + 1];
+            r2 = rest[at + 2];
+        }
+        if (bends) br = bend_rest[i * (int64_t)(P - 2) + (k - 1)];
+        T p0 = x0, p1 = x1, p2 = x2, d0 = 0, d1 = 0, d2 = 0;
+        for (int64_t j = 0; j < m.substeps; j++) {
+            const T *q = qtab + 9 * j;
+            /* 1. root on the head, then p0 = x0 */
+            if (k == 0) {
+                if (has(HB_F_MOTION)) root_step(q, r0, r1, r2, h, x0, x1, x2, v0, v1, v2);
+                p0 = x0;
+                p1 = x1;
+                p2 = x2;
+            }
+            /* 2. velocities and the prediction */
+            if (inner) velocity_predict(m, has, has(HB_F_GUST) ? phtab[j] : (T)0, x0, x1, x2, v0, v1, v2, p0, p1, p2);
+            /* 3. constraints; the multipliers of this lane's stretch (k−1, k), bend (k−1, k+1)
+             * and shape k start the substep at 0 */
+            T ls = 0, lb = 0, lg = 0;
+            auto stretch = [&](int parity) { /* stretch (k−1, k) with k ≡ parity (mod 2) */
+                                             const T a0 = from_prev(p0), a1 = from_prev(p1), a2 = from_prev(p2);
+                                             Step<T> s{0, 0, 0, 0, 0};
+                                             if (inner && (k & 1) == parity) {
+                                                 s.on = distance_step(a0, a1, a2, p0, p1, p2, k - 1 != 0, m.seg_len,
+                                                                      m.stretch_at, ls, s.dl, s.n0, s.n1, s.n2);
+                                                 if (s.on) move_plus(s, p0, p1, p2);
+                                             }
+                                             const Step<T> r =
+                                                 step_from_next(s); /* this lane is the lower end of lane k+1's */
+                                             if (r.on && k >= 1 && k < 31) move_minus(r, p0, p1, p2);
+            };
+            auto bend = [&](int parity) { /* bend (k−1, k+1) with ⌊(k−1)/2⌋ ≡ parity (mod 2) */
+                                          const T a0 = from_prev(p0), a1 = from_prev(p1), a2 = from_prev(p2);
+                                          const T b0 = from_next(p0), b1 = from_next(p1), b2 = from_next(p2);
+                                          Step<T> s{0, 0, 0, 0, 0};
+                                          if (bends && (((k - 1) >> 1) & 1) == parity)
+                                              s.on = distance_step(a0, a1, a2, b0, b1, b2, k - 1 != 0, br, m.bend_at,
+                                                                   lb, s.dl, s.n0, s.n1, s.n2);
+                                          const Step<T> lo =
+                                              step_from_next(s); /* lane k+1's constraint: this lane is its lower end */
+                                          const Step<T> hi =
+                                              step_from_prev(s); /* lane k−1's constraint: this lane is its upper end */
+                                          if (lo.on && k >= 1 && k < 31) move_minus(lo, p0, p1, p2);
+                                          if (hi.on && k >= 1) move_plus(hi, p0, p1, p2);
+            };
+            auto shape = [&]() {
+                if (!shaped) return;
+                T t[3];
+                if (has(HB_F_MOTION)) rotate(q, r0, r1, r2, t);
+                else {
+                    t[0] = r0;
+                    t[1] = r1;
+                    t[2] = r2;
+                }
+                shape_pull(p0, p1, p2, t, m.shape_at, lg);
+            };
+            if (xpbd) {
+                for (int64_t it = 0; it < m.iterations; it++) {
+                    stretch(1);
+                    stretch(0);
+                    if (has(HB_F_BEND)) {
+                        bend(0);
+                        bend(1);
+                    }
+                    if (has(HB_F_SHAPE)) shape();
+                    if (has(HB_F_COLLIDE) && inner) collide_sphere(p0, p1, p2, m.collide_r);
+                }
+            } else {
+                for (int64_t it = 0; it < m.iterations; it++) {
+                    if (has(HB_F_BEND)) {
+                        bend(0);
+                        bend(1);
+                    }
+                    if (has(HB_F_SHAPE)) shape();
+                }
+                /* §3.7 follow the leader, k ascending: lane kk follows lane kk−1's corrected point */
+                for (int kk = 1; kk < P; kk++) {
+                    const T a0 = __shfl_sync(kFull, p0, kk - 1), a1 = __shfl_sync(kFull, p1, kk - 1),
+                            a2 = __shfl_sync(kFull, p2, kk - 1);
+                    if (k == kk) follow(a0, a1, a2, p0, p1, p2, m.seg_len, has(HB_F_COLLIDE), m.collide_r, d0, d1, d2);
+                }
+            }
+            /* 4. velocities from the motion (ftl: less s·d(k+1)/h), then the positions */
+            T e0 = 0, e1 = 0, e2 = 0;
+            if (!xpbd) {
+                e0 = from_next(d0);
+                e1 = from_next(d1);
+                e2 = from_next(d2);
+            }
+            if (inner) {
+                const bool corr = !xpbd && k + 1 < P;
+                v0 = update_velocity(p0, x0, h, corr, m.ftl_s, e0);
+                v1 = update_velocity(p1, x1, h, corr, m.ftl_s, e1);
+                v2 = update_velocity(p2, x2, h, corr, m.ftl_s, e2);
+                x0 = p0;
+                x1 = p1;
+                x2 = p2;
+            }
+        }
+        if (on) {
+            x[at] = x0;
+            x[at + 1] = x1;
+            x[at + 2] = x2;
+            v[at] = v0;
+            v[at + 1] = v1;
+            v[at + 2] = v2;
+        }
+    }
+}
+
 /* ---- the dispatch tables ---- */
 template <typename T>
 using StrandFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, const T *, T *, int64_t);
 template <typename T> using WarpFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, const T *, int64_t);
+/* k_warp and k_warpreg share a signature */
 
 template <typename T, unsigned F> constexpr StrandFn<T> strand_entry()
 {
@@ -132,9 +313,17 @@ template <typename T, unsigned F> constexpr WarpFn<T> warp_entry()
     else return &k_warp<T, DynF>;
 }
 
+template <typename T, unsigned F> constexpr WarpFn<T> warpreg_entry()
+{
+    if constexpr (!valid_mask(F)) return nullptr;
+    else if constexpr (specialised_mask(F)) return &k_warpreg<T, StaticF<F>>;
+    else return &k_warpreg<T, DynF>;
+}
+
 template <typename T, unsigned... Fs> struct Tables {
     static constexpr StrandFn<T> strand[sizeof...(Fs)] = {strand_entry<T, Fs>()...};
     static constexpr WarpFn<T> warp[sizeof...(Fs)] = {warp_entry<T, Fs>()...};
+    static constexpr WarpFn<T> warpreg[sizeof...(Fs)] = {warpreg_entry<T, Fs>()...};
 };
 template <typename T, unsigned... Fs> Tables<T, Fs...> tables_of(std::integer_sequence<unsigned, Fs...>);
 template <typename T> using TablesT = decltype(tables_of<T>(std::make_integer_sequence<unsigned, HB_F_COUNT>()));
@@ -208,6 +397,16 @@ cudaError_t launch_frame_warp(const DModel<T> &m, const T *q, const T *phase, T 
 }
 
 template <typename T>
+cudaError_t launch_frame_warpreg(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
+                                 const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream)
+{
+    if (!valid_mask(m.features) || m.points > kWarpregMaxPoints) return cudaErrorInvalidValue;
+    const WarpFn<T> fn = TablesT<T>::warpreg[m.features];
+    fn<<<grid, block, 0, stream>>>(m, q, phase, x, v, rest, bend_rest, N);
+    return cudaGetLastError();
+}
+
+template <typename T>
 cudaError_t launch_bend_rest(const T *rest, Layout rl, T *out, Layout1 bl, int64_t N, int64_t P, cudaStream_t stream)
 {
     k_bend_rest<T><<<grid_for(N, 256), 256, 0, stream>>>(rest, rl, out, bl, N, P);
@@ -227,6 +426,8 @@ cudaError_t launch_observe(const ObsScene &sc, const T *x, const T *v, Layout la
                                                 const T *, T *, int64_t, int, int, cudaStream_t);                      \
     template cudaError_t launch_frame_warp<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *, const T *, \
                                               int64_t, int, int, cudaStream_t);                                        \
+    template cudaError_t launch_frame_warpreg<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,         \
+                                                 const T *, int64_t, int, int, cudaStream_t);                          \
     template size_t warp_smem_bytes<T>(int64_t);                                                                       \
     template cudaError_t prepare_warp<T>(unsigned, size_t);                                                            \
     template cudaError_t launch_bend_rest<T>(const T *, Layout, T *, Layout1, int64_t, int64_t, cudaStream_t);         \

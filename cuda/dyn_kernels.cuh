@@ -98,6 +98,14 @@ template <typename T>
 cudaError_t launch_frame_warp(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                               const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream);
 template <typename T> size_t warp_smem_bytes(int64_t P);
+
+/* The warpreg variant: one warp per strand, lane k holds point k in registers and
+ * neighbours exchange through warp shuffles; x, v, rest canonical [N][P][3], bend_rest
+ * [N][P−2] as the warp variant. P ≤ kWarpregMaxPoints. */
+constexpr int64_t kWarpregMaxPoints = 32;
+template <typename T>
+cudaError_t launch_frame_warpreg(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
+                                 const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream);
 /* Allows the warp kernel of this feature set `bytes` of dynamic shared memory a block (the
  * opt-in above 48 KB). */
 template <typename T> cudaError_t prepare_warp(unsigned features, size_t bytes);

@@ -166,17 +166,38 @@ template <typename T> HB_DHD void rotate(const T *q, T a0, T a1, T a2, T *r)
     r[2] = q[6] * a0 + q[7] * a1 + q[8] * a2;
 }
 
-/* distance constraint between point a and point b of `p` (dynamics_impl.h distance) */
-template <typename T> HB_DHD void distance(const Arr<T> &p, int64_t ia, int64_t ib, int move_a, T r, T at, T &lambda)
+/* The math of the constraints and steps on scalars, once: the kernels that hold a strand in
+ * memory (frame_body below) and the one that holds a point per lane in registers
+ * (cuda/dyn_kernels.cu k_warpreg) both call these, so every variant does the same
+ * operations in the same order. */
+
+/* §3.5 distance constraint between a and b (dynamics_impl.h distance): the multiplier step.
+ * Returns false when |e| = 0 (nothing moves, λ unchanged); else the caller moves
+ * a ← a − dl·n (unless a is the root) and b ← b + dl·n. */
+template <typename T>
+HB_DHD bool distance_step(T ax, T ay, T az, T bx, T by, T bz, int move_a, T r, T at, T &lambda, T &dl, T &nx, T &ny,
+                          T &nz)
 {
-    const T ex = p(ib, 0) - p(ia, 0), ey = p(ib, 1) - p(ia, 1), ez = p(ib, 2) - p(ia, 2);
+    const T ex = bx - ax, ey = by - ay, ez = bz - az;
     const T len = d_sqrt(ex * ex + ey * ey + ez * ez);
-    if (len == (T)0) return;
+    if (len == (T)0) return false;
     const T c = len - r;
     const T wsum = move_a ? (T)2 : (T)1;
-    const T dl = (-c - at * lambda) / (wsum + at);
+    dl = (-c - at * lambda) / (wsum + at);
     lambda = lambda + dl;
-    const T nx = ex / len, ny = ey / len, nz = ez / len;
+    nx = ex / len;
+    ny = ey / len;
+    nz = ez / len;
+    return true;
+}
+
+/* distance constraint between point a and point b of `p` */
+template <typename T> HB_DHD void distance(const Arr<T> &p, int64_t ia, int64_t ib, int move_a, T r, T at, T &lambda)
+{
+    T dl, nx, ny, nz;
+    if (!distance_step(p(ia, 0), p(ia, 1), p(ia, 2), p(ib, 0), p(ib, 1), p(ib, 2), move_a, r, at, lambda, dl, nx, ny,
+                       nz))
+        return;
     if (move_a) {
         p(ia, 0) = p(ia, 0) - dl * nx;
         p(ia, 1) = p(ia, 1) - dl * ny;
@@ -187,16 +208,17 @@ template <typename T> HB_DHD void distance(const Arr<T> &p, int64_t ia, int64_t 
     p(ib, 2) = p(ib, 2) + dl * nz;
 }
 
-template <typename T> HB_DHD void shape_pull(const Arr<T> &p, int64_t k, const T *t, T at, T &lambda)
+/* §3.5 shape: a zero-length spring from (p0, p1, p2) to the target t (dynamics_impl.h shape_pull). */
+template <typename T> HB_DHD void shape_pull(T &p0, T &p1, T &p2, const T *t, T at, T &lambda)
 {
-    const T ex = p(k, 0) - t[0], ey = p(k, 1) - t[1], ez = p(k, 2) - t[2];
+    const T ex = p0 - t[0], ey = p1 - t[1], ez = p2 - t[2];
     const T c = d_sqrt(ex * ex + ey * ey + ez * ez);
     if (c == (T)0) return;
     const T dl = (-c - at * lambda) / ((T)1 + at);
     lambda = lambda + dl;
-    p(k, 0) = p(k, 0) + dl * (ex / c);
-    p(k, 1) = p(k, 1) + dl * (ey / c);
-    p(k, 2) = p(k, 2) + dl * (ez / c);
+    p0 = p0 + dl * (ex / c);
+    p1 = p1 + dl * (ey / c);
+    p2 = p2 + dl * (ez / c);
 }
 
 /* head collision on a point held in three scalars */
@@ -214,6 +236,83 @@ template <typename T> HB_DHD void collide_sphere(T &p0, T &p1, T &p2, T rc)
     p0 = p0 * sc;
     p1 = p1 * sc;
     p2 = p2 * sc;
+}
+
+/* §3.4 step 1: the root on the head, x0 ← Q·X̄0, v0 ← (x0_new − x0_old)/h. */
+template <typename T> HB_DHD void root_step(const T *q, T r0, T r1, T r2, T h, T &x0, T &x1, T &x2, T &v0, T &v1, T &v2)
+{
+    T r[3];
+    rotate(q, r0, r1, r2, r);
+    v0 = (r[0] - x0) / h;
+    x0 = r[0];
+    v1 = (r[1] - x1) / h;
+    x1 = r[1];
+    v2 = (r[2] - x2) / h;
+    x2 = r[2];
+}
+
+/* §3.4 step 2 for one point k ≥ 1: the velocity, implicit in drag and damping, then the
+ * prediction p = x + h·v. */
+template <typename T, class Feat>
+HB_DHD void velocity_predict(const DModel<T> &m, Feat has, T phase, T x0, T x1, T x2, T &v0, T &v1, T &v2, T &p0, T &p1,
+                             T &p2)
+{
+    const T h = m.h;
+    T vx = v0, vy = v1, vz = v2;
+    if (has(HB_F_WIND)) {
+        T gam = (T)1;
+        if (has(HB_F_GUST)) gam = (T)1 + m.gust * d_sin(phase - m.kappa * (m.dir_y * x1 + m.dir_z * x2));
+        vy = vy + h * (m.gravity_y + m.wind_y * gam);
+        vz = vz + h * (m.wind_z * gam);
+    } else {
+        vy = vy + h * m.gravity_y;
+    }
+    if (has(HB_F_DRAG)) {
+        vx = vx / m.den;
+        vy = vy / m.den;
+        vz = vz / m.den;
+    }
+    v0 = vx;
+    v1 = vy;
+    v2 = vz;
+    p0 = x0 + h * vx;
+    p1 = x1 + h * vy;
+    p2 = x2 + h * vz;
+}
+
+/* §3.7 one follow-the-leader step: (p0, p1, p2) follows its corrected predecessor a; d is
+ * the correction before the collision, then the collision (if on) moves the point. */
+template <typename T>
+HB_DHD void follow(T a0, T a1, T a2, T &p0, T &p1, T &p2, T seg, bool collide, T rc, T &d0, T &d1, T &d2)
+{
+    const T ex = p0 - a0, ey = p1 - a1, ez = p2 - a2;
+    const T len = d_sqrt(ex * ex + ey * ey + ez * ez);
+    T nq0, nq1, nq2;
+    if (len > (T)0) {
+        nq0 = a0 + seg * (ex / len);
+        nq1 = a1 + seg * (ey / len);
+        nq2 = a2 + seg * (ez / len);
+    } else {
+        nq0 = a0;
+        nq1 = a1 - seg;
+        nq2 = a2;
+    }
+    d0 = nq0 - p0;
+    d1 = nq1 - p1;
+    d2 = nq2 - p2;
+    if (collide) collide_sphere(nq0, nq1, nq2, rc);
+    p0 = nq0;
+    p1 = nq1;
+    p2 = nq2;
+}
+
+/* §3.4 step 4 for one coordinate of a point k ≥ 1: v = (p − x)/h, less s·d(k+1)/h for ftl
+ * (corr: the point has a successor and the solver is ftl). */
+template <typename T> HB_DHD T update_velocity(T p, T x, T h, bool corr, T s, T dnext)
+{
+    T vk = (p - x) / h;
+    if (corr) vk = vk - (s * dnext) / h;
+    return vk;
 }
 
 /* k of the g-th member of bend group `parity`: ⌊(k−1)/2⌋ ≡ parity (mod 2), k ascending. */
@@ -253,7 +352,7 @@ HB_DHD void shape_all(const DModel<T> &m, const Strand<T> &s, const T *q, const 
             t[1] = rest(k, 1);
             t[2] = rest(k, 2);
         }
-        shape_pull(p, k, t, at, lam(2 * P + k - 1));
+        shape_pull(p(k, 0), p(k, 1), p(k, 2), t, at, lam(2 * P + k - 1));
     });
 }
 
@@ -274,14 +373,9 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
 
         /* 1. root on the head, then p0 = x0 */
         ex.one([&]() {
-            if (has(HB_F_MOTION)) {
-                T r[3];
-                rotate(q, rest(0, 0), rest(0, 1), rest(0, 2), r);
-                for (int c = 0; c < 3; c++) {
-                    v(0, c) = (r[c] - x(0, c)) / h;
-                    x(0, c) = r[c];
-                }
-            }
+            if (has(HB_F_MOTION))
+                root_step(q, rest(0, 0), rest(0, 1), rest(0, 2), h, x(0, 0), x(0, 1), x(0, 2), v(0, 0), v(0, 1),
+                          v(0, 2));
             p(0, 0) = x(0, 0);
             p(0, 1) = x(0, 1);
             p(0, 2) = x(0, 2);
@@ -289,27 +383,8 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
 
         /* 2. velocities, implicit in drag and damping, then the prediction */
         ex.each(1, P, 1, [&](int64_t k) {
-            T vx = v(k, 0), vy = v(k, 1), vz = v(k, 2);
-            if (has(HB_F_WIND)) {
-                T gam = (T)1;
-                if (has(HB_F_GUST))
-                    gam = (T)1 + m.gust * d_sin(phase - m.kappa * (m.dir_y * x(k, 1) + m.dir_z * x(k, 2)));
-                vy = vy + h * (m.gravity_y + m.wind_y * gam);
-                vz = vz + h * (m.wind_z * gam);
-            } else {
-                vy = vy + h * m.gravity_y;
-            }
-            if (has(HB_F_DRAG)) {
-                vx = vx / m.den;
-                vy = vy / m.den;
-                vz = vz / m.den;
-            }
-            v(k, 0) = vx;
-            v(k, 1) = vy;
-            v(k, 2) = vz;
-            p(k, 0) = x(k, 0) + h * vx;
-            p(k, 1) = x(k, 1) + h * vy;
-            p(k, 2) = x(k, 2) + h * vz;
+            velocity_predict(m, has, phase, x(k, 0), x(k, 1), x(k, 2), v(k, 0), v(k, 1), v(k, 2), p(k, 0), p(k, 1),
+                             p(k, 2));
         });
 
         /* 3. constraints; every multiplier starts the substep at 0 */
@@ -341,23 +416,9 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
             }
             /* §3.7 follow the leader, k ascending: each point follows its corrected predecessor */
             ex.one([&]() {
-                for (int64_t k = 1; k < P; k++) {
-                    const T ex_ = p(k, 0) - p(k - 1, 0), ey = p(k, 1) - p(k - 1, 1), ez = p(k, 2) - p(k - 1, 2);
-                    const T len = d_sqrt(ex_ * ex_ + ey * ey + ez * ez);
-                    T nq[3];
-                    if (len > (T)0) {
-                        nq[0] = p(k - 1, 0) + m.seg_len * (ex_ / len);
-                        nq[1] = p(k - 1, 1) + m.seg_len * (ey / len);
-                        nq[2] = p(k - 1, 2) + m.seg_len * (ez / len);
-                    } else {
-                        nq[0] = p(k - 1, 0);
-                        nq[1] = p(k - 1, 1) - m.seg_len;
-                        nq[2] = p(k - 1, 2);
-                    }
-                    for (int c = 0; c < 3; c++) d(k, c) = nq[c] - p(k, c);
-                    if (has(HB_F_COLLIDE)) collide_sphere(nq[0], nq[1], nq[2], m.collide_r);
-                    for (int c = 0; c < 3; c++) p(k, c) = nq[c];
-                }
+                for (int64_t k = 1; k < P; k++)
+                    follow(p(k - 1, 0), p(k - 1, 1), p(k - 1, 2), p(k, 0), p(k, 1), p(k, 2), m.seg_len,
+                           has(HB_F_COLLIDE), m.collide_r, d(k, 0), d(k, 1), d(k, 2));
             });
         }
 
@@ -365,10 +426,9 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
          * point the same operations as the reference's three loops, in the same order. */
         const int ftl = m.solver == HB_SOLVER_FTL;
         ex.each(1, P, 1, [&](int64_t k) {
+            const bool corr = ftl && k + 1 < P;
             for (int c = 0; c < 3; c++) {
-                T vk = (p(k, c) - x(k, c)) / h;
-                if (ftl && k + 1 < P) vk = vk - (m.ftl_s * d(k + 1, c)) / h;
-                v(k, c) = vk;
+                v(k, c) = update_velocity(p(k, c), x(k, c), h, corr, m.ftl_s, corr ? d(k + 1, c) : (T)0);
                 x(k, c) = p(k, c);
             }
         });

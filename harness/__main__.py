@@ -165,6 +165,17 @@ def cmd_accuracy(args):
 
 
 def cmd_headline(args):
+    if args.model == "dynamic":
+        from . import headline_dynamic
+
+        headline_dynamic.run(
+            strands=args.strands,
+            repeat=min(args.repeat, 5),
+            cpu_repeat=args.cpu_repeat,
+            ncu=args.ncu,
+            out_dir=args.out,
+        )
+        return 0
     from . import headline
 
     headline.run(
@@ -390,6 +401,14 @@ def parser():
     h.add_argument("--repeat", type=whole(1), default=9, help="GPU repetitions per stage (default 9)")
     h.add_argument("--cpu-repeat", type=whole(1), default=3, help="CPU repetitions per stage (default 3)")
     h.add_argument("--block-size", type=whole(32), default=256)
+    h.add_argument(
+        "--model",
+        choices=("paper", "dynamic"),
+        default="paper",
+        help="paper: the paper scene (default); dynamic: the dynamic model's four targets "
+        "(memory-bound case, default scene, real-time regime, CPU), results/headline/headline_dynamic.json",
+    )
+    h.add_argument("--ncu", action="store_true", help="dynamic: also profile the best kernel with Nsight Compute")
     h.add_argument("--out", default=None, help="results directory (default results/headline)")
     h.set_defaults(func=cmd_headline)
 

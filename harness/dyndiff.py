@@ -8,9 +8,13 @@ B put it farther apart than DYN_STEP_K·u, u = ε·E·S·I (E = R + h + L, ε of
 precision, S substeps and I iterations of A), or when either is non-finite. That rule is for ONE frame advanced from the
 same input (stepdiff); over many frames two correct builds drift apart (collisions and
 the solvers amplify rounding), so a whole-trajectory diff of two backends is expected to
-fail after a while and says so frame by frame: use stepdiff to validate a port. The
-observables of every compared frame are printed side by side (A, B, B − A). Each file's
-invariants (dynamic_checks.py) are checked on its compared frames.
+fail after a while and says so frame by frame: use stepdiff to validate a port. Where both
+files stored the velocities of a compared step, they are judged by the same rule on
+h·|Δv| (the position change a velocity makes in one substep). The observables of every
+compared frame are printed side by side (A, B, B − A) and judged by what the two states'
+difference allows (observables_ok). Each file's invariants (dynamic_checks.py) are
+checked on its compared frames. The GPU tests (tests/test_gpu_dynamic.py) judge with this
+same function.
 
 stepdiff: for each chosen simulated frame k of a reference A written with --velocities
 all, run BIN --input A --input-frame k --stages simulate --frames 1 into a temporary
@@ -82,6 +86,7 @@ class DynDiffResult:
     def equivalent(self):
         return (
             all(f.ok for f in self.frames)
+            and not any(o.get("failures") for o in self.observables)
             and self.invariants_a.ok
             and self.invariants_b.ok
             and any(f.compared for f in self.frames)
@@ -101,6 +106,8 @@ class DynDiffResult:
                     else f"{f.over} point(s) over tolerance (allowed {f.allowed_over})"
                 )
                 out.append(f"step {f.step} ({f.stage}): {why}, max error {f.max_abs:.3g}")
+        for o in self.observables:
+            out += [f"step {o['step']}: observable {m}" for m in o.get("failures", [])]
         for label, rep in (("A", self.invariants_a), ("B", self.invariants_b)):
             out += [f"{label} {v.message}" for v in rep.all_violations()]
         if not any(f.compared for f in self.frames):
@@ -136,7 +143,15 @@ class DynDiffResult:
         }
 
 
+def _over(dist, finite, tol, unit):
+    if tol.point_k == 0.0:
+        return (dist > 0) | ~finite
+    return ~(dist <= tol.point_k * unit) | ~finite
+
+
 def compare_sim_frame(a, b, fa, fb, tol, unit, ulp_dtype):
+    """Positions, and the velocities where both files stored them at this step (|Δv|·h, the
+    position change a velocity makes in one substep, on the positions' rule)."""
     fd = diff.FrameDiff(fa, fb, "simulate")
     xa, xb = a.frame(fa), b.frame(fb)
     finite = np.all(np.isfinite(xa), axis=2) & np.all(np.isfinite(xb), axis=2)
@@ -150,15 +165,51 @@ def compare_sim_frame(a, b, fa, fb, tol, unit, ulp_dtype):
         fd.max_k = fd.max_abs / unit
     else:
         fd.rms_abs = float("nan")
-    over = (dist > 0) | ~finite if tol.point_k == 0.0 else ~(dist <= tol.point_k * unit) | ~finite
-    fd.over = int(over.sum())
+    fd.over = int(_over(dist, finite, tol, unit).sum())
     fd.max_rel_L = fd.max_abs / a.hair_length
     both = np.isfinite(xa) & np.isfinite(xb)
     u = ulp_distance(xa[both], xb[both], ulp_dtype)
     if u.size:
         fd.ulp_max = float(u.max())
         fd.ulp_p50, fd.ulp_p99 = (float(v) for v in np.percentile(u.astype(np.float64), [50, 99]))
+    step = int(a.step[fa])
+    va, vb = a.velocity_at_step(step), b.velocity_at_step(int(b.step[fb]))
+    fd.velocity_compared = va is not None and vb is not None
+    if fd.velocity_compared:
+        h = fd.velocity_h = float(a.dynamic_params["frame_dt"]) / int(a.dynamic_params["substeps"])
+        vfinite = np.all(np.isfinite(va), axis=2) & np.all(np.isfinite(vb), axis=2)
+        with np.errstate(invalid="ignore", over="ignore"):
+            vdist = h * np.sqrt(np.sum((va.astype(np.float64) - vb.astype(np.float64)) ** 2, axis=2))
+        fd.nonfinite += int((~vfinite).sum())
+        fd.velocity_max_abs = float(vdist[vfinite].max()) if vfinite.any() else float("nan")
+        fd.velocity_over = int(_over(vdist, vfinite, tol, unit).sum())
+        fd.over += fd.velocity_over
     return fd
+
+
+def observables_ok(row, fd, seg_len, exact):
+    """Failures of one compared frame's observables. They are computed in double from each
+    state, so they may differ only as the states do: equal bits where exact; else stretch
+    by at most 2·max|Δx|/ℓ, penetration by max|Δx|, kinetic energy (where the velocities
+    were compared) by ½·max|Δv|·(√(2·KE_a) + √(2·KE_b)), each plus DYN_OBSERVABLE_K·ε64 of
+    the value for the double sums."""
+    bad = []
+    slack = lambda v: tolerances.DYN_OBSERVABLE_K * tolerances.EPS["fp64"] * max(abs(v), 1.0)  # noqa: E731
+    bounds = {"stretch_max": 2.0 * fd.max_abs / seg_len, "penetration_max": fd.max_abs}
+    if getattr(fd, "velocity_compared", False) and math.isfinite(fd.velocity_max_abs):
+        dv = fd.velocity_max_abs / fd.velocity_h
+        ka, kb = row["kinetic_energy"]["a"], row["kinetic_energy"]["b"]
+        bounds["kinetic_energy"] = 0.5 * dv * (math.sqrt(2.0 * max(ka, 0.0)) + math.sqrt(2.0 * max(kb, 0.0)))
+    for name, bound in bounds.items():
+        va, vb = row[name]["a"], row[name]["b"]
+        if math.isnan(va) and math.isnan(vb):
+            continue
+        ok = va == vb if exact else abs(vb - va) <= bound + slack(va)
+        if not ok:
+            bad.append(f"{name} {va!r} vs {vb!r}" + ("" if exact else f" (allowed ±{bound + slack(va):.3g})"))
+    if row["blown_up_strands"]["a"] != row["blown_up_strands"]["b"]:
+        bad.append(f"blown_up_strands {row['blown_up_strands']['a']} vs {row['blown_up_strands']['b']}")
+    return bad
 
 
 def _pick_steps(a, b, frames):
@@ -219,6 +270,7 @@ def compare(path_a, path_b, frames="all", exact=False, check_paper=True):
                     va = float(oa.loc[s, name]) if s in oa.index else float("nan")
                     vb = float(ob.loc[s, name]) if s in ob.index else float("nan")
                     row[name] = {"a": va, "b": vb, "diff": vb - va}
+                row["failures"] = observables_ok(row, fd, a.hair_length / (a.points - 1), exact)
                 res.observables.append(row)
             else:
                 fd = diff.compare_frame(a, b, fa, fb, ptol, eps, coarser(a.dtype, b.dtype))

@@ -9,6 +9,10 @@ Bytes a stage must move, for N strands of P points at s bytes per coordinate (4 
                 the points it moves (M = the record's moved_points): N·P·2·s + M·2·s
                 (when M is unknown, every point is counted as written: N·P·2·s·2)
   wind+collide  (fused into one kernel) counted once:              N·P·2·s·2
+  simulate      per frame (docs/model.md §3): reads and writes x and v of every point,
+                and reads the rest shape X̄ when bend, shape or head motion uses it:
+                N·P·3·s·4 (+ N·P·3·s); substeps and iterations stay on chip, so the
+                bytes do not grow with S·I (the arithmetic does)
 x never changes after init, so wind and collide need not touch it (the root's x is not
 needed either). A skipped stage (w = 0) and the collide half of a fused pair
 ("into-previous") move nothing. These are lower bounds of the traffic: a kernel that
@@ -40,6 +44,16 @@ def stage_bytes(stage, strands, points, precision, fused="", skipped=False, move
     if stage in ("wind", "collide"):
         return strands * points * 2 * s * 2
     raise ValueError(f"no roofline for stage '{stage}'")
+
+
+def simulate_bytes(strands, points, precision, features=()):
+    """Bytes one simulated frame must move (see the module comment); `features` the names of
+    the declared features (bend, shape, motion read the rest shape)."""
+    s = real_size(precision)
+    nbytes = strands * points * 3 * s * 4
+    if {"bend", "shape", "motion"} & set(features):
+        nbytes += strands * points * 3 * s
+    return nbytes
 
 
 def achieved_gbps(nbytes, ms):

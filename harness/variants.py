@@ -25,6 +25,14 @@ class Declared:
     precisions: tuple
     variants: tuple  # names, in the binary's order
     stages: dict  # variant name -> tuple of the stages it runs
+    max_points: dict  # variant name -> the most points per strand it simulates (None: no limit)
+
+    def runs(self, variant, stage="simulate", points=None):
+        """Whether `variant` runs `stage` (and, for simulate, strands of `points` points)."""
+        if stage not in self.stages.get(variant, ()):
+            return False
+        limit = self.max_points.get(variant)
+        return points is None or limit is None or points <= limit
 
 
 @lru_cache(maxsize=None)
@@ -48,6 +56,7 @@ def _read(path):
             precisions=tuple(d.get("precisions", ("fp32", "fp64"))),
             variants=names,
             stages={str(v["name"]): tuple(v.get("stages", ())) for v in variants},
+            max_points={str(v["name"]): (int(v["max_points"]) if v.get("max_points") else None) for v in variants},
         )
     except (ValueError, KeyError, TypeError, AttributeError):
         raise HarnessError(f"{path} --list-variants did not print the documented JSON object") from None

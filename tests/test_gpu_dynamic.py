@@ -5,37 +5,43 @@ the reason, where there is no usable GPU.
 One frame on the GPU from the CPU's state: the CPU runs `init,simulate` for K frames with
 --velocities all; each GPU build resumes from the CPU's frame k (`--input cpu.h5
 --input-frame k --stages simulate --frames 1`) and its frame is compared with the CPU's
-frame k+1, positions, velocities and observables. For each variant (strand, warp) x solver
-(xpbd, ftl) x precision x block size x build, on scenes with the feature set compiled in
-(cuda/dyn_kernels.cuh specialised_mask) and one that runs the generic kernel.
+frame k+1, positions, velocities and observables. For each variant that runs simulate (from
+the binary's --list-variants, within its most-points limit) x solver (xpbd, ftl) x precision
+x block size x build, on scenes with the feature set compiled in (cuda/dyn_kernels.cuh
+specialised_mask) and one that runs the generic kernel.
 
-Rules (harness/tolerances.py GPU_DYN_*): the strict build equals the CPU bit for bit
-without gusts, and is within GPU_DYN_POS / GPU_DYN_VEL with them; the normal and fast-math
-builds are within their bounds. Every build: bit-identical across block sizes and repeats.
-Strict build: strand and warp bit-identical. The measured worst errors go to
+Rules: every frame is judged by harness.dyndiff.compare, the function behind `harness
+stepdiff` and the bench's validation (positions and velocities by the DYN_STEP_K rule of
+harness/tolerances.py, observables within what the states' difference allows); the strict
+build equals the CPU bit for bit without gusts (GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS).
+Every build: bit-identical across block sizes and repeats.
+Strict build: all simulate variants bit-identical. The measured worst errors go to
 build/gpu_dyn_test_errors.json (for recalibrating the tolerances).
 """
 
 import json
 import subprocess
 
-import numpy as np
 import pytest
 
 from conftest import BUILD, CPU_BIN, CUDA_BIN, CUDA_FASTMATH_BIN, CUDA_STRICT_BIN
-from harness.tolerances import (
-    GPU_DYN_MAX_OVER_FRACTION,
-    GPU_DYN_OBS_ABS,
-    GPU_DYN_OBS_REL,
-    GPU_DYN_POS,
-    GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS,
-    GPU_DYN_VEL,
-)
+from harness import HarnessError, dyndiff, variants
+from harness.tolerances import GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS
 from harness.trajectory import open_trajectory
 
 pytestmark = pytest.mark.gpu
 
-VARIANTS = ("strand", "warp")
+
+def _simulate_variants():
+    """The CUDA variants that run simulate, and what the binary declares (its --list-variants)."""
+    try:
+        d = variants.declared("cuda")
+    except HarnessError:
+        return (), None
+    return tuple(v for v in d.variants if d.runs(v)), d
+
+
+VARIANTS, DECLARED = _simulate_variants()
 SOLVERS = ("xpbd", "ftl")
 PRECISIONS = ("fp32", "fp64")
 BLOCKS = (32, 96, 256, 1024)
@@ -81,6 +87,20 @@ SCENES = {
 }
 GUSTS = {"collide": False, "all": True, "generic": False}
 
+
+def scene_points(scene):
+    a = SCENES[scene]
+    return int(a[a.index("--points") + 1])
+
+
+def runs(variant, scene):
+    return DECLARED is not None and DECLARED.runs(variant, points=scene_points(scene))
+
+
+# (variant, scene) pairs a variant can run: a variant with a most-points limit skips the
+# scene over it (its refusal is tested below)
+PAIRS = tuple((v, sc) for v in VARIANTS for sc in SCENES if runs(v, sc))
+
 ERRORS = {}
 
 
@@ -110,23 +130,9 @@ def dyn_args(scene, solver):
     return ["--substeps", SUBSTEPS, "--iterations", ITERATIONS, "--solver", solver, *SCENES[scene]]
 
 
-class Frame:
-    """A simulated frame of a file (default: the last written): positions, velocities, observables."""
-
-    OBSERVABLES = ("stretch_max", "penetration_max", "kinetic_energy", "blown_up_strands")
-
-    def __init__(self, path, index=-1):
-        with open_trajectory(path) as t:
-            idx = index % t.n_frames
-            self.step = int(t.step[idx])
-            self.n, self.p = t.n_strands, t.points
-            self.x = t.frame(idx)
-            self.flags = t.flags
-            self.v = t.velocity_at_step(self.step)
-            assert self.v is not None, f"{path}: no velocities stored for step {self.step}"
-            rows = t.observables[t.observables["step"] == self.step]
-            assert len(rows) == 1, f"{path}: no observables for step {self.step}"
-            self.obs = {k: rows.iloc[0][k].item() for k in self.OBSERVABLES}
+def last_step(path):
+    with open_trajectory(path) as t:
+        return int(t.step[-1])
 
 
 _CACHE = {}
@@ -203,72 +209,41 @@ def gpu_frame(work, cpu_run):
                 out,
                 "--force",
             )
-            _CACHE[key] = Frame(out)
+            _CACHE[key] = out
         return _CACHE[key]
 
     return get
 
 
-def cpu_next(cpu_run, scene, solver, precision):
-    key = ("cpu-next", scene, solver, precision)
-    if key not in _CACHE:
-        _CACHE[key] = Frame(cpu_run(scene, solver, precision), FRAME_IN + 1)
-    return _CACHE[key]
-
-
-def point_errors(a, b):
-    return np.linalg.norm(a.astype(np.float64) - b.astype(np.float64), axis=-1)
-
-
-def assert_close(gpu, cpu, build, precision, what):
-    h = (1.0 / 60.0) / SUBSTEPS
-    for name, ga, ca, tol, scale in (
-        ("positions", gpu.x, cpu.x, GPU_DYN_POS, 1.0 / L),
-        ("velocities", gpu.v, cpu.v, GPU_DYN_VEL, h / L),
-    ):
-        assert ga.shape == ca.shape, f"{what} {name}: shapes {ga.shape} vs {ca.shape}"
-        assert np.isfinite(ga).all(), f"{what} {name}: NaN or Inf in the GPU state"
-        d = point_errors(ga, ca) * scale
-        t = tol[build][precision]
-        over = int((d > t).sum())
-        allowed = int(GPU_DYN_MAX_OVER_FRACTION[precision] * d.size)
-        worst = float(d.max())
-        record(f"{name} {build} {precision}", worst)
-        assert over <= allowed, (
-            f"{what} {name}: {over} of {d.size} points more than {t:g} apart (allowed "
-            f"{allowed}); worst {worst:.3g} at {np.unravel_index(d.argmax(), d.shape)}"
-        )
-    for k in ("stretch_max", "penetration_max", "kinetic_energy"):
-        g, c = float(gpu.obs[k]), float(cpu.obs[k])
-        assert abs(g - c) <= GPU_DYN_OBS_REL[precision] * abs(c) + GPU_DYN_OBS_ABS[precision], (
-            f"{what}: {k} {g!r} on the GPU, {c!r} on the CPU"
-        )
-    assert gpu.obs["blown_up_strands"] == cpu.obs["blown_up_strands"] == 0, f"{what}: blown-up strands"
+def judge(a, b, what, exact=False):
+    """harness.dyndiff.compare of the last frame of GPU file b against the same step of a:
+    the rule of `harness stepdiff` and of the bench (positions, velocities, observables)."""
+    step = last_step(b)
+    r = dyndiff.compare(a, b, frames=[step], exact=exact, check_paper=False)
+    f = r.frames[0]
+    if not exact:
+        record(f"positions {what}", f.max_rel_L)
+        if getattr(f, "velocity_compared", False):
+            record(f"velocities {what}", f.velocity_max_abs / r.hair_length)
+    assert getattr(f, "velocity_compared", False), f"{what}: velocities of step {step} not stored in both files"
+    assert r.equivalent, f"{what}: " + "; ".join(r.failures()[:5])
 
 
 def same_bits(a, b):
-    return (
-        a.x.dtype == b.x.dtype and a.x.tobytes() == b.x.tobytes() and a.v.tobytes() == b.v.tobytes() and a.obs == b.obs
-    )
+    """Two GPU files of the same frame: bit-identical positions, velocities and observables."""
+    return dyndiff.compare(a, b, frames=[last_step(a)], exact=True, check_paper=False).equivalent
 
 
 # ---- against the CPU ------------------------------------------------------------------------
 @pytest.mark.parametrize("precision", PRECISIONS)
 @pytest.mark.parametrize("solver", SOLVERS)
-@pytest.mark.parametrize("scene", tuple(SCENES))
-@pytest.mark.parametrize("variant", VARIANTS)
+@pytest.mark.parametrize(("variant", "scene"), PAIRS)
 @pytest.mark.parametrize("build", tuple(BUILDS))
 def test_frame_matches_cpu(cpu_run, gpu_frame, build, variant, scene, solver, precision):
-    cpu = cpu_next(cpu_run, scene, solver, precision)
+    cpu = cpu_run(scene, solver, precision)
     gpu = gpu_frame(build, variant, scene, solver, precision, 256)
-    assert gpu.step == cpu.step
-    what = f"{build} {variant} {scene} {solver} {precision}"
-    if build == "strict" and GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS and not GUSTS[scene]:
-        assert gpu.x.tobytes() == cpu.x.tobytes(), f"{what}: positions differ from the CPU's (must be bit-identical)"
-        assert gpu.v.tobytes() == cpu.v.tobytes(), f"{what}: velocities differ from the CPU's (must be bit-identical)"
-        assert gpu.obs == cpu.obs, f"{what}: observables {gpu.obs} vs the CPU's {cpu.obs}"
-    else:
-        assert_close(gpu, cpu, build, precision, what)
+    exact = build == "strict" and GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS and not GUSTS[scene]
+    judge(cpu, gpu, f"{build} {precision}" if not exact else f"{build} {variant} {scene} {solver} {precision}", exact)
 
 
 # ---- determinism ------------------------------------------------------------------------------
@@ -293,10 +268,41 @@ def test_bits_do_not_depend_on_block_size_or_repeats(gpu_frame, build, variant, 
 @pytest.mark.parametrize("precision", PRECISIONS)
 @pytest.mark.parametrize("solver", SOLVERS)
 @pytest.mark.parametrize("scene", tuple(SCENES))
-def test_strict_strand_and_warp_identical(gpu_frame, scene, solver, precision):
-    a = gpu_frame("strict", "strand", scene, solver, precision, 256)
-    b = gpu_frame("strict", "warp", scene, solver, precision, 256)
-    assert same_bits(a, b), f"strict {scene} {solver} {precision}: strand and warp differ"
+def test_strict_variants_identical(gpu_frame, scene, solver, precision):
+    """The strict build: every simulate variant gives the same bits (one order of the math)."""
+    names = [v for v in VARIANTS if runs(v, scene)]
+    assert len(names) >= 2, f"{scene}: fewer than two variants run it: {names}"
+    a = gpu_frame("strict", names[0], scene, solver, precision, 256)
+    for other in names[1:]:
+        b = gpu_frame("strict", other, scene, solver, precision, 256)
+        assert same_bits(a, b), f"strict {scene} {solver} {precision}: {names[0]} and {other} differ"
+
+
+def test_variant_over_its_point_limit_is_refused(tmp_path):
+    limited = [(v, DECLARED.max_points[v]) for v in VARIANTS if DECLARED.max_points.get(v)]
+    assert limited, "no simulate variant declares a most-points limit"
+    for v, most in limited:
+        out = tmp_path / f"{v}.h5"
+        p = run(
+            CUDA_BIN,
+            "--strands",
+            10,
+            "--points",
+            most + 1,
+            "--stages",
+            "init,simulate",
+            "--frames",
+            1,
+            "--variant",
+            v,
+            "--quiet",
+            "--output",
+            out,
+            check=False,
+        )
+        assert p.returncode == 2, (v, p.returncode, p.stderr)
+        assert "--points" in p.stderr and v in p.stderr and "\n" not in p.stderr.strip(), p.stderr
+        assert not out.exists()
 
 
 # ---- refusals ---------------------------------------------------------------------------------
