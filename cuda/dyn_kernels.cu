@@ -170,38 +170,24 @@ __global__ void __launch_bounds__(kMaxThreads)
     const bool bends = has(HB_F_BEND) && k >= 1 && k + 1 < P;
     const bool xpbd = m.solver == HB_SOLVER_XPBD;
     const T h = m.h;
-    /* A warp takes strands grid-strided (the loop bound is the same for every lane) and, in
-     * fp32, loads the next strand's point while it works on this one, so that its loads are
-     * in flight during the arithmetic (the grid holds what the device runs at once). */
-    const int64_t stride = (int64_t)gridDim.x * wpb;
-    T nx0 = 0, nx1 = 0, nx2 = 0, nv0 = 0, nv1 = 0, nv2 = 0, nr0 = 0, nr1 = 0, nr2 = 0, nbr = 0;
-    auto load = [&](int64_t i) {
-        if (i >= N) return;
+    /* the loop bound is the same for every lane of a warp: whole warps take each strand */
+    for (int64_t i = (int64_t)blockIdx.x * wpb + w; i < N; i += (int64_t)gridDim.x * wpb) {
         const int64_t at = i * 3 * (int64_t)P + 3 * k;
+        T x0 = 0, x1 = 0, x2 = 0, v0 = 0, v1 = 0, v2 = 0, r0 = 0, r1 = 0, r2 = 0, br = 0;
         if (on) {
-            nx0 = x[at];
-            nx1 = x[at + 1];
-            nx2 = x[at + 2];
-            nv0 = v[at];
-            nv1 = v[at + 1];
-            nv2 = v[at + 2];
+            x0 = x[at];
+            x1 = x[at + 1];
+            x2 = x[at + 2];
+            v0 = v[at];
+            v1 = v[at + 1];
+            v2 = v[at + 2];
         }
         if (need_rest) {
-            nr0 = rest[at];
-            nr1 = rest[at + 1];
-            nr2 = rest[at + 2];
+            r0 = rest[at];
+            r1 = rest[at + 1];
+            r2 = rest[at + 2];
         }
-        if (bends) nbr = bend_rest[i * (int64_t)(P - 2) + (k - 1)];
-    };
-    /* fp64 has no registers to spare for it (the prefetch made its kernels spill) */
-    constexpr bool prefetch = sizeof(T) == 4;
-    if (prefetch) load((int64_t)blockIdx.x * wpb + w);
-    for (int64_t i = (int64_t)blockIdx.x * wpb + w; i < N; i += stride) {
-        const int64_t at = i * 3 * (int64_t)P + 3 * k;
-        if (!prefetch) load(i);
-        T x0 = nx0, x1 = nx1, x2 = nx2, v0 = nv0, v1 = nv1, v2 = nv2;
-        const T r0 = nr0, r1 = nr1, r2 = nr2, br = nbr;
-        if (prefetch) load(i + stride);
+        if (bends) br = bend_rest[i * (int64_t)(P - 2) + (k - 1)];
         T p0 = x0, p1 = x1, p2 = x2, d0 = 0, d1 = 0, d2 = 0;
         for (int64_t j = 0; j < m.substeps; j++) {
             const T *q = qtab + 9 * j;
@@ -416,21 +402,7 @@ cudaError_t launch_frame_warpreg(const DModel<T> &m, const T *q, const T *phase,
 {
     if (!valid_mask(m.features) || m.points > kWarpregMaxPoints) return cudaErrorInvalidValue;
     const WarpFn<T> fn = TablesT<T>::warpreg[m.features];
-    /* at most the blocks the device holds at once: each warp then takes several strands
-     * and prefetches the next (k_warpreg) */
-    static int resident[2][HB_F_COUNT][kMaxThreads / 32 + 1]; /* per precision, feature set, block */
-    if (block < 32 || block > kMaxThreads) return cudaErrorInvalidValue;
-    int &r = resident[sizeof(T) == 8][m.features][block / 32];
-    if (r == 0) {
-        int per_sm = 0, dev = 0, sms = 0;
-        cudaError_t e = cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, fn, block, 0);
-        if (e == cudaSuccess) e = cudaGetDevice(&dev);
-        if (e == cudaSuccess) e = cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev);
-        if (e != cudaSuccess) return e;
-        r = per_sm * sms > 0 ? per_sm * sms : 1;
-    }
-    const int g = grid < r ? grid : r;
-    fn<<<g, block, 0, stream>>>(m, q, phase, x, v, rest, bend_rest, N);
+    fn<<<grid, block, 0, stream>>>(m, q, phase, x, v, rest, bend_rest, N);
     return cudaGetLastError();
 }
 
