@@ -1,10 +1,12 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
-Commands: run, diff, stepdiff, sweep, plot, report, bench, accuracy, headline, export, calibrate
-(`--help` on each). User errors print one line `harness: error: …` and exit non-zero, never a traceback."""
+Commands: run, diff, stepdiff, sweep, plot, report, bench, accuracy, headline, export, calibrate,
+featurecost, peer, animate (`--help` on each). User errors print one line `harness: error: …` and
+exit non-zero, never a traceback."""
 
 import argparse
 import json
+import math
 import sys
 
 from . import HarnessError, __version__
@@ -215,6 +217,63 @@ def cmd_featurecost(args):
         timeout=args.timeout,
     )
     print(featurecost_report.markdown(rows), end="")
+    return 0
+
+
+def setting(text):
+    """An argparse type: a setting 'SxI' (substeps × iterations), each a whole number ≥ 1."""
+    parts = text.lower().split("x")
+    try:
+        s, i = (int(v, 10) for v in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs SxI, e.g. 8x1 (got '{text}')") from None
+    if s < 1 or i < 1:
+        raise argparse.ArgumentTypeError(f"S and I must be at least 1 (got '{text}')")
+    return (s, i)
+
+
+def number(text):
+    """An argparse type: a finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs a number (got '{text}')") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"needs a finite number (got '{text}')")
+    return value
+
+
+def cmd_peer(args):
+    from . import peer_report
+
+    if not args.report_only:
+        from . import peer
+
+        args.argv = sys.argv[2:] if len(sys.argv) > 2 and sys.argv[1] == "peer" else None
+        try:
+            peer.run_study(args)
+        except peer.PeerUnavailable as e:  # an optional dependency: skipped, not failed
+            print(f"harness: peer: skipped: {e}", file=sys.stderr)
+            return 0
+    path = peer_report.write(args.out, args.report_dir)
+    print(f"wrote {path}")
+    return 0
+
+
+def cmd_animate(args):
+    from . import animate
+
+    for path in animate.run(
+        args.state,
+        out=args.out,
+        max_strands=args.max_strands,
+        every=args.every,
+        fps=args.fps,
+        force=args.force,
+        strands=args.strands,
+        frames=args.frames,
+    ):
+        print(f"wrote {path}")
     return 0
 
 
@@ -462,6 +521,57 @@ def parser():
     fc.add_argument("--timeout", type=seconds, default=None)
     fc.add_argument("--out", default=None, help="CSV file to write")
     fc.set_defaults(func=cmd_featurecost)
+
+    pe = sub.add_parser(
+        "peer",
+        help="the same chain scenes in Bender's PositionBasedDynamics (pypbd) beside ours",
+        description="Run chains released from rest in hairsim-cpu and in pypbd (XPBD distance constraints, "
+        "the parameters mapped as docs/decisions.md says), against our converged fp64 reference: error, "
+        "stretch and time per frame at several strand counts. Writes results/peer/ and report/peer.md. "
+        "Needs pypbd (optional): without it, one line says so and the exit status is 2.",
+    )
+    pe.add_argument("--points", type=whole(2), default=32, help="points per chain, root included (default 32)")
+    pe.add_argument("--length", type=number, default=30.0, help="chain length L, cm (default 30)")
+    pe.add_argument(
+        "--tilts", type=number, nargs="+", default=[30.0, 60.0], help="degrees from the downward vertical (30 60)"
+    )
+    pe.add_argument("--frames", type=whole(1), default=30, help="accuracy horizon in frames (default 30: 0.5 s)")
+    pe.add_argument("--frame-dt", type=number, default=1 / 60, help="frame length Δt, s (default 1/60)")
+    pe.add_argument("--gravity", type=number, default=981.0, help="g0, cm/s² (default 981)")
+    pe.add_argument("--compliance", type=number, default=0.0, help="stretch compliance α (default 0: rigid)")
+    pe.add_argument(
+        "--settings", type=setting, nargs="+", default=[(8, 1), (32, 1), (8, 4)], help="SxI pairs (8x1 32x1 8x4)"
+    )
+    pe.add_argument(
+        "--strands", type=whole(1), nargs="+", default=[1, 100, 1000, 10000], help="chains timed (1 100 1000 10000)"
+    )
+    pe.add_argument("--threads", type=whole(1), default=1, help="threads for both solvers (default 1)")
+    pe.add_argument("--time-frames", type=whole(1), default=5, help="frames per timing run (default 5)")
+    pe.add_argument("--repeat", type=whole(1), default=3, help="our --repeat; the peer steps frames × repeat")
+    pe.add_argument("--ref-start", type=whole(1), default=64, help="first S of the reference doubling (64)")
+    pe.add_argument("--ref-max", type=whole(2), default=16384, help="largest S of the reference (16384)")
+    pe.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
+    pe.add_argument("--out", default=None, help="results directory (default results/peer)")
+    pe.add_argument("--report-dir", default=None, help="where peer.md goes (default report/)")
+    pe.add_argument("--report-only", action="store_true", help="only re-render report/peer.md from --out")
+    pe.set_defaults(func=cmd_peer)
+
+    an = sub.add_parser(
+        "animate",
+        help="an animation of a dynamic state from the side and from the front",
+        description="Draw the frames of a dynamic HDF5 state (read through harness.trajectory) seen from "
+        "the side and from the front, the head sphere drawn, as a GIF (and an MP4 beside it where ffmpeg "
+        "is on PATH). Without STATE, runs configs/scenes/dynamic.toml on hairsim-cpu first.",
+    )
+    an.add_argument("state", nargs="?", default=None, help="a dynamic state file (default: run the dynamic scene)")
+    an.add_argument("--out", default=None, help="the GIF to write (default report/dynamic.gif)")
+    an.add_argument("--max-strands", type=whole(1), default=150, help="strands drawn at most (default 150)")
+    an.add_argument("--every", type=whole(1), default=None, help="draw every K-th frame (default: about 60 frames)")
+    an.add_argument("--fps", type=whole(1), default=None, help="frames per second of the GIF (default: real time)")
+    an.add_argument("--strands", type=whole(1), default=300, help="without STATE: strands simulated (default 300)")
+    an.add_argument("--frames", type=whole(1), default=120, help="without STATE: frames simulated (default 120)")
+    an.add_argument("--force", action="store_true", help="replace existing output files")
+    an.set_defaults(func=cmd_animate)
     return p
 
 

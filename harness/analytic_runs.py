@@ -63,6 +63,19 @@ def pendulum_positions(length, theta0):
     return np.array([[[0.0, 0.0, 0.0], [0.0, -length * math.cos(theta0), length * math.sin(theta0)]]])
 
 
+def straight_chain_positions(points, length, theta0, azimuth=0.0):
+    """A straight chain of P points from the origin with links ℓ = L/(P−1), at angle θ0
+    from the downward vertical (θ0 = π/2: horizontal), in the vertical plane turned by
+    `azimuth` about +y from the (y, z) plane (azimuth 0 leans toward +z, π/2 toward +x).
+    P = 2 is `pendulum_positions` turned by the azimuth."""
+    r = (length / (points - 1)) * np.arange(points)
+    pos = np.zeros((1, points, 3))
+    pos[0, :, 0] = r * math.sin(theta0) * math.sin(azimuth)
+    pos[0, :, 1] = -r * math.cos(theta0)
+    pos[0, :, 2] = r * math.sin(theta0) * math.cos(azimuth)
+    return pos
+
+
 def chain_positions(points, length, amplitude, shape="continuum"):
     """A chain of P points hanging from the origin with rigid links ℓ = L/(P−1), displaced
     along z by amplitude × the first-mode shape with the tip at `amplitude`.

@@ -400,3 +400,27 @@ SIMD_DYN_GUST_MAX_FRAMES = 10  # the horizon the bounds were measured for
 # 4·ε·E·S·I = 6.1e-4 cm = 2.0e-5·L in fp32 and 1.1e-12 cm = 3.8e-14·L in fp64 there:
 # margins of about 100 over the measured fp32 and fp64 errors.
 GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS = True
+# ---- beside a peer: Bender's PositionBasedDynamics (pypbd) on chains (harness/peer.py,
+# tests/test_peer.py; the mapping and the differences in docs/decisions.md, "The peer") ----
+# The converged reference of `harness peer`: S doubles until the largest change of a point
+# from S to 2S is below this fraction of the smallest error the comparison reports.
+PEER_REF_FRACTION = 0.1
+# The peer runs the same scheme as our xpbd for these chains (docs/decisions.md), so its
+# trajectories equal our fp64 runs up to rounding, which the swinging chain amplifies with
+# the substeps taken. Measured (pypbd 2.2.2 against hairsim-cpu fp64, P = 32, L = 30 cm,
+# rigid, tilts 30°, 60°, 90°, Δt = 1/60 s), max |Δx|/L over 30 frames: S = 8, I = 1:
+# 2.1e-13; S = 8, I = 4: 1.5e-13; S = 32: 2.8e-12; S = 128: 6.5e-11; S = 256: 2.4e-10;
+# S = 512: 5.3e-10, i.e. at most 3.4e-14·L per substep taken (S × frames). Soft links
+# (α = 1e-6 and 1e-4, S = 8, I = 2): 1.4e-13 and 4.2e-13. Over 60 frames at S = 128 the
+# drift reached 1.3e-8·L: the rule below is for horizons of ≤ 30 frames.
+PEER_SAME_SCHEME_PER_SUBSTEP = 2e-13  # ·L per substep taken (6× the worst measured rate)
+# A doubled stiffness (α/2 for α = 1e-6) moved the same run by 0.064·L: the rule separates
+# a wrong mapping from rounding by eight orders of magnitude.
+# Pendulum (docs/model.md §4.1: P = 2, ℓ = 30 cm, rigid, θ0 = 0.1 and 2.0 rad, S = 8 and 32):
+# the peer's period equals ours to ≤ 1.3e-12 relative (both 1.69e-5 from the closed form at
+# θ0 = 0.1, S = 32, the ANALYTIC_PENDULUM_SMALL_REL case).
+PEER_PERIOD_REL = 1e-11  # |T_peer − T_ours|/T (worst measured 1.3e-12; margin 7.7×)
+# A rigid chain (P = 32, tilts 60° and 90°, 30 frames, I = 1) stretches by max |len/ℓ − 1| =
+# 0.068 (S = 32), 4.0e-3 (S = 128), 1.17e-3 (S = 256), 3.2e-4 (S = 512), the same in both
+# solvers to 1e-12 (they share the scheme): XPBD holds the length as S grows.
+PEER_RIGID_STRETCH_S256 = 2e-3  # both solvers at S = 256 (measured 1.17e-3; margin 1.7×)
