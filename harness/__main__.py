@@ -142,9 +142,15 @@ def cmd_report(args):
 
 
 def cmd_bench(args):
-    from . import bench
+    from . import bench, bench_dynamic
 
-    return bench.run(args.sweep, out=args.out, gpu=args.gpu, report_dir=args.report_dir)
+    code = 0
+    if args.model in ("all", "paper"):
+        code = bench.run(args.sweep, out=args.out, gpu=args.gpu, report_dir=args.report_dir)
+    if args.model in ("all", "dynamic"):
+        root = args.out if args.model == "dynamic" else None
+        code = bench_dynamic.run(out=root, gpu=args.gpu, report_dir=args.report_dir) or code
+    return code
 
 
 def cmd_accuracy(args):
@@ -416,6 +422,13 @@ def parser():
     b.add_argument("--out", help="results directory (default results/<sweep name>)")
     b.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto")
     b.add_argument("--report-dir", default=None, help="where to write the report (default report/)")
+    b.add_argument(
+        "--model",
+        choices=("all", "paper", "dynamic"),
+        default="all",
+        help="all (default): the paper model's bench, then the dynamic model's; --out is the paper "
+        "sweep's directory with all, the dynamic bench's root with dynamic (default results/)",
+    )
     b.set_defaults(func=cmd_bench)
 
     a = sub.add_parser(

@@ -52,6 +52,12 @@ COLUMNS = [
     "binary",
     "session",
     "finished_at",
+    # the simulate stage (dynamic scenes); empty for the paper stages
+    "solver",
+    "substeps",
+    "iterations",
+    "features",
+    "point_substeps_per_s",
 ]
 HEADER = ",".join(COLUMNS) + "\n"
 

@@ -37,15 +37,20 @@ def rows_of_record(case, record, copy_gbps, session, binary):
         times = st.get("times_ms") or []
         q1, q3 = quartiles(times)
         fused = st.get("fused") or ""
-        nbytes = roofline.stage_bytes(
-            st["stage"],
-            case.strands,
-            case.points,
-            case.precision,
-            fused=fused,
-            skipped=bool(st.get("skipped")),
-            moved=st.get("moved_points"),
-        )
+        sim = st["stage"] == "simulate"
+        if sim:  # per frame; the rest shape counts where a feature reads it
+            feats = (st.get("features") or "").split("+")
+            nbytes = roofline.simulate_bytes(case.strands, case.points, case.precision, feats)
+        else:
+            nbytes = roofline.stage_bytes(
+                st["stage"],
+                case.strands,
+                case.points,
+                case.precision,
+                fused=fused,
+                skipped=bool(st.get("skipped")),
+                moved=st.get("moved_points"),
+            )
         gbps = roofline.achieved_gbps(nbytes, st.get("median_ms"))
         rows.append(
             {
@@ -78,6 +83,11 @@ def rows_of_record(case, record, copy_gbps, session, binary):
                 "achieved_gbps": gbps,
                 "copy_gbps": copy_gbps,
                 "bandwidth_fraction": (gbps / copy_gbps) if (gbps and copy_gbps) else None,
+                "solver": st.get("solver", "") if sim else "",
+                "substeps": st.get("substeps", "") if sim else "",
+                "iterations": st.get("iterations", "") if sim else "",
+                "features": st.get("features", "") if sim else "",
+                "point_substeps_per_s": st.get("point_substeps_per_s") if sim else None,
                 "end_to_end_ms": record.get("end_to_end_ms"),
                 "h2d_ms": record.get("h2d_ms"),
                 "d2h_ms": record.get("d2h_ms"),
@@ -93,6 +103,10 @@ def rows_of_record(case, record, copy_gbps, session, binary):
 
 def case_flags(sweep, case):
     scene = sweep.scene.with_overrides(strands=case.strands, points=case.points, precision=case.precision)
+    if case.solver:
+        from dataclasses import replace
+
+        scene = replace(scene, dynamic={**scene.dynamic, "--solver": case.solver})
     threads = None if case.threads in ("", "all") else case.threads
     flags = run_flags(
         scene,
@@ -103,6 +117,8 @@ def case_flags(sweep, case):
         repeat=case.repeat,
         warmup=case.warmup,
     )
+    if scene.model == "dynamic":  # simulate times each frame on its own (--end-to-end is refused)
+        return flags
     return flags + ["--end-to-end"]  # end_to_end_ms (and h2d/d2h on cuda) in the record
 
 

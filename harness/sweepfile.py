@@ -3,6 +3,7 @@
     name = "default"          # results/<name>/ (optional; defaults to the file's stem)
     description = "…"
     scene = "paper"           # a scene name in configs/scenes/ or a path
+    frames = 3                # dynamic scenes: simulated frames per case (else the scene's)
     repeat = 9                # timed repetitions per stage (≥ 9: median and IQR)
     warmup = 1                # untimed runs per stage before them
     timeout_s = 600           # per case
@@ -10,6 +11,7 @@
     strands = [1000, 10000]
     points = [32]
     precision = ["fp32", "fp64"]
+    solver = ["xpbd", "ftl"]  # dynamic scenes only (default: the scene's solver)
     [cpu]                     # leave the table out to run no cpu case
     variant = ["ref", "simd"]
     threads = [1, "all"]      # "all" = every core (the binary's default)
@@ -31,18 +33,20 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import HarnessError
+from .dynscene import SOLVERS, with_frames
 from .paths import CUDA_BUILDS, SWEEPS, config_file, read_toml
 from .scenes import PRECISIONS, is_scene_file, load_scene
+from .variants import declared
 from .variants import names as declared_variants
 
 MIN_REPEAT = 9
-SHARED_AXES = ("strands", "points", "precision")
+SHARED_AXES = ("strands", "points", "precision", "solver")  # solver: dynamic scenes only
 BACKEND_AXES = {"cpu": ("variant", "threads"), "cuda": ("build", "variant", "block_size")}
 DEFAULTS = {
     "cpu": {"variant": ["ref"], "threads": ["all"]},
     "cuda": {"build": ["default"], "variant": ["fused"], "block_size": [256]},
 }
-TOP_KEYS = ("name", "description", "scene", "repeat", "warmup", "timeout_s", "axes", "cpu", "cuda")
+TOP_KEYS = ("name", "description", "scene", "frames", "repeat", "warmup", "timeout_s", "axes", "cpu", "cuda")
 
 
 class SweepError(HarnessError):
@@ -62,13 +66,14 @@ class Case:
     points: int
     repeat: int
     warmup: int
+    solver: str = ""  # dynamic scenes: xpbd | ftl ("" = the scene's own)
 
     @property
     def case_id(self):
         where = f"t{self.threads}" if self.backend == "cpu" else f"{self.build}:b{self.block_size}"
         return (
             f"{self.scene}:{self.backend}:{self.variant}:{where}:{self.precision}:"
-            f"N{self.strands}:P{self.points}:r{self.repeat}w{self.warmup}"
+            f"N{self.strands}:P{self.points}:r{self.repeat}w{self.warmup}" + (f":{self.solver}" if self.solver else "")
         )
 
 
@@ -102,6 +107,7 @@ class Sweep:
                         points=int(v["points"]),
                         repeat=self.repeat,
                         warmup=self.warmup,
+                        solver=str(v.get("solver", "")),
                     )
                 )
                 if out[-1].case_id in seen:
@@ -137,6 +143,8 @@ def _check_axis(where, label, values, backend):
             raise SweepError(f'{where}: {label} values must be whole numbers ≥ 1 or "all", got {v!r}')
         elif key == "build" and v not in CUDA_BUILDS:
             raise SweepError(f"{where}: {label} '{v}' is not one of {', '.join(CUDA_BUILDS)}")
+        elif key == "solver" and v not in SOLVERS:
+            raise SweepError(f"{where}: {label} '{v}' is not one of {', '.join(SOLVERS)}")
         elif key == "variant":
             known = known_variants(backend)
             if known and v not in known:
@@ -188,6 +196,13 @@ def load_sweep(ref):
     warmup = data.get("warmup", 1)
     if isinstance(warmup, bool) or not isinstance(warmup, int) or warmup < 0:
         raise SweepError(f"{where}: warmup must be a whole number ≥ 0, got {warmup!r}")
+    if "frames" in data:  # a dynamic scene's frames per case (each timed on its own)
+        if scene.model != "dynamic":
+            raise SweepError(f"{where}: frames needs a dynamic scene (scene {scene.name} is the paper model)")
+        f = data["frames"]
+        if isinstance(f, bool) or not isinstance(f, int) or f < 1:
+            raise SweepError(f"{where}: frames must be a whole number ≥ 1, got {f!r}")
+        scene = with_frames(scene, f)
     timeout = data.get("timeout_s", 600)
     if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not timeout > 0:
         raise SweepError(f"{where}: timeout_s must be a number > 0")
@@ -196,6 +211,8 @@ def load_sweep(ref):
         if key not in SHARED_AXES:
             raise SweepError(f"{where}: unknown key 'axes.{key}' (known: {', '.join(SHARED_AXES)})")
     shared_axes = {"strands": [scene.strands], "points": [scene.points], "precision": [scene.precision]}
+    if scene.model == "dynamic":
+        shared_axes["solver"] = [scene.dynamic.get("--solver", "xpbd")]
     for key, value in shared.items():
         shared_axes[key] = _check_axis(where, f"axes.{key}", _list(where, f"axes.{key}", value), None)
     groups = []
@@ -222,6 +239,21 @@ def load_sweep(ref):
     for backend, b in axes:
         for p in b["points"]:
             scene.with_overrides(points=p)  # ℓ ≥ h for every point count
+        if "solver" in b and scene.model != "dynamic":
+            raise SweepError(f"{where}: a solver axis needs a dynamic scene (scene {scene.name} is the paper model)")
+        if scene.model == "dynamic":  # every variant listed must run simulate, at every point count
+            for build in b.get("build", ["default"]):
+                try:
+                    decl = declared(backend, build)
+                except HarnessError:
+                    continue  # not built here: the case is skipped later, saying so
+                for v in b["variant"]:
+                    for p in b["points"]:
+                        if v in decl.variants and not decl.runs(v, points=p):
+                            raise SweepError(
+                                f"{where}: the {backend} variant {v} does not simulate {p} points a strand "
+                                "(see --list-variants)"
+                            )
     return Sweep(
         name=_results_name(where, data.get("name", path.stem)),
         path=path,
