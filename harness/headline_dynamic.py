@@ -361,7 +361,7 @@ def table(result):
         lines.append(f"{'case':34} {'N':>9} {'S':>3} {'I':>3} {'ms/frame':>10} {'pt-substeps/s':>14} {'%BW':>7}")
         for r in rows:
             lines.append(
-                f"{r['label'] + (' ' + r['case'] if 'case' in r else ''):34} {r['strands']:9d} {r['substeps']:3d} "
+                f"{r['label'] + (' ' + r['case'] if r.get('case') else ''):34} {r['strands']:9d} {r['substeps']:3d} "
                 f"{r['iterations']:3d} {r['median_ms']:10.4f} {r['point_substeps_per_s']:14.3e} {pct(r['fraction']):>7}"
             )
     s = result.get("summary", {})

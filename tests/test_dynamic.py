@@ -517,3 +517,50 @@ def test_harness_run_prints_observables(cpu_bin, tmp_path, capsys):
     assert "blown up: no; invariants: all hold" in text
     with open_trajectory(out) as t:
         assert len(t.observables) == 40 and t.features == "bend+shape+wind+gust+motion+collide+drag"
+
+
+def _step_limit(path):
+    with open_trajectory(path) as t:
+        substeps, iterations = int(t.dynamic_params["substeps"]), int(t.dynamic_params["iterations"])
+        E = tolerances.extent(float(t.params["head_radius"]), float(t.params["hair_offset"]), t.hair_length)
+        h = float(t.dynamic_params["frame_dt"]) / substeps
+        steps = [int(s) for s in t.velocity_steps]
+    return tolerances.DYN_STEP_K[("fp64", "fp64")] * tolerances.EPS["fp64"] * E * substeps * iterations, h, steps
+
+
+def test_stepdiff_judges_velocities(cpu_bin, reference, tmp_path, capsys):
+    """A stored velocity of frame 4 off by 100 times the rule (on h·|Δv|) fails the step
+    into frame 4; positions alone would pass it."""
+    import h5py
+
+    limit, h, steps = _step_limit(reference["fp64"])
+    with open_trajectory(reference["fp64"]) as t:
+        i = steps.index(int(t.step[4]))  # the velocity frame stored with position frame 4
+    bad = tmp_path / "badv.h5"
+    bad.write_bytes(reference["fp64"].read_bytes())
+    with h5py.File(bad, "r+") as f:
+        v = f["particles/hair/velocity/value"]
+        a = v[i]
+        a[37, 1] += 100 * limit / h
+        v[i] = a
+    assert harness_main(["stepdiff", "--reference", str(bad), "--binary", str(cpu_bin), "--frames", "3"]) == 1
+    capsys.readouterr()
+    assert harness_main(["stepdiff", "--reference", str(bad), "--binary", str(cpu_bin), "--frames", "2"]) == 0
+
+
+def test_diff_judges_observables(reference, tmp_path):
+    """An observable that the two states' difference cannot explain is a failure, named."""
+    import h5py
+
+    bad = tmp_path / "bado.h5"
+    bad.write_bytes(reference["fp64"].read_bytes())
+    with h5py.File(bad, "r+") as f:
+        o = f["observables/kinetic_energy/value"]
+        o[2] = o[2] * 1.5 + 1.0
+    with open_trajectory(bad) as t:
+        step = int(t.observables["step"].iloc[2])
+    r = dyndiff.compare(reference["fp64"], bad, frames=[step], check_paper=False)
+    assert not r.equivalent
+    assert any("kinetic_energy" in m for m in r.failures()), r.failures()
+    same = dyndiff.compare(reference["fp64"], reference["fp64"], frames=[step], check_paper=False)
+    assert same.equivalent and not same.failures()
