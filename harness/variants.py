@@ -1,7 +1,8 @@
 """The variants each binary declares: `hairsim-* --list-variants` (one JSON object).
 
     {"backend": "cpu", "build": "default", "default_variant": "ref",
-     "precisions": ["fp32", "fp64"], "variants": [{"name": "ref", "stages": [...], ...}]}
+     "precisions": ["fp32", "fp64"], "variants": [{"name": "ref", "stages": [...], ...}],
+     "solvers": ["xpbd", "ftl"]}
 
 The one place the harness and the tests learn variant names; read once per binary. Keys
 other than these are ignored, and missing optional ones get defaults, so a binary that
@@ -25,6 +26,11 @@ class Declared:
     precisions: tuple
     variants: tuple  # names, in the binary's order
     stages: dict  # variant name -> tuple of the stages it runs
+    solvers: tuple = ()  # the dynamic model's solvers, in the binary's order (none declared: ())
+
+    def running(self, stage):
+        """The variants that run `stage`, in the binary's order."""
+        return tuple(v for v in self.variants if stage in self.stages.get(v, ()))
 
 
 @lru_cache(maxsize=None)
@@ -48,6 +54,7 @@ def _read(path):
             precisions=tuple(d.get("precisions", ("fp32", "fp64"))),
             variants=names,
             stages={str(v["name"]): tuple(v.get("stages", ())) for v in variants},
+            solvers=tuple(str(x) for x in d.get("solvers", ())),
         )
     except (ValueError, KeyError, TypeError, AttributeError):
         raise HarnessError(f"{path} --list-variants did not print the documented JSON object") from None
