@@ -181,6 +181,15 @@ def accuracy_model(args):
     from . import scenes
 
     model = args.model
+    if args.from_csv and model is None:
+        from .dynaccuracy import COLUMNS
+
+        try:
+            with open(args.from_csv, encoding="utf-8") as fh:
+                header = fh.readline().strip().split(",")
+        except (OSError, UnicodeDecodeError) as e:
+            raise HarnessError(f"accuracy: --from-csv {args.from_csv}: cannot read ({e})") from None
+        model = "dynamic" if header == list(COLUMNS) else "paper"
     if args.scene is not None and not args.from_csv:
         scene_model = scenes.load_scene(args.scene).model
         if model is not None and model != scene_model:

@@ -419,7 +419,7 @@ class Study:
 
 
 def _gpu_reference_build(gpu_ok, plan):
-    if not gpu_ok or plan.gpu == "no" or not binary_path("cuda").exists():
+    if not gpu_ok or not binary_path("cuda").exists():
         return None
     sim = variants.declared("cuda").running(SIMULATE)
     return Build("cuda", "default", sim[0]) if sim else None
@@ -446,6 +446,8 @@ def run_study(plan, out_dir=None, report_dir=None, force=False, command=None, re
     study.scratch.mkdir(parents=True)
     report_dir.mkdir(parents=True, exist_ok=True)
     gpu_ok, gpu_why = env.gpu_status()
+    if gpu_ok and plan.gpu == "no":
+        gpu_ok, gpu_why = False, "--gpu no"
     builds = study_builds(gpu_ok)
     cpu_oracle = Build("cpu", "default", variants.declared("cpu").default_variant)
     if REF_SOLVER not in variants.declared("cpu").solvers:
@@ -486,10 +488,14 @@ def run_study(plan, out_dir=None, report_dir=None, force=False, command=None, re
 
         # 2. the reference (GPU fp64 where usable and validated against the CPU)
         gpu_ref = _gpu_reference_build(gpu_ok, plan)
-        check_rows, gpu_note = [], None
+        check_rows, gpu_note = (
+            [],
+            f"not used: {gpu_why if not gpu_ok else 'the default cuda build is absent or runs no simulate variant'}",
+        )
         if gpu_ref is not None:
             S0 = plan.first_rung
-            cpu_run = read_run(study.rung(cpu_oracle, S0))
+            cpu_path = study.rung(cpu_oracle, S0)
+            cpu_run = read_run(cpu_path)
             gpu_path = study.rung(gpu_ref, S0)
             gpu_run = read_run(gpu_path)
             g_rms, g_max = frame_errors(gpu_run.pos, cpu_run.pos, study.L)
@@ -526,7 +532,7 @@ def run_study(plan, out_dir=None, report_dir=None, force=False, command=None, re
             else:
                 gpu_note = "rejected: it differs from the CPU's by more than allowed; the CPU ladder is used"
                 log(f"dynamic accuracy: the GPU fp64 reference is {gpu_note}")
-                ref = study.ladder(cpu_oracle, mode_paths)
+                ref = study.ladder(cpu_oracle, mode_paths, first_path=cpu_path)
         else:
             ref = study.ladder(cpu_oracle, mode_paths)
 

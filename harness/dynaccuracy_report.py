@@ -508,8 +508,8 @@ def convergence_lines(rows, study):
             f"(max {c['max_err_L'].max():.2e}·L), allowed {tolerances.DYN_ACC_GPU_REF_SHARE:g} × the margin; "
             f"{ref.get('gpu_check')}."
         )
-    elif study.get("gpu") != "usable":
-        out.append(f"No GPU reference: {study.get('gpu')}.")
+    else:
+        out.append(f"No GPU reference: {ref.get('gpu_check')}.")
     out.append("")
     return out
 

@@ -125,13 +125,18 @@ def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, 
     page = (rep / dynaccuracy_report.PAGE).read_text()
     for heading in ("The converged reference", "Small steps against iterations", "Which settings for which use"):
         assert f"### {heading}" in page
-    assert "**Converged**" in page and "No GPU reference" in page
+    assert "**Converged**" in page and "No GPU reference: not used: HAIRBENCH_NO_GPU is set" in page
     for png in (dynaccuracy_report.PARETO_PNG, dynaccuracy_report.GROWTH_PNG, dynaccuracy_report.STEPS_PNG):
         assert (rep / png).stat().st_size > 5000
     assert not (out / "states").exists()
     # the convergence table re-derived from the CSV agrees with what the study decided
     table = dynaccuracy_report.section(out, rep, write_page=False)
     assert any("converged over the" in ln for ln in table)
+    # --from-csv re-renders (the model read from the CSV's header), elsewhere
+    assert (
+        cli.main(["accuracy", "--from-csv", str(out / dynaccuracy.CSV_NAME), "--report-dir", str(tmp_path / "r2")]) == 0
+    )
+    assert (tmp_path / "r2" / dynaccuracy_report.PAGE).read_text() == page
     before = (out / dynaccuracy.CSV_NAME).read_bytes()
     with pytest.raises(dynaccuracy.HarnessError, match="exists: pass --force"):
         dynaccuracy.run_study(dynaccuracy.Plan(**TINY), out, rep, log=quiet)
