@@ -153,23 +153,123 @@ def cmd_bench(args):
     return code
 
 
+PAPER_ACCURACY = dict(
+    scene="paper",
+    strands=100_000,
+    points=32,
+    repeat=9,
+    resolution=[4, 8, 16, 32, 64, 128, 256],
+    resolution_strands=20_000,
+)
+PAPER_ONLY = ("resolution", "resolution_strands")
+DYNAMIC_ONLY = (
+    "quick",
+    "seconds",
+    "horizon",
+    "substeps",
+    "iterations",
+    "time_strands",
+    "time_frames",
+    "ref_start",
+    "ref_max",
+    "jobs",
+    "analytic",
+    "gpu",
+    "force",
+)
+
+
+def _flag(name):
+    return "--" + name.replace("_", "-")
+
+
+def accuracy_model(args):
+    """paper | dynamic: --model, else the model of --scene, else paper; a contradiction or
+    an option of the other model is refused."""
+    from . import scenes
+
+    model = args.model
+    if args.from_csv and model is None:
+        from .dynaccuracy import COLUMNS
+
+        try:
+            with open(args.from_csv, encoding="utf-8") as fh:
+                header = fh.readline().strip().split(",")
+        except (OSError, UnicodeDecodeError) as e:
+            raise HarnessError(f"accuracy: --from-csv {args.from_csv}: cannot read ({e})") from None
+        model = "dynamic" if header == list(COLUMNS) else "paper"
+    if args.scene is not None and not args.from_csv:
+        scene_model = scenes.load_scene(args.scene).model
+        if model is not None and model != scene_model:
+            raise HarnessError(f"accuracy: --model {model} but scene {args.scene} is a {scene_model}-model scene")
+        model = scene_model
+    model = model or "paper"
+    other = PAPER_ONLY if model == "dynamic" else DYNAMIC_ONLY
+    given = [_flag(k) for k in other if getattr(args, k) not in (None, False)]
+    if given:
+        what = "is an option" if len(given) == 1 else "are options"
+        theirs = "paper" if model == "dynamic" else "dynamic"
+        raise HarnessError(f"accuracy: {', '.join(given)} {what} of the {theirs} model's study, not of --model {model}")
+    return model
+
+
 def cmd_accuracy(args):
+    if accuracy_model(args) == "dynamic":
+        return accuracy_dynamic(args)
     from . import accuracy, accuracy_report
 
     if args.from_csv:
         accuracy_report.report_from_csv(args.from_csv, report_dir=args.report_dir)
         return 0
+    opt = {k: getattr(args, k) if getattr(args, k) is not None else v for k, v in PAPER_ACCURACY.items()}
     accuracy.run_study(
-        args.scene,
-        strands=args.strands,
-        points=args.points,
-        repeat=args.repeat,
-        resolution=tuple(args.resolution),
-        res_strands=args.resolution_strands,
+        opt["scene"],
+        strands=opt["strands"],
+        points=opt["points"],
+        repeat=opt["repeat"],
+        resolution=tuple(opt["resolution"]),
+        res_strands=opt["resolution_strands"],
         out_dir=args.out,
         report_dir=args.report_dir,
     )
     return 0
+
+
+def accuracy_dynamic(args):
+    from pathlib import Path
+
+    from . import dynaccuracy, dynaccuracy_report
+    from .paths import display
+
+    if args.from_csv:
+        for path in dynaccuracy_report.write(Path(args.from_csv).parent, args.report_dir):
+            print(f"wrote {display(path)}")
+        return 0
+    given = {
+        k: getattr(args, k)
+        for k in (
+            "scene",
+            "strands",
+            "points",
+            "repeat",
+            "seconds",
+            "horizon",
+            "time_strands",
+            "time_frames",
+            "ref_start",
+            "ref_max",
+            "jobs",
+            "analytic",
+            "gpu",
+        )
+        if getattr(args, k) is not None
+    }
+    for k in ("substeps", "iterations"):
+        if getattr(args, k) is not None:
+            given[k] = tuple(sorted(set(getattr(args, k))))
+    plan = dynaccuracy.Plan.quick(**given) if args.quick else dynaccuracy.Plan(**given)
+    command = " ".join(["python -m harness", *sys.argv[1:]])
+    return dynaccuracy.run_study(plan, out_dir=args.out, report_dir=args.report_dir, force=args.force, command=command)
 
 
 def cmd_headline(args):
@@ -433,30 +533,64 @@ def parser():
 
     a = sub.add_parser(
         "accuracy",
-        help="speed against accuracy: every mode against the fp64 reference",
-        description="Run the scene in every precision/build mode available here and in "
-        "several model resolutions, compare with hairsim-cpu --precision "
-        "fp64, time each mode apart, and write results/accuracy/ and "
-        "report/accuracy.md with a Pareto plot.",
+        help="speed against accuracy: every mode against a reference (paper or dynamic model)",
+        description="Paper model (default): run the scene in every precision/build mode available "
+        "here and in several model resolutions, compare with hairsim-cpu --precision fp64, time "
+        "each mode apart, and write results/accuracy/ and report/accuracy.md with a Pareto plot. "
+        "Dynamic model (--model dynamic, or a dynamic --scene): every solver x substeps x "
+        "iterations x precision x build against a converged xpbd fp64 reference (substeps doubled "
+        "until S and 2S agree to a tenth of the smallest error), time per frame measured apart, "
+        "small steps against iterations, the analytic checks and a recommendation; writes "
+        "results/dynamic-accuracy/ and report/dynamic_accuracy.md with its plots "
+        "(docs/harness.md). Exit 0, or 1 when the dynamic reference did not converge.",
     )
-    a.add_argument("--scene", default="paper", help="scene name or .toml path (default paper)")
-    a.add_argument("--strands", type=whole(1), default=100_000)
-    a.add_argument("--points", type=whole(2), default=32)
-    a.add_argument("--repeat", type=whole(1), default=9, help="timed repetitions per stage (default 9)")
+    a.add_argument(
+        "--model", choices=("paper", "dynamic"), default=None, help="default: the --scene's model, else paper"
+    )
+    a.add_argument("--scene", default=None, help="scene name or .toml path (default paper, or dynamic)")
+    a.add_argument("--strands", type=whole(1), default=None, help="paper 100000; dynamic 256 (--quick 32)")
+    a.add_argument("--points", type=whole(2), default=None, help="default: paper 32; dynamic the scene's")
+    a.add_argument("--repeat", type=whole(1), default=None, help="timed repetitions (default: paper 9, dynamic 3)")
     a.add_argument(
         "--resolution",
         type=whole(2),
         nargs="+",
-        default=[4, 8, 16, 32, 64, 128, 256],
-        help="points per strand of the resolution study (the largest is the reference)",
+        default=None,
+        help="paper: points per strand of the resolution study (the largest is the reference; default 4 … 256)",
     )
-    a.add_argument("--resolution-strands", type=whole(1), default=20_000)
-    a.add_argument("--out", default=None, help="results directory (default results/accuracy)")
+    a.add_argument("--resolution-strands", type=whole(1), default=None, help="paper: default 20000")
+    a.add_argument("--quick", action="store_true", help="dynamic: a small study (32 strands, 0.25 s, S 1 4 16, I 1 2)")
+    a.add_argument("--seconds", type=seconds, default=None, help="dynamic: simulated time (default 1; --quick 0.25)")
+    a.add_argument(
+        "--horizon", type=seconds, default=None, help="dynamic: time over which errors are compared (default 0.5)"
+    )
+    a.add_argument(
+        "--substeps", type=whole(1), nargs="+", default=None, help="dynamic: S values (default 1 2 4 8 16 32)"
+    )
+    a.add_argument("--iterations", type=whole(1), nargs="+", default=None, help="dynamic: I values (default 1 2 4)")
+    a.add_argument(
+        "--time-strands", type=whole(1), default=None, help="dynamic: strands of the timing runs (default 10000)"
+    )
+    a.add_argument("--time-frames", type=whole(1), default=None, help="dynamic: frames of a timing run (default 1)")
+    a.add_argument(
+        "--ref-start", type=whole(2), default=None, help="dynamic: first S of the reference (default 2 x max S)"
+    )
+    a.add_argument("--ref-max", type=whole(2), default=None, help="dynamic: largest S of the reference (default 16384)")
+    a.add_argument("--jobs", type=whole(1), default=None, help="dynamic: parallel checked runs (default: cores)")
+    a.add_argument(
+        "--analytic", choices=("full", "quick", "none"), default=None, help="dynamic: the analytic tables to run"
+    )
+    a.add_argument("--gpu", choices=("auto", "no"), default=None, help="dynamic: GPU modes and reference if usable")
+    a.add_argument("--force", action="store_true", help="dynamic: replace an existing results CSV")
+    a.add_argument(
+        "--out", default=None, help="results directory (default results/accuracy or results/dynamic-accuracy)"
+    )
     a.add_argument("--report-dir", default=None, help="where to write (default report/)")
     a.add_argument(
         "--from-csv",
         default=None,
-        help="only rewrite the table and plot from an existing accuracy.csv (e.g. results/accuracy/accuracy.csv)",
+        help="only rewrite the report from an existing CSV (results/accuracy/accuracy.csv, or with "
+        "--model dynamic results/dynamic-accuracy/dynamic_accuracy.csv)",
     )
     a.set_defaults(func=cmd_accuracy)
 

@@ -22,6 +22,9 @@ def load_rows(csv_path):
             rows = list(csv.DictReader(fh))
     except OSError as e:
         raise HarnessError(f"{display(csv_path)}: cannot read ({e.strerror})") from None
+    missing = [k for k in ints + floats if rows and k not in rows[0]]
+    if missing:
+        raise HarnessError(f"{display(csv_path)}: not an accuracy.csv (no column {', '.join(missing)})")
     for r in rows:
         for k in ints:
             r[k] = int(r[k])

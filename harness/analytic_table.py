@@ -168,29 +168,34 @@ def fp32_tables(binary, work, sa, pend_s, wind_s, chain_s):
     return out
 
 
+def tables(binary, quick=False):
+    """Every table, as Markdown lines (a temporary directory holds the runs)."""
+    sa = _support()
+    pend_s = (1, 2, 4) if quick else (1, 2, 4, 8, 16, 32, 64, 128)
+    wind_s = (1,) if quick else (1, 8, 64)
+    chain_s = (16, 64) if quick else (1, 4, 16, 64, 256, 1024)
+    lines = []
+    with tempfile.TemporaryDirectory(prefix="hb_analytic_") as work:
+        lines += pendulum_tables(binary, work, sa, pend_s)
+        lines += wind_table(binary, work, sa, wind_s)
+        lines += chain_tables(binary, work, sa, chain_s)
+        lines += fp32_tables(
+            binary,
+            work,
+            sa,
+            pend_s,
+            (1, 8, 64, 256) if not quick else (1, 8),
+            chain_s[1:] if not quick else chain_s,
+        )
+    return lines
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(prog="python -m harness.analytic_table", description=__doc__.splitlines()[0])
     p.add_argument("--binary", default=str(ROOT / "build" / "hairsim-cpu"))
     p.add_argument("--quick", action="store_true", help="fewer S (a smoke run)")
     args = p.parse_args(argv)
-    sa = _support()
-    pend_s = (1, 2, 4) if args.quick else (1, 2, 4, 8, 16, 32, 64, 128)
-    wind_s = (1,) if args.quick else (1, 8, 64)
-    chain_s = (16, 64) if args.quick else (1, 4, 16, 64, 256, 1024)
-    lines = []
-    with tempfile.TemporaryDirectory(prefix="hb_analytic_") as work:
-        lines += pendulum_tables(args.binary, work, sa, pend_s)
-        lines += wind_table(args.binary, work, sa, wind_s)
-        lines += chain_tables(args.binary, work, sa, chain_s)
-        lines += fp32_tables(
-            args.binary,
-            work,
-            sa,
-            pend_s,
-            (1, 8, 64, 256) if not args.quick else (1, 8),
-            chain_s[1:] if not args.quick else chain_s,
-        )
-    print("\n".join(lines))
+    print("\n".join(tables(args.binary, args.quick)))
     return 0
 
 

@@ -290,6 +290,40 @@ DYN_STEP_WHY = (
 DYN_FP32_VS_FP64_FRAMES = 10
 DYN_FP32_VS_FP64_REL_L = 1e-5
 
+# The dynamic accuracy study (`python -m harness accuracy --model dynamic`,
+# harness/dynaccuracy.py). Its reference is xpbd fp64 with S doubled until, at every frame
+# up to the horizon, the RMS difference between S and 2S over all points is under
+# DYN_ACC_REF_FACTOR times the smallest RMS error any mode of the study has at that frame:
+# the reference's own error is then about a tenth of the smallest error reported, or less
+# (the rule, not a measurement; the convergence table of report/dynamic_accuracy.md
+# shows it rung by rung, for the max measure too).
+DYN_ACC_REF_FACTOR = 0.1
+# A GPU fp64 reference is used only when its first rung differs from the CPU's by less than
+# DYN_ACC_GPU_REF_SHARE of that margin (RMS of GPU − CPU < 0.1 × 0.1 × the smallest RMS
+# error, every frame up to the horizon): the GPU's rounding then cannot change a verdict.
+DYN_ACC_GPU_REF_SHARE = 0.1
+# The Pareto front treats RMS errors within DYN_ACC_FRONT_TIE (relative) as equal, so that
+# a slower build or precision is not a front point by rounding alone. Measured (the full
+# study on the 2-core dev machine: 256 strands, 1 s, horizon 0.5 s, 168 modes): at equal
+# solver, S and I, the worst frame's RMS error of fp32 against fp64 differs by ≤ 1.8e-4
+# relative for xpbd, ≤ 1.9e-3 for ftl up to S·I = 32 and 1.1e-2 for ftl at S = 32, I = 4
+# (where ftl's error is 0.2·L, far from the front); simd against ref ≤ 9.0e-3 (the same
+# mode). 2e-2 is 11× the worst below S = 32 and still far below the factor 1.4–2 between
+# neighbouring S.
+DYN_ACC_FRONT_TIE = 2e-2
+# The recommendation of the study: per use, the budget a mode must meet over the horizon
+# (RMS position error over L, stretch_max) and never blow up; the cheapest such mode is
+# recommended. These are this project's statements of what each use tolerates, not
+# measurements: L = 30 cm, so 5e-2·L is 1.5 cm of RMS drift over the horizon, 1e-2·L
+# 3 mm, 2e-3·L 0.6 mm (about the width of a clump of a few dozen hairs). The stretch budgets
+# follow the complaints of hair-solver users (stretchy strands): 10 % is visible but
+# tolerable in a preview, 2 % is at the edge of what players notice, 0.5 % is not seen.
+DYN_ACC_USES = {
+    "previews": (5e-2, 0.10, "see the motion at a glance"),
+    "games": (1e-2, 0.02, "real-time, stretch must not show"),
+    "offline": (2e-3, 0.005, "film quality, close to the converged motion"),
+}
+
 # ---------------------------------------------------------------------------------------
 # ANALYTIC CHECKS of the dynamic model (docs/model.md §4; tests/test_analytic.py; the full
 # S sweeps in docs/analytic.md, made by `python -m harness.analytic_table`). Measured on the

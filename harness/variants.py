@@ -1,7 +1,8 @@
 """The variants each binary declares: `hairsim-* --list-variants` (one JSON object).
 
     {"backend": "cpu", "build": "default", "default_variant": "ref",
-     "precisions": ["fp32", "fp64"], "variants": [{"name": "ref", "stages": [...], ...}]}
+     "precisions": ["fp32", "fp64"], "variants": [{"name": "ref", "stages": [...], ...}],
+     "solvers": ["xpbd", "ftl"]}
 
 The one place the harness and the tests learn variant names; read once per binary. Keys
 other than these are ignored, and missing optional ones get defaults, so a binary that
@@ -26,6 +27,7 @@ class Declared:
     variants: tuple  # names, in the binary's order
     stages: dict  # variant name -> tuple of the stages it runs
     max_points: dict  # variant name -> the most points per strand it simulates (None: no limit)
+    solvers: tuple = ()  # the dynamic model's solvers, in the binary's order (none declared: ())
 
     def runs(self, variant, stage="simulate", points=None):
         """Whether `variant` runs `stage` (and, for simulate, strands of `points` points)."""
@@ -33,6 +35,10 @@ class Declared:
             return False
         limit = self.max_points.get(variant)
         return points is None or limit is None or points <= limit
+
+    def running(self, stage, points=None):
+        """The variants that run `stage` (at `points` points a strand), in the binary's order."""
+        return tuple(v for v in self.variants if self.runs(v, stage, points))
 
 
 @lru_cache(maxsize=None)
@@ -57,6 +63,7 @@ def _read(path):
             variants=names,
             stages={str(v["name"]): tuple(v.get("stages", ())) for v in variants},
             max_points={str(v["name"]): (int(v["max_points"]) if v.get("max_points") else None) for v in variants},
+            solvers=tuple(str(x) for x in d.get("solvers", ())),
         )
     except (ValueError, KeyError, TypeError, AttributeError):
         raise HarnessError(f"{path} --list-variants did not print the documented JSON object") from None

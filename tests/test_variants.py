@@ -47,6 +47,7 @@ def test_keys_added_later_are_ignored(build_dir):
     script(build_dir / "hairsim-cpu", json.dumps(listing))
     d = variants.declared("cpu")
     assert d.variants == ("ref", "simd") and d.stages["ref"][-1] == "simulate"
+    assert d.solvers == ("pbd",) and d.running("simulate") == ("ref",) and d.running("init") == ("ref", "simd")
 
 
 def test_a_missing_binary_has_no_names_and_sweeps_keep_their_cases(build_dir):
