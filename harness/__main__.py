@@ -149,7 +149,10 @@ def cmd_bench(args):
         code = bench.run(args.sweep, out=args.out, gpu=args.gpu, report_dir=args.report_dir)
     if args.model in ("all", "dynamic"):
         root = args.out if args.model == "dynamic" else None
-        code = bench_dynamic.run(out=root, gpu=args.gpu, report_dir=args.report_dir) or code
+        code = (
+            bench_dynamic.run(out=root, gpu=args.gpu, report_dir=args.report_dir, quick_studies=args.quick_studies)
+            or code
+        )
     return code
 
 
@@ -528,6 +531,11 @@ def parser():
         default="all",
         help="all (default): the paper model's bench, then the dynamic model's; --out is the paper "
         "sweep's directory with all, the dynamic bench's root with dynamic (default results/)",
+    )
+    b.add_argument(
+        "--quick-studies",
+        action="store_true",
+        help="dynamic: the small versions of the studies (accuracy --quick, stability --quick)",
     )
     b.set_defaults(func=cmd_bench)
 

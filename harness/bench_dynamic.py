@@ -183,8 +183,8 @@ def _harness(argv, say):
         raise HarnessError(f"`python -m harness {' '.join(argv)}` exited with status {code}", code=code)
 
 
-def studies(root, builds, say, quick=False):
-    """The dynamic studies, each into root/<study>."""
+def studies(root, builds, say, report_dir=None, quick=False):
+    """The dynamic studies, each into root/<study> (`quick`: their small versions)."""
     fc = root / "featurecost"
     fc.mkdir(parents=True, exist_ok=True)
     _harness(["featurecost", "--backend", "cpu", "--out", str(fc / "cpu.csv")], say)
@@ -194,11 +194,17 @@ def studies(root, builds, say, quick=False):
             out = fc / f"cuda-{v}.csv"
             argv = ["featurecost", "--backend", "cuda", "--variant", v, "--strands", "1000000", "--out", str(out)]
             _harness(argv, say)
+    acc = ["accuracy", "--model", "dynamic", "--out", str(root / "dynamic-accuracy"), "--force"]
+    acc += ["--report-dir", str(report_dir)] if report_dir else []
+    acc += ["--quick"] if quick else []
+    if not builds:
+        acc += ["--gpu", "no"]
+    _harness(acc, say)
     _harness(["peer", "--out", str(root / "peer"), "--report-dir", str(root / "peer")], say)
-    _harness(["animate", "--force"], say)
+    _harness(["animate", "--force"] + (["--out", str(Path(report_dir) / "dynamic.gif")] if report_dir else []), say)
 
 
-def run(out=None, gpu="auto", report_dir=None, log=None):
+def run(out=None, gpu="auto", report_dir=None, quick_studies=False, log=None):
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
     root = Path(out) if out else RESULTS
@@ -209,7 +215,7 @@ def run(out=None, gpu="auto", report_dir=None, log=None):
         say(f"harness: dynamic GPU rows skipped: {gpu_note}")
     validate(sweep_dir, builds, gpu_note, say)
     _, failed = run_sweep(SWEEP, out=sweep_dir, gpu="no" if gpu_note else gpu, log=say, announce_skips=False)
-    studies(root, builds, say)
+    studies(root, builds, say, report_dir=report_dir, quick=quick_studies)
     from . import report_dynamic
 
     path = report_dynamic.build(root, report_dir)

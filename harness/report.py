@@ -318,10 +318,14 @@ def build(results_dir="results/default", report_dir=None):
             "`python3 -m harness accuracy` on this machine.",
             "",
         ]
-    # the dynamic model's study of the same machine (`python -m harness accuracy --model dynamic`)
-    from .dynaccuracy_report import section as dynamic_accuracy_section
-
-    lines += dynamic_accuracy_section(Path(results_dir).parent / "dynamic-accuracy", out_dir)
+    # the dynamic model has its own page (harness/report_dynamic.py)
+    lines += [
+        "## The dynamic model",
+        "",
+        "The time-stepped model (validation, throughput, the headline targets, speed against "
+        "accuracy, stability, the peer, the animation) is reported in [dynamic.md](dynamic.md).",
+        "",
+    ]
     lines += environment_section(env)
     path = out_dir / "report.md"
     tmp = path.with_name(f"report.md.tmp.{os.getpid()}")

@@ -175,18 +175,16 @@ def headline_lines(path):
     return out
 
 
-def _study(root, name, module, what, command):
-    """A study's section from its own renderer, or a line saying how to make it."""
+def _study(root, name, module, what, command, out_dir):
+    """A study's section from its own renderer (section(results_dir, report_dir)), or a
+    line saying how to make it."""
     import importlib
 
     d = Path(root) / name
-    try:
-        mod = importlib.import_module(f".{module}", __package__)
-    except ImportError:
-        return [f"## {what}", "", f"Not available in this build of the harness ({module}).", ""]
-    if not d.exists() or not hasattr(mod, "section"):
+    mod = importlib.import_module(f".{module}", __package__)
+    if not d.exists():
         return [f"## {what}", "", f"Not measured with these results (no `{display(d)}`): `{command}`.", ""]
-    return mod.section(d)
+    return mod.section(d, out_dir) + [""]
 
 
 def build(root, report_dir=None):
@@ -226,8 +224,14 @@ def build(root, report_dir=None):
         cmd = "python -m harness bench --model dynamic"
         lines += [f"Not measured (no `{display(sweep_dir / 'runs.csv')}`): `{cmd}`.", ""]
     lines += featurecost_report.section(sorted((root / "featurecost").glob("*.csv"))) + [""]
-    lines += _study(root, "dynaccuracy", "dynaccuracy_report", "Speed against accuracy", "harness dynaccuracy")
-    lines += _study(root, "stability", "stability_report", "Stability at the extremes", "harness stability")
+    lines += _study(
+        root,
+        "dynamic-accuracy",
+        "dynaccuracy_report",
+        "Speed against accuracy",
+        "harness accuracy --model dynamic",
+        out_dir,
+    )
     lines += peer_report.section(root / "peer", out_dir, missing_ok=True) + [""]
     gif = out_dir / "dynamic.gif"
     lines += ["## The default scene in motion", ""]
