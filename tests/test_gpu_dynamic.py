@@ -19,19 +19,12 @@ build/gpu_dyn_test_errors.json (for recalibrating the tolerances).
 import json
 import subprocess
 
-import numpy as np
 import pytest
 
 from conftest import BUILD, CPU_BIN, CUDA_BIN, CUDA_FASTMATH_BIN, CUDA_STRICT_BIN
-from harness.tolerances import (
-    GPU_DYN_MAX_OVER_FRACTION,
-    GPU_DYN_OBS_ABS,
-    GPU_DYN_OBS_REL,
-    GPU_DYN_POS,
-    GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS,
-    GPU_DYN_VEL,
-)
-from harness.trajectory import open_trajectory
+from harness.tolerances import GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS
+from support import dynframe
+from support.dynframe import Frame, same_bits
 
 pytestmark = pytest.mark.gpu
 
@@ -108,25 +101,6 @@ def run(binary, *args, check=True, timeout=300):
 
 def dyn_args(scene, solver):
     return ["--substeps", SUBSTEPS, "--iterations", ITERATIONS, "--solver", solver, *SCENES[scene]]
-
-
-class Frame:
-    """A simulated frame of a file (default: the last written): positions, velocities, observables."""
-
-    OBSERVABLES = ("stretch_max", "penetration_max", "kinetic_energy", "blown_up_strands")
-
-    def __init__(self, path, index=-1):
-        with open_trajectory(path) as t:
-            idx = index % t.n_frames
-            self.step = int(t.step[idx])
-            self.n, self.p = t.n_strands, t.points
-            self.x = t.frame(idx)
-            self.flags = t.flags
-            self.v = t.velocity_at_step(self.step)
-            assert self.v is not None, f"{path}: no velocities stored for step {self.step}"
-            rows = t.observables[t.observables["step"] == self.step]
-            assert len(rows) == 1, f"{path}: no observables for step {self.step}"
-            self.obs = {k: rows.iloc[0][k].item() for k in self.OBSERVABLES}
 
 
 _CACHE = {}
@@ -216,40 +190,8 @@ def cpu_next(cpu_run, scene, solver, precision):
     return _CACHE[key]
 
 
-def point_errors(a, b):
-    return np.linalg.norm(a.astype(np.float64) - b.astype(np.float64), axis=-1)
-
-
 def assert_close(gpu, cpu, build, precision, what):
-    h = (1.0 / 60.0) / SUBSTEPS
-    for name, ga, ca, tol, scale in (
-        ("positions", gpu.x, cpu.x, GPU_DYN_POS, 1.0 / L),
-        ("velocities", gpu.v, cpu.v, GPU_DYN_VEL, h / L),
-    ):
-        assert ga.shape == ca.shape, f"{what} {name}: shapes {ga.shape} vs {ca.shape}"
-        assert np.isfinite(ga).all(), f"{what} {name}: NaN or Inf in the GPU state"
-        d = point_errors(ga, ca) * scale
-        t = tol[build][precision]
-        over = int((d > t).sum())
-        allowed = int(GPU_DYN_MAX_OVER_FRACTION[precision] * d.size)
-        worst = float(d.max())
-        record(f"{name} {build} {precision}", worst)
-        assert over <= allowed, (
-            f"{what} {name}: {over} of {d.size} points more than {t:g} apart (allowed "
-            f"{allowed}); worst {worst:.3g} at {np.unravel_index(d.argmax(), d.shape)}"
-        )
-    for k in ("stretch_max", "penetration_max", "kinetic_energy"):
-        g, c = float(gpu.obs[k]), float(cpu.obs[k])
-        assert abs(g - c) <= GPU_DYN_OBS_REL[precision] * abs(c) + GPU_DYN_OBS_ABS[precision], (
-            f"{what}: {k} {g!r} on the GPU, {c!r} on the CPU"
-        )
-    assert gpu.obs["blown_up_strands"] == cpu.obs["blown_up_strands"] == 0, f"{what}: blown-up strands"
-
-
-def same_bits(a, b):
-    return (
-        a.x.dtype == b.x.dtype and a.x.tobytes() == b.x.tobytes() and a.v.tobytes() == b.v.tobytes() and a.obs == b.obs
-    )
+    dynframe.assert_close(gpu, cpu, build, precision, what, (1.0 / 60.0) / SUBSTEPS, L, record)
 
 
 # ---- against the CPU ------------------------------------------------------------------------
