@@ -443,6 +443,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
     const int simulate = o.stages[o.n_stages - 1] == HB_STAGE_SIMULATE;
     if (simulate) {
         CHECK(hb_dynamics_validate(&o.scene.dyn, err, sizeof err), HB_EXIT_USAGE);
+        CHECK(hb_dynamics_validate_scene(&o.scene, err, sizeof err), HB_EXIT_USAGE);
         if (o.end_to_end) {
             snprintf(err, sizeof err, "--end-to-end is not measured for simulate: its frames are timed one by one");
             CHECK(1, HB_EXIT_USAGE);

@@ -2,6 +2,7 @@
  * message naming the flag). */
 #include "params.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -45,6 +46,18 @@ double hb_wind_angle_reduced(const hb_scene *s)
         return -1;                                                                                                     \
     } while (0)
 
+/* The lengths a precision can square without underflow or overflow (docs/decisions.md,
+ * "Representable scenes"). */
+static double length_min(hb_precision p)
+{
+    return p == HB_FP32 ? 1e-18 : 1e-150;
+}
+
+static double length_max(hb_precision p)
+{
+    return p == HB_FP32 ? 1e18 : 1e150;
+}
+
 static int finite_positive(double v)
 {
     return isfinite(v) && v > 0.0;
@@ -72,8 +85,7 @@ int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
     /* Every length must square without leaving the precision's normal range, or the
      * model's r², ℓ² and ρ·rc underflow to denormals or zero (docs/decisions.md,
      * "fp32_near_denormal_range"). */
-    const double lo = s->precision == HB_FP32 ? 1e-18 : 1e-150;
-    const double hi = s->precision == HB_FP32 ? 1e18 : 1e150;
+    const double lo = length_min(s->precision), hi = length_max(s->precision);
     const struct {
         const char *flag;
         double v;
@@ -167,5 +179,60 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
     const double h = d->frame_dt / (double)d->substeps;
     if (!(h >= 1e-12 && h <= 1e3))
         FAIL("--frame-dt / --substeps = %g s is outside the substep lengths this model takes [1e-12, 1e3]", h);
+    return 0;
+}
+
+/* The dynamic model's derived constants (docs/model.md §3.4), computed in double and
+ * rounded once to the working precision, must be finite there, and the lengths it squares
+ * must stay in the precision's range; else the first substep makes NaN (docs/decisions.md,
+ * "dynamic_constant_overflow"). Only the constants a run evaluates are checked. */
+static int fits(double v, hb_precision p)
+{
+    return p == HB_FP32 ? isfinite((float)v) : isfinite(v);
+}
+
+int hb_dynamics_validate_scene(const hb_scene *s, char *err, size_t errlen)
+{
+    const hb_dynamics *d = &s->dyn;
+    const hb_precision p = s->precision;
+    const char *name = hb_precision_name(p);
+    const char *hint = p == HB_FP32 ? " (use --precision fp64)" : "";
+    const double h = d->frame_dt / (double)d->substeps;
+    const int wind = d->wind_speed > 0.0 && d->drag > 0.0, gust = wind && d->gust_amplitude > 0.0;
+    const int bend = d->bend && s->points >= 3; /* P = 2 has no bend constraint */
+    const int shape = d->shape && floor(d->shape_range * (double)(s->points - 1)) >= 1.0; /* K ≥ 1 */
+    const double hi = length_max(p);
+    const double rc = s->head_radius + d->collision_margin;
+    /* the largest acceleration of the velocity step, c_d·U·(1 + A_g) for the wind's share */
+    const double wind_a = wind ? d->drag * d->wind_speed * (1.0 + (gust ? d->gust_amplitude : 0.0)) : 0.0;
+    const struct {
+        const char *what;
+        double v;
+        int used;
+    } c[] = {
+        {"--gravity", d->gravity, 1},
+        {"--stretch-compliance / h^2 (h = --frame-dt / --substeps)", d->stretch_compliance / (h * h),
+         d->solver == HB_SOLVER_XPBD},
+        {"--bend-compliance / h^2 (h = --frame-dt / --substeps)", d->bend_compliance / (h * h), bend},
+        {"--shape-compliance / h^2 (h = --frame-dt / --substeps)", d->shape_compliance / (h * h), shape},
+        {"--drag x --wind-speed x (1 + --gust-amplitude)", wind_a, wind},
+        {"h (--gravity + --drag x --wind-speed x (1 + --gust-amplitude))", h * (d->gravity + wind_a), 1},
+        /* the gust's phase at a point as far out as a strand that has not blown up reaches */
+        {"2 pi / --gust-wavelength x (--head-radius + --collision-margin + 2 --hair-length)",
+         2.0 * M_PI / d->gust_wavelength * (rc + 2.0 * s->hair_length), gust},
+    }; /* 1 + h·(c_d + β) may be Inf: v/Inf = 0 is the limit of infinite drag */
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++)
+        if (c[i].used && !fits(c[i].v, p))
+            FAIL("%s = %g overflows %s (largest %g)%s", c[i].what, c[i].v, name, p == HB_FP32 ? FLT_MAX : DBL_MAX,
+                 hint);
+    if (d->collider && !(rc <= hi))
+        FAIL("--head-radius + --collision-margin = %g is beyond the lengths %s can square (at most %g)%s", rc, name, hi,
+             hint);
+    /* how far a point at rest moves in one substep: h·v after v = h·a/D */
+    const double fall = h * h * (d->gravity + wind_a) / (d->drag_declared ? 1.0 + h * (d->drag + d->damping) : 1.0);
+    if (!(fall <= hi))
+        FAIL("one substep moves a point by h^2 (--gravity + --drag x --wind-speed x (1 + --gust-amplitude)) / "
+             "(1 + h (--drag + --damping)) = %g, beyond the lengths %s can square (at most %g): more --substeps%s",
+             fall, name, hi, p == HB_FP32 ? " or --precision fp64" : "");
     return 0;
 }

@@ -125,6 +125,9 @@ const char *hb_precision_name(hb_precision p);
 int hb_scene_validate(const hb_scene *s, char *err, size_t errlen);
 /* Checks the dynamic parameters (docs/model.md §3); one line naming the flag on failure. */
 int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen);
+/* Checks that the dynamic model's derived constants fit the scene's precision and that the
+ * lengths it squares stay in range; one line naming the flags on failure. */
+int hb_dynamics_validate_scene(const hb_scene *s, char *err, size_t errlen);
 void hb_dynamics_defaults(hb_dynamics *d);
 const char *hb_solver_name(hb_solver s);
 const char *hb_motion_name(hb_motion m);

@@ -1,8 +1,8 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
 Commands: run, diff, stepdiff, sweep, plot, report, bench, accuracy, headline, export, calibrate,
-featurecost, peer, animate (`--help` on each). User errors print one line `harness: error: …` and
-exit non-zero, never a traceback."""
+featurecost, peer, animate, stability (`--help` on each). User errors print one line
+`harness: error: …` and exit non-zero, never a traceback."""
 
 import argparse
 import json
@@ -383,6 +383,25 @@ def cmd_animate(args):
         frames=args.frames,
     ):
         print(f"wrote {path}")
+
+
+def cmd_stability(args):
+    from . import stability, stability_report
+
+    if args.from_csv:
+        stability_report.report_from_csv(args.from_csv, report_dir=args.report_dir)
+        return 0
+    stability.run_study(
+        slices=tuple(args.slice or stability.SLICE_NAMES),
+        quick=args.quick,
+        strands=args.strands,
+        frames=args.frames,
+        jobs=args.jobs,
+        gpu=args.gpu,
+        timeout=args.timeout,
+        out_dir=args.out,
+        report_dir=args.report_dir,
+    )
     return 0
 
 
@@ -727,6 +746,29 @@ def parser():
     an.add_argument("--frames", type=whole(1), default=120, help="without STATE: frames simulated (default 120)")
     an.add_argument("--force", action="store_true", help="replace existing output files")
     an.set_defaults(func=cmd_animate)
+
+    from .stability import FRAMES, SLICE_NAMES, STRANDS
+
+    sb = sub.add_parser(
+        "stability",
+        help="the dynamic model's stability map: verdicts over 2-D slices of the scene space",
+        description="Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend "
+        "compliance and points; head-motion frequency against amplitude) for both solvers and precisions, "
+        "on the CPU and every built CUDA build where a GPU answers; judge each cell ok, over-stretched, "
+        "penetrating or blown up; write results/stability/, report/stability_*.png and "
+        "report/dynamic_stability.md.",
+    )
+    sb.add_argument("--quick", action="store_true", help="a coarser grid (about a quarter of the cells)")
+    sb.add_argument("--slice", action="append", choices=SLICE_NAMES, help="run only this slice (repeatable)")
+    sb.add_argument("--strands", type=whole(1), default=STRANDS, help=f"strands per cell (default {STRANDS})")
+    sb.add_argument("--frames", type=whole(1), default=FRAMES, help=f"frames per cell (default {FRAMES}: 1 s)")
+    sb.add_argument("--jobs", type=whole(1), default=None, help="cells run at once (default: all cores)")
+    sb.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto", help="run the CUDA builds too")
+    sb.add_argument("--timeout", type=seconds, default=None, help="seconds per cell before giving up")
+    sb.add_argument("--out", default=None, help="results directory (default results/stability)")
+    sb.add_argument("--report-dir", default=None, help="where to write (default report/)")
+    sb.add_argument("--from-csv", default=None, help="only redraw the report from an existing stability.csv")
+    sb.set_defaults(func=cmd_stability)
     return p
 
 

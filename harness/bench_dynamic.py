@@ -200,6 +200,10 @@ def studies(root, builds, say, report_dir=None, quick=False):
     if not builds:
         acc += ["--gpu", "no"]
     _harness(acc, say)
+    stab = ["stability", "--out", str(root / "stability"), "--gpu", "auto" if builds else "no"]
+    stab += ["--report-dir", str(report_dir)] if report_dir else []
+    stab += ["--quick"] if quick else []
+    _harness(stab, say)
     _harness(["peer", "--out", str(root / "peer"), "--report-dir", str(root / "peer")], say)
     _harness(["animate", "--force"] + (["--out", str(Path(report_dir) / "dynamic.gif")] if report_dir else []), say)
 

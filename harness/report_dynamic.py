@@ -232,6 +232,7 @@ def build(root, report_dir=None):
         "harness accuracy --model dynamic",
         out_dir,
     )
+    lines += _study(root, "stability", "stability_report", "Stability at the extremes", "harness stability", out_dir)
     lines += peer_report.section(root / "peer", out_dir, missing_ok=True) + [""]
     gif = out_dir / "dynamic.gif"
     lines += ["## The default scene in motion", ""]

@@ -458,3 +458,27 @@ PEER_PERIOD_REL = 1e-11  # |T_peer − T_ours|/T (worst measured 1.3e-12; margin
 # 0.068 (S = 32), 4.0e-3 (S = 128), 1.17e-3 (S = 256), 3.2e-4 (S = 512), the same in both
 # solvers to 1e-12 (they share the scheme): XPBD holds the length as S grows.
 PEER_RIGID_STRETCH_S256 = 2e-3  # both solvers at S = 256 (measured 1.17e-3; margin 1.7×)
+
+
+# ---- verdicts of the dynamic stability map (harness/stability.py, docs/decisions.md
+# "Stability map of the dynamic model") ------------------------------------------------------
+# These are not rounding tolerances but the lines a cell of the map is judged by; they live
+# here because every number that judges a result does. Each is taken over every frame of
+# the map's horizon (observables of docs/model.md §3.8, computed by the binary).
+#
+# Over-stretched: stretch_max > STABILITY_STRETCH_MAX (a segment 10 % longer or shorter than
+# ℓ). Hair keratin is elastic only to about 2 % strain; a strand drawn 10 % longer than its
+# rest length reads as rubber in an animation. The bound is a judgement of what is visible,
+# far above rounding (the rigid FTL chain of the still scene measures ≤ 1.2e-3 at S ≥ 2, the
+# collider moving a point it had placed) and far below the failures the map exists to find
+# (xpbd at S = 1 on the still scene: 14.4, i.e. 1440 %, and blown up).
+STABILITY_STRETCH_MAX = 0.10
+# Penetrating: penetration_max > STABILITY_PENETRATION_REL · R_c (1e-3·R_c = 0.1 mm at the
+# default R = 10 cm, about one hair diameter). The contract's own bound after a frame is
+# DYN_PENETRATION_K·ε·R_c (rounding, ≤ 1e-6·R_c in fp32); a cell between the two is a
+# contract violation that the map's check column reports, not a visible penetration. The
+# collider is a projection run last in every iteration (xpbd) and on every FTL point, so
+# the map measured ≤ 1.9e-7·R_c in all 844 CPU cells: no cell is penetrating.
+STABILITY_PENETRATION_REL = 1e-3
+# Blown up: the model's own definition (§3.8: NaN/Inf, or a point farther than 2L from its
+# root), the files' blown_up_strands observable; no bound of the harness.
