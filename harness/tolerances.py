@@ -428,11 +428,11 @@ SIMD_DYN_GUST_MAX_FRAMES = 10  # the horizon the bounds were measured for
 # is the CPU's, chunk by chunk in strand order); with gusts CUDA's sinf/sin (≤ 2 ulp from
 # the correctly rounded value) perturb the wind factor and the frame carries that along.
 # Measured on an H200 (tests/test_gpu_dynamic.py, 1500 strands × 32 and 45 points, S = 8,
-# I = 4, every feature, both solvers, blocks 32…1024; build/gpu_dyn_test_errors.json):
-# worst |Δx|/L 1.6e-7 (normal fp32), 1.8e-7 (fast-math fp32), 3.6e-16 (fp64, strict with
-# gusts); worst h·|Δv|/L 1.3e-7 (fp32), 4.7e-16 (fp64). The DYN_STEP_K rule allows
-# 4·ε·E·S·I = 6.1e-4 cm = 2.0e-5·L in fp32 and 1.1e-12 cm = 3.8e-14·L in fp64 there:
-# margins of about 100 over the measured fp32 and fp64 errors.
+# I = 4, every feature, both solvers, strand/warp/warpreg, blocks 32…1024;
+# build/gpu_dyn_test_errors.json): worst |Δx|/L 5.0e-7 (normal fp32), 6.3e-7 (fast-math
+# fp32), 2.3e-7 (strict fp32, gusts), 1.0e-15 (normal fp64); worst h·|Δv|/L 3.2e-7 (fp32),
+# 3.8e-16 (fp64). The DYN_STEP_K rule allows 4·ε·E·S·I = 6.1e-4 cm = 2.0e-5·L in fp32 and
+# 1.1e-12 cm = 3.8e-14·L in fp64 there: margins of 32 and 38 over the worst measured.
 GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS = True
 # ---- beside a peer: Bender's PositionBasedDynamics (pypbd) on chains (harness/peer.py,
 # tests/test_peer.py; the mapping and the differences in docs/decisions.md, "The peer") ----
