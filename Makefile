@@ -154,7 +154,8 @@ sanitize: setup check-hdf5
 # exercises the output, resume and end-to-end paths, and simulate on the strand and warp
 # variants (both solvers and precisions, a resume from a middle frame). Needs a GPU.
 SAN_RUN := --strands 1000 --points 16 --hair-length 10 --repeat 2 --end-to-end --quiet
-# simulate (strand, warp): every feature, P = 45 (the warp's lanes take one or two points), 3 frames
+# simulate (every variant that runs it, from --list-variants): every feature, P = 45 (the warp's lanes
+# take one or two points) or the variant's most points, 3 frames, the frame loop
 SAN_SIM := --strands 300 --points 45 --hair-length 10 --stages init,simulate --frames 3 --velocities all --repeat 2 \
   --substeps 2 --iterations 2 --bend-compliance 1e-6 --shape-compliance 1e-5 --wind-speed 300 --drag 2 \
   --gust-amplitude 0.5 --head-motion nod --quiet
@@ -170,16 +171,17 @@ sanitize-gpu: cuda
 	  echo "racecheck $$v"; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_RUN) --variant $$v; \
 	done; \
-	for v in strand warp; do for p in fp32 fp64; do for s in xpbd ftl; do \
-	  echo "memcheck simulate $$v $$p $$s"; \
-	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) \
-	    --variant $$v --precision $$p --solver $$s --output $(BUILD)/san-sim-$$v-$$p-$$s.h5 --force; \
+	for vp in $$($(PYTHON) -c "from harness import variants; d = variants.declared('cuda'); print(*(f'{v}:{min(45, d.max_points.get(v) or 45)}' for v in d.running('simulate')))"); do \
+	  v=$${vp%%:*}; np=$${vp##*:}; for p in fp32 fp64; do for s in xpbd ftl; do \
+	  echo "memcheck simulate $$v $$p $$s ($$np points)"; \
+	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --points $$np \
+	    --variant $$v --precision $$p --solver $$s --frame-loop --output $(BUILD)/san-sim-$$v-$$p-$$s.h5 --force; \
 	  compute-sanitizer --tool memcheck --error-exitcode 9 $(BUILD)/hairsim-cuda --input $(BUILD)/san-sim-$$v-$$p-$$s.h5 \
 	    --input-frame 2 --stages simulate --frames 1 --variant $$v --quiet --output $(BUILD)/san-sim-$$v-$$p-$$s-r.h5 --force; \
 	  done; done; \
 	  echo "racecheck simulate $$v"; \
-	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --variant $$v --frames 1; \
-	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --variant $$v --frames 1 --solver ftl; \
+	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --points $$np --variant $$v --frames 1; \
+	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --points $$np --variant $$v --frames 1 --solver ftl; \
 	done; rm -f $(BUILD)/san-*.h5; echo "compute-sanitizer: memcheck and racecheck found no errors in any variant"
 
 # ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----

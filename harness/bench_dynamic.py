@@ -183,14 +183,33 @@ def _harness(argv, say):
         raise HarnessError(f"`python -m harness {' '.join(argv)}` exited with status {code}", code=code)
 
 
+def fastest_gpu_variants(sweep_dir):
+    """The default build's simulate variant with the most point-substeps per second at the
+    sweep's largest fp32 strand count; every simulate variant when the sweep has no GPU row."""
+    decl = variants.declared("cuda")
+    every = list(decl.running("simulate", points=32))
+    try:
+        from .results_data import load
+
+        rows, _ = load(sweep_dir)
+    except HarnessError:
+        return every
+    g = rows[(rows["stage"] == "simulate") & (rows["backend"] == "cuda") & (rows["precision"] == "fp32")]
+    g = g[g["build"].isin(["", "default"])]
+    if g.empty:
+        return every
+    top = g[g["strands"] == g["strands"].max()]
+    best = top.loc[top["point_substeps_per_s"].astype(float).idxmax()]
+    return [str(best["variant"])]
+
+
 def studies(root, builds, say, report_dir=None, quick=False):
     """The dynamic studies, each into root/<study> (`quick`: their small versions)."""
     fc = root / "featurecost"
     fc.mkdir(parents=True, exist_ok=True)
     _harness(["featurecost", "--backend", "cpu", "--out", str(fc / "cpu.csv")], say)
-    if builds:  # every variant that simulates, on the default build, at a size that fills the GPU
-        decl = variants.declared("cuda")
-        for v in (n for n in decl.variants if decl.runs(n, points=32)):
+    if builds:  # the sweep's fastest variant (else every one that simulates), at a size that fills the GPU
+        for v in fastest_gpu_variants(root / SWEEP):
             out = fc / f"cuda-{v}.csv"
             argv = ["featurecost", "--backend", "cuda", "--variant", v, "--strands", "1000000", "--out", str(out)]
             _harness(argv, say)
