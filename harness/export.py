@@ -38,6 +38,12 @@ def _writable(path):
 
 
 def _replace(tmp, path):
+    """fsync the finished temporary, then rename it over path (as the binaries do)."""
+    fd = os.open(tmp, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
     os.replace(tmp, path)
     return Path(path)
 
