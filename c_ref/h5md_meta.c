@@ -47,22 +47,18 @@ int hb_h5md_str_attr(hid_t loc, const char *name, const char *value)
     return rc < 0 ? -1 : 0;
 }
 
-/* `unit` is a variable-length string: readers built on h5py (MDAnalysis) get a str back and
- * look it up in their unit tables; a fixed-length one comes back as bytes and is refused. */
+int hb_h5md_unit(hid_t dataset, const char *unit)
+{
+    return hb_h5md_str_attr(dataset, "unit", unit);
+}
+
 static int unit_on(hid_t file, const char *path, const char *unit)
 {
     hid_t d = H5Dopen2(file, path, H5P_DEFAULT);
     if (d < 0) return -1;
-    hid_t t = H5Tcopy(H5T_C_S1), sp = H5Screate(H5S_SCALAR);
-    H5Tset_size(t, H5T_VARIABLE);
-    H5Tset_cset(t, H5T_CSET_UTF8);
-    hid_t a = H5Acreate2(d, "unit", t, sp, H5P_DEFAULT, H5P_DEFAULT);
-    herr_t rc = a < 0 ? -1 : H5Awrite(a, t, &unit);
-    if (a >= 0) H5Aclose(a);
-    H5Sclose(sp);
-    H5Tclose(t);
+    int rc = hb_h5md_unit(d, unit);
     H5Dclose(d);
-    return rc < 0 ? -1 : 0;
+    return rc;
 }
 
 /* int32 strand ids, written a chunk at a time (no N·P buffer); compressed where HDF5 has
@@ -110,6 +106,7 @@ int hb_h5md_finish(hid_t file, const hb_scene *s)
     bad |= a < 0 || H5Awrite(a, H5T_NATIVE_INT32, version) < 0;
     if (a >= 0) H5Aclose(a);
     H5Sclose(sp);
+    bad |= units < 0 || hb_h5md_str_attr(units, "system", "SI") < 0; /* cm and s: SI prefixes and units */
     if (units >= 0) H5Gclose(units);
     if (modules >= 0) H5Gclose(modules);
     bad |= unit_on(file, "particles/hair/position/value", "cm") < 0;

@@ -273,7 +273,7 @@ int hb_writer_rest(hb_writer *w, const void *rest, char *err, size_t errlen)
                          H5P_DEFAULT);
     herr_t rc =
         d < 0 ? -1 : H5Dwrite(d, f64 ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, rest);
-    if (rc >= 0 && attr_str(d, "unit", "cm") < 0) rc = -1;
+    if (rc >= 0 && hb_h5md_unit(d, "cm") < 0) rc = -1;
     if (d >= 0) H5Dclose(d);
     H5Sclose(sp);
     H5Gclose(hair);
@@ -292,7 +292,7 @@ int hb_writer_velocity(hb_writer *w, const void *v, int64_t step, double time, c
         hid_t hair = H5Gopen2(w->file, "particles/hair", H5P_DEFAULT);
         hid_t g = make_group(hair, "velocity");
         w->velocity = g < 0 ? -1 : create_frames_ds(g, "value", w->rows, w->scene.precision);
-        if (w->velocity >= 0 && attr_str(w->velocity, "unit", "cm s-1") < 0) {
+        if (w->velocity >= 0 && hb_h5md_unit(w->velocity, "cm s-1") < 0) {
             H5Dclose(w->velocity);
             w->velocity = -1;
         }
@@ -391,12 +391,12 @@ static int write_series(hid_t obs, const char *name, hid_t ftype, hid_t mtype, c
     bad |= ds_1d(g, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, w->obs_time) < 0;
     if (!bad && unit) {
         hid_t d = H5Dopen2(g, "value", H5P_DEFAULT);
-        bad |= d < 0 || attr_str(d, "unit", unit) < 0;
+        bad |= d < 0 || hb_h5md_unit(d, unit) < 0;
         if (d >= 0) H5Dclose(d);
     }
     if (!bad) {
         hid_t d = H5Dopen2(g, "time", H5P_DEFAULT);
-        bad |= d < 0 || attr_str(d, "unit", "s") < 0;
+        bad |= d < 0 || hb_h5md_unit(d, "s") < 0;
         if (d >= 0) H5Dclose(d);
     }
     H5Gclose(g);
@@ -450,6 +450,9 @@ static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
         if (g >= 0) {
             bad |= ds_1d(g, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, (hsize_t)w->n_vel, w->vel_step) < 0;
             bad |= ds_1d(g, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (hsize_t)w->n_vel, w->vel_time) < 0;
+            hid_t t = bad ? -1 : H5Dopen2(g, "time", H5P_DEFAULT);
+            bad |= t < 0 || hb_h5md_unit(t, "s") < 0;
+            if (t >= 0) H5Dclose(t);
             H5Gclose(g);
         }
     }

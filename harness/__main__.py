@@ -451,10 +451,10 @@ def parser():
     r.add_argument("--force", action="store_true", help="allow replacing --output")
     r.add_argument("--timeout", type=seconds, default=None, help="seconds before giving up")
     r.add_argument("--json", action="store_true", help="print the binary's JSON record")
-    r.add_argument("--frames", type=int, default=None, help="dynamic scenes: override dynamics.frames")
+    r.add_argument("--frames", type=whole(1), default=None, help="dynamic scenes: override dynamics.frames")
     r.add_argument(
         "--every",
-        type=int,
+        type=whole(1),
         default=None,
         help="dynamic scenes: print every K-th frame's observables (default: about 30 lines)",
     )
@@ -474,7 +474,7 @@ def parser():
     sd.add_argument("--frames", default="all", help="frame indices of A: all (default), K, K..L, K.., ..L")
     sd.add_argument("--exact", action="store_true", help="require bit-identical frames")
     sd.add_argument("--keep", help="keep the binary's outputs in this directory")
-    sd.add_argument("--timeout", type=float, default=None, help="seconds per binary run")
+    sd.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
     sd.add_argument(
         "flags", nargs=argparse.REMAINDER, help="further flags for the binary (after the options, e.g. -- --threads 1)"
     )
@@ -779,6 +779,16 @@ def main(argv=None):
     except HarnessError as e:
         print(f"harness: error: {e}", file=sys.stderr)
         return e.code if e.code else 2
+    except OSError as e:  # a path given that cannot be read or written, or a full disk: no traceback
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"harness: error: {where}{e.strerror or e}", file=sys.stderr)
+        return (
+            2
+            if isinstance(
+                e, (FileNotFoundError, FileExistsError, IsADirectoryError, NotADirectoryError, PermissionError)
+            )
+            else 4
+        )
     except KeyboardInterrupt:
         print("harness: interrupted", file=sys.stderr)
         return 130

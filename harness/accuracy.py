@@ -24,13 +24,12 @@ import csv
 import json
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from . import env, invariants, runner, scenes, variants
 from .accuracy_report import REFERENCE, pareto_plot, write_markdown
-from .paths import REPORT, RESULTS, binary_path, display
+from .paths import REPORT, RESULTS, binary_path, display, output_dir
 from .states import open_state
 
 
@@ -160,11 +159,9 @@ def run_study(
     log=print,
 ):
     scene = scenes.load_scene(scene_name).with_overrides(strands=strands, points=points)
-    out_dir = Path(out_dir or RESULTS / "accuracy")
-    report_dir = Path(report_dir or REPORT)
-    scratch = out_dir / "states"
-    scratch.mkdir(parents=True, exist_ok=True)
-    report_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = output_dir(out_dir or RESULTS / "accuracy")
+    report_dir = output_dir(report_dir or REPORT, "--report-dir")
+    scratch = output_dir(out_dir / "states")
     gpu_ok, why = env.gpu_status()
     L = scene.hair_length
     rows = []

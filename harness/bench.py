@@ -21,7 +21,7 @@ import tempfile
 from pathlib import Path
 
 from . import HarnessError, diff, env, report, runner, variants
-from .paths import CUDA_BUILDS, RESULTS, binary_path, display
+from .paths import CUDA_BUILDS, RESULTS, binary_path, display, output_dir
 from .plots import ensure_figure_state
 from .sweep import run_sweep, write_json
 from .sweepfile import load_sweep
@@ -177,8 +177,7 @@ def run(sweep_ref="default", out=None, gpu="auto", report_dir=None, log=None):
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
     sweep = load_sweep(sweep_ref)
-    out_dir = Path(out) if out else RESULTS / sweep.name
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = output_dir(out if out else RESULTS / sweep.name)
     builds, gpu_note = gpu_plan(gpu)
     if gpu_note:
         say(f"harness: GPU rows skipped: {gpu_note}")

@@ -7,6 +7,11 @@
   few kilobytes at any strand count.
 - USD (`STATE.usdc`, needs PyPI `usd-core`): one `BasisCurves` prim, linear, with one time
   sample per frame, for Blender, Houdini and usdview.
+
+A dynamic state's velocities go with the frames whose step has one (XDMF attribute
+`velocity`, USD `velocities`), and its rest shape with every frame (XDMF `rest_position`,
+USD primvar `rest`). Its observables are per-frame numbers, not geometry: they stay in the
+state (harness.trajectory reads them).
 """
 
 import os
@@ -18,6 +23,8 @@ import numpy as np
 from . import HarnessError
 
 POSITION = "particles/hair/position"
+VELOCITY = "particles/hair/velocity"
+REST = "particles/hair/rest_position"
 BLOCK_ROWS = 1 << 20  # rows written or read at a time
 
 
@@ -31,6 +38,12 @@ def _writable(path):
 
 
 def _replace(tmp, path):
+    """fsync the finished temporary, then rename it over path (as the binaries do)."""
+    fd = os.open(tmp, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
     os.replace(tmp, path)
     return Path(path)
 
@@ -68,6 +81,21 @@ def frame_times(f):
     return np.arange(frames, dtype=np.float64)
 
 
+def velocity_frames(f):
+    """{position frame index: velocity frame index} for the frames whose step has velocities."""
+    if f"{VELOCITY}/value" not in f:
+        return {}
+    at = {int(s): j for j, s in enumerate(f[f"{VELOCITY}/step"][()])}
+    return {k: at[int(s)] for k, s in enumerate(f[f"{POSITION}/step"][()]) if int(s) in at}
+
+
+def seconds_per_frame(f):
+    """The physical time between the last two frames of a state, or None (the paper
+    model's frames carry no time)."""
+    t = np.asarray(f[f"{POSITION}/time"][()], dtype=np.float64) if f"{POSITION}/time" in f else []
+    return float(t[-1] - t[-2]) if len(t) > 1 and t[-1] > t[-2] else None
+
+
 def write_connectivity(path, n, p):
     """[N][P] point indices of each strand's polyline, compressed, written in blocks."""
     import h5py
@@ -91,10 +119,32 @@ def write_connectivity(path, n, p):
     return dtype
 
 
-def _xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_strand):
+def _vector(name, state_ref, dataset, rows, float_bytes, index=None, count=None):
+    """An XDMF node attribute of 3-vectors: DATASET [rows][3], or its frame INDEX of COUNT."""
+    heavy = f'<DataItem Dimensions="{{dims}}" NumberType="Float" Precision="{float_bytes}" Format="HDF">{state_ref}:/{dataset}</DataItem>'
+    if index is None:
+        item = heavy.format(dims=f"{rows} 3")
+    else:
+        item = (
+            f'<DataItem ItemType="HyperSlab" Dimensions="{rows} 3" Type="HyperSlab">\n'
+            f'       <DataItem Dimensions="3 3" Format="XML">{index} 0 0 1 1 1 1 {rows} 3</DataItem>\n'
+            f"       {heavy.format(dims=f'{count} {rows} 3')}\n"
+            f"      </DataItem>"
+        )
+    return f'\n     <Attribute Name="{name}" AttributeType="Vector" Center="Node">\n      {item}\n     </Attribute>'
+
+
+def _xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_strand, dyn):
     rows = n * p
     grids = []
     for k in range(frames):
+        extra = ""
+        if k in dyn["velocity"]:
+            extra += _vector(
+                "velocity", state_ref, f"{VELOCITY}/value", rows, float_bytes, dyn["velocity"][k], dyn["n_velocity"]
+            )
+        if dyn["rest"]:
+            extra += _vector("rest_position", state_ref, REST, rows, float_bytes)
         strand = (
             (
                 f'\n     <Attribute Name="strand" AttributeType="Scalar" Center="Node">\n'
@@ -114,7 +164,7 @@ def _xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_
        <DataItem Dimensions="3 3" Format="XML">{k} 0 0 1 1 1 1 {rows} 3</DataItem>
        <DataItem Dimensions="{frames} {rows} 3" NumberType="Float" Precision="{float_bytes}" Format="HDF">{state_ref}:/{POSITION}/value</DataItem>
       </DataItem>
-     </Geometry>{strand}
+     </Geometry>{strand}{extra}
     </Grid>""")
     body = "\n".join(grids)
     return f"""<?xml version="1.0" ?>
@@ -141,6 +191,11 @@ def export_xdmf(state, out_prefix=None):
         frames, float_bytes = value.shape[0], value.dtype.itemsize
         times = frame_times(f)
         has_strand = "particles/hair/strand" in f
+        dyn = {
+            "velocity": velocity_frames(f),
+            "n_velocity": f[f"{VELOCITY}/value"].shape[0] if f"{VELOCITY}/value" in f else 0,
+            "rest": REST in f,
+        }
     tmp_topo, tmp_xdmf = _writable(topo_path), _writable(xdmf_path)
     try:
         int_bytes = np.dtype(write_connectivity(tmp_topo, n, p)).itemsize
@@ -150,7 +205,7 @@ def export_xdmf(state, out_prefix=None):
     here = xdmf_path.parent.resolve()
     state_ref = escape(os.path.relpath(state.resolve(), here))
     topo_ref = escape(os.path.relpath(topo_path.resolve(), here))
-    tmp_xdmf.write_text(_xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_strand))
+    tmp_xdmf.write_text(_xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_strand, dyn))
     return _replace(tmp_xdmf, xdmf_path), _replace(tmp_topo, topo_path)
 
 
@@ -177,7 +232,9 @@ def export_usd(state, out_prefix=None):
         UsdGeom.SetStageMetersPerUnit(stage, 0.01)  # positions are in cm
         stage.SetStartTimeCode(0)
         stage.SetEndTimeCode(frames - 1)
-        stage.SetTimeCodesPerSecond(24)
+        dt = seconds_per_frame(f)
+        # time code = frame index; a dynamic state's frame rate makes its velocities (per second) agree
+        stage.SetTimeCodesPerSecond(1.0 / dt if dt else 24)
         root = UsdGeom.Xform.Define(stage, "/hair")
         stage.SetDefaultPrim(root.GetPrim())
         curves = UsdGeom.BasisCurves.Define(stage, "/hair/strands")
@@ -189,6 +246,17 @@ def export_usd(state, out_prefix=None):
         for k in range(frames):
             frame = np.ascontiguousarray(value[k], dtype=np.float32)
             points.Set(Vt.Vec3fArray.FromNumpy(frame), Usd.TimeCode(k))
+        vel = velocity_frames(f)
+        if vel:
+            velocities = curves.CreateVelocitiesAttr()
+            for k, j in vel.items():
+                frame = np.ascontiguousarray(f[f"{VELOCITY}/value"][j], dtype=np.float32)
+                velocities.Set(Vt.Vec3fArray.FromNumpy(frame), Usd.TimeCode(k))
+        if REST in f:
+            rest = UsdGeom.PrimvarsAPI(curves).CreatePrimvar(
+                "rest", Sdf.ValueTypeNames.Point3fArray, UsdGeom.Tokens.vertex
+            )
+            rest.Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(f[REST][()], dtype=np.float32)))
         prim = curves.GetPrim()
         prim.CreateAttribute("hairbench:frameTime", Sdf.ValueTypeNames.DoubleArray).Set(Vt.DoubleArray.FromNumpy(times))
         try:

@@ -16,10 +16,9 @@ runs after a warm-up, per-stage compute only (docs/interfaces.md).
 
 import json
 import os
-from pathlib import Path
 
 from . import env, roofline, runner, variants
-from .paths import CUDA_BUILDS, RESULTS, binary_path, display
+from .paths import CUDA_BUILDS, RESULTS, binary_path, display, output_dir
 
 STAGES = "init,collide,wind,collide"
 
@@ -59,8 +58,7 @@ def _row(label, rec, copy_gbps):
 
 
 def run(strands=4 * 1024 * 1024, points=32, repeat=9, cpu_repeat=3, block_size=256, out_dir=None, log=print):
-    out_dir = Path(out_dir or RESULTS / "headline")
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = output_dir(out_dir or RESULTS / "headline")
     base = ["--strands", strands, "--points", points, "--stages", STAGES]
     result = {"strands": strands, "points": points, "env": env.collect(), "rows": []}
     cpu = binary_path("cpu")

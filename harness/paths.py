@@ -75,3 +75,18 @@ def read_toml(path, where, error):
         raise error(f"{where}: not UTF-8 text (byte {e.start}); TOML files are UTF-8") from None
     except OSError as e:
         raise error(f"{where}: cannot read: {e.strerror}") from None
+
+
+def output_dir(path, what="--out"):
+    """Make the directory `path` (and its parents) for a command's outputs; a path that
+    exists and is not a directory, or cannot be made, is refused in one line."""
+    from . import HarnessError
+
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise HarnessError(f"{what} {path} exists and is not a directory")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise HarnessError(f"{what} {path}: cannot make the directory ({e.strerror or e})") from None
+    return path

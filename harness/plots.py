@@ -22,7 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from . import results_data  # noqa: E402
-from .paths import REPORT, binary_path  # noqa: E402
+from .paths import REPORT, binary_path, output_dir  # noqa: E402
 
 FIGURE_STRANDS = 400  # strands in the Fig. 1/2 state
 FIGURE_DRAWN = 160  # strands drawn of them
@@ -246,7 +246,7 @@ def hair_figures(state_path, out_dir):
 
 def make_all(results_dir, report_dir=None):
     """Every plot of a results directory; returns the paths written."""
-    out_dir = Path(report_dir) if report_dir else REPORT
+    out_dir = output_dir(report_dir if report_dir else REPORT, "--report-dir")
     rows, env = results_data.load(results_dir)
     cases = results_data.per_case(rows)
     gpu_note = results_data.gpu_absent_reason(env)

@@ -14,7 +14,7 @@ import os
 from pathlib import Path
 
 from . import results_data
-from .paths import REPORT, display
+from .paths import REPORT, display, output_dir
 from .plots import make_all
 from .results_data import curve_of, interp_time, strands_at_time
 
@@ -264,8 +264,7 @@ def headline_section(path):
 
 
 def build(results_dir="results/default", report_dir=None):
-    out_dir = Path(report_dir) if report_dir else REPORT
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = output_dir(report_dir if report_dir else REPORT, "--report-dir")
     rows, env = results_data.load(results_dir)
     cases = results_data.per_case(rows)
     pictures = make_all(results_dir, out_dir)

@@ -41,7 +41,7 @@ have_hdf5() {
 need=()
 command -v "$CC_BIN" >/dev/null 2>&1 && command -v make >/dev/null 2>&1 || need+=("a C compiler and make")
 command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
-command -v "$CC_BIN" >/dev/null 2>&1 && ! have_hdf5 && need+=("the HDF5 C library")
+{ ! command -v "$CC_BIN" >/dev/null 2>&1 || ! have_hdf5; } && need+=("the HDF5 C library")
 command -v "$PY" >/dev/null 2>&1 || need+=("$PY")
 if [ ${#need[@]} -gt 0 ]; then
   what=$(IFS=,; echo "${need[*]}" | sed 's/,/, /g')

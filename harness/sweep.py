@@ -10,12 +10,11 @@ results/<name>/env.json, one entry per session (a resumed run adds one).
 
 import json
 import os
-from pathlib import Path
 
 import numpy as np
 
 from . import HarnessError, env, roofline, runlog
-from .paths import RESULTS, binary_path, display
+from .paths import RESULTS, binary_path, display, output_dir
 from .progress import Progress
 from .runner import BackendError, DoesNotFit, run_binary, run_flags
 from .scenes import SceneError
@@ -188,8 +187,7 @@ def check_same_machine(before, now, out_dir):
 def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
     """Run (or resume) a sweep; return (results dir, number of failed cases)."""
     sweep = load_sweep(sweep_ref)
-    out_dir = Path(out) if out else RESULTS / sweep.name
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = output_dir(out if out else RESULTS / sweep.name)
     csv_path = out_dir / "runs.csv"
     env_path = out_dir / "env.json"
     say = log or (lambda m: print(m, flush=True))

@@ -76,6 +76,8 @@ FLAGS = [
     ("strands_text", ["--strands", "x"]),
     ("points_one", ["--points", "1"]),
     ("stages_empty_item", ["--stages", "init,,wind"]),
+    ("frames_zero", ["--frames", "0"]),
+    ("every_zero", ["--every", "0"]),
     ("unknown_flag", ["--colour", "red"]),
 ]
 
@@ -83,6 +85,24 @@ FLAGS = [
 @pytest.mark.parametrize("name,args", FLAGS, ids=[f[0] for f in FLAGS])
 def test_bad_flag_is_one_line(name, args, cpu_bin):
     one_line_refusal(harness("run", "still", *args))
+
+
+OTHER_COMMANDS = [
+    ("stepdiff_timeout_negative", ["stepdiff", "--reference", "r.h5", "--binary", "b", "--timeout", "-1"]),
+    ("stepdiff_timeout_nan", ["stepdiff", "--reference", "r.h5", "--binary", "b", "--timeout", "nan"]),
+    ("sweep_out_a_device", ["sweep", "quick", "--out", "/dev/null"]),
+    ("report_into_a_file", ["report", "results/reference-h200/sweep", "--report-dir", "{file}"]),
+    ("plot_into_a_file", ["plot", "results/reference-h200/sweep", "--report-dir", "{file}"]),
+    ("featurecost_strands_zero", ["featurecost", "--strands", "0"]),
+]
+
+
+@pytest.mark.parametrize("name,args", OTHER_COMMANDS, ids=[c[0] for c in OTHER_COMMANDS])
+def test_bad_flag_of_other_commands_is_one_line(tmp_path, name, args):
+    a_file = tmp_path / "a_file"
+    a_file.write_text("keep")
+    one_line_refusal(harness(*(a.format(file=a_file) for a in args)))
+    assert a_file.read_text() == "keep"
 
 
 def test_bad_command_is_one_line():

@@ -3,6 +3,7 @@ not a regular file is refused even with --force, a signalled run leaves no tempo
 and exits non-zero, and the next run into a directory removes the temporaries of dead runs."""
 
 import os
+import shutil
 import signal
 import subprocess
 import time
@@ -119,3 +120,52 @@ def test_stale_temporaries_of_dead_runs_are_removed(cpu_bin, tmp_path):
     notes = [line for line in r.stderr.splitlines() if "stale temporary" in line]
     assert len(notes) == 1 and "removed 2 stale temporary files" in notes[0], r.stderr
     assert sorted(tmp_leftovers(tmp_path)) == sorted([f"notes.txt.tmp.{pid}", f"alive.h5.tmp.{os.getpid()}"])
+
+
+def test_fsync_before_the_rename(cpu_bin, tmp_path):
+    """The system calls themselves, seen by strace: the temporary is fsynced, then renamed
+    over the output, then the directory is fsynced."""
+    if shutil.which("strace") is None:
+        pytest.skip("strace not installed (apt-get install strace)")
+    out = tmp_path / "s.h5"
+    trace = tmp_path / "trace"
+    p = subprocess.run(
+        ["strace", "-f", "-y", "-o", str(trace), "-e", "trace=fsync,fdatasync,rename,renameat,renameat2"]
+        + [str(cpu_bin), *SMALL, "--output", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    if p.returncode != 0 and "ptrace" in p.stderr:
+        pytest.skip(f"strace cannot trace here: {p.stderr.strip()[-200:]}")
+    assert p.returncode == 0, p.stderr
+    calls = [line.split(None, 1)[1] for line in trace.read_text().splitlines() if "(" in line and "---" not in line]
+    synced = [i for i, c in enumerate(calls) if c.startswith(("fsync(", "fdatasync(")) and f"<{out}.tmp." in c]
+    renamed = [i for i, c in enumerate(calls) if c.startswith("rename") and f'"{out}"' in c and c.endswith("= 0")]
+    dir_synced = [i for i, c in enumerate(calls) if c.startswith("fsync(") and f"<{tmp_path}>)" in c]
+    assert synced and renamed and dir_synced, calls
+    assert synced[-1] < renamed[0] < dir_synced[-1], calls
+
+
+def test_output_replaced_while_running_is_refused_and_the_temporary_removed(cpu_bin, tmp_path):
+    """An error path with a real run: the --output becomes a directory while the run writes
+    its temporary; the check before the rename refuses it, and nothing is left behind."""
+    out = tmp_path / "s.h5"
+    proc = subprocess.Popen(
+        [str(cpu_bin), "--strands", "4000", "--points", "16", "--stages", "init,simulate", "--frames", "600"]
+        + ["--threads", "1", "--output", str(out), "--quiet"],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert _wait_for_tmp(tmp_path, proc), "the run ended before its temporary file appeared"
+        out.mkdir()
+        _, err = proc.communicate(timeout=600)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode != 0 and "is a directory" in err, err
+    assert err.strip().count("\n") == 0, err
+    assert out.is_dir() and not any(out.iterdir())
+    assert tmp_leftovers(tmp_path) == []

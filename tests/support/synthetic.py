@@ -116,3 +116,38 @@ def write_state(path, positions, stages, precision=None, params=None, skipped=No
             )
     os.replace(tmp, path)
     return path
+
+
+# Departures from H5MD that harness.h5md.problems must name (tests/test_readers.py).
+H5MD_BREAKS = {
+    "variable_length_unit": "'unit' is not a fixed-length ASCII string",
+    "no_unit_system": "no 'system' attribute",
+    "unknown_unit": "'furlong' is not an SI unit symbol",
+    "time_without_unit": "time has no unit 's'",
+    "strand_ids_wrong": "strand is not the strand index",
+    "variable_length_author": "/h5md/author: 'name' is not a fixed-length ASCII string",
+}
+
+
+def break_h5md(path, how):
+    """Change one thing of a state at `path`, in place, so that it departs from H5MD (or
+    from the documented strand ids) in the way H5MD_BREAKS[how] names."""
+    import h5py
+
+    with h5py.File(path, "r+") as f:
+        value, time = f["particles/hair/position/value"], f["particles/hair/position/time"]
+        if how == "variable_length_unit":
+            value.attrs["unit"] = "cm"  # h5py writes a str as a variable-length UTF-8 string
+        elif how == "no_unit_system":
+            del f["h5md/modules/units"].attrs["system"]
+        elif how == "unknown_unit":
+            value.attrs["unit"] = np.bytes_(b"furlong")
+        elif how == "time_without_unit":
+            del time.attrs["unit"]
+        elif how == "strand_ids_wrong":
+            ids = f["particles/hair/strand"]
+            ids[0] = ids[0] + 1
+        elif how == "variable_length_author":
+            f["h5md/author"].attrs["name"] = "someone"
+        else:
+            raise ValueError(how)
