@@ -30,12 +30,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <vector>
 
 #include "backend.h"
 #include "check.cuh"
 #include "dyn_kernels.cuh"
+#include "host.h"
 #include "kernels.cuh"
 #include "model.h"
 
@@ -75,40 +75,17 @@ struct cuda_impl {
     DynState *dyn; /* simulate (backend_dyn.cuh); NULL when the run does not simulate */
 };
 
-double now_ms()
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
-}
-
 uint64_t sat_add(uint64_t a, uint64_t b)
 {
     return a > UINT64_MAX - b ? UINT64_MAX : a + b;
 }
 
-/* The scene's numbers rounded once to the working precision, exactly as backend_cpu.c's
- * round_scene does: derived values in double, then each rounded once to float. */
+/* The scene's numbers rounded once to the working precision (host.c, shared with the CPU). */
 void round_scene(cuda_impl *c, const hb_scene *s)
 {
     hb_model_f64 d;
-    d.seed = s->seed;
-    d.points = s->points;
-    d.head_radius = s->head_radius;
-    d.hair_offset = s->hair_offset;
-    d.face_margin = s->face_margin;
-    d.seg_len = hb_segment_length(s);
-    d.wind_strength = s->wind_strength;
-    d.wind_angle = hb_wind_angle_reduced(s);
     hb_model_f32 f;
-    f.seed = s->seed;
-    f.points = s->points;
-    f.head_radius = (float)d.head_radius;
-    f.hair_offset = (float)d.hair_offset;
-    f.face_margin = (float)d.face_margin;
-    f.seg_len = (float)d.seg_len;
-    f.wind_strength = (float)d.wind_strength;
-    f.wind_angle = (float)d.wind_angle;
+    hb_model_round(s, &f, &d);
     c->m64 = hb::model_from<hb_model_f64, double>(d);
     c->m32 = hb::model_from<hb_model_f32, float>(f);
 }
@@ -193,21 +170,15 @@ int setup_inner(hb_backend *b, cuda_impl *c, const hb_options *o, int need_save,
     size_t free_b = 0, total_b = 0;
     HB_CUDA(cudaMemGetInfo(&free_b, &total_b));
     if (need > (uint64_t)free_b) {
-        snprintf(err, errlen,
-                 "the state needs %.2f GB of GPU memory (%lld strands x %lld points, %s: state%s%s%s) but only %.2f GB "
-                 "is free on %s",
-                 1e-9 * (double)need, (long long)c->N, (long long)c->P, hb_precision_name(o->scene.precision),
-                 point_major ? " + staging" : "", need_save ? " + saved copy" : "",
-                 dyn_bytes ? " + simulate (velocities, rest shape, scratch)" : "", 1e-9 * (double)free_b, c->device);
+        char detail[160];
+        snprintf(detail, sizeof detail, ": state%s%s%s", point_major ? " + staging" : "",
+                 need_save ? " + saved copy" : "", dyn_bytes ? " + simulate (velocities, rest shape, scratch)" : "");
+        hb_memory_message(err, errlen, &o->scene, "GPU", need, (uint64_t)free_b, detail, c->device);
         return HB_EXIT_MEMORY;
     }
     const uint64_t avail = hb_host_memory_available();
     if (avail && driver_bytes > avail) {
-        snprintf(
-            err, errlen,
-            "the state needs %.2f GB of host memory (%lld strands x %lld points, %s) but only %.2f GB is available",
-            1e-9 * (double)driver_bytes, (long long)c->N, (long long)c->P, hb_precision_name(o->scene.precision),
-            1e-9 * (double)avail);
+        hb_memory_message(err, errlen, &o->scene, "host", driver_bytes, avail, NULL, NULL);
         return HB_EXIT_MEMORY;
     }
 
@@ -237,7 +208,7 @@ int cuda_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t drive
 int cuda_load(hb_backend *b, const void *canonical, double *ms, char *err, size_t errlen)
 {
     cuda_impl *c = (cuda_impl *)b->impl;
-    const double t0 = now_ms();
+    const double t0 = hb_now_ms();
     if (dyn_is_strand_major(c)) {
         HB_CUDA(cudaMemcpy(c->state, canonical, (size_t)c->bytes, cudaMemcpyHostToDevice));
     } else {
@@ -253,14 +224,14 @@ int cuda_load(hb_backend *b, const void *canonical, double *ms, char *err, size_
                        "the canonical-to-point-major kernel launch");
     }
     HB_CUDA_AS(cudaDeviceSynchronize(), "load (cudaDeviceSynchronize)");
-    *ms = now_ms() - t0;
+    *ms = hb_now_ms() - t0;
     return 0;
 }
 
 int cuda_fetch(hb_backend *b, void *canonical, double *ms, char *err, size_t errlen)
 {
     cuda_impl *c = (cuda_impl *)b->impl;
-    const double t0 = now_ms();
+    const double t0 = hb_now_ms();
     if (dyn_is_strand_major(c)) {
         HB_CUDA(cudaMemcpy(canonical, c->state, (size_t)c->bytes, cudaMemcpyDeviceToHost));
     } else {
@@ -276,7 +247,7 @@ int cuda_fetch(hb_backend *b, void *canonical, double *ms, char *err, size_t err
         HB_CUDA(cudaMemcpy(canonical, c->staging, (size_t)c->bytes, cudaMemcpyDeviceToHost));
     }
     HB_CUDA_AS(cudaDeviceSynchronize(), "fetch (cudaDeviceSynchronize)");
-    *ms = now_ms() - t0;
+    *ms = hb_now_ms() - t0;
     return 0;
 }
 

@@ -411,10 +411,10 @@ int cuda_dyn_loop(hb_backend *b, const hb_dyn_frame *plans, int n, double *ms, d
     HB_CUDA(cudaDeviceSynchronize());
     /* launched one by one: a warm-up pass, then the timed one */
     for (int pass = 0; pass < 2; pass++) {
-        const double t0 = now_ms();
+        const double t0 = hb_now_ms();
         HB_CUDA_AS(dyn_enqueue_loop(c, r, n, tq, tp), dyn_launch_name(c));
         HB_CUDA_AS(cudaStreamSynchronize(r.st), "the frame loop (cudaStreamSynchronize)");
-        *ms = (now_ms() - t0) / (double)n;
+        *ms = (hb_now_ms() - t0) / (double)n;
     }
     /* the same n frames captured once as a graph: a warm-up replay, then the timed one */
     HB_CUDA(cudaStreamBeginCapture(r.st, cudaStreamCaptureModeThreadLocal));
@@ -425,10 +425,10 @@ int cuda_dyn_loop(hb_backend *b, const hb_dyn_frame *plans, int n, double *ms, d
     HB_CUDA(cudaGraphInstantiate(&r.ge, r.g, 0));
     HB_CUDA(cudaGraphUpload(r.ge, r.st));
     for (int pass = 0; pass < 2; pass++) {
-        const double t0 = now_ms();
+        const double t0 = hb_now_ms();
         HB_CUDA(cudaGraphLaunch(r.ge, r.st));
         HB_CUDA_AS(cudaStreamSynchronize(r.st), "the frame loop's graph (cudaStreamSynchronize)");
-        *graph_ms = (now_ms() - t0) / (double)n;
+        *graph_ms = (hb_now_ms() - t0) / (double)n;
     }
     return 0;
 }

@@ -383,6 +383,7 @@ def cmd_animate(args):
         frames=args.frames,
     ):
         print(f"wrote {path}")
+    return 0
 
 
 def cmd_stability(args):
