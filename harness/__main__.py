@@ -8,6 +8,7 @@ import argparse
 import json
 import math
 import sys
+from pathlib import Path
 
 from . import HarnessError, __version__
 
@@ -148,7 +149,9 @@ def cmd_bench(args):
     if args.model in ("all", "paper"):
         code = bench.run(args.sweep, out=args.out, gpu=args.gpu, report_dir=args.report_dir)
     if args.model in ("all", "dynamic"):
-        root = args.out if args.model == "dynamic" else None
+        # with both models the dynamic results sit beside the paper sweep's directory, as the
+        # headline and accuracy results do (results/ by default)
+        root = args.out if args.model == "dynamic" else (str(Path(args.out).parent) if args.out else None)
         code = (
             bench_dynamic.run(out=root, gpu=args.gpu, report_dir=args.report_dir, quick_studies=args.quick_studies)
             or code
@@ -550,7 +553,8 @@ def parser():
         choices=("all", "paper", "dynamic"),
         default="all",
         help="all (default): the paper model's bench, then the dynamic model's; --out is the paper "
-        "sweep's directory with all, the dynamic bench's root with dynamic (default results/)",
+        "sweep's directory (the dynamic results go beside it) with all, the dynamic bench's root with "
+        "dynamic (default results/)",
     )
     b.add_argument(
         "--quick-studies",

@@ -24,6 +24,8 @@ def bench(tmp_path, *extra, env=None):
         "-m",
         "harness",
         "bench",
+        "--model",
+        "paper",
         "--sweep",
         "configs/sweeps/quick.toml",
         "--out",
