@@ -26,14 +26,13 @@ frame loop (host clock over the loop).
 
 import csv
 import io
-import json
-import os
 import shutil
 import subprocess
 from pathlib import Path
 
 from . import HarnessError, dynscene, env, roofline, runner, scenes, variants
 from .paths import RESULTS, binary_path, display
+from .sweep import write_json
 
 # the targets (reported beside the numbers, never asserted)
 TARGET_MEMORY_FRACTION = 0.90
@@ -286,9 +285,7 @@ def run(strands=4 * 1024 * 1024, repeat=5, frames=2, cpu_repeat=3, ncu=False, ou
 
     summarise(result)
     path = out_dir / "headline_dynamic.json"
-    tmp = path.with_name(f"{path.name}.tmp.{os.getpid()}")
-    tmp.write_text(json.dumps(result, indent=1) + "\n")
-    os.replace(tmp, path)
+    write_json(path, result)
     log(table(result))
     log(f"wrote {display(path)}")
     return result

@@ -6,8 +6,6 @@ usable NVIDIA GPU (or no built CUDA binary) is present.
 """
 
 import os
-import shutil
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -22,18 +20,13 @@ CUDA_FASTMATH_BIN = BUILD / "hairsim-cuda-fastmath"
 
 
 def _gpu_reason():
-    """Return None when a GPU is usable here, else the reason it is not."""
-    if os.environ.get("HAIRBENCH_NO_GPU"):
-        return "HAIRBENCH_NO_GPU is set"
-    smi = shutil.which("nvidia-smi")
-    if smi is None:
-        return "no nvidia-smi on PATH: this machine has no NVIDIA GPU"
-    try:
-        out = subprocess.run([smi, "-L"], capture_output=True, text=True, timeout=30)
-    except (OSError, subprocess.TimeoutExpired) as e:
-        return f"nvidia-smi failed: {e}"
-    if out.returncode != 0 or "GPU" not in out.stdout:
-        return "nvidia-smi lists no GPU"
+    """Return None when a GPU is usable here, else the reason it is not (harness.env's
+    detection, the one the harness uses, plus the built CUDA binary)."""
+    from harness import env
+
+    ok, why = env.gpu_status()
+    if not ok:
+        return why
     if not CUDA_BIN.exists():
         return f"{CUDA_BIN} is not built (run make)"
     return None
