@@ -126,8 +126,10 @@ def headline_lines(path):
     h = json.loads(path.read_text())
     s, t = h.get("summary", {}), h["targets"]
     env = h.get("env", {})
+    gpus = ", ".join(g.get("name", "?") for g in env.get("gpus") or []) or "no GPU"
+    where = f"{gpus} (driver {env.get('driver') or '?'}), {env.get('cpu_model') or '?'} × {env.get('cpu_cores') or '?'}"
     out = [
-        f"Measured by `python -m harness headline --model dynamic` on {env.get('gpu') or env.get('cpu') or '?'} "
+        f"Measured by `python -m harness headline --model dynamic` on {where} "
         f"(revision {env.get('git_revision', '?')}), {h['strands']:,} strands × {h['points']} points, fp32.",
         "",
         "| target | goal | measured | where | met |",
@@ -218,7 +220,8 @@ def build(root, report_dir=None):
             if p:
                 lines += [f"![{p.stem}]({os.path.relpath(p, out_dir)})", ""]
         sess = (env.get("sessions") or [{}])[-1]
-        where = {k: sess.get(k) for k in ("gpu", "cpu", "git_revision") if k in sess}
+        host = sess.get("host") or sess
+        where = {k: host.get(k) for k in ("cpu_model", "cpu_cores", "gpus", "git_revision") if k in host}
         lines += [f"Sweep environment: {json.dumps(where)}", ""]
     else:
         cmd = "python -m harness bench --model dynamic"
