@@ -327,6 +327,7 @@ def cmd_featurecost(args):
         block_size=args.block_size,
         out=args.out,
         timeout=args.timeout,
+        instructions=args.instructions,
     )
     print(featurecost_report.markdown(rows), end="")
     return 0
@@ -699,6 +700,12 @@ def parser():
     fc.add_argument("--block-size", type=whole(32), default=None)
     fc.add_argument("--timeout", type=seconds, default=None)
     fc.add_argument("--out", default=None, help="CSV file to write")
+    fc.add_argument(
+        "--instructions",
+        action="store_true",
+        help="cpu oracle: also count, under valgrind's callgrind, the instructions per point-substep of "
+        "the frame function (deterministic where times are noisy)",
+    )
     fc.set_defaults(func=cmd_featurecost)
 
     pe = sub.add_parser(

@@ -13,6 +13,7 @@ compiles it out), never by setting it to zero:
 """
 
 import csv
+import shutil
 from pathlib import Path
 
 from . import HarnessError, runner, scenes
@@ -48,6 +49,7 @@ FIELDS = (
     "max_ms",
     "point_substeps_per_s",
     "device",
+    "instructions_per_point_substep",
 )
 
 
@@ -100,6 +102,7 @@ def measure(
     out=None,
     timeout=None,
     progress=print,
+    instructions=False,
 ):
     scene = scenes.load_scene(scene_ref).with_overrides(strands=strands, points=points)
     if scene.model != "dynamic":
@@ -111,6 +114,7 @@ def measure(
     for name, flags in cases(base):
         rec = runner.run_binary(binary, flags, timeout=timeout)
         st = declared(rec)
+        ips = instructions_per_point_substep(binary, flags, rec, st, timeout) if instructions else None
         row = {
             "row": name,
             "features": st["features"],
@@ -129,6 +133,7 @@ def measure(
             "max_ms": st["max_ms"],
             "point_substeps_per_s": st["point_substeps_per_s"],
             "device": rec["device"],
+            "instructions_per_point_substep": ips,
         }
         progress(f"featurecost: {name:28s} {st['features']:44s} {st['median_ms']:10.3f} ms/frame")
         rows.append(row)
@@ -140,6 +145,34 @@ def measure(
             w.writeheader()
             w.writerows(rows)
     return rows
+
+
+def instructions_per_point_substep(binary, flags, rec, st, timeout=None):
+    """CPU oracle only: the instructions executed inside the per-strand frame function
+    (hb_dyn_frame_strand_f32/_f64, the whole of a frame's model arithmetic) over the frames'
+    point-substeps, counted by valgrind's callgrind: deterministic, whatever else the machine
+    is doing, where wall times on a shared machine are not."""
+    import re
+    import subprocess
+    import tempfile
+
+    if rec["backend"] != "cpu" or rec.get("variant") not in (None, "ref"):
+        raise HarnessError("featurecost --instructions counts the CPU oracle (--backend cpu, variant ref) only")
+    valgrind = shutil.which("valgrind")
+    if not valgrind:
+        raise HarnessError("featurecost --instructions needs valgrind (apt-get install valgrind)")
+    fn = "hb_dyn_frame_strand_" + ("f64" if rec["precision"] == "fp64" else "f32")
+    args = [str(a) for a in flags]
+    timing = ("--repeat", "--warmup")
+    args = [a for i, a in enumerate(args) if a not in timing and args[i - 1] not in timing]
+    with tempfile.TemporaryDirectory() as d:
+        cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={d}/cg", f"--toggle-collect={fn}", str(binary)]
+        p = subprocess.run(cmd + args + ["--threads", "1", "--quiet"], capture_output=True, text=True, timeout=timeout)
+    m = re.search(r"Collected\s*:\s*([0-9]+)", p.stderr)
+    if p.returncode != 0 or not m:
+        raise HarnessError(f"callgrind failed on {binary.name}: {runner.last_line(p.stderr)}")
+    point_substeps = rec["strands"] * rec["points"] * st["substeps"] * st["frames"]
+    return int(m.group(1)) / point_substeps
 
 
 def _set(flags, flag, value):

@@ -27,16 +27,23 @@ def markdown(rows):
         f"{int(first['strands']):,} strands × {first['points']} points, {first['precision']}, {first['solver']} "
         f"S = {first['substeps']}, I = {first['iterations']}; {where}; {first['device']}",
         "",
-        "| case | features compiled in | ms / frame (median) | min … max | point-substeps/s | vs full |",
-        "| --- | --- | ---: | ---: | ---: | ---: |",
+        "| case | features compiled in | ms / frame (median) | min … max | point-substeps/s | vs full |"
+        + (" instructions / point-substep |" if counted(rows) else ""),
+        "| --- | --- | ---: | ---: | ---: | ---: |" + (" ---: |" if counted(rows) else ""),
     ]
     for r in rows:
         rel = f"{float(r['median_ms']) / float(full['median_ms']):.2f}" if full else "—"
+        ips = f" {float(r['instructions_per_point_substep']):.1f} |" if counted(rows) else ""
         lines.append(
             f"| {r['row']} | {r['features']} | {float(r['median_ms']):.3f} | {float(r['min_ms']):.3f} … "
-            f"{float(r['max_ms']):.3f} | {float(r['point_substeps_per_s']):.3g} | {rel} |"
+            f"{float(r['max_ms']):.3f} | {float(r['point_substeps_per_s']):.3g} | {rel} |{ips}"
         )
     return "\n".join(lines) + "\n"
+
+
+def counted(rows):
+    """Whether the rows carry callgrind's instruction counts (featurecost --instructions)."""
+    return all(r.get("instructions_per_point_substep") not in (None, "") for r in rows)
 
 
 def _only_row(feature):

@@ -2,6 +2,9 @@
 costs against the right base rows, spread marks, and the row faster than `none` named."""
 
 import csv
+import shutil
+
+import pytest
 
 from harness import featurecost, featurecost_report
 
@@ -72,3 +75,19 @@ def test_csv_paths_cpu_first_and_a_note_without_any(tmp_path):
     for name in ("cuda.csv", "cpu.csv", "cuda-strict.csv"):
         _write(d / name, _rows({}))
     assert [p.name for p in featurecost_report.csv_paths(results)] == ["cpu.csv", "cuda.csv", "cuda-strict.csv"]
+
+
+@pytest.mark.skipif(shutil.which("valgrind") is None, reason="valgrind is not installed: no instruction counts")
+def test_instruction_counts_are_deterministic(tmp_path):
+    """featurecost --instructions counts the frame function's instructions under callgrind:
+    the same run counted twice gives the same number, and the full scene costs more than
+    gravity and stretch alone."""
+
+    def count():
+        return featurecost.measure(strands=20, frames=1, repeat=1, threads=1, instructions=True, progress=lambda *_: 0)
+
+    rows = [count(), count()]
+    a = {r["row"]: r["instructions_per_point_substep"] for r in rows[0]}
+    b = {r["row"]: r["instructions_per_point_substep"] for r in rows[1]}
+    assert a == b
+    assert a["full"] > a["none (gravity, stretch)"] > 0
