@@ -81,23 +81,14 @@ COLUMNS = (
 )
 
 
-@dataclass(frozen=True)
-class Build:
+class Build(variants.Runner):
     """One binary and variant that runs `simulate`."""
-
-    backend: str  # cpu | cuda
-    build: str  # default | strict | fastmath
-    variant: str
 
     @property
     def label(self):
         if self.backend == "cpu":
             return f"cpu {self.variant}"
         return f"gpu {'normal' if self.build == 'default' else self.build} {self.variant}"
-
-    @property
-    def binary(self):
-        return binary_path(self.backend, self.build)
 
 
 @dataclass(frozen=True)

@@ -141,12 +141,7 @@ COLUMNS = (
 )
 
 
-@dataclass(frozen=True)
-class Backend:
-    backend: str  # cpu | cuda
-    build: str  # default | strict | fastmath
-    variant: str
-
+class Backend(variants.Runner):
     @property
     def label(self):
         return "cpu" if self.backend == "cpu" else f"cuda-{self.build}"
@@ -169,7 +164,8 @@ def text(value):
 
 
 def backends(gpu="auto", log=print):
-    """The CPU's default variant, and each built CUDA build's default variant where a GPU answers."""
+    """The CPU oracle, and each built CUDA build's first variant that simulates any point
+    count (the map's P axis reaches 128) where a GPU answers."""
     out = [Backend("cpu", "default", variants.declared("cpu").default_variant)]
     if gpu == "no":
         log("stability: GPU builds not run (--gpu no)")
@@ -182,7 +178,7 @@ def backends(gpu="auto", log=print):
         return out
     for build in ("default", "strict", "fastmath"):
         if binary_path("cuda", build).exists():
-            out.append(Backend("cuda", build, variants.declared("cuda", build).default_variant))
+            out.append(Backend("cuda", build, variants.simulating("cuda", build)))
         else:
             log(f"stability: {display(binary_path('cuda', build))} not built: its cells are not run")
     if gpu == "yes" and len(out) == 1:

@@ -41,6 +41,29 @@ class Declared:
         return tuple(v for v in self.variants if self.runs(v, stage, points))
 
 
+@dataclass(frozen=True)
+class Runner:
+    """One binary (backend and build) and one of its variants."""
+
+    backend: str  # cpu | cuda
+    build: str  # default | strict | fastmath
+    variant: str
+
+    @property
+    def binary(self):
+        return binary_path(self.backend, self.build)
+
+
+def simulating(backend, build="default"):
+    """The first variant of a binary that simulates strands of any length (no max_points):
+    what a study that draws the point count runs."""
+    d = declared(backend, build)
+    for v in d.running("simulate"):
+        if d.max_points.get(v) is None:
+            return v
+    raise HarnessError(f"{binary_path(backend, build)} declares no variant that simulates any point count")
+
+
 @lru_cache(maxsize=None)
 def _read(path):
     try:

@@ -75,3 +75,25 @@ def test_the_real_binaries_declare_their_default(cpu_bin, monkeypatch):
     variants.clear_cache()
     d = variants.declared("cpu")
     assert d.backend == "cpu" and d.default_variant in d.variants
+
+
+def test_a_study_that_draws_the_point_count_runs_a_variant_without_a_point_limit(build_dir):
+    listing = {
+        "backend": "cuda",
+        "build": "default",
+        "default_variant": "fused",
+        "precisions": ["fp32"],
+        "solvers": ["xpbd"],
+        "variants": [
+            {"name": "fused", "stages": ["init", "collide", "wind"]},
+            {"name": "warpreg", "stages": ["init", "simulate"], "max_points": 32},
+            {"name": "warp", "stages": ["init", "simulate"]},
+        ],
+    }
+    script(build_dir / "hairsim-cuda", json.dumps(listing))
+    assert variants.simulating("cuda") == "warp"
+    listing["variants"].pop()
+    script(build_dir / "hairsim-cuda", json.dumps(listing))
+    variants.clear_cache()
+    with pytest.raises(HarnessError, match="declares no variant that simulates any point count"):
+        variants.simulating("cuda")
