@@ -66,7 +66,7 @@ NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
 
-.PHONY: all cpu cuda test bench report help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt
+.PHONY: all cpu cuda test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt
 
 # The Python that runs the tests and the harness: harness/setup.sh picks it (PYTHON when it has
 # the packages, else ./.venv) after installing what is missing, and writes its path here.
@@ -82,6 +82,7 @@ help:
 	@echo "make test     build and run the pytest suite (GPU tests skip with a reason without a GPU)"
 	@echo "make bench    validate GPU variants against the CPU, sweep, plot and report (python3 -m harness bench)"
 	@echo "make report   rebuild report/ from results/default (REPORT_FROM=results/reference-h200/sweep for the committed H200 run)"
+	@echo "make report-dynamic  rebuild report/dynamic.md from results/ (DYNAMIC_FROM=results/reference-h200 for the committed H200 run)"
 	@echo "make sanitize build the C reference with ASan+UBSan and run the CPU tests under it"
 	@echo "make sanitize-gpu  compute-sanitizer memcheck + racecheck over every CUDA variant (GPU node)"
 	@echo "make lint     ruff check, ruff format --check, mypy (lint-py) and clang-format --dry-run (lint-c)"
@@ -143,6 +144,9 @@ bench: setup
 # from an H200 is results/reference-h200/sweep)
 report: setup
 	$(RUN_PY) -m harness report $(REPORT_FROM)
+
+report-dynamic: setup
+	$(RUN_PY) -m harness report-dynamic $(DYNAMIC_FROM)
 
 # ASan + UBSan over the C reference: a separate build in build/asan, the C tests run on it.
 sanitize: setup check-hdf5

@@ -142,6 +142,17 @@ def cmd_report(args):
     return 0
 
 
+def cmd_report_dynamic(args):
+    from . import report_dynamic
+    from .paths import display
+
+    root = Path(args.root)
+    if not root.is_dir():
+        raise HarnessError(f"{args.root}: not a directory (a dynamic bench root: dynamic/, featurecost/, ...)", code=2)
+    print(f"wrote {display(report_dynamic.build(root, args.report_dir))}")
+    return 0
+
+
 def cmd_bench(args):
     from . import bench, bench_dynamic
 
@@ -153,7 +164,7 @@ def cmd_bench(args):
         # headline and accuracy results do (results/ by default)
         root = args.out if args.model == "dynamic" else (str(Path(args.out).parent) if args.out else None)
         code = (
-            bench_dynamic.run(out=root, gpu=args.gpu, report_dir=args.report_dir, quick_studies=args.quick_studies)
+            bench_dynamic.run(out=root, gpu=args.gpu, report_dir=args.report_dir, quick_studies=not args.full_studies)
             or code
         )
     return code
@@ -539,6 +550,16 @@ def parser():
         q.add_argument("--report-dir", default=None, help="where to write (default report/)")
         q.set_defaults(func=fn)
 
+    rd = sub.add_parser(
+        "report-dynamic",
+        help="write report/dynamic.md (and its plots) from a dynamic bench root",
+        description="Write report/dynamic.md and its plots from the results of the dynamic bench "
+        "(ROOT/dynamic/, featurecost/, dynamic-accuracy/, stability/, peer/, headline/): rendering only.",
+    )
+    rd.add_argument("root", nargs="?", default="results", help="the bench root (default results/)")
+    rd.add_argument("--report-dir", default=None, help="where to write (default report/)")
+    rd.set_defaults(func=cmd_report_dynamic)
+
     b = sub.add_parser(
         "bench",
         help="the make bench pipeline: check, validate, sweep, report",
@@ -558,9 +579,10 @@ def parser():
         "dynamic (default results/)",
     )
     b.add_argument(
-        "--quick-studies",
+        "--full-studies",
         action="store_true",
-        help="dynamic: the small versions of the studies (accuracy --quick, stability --quick)",
+        help="dynamic: the full accuracy study and stability map (tens of minutes) instead of the "
+        "bench's size (accuracy --quick, stability --quick: minutes on a 16-core + H200 node)",
     )
     b.set_defaults(func=cmd_bench)
 

@@ -227,7 +227,7 @@ def studies(root, builds, say, report_dir=None, quick=False):
     _harness(["animate", "--force"] + (["--out", str(Path(report_dir) / "dynamic.gif")] if report_dir else []), say)
 
 
-def run(out=None, gpu="auto", report_dir=None, quick_studies=False, log=None):
+def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None):
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
     root = Path(out) if out else RESULTS

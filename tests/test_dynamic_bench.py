@@ -4,6 +4,7 @@ the refusals of --frame-loop. Tiny sizes: seconds."""
 
 import json
 import subprocess
+import sys
 
 import pytest
 
@@ -164,3 +165,29 @@ def test_list_variants_declares_point_limits():
     assert all("max_points" not in v for v in d["variants"])  # the CPU variants simulate any P
     decl = variants.declared("cpu")
     assert all(decl.runs(v, points=10_000) for v in decl.variants)
+
+
+def test_the_committed_reference_renders_every_dynamic_section(tmp_path):
+    """report/dynamic.md is rendered from the committed H200 run: every section comes from
+    its files (none says it was not measured) and every picture it links exists."""
+    import re
+
+    from conftest import ROOT
+
+    p = subprocess.run(
+        [sys.executable, "-m", "harness", "report-dynamic", "results/reference-h200", "--report-dir", str(tmp_path)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert p.returncode == 0, p.stdout + p.stderr
+    text = (tmp_path / "dynamic.md").read_text()
+    assert not re.search(r"Not measured (\(no|with these)|Not validated", text), "a section says its files are missing"
+    checks = json.loads((ROOT / "results/reference-h200/dynamic/validation.json").read_text())["checks"]
+    assert f"{len(checks)} comparisons, {len(checks)} equivalent" in text
+    assert any(c["what"].startswith("cuda") for c in checks)
+    for section in ("Headline targets", "Speed against accuracy", "Stability of the dynamic model", "Beside a peer"):
+        assert f"## {section}" in text
+    pictures = re.findall(r"!\[[^]]*\]\(([^)]+\.png)\)", text)
+    assert len(pictures) >= 8 and all((tmp_path / pic).is_file() for pic in pictures)
