@@ -34,6 +34,7 @@ import pytest
 from conftest import BUILD, CPU_BIN, CUDA_BIN, CUDA_FASTMATH_BIN, CUDA_STRICT_BIN
 from harness import tolerances, variants
 from support.invariants_check import assert_invariants
+from support.measured import write_worst
 from support.statecheck import State, assert_equivalent, run
 
 pytestmark = pytest.mark.gpu
@@ -57,11 +58,7 @@ ERRORS = {}  # measured worst errors (units of u), written to build/gpu_test_err
 @pytest.fixture(scope="session", autouse=True)
 def _write_measurements():
     yield
-    if ERRORS:
-        try:
-            (BUILD / "gpu_test_errors.json").write_text(json.dumps(ERRORS, indent=1, sort_keys=True) + "\n")
-        except OSError:
-            pass
+    write_worst(BUILD / "gpu_test_errors.json", ERRORS)
 
 
 # ---- helpers ---------------------------------------------------------------------------------

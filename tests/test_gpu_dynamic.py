@@ -19,7 +19,6 @@ Strict build: all simulate variants bit-identical. The measured worst errors go 
 build/gpu_dyn_test_errors.json (for recalibrating the tolerances).
 """
 
-import json
 import subprocess
 
 import pytest
@@ -28,6 +27,7 @@ from conftest import BUILD, CPU_BIN, CUDA_BIN, CUDA_FASTMATH_BIN, CUDA_STRICT_BI
 from harness import HarnessError, dyndiff, variants
 from harness.tolerances import GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS
 from harness.trajectory import open_trajectory
+from support.measured import write_worst
 
 pytestmark = pytest.mark.gpu
 
@@ -107,11 +107,7 @@ ERRORS = {}
 @pytest.fixture(scope="session", autouse=True)
 def _write_measurements():
     yield
-    if ERRORS:
-        try:
-            (BUILD / "gpu_dyn_test_errors.json").write_text(json.dumps(ERRORS, indent=1, sort_keys=True) + "\n")
-        except OSError:
-            pass
+    write_worst(BUILD / "gpu_dyn_test_errors.json", ERRORS)
 
 
 def record(key, value):
