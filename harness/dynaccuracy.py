@@ -420,6 +420,24 @@ def _row(**kw):
     return {k: kw.get(k) for k in COLUMNS}
 
 
+def _frame_rows(run, rms, mx, **shared):
+    """One row per simulated frame of `run`, with its errors against a reference (rms, mx,
+    per frame) and the columns every frame shares."""
+    return [
+        _row(
+            **shared,
+            frame=f + 1,
+            time_s=run.times[f],
+            rms_err_L=rms[f],
+            max_err_L=mx[f],
+            stretch_max=run.stretch[f],
+            penetration_max=run.penetration[f],
+            blown_up_strands=run.blown[f],
+        )
+        for f in range(len(run.times))
+    ]
+
+
 def run_study(plan, out_dir=None, report_dir=None, force=False, command=None, render=True, log=print):
     """Measure, write the CSV, analytic.md and env.json, render the report (unless
     render=False); return the exit status (0: reference converged over the horizon, 1: it
@@ -494,30 +512,23 @@ def run_study(plan, out_dir=None, report_dir=None, force=False, command=None, re
             share = tolerances.DYN_ACC_GPU_REF_SHARE * tolerances.DYN_ACC_REF_FACTOR
             H = study.horizon_frames
             valid = bool(reference_ok(g_rms[:H], ref["min_rms"][:H], share).all()) and not (gpu_run.blown > 0).any()
-            for f in range(len(g_rms)):
-                check_rows.append(
-                    _row(
-                        study="gpu_check",
-                        mode=f"{gpu_ref.label} vs {cpu_oracle.label} S{S0}",
-                        backend="cuda",
-                        build=gpu_ref.build,
-                        variant=gpu_ref.variant,
-                        solver=REF_SOLVER,
-                        substeps=S0,
-                        iterations=REF_ITERATIONS,
-                        precision=REF_PRECISION,
-                        strands=plan.strands,
-                        points=study.scene.points,
-                        frame=f + 1,
-                        time_s=gpu_run.times[f],
-                        rms_err_L=g_rms[f],
-                        max_err_L=g_max[f],
-                        stretch_max=gpu_run.stretch[f],
-                        penetration_max=gpu_run.penetration[f],
-                        blown_up_strands=gpu_run.blown[f],
-                        ref_substeps=S0,
-                    )
-                )
+            check_rows += _frame_rows(
+                gpu_run,
+                g_rms,
+                g_max,
+                study="gpu_check",
+                mode=f"{gpu_ref.label} vs {cpu_oracle.label} S{S0}",
+                backend="cuda",
+                build=gpu_ref.build,
+                variant=gpu_ref.variant,
+                solver=REF_SOLVER,
+                substeps=S0,
+                iterations=REF_ITERATIONS,
+                precision=REF_PRECISION,
+                strands=plan.strands,
+                points=study.scene.points,
+                ref_substeps=S0,
+            )
             if valid:
                 gpu_note = "validated"
             else:
@@ -603,36 +614,29 @@ def _rows(study, modes, mode_paths, ref, timing):
         r = read_run(mode_paths[m.name])
         rms, mx = frame_errors(r.pos, ref["final"].pos, study.L)
         ms, ms_min, rec = timing[m.name]
-        for f in range(len(r.times)):
-            rows.append(
-                _row(
-                    study="mode",
-                    mode=m.name,
-                    backend=m.build.backend,
-                    build=m.build.build,
-                    variant=m.build.variant,
-                    solver=m.solver,
-                    substeps=m.substeps,
-                    iterations=m.iterations,
-                    precision=m.precision,
-                    strands=study.plan.strands,
-                    points=study.scene.points,
-                    frame=f + 1,
-                    time_s=r.times[f],
-                    rms_err_L=rms[f],
-                    max_err_L=mx[f],
-                    stretch_max=r.stretch[f],
-                    penetration_max=r.penetration[f],
-                    blown_up_strands=r.blown[f],
-                    time_per_frame_ms=ms,
-                    time_per_frame_min_ms=ms_min,
-                    time_strands=study.plan.time_strands,
-                    threads=rec.get("threads") if m.build.backend == "cpu" else None,
-                    block_size=rec.get("block_size") if m.build.backend == "cuda" else None,
-                    device=rec.get("device"),
-                    ref_substeps=final_S,
-                )
-            )
+        rows += _frame_rows(
+            r,
+            rms,
+            mx,
+            study="mode",
+            mode=m.name,
+            backend=m.build.backend,
+            build=m.build.build,
+            variant=m.build.variant,
+            solver=m.solver,
+            substeps=m.substeps,
+            iterations=m.iterations,
+            precision=m.precision,
+            strands=study.plan.strands,
+            points=study.scene.points,
+            time_per_frame_ms=ms,
+            time_per_frame_min_ms=ms_min,
+            time_strands=study.plan.time_strands,
+            threads=rec.get("threads") if m.build.backend == "cpu" else None,
+            block_size=rec.get("block_size") if m.build.backend == "cuda" else None,
+            device=rec.get("device"),
+            ref_substeps=final_S,
+        )
     return rows
 
 
