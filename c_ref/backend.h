@@ -21,7 +21,8 @@ extern "C" {
 typedef struct hb_backend hb_backend;
 
 /* One kernel variant of a backend: its name, the stages it runs (bit 1 << hb_stage), a
- * one-line summary and the most points per strand it can simulate (0: no limit). Declared
+ * one-line summary, the most points per strand it can simulate (0: no limit) and the most
+ * threads a block its simulate kernel launches with (0: the backend's limit). Declared
  * once, in the backend; `--list-variants` prints the table as JSON and the harness reads it
  * from there. */
 typedef struct {
@@ -29,6 +30,7 @@ typedef struct {
     unsigned stages;
     const char *summary;
     int64_t max_points;
+    int max_block;
 } hb_variant;
 
 /* The result of running one stage (or a fused group) once. */

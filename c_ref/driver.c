@@ -88,6 +88,7 @@ static int list_variants(const hb_backend *b)
             }
         printf("], \"summary\": \"%s\"", v->summary);
         if (v->max_points > 0) printf(", \"max_points\": %lld", (long long)v->max_points);
+        if (v->max_block > 0) printf(", \"max_block\": %d", v->max_block);
         printf("}");
     }
     printf("], \"solvers\": [\"xpbd\", \"ftl\"], \"features\": [");
@@ -452,6 +453,13 @@ int hb_main(int argc, char **argv, hb_backend *b)
             snprintf(err, sizeof err,
                      "--points %lld: the %s variant %s simulates at most %lld points a strand (see --list-variants)",
                      (long long)o.scene.points, b->name, var->name, (long long)var->max_points);
+            CHECK(1, HB_EXIT_USAGE);
+        }
+        if (var->max_block > 0 && o.block_size > var->max_block) {
+            snprintf(err, sizeof err,
+                     "--block-size %d: the %s variant %s simulates with at most %d threads a block (see "
+                     "--list-variants)",
+                     o.block_size, b->name, var->name, var->max_block);
             CHECK(1, HB_EXIT_USAGE);
         }
         if (o.frame_loop && !b->dyn_loop) {

@@ -51,7 +51,8 @@ enum Variant {
     V_FUSED = 2,
     V_STRAND = 3,
     V_WARP = 4,
-    V_WARPREG = 5
+    V_WARPREG = 5,
+    V_LANES = 6
 }; /* strand, warp, warpreg: backend_dyn.cuh */
 struct DynState;
 
@@ -150,6 +151,7 @@ int setup_inner(hb_backend *b, cuda_impl *c, const hb_options *o, int need_save,
                  : strcmp(v, "strand") == 0  ? V_STRAND
                  : strcmp(v, "warp") == 0    ? V_WARP
                  : strcmp(v, "warpreg") == 0 ? V_WARPREG
+                 : strcmp(v, "lanes") == 0   ? V_LANES
                                              : V_FUSED;
     c->block = o->block_size;
     b->block_size = c->block;
@@ -480,6 +482,10 @@ const hb_variant cuda_variants[] = {
      "strand-major like paper; simulate: one warp per strand, lane k holds point k in registers (at most 32 points), "
      "neighbours through warp shuffles",
      hb::dyn::kWarpregMaxPoints},
+    {"lanes", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
+     "strand-major like paper; simulate: a half-warp per strand, 2, 4 or 8 consecutive points a lane in registers "
+     "(at most 128 points), every lane busy in every constraint group",
+     hb::dyn::kLanesMaxPoints, hb::dyn::kLanesMaxBlock},
     {NULL, 0, NULL, 0},
 };
 

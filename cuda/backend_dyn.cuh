@@ -40,12 +40,12 @@ struct DynState {
 
 int dyn_is_strand_major(const cuda_impl *c)
 {
-    return c->variant == V_PAPER || c->variant == V_WARP || c->variant == V_WARPREG;
+    return c->variant == V_PAPER || c->variant == V_WARP || c->variant == V_WARPREG || c->variant == V_LANES;
 }
 
 int dyn_is_warp(const cuda_impl *c)
 {
-    return c->variant == V_WARP || c->variant == V_WARPREG;
+    return c->variant == V_WARP || c->variant == V_WARPREG || c->variant == V_LANES;
 }
 
 /* The variant's layouts of the state (and of velocities and rest shape). */
@@ -114,6 +114,12 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
         const int64_t resident = (int64_t)prop.multiProcessorCount * prop.maxThreadsPerMultiProcessor;
         d->grid = dyn_strand_grid(N, c->block, resident);
         need = sat_add(need, (uint64_t)d->grid * (uint64_t)c->block * 9u * (uint64_t)P * rs);
+    } else if (c->variant == V_LANES) {
+        if (P > hbd::kLanesMaxPoints) { /* the driver refuses it first, from the variant table */
+            snprintf(err, errlen, "internal error: lanes with %lld points", (long long)P);
+            return -1;
+        }
+        d->grid = 0; /* launch_frame_lanes sizes its grid */
     } else if (c->variant == V_WARPREG) {
         if (P > hbd::kWarpregMaxPoints) { /* the driver refuses it first, from the variant table */
             snprintf(err, errlen, "internal error: warpreg with %lld points", (long long)P);
@@ -244,6 +250,9 @@ template <typename T> int dyn_load_t(cuda_impl *c, const void *velocity, const v
         const size_t smem = hbd::warp_smem_bytes<T>(c->P) * (size_t)(c->block / 32);
         HB_CUDA_AS(hbd::prepare_warp<T>(d->m64.features, smem), "raising the warp kernel's shared-memory limit");
     }
+    if (c->variant == V_LANES)
+        HB_CUDA_AS(hbd::prepare_lanes<T>(d->m64.features, d->m64.solver, c->P, c->block),
+                   "raising the lanes kernel's shared-memory limit");
     HB_CUDA_AS(cudaDeviceSynchronize(), "dyn_load (cudaDeviceSynchronize)");
     return 0;
 }
@@ -268,6 +277,9 @@ cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m, const void *q, con
         return hbd::launch_frame_strand<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel,
                                            (const T *)d->rest, (const T *)d->bend_rest, (T *)d->scratch, c->N, d->grid,
                                            c->block, stream);
+    if (c->variant == V_LANES)
+        return hbd::launch_frame_lanes<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel,
+                                          (const T *)d->rest, (const T *)d->bend_rest, c->N, c->block, stream);
     if (c->variant == V_WARPREG)
         return hbd::launch_frame_warpreg<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel,
                                             (const T *)d->rest, (const T *)d->bend_rest, c->N, d->grid, c->block,
@@ -280,6 +292,7 @@ const char *dyn_launch_name(const cuda_impl *c)
 {
     return c->variant == V_STRAND    ? "the simulate kernel launch (strand)"
            : c->variant == V_WARPREG ? "the simulate kernel launch (warpreg)"
+           : c->variant == V_LANES   ? "the simulate kernel launch (lanes)"
                                      : "the simulate kernel launch (warp)";
 }
 

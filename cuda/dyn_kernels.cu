@@ -19,16 +19,6 @@
 namespace hb {
 namespace dyn {
 
-/* the kernel's feature policy from the run's mask (outside the anonymous namespace: with
- * every mask specialised the generic one is never referenced) */
-template <class Feat> struct MakeFeat;
-template <unsigned F> struct MakeFeat<StaticF<F>> {
-    __device__ static StaticF<F> make(unsigned) { return StaticF<F>(); }
-};
-template <> struct MakeFeat<DynF> {
-    __device__ static DynF make(unsigned f) { return DynF{f}; }
-};
-
 namespace {
 
 constexpr int kMaxThreads = 1024;

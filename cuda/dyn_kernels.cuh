@@ -17,6 +17,15 @@
 namespace hb {
 namespace dyn {
 
+/* The kernel's feature policy from the run's mask (StaticF folds it, DynF tests it). */
+template <class Feat> struct MakeFeat;
+template <unsigned F> struct MakeFeat<StaticF<F>> {
+    __device__ static StaticF<F> make(unsigned) { return StaticF<F>(); }
+};
+template <> struct MakeFeat<DynF> {
+    __device__ static DynF make(unsigned f) { return DynF{f}; }
+};
+
 /* Where strand i's point k, coordinate c lies in an array: base[i·is + k·ks + c·cs].
  *   point-major X|Y|Z [P][N] (the strand variant): is = 1, ks = N, cs = N·P
  *   canonical [N][P][3] (the warp variant):        is = 3P, ks = 3, cs = 1 */
@@ -106,6 +115,18 @@ constexpr int64_t kWarpregMaxPoints = 32;
 template <typename T>
 cudaError_t launch_frame_warpreg(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                                  const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream);
+/* The lanes variant (cuda/dyn_lanes.cu): L lanes a strand, G consecutive points a lane in
+ * registers (xpbd: L = 16, G = 2, 4, 8; ftl: fewer lanes with more points), P ≤
+ * kLanesMaxPoints; x, v, rest canonical [N][P][3], bend_rest [N][P−2]; lanes_smem_bytes of
+ * dynamic shared memory a block (a warp's strands staged for coalesced loads and stores, and
+ * their rest shape). The launcher sizes the grid itself: one pass over the strands. */
+constexpr int64_t kLanesMaxPoints = 128;
+constexpr int kLanesMaxBlock = 256; /* __launch_bounds__: up to 255 registers a thread */
+template <typename T> size_t lanes_smem_bytes(unsigned features, int solver, int64_t P, int block);
+template <typename T> cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block);
+template <typename T>
+cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
+                               const T *bend_rest, int64_t N, int block, cudaStream_t stream);
 /* Allows the warp kernel of this feature set `bytes` of dynamic shared memory a block (the
  * opt-in above 48 KB). */
 template <typename T> cudaError_t prepare_warp(unsigned features, size_t bytes);

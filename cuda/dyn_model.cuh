@@ -52,6 +52,10 @@ template <typename T> struct DModel {
     unsigned features;
     T h, seg_len, gravity_y, wind_y, wind_z, dir_y, dir_z, kappa, gust, den, stretch_at, bend_at, shape_at, collide_r,
         ftl_s;
+    /* the normal build's constant reciprocals (docs/cuda.md "Builds and arithmetic"), each
+     * computed once in double from the rounded constants and rounded once: 1/h, 1/D,
+     * 1/(W + α̃) for W = 1 (root) and 2 of stretch and bend, 1/(1 + α̃_g), R_c² */
+    T inv_h, inv_den, inv_s1, inv_s2, inv_b1, inv_b2, inv_g, rc2;
 };
 
 template <typename T, typename M> inline DModel<T> dmodel_from(const M &m)
@@ -78,6 +82,14 @@ template <typename T, typename M> inline DModel<T> dmodel_from(const M &m)
     r.shape_at = m.shape_at;
     r.collide_r = m.collide_r;
     r.ftl_s = m.ftl_s;
+    r.inv_h = (T)(1.0 / (double)r.h);
+    r.inv_den = (T)(1.0 / (double)r.den);
+    r.inv_s1 = (T)(1.0 / (1.0 + (double)r.stretch_at));
+    r.inv_s2 = (T)(1.0 / (2.0 + (double)r.stretch_at));
+    r.inv_b1 = (T)(1.0 / (1.0 + (double)r.bend_at));
+    r.inv_b2 = (T)(1.0 / (2.0 + (double)r.bend_at));
+    r.inv_g = (T)(1.0 / (1.0 + (double)r.shape_at));
+    r.rc2 = (T)((double)r.collide_r * (double)r.collide_r);
     return r;
 }
 

@@ -120,7 +120,7 @@ class DynValidator:
             for build in builds:
                 decl = variants.declared("cuda", build)
                 for v in (n for n in decl.variants if decl.runs(n, points=self.scene.points)):
-                    for block in BLOCK_SIZES:
+                    for block in (b for b in BLOCK_SIZES if decl.runs(v, points=self.scene.points, block=b)):
                         tag = f"cuda-{build}-{v}-b{block}-{precision}-{solver}"
                         g = self.step(ref, binary_path("cuda", build), ["--variant", v, "--block-size", block], tag)
                         if build == "strict" and block == BLOCK_SIZES[-1]:

@@ -11,7 +11,7 @@ declares more (solvers, stages) still reads.
 
 import json
 import subprocess
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 from . import HarnessError
@@ -28,13 +28,18 @@ class Declared:
     stages: dict  # variant name -> tuple of the stages it runs
     max_points: dict  # variant name -> the most points per strand it simulates (None: no limit)
     solvers: tuple = ()  # the dynamic model's solvers, in the binary's order (none declared: ())
+    max_block: dict = field(default_factory=dict)  # variant -> most threads a block of its simulate (absent: 1024)
 
-    def runs(self, variant, stage="simulate", points=None):
-        """Whether `variant` runs `stage` (and, for simulate, strands of `points` points)."""
+    def runs(self, variant, stage="simulate", points=None, block=None):
+        """Whether `variant` runs `stage` (and, for simulate, strands of `points` points with
+        `block` threads a block)."""
         if stage not in self.stages.get(variant, ()):
             return False
         limit = self.max_points.get(variant)
-        return points is None or limit is None or points <= limit
+        if points is not None and limit is not None and points > limit:
+            return False
+        most = self.max_block.get(variant)
+        return block is None or stage != "simulate" or most is None or int(block) <= most
 
     def running(self, stage, points=None):
         """The variants that run `stage` (at `points` points a strand), in the binary's order."""
@@ -87,6 +92,7 @@ def _read(path):
             stages={str(v["name"]): tuple(v.get("stages", ())) for v in variants},
             max_points={str(v["name"]): (int(v["max_points"]) if v.get("max_points") else None) for v in variants},
             solvers=tuple(str(x) for x in d.get("solvers", ())),
+            max_block={str(v["name"]): int(v["max_block"]) for v in variants if v.get("max_block")},
         )
     except (ValueError, KeyError, TypeError, AttributeError):
         raise HarnessError(f"{path} --list-variants did not print the documented JSON object") from None

@@ -1,0 +1,559 @@
+/* dyn_lanes.cu — the lanes variant of the dynamic model's frame (docs/cuda.md "The lanes
+ * variant"): a half-warp of 16 lanes per strand (two strands a warp), lane l holding the G
+ * consecutive points G·l … G·l + G − 1 in registers for the whole frame, G = 2, 4 or 8
+ * (P ≤ 32, 64, 128). Every group of docs/model.md §3.6 keeps nearly every lane busy:
+ *   stretch, k odd      (G·l+2m, G·l+2m+1): inside the lane;
+ *   stretch, k even     inside the lane, and (G·l − 1, G·l) across, computed by the upper lane;
+ *   bend                inside the lane where both ends are; across a boundary (l, l+1) the
+ *                       two constraints (G·l+G−2, G·l+G) and (G·l+G−1, G·l+G+1) are split:
+ *                       the lower lane computes the first, the upper lane the second.
+ * A lane that computes a constraint across lanes receives the other end by a shuffle and
+ * sends its new position back, so every point is written by one lane.
+ *
+ * Arithmetic (docs/cuda.md "Builds and arithmetic"): the strict build (HB_REFERENCE_ARITHMETIC)
+ * calls dyn_model.cuh's reference helpers, the same operations as c_ref/dynamics_impl.h, so
+ * it gives the CPU's bits; the normal and fast-math builds use reciprocal square roots and
+ * the scene's precomputed reciprocals (DModel::inv_*), judged by the one-frame rule.
+ */
+#include <utility>
+
+#include "dyn_kernels.cuh"
+
+namespace hb {
+namespace dyn {
+namespace {
+
+#if defined(HB_REFERENCE_ARITHMETIC)
+constexpr bool kFree = false;
+#else
+constexpr bool kFree = true;
+#endif
+
+/* Blocks of kLanesMaxBlock an SM must hold (__launch_bounds__'s second argument, which caps
+ * the registers a thread): fp32 at P ≤ 32 HB_LANES_MINB for xpbd and HB_LANES_FTL_MINB for
+ * ftl (measured, docs/cuda.md), 1 (up to 255 registers) otherwise. */
+#ifndef HB_LANES_MINB
+#define HB_LANES_MINB 1
+#endif
+#ifndef HB_LANES_FTL_MINB
+#define HB_LANES_FTL_MINB 1
+#endif
+#ifndef HB_LANES_FTL_G
+#define HB_LANES_FTL_G 4
+#endif
+constexpr int kFtlG = HB_LANES_FTL_G, kFtlL = 32 / HB_LANES_FTL_G;
+template <typename T, int G, int L, bool Ftl> constexpr int lanes_min_blocks()
+{
+    return sizeof(T) != 4                      ? 1
+           : (!Ftl && G == 2)                  ? HB_LANES_MINB
+           : (Ftl && G == kFtlG && L == kFtlL) ? HB_LANES_FTL_MINB
+                                               : 1;
+}
+
+template <typename T> struct V3 {
+    T x, y, z;
+};
+/* shuffles within a strand's L lanes */
+template <int L, typename T> __device__ __forceinline__ V3<T> up(const V3<T> &a)
+{
+    return V3<T>{__shfl_up_sync(kAll, a.x, 1, L), __shfl_up_sync(kAll, a.y, 1, L), __shfl_up_sync(kAll, a.z, 1, L)};
+}
+template <int L, typename T> __device__ __forceinline__ V3<T> down(const V3<T> &a)
+{
+    return V3<T>{__shfl_down_sync(kAll, a.x, 1, L), __shfl_down_sync(kAll, a.y, 1, L),
+                 __shfl_down_sync(kAll, a.z, 1, L)};
+}
+template <int L, typename T> __device__ __forceinline__ V3<T> from(const V3<T> &a, int src)
+{
+    return V3<T>{__shfl_sync(kAll, a.x, src, L), __shfl_sync(kAll, a.y, src, L), __shfl_sync(kAll, a.z, src, L)};
+}
+
+/* §3.5 distance constraint between a and b with rest r: moves a (unless it is the root) and b.
+ * inv1, inv2: 1/(1 + α̃) and 1/(2 + α̃) (free arithmetic only). */
+template <typename T>
+__device__ __forceinline__ void dist(V3<T> &a, V3<T> &b, bool root_a, T r, T at, T inv1, T inv2, T &lam)
+{
+    if constexpr (kFree) {
+        const T ex = b.x - a.x, ey = b.y - a.y, ez = b.z - a.z;
+        const T q = ex * ex + ey * ey + ez * ez;
+        if (q == (T)0) return;
+        const T inv = rsq(q);
+        const T dl = ((r - q * inv) - at * lam) * (root_a ? inv1 : inv2);
+        lam = lam + dl;
+        const T s = dl * inv;
+        if (!root_a) {
+            a.x = a.x - s * ex;
+            a.y = a.y - s * ey;
+            a.z = a.z - s * ez;
+        }
+        b.x = b.x + s * ex;
+        b.y = b.y + s * ey;
+        b.z = b.z + s * ez;
+    } else {
+        T dl, nx, ny, nz;
+        if (!distance_step(a.x, a.y, a.z, b.x, b.y, b.z, !root_a, r, at, lam, dl, nx, ny, nz)) return;
+        if (!root_a) {
+            a.x = a.x - dl * nx;
+            a.y = a.y - dl * ny;
+            a.z = a.z - dl * nz;
+        }
+        b.x = b.x + dl * nx;
+        b.y = b.y + dl * ny;
+        b.z = b.z + dl * nz;
+    }
+}
+
+template <typename T> __device__ __forceinline__ void collide(const DModel<T> &m, V3<T> &p)
+{
+    if constexpr (kFree) {
+        const T q = p.x * p.x + p.y * p.y + p.z * p.z;
+        if (!(q < m.rc2)) return;
+        if (q == (T)0) {
+            p = V3<T>{(T)0, m.collide_r, (T)0};
+            return;
+        }
+        const T s = m.collide_r * rsq(q);
+        p = V3<T>{p.x * s, p.y * s, p.z * s};
+    } else {
+        collide_sphere(p.x, p.y, p.z, m.collide_r);
+    }
+}
+
+template <typename T> __device__ __forceinline__ void shape(const DModel<T> &m, V3<T> &p, const V3<T> &t, T &lam)
+{
+    if constexpr (kFree) {
+        const T ex = p.x - t.x, ey = p.y - t.y, ez = p.z - t.z;
+        const T q = ex * ex + ey * ey + ez * ez;
+        if (q == (T)0) return;
+        const T inv = rsq(q);
+        const T dl = (-(q * inv) - m.shape_at * lam) * m.inv_g;
+        lam = lam + dl;
+        const T s = dl * inv;
+        p = V3<T>{p.x + s * ex, p.y + s * ey, p.z + s * ez};
+    } else {
+        const T tt[3] = {t.x, t.y, t.z};
+        shape_pull(p.x, p.y, p.z, tt, m.shape_at, lam);
+    }
+}
+
+/* §3.4 step 2 for a point k ≥ 1: the velocity (implicit in drag and damping) and the prediction. */
+template <typename T, class Feat>
+__device__ __forceinline__ void predict(const DModel<T> &m, Feat has, T phase, const V3<T> &x, V3<T> &v, V3<T> &p)
+{
+    if constexpr (kFree) {
+        const T h = m.h;
+        T vx = v.x, vy = v.y, vz = v.z;
+        if (has(HB_F_WIND)) {
+            T gam = (T)1;
+            if (has(HB_F_GUST)) gam = (T)1 + m.gust * d_sin(phase - m.kappa * (m.dir_y * x.y + m.dir_z * x.z));
+            vy = vy + h * (m.gravity_y + m.wind_y * gam);
+            vz = vz + h * (m.wind_z * gam);
+        } else {
+            vy = vy + h * m.gravity_y;
+        }
+        if (has(HB_F_DRAG)) {
+            vx = vx * m.inv_den;
+            vy = vy * m.inv_den;
+            vz = vz * m.inv_den;
+        }
+        v = V3<T>{vx, vy, vz};
+        p = V3<T>{x.x + h * vx, x.y + h * vy, x.z + h * vz};
+    } else {
+        velocity_predict(m, has, phase, x.x, x.y, x.z, v.x, v.y, v.z, p.x, p.y, p.z);
+    }
+}
+
+/* §3.7 one follow-the-leader step of p after its corrected predecessor a; d: the correction. */
+template <typename T, class Feat>
+__device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, const V3<T> &a, V3<T> &p, V3<T> &d)
+{
+    if constexpr (kFree) {
+        const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
+        const T q = ex * ex + ey * ey + ez * ez;
+        V3<T> n;
+        if (q > (T)0) {
+            const T f = m.seg_len * rsq(q);
+            n = V3<T>{a.x + f * ex, a.y + f * ey, a.z + f * ez};
+        } else {
+            n = V3<T>{a.x, a.y - m.seg_len, a.z};
+        }
+        d = V3<T>{n.x - p.x, n.y - p.y, n.z - p.z};
+        if (has(HB_F_COLLIDE)) collide(m, n);
+        p = n;
+    } else {
+        follow(a.x, a.y, a.z, p.x, p.y, p.z, m.seg_len, has(HB_F_COLLIDE), m.collide_r, d.x, d.y, d.z);
+    }
+}
+
+/* §3.4 step 4 for a point k ≥ 1 (corr: ftl and k < P − 1, dn = d_{k+1}). */
+template <typename T>
+__device__ __forceinline__ void update(const DModel<T> &m, bool corr, const V3<T> &dn, V3<T> &x, V3<T> &v,
+                                       const V3<T> &p)
+{
+    if constexpr (kFree) {
+        if (corr) {
+            const T s = m.ftl_s;
+            v = V3<T>{((p.x - x.x) - s * dn.x) * m.inv_h, ((p.y - x.y) - s * dn.y) * m.inv_h,
+                      ((p.z - x.z) - s * dn.z) * m.inv_h};
+        } else {
+            v = V3<T>{(p.x - x.x) * m.inv_h, (p.y - x.y) * m.inv_h, (p.z - x.z) * m.inv_h};
+        }
+    } else {
+        v.x = update_velocity(p.x, x.x, m.h, corr, m.ftl_s, dn.x);
+        v.y = update_velocity(p.y, x.y, m.h, corr, m.ftl_s, dn.y);
+        v.z = update_velocity(p.z, x.z, m.h, corr, m.ftl_s, dn.z);
+    }
+    x = p;
+}
+
+template <typename T> __device__ __forceinline__ V3<T> rotated(const T *q, const V3<T> &a)
+{ /* Q·a as dyn_model.cuh's rotate: each row summed left to right */
+    return V3<T>{q[0] * a.x + q[1] * a.y + q[2] * a.z, q[3] * a.x + q[4] * a.y + q[5] * a.z,
+                 q[6] * a.x + q[7] * a.y + q[8] * a.z};
+}
+
+/* Shared memory of a warp: its strands' x and v ([N][P][3] rows, staged together so that
+ * every load of both is in flight at once), then their rest shape (kept for the frame). */
+template <typename T, int G, int L> __host__ __device__ constexpr int64_t lanes_warp_reals(int64_t P)
+{
+    return 3 * (32 / L) * 3 * P;
+}
+
+/* src[base + e] for e < n into buf: the loads first, 3G a lane at most (n ≤ (32/L)·3P ≤ 96G). */
+template <typename T, int G>
+__device__ __forceinline__ void gather(T *buf, const T *__restrict__ src, int64_t base, int n, int lane)
+{
+    T r[3 * G];
+#pragma unroll
+    for (int u = 0; u < 3 * G; u++) /* past n: a repeated load of the last real, not stored */
+        r[u] = src[base + (lane + 32 * u < n ? lane + 32 * u : n - 1)];
+#pragma unroll
+    for (int u = 0; u < 3 * G; u++)
+        if (lane + 32 * u < n) buf[lane + 32 * u] = r[u];
+}
+
+template <typename T, int G>
+__device__ __forceinline__ void unpack(const T *s, int k0, int P, bool live, V3<T> (&dst)[G])
+{
+#pragma unroll
+    for (int i = 0; i < G; i++) {
+        const int k = k0 + i;
+        if (live && k < P) dst[i] = V3<T>{s[3 * k], s[3 * k + 1], s[3 * k + 2]};
+        else dst[i] = V3<T>{(T)0, (T)0, (T)0};
+    }
+}
+
+template <typename T, int G> __device__ __forceinline__ void pack(T *s, int k0, int P, bool live, const V3<T> (&src)[G])
+{
+#pragma unroll
+    for (int i = 0; i < G; i++) {
+        const int k = k0 + i;
+        if (live && k < P) {
+            s[3 * k] = src[i].x;
+            s[3 * k + 1] = src[i].y;
+            s[3 * k + 2] = src[i].z;
+        }
+    }
+}
+
+/* The frame of (32/L) strands a warp, L lanes a strand, G points a lane (G·L ≥ P); Ftl: the
+ * solver of §3.7, else §3.6. */
+template <typename T, class Feat, int G, int L, bool Ftl>
+__global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>())
+    k_lanes(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
+            const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N)
+{
+    constexpr int SPW = 32 / L; /* strands a warp */
+    extern __shared__ __align__(16) unsigned char hb_lanes_smem[];
+    const Feat has = MakeFeat<Feat>::make(m.features);
+    const int lane = (int)(threadIdx.x & 31u), w = (int)(threadIdx.x >> 5), wpb = (int)(blockDim.x >> 5);
+    const int seg = lane / L, l = lane % L;
+    const int P = (int)m.points, K = (int)m.shape_count, k0 = G * l;
+    const int row = 3 * P; /* reals of a strand */
+    T *xv = (T *)hb_lanes_smem + (int64_t)w * lanes_warp_reals<T, G, L>(P);
+    T *rs = xv + 2 * SPW * row; /* the rest shape of the warp's strands */
+    const bool need_rest = has(HB_F_MOTION) || has(HB_F_SHAPE);
+    const int stages = (P + G - 1) / G; /* lanes that hold points */
+
+    /* the loop bound is the same for every lane of a warp: whole warps take each group of strands */
+    for (int64_t s0 = SPW * ((int64_t)blockIdx.x * wpb + w); s0 < N; s0 += SPW * (int64_t)gridDim.x * wpb) {
+        const int ns = N - s0 >= SPW ? SPW : (int)(N - s0);
+        const bool live = seg < ns;
+        const int64_t base = s0 * row;
+        const int n = ns * row;
+        V3<T> X[G], V[G], Q[G], D[G];
+        { /* x and v: every load of both in flight at once */
+            T rx[3 * G], rv[3 * G];
+#pragma unroll
+            for (int u = 0; u < 3 * G; u++) {
+                const int e = lane + 32 * u < n ? lane + 32 * u : n - 1;
+                rx[u] = x[base + e];
+                rv[u] = v[base + e];
+            }
+#pragma unroll
+            for (int u = 0; u < 3 * G; u++)
+                if (lane + 32 * u < n) {
+                    xv[lane + 32 * u] = rx[u];
+                    xv[SPW * row + lane + 32 * u] = rv[u];
+                }
+        }
+        if (need_rest) gather<T, G>(rs, rest, base, n, lane);
+        __syncwarp();
+        unpack<T, G>(xv + seg * row, k0, P, live, X);
+        unpack<T, G>(xv + SPW * row + seg * row, k0, P, live, V);
+        T br[G], brp = (T)0;
+        if (has(HB_F_BEND)) { /* [N][P−2]: this lane's (k0+i, k0+i+2), i ≤ G−2, and (k0−1, k0+1) */
+            __syncwarp();     /* x and v unpacked: their rows take the bend rest lengths */
+            gather<T, G>(xv, bend_rest, s0 * (int64_t)(P - 2), ns * (P - 2), lane);
+            __syncwarp();
+            const T *sb = xv + seg * (P - 2);
+#pragma unroll
+            for (int i = 0; i < G; i++) br[i] = live && k0 + i + 2 < P ? sb[k0 + i] : (T)0;
+            brp = live && l >= 1 && k0 + 1 < P ? sb[k0 - 1] : (T)0;
+        }
+        const T *R = rs + seg * row; /* the rest shape X̄ of this lane's strand */
+#pragma unroll
+        for (int i = 0; i < G; i++) { /* a lane's points past the tip stay defined */
+            D[i] = V3<T>{(T)0, (T)0, (T)0};
+            Q[i] = X[i];
+        }
+
+        for (int64_t j = 0; j < m.substeps; j++) {
+            const T *q = qtab + 9 * j;
+            /* 1. the root on the head, then p0 = x0 */
+            if (l == 0) {
+                if (has(HB_F_MOTION)) {
+                    const V3<T> r0{R[0], R[1], R[2]};
+                    if constexpr (kFree) {
+                        const V3<T> r = rotated(q, r0);
+                        V[0] = V3<T>{(r.x - X[0].x) * m.inv_h, (r.y - X[0].y) * m.inv_h, (r.z - X[0].z) * m.inv_h};
+                        X[0] = r;
+                    } else {
+                        root_step(q, r0.x, r0.y, r0.z, m.h, X[0].x, X[0].y, X[0].z, V[0].x, V[0].y, V[0].z);
+                    }
+                }
+                Q[0] = X[0];
+            }
+            /* 2. velocities and the prediction */
+            const T phase = has(HB_F_GUST) ? phtab[j] : (T)0;
+#pragma unroll
+            for (int i = 0; i < G; i++)
+                if (k0 + i >= 1 && k0 + i < P) predict(m, has, phase, X[i], V[i], Q[i]);
+            /* the shape targets T_k = Q(t+h)·X̄_k of this substep (the same in every iteration) */
+            V3<T> S[G];
+#pragma unroll
+            for (int i = 0; i < G; i++) {
+                const int k = k0 + i;
+                S[i] = V3<T>{(T)0, (T)0, (T)0};
+                if (has(HB_F_SHAPE) && k >= 1 && k <= K) {
+                    S[i] = V3<T>{R[3 * k], R[3 * k + 1], R[3 * k + 2]};
+                    if (has(HB_F_MOTION)) S[i] = rotated(q, S[i]);
+                }
+            }
+
+            /* 3. constraints; every multiplier starts the substep at 0 */
+            T lso[G / 2], lse[G / 2], lbi[G], lg[G], lsx = 0, lc1 = 0, lc2 = 0;
+#pragma unroll
+            for (int i = 0; i < G / 2; i++) lso[i] = lse[i] = (T)0;
+#pragma unroll
+            for (int i = 0; i < G; i++) lbi[i] = lg[i] = (T)0;
+
+            auto stretch = [&]() {
+#pragma unroll
+                for (int i = 0; i + 1 < G; i += 2) /* k odd: inside the lane */
+                    if (k0 + i + 1 < P)
+                        dist(Q[i], Q[i + 1], k0 + i == 0, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lso[i / 2]);
+#pragma unroll
+                for (int i = 1; i + 1 < G; i += 2) /* k even: inside the lane … */
+                    if (k0 + i + 1 < P)
+                        dist(Q[i], Q[i + 1], false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lse[i / 2]);
+                V3<T> a = up<L>(Q[G - 1]); /* … and (k0 − 1, k0) on this lane, the lower end sent back */
+                if (l >= 1 && k0 < P) dist(a, Q[0], false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lsx);
+                const V3<T> na = down<L>(a);
+                if (l + 1 < L && k0 + G < P) Q[G - 1] = na;
+            };
+            /* bend group g (⌊(k−1)/2⌋ ≡ g mod 2): the constraints (a, a+2) with (a>>1)&1 = g */
+            auto bend = [&](int g) {
+#pragma unroll
+                for (int i = 0; i + 2 < G; i++)
+                    if ((((k0 + i) >> 1) & 1) == g && k0 + i + 2 < P)
+                        dist(Q[i], Q[i + 2], k0 + i == 0, br[i], m.bend_at, m.inv_b1, m.inv_b2, lbi[i]);
+                if constexpr (G == 2) {
+                    /* lanes pair up: l is the lower lane of (2l, 2l+2), (2l+1, 2l+3) when l ≡ g
+                     * (mod 2) and computes the first; its partner l+1 computes the second */
+                    const bool lower = (l & 1) == g;
+                    const int partner = lower ? (l + 1 < L ? l + 1 : l) : (l >= 1 ? l - 1 : l);
+                    const bool c1 = lower && l + 1 < L && k0 + 2 < P;
+                    const bool c2 = !lower && l >= 1 && k0 + 1 < P;
+                    const V3<T> mine{lower ? Q[1].x : Q[0].x, lower ? Q[1].y : Q[0].y, lower ? Q[1].z : Q[0].z};
+                    V3<T> o = from<L>(mine, partner);
+                    if (c1) dist(Q[0], o, k0 == 0, br[0], m.bend_at, m.inv_b1, m.inv_b2, lc1);
+                    if (c2) dist(o, Q[1], false, brp, m.bend_at, m.inv_b1, m.inv_b2, lc2);
+                    const V3<T> back = from<L>(o, partner);
+                    if (lower && l + 1 < L && k0 + 3 < P) Q[1] = back; /* the partner's c2 */
+                    if (!lower && l >= 1 && k0 < P) Q[0] = back;       /* the partner's c1 */
+                } else {
+                    /* every boundary (l, l+1) in group 1: (k0+G−2, k0+G) on the lower lane,
+                     * (k0+G−1, k0+G+1) on the upper */
+                    V3<T> hi0 = down<L>(Q[0]);
+                    V3<T> lolast = up<L>(Q[G - 1]);
+                    const bool c1 = l + 1 < L && (((k0 + G - 2) >> 1) & 1) == g && k0 + G < P;
+                    const bool c2 = l >= 1 && (((k0 - 1) >> 1) & 1) == g && k0 + 1 < P;
+                    if (c1) dist(Q[G - 2], hi0, false, br[G - 2], m.bend_at, m.inv_b1, m.inv_b2, lc1);
+                    if (c2) dist(lolast, Q[1], false, brp, m.bend_at, m.inv_b1, m.inv_b2, lc2);
+                    const V3<T> n0 = up<L>(hi0), nl = down<L>(lolast);
+                    if (l >= 1 && (((k0 - 2) >> 1) & 1) == g && k0 < P) Q[0] = n0;
+                    if (l + 1 < L && (((k0 + G - 1) >> 1) & 1) == g && k0 + G + 1 < P) Q[G - 1] = nl;
+                }
+            };
+            auto shapes = [&]() {
+#pragma unroll
+                for (int i = 0; i < G; i++) {
+                    const int k = k0 + i;
+                    if (k >= 1 && k <= K) shape(m, Q[i], S[i], lg[i]);
+                }
+            };
+            if constexpr (!Ftl) {
+                for (int64_t it = 0; it < m.iterations; it++) {
+                    stretch();
+                    if (has(HB_F_BEND)) {
+                        bend(0);
+                        bend(1);
+                    }
+                    if (has(HB_F_SHAPE)) shapes();
+                    if (has(HB_F_COLLIDE)) {
+#pragma unroll
+                        for (int i = 0; i < G; i++)
+                            if (k0 + i >= 1 && k0 + i < P) collide(m, Q[i]);
+                    }
+                }
+            } else {
+                for (int64_t it = 0; it < m.iterations; it++) {
+                    if (has(HB_F_BEND)) {
+                        bend(0);
+                        bend(1);
+                    }
+                    if (has(HB_F_SHAPE)) shapes();
+                }
+                /* §3.7 follow the leader, k ascending: lane st takes its points after lane st − 1 */
+                for (int st = 0; st < stages; st++) {
+                    const V3<T> a = up<L>(Q[G - 1]);
+                    if (l == st) {
+#pragma unroll
+                        for (int i = 0; i < G; i++) {
+                            const int k = k0 + i;
+                            if (k >= 1 && k < P) follow_one(m, has, i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i]);
+                        }
+                    }
+                }
+            }
+            /* 4. velocities from the motion (ftl: less s·d(k+1)/h), then the positions */
+            V3<T> dn{(T)0, (T)0, (T)0};
+            if constexpr (Ftl) dn = down<L>(D[0]);
+#pragma unroll
+            for (int i = 0; i < G; i++) {
+                const int k = k0 + i;
+                if (k >= 1 && k < P)
+                    update(m, Ftl && k + 1 < P, i + 1 < G ? D[i + 1 < G ? i + 1 : i] : dn, X[i], V[i], Q[i]);
+            }
+        }
+        __syncwarp();
+        pack<T, G>(xv + seg * row, k0, P, live, X);
+        pack<T, G>(xv + SPW * row + seg * row, k0, P, live, V);
+        __syncwarp();
+#pragma unroll
+        for (int u = 0; u < 3 * G; u++)
+            if (lane + 32 * u < n) {
+                x[base + lane + 32 * u] = xv[lane + 32 * u];
+                v[base + lane + 32 * u] = xv[SPW * row + lane + 32 * u];
+            }
+        __syncwarp();
+    }
+}
+
+/* ---- dispatch: the layout from the solver and P, the kernel from the feature mask ----
+ * xpbd: 16 lanes a strand, G = 2, 4, 8. ftl, whose follow-the-leader pass runs lane after
+ * lane: fewer lanes a strand with more points each (docs/cuda.md "The lanes variant"):
+ * P ≤ 32 at HB_LANES_FTL_G points a lane, P ≤ 64 at 8 points on 8 lanes, else as xpbd.
+ * The two layouts of P ≤ 32 have kernels of their own for the specialised feature sets. */
+template <typename T>
+using LanesFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, const T *, int64_t);
+
+template <typename T, int G, int L, bool Ftl, unsigned F> constexpr LanesFn<T> lanes_entry()
+{
+    constexpr bool own = (!Ftl && G == 2 && L == 16) || (Ftl && G == kFtlG && L == kFtlL);
+    if constexpr (!valid_mask(F)) return nullptr;
+    else if constexpr (own && specialised_mask(F)) return &k_lanes<T, StaticF<F>, G, L, Ftl>;
+    else return &k_lanes<T, DynF, G, L, Ftl>;
+}
+template <typename T, int G, int L, bool Ftl, unsigned... Fs> struct LanesTable {
+    static constexpr LanesFn<T> fn[sizeof...(Fs)] = {lanes_entry<T, G, L, Ftl, Fs>()...};
+};
+template <typename T, int G, int L, bool Ftl, unsigned... Fs>
+LanesTable<T, G, L, Ftl, Fs...> lanes_table_of(std::integer_sequence<unsigned, Fs...>);
+template <typename T, int G, int L, bool Ftl>
+using LanesTableT = decltype(lanes_table_of<T, G, L, Ftl>(std::make_integer_sequence<unsigned, HB_F_COUNT>()));
+
+/* The kernel of a run, its lanes a strand and its shared memory a warp. */
+template <typename T> struct LanesPick {
+    LanesFn<T> fn;
+    int lanes;
+    int64_t warp_reals;
+};
+template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int64_t P)
+{
+    return LanesPick<T>{LanesTableT<T, G, L, Ftl>::fn[f], L, lanes_warp_reals<T, G, L>(P)};
+}
+template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P)
+{
+    if (!valid_mask(f) || P < 2 || P > kLanesMaxPoints) return LanesPick<T>{nullptr, 0, 0};
+    if (solver == HB_SOLVER_FTL) {
+        if (P <= 32) return pick<T, kFtlG, kFtlL, true>(f, P);
+        if (P <= 64) return pick<T, 8, 8, true>(f, P);
+        return pick<T, 8, 16, true>(f, P);
+    }
+    if (P <= 32) return pick<T, 2, 16, false>(f, P);
+    if (P <= 64) return pick<T, 4, 16, false>(f, P);
+    return pick<T, 8, 16, false>(f, P);
+}
+
+} /* namespace */
+
+template <typename T> size_t lanes_smem_bytes(unsigned features, int solver, int64_t P, int block)
+{
+    return (size_t)(block / 32) * (size_t)lanes_pick<T>(features, solver, P).warp_reals * sizeof(T);
+}
+
+template <typename T> cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block)
+{
+    const LanesPick<T> k = lanes_pick<T>(features, solver, P);
+    if (!k.fn) return cudaErrorInvalidValue;
+    return cudaFuncSetAttribute(k.fn, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                (int)lanes_smem_bytes<T>(features, solver, P, block));
+}
+
+template <typename T>
+cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
+                               const T *bend_rest, int64_t N, int block, cudaStream_t stream)
+{
+    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points);
+    if (!k.fn) return cudaErrorInvalidValue;
+    const int64_t per_block = (int64_t)(block / 32) * (32 / k.lanes);
+    const int64_t g = (N + per_block - 1) / per_block;
+    const int grid = (int)(g < 1 ? 1 : g > 2147483647 ? 2147483647 : g);
+    k.fn<<<grid, block, (size_t)(block / 32) * (size_t)k.warp_reals * sizeof(T), stream>>>(m, q, phase, x, v, rest,
+                                                                                           bend_rest, N);
+    return cudaGetLastError();
+}
+
+#define HB_LANES_INSTANTIATE(T)                                                                                        \
+    template size_t lanes_smem_bytes<T>(unsigned, int, int64_t, int);                                                  \
+    template cudaError_t prepare_lanes<T>(unsigned, int, int64_t, int);                                                \
+    template cudaError_t launch_frame_lanes<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,           \
+                                               const T *, int64_t, int, cudaStream_t);
+HB_LANES_INSTANTIATE(float)
+HB_LANES_INSTANTIATE(double)
+#undef HB_LANES_INSTANTIATE
+
+} /* namespace dyn */
+} /* namespace hb */
