@@ -1,4 +1,4 @@
-/* model.h — the paper model of DESIGN §3 on one strand, in fp32 and fp64.
+/* model.h — the paper model (docs/model.md §2) on one strand, in fp32 and fp64.
  *
  * A strand is P points of (x, y, z) at `s[3k + c]` (the canonical strand-major layout:
  * strand i starts at state + 3·P·i). Every function here is pure and touches one strand,
@@ -29,7 +29,7 @@ typedef struct {
 } hb_model_f64;
 
 /* Relative rounding allowance of the collide test: a point counts as inside the shell
- * only when its slice radius is below rc·(1 − HB_SHELL_ULPS·ε) (DESIGN §3 collide;
+ * only when its slice radius is below rc·(1 − HB_SHELL_ULPS·ε) (docs/model.md §2.5;
  * docs/decisions.md). */
 #define HB_SHELL_ULPS 16
 

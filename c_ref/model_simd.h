@@ -1,4 +1,4 @@
-/* model_simd.h — the paper model of DESIGN §3 on the point-major layout, vectorised across
+/* model_simd.h — the paper model (docs/model.md §2) on the point-major layout, vectorised across
  * strands: the `simd` variant of hairsim-cpu (docs/cpu_simd.md).
  *
  * Layout: three arrays X, Y, Z of [P][S] reals, S = the row stride (N rounded up to a whole

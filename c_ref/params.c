@@ -1,4 +1,4 @@
-/* params.c — scene validation (DESIGN §8: bad scenes are refused before any work, with a
+/* params.c — scene validation (docs/model.md §2.6: bad scenes are refused before any work, with a
  * message naming the flag). */
 #include "params.h"
 
@@ -80,7 +80,7 @@ int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
      * exactly; a relative allowance of 1e-12 keeps that edge usable. */
     if (!(ell >= s->hair_offset * (1.0 - 1e-12)))
         FAIL("--hair-length/(--points - 1) = %g is shorter than --hair-offset %g: a segment could not reach the "
-             "shell (DESIGN §3 collide needs l >= h)",
+             "shell (docs/model.md §2.5: collide needs l >= h)",
              ell, s->hair_offset);
     /* Every length must square without leaving the precision's normal range, or the
      * model's r², ℓ² and ρ·rc underflow to denormals or zero (docs/decisions.md,

@@ -1,6 +1,6 @@
 /* philox.h — Philox4x32-10 counter-based RNG (Salmon et al., SC'11, "Parallel random
  * numbers: as easy as 1, 2, 3"; the algorithm and constants as published with Random123)
- * and the draw → uniform conversion of DESIGN §3 "Randomness".
+ * and the draw → uniform conversion of docs/model.md §1.4.
  *
  * Header-only so that the C reference and the CUDA port compile the *same* integer code:
  * every backend, thread count, block size and strand split draws identical bits. Checked
