@@ -15,7 +15,7 @@
 extern "C" {
 #endif
 
-/* The scene's numbers rounded once to the working precision (docs/decisions.md). */
+/* The scene's numbers rounded once to the working precision (docs/model.md §1.3). */
 typedef struct {
     uint64_t seed;
     int64_t points;
@@ -30,7 +30,7 @@ typedef struct {
 
 /* Relative rounding allowance of the collide test: a point counts as inside the shell
  * only when its slice radius is below rc·(1 − HB_SHELL_ULPS·ε) (docs/model.md §2.5;
- * docs/decisions.md). */
+ * docs/decisions/testing.md). */
 #define HB_SHELL_ULPS 16
 
 /* init = place the root from the RNG, then drape; drape alone re-drapes from s[0..2]. */

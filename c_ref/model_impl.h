@@ -61,7 +61,7 @@ void SFX(hb_drape_strand)(const MODEL *m, REAL *s)
              * predecessor, new point) has cos α = (ρ² + rc² − ℓ²) / (2ρ rc). Evaluated in
              * the equivalent half-angle form sin²(α/2) = (ℓ − g)(ℓ + g) / (4ρ rc), g = rc − ρ,
              * which keeps its accuracy for short segments where cos α is near 1
-             * (docs/decisions.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
+             * (docs/decisions/paper-model.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
              * is s² < 0. */
             int fits = 0;
             REAL s2 = 0;
@@ -182,7 +182,7 @@ int64_t SFX(hb_collide_strand)(const MODEL *m, REAL *s)
              * a = (d² + rc² − ℓ²) / 2d along the unit u towards the predecessor, the
              * candidates at a·u ± hh·u⊥ with hh = √(rc² − a²). Evaluated through
              * t = d − a = ((d − rc)(d + rc) + ℓ²) / 2d and hh² = (rc − a)(rc + a), which
-             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions.md,
+             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions/paper-model.md,
              * "collide_short_segment"). */
             const REAL d2 = py * py + pz * pz;
             const REAL d = SQRT(d2);

@@ -107,7 +107,7 @@ enum {
 };
 
 /* Derived values, computed once in double on the host and rounded once to the working
- * precision by each backend (docs/decisions.md). */
+ * precision by each backend (docs/model.md §1.3). */
 static inline double hb_segment_length(const hb_scene *s)
 {
     return s->hair_length / (double)(s->points - 1);

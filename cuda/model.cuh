@@ -194,7 +194,7 @@ template <typename T, class V> HB_HD void drape(const Model<T> &m, const V &s, c
              * predecessor, new point) has cos α = (ρ² + rc² − ℓ²) / (2ρ rc). Evaluated in
              * the equivalent half-angle form sin²(α/2) = (ℓ − g)(ℓ + g) / (4ρ rc), g = rc − ρ,
              * which keeps its accuracy for short segments where cos α is near 1
-             * (docs/decisions.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
+             * (docs/decisions/paper-model.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
              * is s² < 0. */
             int fits = 0;
             T s2 = 0;
@@ -354,7 +354,7 @@ template <typename T> struct CollideWalk {
              * a = (d² + rc² − ℓ²) / 2d along the unit u towards the predecessor, the
              * candidates at a·u ± hh·u⊥ with hh = √(rc² − a²). Evaluated through
              * t = d − a = ((d − rc)(d + rc) + ℓ²) / 2d and hh² = (rc − a)(rc + a), which
-             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions.md,
+             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions/paper-model.md,
              * "collide_short_segment"). */
             const T d2 = py * py + pz * pz;
             const T d = m_sqrt(d2);
