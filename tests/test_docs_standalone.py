@@ -118,10 +118,8 @@ def test_help_describes_both_models_and_every_stage(cpu_bin):
     assert {"init", "collide", "wind", "simulate"} <= stages
     lines = text.splitlines()
     first = next(i for i, line in enumerate(lines) if line.strip().startswith("--stages"))
-    entry = [lines[first]] + [
-        line for line in itertools.takewhile(lambda s: s.startswith(" " * 8), lines[first + 1 :])
-    ]
-    stages_line = " ".join(entry)
+    continued = itertools.takewhile(lambda s: s.startswith(" " * 8), lines[first + 1 :])
+    stages_line = " ".join([lines[first], *continued])
     for stage in stages:
         assert re.search(rf"\b{stage}\b", stages_line), f"--stages help does not name {stage}: {stages_line}"
     for doc in re.findall(r"docs/[\w.-]+\.md", text):
