@@ -15,6 +15,7 @@ ROOT = Path(__file__).resolve().parent.parent
 # Excluded for now: harness/ and tests/ are being reorganised on another branch; their
 # citations are retargeted after that merge, and then these two entries are removed.
 NOT_YET_CHECKED = ("harness/", "tests/")
+THIS_FILE = "tests/test_docs_standalone.py"  # names the patterns it looks for
 
 # "DESIGN" as a document: the word in capitals (any "DESIGN §n", "DESIGN.md"), and the
 # background folder and files by name. Lower-case "design" is ordinary prose.
@@ -47,7 +48,7 @@ def doc_files():
 def test_no_tracked_file_cites_a_document_outside_the_repository():
     found = []
     for rel in tracked_files():
-        if rel.startswith(NOT_YET_CHECKED) or not (ROOT / rel).is_file():
+        if rel.startswith(NOT_YET_CHECKED) or rel == THIS_FILE or not (ROOT / rel).is_file():
             continue
         text = text_of(rel)
         if text is None:
