@@ -1,5 +1,5 @@
 /* backend_cpu.c — the C reference backend: the canonical strand-major state in host
- * memory, OpenMP over strands (DESIGN §5). Strands are independent and each is computed by
+ * memory, OpenMP over strands (docs/model.md §5.1). Strands are independent and each is computed by
  * one thread start to finish, so the bits do not depend on the thread count.
  *
  * Two variants:

@@ -104,7 +104,9 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
     int cuda = strcmp(backend, "cuda") == 0;
     fprintf(f,
             "usage: %s [options]\n"
-            "Hair-strand simulation, DESIGN §3 paper model (%s backend). Writes HDF5 states (docs/interfaces.md).\n"
+            "Hair-strand simulation (%s backend) with two models (docs/model.md): the paper model's one-shot\n"
+            "stages init, collide and wind, and the dynamic model's time-stepped simulate stage. Writes HDF5\n"
+            "states and a JSON record (docs/interfaces.md).\n"
             "\nscene:\n"
             "  --strands N          number of strands (default 1000)\n"
             "  --points P           points per strand incl. the root, >= 2 (default 32)\n"
@@ -115,7 +117,9 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
             "  --face-margin M      face margin of the root draw (default 1)\n"
             "  --wind-strength W    wind strength in [0, 1] (default 0.5)\n"
             "  --wind-angle PSI     wind direction, radians from +z toward +y (default pi)\n"
-            "  --stages LIST        ordered stages from init,collide,wind (default init,collide,wind,collide)\n"
+            "  --stages LIST        comma-separated, in order: init,collide,wind of the paper model (repeats\n"
+            "                       allowed, init first), then simulate of the dynamic model, once and last\n"
+            "                       (default init,collide,wind,collide)\n"
             "  --precision P        fp32 or fp64 (default fp32)\n"
             "\nrun:\n"
             "  --variant NAME       %s\n"

@@ -1,6 +1,6 @@
 /* driver.c — the run shared by every backend: parse, refuse bad input before any work,
- * run the listed stages (DESIGN §8: only those), time them (DESIGN §7), write the HDF5
- * state (§4) and the JSON record. */
+ * run the listed stages (docs/model.md §2.6: only those), time them (§5.3), write the HDF5
+ * state and the JSON record (docs/interfaces.md). */
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -425,7 +425,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
         return HB_EXIT_OK;
     }
 
-    /* ---- refuse bad input before any work (DESIGN §8) ---- */
+    /* ---- refuse bad input before any work (docs/model.md §2.6) ---- */
     if (o.input) {
         CHECK(hb_input_open(o.input, &run.in, err, sizeof err), HB_EXIT_USAGE);
         run.have_input = 1;
@@ -543,7 +543,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
     }
     if (b->keep_intermediate) b->keep_intermediate(b, run.w != NULL);
 
-    /* ---- the stages, each timed from the same input (DESIGN §7) ---- */
+    /* ---- the stages, each timed from the same input (docs/model.md §5.3) ---- */
     double *times = run.times;
     for (int i = 0; i < o.n_stages;) {
         hb_stage st = o.stages[i];
@@ -561,7 +561,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
             break; /* simulate is the last stage */
         }
         if (st == HB_STAGE_WIND && o.scene.wind_strength == 0.0) {
-            /* a stage whose effect is nil is not launched (DESIGN §8) */
+            /* a stage whose effect is nil is not launched (docs/model.md §2.6) */
             sr->meta.skipped = 1;
             if (run.w) {
                 double ms;

@@ -5,7 +5,7 @@
  *
  * A strand's positions x, velocities v and rest shape X̄ are P points of (x, y, z) in the
  * canonical strand-major layout, as in model.h. dynamics_impl.h holds the math, written
- * once; dynamics.c instantiates it for float and double.
+ * once; dynamics_f32.c and dynamics_f64.c instantiate it for float and double.
  */
 #ifndef HB_DYNAMICS_H
 #define HB_DYNAMICS_H
@@ -87,7 +87,7 @@ int hb_obs_blown_up(const hb_observables *o);
 /* acc ← acc combined with o (max, max, sum, sum). */
 void hb_dyn_reduce_into(hb_obs_partial *acc, const hb_obs_partial *o);
 
-/* ---- one strand (dynamics_impl.h via dynamics.c) ----
+/* ---- one strand (dynamics_impl.h via dynamics_f32.c, dynamics_f64.c) ----
  * `scratch` holds 9·P reals. `bend_rest` holds P − 2 rest lengths (hb_dyn_bend_rest). */
 void hb_dyn_bend_rest_f32(const hb_dyn_model_f32 *m, const float *rest, float *bend_rest);
 void hb_dyn_bend_rest_f64(const hb_dyn_model_f64 *m, const double *rest, double *bend_rest);

@@ -1,5 +1,6 @@
 /* dynamics_impl.h — the dynamic model (docs/model.md §3), written once for a floating
- * type REAL; dynamics.c includes it for float and for double (SFX, DMODEL, SQRT, SIN).
+ * type REAL; dynamics_f32.c and dynamics_f64.c include it for float and for double (SFX,
+ * DMODEL, SQRT, SIN).
  *
  * One call advances one strand by one frame of S substeps. The feature set F is a
  * compile-time constant in every instantiation of frame_body (see the dispatch at the

@@ -1,4 +1,4 @@
-/* model.h — the paper model of DESIGN §3 on one strand, in fp32 and fp64.
+/* model.h — the paper model (docs/model.md §2) on one strand, in fp32 and fp64.
  *
  * A strand is P points of (x, y, z) at `s[3k + c]` (the canonical strand-major layout:
  * strand i starts at state + 3·P·i). Every function here is pure and touches one strand,
@@ -15,7 +15,7 @@
 extern "C" {
 #endif
 
-/* The scene's numbers rounded once to the working precision (docs/decisions.md). */
+/* The scene's numbers rounded once to the working precision (docs/model.md §1.3). */
 typedef struct {
     uint64_t seed;
     int64_t points;
@@ -29,8 +29,8 @@ typedef struct {
 } hb_model_f64;
 
 /* Relative rounding allowance of the collide test: a point counts as inside the shell
- * only when its slice radius is below rc·(1 − HB_SHELL_ULPS·ε) (DESIGN §3 collide;
- * docs/decisions.md). */
+ * only when its slice radius is below rc·(1 − HB_SHELL_ULPS·ε) (docs/model.md §2.5;
+ * docs/decisions/testing.md). */
 #define HB_SHELL_ULPS 16
 
 /* init = place the root from the RNG, then drape; drape alone re-drapes from s[0..2]. */

@@ -1,4 +1,4 @@
-/* model_impl.h — the paper model (DESIGN §3), written once for a floating type REAL.
+/* model_impl.h — the paper model (docs/model.md §2), written once for a floating type REAL.
  *
  * Included twice by model.c (REAL = float, then double) with the math functions named by
  * SQRT, SIN, COS, ASIN, ATAN2 and the machine epsilon EPS. The CUDA port (cuda/model.cuh)
@@ -13,7 +13,7 @@
 #define HALF_PI_R ((REAL)1.57079632679489661923)
 #define TWO_PI_R ((REAL)6.28318530717958647692)
 
-/* ---- DESIGN §3 "Stage init — roots (SetStartPoint)" ---------------------------------- */
+/* ---- docs/model.md §2.2 roots (SetStartPoint) ----------------------------------------- */
 static void SFX(place_root)(const MODEL *m, uint64_t strand, REAL *s)
 {
     uint32_t r[4];
@@ -39,7 +39,7 @@ static void SFX(place_root)(const MODEL *m, uint64_t strand, REAL *s)
     s[2] = z;
 }
 
-/* ---- DESIGN §3 "Stage init — drape (SetEndPoint, interpolated points, slerp)" -------- */
+/* ---- docs/model.md §2.3 drape (SetEndPoint, interpolated points, slerp) -------------- */
 void SFX(hb_drape_strand)(const MODEL *m, REAL *s)
 {
     const int64_t P = m->points;
@@ -61,7 +61,7 @@ void SFX(hb_drape_strand)(const MODEL *m, REAL *s)
              * predecessor, new point) has cos α = (ρ² + rc² − ℓ²) / (2ρ rc). Evaluated in
              * the equivalent half-angle form sin²(α/2) = (ℓ − g)(ℓ + g) / (4ρ rc), g = rc − ρ,
              * which keeps its accuracy for short segments where cos α is near 1
-             * (docs/decisions.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
+             * (docs/decisions/paper-model.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
              * is s² < 0. */
             int fits = 0;
             REAL s2 = 0;
@@ -107,7 +107,7 @@ void SFX(hb_init_strand)(const MODEL *m, uint64_t strand, REAL *s)
     SFX(hb_drape_strand)(m, s);
 }
 
-/* ---- DESIGN §3 "Stage wind" ----------------------------------------------------------- */
+/* ---- docs/model.md §2.4 wind ------------------------------------------------------------ */
 /* Each segment's direction φk turns toward ψ by t = w·k/(P−1) of the shorter arc (a 2-D
  * slerp); the strand is rebuilt from the root with segments of length ℓ. The caller does
  * not call this when w = 0 (the identity). */
@@ -143,7 +143,7 @@ void SFX(hb_wind_strand)(const MODEL *m, REAL *s)
     }
 }
 
-/* ---- DESIGN §3 "Stage collide" -------------------------------------------------------- */
+/* ---- docs/model.md §2.5 collide --------------------------------------------------------- */
 /* Walk from the root. A point inside the shell (beyond the rounding allowance) moves to
  * the intersection of the shell circle with the circle of radius ℓ around its
  * predecessor that is closest to where it was (a tie takes the upper one); once a point
@@ -182,7 +182,7 @@ int64_t SFX(hb_collide_strand)(const MODEL *m, REAL *s)
              * a = (d² + rc² − ℓ²) / 2d along the unit u towards the predecessor, the
              * candidates at a·u ± hh·u⊥ with hh = √(rc² − a²). Evaluated through
              * t = d − a = ((d − rc)(d + rc) + ℓ²) / 2d and hh² = (rc − a)(rc + a), which
-             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions.md,
+             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions/paper-model.md,
              * "collide_short_segment"). */
             const REAL d2 = py * py + pz * pz;
             const REAL d = SQRT(d2);

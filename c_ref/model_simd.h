@@ -1,4 +1,4 @@
-/* model_simd.h — the paper model of DESIGN §3 on the point-major layout, vectorised across
+/* model_simd.h — the paper model (docs/model.md §2) on the point-major layout, vectorised across
  * strands: the `simd` variant of hairsim-cpu (docs/cpu_simd.md).
  *
  * Layout: three arrays X, Y, Z of [P][S] reals, S = the row stride (N rounded up to a whole
@@ -10,7 +10,7 @@
  * strand are padding: computed, never read back, never counted).
  *
  * The formulas are those of model_impl.h, operation for operation (including the two
- * better-conditioned evaluations of docs/decisions.md), with its branches turned into
+ * better-conditioned evaluations of docs/model.md §2.3, §2.5), with its branches turned into
  * selects; the only difference is that sin/cos/asin/atan2 are glibc's libmvec vector
  * functions. model_simd.c is compiled for x86-64-v3 (AVX2 + FMA): call these only after
  * hb_simd_cpu_ok() in a file compiled for the baseline ISA (backend_cpu.c does).

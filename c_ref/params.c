@@ -1,4 +1,4 @@
-/* params.c — scene validation (DESIGN §8: bad scenes are refused before any work, with a
+/* params.c — scene validation (docs/model.md §2.6: bad scenes are refused before any work, with a
  * message naming the flag). */
 #include "params.h"
 
@@ -46,7 +46,7 @@ double hb_wind_angle_reduced(const hb_scene *s)
         return -1;                                                                                                     \
     } while (0)
 
-/* The lengths a precision can square without underflow or overflow (docs/decisions.md,
+/* The lengths a precision can square without underflow or overflow (docs/decisions/paper-model.md,
  * "Representable scenes"). */
 static double length_min(hb_precision p)
 {
@@ -80,10 +80,10 @@ int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
      * exactly; a relative allowance of 1e-12 keeps that edge usable. */
     if (!(ell >= s->hair_offset * (1.0 - 1e-12)))
         FAIL("--hair-length/(--points - 1) = %g is shorter than --hair-offset %g: a segment could not reach the "
-             "shell (DESIGN §3 collide needs l >= h)",
+             "shell (docs/model.md §2.5: collide needs l >= h)",
              ell, s->hair_offset);
     /* Every length must square without leaving the precision's normal range, or the
-     * model's r², ℓ² and ρ·rc underflow to denormals or zero (docs/decisions.md,
+     * model's r², ℓ² and ρ·rc underflow to denormals or zero (docs/decisions/paper-model.md,
      * "fp32_near_denormal_range"). */
     const double lo = length_min(s->precision), hi = length_max(s->precision);
     const struct {
@@ -122,7 +122,7 @@ const char *hb_motion_name(hb_motion m)
     return "?";
 }
 
-/* Defaults (docs/decisions.md, "dynamic defaults"): what a flag left out means. */
+/* Defaults (docs/decisions/dynamic-model.md, "Dynamic defaults"): what a flag left out means. */
 void hb_dynamics_defaults(hb_dynamics *d)
 {
     memset(d, 0, sizeof *d);
@@ -184,7 +184,7 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
 
 /* The dynamic model's derived constants (docs/model.md §3.4), computed in double and
  * rounded once to the working precision, must be finite there, and the lengths it squares
- * must stay in the precision's range; else the first substep makes NaN (docs/decisions.md,
+ * must stay in the precision's range; else the first substep makes NaN (docs/decisions/testing.md,
  * "dynamic_constant_overflow"). Only the constants a run evaluates are checked. */
 static int fits(double v, hb_precision p)
 {

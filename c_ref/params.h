@@ -1,4 +1,4 @@
-/* params.h — the scene parameters and run options shared by every backend (DESIGN §3, §8;
+/* params.h — the scene parameters and run options shared by every backend (docs/model.md §2;
  * the flags are documented in docs/interfaces.md). */
 #ifndef HB_PARAMS_H
 #define HB_PARAMS_H
@@ -107,7 +107,7 @@ enum {
 };
 
 /* Derived values, computed once in double on the host and rounded once to the working
- * precision by each backend (docs/decisions.md). */
+ * precision by each backend (docs/model.md §1.3). */
 static inline double hb_segment_length(const hb_scene *s)
 {
     return s->hair_length / (double)(s->points - 1);
@@ -121,7 +121,7 @@ static inline size_t hb_real_size(hb_precision p)
 const char *hb_stage_name(hb_stage s);
 const char *hb_precision_name(hb_precision p);
 
-/* Checks a scene against DESIGN §3/§8; on failure writes one line naming the flag. */
+/* Checks a scene against docs/model.md §2.6; on failure writes one line naming the flag. */
 int hb_scene_validate(const hb_scene *s, char *err, size_t errlen);
 /* Checks the dynamic parameters (docs/model.md §3); one line naming the flag on failure. */
 int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen);

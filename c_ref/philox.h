@@ -1,13 +1,13 @@
 /* philox.h — Philox4x32-10 counter-based RNG (Salmon et al., SC'11, "Parallel random
  * numbers: as easy as 1, 2, 3"; the algorithm and constants as published with Random123)
- * and the draw → uniform conversion of DESIGN §3 "Randomness".
+ * and the draw → uniform conversion of docs/model.md §1.4.
  *
  * Header-only so that the C reference and the CUDA port compile the *same* integer code:
  * every backend, thread count, block size and strand split draws identical bits. Checked
  * against Random123's published known-answer vectors by `hairsim-cpu --self-test rng`
  * (tests/test_rng.py).
  *
- * Stream layout (this project's choice, docs/decisions.md):
+ * Stream layout (docs/model.md §1.4):
  *   key     = { seed low 32 bits, seed high 32 bits }
  *   counter = { strand low 32 bits, strand high 32 bits, draw / 4, 0 }
  *   draw d of strand i is word d % 4 of philox(counter(i, d / 4), key).
@@ -78,7 +78,7 @@ HB_HD void hb_draw_block(uint64_t seed, uint64_t strand, uint32_t block, uint32_
 
 /* A 32-bit draw → uniform in [0, 1) with 24 random bits: (x >> 8) · 2^-24, integer
  * operations and a power-of-two scale only. The value is exact in float and in double, so
- * fp32 and fp64 runs start from the same draws (docs/decisions.md). */
+ * fp32 and fp64 runs start from the same draws (docs/model.md §1.4). */
 HB_HD double hb_u01(uint32_t x)
 {
     return (double)(x >> 8) * (1.0 / 16777216.0);

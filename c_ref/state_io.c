@@ -1,4 +1,4 @@
-/* state_io.c — HDF5 states, H5MD 1.1 shaped (DESIGN §4; layout in docs/interfaces.md). */
+/* state_io.c — HDF5 states, H5MD 1.1 shaped (layout in docs/interfaces.md). */
 #include "state_io.h"
 #include "safe_write.h"
 #include "h5md_meta.h"

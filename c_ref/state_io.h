@@ -1,4 +1,4 @@
-/* state_io.h — the HDF5 state of DESIGN §4 (layout in docs/interfaces.md): a writer that
+/* state_io.h — the HDF5 state (layout in docs/interfaces.md): a writer that
  * appends frames to a temporary file and renames it when complete, and a reader that
  * validates an --input file before any work. */
 #ifndef HB_STATE_IO_H

@@ -1,4 +1,4 @@
-/* backend_cuda.cu — the CUDA backend (DESIGN §5): the hb_backend the shared driver
+/* backend_cuda.cu — the CUDA backend (docs/model.md §5.1): the hb_backend the shared driver
  * (c_ref/driver.c) runs, and main().
  *
  * Variants (docs/cuda.md):
@@ -19,7 +19,7 @@
  * there when asked, see keep_intermediate), and a saved copy when the driver repeats
  * stages. Checked against cudaMemGetInfo before anything is allocated.
  *
- * Timing (DESIGN §7): run_stage records CUDA events immediately around its kernel
+ * Timing (docs/model.md §5.3): run_stage records CUDA events immediately around its kernel
  * launch(es) and nothing else; r->ms is their elapsed time. The collide count is read back
  * after the stop event. load/fetch report the host wall time of the whole transfer,
  * conversion included, after synchronisation.

@@ -1,4 +1,4 @@
-/* model.cuh — the paper model (DESIGN §3) for the CUDA port: c_ref/model_impl.h written as
+/* model.cuh — the paper model (docs/model.md §2) for the CUDA port: c_ref/model_impl.h written as
  * `__host__ __device__` templates over the floating type T and the memory layout.
  *
  * This file follows c_ref/model_impl.h operation by operation: the same expressions in the
@@ -174,7 +174,7 @@ template <typename T> struct PointMajor {
     HB_HD static PointMajor make(T *a, T *b, T *c, int64_t N, int64_t) { return PointMajor{a, b, c, N}; }
 };
 
-/* ---- DESIGN §3 "Stage init — drape" (model_impl.h: hb_drape_strand) ------------------------------ */
+/* ---- docs/model.md §2.3 drape (model_impl.h: hb_drape_strand) ------------------------------------ */
 /* The root (x0, py, pz) is already stored; writes points 1 … P−1. */
 template <typename T, class V> HB_HD void drape(const Model<T> &m, const V &s, const T x0, T py, T pz)
 {
@@ -194,7 +194,7 @@ template <typename T, class V> HB_HD void drape(const Model<T> &m, const V &s, c
              * predecessor, new point) has cos α = (ρ² + rc² − ℓ²) / (2ρ rc). Evaluated in
              * the equivalent half-angle form sin²(α/2) = (ℓ − g)(ℓ + g) / (4ρ rc), g = rc − ρ,
              * which keeps its accuracy for short segments where cos α is near 1
-             * (docs/decisions.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
+             * (docs/decisions/paper-model.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
              * is s² < 0. */
             int fits = 0;
             T s2 = 0;
@@ -236,7 +236,7 @@ template <typename T, class V> HB_HD void drape(const Model<T> &m, const V &s, c
     }
 }
 
-/* ---- DESIGN §3 "Stage init": roots (model_impl.h: place_root) then the drape ----------- */
+/* ---- docs/model.md §2.2, §2.3 init: roots (model_impl.h: place_root) then the drape -------- */
 template <typename T, class Layout> HB_HD void init_strand(const Model<T> &m, const Layout &lay, int64_t i)
 {
     const typename Layout::View s = lay.strand(i);
@@ -271,7 +271,7 @@ template <typename T, class Layout> HB_HD void drape_strand(const Model<T> &m, c
     drape(m, s, s.x(0), s.y(0), s.z(0));
 }
 
-/* ---- DESIGN §3 "Stage wind": one step of the walk (model_impl.h: hb_wind_strand) ------- */
+/* ---- docs/model.md §2.4 wind: one step of the walk (model_impl.h: hb_wind_strand) ------- */
 /* Keeps the predecessor before the wind (oy, oz) and after it (ny, nz). */
 template <typename T> struct WindWalk {
     T ell, w, psi, last;
@@ -312,7 +312,7 @@ template <typename T> struct WindWalk {
     }
 };
 
-/* ---- DESIGN §3 "Stage collide": one step of the walk (model_impl.h: hb_collide_strand) -- */
+/* ---- docs/model.md §2.5 collide: one step of the walk (model_impl.h: hb_collide_strand)  */
 template <typename T> struct CollideWalk {
     T ell, rc, inner2;
     T py, pz; /* the predecessor, after collision */
@@ -354,7 +354,7 @@ template <typename T> struct CollideWalk {
              * a = (d² + rc² − ℓ²) / 2d along the unit u towards the predecessor, the
              * candidates at a·u ± hh·u⊥ with hh = √(rc² − a²). Evaluated through
              * t = d − a = ((d − rc)(d + rc) + ℓ²) / 2d and hh² = (rc − a)(rc + a), which
-             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions.md,
+             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions/paper-model.md,
              * "collide_short_segment"). */
             const T d2 = py * py + pz * pz;
             const T d = m_sqrt(d2);
