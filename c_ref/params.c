@@ -1,6 +1,7 @@
 /* params.c — scene validation (DESIGN §8: bad scenes are refused before any work, with a
  * message naming the flag). */
 #include "params.h"
+#include "checked.h"
 
 #include <float.h>
 #include <math.h>
@@ -26,11 +27,11 @@ const char *hb_precision_name(hb_precision p)
 uint64_t hb_state_bytes(const hb_scene *s)
 {
     if (s->n_strands <= 0 || s->points <= 0) return 0;
-    uint64_t n = (uint64_t)s->n_strands, p = (uint64_t)s->points;
-    uint64_t per_strand = p * 3u * hb_real_size(s->precision);
-    if (per_strand / p != 3u * hb_real_size(s->precision)) return 0;
-    if (n > UINT64_MAX / per_strand) return 0;
-    return n * per_strand;
+    uint64_t rows, bytes;
+    if (hb_mul_u64((uint64_t)s->n_strands, (uint64_t)s->points, &rows) ||
+        hb_mul3_u64(rows, 3u, hb_real_size(s->precision), &bytes))
+        return 0;
+    return bytes;
 }
 
 double hb_wind_angle_reduced(const hb_scene *s)

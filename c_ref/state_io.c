@@ -1,6 +1,7 @@
 /* state_io.c — HDF5 states, H5MD 1.1 shaped (DESIGN §4; layout in docs/interfaces.md). */
 #include "state_io.h"
 #include "safe_write.h"
+#include "checked.h"
 #include "h5md_meta.h"
 
 #include <errno.h>
@@ -156,7 +157,11 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     }
     w->file = w->value = w->velocity = -1;
     w->scene = *scene;
-    w->rows = (uint64_t)scene->n_strands * (uint64_t)scene->points;
+    if (hb_mul_u64((uint64_t)scene->n_strands, (uint64_t)scene->points, &w->rows)) {
+        snprintf(err, errlen, "--strands x --points is too large to address");
+        free(w);
+        return NULL;
+    }
     if (hb_safe_output_check(path, force, err, errlen)) goto fail;
     w->path = strdup(path);
     size_t n = strlen(path) + 32;
@@ -226,7 +231,9 @@ fail:
 /* Resizes *a to `cap` entries of `size` bytes; −1 (and *a unchanged) when out of memory. */
 static int resize(void **a, int cap, size_t size)
 {
-    void *p = realloc(*a, (size_t)cap * size);
+    uint64_t bytes;
+    if (cap < 0 || hb_mul_u64((uint64_t)cap, size, &bytes)) return -1;
+    void *p = realloc(*a, (size_t)bytes);
     if (!p) return -1;
     *a = p;
     return 0;
