@@ -14,6 +14,7 @@
 #include "host.h"
 #include "philox.h"
 #include "record.h"
+#include "safe_write.h"
 #include "state_io.h"
 
 static const char *g_prog = "hairsim";
@@ -657,7 +658,8 @@ int hb_main(int argc, char **argv, hb_backend *b)
         double t0 = hb_now_ms(), before = 1e3 * hb_writer_seconds(run.w);
         hb_writer *w = run.w;
         run.w = NULL;
-        CHECK(hb_writer_close(w, &rm, err, sizeof err), HB_EXIT_RUNTIME);
+        const int rc_close = hb_writer_close(w, &rm, err, sizeof err);
+        CHECK(rc_close, rc_close == HB_SAFE_EXISTS ? HB_EXIT_USAGE : HB_EXIT_RUNTIME);
         rec.hdf5_write_ms = before + (hb_now_ms() - t0);
     }
     if (o.json) hb_record_json(stdout, &rec);
