@@ -272,6 +272,8 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
                  (long long)o->frames, (long long)d->substeps, (long long)gf0);
         FAIL_IF(1, HB_EXIT_USAGE);
     }
+    const double t_end = (double)(gf0 + (o->frame_loop ? 2 : 1) * o->frames) * d->frame_dt;
+    FAIL_IF(hb_dynamics_validate_time(s, t_end, err, errlen), HB_EXIT_USAGE);
     FAIL_IF(b->dyn_load(b, vel, rest, err, errlen), HB_EXIT_RUNTIME);
     if (r->w) FAIL_IF(hb_writer_rest(r->w, rest, err, errlen), HB_EXIT_RUNTIME);
 

@@ -192,6 +192,19 @@ static int fits(double v, hb_precision p)
     return p == HB_FP32 ? isfinite((float)v) : isfinite(v);
 }
 
+int hb_dynamics_validate_time(const hb_scene *s, double t_end, char *err, size_t errlen)
+{
+    const hb_dynamics *d = &s->dyn;
+    const int gust = d->wind_speed > 0.0 && d->drag > 0.0 && d->gust_amplitude > 0.0;
+    const double w = 2.0 * M_PI * d->motion_frequency; /* evaluated as (2πf)·t */
+    if (d->motion != HB_MOTION_STILL && !(isfinite(w) && isfinite(w * t_end)))
+        FAIL("2 pi x --motion-frequency x t = %g at t = %g s overflows fp64 (largest %g)", w * t_end, t_end, DBL_MAX);
+    if (gust && !isfinite(d->gust_frequency * t_end))
+        FAIL("--gust-frequency x t = %g at t = %g s overflows fp64 (largest %g)", d->gust_frequency * t_end, t_end,
+             DBL_MAX);
+    return 0;
+}
+
 int hb_dynamics_validate_scene(const hb_scene *s, char *err, size_t errlen)
 {
     const hb_dynamics *d = &s->dyn;
