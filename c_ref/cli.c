@@ -228,9 +228,10 @@ static int parse_f64(const char *flag, const char *v, double *out, char *err, si
 {
     char *end;
     int plain;
-    if (!decimal_syntax(v, &plain)) FAIL("%s needs a decimal number (got '%s')", flag, v);
     errno = 0;
     double x = strtod(v, &end);
+    if (end != v && *end == '\0' && !isfinite(x)) FAIL("%s must be finite (got '%s')", flag, v);
+    if (!decimal_syntax(v, &plain)) FAIL("%s needs a decimal number (got '%s')", flag, v);
     if (!isfinite(x)) FAIL("%s must be finite (got '%s')", flag, v);
     *out = x;
     return 0;
