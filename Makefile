@@ -152,7 +152,7 @@ report-dynamic: setup
 sanitize: setup check-hdf5
 	$(MAKE) BUILD=build/asan COPT="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" \
 	  CC="$(CC) -fsanitize=address,undefined" build/asan/hairsim-cpu
-	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(RUN_PY) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume"
+	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(RUN_PY) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume or fault_probe"
 
 # compute-sanitizer (memcheck, racecheck) over every CUDA variant on a small run that also
 # exercises the output, resume and end-to-end paths, and simulate on the strand and warp

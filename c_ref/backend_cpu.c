@@ -17,6 +17,7 @@
 #include <time.h>
 
 #include "backend.h"
+#include "checked.h"
 #include "cli.h"
 #include "dynamics.h"
 #include "dynamics_simd.h"
@@ -76,11 +77,15 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
 
     for (int i = 0; i < o->n_stages; i++) c->dynamic |= o->stages[i] == HB_STAGE_SIMULATE;
     /* simulate adds velocities, the rest shape, bend rest lengths and a saved velocity copy */
-    const uint64_t bend_bytes = (uint64_t)o->scene.n_strands *
-                                (uint64_t)(o->scene.points - 2 > 0 ? o->scene.points - 2 : 1) *
-                                hb_real_size(o->scene.precision);
-    const uint64_t dyn = c->dynamic ? c->bytes * (need_save ? 3u : 2u) + bend_bytes : 0;
-    uint64_t need = c->bytes * (need_save ? 2u : 1u) + dyn + driver_bytes;
+    uint64_t bend_bytes; /* saturated sizes: the memory check below refuses them */
+    hb_mul3_u64((uint64_t)o->scene.n_strands, (uint64_t)(o->scene.points - 2 > 0 ? o->scene.points - 2 : 1),
+                hb_real_size(o->scene.precision), &bend_bytes);
+    const uint64_t dyn = c->dynamic ? hb_add_sat(hb_mul_sat(c->bytes, need_save ? 3u : 2u), bend_bytes) : 0;
+    const uint64_t need = hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, need_save ? 2u : 1u), dyn), driver_bytes);
+    if (need == UINT64_MAX) {
+        snprintf(err, errlen, "--strands x --points: the run's memory does not fit in 64 bits");
+        return HB_EXIT_USAGE;
+    }
     uint64_t avail = hb_host_memory_available();
     if (avail && need > avail) {
         hb_memory_message(err, errlen, &o->scene, "host", need, avail, c->dynamic ? ", simulate" : "", NULL);
@@ -188,12 +193,13 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
     c->nblocks = (s->n_strands + c->block - 1) / c->block;
     c->stride = c->nblocks * c->block;
     const uint64_t rs = hb_real_size(s->precision);
-    /* 3 arrays of P × stride reals; no overflow: stride < N + block and the canonical
-     * state of N strands fits in uint64 (hb_state_bytes) */
-    const uint64_t one = (uint64_t)s->points * (uint64_t)c->stride * rs;
+    /* 3 arrays of P × stride reals (saturated: the memory check below refuses it) */
+    uint64_t one;
+    hb_mul3_u64((uint64_t)s->points, (uint64_t)c->stride, rs, &one);
     for (int i = 0; i < o->n_stages; i++) c->dynamic |= o->stages[i] == HB_STAGE_SIMULATE;
     const uint64_t dyn = c->dynamic ? simd_dyn_bytes(c, one, need_save) : 0;
-    uint64_t need = 3u * one * (need_save ? 2u : 1u) + dyn + driver_bytes;
+    const uint64_t need =
+        hb_add_sat(hb_add_sat(hb_mul_sat(hb_mul_sat(one, 3u), need_save ? 2u : 1u), dyn), driver_bytes);
     uint64_t avail = hb_host_memory_available();
     if ((avail && need > avail) || one > SIZE_MAX / 4) {
         hb_memory_message(err, errlen, s, "host", need, avail, c->dynamic ? ", simd, simulate" : ", simd", NULL);
@@ -304,7 +310,9 @@ static int64_t simd_run_stage(cpu_impl *c, hb_stage st)
 static uint64_t simd_dyn_bytes(const cpu_impl *c, uint64_t one, int need_save)
 {
     const int64_t rows = c->scene.points - 2 > 0 ? c->scene.points - 2 : 1;
-    return 3u * one * (need_save ? 3u : 2u) + (uint64_t)rows * (uint64_t)c->stride * hb_real_size(c->scene.precision);
+    uint64_t bend;
+    hb_mul3_u64((uint64_t)rows, (uint64_t)c->stride, hb_real_size(c->scene.precision), &bend);
+    return hb_add_sat(hb_mul_sat(hb_mul_sat(one, 3u), need_save ? 3u : 2u), bend);
 }
 
 static int simd_dyn_setup(cpu_impl *c, int need_save, uint64_t need, char *err, size_t errlen)
@@ -442,7 +450,7 @@ static int simd_dyn_observe(cpu_impl *c, hb_observables *obs, char *err, size_t 
     const int64_t N = c->scene.n_strands, P = c->scene.points, S = c->stride;
     const int64_t nchunks = (N + SIMD_OBS_CHUNK - 1) / SIMD_OBS_CHUNK;
     hb_obs_partial *part = calloc((size_t)nchunks, sizeof *part);
-    hb_obs_partial *strand = malloc((size_t)N * sizeof *strand);
+    hb_obs_partial *strand = malloc((size_t)hb_mul_sat((uint64_t)N, sizeof *strand));
     if (!part || !strand) {
         free(part);
         free(strand);
@@ -606,7 +614,7 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
 #define DYN_FRAME(T, SFX, M)                                                                                           \
     _Pragma("omp parallel")                                                                                            \
     {                                                                                                                  \
-        T *scratch = malloc((size_t)P * 9u * sizeof(T));                                                               \
+        T *scratch = malloc((size_t)hb_mul_sat((uint64_t)P, 9u * sizeof(T)));                                          \
         if (!scratch) {                                                                                                \
             _Pragma("omp atomic write") failed = 1;                                                                    \
         } else {                                                                                                       \

@@ -82,6 +82,9 @@ int hb_dyn_flag_differs(int i, const hb_dynamics *a, const hb_dynamics *b)
 {
     const dyn_flag *df = &dyn_flags[i];
     const char *pa = (const char *)a + df->offset, *pb = (const char *)b + df->offset;
+    if (df->declares &&
+        *(const int *)((const char *)a + df->declares) != *(const int *)((const char *)b + df->declares))
+        return 1; /* declaring a feature changes the physics, whatever the value */
     switch (df->kind) {
     case DF_REAL: return *(const double *)pa != *(const double *)pb;
     case DF_COUNT: return *(const int64_t *)pa != *(const int64_t *)pb;
@@ -160,12 +163,39 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
         return -1;                                                                                                     \
     } while (0)
 
+/* The one grammar of every number on the command line (docs/interfaces.md, "Numbers"):
+ * [+-]digits[.digits][(e|E)[+-]digits] or [+-].digits[…], decimal only; no spaces, hex,
+ * inf or nan. Returns 1 when v matches it, and *plain = 1 when it is [+-]digits alone. */
+static int decimal_syntax(const char *v, int *plain)
+{
+    const char *c = v;
+    if (*c == '+' || *c == '-') c++;
+    int digits = 0, dot = 0, expo = 0;
+    for (; *c >= '0' && *c <= '9'; c++) digits++;
+    if (*c == '.') {
+        dot = 1;
+        for (c++; *c >= '0' && *c <= '9'; c++) digits++;
+    }
+    if (!digits) return 0;
+    if (*c == 'e' || *c == 'E') {
+        expo = 1;
+        c++;
+        if (*c == '+' || *c == '-') c++;
+        if (!(*c >= '0' && *c <= '9')) return 0;
+        while (*c >= '0' && *c <= '9') c++;
+    }
+    *plain = !dot && !expo;
+    return *c == '\0';
+}
+
 static int parse_i64(const char *flag, const char *v, int64_t lo, int64_t *out, char *err, size_t errlen)
 {
     char *end;
+    int plain;
+    if (!decimal_syntax(v, &plain)) FAIL("%s needs a whole number (got '%s')", flag, v);
     errno = 0;
     long long x = strtoll(v, &end, 10);
-    if (end == v || *end != '\0') {
+    if (!plain) {
         /* accept 1e6-style integers */
         double d = strtod(v, &end);
         if (end == v || *end != '\0' || !isfinite(d) || d != floor(d) || fabs(d) > 9.2e18)
@@ -182,10 +212,17 @@ static int parse_i64(const char *flag, const char *v, int64_t lo, int64_t *out, 
 static int parse_u64(const char *flag, const char *v, uint64_t *out, char *err, size_t errlen)
 {
     char *end;
-    errno = 0;
+    int plain;
+    if (!decimal_syntax(v, &plain)) FAIL("%s needs a whole number (got '%s')", flag, v);
     if (v[0] == '-') FAIL("%s needs a non-negative whole number (got '%s')", flag, v);
+    errno = 0;
+    if (!plain) { /* 1e6-style, as for the other whole numbers */
+        double d = strtod(v, &end);
+        if (d != floor(d) || !(d < 18446744073709551616.0)) FAIL("%s needs a whole number (got '%s')", flag, v);
+        *out = (uint64_t)d;
+        return 0;
+    }
     unsigned long long x = strtoull(v, &end, 10); /* base 10: 010 is ten */
-    if (end == v || *end != '\0') FAIL("%s needs a whole number (got '%s')", flag, v);
     if (errno == ERANGE) FAIL("%s is out of range (got '%s')", flag, v);
     *out = x;
     return 0;
@@ -194,9 +231,11 @@ static int parse_u64(const char *flag, const char *v, uint64_t *out, char *err, 
 static int parse_f64(const char *flag, const char *v, double *out, char *err, size_t errlen)
 {
     char *end;
+    int plain;
     errno = 0;
     double x = strtod(v, &end);
-    if (end == v || *end != '\0') FAIL("%s needs a number (got '%s')", flag, v);
+    if (end != v && *end == '\0' && !isfinite(x)) FAIL("%s must be finite (got '%s')", flag, v);
+    if (!decimal_syntax(v, &plain)) FAIL("%s needs a decimal number (got '%s')", flag, v);
     if (!isfinite(x)) FAIL("%s must be finite (got '%s')", flag, v);
     *out = x;
     return 0;

@@ -9,10 +9,12 @@
 #include <time.h>
 
 #include "backend.h"
+#include "checked.h"
 #include "cli.h"
 #include "host.h"
 #include "philox.h"
 #include "record.h"
+#include "safe_write.h"
 #include "state_io.h"
 
 static const char *g_prog = "hairsim";
@@ -271,6 +273,8 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
                  (long long)o->frames, (long long)d->substeps, (long long)gf0);
         FAIL_IF(1, HB_EXIT_USAGE);
     }
+    const double t_end = (double)(gf0 + (o->frame_loop ? 2 : 1) * o->frames) * d->frame_dt;
+    FAIL_IF(hb_dynamics_validate_time(s, t_end, err, errlen), HB_EXIT_USAGE);
     FAIL_IF(b->dyn_load(b, vel, rest, err, errlen), HB_EXIT_RUNTIME);
     if (r->w) FAIL_IF(hb_writer_rest(r->w, rest, err, errlen), HB_EXIT_RUNTIME);
 
@@ -494,7 +498,8 @@ int hb_main(int argc, char **argv, hb_backend *b)
     const uint64_t bytes = hb_state_bytes(&o.scene);
     const int need_host = o.output != NULL || o.end_to_end || simulate;
     /* simulate: the rest shape and the velocities pass through the host once */
-    uint64_t driver_bytes = (need_host ? bytes : 0) + (o.input ? bytes : 0) + (simulate ? 2 * bytes : 0);
+    const uint64_t driver_bytes =
+        hb_add_sat(hb_add_sat(need_host ? bytes : 0, o.input ? bytes : 0), simulate ? hb_mul_sat(bytes, 2u) : 0);
     const int need_save = o.repeat > 1 || o.warmup > 0;
     int status = b->setup(b, &o, need_save, driver_bytes, err, sizeof err);
     if (status != HB_EXIT_OK) {
@@ -512,7 +517,16 @@ int hb_main(int argc, char **argv, hb_backend *b)
         snprintf(err, sizeof err, "cannot allocate the %llu-byte input frame", (unsigned long long)bytes);
         CHECK(1, HB_EXIT_MEMORY);
     }
-    run.times = calloc(((size_t)o.n_stages + (simulate ? (size_t)o.frames : 0)) * (size_t)o.repeat, sizeof *run.times);
+    /* one time per stage (or simulated frame) and repeat, counted by an int */
+    uint64_t n_times, times_bytes;
+    if (hb_add_u64((uint64_t)o.n_stages, simulate ? (uint64_t)o.frames : 0, &n_times) ||
+        hb_mul_u64(n_times, (uint64_t)o.repeat, &n_times) || n_times > INT32_MAX ||
+        hb_mul_u64(n_times, sizeof *run.times, &times_bytes)) {
+        snprintf(err, sizeof err, "--frames %lld x --repeat %lld is more timings than a run keeps (at most %d)",
+                 (long long)(simulate ? o.frames : 0), (long long)o.repeat, INT32_MAX);
+        CHECK(1, HB_EXIT_USAGE);
+    }
+    run.times = calloc((size_t)n_times, sizeof *run.times);
     if (!run.times) {
         snprintf(err, sizeof err, "out of host memory");
         CHECK(1, HB_EXIT_MEMORY);
@@ -654,7 +668,8 @@ int hb_main(int argc, char **argv, hb_backend *b)
         double t0 = hb_now_ms(), before = 1e3 * hb_writer_seconds(run.w);
         hb_writer *w = run.w;
         run.w = NULL;
-        CHECK(hb_writer_close(w, &rm, err, sizeof err), HB_EXIT_RUNTIME);
+        const int rc_close = hb_writer_close(w, &rm, err, sizeof err);
+        CHECK(rc_close, rc_close == HB_SAFE_EXISTS ? HB_EXIT_USAGE : HB_EXIT_RUNTIME);
         rec.hdf5_write_ms = before + (hb_now_ms() - t0);
     }
     if (o.json) hb_record_json(stdout, &rec);

@@ -2,6 +2,7 @@
  * (docs/model.md §3.10): the features of a run, its constants rounded once, and each
  * frame's table of head rotations and gust phases, computed in double. */
 #include "dynamics.h"
+#include "checked.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -77,10 +78,11 @@ int hb_dyn_frame_alloc(hb_dyn_frame *f, int64_t substeps)
 {
     memset(f, 0, sizeof *f);
     f->substeps = substeps;
-    f->q64 = malloc((size_t)substeps * 9u * sizeof *f->q64);
-    f->phase64 = malloc((size_t)substeps * sizeof *f->phase64);
-    f->q32 = malloc((size_t)substeps * 9u * sizeof *f->q32);
-    f->phase32 = malloc((size_t)substeps * sizeof *f->phase32);
+    const uint64_t n = (uint64_t)substeps; /* a saturated size fails malloc */
+    f->q64 = malloc((size_t)hb_mul_sat(n, 9u * sizeof *f->q64));
+    f->phase64 = malloc((size_t)hb_mul_sat(n, sizeof *f->phase64));
+    f->q32 = malloc((size_t)hb_mul_sat(n, 9u * sizeof *f->q32));
+    f->phase32 = malloc((size_t)hb_mul_sat(n, sizeof *f->phase32));
     if (!f->q64 || !f->phase64 || !f->q32 || !f->phase32) {
         hb_dyn_frame_free(f);
         return -1;

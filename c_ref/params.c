@@ -1,6 +1,7 @@
 /* params.c — scene validation (docs/model.md §2.6: bad scenes are refused before any work, with a
  * message naming the flag). */
 #include "params.h"
+#include "checked.h"
 
 #include <float.h>
 #include <math.h>
@@ -26,11 +27,11 @@ const char *hb_precision_name(hb_precision p)
 uint64_t hb_state_bytes(const hb_scene *s)
 {
     if (s->n_strands <= 0 || s->points <= 0) return 0;
-    uint64_t n = (uint64_t)s->n_strands, p = (uint64_t)s->points;
-    uint64_t per_strand = p * 3u * hb_real_size(s->precision);
-    if (per_strand / p != 3u * hb_real_size(s->precision)) return 0;
-    if (n > UINT64_MAX / per_strand) return 0;
-    return n * per_strand;
+    uint64_t rows, bytes;
+    if (hb_mul_u64((uint64_t)s->n_strands, (uint64_t)s->points, &rows) ||
+        hb_mul3_u64(rows, 3u, hb_real_size(s->precision), &bytes))
+        return 0;
+    return bytes;
 }
 
 double hb_wind_angle_reduced(const hb_scene *s)
@@ -189,6 +190,19 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
 static int fits(double v, hb_precision p)
 {
     return p == HB_FP32 ? isfinite((float)v) : isfinite(v);
+}
+
+int hb_dynamics_validate_time(const hb_scene *s, double t_end, char *err, size_t errlen)
+{
+    const hb_dynamics *d = &s->dyn;
+    const int gust = d->wind_speed > 0.0 && d->drag > 0.0 && d->gust_amplitude > 0.0;
+    const double w = 2.0 * M_PI * d->motion_frequency; /* evaluated as (2πf)·t */
+    if (d->motion != HB_MOTION_STILL && !(isfinite(w) && isfinite(w * t_end)))
+        FAIL("2 pi x --motion-frequency x t = %g at t = %g s overflows fp64 (largest %g)", w * t_end, t_end, DBL_MAX);
+    if (gust && !isfinite(d->gust_frequency * t_end))
+        FAIL("--gust-frequency x t = %g at t = %g s overflows fp64 (largest %g)", d->gust_frequency * t_end, t_end,
+             DBL_MAX);
+    return 0;
 }
 
 int hb_dynamics_validate_scene(const hb_scene *s, char *err, size_t errlen)

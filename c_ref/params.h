@@ -128,6 +128,9 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen);
 /* Checks that the dynamic model's derived constants fit the scene's precision and that the
  * lengths it squares stay in range; one line naming the flags on failure. */
 int hb_dynamics_validate_scene(const hb_scene *s, char *err, size_t errlen);
+/* Checks that the head motion's phase 2πf·t and the gust's f_g·t stay finite up to t_end
+ * seconds, for the features the run evaluates; one line naming the flag on failure. */
+int hb_dynamics_validate_time(const hb_scene *s, double t_end, char *err, size_t errlen);
 void hb_dynamics_defaults(hb_dynamics *d);
 const char *hb_solver_name(hb_solver s);
 const char *hb_motion_name(hb_motion m);

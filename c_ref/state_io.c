@@ -1,6 +1,7 @@
 /* state_io.c — HDF5 states, H5MD 1.1 shaped (layout in docs/interfaces.md). */
 #include "state_io.h"
 #include "safe_write.h"
+#include "checked.h"
 #include "h5md_meta.h"
 
 #include <errno.h>
@@ -11,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #define FAIL(...)                                                                                                      \
@@ -98,6 +100,7 @@ static hid_t make_group(hid_t loc, const char *name)
 /* ---- writer ------------------------------------------------------------------------- */
 struct hb_writer {
     char *path, *tmp;
+    int force; /* --force: the rename may replace a file that appeared during the run */
     hid_t file, value;
     hb_scene scene;
     uint64_t rows; /* N·P */
@@ -140,7 +143,7 @@ void hb_writer_abort(hb_writer *w)
     if (w->velocity >= 0) H5Dclose(w->velocity);
     if (w->value >= 0) H5Dclose(w->value);
     if (w->file >= 0) H5Fclose(w->file);
-    if (w->tmp) unlink(w->tmp);
+    if (w->tmp && w->tmp[0]) unlink(w->tmp);
     hb_safe_forget();
     writer_free(w);
 }
@@ -156,15 +159,27 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     }
     w->file = w->value = w->velocity = -1;
     w->scene = *scene;
-    w->rows = (uint64_t)scene->n_strands * (uint64_t)scene->points;
+    if (hb_mul_u64((uint64_t)scene->n_strands, (uint64_t)scene->points, &w->rows)) {
+        snprintf(err, errlen, "--strands x --points is too large to address");
+        free(w);
+        return NULL;
+    }
     if (hb_safe_output_check(path, force, err, errlen)) goto fail;
+    w->force = force;
     w->path = strdup(path);
-    size_t n = strlen(path) + 32;
-    w->tmp = malloc(n);
+    size_t n = strlen(path) + 64;
+    w->tmp = calloc(n, 1); /* "" until named: the abort path unlinks nothing */
     if (!w->path || !w->tmp) FAIL("out of host memory");
-    snprintf(w->tmp, n, "%s.tmp.%ld", path, (long)getpid());
+    if (hb_safe_tmp_name(path, w->tmp, n)) {
+        w->tmp[0] = '\0';
+        FAIL("--output %s: the path is too long", path);
+    }
+    /* the user block holds the marker that makes the temporary file ours (safe_write.h) */
+    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
+    H5Pset_userblock(fcpl, HB_TMP_USERBLOCK);
     hb_safe_track(w->tmp); /* removed on a signal or exit() from here on */
-    w->file = H5Fcreate(w->tmp, H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT);
+    w->file = H5Fcreate(w->tmp, H5F_ACC_EXCL, fcpl, H5P_DEFAULT);
+    H5Pclose(fcpl);
     if (w->file < 0) {
         hb_safe_forget(); /* not ours to remove: it may exist already */
         snprintf(err, errlen, "--output %s: cannot create %s (%s)", path, w->tmp, strerror(errno));
@@ -172,6 +187,7 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
         w->tmp = NULL;
         goto fail;
     }
+    if (hb_safe_mark(w->tmp)) FAIL("--output %s: cannot write %s (%s)", path, w->tmp, strerror(errno));
 
     /* /h5md: version, author, creator (H5MD 1.1 §"H5MD metadata") */
     hid_t h5md = make_group(w->file, "h5md");
@@ -226,7 +242,9 @@ fail:
 /* Resizes *a to `cap` entries of `size` bytes; −1 (and *a unchanged) when out of memory. */
 static int resize(void **a, int cap, size_t size)
 {
-    void *p = realloc(*a, (size_t)cap * size);
+    uint64_t bytes;
+    if (cap < 0 || hb_mul_u64((uint64_t)cap, size, &bytes)) return -1;
+    void *p = realloc(*a, (size_t)bytes);
     if (!p) return -1;
     *a = p;
     return 0;
@@ -584,9 +602,10 @@ out:
         hb_writer_abort(w);
         return -1;
     }
-    if (hb_safe_commit(w->tmp, w->path, err, errlen) != 0) {
+    const int rc_commit = hb_safe_commit(w->tmp, w->path, w->force, err, errlen);
+    if (rc_commit != 0) {
         hb_writer_abort(w);
-        return -1;
+        return rc_commit;
     }
     w->seconds += now_s() - t0;
     writer_free(w);
@@ -862,6 +881,16 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
     return 0;
 }
 
+/* The first of n reals in buf that is NaN or ±Inf, or −1 when all are finite. */
+static int64_t first_nonfinite(const void *buf, uint64_t n, hb_precision prec)
+{
+    for (uint64_t i = 0; i < n; i++) {
+        double v = prec == HB_FP64 ? ((const double *)buf)[i] : (double)((const float *)buf)[i];
+        if (!isfinite(v)) return (int64_t)i;
+    }
+    return -1;
+}
+
 int hb_input_read_rest(hb_input *in, void *buf, char *err, size_t errlen)
 {
     hid_t d = H5Dopen2((hid_t)in->hid, "particles/hair/rest_position", H5P_DEFAULT);
@@ -871,6 +900,12 @@ int hb_input_read_rest(hb_input *in, void *buf, char *err, size_t errlen)
     if (d >= 0) H5Dclose(d);
     if (rc < 0) {
         snprintf(err, errlen, "--input: HDF5 could not read the rest shape (truncated file?)");
+        return -1;
+    }
+    const int64_t bad =
+        first_nonfinite(buf, (uint64_t)in->scene.n_strands * (uint64_t)in->scene.points * 3u, in->scene.precision);
+    if (bad >= 0) {
+        snprintf(err, errlen, "--input: the rest shape holds a NaN or Inf at point %lld", (long long)(bad / 3));
         return -1;
     }
     return 0;
@@ -897,6 +932,12 @@ int hb_input_read_velocity(hb_input *in, int index, void *buf, char *err, size_t
         snprintf(err, errlen, "--input: HDF5 could not read velocity frame %d (truncated file?)", index);
         return -1;
     }
+    const int64_t bad = first_nonfinite(buf, rows * 3u, in->scene.precision);
+    if (bad >= 0) {
+        snprintf(err, errlen, "--input: velocity frame %d holds a NaN or Inf at point %lld", index,
+                 (long long)(bad / 3));
+        return -1;
+    }
     return 0;
 }
 
@@ -913,6 +954,9 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
     quiet_hdf5();
     memset(in, 0, sizeof *in);
     if (access(path, F_OK) != 0) FAIL("--input %s: no such file", path);
+    struct stat st; /* a FIFO or device would block or never end: only regular files */
+    if (stat(path, &st) != 0) FAIL("--input %s: cannot read it (%s)", path, strerror(errno));
+    if (!S_ISREG(st.st_mode)) FAIL("--input %s is %s; --input must be a regular file", path, hb_file_kind(st.st_mode));
     if (access(path, R_OK) != 0) FAIL("--input %s: not readable (%s)", path, strerror(errno));
     if (H5Fis_hdf5(path) <= 0) FAIL("--input %s is not an HDF5 file", path);
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
@@ -1062,14 +1106,10 @@ int hb_input_read_frame(hb_input *in, int fidx, void *buf, char *err, size_t err
         snprintf(err, errlen, "--input: HDF5 could not read frame %d (truncated file?)", fidx);
         return -1;
     }
-    uint64_t n = (uint64_t)rows * 3u;
-    for (uint64_t i = 0; i < n; i++) {
-        double v = s->precision == HB_FP64 ? ((const double *)buf)[i] : (double)((const float *)buf)[i];
-        if (!isfinite(v)) {
-            snprintf(err, errlen, "--input: frame %d holds a NaN or Inf at point %llu", fidx,
-                     (unsigned long long)(i / 3));
-            return -1;
-        }
+    const int64_t bad = first_nonfinite(buf, (uint64_t)rows * 3u, s->precision);
+    if (bad >= 0) {
+        snprintf(err, errlen, "--input: frame %d holds a NaN or Inf at point %lld", fidx, (long long)(bad / 3));
+        return -1;
     }
     return 0;
 }

@@ -43,10 +43,12 @@ typedef struct {
 
 typedef struct hb_writer hb_writer;
 
-/* Opens FILE.tmp.<pid>; refuses an existing `path` unless `force`. */
+/* Opens a marked temporary file beside `path` (safe_write.h); refuses an existing `path`
+ * unless `force`. */
 hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, char *err, size_t errlen);
 int hb_writer_append(hb_writer *w, const void *frame, const hb_frame_meta *fm, char *err, size_t errlen);
-/* Writes /parameters, closes, renames to the final name. Frees w in every case. */
+/* Writes /parameters, closes, renames to the final name (HB_SAFE_EXISTS when the name was
+ * taken during the run and `force` was not given). Frees w in every case. */
 int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errlen);
 /* Closes and deletes the temporary file. Frees w. */
 void hb_writer_abort(hb_writer *w);

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "backend.h"
+#include "checked.h"
 #include "check.cuh"
 #include "dyn_kernels.cuh"
 #include "host.h"

@@ -106,14 +106,14 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
     HB_CUDA(cudaGetDeviceProperties(&prop, 0));
     uint64_t need = sat_add(c->bytes, c->bytes); /* velocities, rest shape */
     if (need_save) need = sat_add(need, c->bytes);
-    need = sat_add(need, (uint64_t)N * (uint64_t)(P - 2 > 0 ? P - 2 : 1) * rs);
-    need = sat_add(need, (uint64_t)d->S * 10u * rs);
+    need = sat_add(need, hb_mul_sat(hb_mul_sat((uint64_t)N, (uint64_t)(P - 2 > 0 ? P - 2 : 1)), rs));
+    need = sat_add(need, hb_mul_sat((uint64_t)d->S, 10u * rs));
     d->nchunks = (N + hbd::kObsChunk - 1) / hbd::kObsChunk;
-    need = sat_add(need, (uint64_t)d->nchunks * sizeof(hbd::ObsPartial));
+    need = sat_add(need, hb_mul_sat((uint64_t)d->nchunks, sizeof(hbd::ObsPartial)));
     if (c->variant == V_STRAND) {
         const int64_t resident = (int64_t)prop.multiProcessorCount * prop.maxThreadsPerMultiProcessor;
         d->grid = dyn_strand_grid(N, c->block, resident);
-        need = sat_add(need, (uint64_t)d->grid * (uint64_t)c->block * 9u * (uint64_t)P * rs);
+        need = sat_add(need, hb_mul_sat(hb_mul_sat((uint64_t)d->grid * (uint64_t)c->block * 9u, (uint64_t)P), rs));
     } else if (c->variant == V_LANES) {
         if (P > hbd::kLanesMaxPoints) { /* the driver refuses it first, from the variant table */
             snprintf(err, errlen, "internal error: lanes with %lld points", (long long)P);
@@ -159,20 +159,21 @@ int dyn_alloc(cuda_impl *c, int need_save, char *err, size_t errlen)
     if ((rc = device_alloc(&d->vel, c->bytes, c, "velocities", err, errlen))) return rc;
     if ((rc = device_alloc(&d->rest, c->bytes, c, "rest shape", err, errlen))) return rc;
     if (need_save && (rc = device_alloc(&d->vel_saved, c->bytes, c, "saved velocities", err, errlen))) return rc;
-    if ((rc = device_alloc(&d->bend_rest, (uint64_t)c->N * (uint64_t)(P - 2 > 0 ? P - 2 : 1) * rs, c,
-                           "bend rest lengths", err, errlen)))
+    if ((rc = device_alloc(&d->bend_rest, hb_mul_sat(hb_mul_sat((uint64_t)c->N, (uint64_t)(P - 2 > 0 ? P - 2 : 1)), rs),
+                           c, "bend rest lengths", err, errlen)))
         return rc;
-    if ((rc = device_alloc(&d->q, (uint64_t)d->S * 9u * rs, c, "rotation table", err, errlen))) return rc;
-    if ((rc = device_alloc(&d->ph, (uint64_t)d->S * rs, c, "phase table", err, errlen))) return rc;
-    if ((rc = device_alloc((void **)&d->d_obs, (uint64_t)d->nchunks * sizeof(hbd::ObsPartial), c, "observables", err,
-                           errlen)))
+    if ((rc = device_alloc(&d->q, hb_mul_sat((uint64_t)d->S, 9u * rs), c, "rotation table", err, errlen))) return rc;
+    if ((rc = device_alloc(&d->ph, hb_mul_sat((uint64_t)d->S, rs), c, "phase table", err, errlen))) return rc;
+    if ((rc = device_alloc((void **)&d->d_obs, hb_mul_sat((uint64_t)d->nchunks, sizeof(hbd::ObsPartial)), c,
+                           "observables", err, errlen)))
         return rc;
     if (c->variant == V_STRAND &&
-        (rc = device_alloc(&d->scratch, (uint64_t)d->grid * (uint64_t)c->block * 9u * (uint64_t)P * rs, c,
+        (rc = device_alloc(&d->scratch,
+                           hb_mul_sat(hb_mul_sat((uint64_t)d->grid * (uint64_t)c->block * 9u, (uint64_t)P), rs), c,
                            "per-thread scratch", err, errlen)))
         return rc;
-    d->h_obs = (hbd::ObsPartial *)malloc((size_t)d->nchunks * sizeof *d->h_obs);
-    d->h_part = (hb_obs_partial *)malloc((size_t)d->nchunks * sizeof *d->h_part);
+    d->h_obs = (hbd::ObsPartial *)malloc((size_t)hb_mul_sat((uint64_t)d->nchunks, sizeof *d->h_obs));
+    d->h_part = (hb_obs_partial *)malloc((size_t)hb_mul_sat((uint64_t)d->nchunks, sizeof *d->h_part));
     if (!d->h_obs || !d->h_part) {
         snprintf(err, errlen, "out of host memory for the observables");
         return HB_EXIT_MEMORY;

@@ -7,6 +7,7 @@ featurecost, peer, animate, stability (`--help` on each). User errors print one 
 import argparse
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -259,7 +260,8 @@ def accuracy_dynamic(args):
     from .paths import display
 
     if args.from_csv:
-        for path in dynaccuracy_report.write(Path(args.from_csv).parent, args.report_dir):
+        csv_path = Path(args.from_csv)
+        for path in dynaccuracy_report.write(csv_path.parent, args.report_dir, csv_path=csv_path):
             print(f"wrote {display(path)}")
         return 0
     given = {
@@ -809,10 +811,15 @@ def parser():
 def main(argv=None):
     args = parser().parse_args(argv)
     try:
-        return args.func(args)
+        rc = args.func(args)
+        sys.stdout.flush()  # a closed pipe shows here, inside the handlers below
+        return rc
     except HarnessError as e:
         print(f"harness: error: {e}", file=sys.stderr)
         return e.code if e.code else 2
+    except BrokenPipeError:  # the reader went away (`| head`): quiet, as other tools
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
+        return 141
     except OSError as e:  # a path given that cannot be read or written, or a full disk: no traceback
         where = f"{e.filename}: " if e.filename else ""
         print(f"harness: error: {where}{e.strerror or e}", file=sys.stderr)
@@ -826,8 +833,6 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("harness: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:
-        return 1
 
 
 if __name__ == "__main__":

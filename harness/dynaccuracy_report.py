@@ -28,12 +28,13 @@ KEYS = ("backend", "build", "variant", "solver", "substeps", "iterations", "prec
 # ---- reading --------------------------------------------------------------------------
 
 
-def load(results_dir):
-    """(rows DataFrame, study dict of env.json, env dict, analytic Markdown lines)."""
+def load(results_dir, csv_path=None):
+    """(rows DataFrame, study dict of env.json, env dict, analytic Markdown lines); the rows
+    from csv_path when given, else from results_dir's table."""
     import pandas as pd
 
     results_dir = Path(results_dir)
-    csv_path = results_dir / CSV_NAME
+    csv_path = Path(csv_path) if csv_path else results_dir / CSV_NAME
     try:
         rows = pd.read_csv(csv_path)
     except FileNotFoundError:
@@ -620,13 +621,13 @@ def markdown(rows, study, env, analytic):
     return out, summ, front, pairs
 
 
-def write(results_dir=None, report_dir=None):
-    """Write report/dynamic_accuracy.md and its pictures from a results directory; return
-    the paths written."""
+def write(results_dir=None, report_dir=None, csv_path=None):
+    """Write report/dynamic_accuracy.md and its pictures from a results directory (its table
+    or csv_path); return the paths written. Nothing is created when the input is refused."""
     results_dir = Path(results_dir or RESULTS / RESULTS_NAME)
     report_dir = Path(report_dir or REPORT)
+    rows, study, env, analytic = load(results_dir, csv_path)
     report_dir.mkdir(parents=True, exist_ok=True)
-    rows, study, env, analytic = load(results_dir)
     lines, summ, _, pairs = markdown(rows, study, env, analytic)
     pics = [
         pareto_plot(summ, study, report_dir / PARETO_PNG),

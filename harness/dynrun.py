@@ -40,6 +40,8 @@ def run(binary, flags, output=None, timeout=None, as_json=False, every=None, out
         path = Path(output)
     try:
         record = runner.run_binary(binary, flags, timeout=timeout)
+        if tmp:  # removed below: no path to claim
+            record["output"] = None
         with open_trajectory(path) as t:
             obs = t.observables
             rep = dynamic_checks.check(t)

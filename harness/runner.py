@@ -6,12 +6,13 @@ sweep can skip the case and go on.
 """
 
 import json
+import signal
 import subprocess
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
-from . import HarnessError
+from . import HarnessError, tempfiles
 from .paths import display
 
 RECORD_KEYS = ("backend", "precision", "strands", "points", "stages")
@@ -48,11 +49,23 @@ def run_binary(
     binary = require_binary(binary)
     cmd = [str(binary), *map(str, args), "--json", "--quiet"]
     try:
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        raise BackendError(f"{binary.name} did not finish within {timeout} s: {' '.join(cmd[1:])}") from None
+        child = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     except OSError as e:
         raise BackendError(f"cannot run {display(binary)}: {e.strerror}") from None
+    try:
+        stdout, stderr = child.communicate(timeout=timeout)
+    except BaseException as e:  # a timeout or an interrupt: the child dies, and what it left goes
+        child.kill()
+        child.wait()
+        tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(args))
+        if isinstance(e, subprocess.TimeoutExpired):
+            raise BackendError(f"{binary.name} did not finish within {timeout} s: {' '.join(cmd[1:])}") from None
+        raise
+    proc = subprocess.CompletedProcess(cmd, child.returncode, stdout, stderr)
+    if proc.returncode < 0:  # killed by a signal: the binary removes its own on these, SIGKILL aside
+        tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(args))
+    if proc.returncode == -signal.SIGINT:
+        raise KeyboardInterrupt
     if proc.returncode != 0:
         why = last_line(proc.stderr) or last_line(proc.stdout) or "no message"
         cls = DoesNotFit if proc.returncode == 3 else BackendError

@@ -35,7 +35,7 @@ WORST_FIRST = ("blown up", "penetrating", "over-stretched", *OTHER)
 def load(csv_path):
     try:
         rows = pd.read_csv(csv_path, dtype={"row": str, "col": str}, keep_default_na=False)
-    except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as e:
+    except (OSError, ValueError) as e:  # ValueError: a parse error, no data, or not text at all
         raise HarnessError(f"{display(csv_path)}: cannot read as a stability CSV ({e})") from None
     need = {"slice", "backend", "build", "solver", "precision", "row", "col", "verdict", "stretch_max"}
     lacks = sorted(need - set(rows.columns))

@@ -54,3 +54,24 @@ def cpu_bin():
 @pytest.fixture(scope="session")
 def cuda_bin():
     return CUDA_BIN
+
+
+def pytest_terminal_summary(terminalreporter):
+    """The fault probe's matrix (tests/test_fault_probe.py): its cases by test, and outcomes."""
+    counts: dict[str, dict[str, int]] = {}
+    for outcome in ("passed", "failed", "skipped", "error"):
+        for rep in terminalreporter.stats.get(outcome, []):
+            nodeid = getattr(rep, "nodeid", "")
+            if "test_fault_probe.py::" not in nodeid or getattr(rep, "when", "call") not in ("call", "setup"):
+                continue
+            if outcome == "passed" and rep.when != "call":
+                continue
+            name = nodeid.split("::", 1)[1].split("[", 1)[0]
+            counts.setdefault(name, {}).setdefault(outcome, 0)
+            counts[name][outcome] += 1
+    if counts:
+        total = {o: sum(c.get(o, 0) for c in counts.values()) for o in ("passed", "failed", "skipped", "error")}
+        terminalreporter.write_line(
+            f"fault probe: {sum(total.values())} cases in {len(counts)} rows of the matrix: "
+            + ", ".join(f"{n} {o}" for o, n in total.items() if n)
+        )

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from harness import tempfiles
+
 ROOT_DIR = Path(__file__).resolve().parent.parent
 
 
@@ -21,7 +23,7 @@ def run(binary, *args, check=True):
 
 
 def tmp_leftovers(directory):
-    return sorted(p.name for p in Path(directory).iterdir() if ".tmp." in p.name)
+    return sorted(p.name for p in Path(directory).iterdir() if p.name.startswith(".hairsim-"))
 
 
 SMALL = ["--strands", "20", "--points", "8", "--hair-length", "5", "--quiet"]
@@ -59,7 +61,8 @@ def test_force_replaces_a_regular_file(cpu_bin, tmp_path):
     out = tmp_path / "s.h5"
     out.write_bytes(b"old")
     run(cpu_bin, *SMALL, "--output", out, "--force")
-    assert out.read_bytes()[:8] == HDF5_SIGNATURE
+    # the superblock follows the 512-byte user block that held the temporary's marker
+    assert out.read_bytes()[512:520] == HDF5_SIGNATURE
 
 
 def _wait_for_tmp(directory, proc, timeout=60):
@@ -112,14 +115,20 @@ def test_stale_temporaries_of_dead_runs_are_removed(cpu_bin, tmp_path):
     p = subprocess.Popen(["true"])
     p.wait()
     pid = p.pid
-    (tmp_path / f"old.h5.tmp.{pid}").write_bytes(HDF5_SIGNATURE + b"rest")
-    (tmp_path / f"empty.h5.tmp.{pid}").write_bytes(b"")
-    (tmp_path / f"notes.txt.tmp.{pid}").write_text("not ours")  # not HDF5: kept
-    (tmp_path / f"alive.h5.tmp.{os.getpid()}").write_bytes(HDF5_SIGNATURE)  # live pid: kept
+    marker = tempfiles.MARKER
+    (tmp_path / f".hairsim-{pid}-00000000000000aa.tmp").write_bytes(marker + b"rest")
+    (tmp_path / f".hairsim-{pid}-00000000000000bb.tmp").write_bytes(marker)
+    (tmp_path / f".hairsim-{pid}-00000000000000cc.tmp").write_bytes(HDF5_SIGNATURE)  # no marker: kept
+    (tmp_path / f".hairsim-{os.getpid()}-00000000000000dd.tmp").write_bytes(marker)  # live pid: kept
+    (tmp_path / f"old.h5.tmp.{pid}").write_bytes(HDF5_SIGNATURE)  # not our name: kept
     r = run(cpu_bin, *SMALL, "--output", tmp_path / "new.h5")
     notes = [line for line in r.stderr.splitlines() if "stale temporary" in line]
     assert len(notes) == 1 and "removed 2 stale temporary files" in notes[0], r.stderr
-    assert sorted(tmp_leftovers(tmp_path)) == sorted([f"notes.txt.tmp.{pid}", f"alive.h5.tmp.{os.getpid()}"])
+    assert tmp_leftovers(tmp_path) == [
+        f".hairsim-{os.getpid()}-00000000000000dd.tmp",
+        f".hairsim-{pid}-00000000000000cc.tmp",
+    ]
+    assert (tmp_path / f"old.h5.tmp.{pid}").exists()
 
 
 def test_fsync_before_the_rename(cpu_bin, tmp_path):
@@ -140,7 +149,9 @@ def test_fsync_before_the_rename(cpu_bin, tmp_path):
         pytest.skip(f"strace cannot trace here: {p.stderr.strip()[-200:]}")
     assert p.returncode == 0, p.stderr
     calls = [line.split(None, 1)[1] for line in trace.read_text().splitlines() if "(" in line and "---" not in line]
-    synced = [i for i, c in enumerate(calls) if c.startswith(("fsync(", "fdatasync(")) and f"<{out}.tmp." in c]
+    synced = [
+        i for i, c in enumerate(calls) if c.startswith(("fsync(", "fdatasync(")) and f"<{tmp_path}/.hairsim-" in c
+    ]
     renamed = [i for i, c in enumerate(calls) if c.startswith("rename") and f'"{out}"' in c and c.endswith("= 0")]
     dir_synced = [i for i, c in enumerate(calls) if c.startswith("fsync(") and f"<{tmp_path}>)" in c]
     assert synced and renamed and dir_synced, calls
