@@ -472,22 +472,22 @@ void cuda_teardown(hb_backend *b)
 
 #define CUDA_PAPER_STAGES ((1u << HB_STAGE_INIT) | (1u << HB_STAGE_COLLIDE) | (1u << HB_STAGE_WIND))
 const hb_variant cuda_variants[] = {
-    {"paper", CUDA_PAPER_STAGES, "the paper's scheme: strand-major, one thread per strand, one kernel per stage", 0},
-    {"soa", CUDA_PAPER_STAGES, "point-major structure of arrays, one thread per strand, one kernel per stage", 0},
-    {"fused", CUDA_PAPER_STAGES, "point-major, wind and the collide after it in one kernel", 0},
+    {"paper", CUDA_PAPER_STAGES, "the paper's scheme: strand-major, one thread per strand, one kernel per stage", 0, 0},
+    {"soa", CUDA_PAPER_STAGES, "point-major structure of arrays, one thread per strand, one kernel per stage", 0, 0},
+    {"fused", CUDA_PAPER_STAGES, "point-major, wind and the collide after it in one kernel", 0, 0},
     {"strand", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
-     "point-major like soa; simulate: one thread per strand, a frame's substeps in one launch", 0},
+     "point-major like soa; simulate: one thread per strand, a frame's substeps in one launch", 0, 0},
     {"warp", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
-     "strand-major like paper; simulate: one warp per strand, a lane per point, the frame in shared memory", 0},
+     "strand-major like paper; simulate: one warp per strand, a lane per point, the frame in shared memory", 0, 0},
     {"warpreg", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "strand-major like paper; simulate: one warp per strand, lane k holds point k in registers (at most 32 points), "
      "neighbours through warp shuffles",
-     hb::dyn::kWarpregMaxPoints},
+     hb::dyn::kWarpregMaxPoints, 0},
     {"lanes", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "strand-major like paper; simulate: a half-warp per strand, 2, 4 or 8 consecutive points a lane in registers "
      "(at most 128 points), every lane busy in every constraint group",
      hb::dyn::kLanesMaxPoints, hb::dyn::kLanesMaxBlock},
-    {NULL, 0, NULL, 0},
+    {NULL, 0, NULL, 0, 0},
 };
 
 } /* namespace */
