@@ -42,6 +42,16 @@ constexpr bool kFree = true;
 #define HB_LANES_FTL_G 4
 #endif
 constexpr int kFtlG = HB_LANES_FTL_G, kFtlL = 32 / HB_LANES_FTL_G;
+constexpr unsigned kAll = 0xffffffffu;
+
+__device__ __forceinline__ float rsq(float x)
+{
+    return rsqrtf(x);
+}
+__device__ __forceinline__ double rsq(double x)
+{
+    return rsqrt(x);
+}
 template <typename T, int G, int L, bool Ftl> constexpr int lanes_min_blocks()
 {
     return sizeof(T) != 4                      ? 1
