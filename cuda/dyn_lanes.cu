@@ -33,10 +33,10 @@ constexpr bool kFree = true;
  * the registers a thread): fp32 at P ≤ 32 HB_LANES_MINB for xpbd and HB_LANES_FTL_MINB for
  * ftl (measured, docs/cuda.md), 1 (up to 255 registers) otherwise. */
 #ifndef HB_LANES_MINB
-#define HB_LANES_MINB 1
+#define HB_LANES_MINB 4
 #endif
 #ifndef HB_LANES_FTL_MINB
-#define HB_LANES_FTL_MINB 1
+#define HB_LANES_FTL_MINB 3
 #endif
 #ifndef HB_LANES_FTL_G
 #define HB_LANES_FTL_G 4
@@ -110,6 +110,36 @@ __device__ __forceinline__ void dist(V3<T> &a, V3<T> &b, bool root_a, T r, T at,
         b.x = b.x + dl * nx;
         b.y = b.y + dl * ny;
         b.z = b.z + dl * nz;
+    }
+}
+
+/* The same constraint written from one end: e = other − own; own moves by −Δλ·n (unless it
+ * is the root, which is always the lower end a), other by +Δλ·n. With own = a this is dist;
+ * with own = b, e and n change sign exactly, so every value is the same bit for bit. Both
+ * lanes of a pair run this one path on their own operands, so the warp does not diverge. */
+template <typename T>
+__device__ __forceinline__ void dist_sym(V3<T> &own, V3<T> &other, bool own_root, T r, T at, T inv1, T inv2, T &lam)
+{
+    const T ex = other.x - own.x, ey = other.y - own.y, ez = other.z - own.z;
+    const T q = ex * ex + ey * ey + ez * ez;
+    if constexpr (kFree) {
+        if (q == (T)0) return;
+        const T inv = rsq(q);
+        const T dl = ((r - q * inv) - at * lam) * (own_root ? inv1 : inv2);
+        lam = lam + dl;
+        const T s = dl * inv;
+        if (!own_root) own = V3<T>{own.x - s * ex, own.y - s * ey, own.z - s * ez};
+        other = V3<T>{other.x + s * ex, other.y + s * ey, other.z + s * ez};
+    } else {
+        const T len = d_sqrt(q);
+        if (len == (T)0) return;
+        const T c = len - r;
+        const T wsum = own_root ? (T)1 : (T)2;
+        const T dl = (-c - at * lam) / (wsum + at);
+        lam = lam + dl;
+        const T nx = ex / len, ny = ey / len, nz = ez / len;
+        if (!own_root) own = V3<T>{own.x - dl * nx, own.y - dl * ny, own.z - dl * nz};
+        other = V3<T>{other.x + dl * nx, other.y + dl * ny, other.z + dl * nz};
     }
 }
 
@@ -393,15 +423,23 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
                      * (mod 2) and computes the first; its partner l+1 computes the second */
                     const bool lower = (l & 1) == g;
                     const int partner = lower ? (l + 1 < L ? l + 1 : l) : (l >= 1 ? l - 1 : l);
-                    const bool c1 = lower && l + 1 < L && k0 + 2 < P;
-                    const bool c2 = !lower && l >= 1 && k0 + 1 < P;
+                    const bool act = lower ? l + 1 < L && k0 + 2 < P : l >= 1 && k0 + 1 < P;
+                    V3<T> own{lower ? Q[0].x : Q[1].x, lower ? Q[0].y : Q[1].y, lower ? Q[0].z : Q[1].z};
                     const V3<T> mine{lower ? Q[1].x : Q[0].x, lower ? Q[1].y : Q[0].y, lower ? Q[1].z : Q[0].z};
                     V3<T> o = from<L>(mine, partner);
-                    if (c1) dist(Q[0], o, k0 == 0, br[0], m.bend_at, m.inv_b1, m.inv_b2, lc1);
-                    if (c2) dist(o, Q[1], false, brp, m.bend_at, m.inv_b1, m.inv_b2, lc2);
+                    T lam = lower ? lc1 : lc2;
+                    if (act)
+                        dist_sym(own, o, lower && k0 == 0, lower ? br[0] : brp, m.bend_at, m.inv_b1, m.inv_b2, lam);
+                    if (lower) {
+                        Q[0] = own;
+                        lc1 = lam;
+                    } else {
+                        Q[1] = own;
+                        lc2 = lam;
+                    }
                     const V3<T> back = from<L>(o, partner);
-                    if (lower && l + 1 < L && k0 + 3 < P) Q[1] = back; /* the partner's c2 */
-                    if (!lower && l >= 1 && k0 < P) Q[0] = back;       /* the partner's c1 */
+                    if (lower && l + 1 < L && k0 + 3 < P) Q[1] = back; /* the partner's constraint */
+                    if (!lower && l >= 1 && k0 < P) Q[0] = back;
                 } else {
                     /* every boundary (l, l+1) in group 1: (k0+G−2, k0+G) on the lower lane,
                      * (k0+G−1, k0+G+1) on the upper */
