@@ -52,6 +52,16 @@ __device__ __forceinline__ double rsq(double x)
 {
     return rsqrt(x);
 }
+/* the gust's sine: the phase table is reduced to [0, 2π) on the host (§3.3), so the argument
+ * stays within a few radians, where __sinf is within 2^-21 of sin */
+__device__ __forceinline__ float gust_sin(float x)
+{
+    return __sinf(x);
+}
+__device__ __forceinline__ double gust_sin(double x)
+{
+    return sin(x);
+}
 template <typename T, int G, int L, bool Ftl> constexpr int lanes_min_blocks()
 {
     return sizeof(T) != 4                      ? 1
@@ -185,7 +195,7 @@ __device__ __forceinline__ void predict(const DModel<T> &m, Feat has, T phase, c
         T vx = v.x, vy = v.y, vz = v.z;
         if (has(HB_F_WIND)) {
             T gam = (T)1;
-            if (has(HB_F_GUST)) gam = (T)1 + m.gust * d_sin(phase - m.kappa * (m.dir_y * x.y + m.dir_z * x.z));
+            if (has(HB_F_GUST)) gam = (T)1 + m.gust * gust_sin(phase - m.kappa * (m.dir_y * x.y + m.dir_z * x.z));
             vy = vy + h * (m.gravity_y + m.wind_y * gam);
             vz = vz + h * (m.wind_z * gam);
         } else {
