@@ -20,9 +20,9 @@ CUDA_FASTMATH_BIN = BUILD / "hairsim-cuda-fastmath"
 
 
 def _gpu_reason():
-    """Return None when a GPU is usable here, else the reason it is not (harness.env's
+    """Return None when a GPU is usable here, else the reason it is not (harness.core.env's
     detection, the one the harness uses, plus the built CUDA binary)."""
-    from harness import env
+    from harness.core import env
 
     ok, why = env.gpu_status()
     if not ok:

@@ -5,21 +5,22 @@ import csv
 
 import numpy as np
 
-from harness import accuracy, scenes, tolerances
+from harness.core import scenes, tolerances
+from harness.studies import accuracy_paper
 
 
 def test_along_curve_error_is_zero_on_a_straight_strand_and_sees_a_bend():
     fine = np.zeros((1, 9, 3))
     fine[0, :, 2] = np.arange(9) * 0.5  # a straight strand of length 4
     coarse = fine[:, ::4, :].copy()  # P = 3 on the same curve
-    assert np.allclose(accuracy.along_curve_error(coarse, fine), 0)
+    assert np.allclose(accuracy_paper.along_curve_error(coarse, fine), 0)
     bent = coarse.copy()
     bent[0, 1, 1] = 0.3  # the middle point off the curve by 0.3
-    assert np.isclose(accuracy.along_curve_error(bent, fine).max(), 0.3)
+    assert np.isclose(accuracy_paper.along_curve_error(bent, fine).max(), 0.3)
 
 
 def test_accuracy_study_writes_table_plot_and_recommendation(cpu_bin, tmp_path):
-    rows = accuracy.run_study(
+    rows = accuracy_paper.run_study(
         "paper",
         strands=1500,
         points=16,
@@ -30,9 +31,9 @@ def test_accuracy_study_writes_table_plot_and_recommendation(cpu_bin, tmp_path):
         report_dir=tmp_path / "rep",
         log=lambda *_: None,
     )
-    with open(tmp_path / "acc" / "accuracy.csv") as fh:
+    with open(tmp_path / "acc" / "accuracy_paper.csv") as fh:
         table = list(csv.DictReader(fh))
-    assert set(accuracy.COLUMNS) <= set(table[0])
+    assert set(accuracy_paper.COLUMNS) <= set(table[0])
     modes = {r["mode"] for r in table if r["study"] == "mode"}
     assert {"cpu fp64 ref", "cpu fp32 ref"} <= modes
     fp32 = [r for r in rows if r["mode"] == "cpu fp32 ref"]
@@ -51,7 +52,7 @@ def test_accuracy_study_writes_table_plot_and_recommendation(cpu_bin, tmp_path):
     assert res[0]["max_err_L"] > res[1]["max_err_L"] > 0 and res[2]["max_err_L"] == 0
     png = tmp_path / "rep" / "accuracy_pareto.png"
     assert png.stat().st_size > 5000
-    md = (tmp_path / "rep" / "accuracy.md").read_text()
+    md = (tmp_path / "rep" / "accuracy_paper.md").read_text()
     assert "| cpu fp32 ref |" in md and "Which mode for which use" in md
     assert "GPU modes absent" in md or "gpu fp32 strict" in md
     assert not (tmp_path / "acc" / "states").exists()  # scratch states removed
@@ -61,7 +62,7 @@ def test_a_fused_wind_frame_is_not_checked_for_penetration(tmp_path):
     """Regression: the GPU's fused wind frame (stage 'wind', fused 'wind+collide') holds the
     state after the wind half, inside the shell by design; accuracy once counted it as a
     collide frame and reported 6% penetration."""
-    from harness.states import open_state
+    from harness.io.states import open_state
     from support.synthetic import write_state
 
     inside = np.zeros((1, 1, 3, 3))
@@ -71,8 +72,8 @@ def test_a_fused_wind_frame_is_not_checked_for_penetration(tmp_path):
         tmp_path / "a.h5", frames, ["init", "wind"], fused=["", "wind+collide"], params={"hair_length": 2.0}
     )
     with open_state(a) as s:
-        e = accuracy.frame_errors(s, s, 1, 2.0)
+        e = accuracy_paper.frame_errors(s, s, 1, 2.0)
     assert e["penetration"] == 0
     b = write_state(tmp_path / "b.h5", frames, ["init", "collide"], params={"hair_length": 2.0})
     with open_state(b) as s:
-        assert accuracy.frame_errors(s, s, 1, 2.0)["penetration"] > 0.1
+        assert accuracy_paper.frame_errors(s, s, 1, 2.0)["penetration"] > 0.1

@@ -1,11 +1,11 @@
-"""`python -m harness animate` (harness/animate.py): a tiny dynamic state becomes a GIF with
+"""`python -m harness animate` (harness/studies/animate.py): a tiny dynamic state becomes a GIF with
 the frames the docs promise (the rest frame, then every K-th simulated frame); bad input is
 one line, exit status 2, and no file (nor a temporary one) left behind."""
 
 import pytest
 from PIL import Image
 
-from harness.__main__ import main as harness_main
+from harness.cli.main import main as harness_main
 from support.statecheck import run, tmp_leftovers
 
 FRAMES = 5

@@ -135,7 +135,7 @@ def test_existing_output_is_not_overwritten_without_force(cpu_bin, tmp_path):
     assert p.returncode == 2 and "exists" in p.stderr and "--force" in p.stderr
     assert out.read_text() == "precious\n"
     run(cpu_bin, *SMALL, "--output", out, "--force", "--quiet")
-    State(out)  # a state in the documented layout (harness.states raises otherwise)
+    State(out)  # a state in the documented layout (harness.io.states raises otherwise)
 
 
 def test_output_may_not_be_the_input(cpu_bin, tmp_path, good_state):

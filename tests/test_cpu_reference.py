@@ -9,7 +9,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from harness.states import h5md_layout
+from harness.io.states import h5md_layout
 from support.invariants_check import assert_invariants
 from support.statecheck import State, assert_equivalent, run, run_json
 

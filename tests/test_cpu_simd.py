@@ -4,7 +4,7 @@ simd for the next stage only) and whole runs; DESIGN §3 invariants on its outpu
 independent of the thread count, of repeats and of resuming; nil stages; the refusal on a
 CPU without AVX2; the vector math really vectorised; the bandwidth record.
 
-TOLERANCE: the "simd" pair of harness/tolerances.py (the measurements behind it are in
+TOLERANCE: the "simd" pair of harness/core/tolerances.py (the measurements behind it are in
 docs/cpu_simd.md); every comparison goes through harness diff. collide calls no libm
 function, so there simd must give ref's bits, as asserted below.
 
@@ -28,7 +28,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from test_stability import scene_args, scenes
 
-from harness import tolerances
+from harness.core import tolerances
 from support import synthetic
 from support.invariants_check import assert_invariants
 from support.statecheck import State, assert_equivalent, run, run_json, tmp_leftovers

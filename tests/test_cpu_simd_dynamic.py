@@ -6,7 +6,7 @@ no FMA contraction, IEEE sqrt and division, selects where ref branches. So from 
 input state it must give ref's bits wherever no libm function is called, i.e. without
 gusts: positions of every frame, velocities and observables (the per-strand observables
 are ref's bits and are combined over ref's chunks in ref's order). With gusts the sine is
-libmvec's (≤ 4 ulp) and the runs are compared with harness/tolerances.py's SIMD_DYN_GUST
+libmvec's (≤ 4 ulp) and the runs are compared with harness/core/tolerances.py's SIMD_DYN_GUST
 (the measurement behind it is written there).
 
 Both variants start from the same ref `init,collide` state (--input): simd's own paper
@@ -23,8 +23,8 @@ import numpy as np
 import pytest
 from test_cpu_simd import NO_SIMD, needs_simd
 
-from harness.tolerances import SIMD_DYN_GUST, SIMD_DYN_GUST_MAX_FRAMES
-from harness.trajectory import open_trajectory
+from harness.core.tolerances import SIMD_DYN_GUST, SIMD_DYN_GUST_MAX_FRAMES
+from harness.io.trajectory import open_trajectory
 from support.statecheck import run
 
 STRANDS = 300

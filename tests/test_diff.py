@@ -15,10 +15,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import CPU_BIN, ROOT
-from harness import tolerances
-from harness.__main__ import main
-from harness.diff import compare
-from harness.ulp import ulp_distance
+from harness.check.diff import compare
+from harness.cli.main import main
+from harness.core import tolerances
+from harness.core.ulp import ulp_distance
 from support.synthetic import radial_strands, write_state
 
 STAGES = ["init", "collide", "wind", "collide"]

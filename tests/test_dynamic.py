@@ -1,15 +1,16 @@
 """The dynamic model's C reference (docs/model.md §3): invariants on every frame, declared
 features at zero strength, determinism (threads, resume, frame split), fp32 against fp64,
 --output-every, observables, and `harness stepdiff`. Files are read only through the
-harness (harness/trajectory.py, dynamic_checks.py, dyndiff.py); every tolerance comes from
-harness/tolerances.py. Small sizes: 64 strands × 16 points, ≤ 20 frames."""
+harness (harness/io/trajectory.py, invariants_dynamic.py, diff_dynamic.py); every tolerance comes from
+harness/core/tolerances.py. Small sizes: 64 strands × 16 points, ≤ 20 frames."""
 
 import numpy as np
 import pytest
 
-from harness import dynamic_checks, dyndiff, tolerances
-from harness.__main__ import main as harness_main
-from harness.trajectory import open_trajectory
+from harness.check import diff_dynamic, invariants_dynamic
+from harness.cli.main import main as harness_main
+from harness.core import tolerances
+from harness.io.trajectory import open_trajectory
 from support.statecheck import run
 
 SMALL = ["--strands", "64", "--points", "16"]
@@ -50,7 +51,7 @@ def simulate(cpu_bin, path, *args, frames=20):
 
 def same_bits(a, b, velocities=True):
     """Every common step bit-identical (harness diff --exact), and the last velocities too."""
-    res = dyndiff.compare(a, b, exact=True)
+    res = diff_dynamic.compare(a, b, exact=True)
     if not res.equivalent:
         return False
     if velocities:
@@ -67,7 +68,7 @@ def features(path):
 
 def check_ok(path):
     with open_trajectory(path) as t:
-        rep = dynamic_checks.check(t)
+        rep = invariants_dynamic.check(t)
     assert rep.ok, "; ".join(v.message for v in rep.all_violations()[:5])
     return rep
 
@@ -141,7 +142,7 @@ def test_the_checks_can_fail(cpu_bin, tmp_path):
         with h5py.File(bad, "r+") as f:
             damage(f)
         with open_trajectory(bad) as t:
-            rep = dynamic_checks.check(t)
+            rep = invariants_dynamic.check(t)
         assert name in {v.invariant for v in rep.violations}, [v.message for v in rep.violations]
 
 
@@ -165,7 +166,7 @@ def test_penetration_is_reported(cpu_bin, tmp_path):
         a[3] = a[0] * 0.5  # point 3 of strand 0 halfway to the head's centre
         v[-1] = a
     with open_trajectory(bad) as t:
-        kinds = {v.invariant for v in dynamic_checks.check(t).violations}
+        kinds = {v.invariant for v in invariants_dynamic.check(t).violations}
     assert "collider" in kinds
 
 
@@ -190,10 +191,10 @@ def test_blown_up_run_is_detected_and_matches_the_observables(cpu_bin, tmp_path)
     )
     with open_trajectory(out) as t:
         assert t.observables["blown_up"].any()
-        rep = dynamic_checks.check(t)
+        rep = invariants_dynamic.check(t)
         assert not [v for v in rep.violations if v.invariant == "observables"]
         last = t.frame(-1)
-        assert dynamic_checks.observe(t, last, t.velocity(-1))[3] == int(t.observables["blown_up_strands"].iloc[-1])
+        assert invariants_dynamic.observe(t, last, t.velocity(-1))[3] == int(t.observables["blown_up_strands"].iloc[-1])
 
 
 # ---- a declared feature at zero strength ----------------------------------------------------
@@ -331,7 +332,7 @@ def test_fp32_agrees_with_fp64_over_a_short_horizon(cpu_bin, tmp_path, solver):
     n = tolerances.DYN_FP32_VS_FP64_FRAMES
     a = simulate(cpu_bin, tmp_path / "a.h5", *FULL, "--solver", solver, "--precision", "fp32", frames=n)
     b = simulate(cpu_bin, tmp_path / "b.h5", *FULL, "--solver", solver, "--precision", "fp64", frames=n)
-    res = dyndiff.compare(a, b)
+    res = diff_dynamic.compare(a, b)
     sims = [f for f in res.frames if f.stage == "simulate"]
     assert len(sims) == n and all(f.nonfinite == 0 for f in sims)
     worst = max(f.max_rel_L for f in sims)
@@ -345,7 +346,7 @@ def test_output_every_writes_every_kth_frame_and_the_last(cpu_bin, tmp_path):
         assert [t.simulated_index(f) for f in t.simulated] == [3, 6, 9, 10]
         assert len(t.observables) == 10  # observables for every frame, written or not
         assert list(t.velocity_steps) == [t.step[-1]]
-    res = dyndiff.compare(whole, every, exact=True)  # compared at the common steps
+    res = diff_dynamic.compare(whole, every, exact=True)  # compared at the common steps
     assert res.equivalent and len([f for f in res.frames if f.stage == "simulate"]) == 4
     check_ok(every)
 
@@ -358,7 +359,7 @@ def test_observables_agree_with_positions(cpu_bin, tmp_path, solver):
     with open_trajectory(out) as t:
         obs = t.observables.set_index("step")
         for f in t.simulated:
-            stretch, pen, ke, blown = dynamic_checks.observe(t, t.frame(f), t.velocity_at_step(int(t.step[f])))
+            stretch, pen, ke, blown = invariants_dynamic.observe(t, t.frame(f), t.velocity_at_step(int(t.step[f])))
             row = obs.loc[int(t.step[f])]
             assert stretch == row["stretch_max"] and pen == row["penetration_max"]
             assert blown == row["blown_up_strands"] == 0
@@ -482,7 +483,7 @@ def test_stepdiff_catches_a_wrong_frame(cpu_bin, reference, tmp_path, capsys):
 
 
 def test_shipped_dynamic_scenes_load():
-    from harness import scenes
+    from harness.core import scenes
 
     d = scenes.load_scene("dynamic")
     assert d.model == "dynamic" and d.stages[-1] == "simulate"
@@ -559,8 +560,8 @@ def test_diff_judges_observables(reference, tmp_path):
         o[2] = o[2] * 1.5 + 1.0
     with open_trajectory(bad) as t:
         step = int(t.observables["step"].iloc[2])
-    r = dyndiff.compare(reference["fp64"], bad, frames=[step], check_paper=False)
+    r = diff_dynamic.compare(reference["fp64"], bad, frames=[step], check_paper=False)
     assert not r.equivalent
     assert any("kinetic_energy" in m for m in r.failures()), r.failures()
-    same = dyndiff.compare(reference["fp64"], reference["fp64"], frames=[step], check_paper=False)
+    same = diff_dynamic.compare(reference["fp64"], reference["fp64"], frames=[step], check_paper=False)
     assert same.equivalent and not same.failures()

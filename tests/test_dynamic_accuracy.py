@@ -1,5 +1,5 @@
-"""`python -m harness accuracy --model dynamic` (harness/dynaccuracy.py measures,
-dynaccuracy_report.py renders): the machinery at a tiny size. The study itself (its numbers)
+"""`python -m harness accuracy --model dynamic` (harness/studies/accuracy_dynamic.py measures,
+accuracy_dynamic_report.py renders): the machinery at a tiny size. The study itself (its numbers)
 belongs to `make bench`, not here."""
 
 import csv
@@ -8,8 +8,10 @@ import json
 import numpy as np
 import pytest
 
-from harness import __main__ as cli
-from harness import dynaccuracy, dynaccuracy_report, env, tolerances, variants
+from harness.cli import main as cli
+from harness.core import env, tolerances, variants
+from harness.render import accuracy_dynamic_report
+from harness.studies import accuracy_dynamic
 from support.cuda_standin import install
 
 
@@ -18,15 +20,15 @@ def test_frame_errors_of_a_known_difference():
     x = ref.copy()
     x[1, 0, 2] = (3.0, 4.0, 0.0)  # one point 5 away in frame 1
     x[2, 1, 1, 0] = np.nan  # frame 2 not finite
-    rms, mx = dynaccuracy.frame_errors(x, ref, L=10.0)
+    rms, mx = accuracy_dynamic.frame_errors(x, ref, L=10.0)
     assert rms[0] == 0 and mx[0] == 0
     assert mx[1] == pytest.approx(0.5) and rms[1] == pytest.approx(np.sqrt(25 / 6) / 10)
     assert np.isnan(rms[2]) and np.isnan(mx[2])
 
 
 def test_the_grid_holds_both_sides_of_small_steps_against_iterations():
-    assert dynaccuracy.grid((1, 4), (1, 2)) == [(1, 1), (1, 2), (1, 4), (4, 1), (4, 2)]
-    assert (1, 8) in dynaccuracy.grid((2, 8), (2,)) and (8, 1) in dynaccuracy.grid((2, 8), (2,))
+    assert accuracy_dynamic.grid((1, 4), (1, 2)) == [(1, 1), (1, 2), (1, 4), (4, 1), (4, 2)]
+    assert (1, 8) in accuracy_dynamic.grid((2, 8), (2,)) and (8, 1) in accuracy_dynamic.grid((2, 8), (2,))
 
 
 def test_convergence_is_detected_frame_by_frame():
@@ -35,25 +37,25 @@ def test_convergence_is_detected_frame_by_frame():
         "b": np.array([2e-3, np.nan, 5e-2, 1e-2]),
         "c": np.full(4, np.nan),
     }
-    low = dynaccuracy.smallest(errors)
+    low = accuracy_dynamic.smallest(errors)
     assert np.allclose(low, [2e-3, 2e-2, 4e-2, 1e-2])
     diff = np.array([1e-4, 1e-3, 5e-3, 1e-3])  # the reference's S against 2S
-    ok = dynaccuracy.reference_ok(diff, low, 0.1)
+    ok = accuracy_dynamic.reference_ok(diff, low, 0.1)
     assert ok.tolist() == [True, True, False, False]  # 1e-3 < 2e-3 holds; 5e-3 < 4e-3 does not; 1e-3 < 1e-3 does not
     times = np.array([0.1, 0.2, 0.3, 0.4])
-    assert dynaccuracy.holds_until(ok, times) == 0.2
-    assert dynaccuracy.holds_until(np.ones(4, bool), times) == 0.4
-    assert dynaccuracy.holds_until(np.array([False, True, True, True]), times) == 0.0
-    assert not dynaccuracy.reference_ok(np.array([np.nan]), np.array([1.0]), 0.1)[0]
+    assert accuracy_dynamic.holds_until(ok, times) == 0.2
+    assert accuracy_dynamic.holds_until(np.ones(4, bool), times) == 0.4
+    assert accuracy_dynamic.holds_until(np.array([False, True, True, True]), times) == 0.0
+    assert not accuracy_dynamic.reference_ok(np.array([np.nan]), np.array([1.0]), 0.1)[0]
 
 
 def test_pareto_front_selection():
     t = [1.0, 2.0, 3.0, 4.0, 4.0, 5.0, 6.0, np.nan]
     e = [10.0, 5.0, 6.0, 1.0, 0.5, 0.499, np.nan, 0.1]
     # (3, 6) is beaten by (2, 5); (4, 1) by (4, 0.5); NaNs are never on the front
-    assert dynaccuracy_report.pareto_front(t, e).tolist() == [True, True, False, False, True, True, False, False]
+    assert accuracy_dynamic_report.pareto_front(t, e).tolist() == [True, True, False, False, True, True, False, False]
     # with a tie of 1 %, 0.499 is no better than 0.5: the slower mode leaves the front
-    assert dynaccuracy_report.pareto_front(t, e, tie=0.01).tolist()[5] is False
+    assert accuracy_dynamic_report.pareto_front(t, e, tie=0.01).tolist()[5] is False
 
 
 @pytest.mark.parametrize(
@@ -105,12 +107,12 @@ def quiet():
 def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, tmp_path, quiet, monkeypatch):
     monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
     out, rep = tmp_path / "out", tmp_path / "rep"
-    rc = dynaccuracy.run_study(dynaccuracy.Plan(**TINY), out, rep, log=quiet)
+    rc = accuracy_dynamic.run_study(accuracy_dynamic.Plan(**TINY), out, rep, log=quiet)
     assert rc == 0
-    with open(out / dynaccuracy.CSV_NAME, newline="") as fh:
+    with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
         reader = csv.DictReader(fh)
         rows = list(reader)
-    assert tuple(reader.fieldnames) == dynaccuracy.COLUMNS
+    assert tuple(reader.fieldnames) == accuracy_dynamic.COLUMNS
     cpu = variants.declared("cpu")
     n_modes = len(cpu.running("simulate")) * len(cpu.solvers) * len(cpu.precisions) * 3  # (1,1) (2,1) (1,2)
     mode_rows = [r for r in rows if r["study"] == "mode"]
@@ -122,32 +124,37 @@ def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, 
     assert meta["reference"]["converged"] and meta["reference"]["substeps"] == max(
         int(r["ref_substeps"]) for r in ladder
     )
-    page = (rep / dynaccuracy_report.PAGE).read_text()
+    page = (rep / accuracy_dynamic_report.PAGE).read_text()
     for heading in ("The converged reference", "Small steps against iterations", "Which settings for which use"):
         assert f"### {heading}" in page
     assert "**Converged**" in page and "No GPU reference: not used: HAIRBENCH_NO_GPU is set" in page
-    for png in (dynaccuracy_report.PARETO_PNG, dynaccuracy_report.GROWTH_PNG, dynaccuracy_report.STEPS_PNG):
+    for png in (
+        accuracy_dynamic_report.PARETO_PNG,
+        accuracy_dynamic_report.GROWTH_PNG,
+        accuracy_dynamic_report.STEPS_PNG,
+    ):
         assert (rep / png).stat().st_size > 5000
     assert not (out / "states").exists()
     # the convergence table re-derived from the CSV agrees with what the study decided
-    table = dynaccuracy_report.section(out, rep, write_page=False)
+    table = accuracy_dynamic_report.section(out, rep, write_page=False)
     assert any("converged over the" in ln for ln in table)
     # --from-csv re-renders (the model read from the CSV's header), elsewhere
     assert (
-        cli.main(["accuracy", "--from-csv", str(out / dynaccuracy.CSV_NAME), "--report-dir", str(tmp_path / "r2")]) == 0
+        cli.main(["accuracy", "--from-csv", str(out / accuracy_dynamic.CSV_NAME), "--report-dir", str(tmp_path / "r2")])
+        == 0
     )
-    assert (tmp_path / "r2" / dynaccuracy_report.PAGE).read_text() == page
-    before = (out / dynaccuracy.CSV_NAME).read_bytes()
-    with pytest.raises(dynaccuracy.HarnessError, match="exists: pass --force"):
-        dynaccuracy.run_study(dynaccuracy.Plan(**TINY), out, rep, log=quiet)
-    assert (out / dynaccuracy.CSV_NAME).read_bytes() == before
+    assert (tmp_path / "r2" / accuracy_dynamic_report.PAGE).read_text() == page
+    before = (out / accuracy_dynamic.CSV_NAME).read_bytes()
+    with pytest.raises(accuracy_dynamic.HarnessError, match="exists: pass --force"):
+        accuracy_dynamic.run_study(accuracy_dynamic.Plan(**TINY), out, rep, log=quiet)
+    assert (out / accuracy_dynamic.CSV_NAME).read_bytes() == before
 
 
 def test_the_reference_that_does_not_converge_says_so(cpu_bin, tmp_path, quiet, monkeypatch):
     monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
-    plan = dynaccuracy.Plan(**{**TINY, "substeps": (1, 16), "ref_start": 32, "ref_max": 64})
-    assert dynaccuracy.run_study(plan, tmp_path / "o", tmp_path / "r", log=quiet) == 1
-    assert "**NOT converged**" in (tmp_path / "r" / dynaccuracy_report.PAGE).read_text()
+    plan = accuracy_dynamic.Plan(**{**TINY, "substeps": (1, 16), "ref_start": 32, "ref_max": 64})
+    assert accuracy_dynamic.run_study(plan, tmp_path / "o", tmp_path / "r", log=quiet) == 1
+    assert "**NOT converged**" in (tmp_path / "r" / accuracy_dynamic_report.PAGE).read_text()
 
 
 @pytest.fixture
@@ -172,9 +179,9 @@ def test_gpu_modes_and_the_gpu_reference_check(standin_build, tmp_path, quiet, p
     with the CPU's (tolerances.DYN_ACC_GPU_REF_SHARE)."""
     standin_build(perturb)
     out = tmp_path / "out"
-    plan = dynaccuracy.Plan(**{**TINY, "iterations": (1,), "substeps": (1,)})
-    assert dynaccuracy.run_study(plan, out, tmp_path / "rep", render=False, log=quiet) == 0
-    with open(out / dynaccuracy.CSV_NAME, newline="") as fh:
+    plan = accuracy_dynamic.Plan(**{**TINY, "iterations": (1,), "substeps": (1,)})
+    assert accuracy_dynamic.run_study(plan, out, tmp_path / "rep", render=False, log=quiet) == 0
+    with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
         rows = list(csv.DictReader(fh))
     gpu = {r["variant"] for r in rows if r["study"] == "mode" and r["backend"] == "cuda"}
     assert gpu == {"strand"}
@@ -195,9 +202,9 @@ def test_a_tiny_study_on_the_gpu(tmp_path, quiet):
     """With a real GPU: every cuda build's simulate variants take part, and the GPU fp64
     reference is validated against the CPU (or rejected, which the report then says)."""
     out = tmp_path / "out"
-    plan = dynaccuracy.Plan(**{**TINY, "strands": 64, "time_strands": 4096})
-    assert dynaccuracy.run_study(plan, out, tmp_path / "rep", log=quiet) == 0
-    with open(out / dynaccuracy.CSV_NAME, newline="") as fh:
+    plan = accuracy_dynamic.Plan(**{**TINY, "strands": 64, "time_strands": 4096})
+    assert accuracy_dynamic.run_study(plan, out, tmp_path / "rep", log=quiet) == 0
+    with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
         rows = list(csv.DictReader(fh))
     builds = {(r["build"], r["variant"]) for r in rows if r["study"] == "mode" and r["backend"] == "cuda"}
     assert builds and all(v in variants.declared("cuda", b).running("simulate") for b, v in builds)

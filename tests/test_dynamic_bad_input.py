@@ -7,7 +7,7 @@ import h5py
 import numpy as np
 import pytest
 
-from harness.__main__ import main as harness_main
+from harness.cli.main import main as harness_main
 from support.statecheck import run, tmp_leftovers
 
 SMALL = ["--strands", "20", "--points", "8", "--hair-length", "5"]

@@ -9,9 +9,12 @@ import sys
 import pytest
 
 from conftest import CPU_BIN
-from harness import HarnessError, headline_dynamic, report_dynamic, roofline, variants
-from harness.sweep import case_flags, run_sweep
-from harness.sweepfile import load_sweep
+from harness import HarnessError
+from harness.core import variants
+from harness.io.sweepfile import load_sweep
+from harness.render import report_dynamic
+from harness.studies import headline_dynamic, roofline
+from harness.studies.sweep import case_flags, run_sweep
 
 SWEEP = """
 name = "dyn-t"

@@ -1,4 +1,4 @@
-"""harness.env.git_revision: which code a result says it came from (docs/harness.md,
+"""harness.core.env.git_revision: which code a result says it came from (docs/harness.md,
 "Which code a result came from")."""
 
 import shutil
@@ -6,7 +6,7 @@ import subprocess
 
 import pytest
 
-from harness import env
+from harness.core import env
 
 
 def test_revision_file_wins_over_git(tmp_path, monkeypatch):

@@ -1,4 +1,4 @@
-"""The report's feature-cost section (harness/featurecost_report.py) from hand-made rows:
+"""The report's feature-cost section (harness/render/featurecost_report.py) from hand-made rows:
 costs against the right base rows, spread marks, and the row faster than `none` named."""
 
 import csv
@@ -6,7 +6,8 @@ import shutil
 
 import pytest
 
-from harness import featurecost, featurecost_report
+from harness.render import featurecost_report
+from harness.studies import featurecost
 
 FIELDS = featurecost.FIELDS
 

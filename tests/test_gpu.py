@@ -5,7 +5,7 @@ Binaries: build/hairsim-cuda (normal build: FMA contraction), build/hairsim-cuda
 contraction, IEEE division and square root: differs from the C reference only where CUDA's
 sinf/cosf/asinf/atan2f differ from glibc's, so the tight comparisons use it),
 build/hairsim-cuda-fastmath, and build/hairsim-cpu (the oracle). The variants are those the
-binaries declare (`--list-variants`, harness/variants.py).
+binaries declare (`--list-variants`, harness/core/variants.py).
 
   (a) stage by stage: the CPU's frame k is fed through --input into the GPU for stage k+1
       only, and the GPU's frame is compared with the CPU's frame k+1; the whole run too.
@@ -20,9 +20,9 @@ binaries declare (`--list-variants`, harness/variants.py).
 Plus: the fused JSON record, repeats (save/restore), end-to-end, odd sizes, w = 0, and a
 state past 2^31 elements.
 
-Every comparison is `harness diff` (harness/diff.py) with the tolerances of
-harness/tolerances.py: the "strict" pair for the strict build against the CPU, the pair of
-the files' precision kinds otherwise; invariants are harness/invariants.py's. The errors
+Every comparison is `harness diff` (harness/check/diff.py) with the tolerances of
+harness/core/tolerances.py: the "strict" pair for the strict build against the CPU, the pair of
+the files' precision kinds otherwise; invariants are harness/check/invariants.py's. The errors
 measured (in units of u, tolerances.point_unit) are written to build/gpu_test_errors.json
 for recalibration (docs/harness.md has the numbers).
 """
@@ -32,7 +32,7 @@ import json
 import pytest
 
 from conftest import BUILD, CPU_BIN, CUDA_BIN, CUDA_FASTMATH_BIN, CUDA_STRICT_BIN
-from harness import tolerances, variants
+from harness.core import tolerances, variants
 from support.invariants_check import assert_invariants
 from support.measured import write_worst
 from support.statecheck import State, assert_equivalent, run

@@ -10,9 +10,9 @@ the binary's --list-variants, within its most-points limit) x solver (xpbd, ftl)
 x block size x build, on scenes with the feature set compiled in (cuda/dyn_kernels.cuh
 specialised_mask) and one that runs the generic kernel.
 
-Rules: every frame is judged by harness.dyndiff.compare, the function behind `harness
+Rules: every frame is judged by harness.check.diff_dynamic.compare, the function behind `harness
 stepdiff` and the bench's validation (positions and velocities by the DYN_STEP_K rule of
-harness/tolerances.py, observables within what the states' difference allows); the strict
+harness/core/tolerances.py, observables within what the states' difference allows); the strict
 build equals the CPU bit for bit without gusts (GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS).
 Every build: bit-identical across block sizes and repeats.
 Strict build: all simulate variants bit-identical. The measured worst errors go to
@@ -24,9 +24,11 @@ import subprocess
 import pytest
 
 from conftest import BUILD, CPU_BIN, CUDA_BIN, CUDA_FASTMATH_BIN, CUDA_STRICT_BIN
-from harness import HarnessError, dyndiff, variants
-from harness.tolerances import GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS
-from harness.trajectory import open_trajectory
+from harness import HarnessError
+from harness.check import diff_dynamic
+from harness.core import variants
+from harness.core.tolerances import GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS
+from harness.io.trajectory import open_trajectory
 from support.measured import write_worst
 
 pytestmark = pytest.mark.gpu
@@ -212,10 +214,10 @@ def gpu_frame(work, cpu_run):
 
 
 def judge(a, b, what, exact=False):
-    """harness.dyndiff.compare of the last frame of GPU file b against the same step of a:
+    """harness.check.diff_dynamic.compare of the last frame of GPU file b against the same step of a:
     the rule of `harness stepdiff` and of the bench (positions, velocities, observables)."""
     step = last_step(b)
-    r = dyndiff.compare(a, b, frames=[step], exact=exact, check_paper=False)
+    r = diff_dynamic.compare(a, b, frames=[step], exact=exact, check_paper=False)
     f = r.frames[0]
     if not exact:
         record(f"positions {what}", f.max_rel_L)
@@ -227,7 +229,7 @@ def judge(a, b, what, exact=False):
 
 def same_bits(a, b):
     """Two GPU files of the same frame: bit-identical positions, velocities and observables."""
-    return dyndiff.compare(a, b, frames=[last_step(a)], exact=True, check_paper=False).equivalent
+    return diff_dynamic.compare(a, b, frames=[last_step(a)], exact=True, check_paper=False).equivalent
 
 
 # ---- against the CPU ------------------------------------------------------------------------

@@ -9,8 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from harness import scenes, sweepfile
-from harness.scenes import SceneError
+from harness.core import scenes
+from harness.core.scenes import SceneError
+from harness.io import sweepfile
 
 ROOT_DIR = Path(__file__).resolve().parent.parent
 

@@ -1,4 +1,4 @@
-"""The DESIGN §3 invariants as harness/invariants.py checks them: each planted violation
+"""The DESIGN §3 invariants as harness/check/invariants.py checks them: each planted violation
 is found and named, valid states pass, and the real C reference's outputs pass."""
 
 import subprocess
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from conftest import CPU_BIN
-from harness import invariants
-from harness.states import open_state
+from harness.check import invariants
+from harness.io.states import open_state
 from support.synthetic import radial_strands, write_state
 
 STAGES = ["init", "collide", "wind", "collide"]

@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness import HarnessError, h5md, mdanalysis
-from harness.states import open_state
-from harness.trajectory import OBSERVABLES, open_trajectory
+from harness import HarnessError
+from harness.io import h5md, mdanalysis
+from harness.io.states import open_state
+from harness.io.trajectory import OBSERVABLES, open_trajectory
 from support.synthetic import H5MD_BREAKS, break_h5md
 
 ROOT_DIR = Path(__file__).resolve().parent.parent
@@ -113,7 +114,7 @@ def test_mdanalysis_reads_every_frame(state):
 
 
 def test_mdanalysis_as_it_stands_names_the_unit(state):
-    """The upstream gaps harness.mdanalysis works around: MDAnalysis, untaught, stops at the
+    """The upstream gaps harness.io.mdanalysis works around: MDAnalysis, untaught, stops at the
     first unit it does not know (the fixed-length `s` comes back from h5py as bytes, b's';
     `cm` is not in its tables either). A fresh interpreter: the test above taught this one."""
     pytest.importorskip("MDAnalysis", reason="MDAnalysis not installed (pip install -r requirements-readers.lock)")
@@ -124,13 +125,13 @@ def test_mdanalysis_as_it_stands_names_the_unit(state):
     )
     p = subprocess.run([sys.executable, "-c", code, str(state)], capture_output=True, text=True)
     if p.returncode == 0:
-        pytest.skip("this MDAnalysis reads our units as they are: harness.mdanalysis.teach_units can go")
+        pytest.skip("this MDAnalysis reads our units as they are: harness.io.mdanalysis.teach_units can go")
     assert p.returncode == 3 and "is not recognized by H5MDReader" in p.stdout, p.stdout + p.stderr
 
 
 def test_mdanalysis_refuses_a_dynamic_state_in_one_line(dynamic_state):
     """MDAnalysis pairs every element's k-th entry with position frame k; the dynamic files'
-    velocities and observables start at the first simulated frame, so harness.mdanalysis
+    velocities and observables start at the first simulated frame, so harness.io.mdanalysis
     refuses them instead of handing back velocities of the wrong frames."""
     pytest.importorskip("MDAnalysis", reason="MDAnalysis not installed (pip install -r requirements-readers.lock)")
     with pytest.raises(HarnessError, match="MDAnalysis reads every element at the positions' frames") as e:

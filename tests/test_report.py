@@ -6,9 +6,9 @@ import json
 import numpy as np
 import pytest
 
-from harness import results_data, runlog
-from harness.__main__ import main
-from harness.plots import FIGURE_STATE
+from harness.cli.main import main
+from harness.io import results_data, runlog
+from harness.render.plots import FIGURE_STATE
 from support.synthetic import radial_strands, write_state
 
 STAGES = ["init", "collide", "wind", "collide"]

@@ -8,9 +8,9 @@ import sys
 import pytest
 
 from conftest import CPU_BIN, ROOT
-from harness import scenes
-from harness.paths import SWEEPS
-from harness.sweepfile import load_sweep
+from harness.core import scenes
+from harness.core.paths import SWEEPS
+from harness.io.sweepfile import load_sweep
 
 needs_cpu = pytest.mark.skipif(not CPU_BIN.exists(), reason=f"{CPU_BIN} is not built (run make)")
 

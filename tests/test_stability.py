@@ -14,7 +14,7 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from harness import tolerances, variants
+from harness.core import tolerances, variants
 from support.invariants_check import assert_frames_invariants, assert_invariants
 from support.statecheck import State, run
 
@@ -119,7 +119,7 @@ def test_gpu_agrees_with_cpu_across_the_scene_space(cpu_bin, tmp_path_factory, s
     """The same scene space on the strict CUDA build: the DESIGN §3 invariants on the GPU
     output, and equivalence with the CPU under the harness's tolerance (DESIGN §6)."""
     from conftest import CUDA_STRICT_BIN
-    from harness import diff
+    from harness.check import diff
 
     d = tmp_path_factory.mktemp("stabgpu")
     cpu, gpu = d / "cpu.h5", d / "gpu.h5"
@@ -277,7 +277,7 @@ def _run_backend(cpu_bin, backend, args, out):
         run(cpu_bin, *args, "--output", out, "--quiet")
         return State(out)
     from conftest import CUDA_STRICT_BIN
-    from harness import diff
+    from harness.check import diff
 
     ref = out.with_name(out.stem + "-cpu.h5")
     run(cpu_bin, *args, "--output", ref, "--quiet")

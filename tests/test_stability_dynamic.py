@@ -2,7 +2,7 @@
 search over the dynamic scene space on the CPU (and, marked `gpu`, on the strict CUDA
 build against the CPU), a slice of the stability map whose verdicts are known, and the
 map's verdict and wording rules. The map itself is `python -m harness stability`
-(harness/stability.py); what the searches found and the regressions named after it are in
+(harness/studies/stability.py); what the searches found and the regressions named after it are in
 docs/decisions.md ("Stability search of the dynamic model").
 """
 
@@ -14,9 +14,13 @@ import pytest
 from hypothesis import HealthCheck, event, example, given, settings
 from hypothesis import strategies as st
 
-from harness import HarnessError, dynamic_checks, dyndiff, stability, stability_report, tolerances, variants
-from harness.__main__ import main as harness_main
-from harness.trajectory import open_trajectory
+from harness import HarnessError
+from harness.check import diff_dynamic, invariants_dynamic
+from harness.cli.main import main as harness_main
+from harness.core import tolerances, variants
+from harness.io.trajectory import open_trajectory
+from harness.render import stability_report
+from harness.studies import stability
 from support.statecheck import run
 
 # CI: 120 derandomized examples (about 30 s on the 2-core CI machine); a deeper search:
@@ -147,9 +151,9 @@ def refused_cleanly(p):
 
 
 def check_contract(path):
-    """harness.dynamic_checks on every frame (the reference's roots bit for bit); the report."""
+    """harness.check.invariants_dynamic on every frame (the reference's roots bit for bit); the report."""
     with open_trajectory(path) as t:
-        rep = dynamic_checks.check(t, exact=True)
+        rep = invariants_dynamic.check(t, exact=True)
         blown = int(t.observables["blown_up_strands"].max())
     assert rep.ok, "; ".join(v.message for v in rep.all_violations()[:4])
     return blown
@@ -221,7 +225,7 @@ def test_search_cpu_contract_holds_across_the_dynamic_scene_space(cpu_bin, tmp_p
 def test_search_gpu_frame_agrees_with_cpu(cpu_bin, tmp_path_factory, s, variant, block):
     """A drawn scene on the strict CUDA build: one frame from the CPU's state (positions and
     velocities, --input --input-frame) against the CPU's next frame, by the rule of
-    tests/test_gpu_dynamic.py (harness.dyndiff.compare: bit for bit without gusts, the
+    tests/test_gpu_dynamic.py (harness.check.diff_dynamic.compare: bit for bit without gusts, the
     DYN_STEP_K rule with them); a scene the CPU refuses must be refused by the GPU too."""
     from conftest import CUDA_STRICT_BIN
 
@@ -267,8 +271,8 @@ def test_search_gpu_frame_agrees_with_cpu(cpu_bin, tmp_path_factory, s, variant,
     assert g.returncode == 0, g.stderr
     what = f"strict {variant} block {block} {s['solver']} {s['precision']}"
     exact = tolerances.GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS and not gusts
-    if exact or blown == 0:  # the rule of tests/test_gpu_dynamic.py and the bench (harness.dyndiff)
-        r = dyndiff.compare(cpu, gpu, frames=[step], exact=exact, check_paper=False)
+    if exact or blown == 0:  # the rule of tests/test_gpu_dynamic.py and the bench (harness.check.diff_dynamic)
+        r = diff_dynamic.compare(cpu, gpu, frames=[step], exact=exact, check_paper=False)
         assert r.equivalent, f"{what}: " + "; ".join(r.failures()[:5])
     else:
         event("gusts and a blown-up CPU frame: compared for finiteness only")

@@ -14,9 +14,10 @@ import time
 import pytest
 
 from conftest import ROOT
-from harness import roofline, runlog
-from harness.sweep import quartiles, run_sweep
-from harness.sweepfile import load_sweep
+from harness.io import runlog
+from harness.io.sweepfile import load_sweep
+from harness.studies import roofline
+from harness.studies.sweep import quartiles, run_sweep
 from support.fakebackend import install
 
 SWEEP = """
@@ -190,7 +191,7 @@ def test_groups_and_overrides(tmp_path):
 def test_a_sweep_does_not_resume_rows_of_another_machine(tmp_path):
     """Rows measured on two machines must never mix in one runs.csv."""
     from harness import HarnessError
-    from harness.sweep import check_same_machine
+    from harness.studies.sweep import check_same_machine
 
     h200 = {"cpu_model": "Intel(R) Xeon(R) Processor", "cpu_cores": 16, "gpus": [{"name": "NVIDIA H200"}]}
     laptop = {"cpu_model": "AMD EPYC", "cpu_cores": 2, "gpus": []}

@@ -1,11 +1,13 @@
-"""harness/variants.py: the variant names come from the binaries' --list-variants, read
+"""harness/core/variants.py: the variant names come from the binaries' --list-variants, read
 defensively (keys added later are ignored), and a missing binary means no names."""
 
 import json
 
 import pytest
 
-from harness import HarnessError, sweepfile, variants
+from harness import HarnessError
+from harness.core import variants
+from harness.io import sweepfile
 from support.fakebackend import install
 
 
