@@ -6,6 +6,7 @@ import csv
 import numpy as np
 
 from harness.core import scenes, tolerances
+from harness.render import accuracy_paper_report
 from harness.studies import accuracy_paper
 
 
@@ -28,10 +29,11 @@ def test_accuracy_study_writes_table_plot_and_recommendation(cpu_bin, tmp_path):
         resolution=(4, 16, 46),
         res_strands=500,
         out_dir=tmp_path / "acc",
-        report_dir=tmp_path / "rep",
         log=lambda *_: None,
     )
-    with open(tmp_path / "acc" / "accuracy_paper.csv") as fh:
+    assert not (tmp_path / "rep").exists()  # measuring only: the renderer draws
+    accuracy_paper_report.report_from_csv(tmp_path / "acc" / "accuracy.csv", tmp_path / "rep", log=lambda *_: None)
+    with open(tmp_path / "acc" / "accuracy.csv") as fh:
         table = list(csv.DictReader(fh))
     assert set(accuracy_paper.COLUMNS) <= set(table[0])
     modes = {r["mode"] for r in table if r["study"] == "mode"}
@@ -52,7 +54,7 @@ def test_accuracy_study_writes_table_plot_and_recommendation(cpu_bin, tmp_path):
     assert res[0]["max_err_L"] > res[1]["max_err_L"] > 0 and res[2]["max_err_L"] == 0
     png = tmp_path / "rep" / "accuracy_pareto.png"
     assert png.stat().st_size > 5000
-    md = (tmp_path / "rep" / "accuracy_paper.md").read_text()
+    md = (tmp_path / "rep" / "accuracy.md").read_text()
     assert "| cpu fp32 ref |" in md and "Which mode for which use" in md
     assert "GPU modes absent" in md or "gpu fp32 strict" in md
     assert not (tmp_path / "acc" / "states").exists()  # scratch states removed
@@ -72,8 +74,8 @@ def test_a_fused_wind_frame_is_not_checked_for_penetration(tmp_path):
         tmp_path / "a.h5", frames, ["init", "wind"], fused=["", "wind+collide"], params={"hair_length": 2.0}
     )
     with open_state(a) as s:
-        e = accuracy_paper.frame_errors(s, s, 1, 2.0)
+        e = accuracy_paper.frame_measures(s, s, 1, 2.0)
     assert e["penetration"] == 0
     b = write_state(tmp_path / "b.h5", frames, ["init", "collide"], params={"hair_length": 2.0})
     with open_state(b) as s:
-        assert accuracy_paper.frame_errors(s, s, 1, 2.0)["penetration"] > 0.1
+        assert accuracy_paper.frame_measures(s, s, 1, 2.0)["penetration"] > 0.1

@@ -180,7 +180,7 @@ def test_gpu_modes_and_the_gpu_reference_check(standin_build, tmp_path, quiet, p
     standin_build(perturb)
     out = tmp_path / "out"
     plan = accuracy_dynamic.Plan(**{**TINY, "iterations": (1,), "substeps": (1,)})
-    assert accuracy_dynamic.run_study(plan, out, tmp_path / "rep", render=False, log=quiet) == 0
+    assert accuracy_dynamic.run_study(plan, out, log=quiet) == 0
     with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
         rows = list(csv.DictReader(fh))
     gpu = {r["variant"] for r in rows if r["study"] == "mode" and r["backend"] == "cuda"}

@@ -29,6 +29,9 @@ from harness.check import diff_dynamic
 from harness.core import env, runner, scenes, variants
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.scenes import with_frames
+from harness.io import results_data
+from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
+from harness.studies import accuracy_dynamic, animate, featurecost, peer, stability
 from harness.studies.sweep import run_sweep, write_json
 
 VALIDATION_STRANDS = 2000
@@ -174,26 +177,13 @@ def validate(out_dir, builds, gpu_note, say):
     say(f"harness: dynamic validation: all {len(v.checks)} comparisons equivalent")
 
 
-def _harness(argv, say):
-    """Run a harness subcommand in this process (its own defaults and checks)."""
-    from harness.cli.main import parser
-
-    say(f"harness: {' '.join(argv)}")
-    args = parser().parse_args(argv)
-    code = args.func(args)
-    if code:
-        raise HarnessError(f"`python -m harness {' '.join(argv)}` exited with status {code}", code=code)
-
-
 def fastest_gpu_variants(sweep_dir):
     """The default build's simulate variant with the most point-substeps per second at the
     sweep's largest fp32 strand count; every simulate variant when the sweep has no GPU row."""
     decl = variants.declared("cuda")
     every = list(decl.running("simulate", points=32))
     try:
-        from harness.io.results_data import load
-
-        rows, _ = load(sweep_dir)
+        rows, _ = results_data.load(sweep_dir)
     except HarnessError:
         return every
     g = rows[(rows["stage"] == "simulate") & (rows["backend"] == "cuda") & (rows["precision"] == "fp32")]
@@ -206,27 +196,33 @@ def fastest_gpu_variants(sweep_dir):
 
 
 def studies(root, builds, say, report_dir=None, quick=False):
-    """The dynamic studies, each into root/<study> (`quick`: their small versions)."""
+    """The dynamic studies, each measured into root/<study> (`quick`: their small versions)
+    and rendered into report_dir."""
     fc = root / "featurecost"
     fc.mkdir(parents=True, exist_ok=True)
-    _harness(["featurecost", "--backend", "cpu", "--out", str(fc / "cpu.csv")], say)
+    say("harness: featurecost --backend cpu")
+    featurecost.measure(backend="cpu", out=fc / "cpu.csv")
     if builds:  # the sweep's fastest variant (else every one that simulates), at a size that fills the GPU
         for v in fastest_gpu_variants(root / SWEEP):
-            out = fc / f"cuda-{v}.csv"
-            argv = ["featurecost", "--backend", "cuda", "--variant", v, "--strands", "1000000", "--out", str(out)]
-            _harness(argv, say)
-    acc = ["accuracy", "--model", "dynamic", "--out", str(root / "dynamic-accuracy"), "--force"]
-    acc += ["--report-dir", str(report_dir)] if report_dir else []
-    acc += ["--quick"] if quick else []
-    if not builds:
-        acc += ["--gpu", "no"]
-    _harness(acc, say)
-    stab = ["stability", "--out", str(root / "stability"), "--gpu", "auto" if builds else "no"]
-    stab += ["--report-dir", str(report_dir)] if report_dir else []
-    stab += ["--quick"] if quick else []
-    _harness(stab, say)
-    _harness(["peer", "--out", str(root / "peer"), "--report-dir", str(root / "peer")], say)
-    _harness(["animate", "--force"] + (["--out", str(Path(report_dir) / "dynamic.gif")] if report_dir else []), say)
+            say(f"harness: featurecost --backend cuda --variant {v} --strands 1000000")
+            featurecost.measure(backend="cuda", variant=v, strands=1_000_000, out=fc / f"cuda-{v}.csv")
+    acc_dir = root / accuracy_dynamic.RESULTS_NAME
+    gpu = "auto" if builds else "no"
+    plan = accuracy_dynamic.Plan.quick(gpu=gpu) if quick else accuracy_dynamic.Plan(gpu=gpu)
+    say(f"harness: accuracy --model dynamic{' --quick' if quick else ''} --gpu {gpu}")
+    accuracy_dynamic.run_study(plan, out_dir=acc_dir, force=True, command="python -m harness bench --model dynamic")
+    accuracy_dynamic_report.write(acc_dir, report_dir)
+    say(f"harness: stability{' --quick' if quick else ''} --gpu {gpu}")
+    csv_path = stability.run_study(quick=quick, gpu=gpu, out_dir=root / "stability")
+    stability_report.report_from_csv(csv_path, report_dir=report_dir, log=say)
+    say("harness: peer")
+    try:
+        peer.run_study(peer.Plan(out=str(root / "peer")), log=say)
+    except peer.PeerUnavailable as e:  # an optional dependency: skipped, not failed
+        say(f"harness: peer: skipped: {e}")
+    peer_report.write(root / "peer", root / "peer")
+    say("harness: animate")
+    animate.run(out=Path(report_dir) / "dynamic.gif" if report_dir else None, force=True, log=say)
 
 
 def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None):
@@ -241,8 +237,6 @@ def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None):
     validate(sweep_dir, builds, gpu_note, say)
     _, failed = run_sweep(SWEEP, out=sweep_dir, gpu="no" if gpu_note else gpu, log=say, announce_skips=False)
     studies(root, builds, say, report_dir=report_dir, quick=quick_studies)
-    from harness.render import report_dynamic
-
     path = report_dynamic.build(root, report_dir)
     say(f"harness: dynamic report in {display(path)}")
     return 1 if failed else 0

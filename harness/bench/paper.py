@@ -11,7 +11,7 @@
        compare that frame) per build × variant × precision at block 64;
      any comparison not equivalent stops the bench here, before timing;
   3. the sweep (results/<name>/runs.csv, resumable);
-  4. plots and report/report_paper.md.
+  4. plots and report/report.md.
 Without a GPU it runs the CPU rows and prints one line saying why the GPU rows are skipped.
 """
 

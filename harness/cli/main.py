@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from harness import HarnessError, __version__
+from harness.studies import peer
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -236,6 +237,7 @@ def accuracy_model(args):
 def cmd_accuracy(args):
     if accuracy_model(args) == "dynamic":
         return accuracy_dynamic(args)
+    from harness.core.paths import RESULTS
     from harness.render import accuracy_paper_report
     from harness.studies import accuracy_paper
 
@@ -251,15 +253,16 @@ def cmd_accuracy(args):
         resolution=tuple(opt["resolution"]),
         res_strands=opt["resolution_strands"],
         out_dir=args.out,
-        report_dir=args.report_dir,
     )
+    out = Path(args.out) if args.out else RESULTS / "accuracy"
+    accuracy_paper_report.report_from_csv(out / "accuracy.csv", report_dir=args.report_dir)
     return 0
 
 
 def accuracy_dynamic(args):
     from pathlib import Path
 
-    from harness.core.paths import display
+    from harness.core.paths import RESULTS, display
     from harness.render import accuracy_dynamic_report
     from harness.studies import accuracy_dynamic
 
@@ -291,9 +294,12 @@ def accuracy_dynamic(args):
             given[k] = tuple(sorted(set(getattr(args, k))))
     plan = accuracy_dynamic.Plan.quick(**given) if args.quick else accuracy_dynamic.Plan(**given)
     command = " ".join(["python -m harness", *sys.argv[1:]])
-    return accuracy_dynamic.run_study(
-        plan, out_dir=args.out, report_dir=args.report_dir, force=args.force, command=command
-    )
+    status = accuracy_dynamic.run_study(plan, out_dir=args.out, force=args.force, command=command)
+    for path in accuracy_dynamic_report.write(
+        Path(args.out or RESULTS / accuracy_dynamic.RESULTS_NAME), args.report_dir
+    ):
+        print(f"wrote {display(path)}")
+    return status
 
 
 def cmd_headline(args):
@@ -379,11 +385,11 @@ def cmd_peer(args):
     from harness.render import peer_report
 
     if not args.report_only:
-        from harness.studies import peer
-
-        args.argv = sys.argv[2:] if len(sys.argv) > 2 and sys.argv[1] == "peer" else None
+        fields = peer.Plan.__dataclass_fields__
+        plan = peer.Plan(**{k: getattr(args, k) for k in fields if k != "argv"})
+        plan.argv = sys.argv[2:] if len(sys.argv) > 2 and sys.argv[1] == "peer" else None
         try:
-            peer.run_study(args)
+            peer.run_study(plan)
         except peer.PeerUnavailable as e:  # an optional dependency: skipped, not failed
             print(f"harness: peer: skipped: {e}", file=sys.stderr)
             return 0
@@ -416,7 +422,7 @@ def cmd_stability(args):
     if args.from_csv:
         stability_report.report_from_csv(args.from_csv, report_dir=args.report_dir)
         return 0
-    stability.run_study(
+    csv_path = stability.run_study(
         slices=tuple(args.slice or stability.SLICE_NAMES),
         quick=args.quick,
         strands=args.strands,
@@ -425,8 +431,8 @@ def cmd_stability(args):
         gpu=args.gpu,
         timeout=args.timeout,
         out_dir=args.out,
-        report_dir=args.report_dir,
     )
+    stability_report.report_from_csv(csv_path, report_dir=args.report_dir)
     return 0
 
 
@@ -547,7 +553,7 @@ def parser():
 
     for name, helptext, fn in (
         ("plot", "draw the PNG plots of a results directory", cmd_plot),
-        ("report", "write report/report_paper.md (and its plots)", cmd_report),
+        ("report", "write report/report.md (and its plots)", cmd_report),
     ):
         q = sub.add_parser(name, help=helptext, description=helptext[0].upper() + helptext[1:] + ".")
         q.add_argument(
@@ -600,7 +606,7 @@ def parser():
         help="speed against accuracy: every mode against a reference (paper or dynamic model)",
         description="Paper model (default): run the scene in every precision/build mode available "
         "here and in several model resolutions, compare with hairsim-cpu --precision fp64, time "
-        "each mode apart, and write results/accuracy/ and report/accuracy_paper.md with a Pareto plot. "
+        "each mode apart, and write results/accuracy/ and report/accuracy.md with a Pareto plot. "
         "Dynamic model (--model dynamic, or a dynamic --scene): every solver x substeps x "
         "iterations x precision x build against a converged xpbd fp64 reference (substeps doubled "
         "until S and 2S agree to a tenth of the smallest error), time per frame measured apart, "
@@ -653,7 +659,7 @@ def parser():
     a.add_argument(
         "--from-csv",
         default=None,
-        help="only rewrite the report from an existing CSV (results/accuracy/accuracy_paper.csv, or with "
+        help="only rewrite the report from an existing CSV (results/accuracy/accuracy.csv, or with "
         "--model dynamic results/dynamic-accuracy/dynamic_accuracy.csv)",
     )
     a.set_defaults(func=cmd_accuracy)
@@ -664,7 +670,7 @@ def parser():
         description="At one size, measure the copy bandwidths, every CUDA variant's init and "
         "wind+collide time and bandwidth fraction, and three CPU baselines "
         "(ref 1 thread, ref all cores, simd all cores); write "
-        "results/headline/headline_paper.json.",
+        "results/headline/headline.json.",
     )
     h.add_argument("--strands", type=whole(1), default=4 * 1024 * 1024)
     h.add_argument("--points", type=whole(2), default=32)
@@ -739,6 +745,7 @@ def parser():
     )
     fc.set_defaults(func=cmd_featurecost)
 
+    peer_plan = peer.Plan()
     pe = sub.add_parser(
         "peer",
         help="the same chain scenes in Bender's PositionBasedDynamics (pypbd) beside ours",
@@ -747,26 +754,42 @@ def parser():
         "stretch and time per frame at several strand counts. Writes results/peer/ and report/peer.md. "
         "Needs pypbd (optional): without it, one line says so and the exit status is 2.",
     )
-    pe.add_argument("--points", type=whole(2), default=32, help="points per chain, root included (default 32)")
-    pe.add_argument("--length", type=number, default=30.0, help="chain length L, cm (default 30)")
     pe.add_argument(
-        "--tilts", type=number, nargs="+", default=[30.0, 60.0], help="degrees from the downward vertical (30 60)"
+        "--points", type=whole(2), default=peer_plan.points, help="points per chain, root included (default 32)"
     )
-    pe.add_argument("--frames", type=whole(1), default=30, help="accuracy horizon in frames (default 30: 0.5 s)")
-    pe.add_argument("--frame-dt", type=number, default=1 / 60, help="frame length Δt, s (default 1/60)")
-    pe.add_argument("--gravity", type=number, default=981.0, help="g0, cm/s² (default 981)")
-    pe.add_argument("--compliance", type=number, default=0.0, help="stretch compliance α (default 0: rigid)")
+    pe.add_argument("--length", type=number, default=peer_plan.length, help="chain length L, cm (default 30)")
     pe.add_argument(
-        "--settings", type=setting, nargs="+", default=[(8, 1), (32, 1), (8, 4)], help="SxI pairs (8x1 32x1 8x4)"
+        "--tilts",
+        type=number,
+        nargs="+",
+        default=list(peer_plan.tilts),
+        help="degrees from the downward vertical (30 60)",
     )
     pe.add_argument(
-        "--strands", type=whole(1), nargs="+", default=[1, 100, 1000, 10000], help="chains timed (1 100 1000 10000)"
+        "--frames", type=whole(1), default=peer_plan.frames, help="accuracy horizon in frames (default 30: 0.5 s)"
     )
-    pe.add_argument("--threads", type=whole(1), default=1, help="threads for both solvers (default 1)")
-    pe.add_argument("--time-frames", type=whole(1), default=5, help="frames per timing run (default 5)")
-    pe.add_argument("--repeat", type=whole(1), default=3, help="our --repeat; the peer steps frames × repeat")
-    pe.add_argument("--ref-start", type=whole(1), default=64, help="first S of the reference doubling (64)")
-    pe.add_argument("--ref-max", type=whole(2), default=16384, help="largest S of the reference (16384)")
+    pe.add_argument("--frame-dt", type=number, default=peer_plan.frame_dt, help="frame length Δt, s (default 1/60)")
+    pe.add_argument("--gravity", type=number, default=peer_plan.gravity, help="g0, cm/s² (default 981)")
+    pe.add_argument(
+        "--compliance", type=number, default=peer_plan.compliance, help="stretch compliance α (default 0: rigid)"
+    )
+    pe.add_argument(
+        "--settings", type=setting, nargs="+", default=list(peer_plan.settings), help="SxI pairs (8x1 32x1 8x4)"
+    )
+    pe.add_argument(
+        "--strands", type=whole(1), nargs="+", default=list(peer_plan.strands), help="chains timed (1 100 1000 10000)"
+    )
+    pe.add_argument("--threads", type=whole(1), default=peer_plan.threads, help="threads for both solvers (default 1)")
+    pe.add_argument(
+        "--time-frames", type=whole(1), default=peer_plan.time_frames, help="frames per timing run (default 5)"
+    )
+    pe.add_argument(
+        "--repeat", type=whole(1), default=peer_plan.repeat, help="our --repeat; the peer steps frames × repeat"
+    )
+    pe.add_argument(
+        "--ref-start", type=whole(1), default=peer_plan.ref_start, help="first S of the reference doubling (64)"
+    )
+    pe.add_argument("--ref-max", type=whole(2), default=peer_plan.ref_max, help="largest S of the reference (16384)")
     pe.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
     pe.add_argument("--out", default=None, help="results directory (default results/peer)")
     pe.add_argument("--report-dir", default=None, help="where peer.md goes (default report/)")

@@ -47,11 +47,18 @@ class Runner:
 
     backend: str  # cpu | cuda
     build: str  # default | strict | fastmath
-    variant: str
+    variant: str | None  # None: the binary's default variant
 
     @property
     def binary(self):
         return binary_path(self.backend, self.build)
+
+    @property
+    def label(self):
+        """ "cpu ref", "gpu normal fused": how the studies name it."""
+        if self.backend == "cpu":
+            return f"cpu {self.variant}"
+        return f"gpu {'normal' if self.build == 'default' else self.build} {self.variant}"
 
 
 def simulating(backend, build="default"):

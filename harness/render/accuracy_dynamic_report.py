@@ -17,7 +17,7 @@ import numpy as np
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, RESULTS, display
-from harness.studies.accuracy_dynamic import ANALYTIC_NAME, COLUMNS, CSV_NAME, RESULTS_NAME, holds_until, smallest
+from harness.studies.accuracy import ANALYTIC_NAME, COLUMNS, CSV_NAME, RESULTS_NAME, holds_until, smallest
 
 PAGE = "dynamic_accuracy.md"
 PARETO_PNG = "dynamic_accuracy_pareto.png"

@@ -1,4 +1,4 @@
-"""Render the speed-against-accuracy study (accuracy.py measures it): read accuracy.csv,
+"""Render the speed-against-accuracy study (studies/accuracy_paper.py measures it): read accuracy.csv,
 draw report/accuracy_pareto.png, write report/accuracy.md."""
 
 import csv
@@ -9,8 +9,7 @@ import numpy as np
 
 from harness import HarnessError
 from harness.core.paths import REPORT, display
-
-REFERENCE = "cpu fp64 ref"
+from harness.studies.accuracy import PAPER_REFERENCE, paper_uses
 
 
 def load_rows(csv_path):
@@ -43,12 +42,12 @@ def report_from_csv(csv_path, report_dir=None, log=print):
     mode_rows = [r for r in rows if r["study"] == "mode"]
     res_rows = [r for r in rows if r["study"] == "resolution"]
     strands, points = mode_rows[0]["strands"], mode_rows[0]["points"]
-    res_note = _res_strands_note(csv_path)
+    meta = _env(csv_path)
+    res_note = meta.get("resolution_strands")
     gpu_ran = any(r["backend"] == "cuda" for r in mode_rows)
+    why = meta.get("gpu_absent") or "no GPU rows in this results file"
     png = pareto_plot(rows, report_dir / "accuracy_pareto.png", strands, points)
-    md = write_markdown(
-        rows, report_dir / "accuracy.md", strands, points, res_note, gpu_ran, "no GPU rows in this results file"
-    )
+    md = write_markdown(rows, report_dir / "accuracy.md", strands, points, res_note, gpu_ran, why)
     log(
         f"wrote {display(png)}, {display(md)} from {display(csv_path)} ({len(mode_rows)} mode rows, "
         f"{len(res_rows)} resolution rows)"
@@ -56,12 +55,13 @@ def report_from_csv(csv_path, report_dir=None, log=print):
     return md
 
 
-def _res_strands_note(csv_path):
-    """Strands of the resolution study, from env.json beside the CSV (recorded by run_study)."""
+def _env(csv_path):
+    """env.json beside the CSV (recorded by the study), {} when absent or unreadable."""
     try:
-        return int(json.loads((Path(csv_path).parent / "env.json").read_text()).get("resolution_strands"))
-    except (OSError, ValueError, TypeError, AttributeError):
-        return None
+        meta = json.loads((Path(csv_path).parent / "env.json").read_text())
+    except (OSError, ValueError):
+        return {}
+    return meta if isinstance(meta, dict) else {}
 
 
 def _end_to_end(rows):
@@ -83,7 +83,7 @@ def pareto_plot(rows, path, strands, points):
     fig, ax = plt.subplots(figsize=(7, 4.5))
     floor = 1e-17
     for r in _end_to_end(rows):
-        if r["mode"] == REFERENCE:
+        if r["mode"] == PAPER_REFERENCE:
             continue
         err = max(r["max_err_L"], floor)
         ax.scatter(r["time_ms"], err, s=40)
@@ -121,7 +121,7 @@ def pareto_plot(rows, path, strands, points):
 
 def recommend(rows):
     """Which mode for which use, from the measured end-to-end errors and times."""
-    e2e = [r for r in _end_to_end(rows) if r["mode"] != REFERENCE and np.isfinite(r["max_err_L"])]
+    e2e = [r for r in _end_to_end(rows) if r["mode"] != PAPER_REFERENCE and np.isfinite(r["max_err_L"])]
     if not e2e:
         return ["No mode other than the reference ran."]
     lines = []
@@ -170,9 +170,7 @@ def write_markdown(rows, path, strands, points, res_strands, gpu_ok, why):
         "segment drift | penetration / rc |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    from harness.studies.accuracy_paper import uses as mode_uses
-
-    uses = mode_uses()
+    uses = paper_uses()
     for r in _end_to_end(rows):
         frames = [x for x in rows if x["study"] == "mode" and x["mode"] == r["mode"]]
         worst = max(x["max_err_L"] for x in frames)

@@ -11,7 +11,7 @@ import pandas as pd
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, display
-from harness.studies.stability import OTHER, SLICES, VERDICTS
+from harness.studies.stability_slices import OTHER, SLICES, VERDICTS
 
 ORDER = VERDICTS + OTHER
 COLOURS = {

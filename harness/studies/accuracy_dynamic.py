@@ -43,70 +43,23 @@ import numpy as np
 
 from harness import HarnessError
 from harness.core import env, runner, scenes, scenes_dynamic, tolerances, variants
-from harness.core.paths import CUDA_BUILDS, REPORT, RESULTS, binary_path, display
+from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.io.trajectory import open_trajectory
-
-RESULTS_NAME = "dynamic-accuracy"
-CSV_NAME = "dynamic_accuracy.csv"
-ANALYTIC_NAME = "analytic.md"
-SIMULATE = "simulate"  # the stage a variant must run to take part
-# the reference family of the contract (docs/model.md §3.6), in its working precision fp64
-REF_SOLVER, REF_PRECISION, REF_ITERATIONS = "xpbd", "fp64", 1
-
-COLUMNS = (
-    "study",  # mode | reference | gpu_check
-    "mode",
-    "backend",
-    "build",
-    "variant",
-    "solver",
-    "substeps",
-    "iterations",
-    "precision",
-    "strands",
-    "points",
-    "frame",  # simulated frame, counted from 1
-    "time_s",
-    "rms_err_L",
-    "max_err_L",
-    "stretch_max",
-    "penetration_max",
-    "blown_up_strands",
-    "time_per_frame_ms",  # the simulate stage's median over frames × repeats
-    "time_per_frame_min_ms",  # its fastest (on a shared machine the median can be preempted)
-    "time_strands",
-    "threads",
-    "block_size",
-    "device",
-    "ref_substeps",  # the reference rung compared with (mode, gpu_check) or 2S (reference)
+from harness.studies.accuracy import (
+    ANALYTIC_NAME,
+    COLUMNS,
+    CSV_NAME,
+    REF_ITERATIONS,
+    REF_PRECISION,
+    REF_SOLVER,
+    RESULTS_NAME,
+    Mode,
+    frame_errors,
+    holds_until,
+    smallest,
 )
 
-
-class Build(variants.Runner):
-    """One binary and variant that runs `simulate`."""
-
-    @property
-    def label(self):
-        if self.backend == "cpu":
-            return f"cpu {self.variant}"
-        return f"gpu {'normal' if self.build == 'default' else self.build} {self.variant}"
-
-
-@dataclass(frozen=True)
-class Mode:
-    build: Build
-    solver: str
-    substeps: int
-    iterations: int
-    precision: str
-
-    @property
-    def name(self):
-        return f"{self.build.label} {self.solver} S{self.substeps} I{self.iterations} {self.precision}"
-
-    @property
-    def tag(self):
-        return self.name.replace(" ", "_")
+SIMULATE = "simulate"  # the stage a variant must run to take part
 
 
 @dataclass(frozen=True)
@@ -182,11 +135,11 @@ def check_plan(plan, frame_dt):
 def study_builds(gpu_ok):
     """Every binary × variant here that runs simulate: the cpu variants, then (with a GPU)
     each cuda build present."""
-    out = [Build("cpu", "default", v) for v in variants.declared("cpu").running(SIMULATE)]
+    out = [variants.Runner("cpu", "default", v) for v in variants.declared("cpu").running(SIMULATE)]
     if gpu_ok:
         for build in CUDA_BUILDS:
             if binary_path("cuda", build).exists():
-                out += [Build("cuda", build, v) for v in variants.declared("cuda", build).running(SIMULATE)]
+                out += [variants.Runner("cuda", build, v) for v in variants.declared("cuda", build).running(SIMULATE)]
     return out
 
 
@@ -196,7 +149,7 @@ def study_modes(builds, plan):
     for b in builds:
         d = variants.declared(b.backend, b.build)
         for solver, precision, (s, i) in itertools.product(d.solvers, d.precisions, pairs):
-            out.append(Mode(b, solver, s, i, precision))
+            out.append(Mode(b, precision, solver, s, i))
     return out
 
 
@@ -216,47 +169,11 @@ def configured(scene, *, solver, substeps, iterations, precision, frames, strand
 # ---- errors ---------------------------------------------------------------------------
 
 
-def frame_errors(x, ref, L):
-    """RMS and max over all points of |x − ref| / L for each frame of x, ref [F][N][P][3];
-    NaN where either is not finite."""
-    x = np.asarray(x, dtype=np.float64)
-    ref = np.asarray(ref, dtype=np.float64)
-    with np.errstate(invalid="ignore", over="ignore"):
-        d = np.linalg.norm(x - ref, axis=-1)
-        rms = np.sqrt(np.mean(d * d, axis=(1, 2))) / L
-        mx = np.max(d, axis=(1, 2)) / L
-    bad = ~np.isfinite(rms) | ~np.isfinite(mx)
-    rms[bad] = np.nan
-    mx[bad] = np.nan
-    return rms, mx
-
-
-def smallest(errors):
-    """Per frame, the smallest finite error over modes ({name: [F]}); NaN where none."""
-    stack = np.array([e for e in errors.values()], dtype=np.float64)
-    if stack.size == 0:
-        return np.array([])
-    with np.errstate(invalid="ignore"):
-        stack[~np.isfinite(stack)] = np.inf
-        out = stack.min(axis=0)
-    out[~np.isfinite(out)] = np.nan
-    return out
-
-
 def reference_ok(diff, smallest_error, factor):
     """Per frame: the reference's S-vs-2S difference under `factor` × the smallest mode
     error (False where either is NaN)."""
     with np.errstate(invalid="ignore"):
         return np.asarray(diff) < factor * np.asarray(smallest_error)
-
-
-def holds_until(ok, times):
-    """The last time up to which every frame passes; 0.0 when the first frame fails."""
-    ok = np.asarray(ok, dtype=bool)
-    bad = np.flatnonzero(~ok)
-    if bad.size == 0:
-        return float(times[-1]) if len(times) else 0.0
-    return float(times[bad[0] - 1]) if bad[0] > 0 else 0.0
 
 
 # ---- runs -----------------------------------------------------------------------------
@@ -333,11 +250,11 @@ class Study:
             frames=self.plan.time_frames,
             strands=self.plan.time_strands,
         )
-        flags = runner.run_flags(sc, mode.build.backend, variant=mode.build.variant, repeat=self.plan.repeat)
-        rec = runner.run_binary(mode.build.binary, flags)
+        flags = runner.run_flags(sc, mode.runner.backend, variant=mode.runner.variant, repeat=self.plan.repeat)
+        rec = runner.run_binary(mode.runner.binary, flags)
         sim = [s for s in rec["stages"] if s.get("stage") == SIMULATE]
         if not sim:
-            raise HarnessError(f"{mode.build.binary.name}: its record has no simulate stage")
+            raise HarnessError(f"{mode.runner.binary.name}: its record has no simulate stage")
         return float(sim[0]["median_ms"]), float(sim[0]["min_ms"]), rec
 
     # the reference ladder ------------------------------------------------------------
@@ -414,7 +331,7 @@ def _gpu_reference_build(gpu_ok, plan):
     if not gpu_ok or not binary_path("cuda").exists():
         return None
     sim = variants.declared("cuda").running(SIMULATE)
-    return Build("cuda", "default", sim[0]) if sim else None
+    return variants.Runner("cuda", "default", sim[0]) if sim else None
 
 
 def _row(**kw):
@@ -439,13 +356,12 @@ def _frame_rows(run, rms, mx, **shared):
     ]
 
 
-def run_study(plan, out_dir=None, report_dir=None, force=False, command=None, render=True, log=print):
-    """Measure, write the CSV, analytic.md and env.json, render the report (unless
-    render=False); return the exit status (0: reference converged over the horizon, 1: it
+def run_study(plan, out_dir=None, force=False, command=None, log=print):
+    """Measure, write the CSV, analytic.md and env.json (render/accuracy_dynamic_report.py
+    draws them); return the exit status (0: reference converged over the horizon, 1: it
     did not)."""
     started = time.monotonic()
     out_dir = Path(out_dir or RESULTS / RESULTS_NAME)
-    report_dir = Path(report_dir or REPORT)
     csv_path = out_dir / CSV_NAME
     if csv_path.exists() and not force:
         raise HarnessError(f"{display(csv_path)} exists: pass --force to replace it")
@@ -454,12 +370,11 @@ def run_study(plan, out_dir=None, report_dir=None, force=False, command=None, re
         log(f"dynamic accuracy: removing the scratch states of an earlier run ({display(study.scratch)})")
         shutil.rmtree(study.scratch)
     study.scratch.mkdir(parents=True)
-    report_dir.mkdir(parents=True, exist_ok=True)
     gpu_ok, gpu_why = env.gpu_status()
     if gpu_ok and plan.gpu == "no":
         gpu_ok, gpu_why = False, "--gpu no"
     builds = study_builds(gpu_ok)
-    cpu_oracle = Build("cpu", "default", variants.declared("cpu").default_variant)
+    cpu_oracle = variants.Runner("cpu", "default", variants.declared("cpu").default_variant)
     if REF_SOLVER not in variants.declared("cpu").solvers:
         raise HarnessError(f"{display(cpu_oracle.binary)} declares no {REF_SOLVER} solver (--list-variants)")
     modes = study_modes(builds, plan)
@@ -481,8 +396,10 @@ def run_study(plan, out_dir=None, report_dir=None, force=False, command=None, re
 
                 futures[pool.submit(analytic_table.tables, str(cpu_oracle.binary), plan.analytic == "quick")] = None
             for m in modes:
-                threads = 1 if m.build.backend == "cpu" else None
-                f = pool.submit(study.checked, m.build, m.solver, m.substeps, m.iterations, m.precision, m.tag, threads)
+                threads = 1 if m.runner.backend == "cpu" else None
+                f = pool.submit(
+                    study.checked, m.runner, m.solver, m.substeps, m.iterations, m.precision, m.tag, threads
+                )
                 futures[f] = m
             done = 0
             for f in as_completed(futures):
@@ -595,10 +512,7 @@ def run_study(plan, out_dir=None, report_dir=None, force=False, command=None, re
         ),
     )
     (out_dir / "env.json").write_text(json.dumps(meta, indent=1, default=str) + "\n")
-    from harness.render import accuracy_dynamic_report
-
-    written = accuracy_dynamic_report.write(out_dir, report_dir) if render else []
-    log(f"wrote {display(csv_path)}" + "".join(", " + display(p) for p in written))
+    log(f"wrote {display(csv_path)}")
     if not ref["converged"]:
         log(
             f"dynamic accuracy: the reference did NOT converge over the horizon by S = {final_S} "
@@ -621,9 +535,9 @@ def _rows(study, modes, mode_paths, ref, timing):
             mx,
             study="mode",
             mode=m.name,
-            backend=m.build.backend,
-            build=m.build.build,
-            variant=m.build.variant,
+            backend=m.runner.backend,
+            build=m.runner.build,
+            variant=m.runner.variant,
             solver=m.solver,
             substeps=m.substeps,
             iterations=m.iterations,
@@ -633,8 +547,8 @@ def _rows(study, modes, mode_paths, ref, timing):
             time_per_frame_ms=ms,
             time_per_frame_min_ms=ms_min,
             time_strands=study.plan.time_strands,
-            threads=rec.get("threads") if m.build.backend == "cpu" else None,
-            block_size=rec.get("block_size") if m.build.backend == "cuda" else None,
+            threads=rec.get("threads") if m.runner.backend == "cpu" else None,
+            block_size=rec.get("block_size") if m.runner.backend == "cuda" else None,
             device=rec.get("device"),
             ref_substeps=final_S,
         )

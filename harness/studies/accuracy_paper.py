@@ -1,5 +1,5 @@
 """`python -m harness accuracy`: speed against accuracy, the measuring part
-(accuracy_report.py renders it).
+(render/accuracy_paper_report.py renders it).
 
 Ground truth is `hairsim-cpu --precision fp64`. Every other mode runs the same scene (same
 seed, so the same roots) and is compared with it frame by frame:
@@ -16,61 +16,33 @@ Model resolution: the fp64 reference at P points per strand is compared with the
 P of the study by distance along the curve (each coarse point against the fine polyline at
 the same arc length), and timed with the fastest backend available.
 
-Writes results/accuracy/accuracy.csv and env.json, then has accuracy_report.py draw
-report/accuracy_pareto.png and write report/accuracy.md.
+Writes results/accuracy/accuracy.csv and env.json (render/accuracy_paper_report.py draws
+report/accuracy_pareto.png and writes report/accuracy.md from them).
 """
 
 import csv
 import json
 import os
-from dataclasses import dataclass
 
 import numpy as np
 
 from harness.check import invariants
 from harness.core import env, runner, scenes, variants
-from harness.core.paths import REPORT, RESULTS, binary_path, display, output_dir
+from harness.core.paths import RESULTS, binary_path, display, output_dir
+from harness.core.variants import Runner
 from harness.io.states import open_state
-from harness.render.accuracy_paper_report import REFERENCE, pareto_plot, write_markdown
-
-
-@dataclass(frozen=True)
-class Mode:
-    name: str
-    backend: str  # cpu | cuda
-    build: str  # default | strict | fastmath (cuda)
-    variant: str | None  # None: the binary's default variant (its --list-variants)
-    precision: str
-    use: str  # what a user would pick it for, in a few words
-
-
-# the cpu modes run the cpu's default variant (the oracle); modes() adds one fp32 mode for
-# each other cpu variant the binary declares; the gpu modes run each build's default variant
-MODES = (
-    Mode(REFERENCE, "cpu", "default", None, "fp64", "ground truth"),
-    Mode("cpu fp32 ref", "cpu", "default", None, "fp32", "the readable fp32 oracle"),
-    Mode("gpu fp32 strict", "cuda", "strict", None, "fp32", "validation against the CPU"),
-    Mode("gpu fp32 normal", "cuda", "default", None, "fp32", "production"),
-    Mode("gpu fp32 fast-math", "cuda", "fastmath", None, "fp32", "previews"),
-    Mode("gpu fp64", "cuda", "default", None, "fp64", "reference on the GPU"),
-)
-OTHER_CPU_USE = "fast CPU baseline"
+from harness.studies.accuracy import PAPER_MODES, PAPER_OTHER_CPU_USE, Mode, frame_errors
 
 
 def modes():
-    """MODES with one "cpu fp32 <variant>" mode per cpu variant other than the default."""
+    """PAPER_MODES with one "cpu fp32 <variant>" mode per cpu variant other than the default."""
     cpu = variants.declared("cpu")
     extra = tuple(
-        Mode(f"cpu fp32 {v}", "cpu", "default", v, "fp32", OTHER_CPU_USE)
+        Mode(Runner("cpu", "default", v), "fp32", label=f"cpu fp32 {v}", use=PAPER_OTHER_CPU_USE)
         for v in cpu.variants
         if v != cpu.default_variant
     )
-    return MODES[:2] + extra + MODES[2:]
-
-
-def uses():
-    """Mode name -> what it is for (also for modes read back from a CSV)."""
-    return {m.name: m.use for m in MODES}
+    return PAPER_MODES[:2] + extra + PAPER_MODES[2:]
 
 
 COLUMNS = (
@@ -94,20 +66,20 @@ COLUMNS = (
 
 
 def _mode_available(mode, gpu_ok):
-    if mode.backend == "cuda":
-        return gpu_ok and binary_path("cuda", mode.build).exists()
+    if mode.runner.backend == "cuda":
+        return gpu_ok and binary_path("cuda", mode.runner.build).exists()
     return binary_path("cpu").exists()
 
 
 def _variant(mode):
-    return mode.variant or variants.declared(mode.backend, mode.build).default_variant
+    return mode.runner.variant or variants.declared(mode.runner.backend, mode.runner.build).default_variant
 
 
-def frame_errors(test, ref, f, L):
-    """The four error measures of frame f of `test` against `ref` (both [N][P][3])."""
+def frame_measures(test, ref, f, L):
+    """The four error measures of frame f of `test` against `ref` (both [N][P][3]): the
+    position errors (studies/accuracy.py) and the segment drift and penetration of `test`."""
     a = test.frame(f).astype(np.float64)
-    b = ref.frame(f).astype(np.float64)
-    d = np.linalg.norm(a - b, axis=-1)
+    max_err, rms_err = frame_errors(a, ref.frame(f), L)[::-1]
     if not np.isfinite(a).all():
         return dict(max_err_L=float("nan"), rms_err_L=float("nan"), seg_drift=float("nan"), penetration=float("nan"))
     ell = test.segment_length
@@ -118,9 +90,7 @@ def frame_errors(test, ref, f, L):
         rc = np.hypot(a[:, 0, 1], a[:, 0, 2]) + float(test.params["hair_offset"])
         r = np.hypot(a[:, 1:, 1], a[:, 1:, 2])
         pen = float(max(0.0, ((rc[:, None] - r) / rc[:, None]).max())) if r.size else 0.0
-    return dict(
-        max_err_L=float(d.max() / L), rms_err_L=float(np.sqrt((d * d).mean()) / L), seg_drift=drift, penetration=pen
-    )
+    return dict(max_err_L=max_err, rms_err_L=rms_err, seg_drift=drift, penetration=pen)
 
 
 def along_curve_error(coarse, fine):
@@ -156,12 +126,12 @@ def run_study(
     resolution=(4, 8, 16, 32, 64, 128, 256),
     res_strands=20_000,
     out_dir=None,
-    report_dir=None,
     log=print,
 ):
+    """Measure every mode and the model resolution; write accuracy.csv and env.json into
+    out_dir (render/accuracy_paper_report.py draws them) and return the rows."""
     scene = scenes.load_scene(scene_name).with_overrides(strands=strands, points=points)
     out_dir = output_dir(out_dir or RESULTS / "accuracy")
-    report_dir = output_dir(report_dir or REPORT, "--report-dir")
     scratch = output_dir(out_dir / "states")
     gpu_ok, why = env.gpu_status()
     L = scene.hair_length
@@ -176,26 +146,26 @@ def run_study(
         if not _mode_available(mode, gpu_ok):
             log(
                 f"accuracy: skipping {mode.name}: "
-                + (why if mode.backend == "cuda" and not gpu_ok else "not built here")
+                + (why if mode.runner.backend == "cuda" and not gpu_ok else "not built here")
             )
             continue
-        binary = binary_path(mode.backend, mode.build)
+        binary = binary_path(mode.runner.backend, mode.runner.build)
         sc = scene.with_overrides(precision=mode.precision)
         path = state_path(mode.name)
         variant = _variant(mode)
-        flags = runner.run_flags(sc, mode.backend, variant=variant, output=path, force=True)
+        flags = runner.run_flags(sc, mode.runner.backend, variant=variant, output=path, force=True)
         rec = runner.run_binary(binary, flags)
-        t_ms, trec = _time(binary, runner.run_flags(sc, mode.backend, variant=variant), repeat)
+        t_ms, trec = _time(binary, runner.run_flags(sc, mode.runner.backend, variant=variant), repeat)
         log(f"accuracy: {mode.name}: {t_ms:.2f} ms")
         with open_state(path) as test, open_state(ref_path) as ref:
             for f in range(test.n_frames):
-                e = frame_errors(test, ref, f, L)
+                e = frame_measures(test, ref, f, L)
                 rows.append(
                     dict(
                         study="mode",
                         mode=mode.name,
-                        backend=mode.backend,
-                        build=mode.build,
+                        backend=mode.runner.backend,
+                        build=mode.runner.build,
                         variant=variant,
                         precision=mode.precision,
                         strands=strands,
@@ -264,11 +234,10 @@ def run_study(
         for row in rows:
             w.writerow({k: row.get(k) for k in COLUMNS})
     os.replace(tmp, csv_path)
-    (out_dir / "env.json").write_text(json.dumps(dict(env.collect(), resolution_strands=res_strands), indent=1) + "\n")
-    png = pareto_plot(rows, report_dir / "accuracy_pareto.png", strands, points)
-    md = write_markdown(rows, report_dir / "accuracy.md", strands, points, res_strands, gpu_ok, why)
+    meta = dict(env.collect(), resolution_strands=res_strands, gpu_absent=None if gpu_ok else why)
+    (out_dir / "env.json").write_text(json.dumps(meta, indent=1) + "\n")
     for p in scratch.glob("*.h5"):
         p.unlink()
     scratch.rmdir()
-    log(f"wrote {display(csv_path)}, {display(png)}, {display(md)}")
+    log(f"wrote {display(csv_path)}")
     return rows

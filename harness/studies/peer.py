@@ -26,6 +26,7 @@ import math
 import os
 import platform
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -325,8 +326,32 @@ def check_args(args):
         raise HarnessError("peer: needs 1 ≤ --ref-start and --ref-max ≥ 2 × --ref-start")
 
 
+@dataclass
+class Plan:
+    """What the peer comparison runs (the `harness peer` flags, their defaults here)."""
+
+    points: int = 32
+    length: float = 30.0
+    tilts: tuple = (30.0, 60.0)
+    frames: int = 30
+    frame_dt: float = 1 / 60
+    gravity: float = 981.0
+    compliance: float = 0.0
+    settings: tuple = ((8, 1), (32, 1), (8, 4))
+    strands: tuple = (1, 100, 1000, 10000)
+    threads: int = 1
+    time_frames: int = 5
+    repeat: int = 3
+    ref_start: int = 64
+    ref_max: int = 16384
+    timeout: float | None = None
+    out: str | None = None
+    argv: list | None = None  # the command's own words, recorded in peer.json
+
+
 def run_study(args, log=print):
-    """The whole comparison; writes the CSVs and peer.json under args.out, returns that dir."""
+    """The whole comparison (args: a Plan); writes the CSVs and peer.json under args.out,
+    returns that dir."""
     check_args(args)
     reason = peer.unavailable()
     if reason:

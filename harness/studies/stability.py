@@ -1,5 +1,5 @@
 """`python -m harness stability`: where the dynamic model is stable, the measuring part
-(stability_report.py renders it).
+(render/stability_report.py renders it).
 
 A map, not anecdotes: 2-D slices through the dynamic scene space (substeps against wind
 speed, stretch compliance, bend compliance and points per strand; head-motion frequency
@@ -19,8 +19,8 @@ harness/core/tolerances.py:
 (the first that applies). Each cell's last frame also goes through
 harness.check.invariants_dynamic; its violations are recorded beside the verdict.
 
-Writes results/stability/stability.csv and env.json, then has stability_report.py draw
-report/stability_<slice>.png and write report/dynamic_stability.md.
+Writes results/stability/stability.csv and env.json, and render/stability_report.py draws
+report/stability_<slice>.png and writes report/dynamic_stability.md.
 """
 
 import csv
@@ -29,7 +29,7 @@ import os
 import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 from harness import HarnessError
@@ -38,80 +38,10 @@ from harness.core import env, runner, scenes, tolerances, variants
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io.trajectory import open_trajectory
+from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES
 
-VERDICTS = ("ok", "over-stretched", "penetrating", "blown up")  # mildest first
-OTHER = ("refused", "failed")
 SOLVERS = ("xpbd", "ftl")
 PRECISIONS = ("fp32", "fp64")
-OFF = "off"  # an axis value that leaves its feature undeclared
-
-
-@dataclass(frozen=True)
-class Axis:
-    key: str  # a flag of the simulate stage (--substeps, …) or "points"
-    label: str  # how the report names it
-    values: tuple  # OFF = leave the flag out (the feature undeclared)
-    quick: tuple  # the subset `--quick` runs
-    unit: str = ""
-
-
-@dataclass(frozen=True)
-class Slice:
-    name: str
-    title: str
-    scene: str  # base scene in configs/scenes/
-    fixed: tuple  # (flag, value) changes to the base scene
-    rows: Axis
-    cols: Axis
-
-
-SUBSTEPS = Axis("--substeps", "S", (1, 2, 4, 8, 16, 32, 64), (1, 4, 16, 64))
-# The base is the shipped still scene (gravity, the collider, damping 0.5, S = 8, I = 2),
-# so that one slice changes one or two things a user would; wind acts only through drag,
-# so the wind slice declares the default scene's drag and gusts.
-SLICES = (
-    Slice(
-        "substeps-wind",
-        "substeps against wind speed (drag 0.5/s, gusts 0.5)",
-        "still-dynamic",
-        (("--drag", 0.5), ("--gust-amplitude", 0.5), ("--gust-wavelength", 60.0)),
-        SUBSTEPS,
-        Axis("--wind-speed", "U", (0, 500, 1000, 2000, 4000, 8000), (0, 2000, 8000), "cm/s"),
-    ),
-    Slice(
-        "substeps-stretch",
-        "substeps against stretch compliance",
-        "still-dynamic",
-        (),
-        SUBSTEPS,
-        Axis("--stretch-compliance", "α_s", (0, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4), (0, 1e-6, 1e-4)),
-    ),
-    Slice(
-        "substeps-bend",
-        "substeps against bend compliance (off = bend undeclared)",
-        "still-dynamic",
-        (),
-        SUBSTEPS,
-        Axis("--bend-compliance", "α_b", (OFF, 0, 1e-8, 1e-6, 1e-4, 1e-2), (OFF, 0, 1e-4)),
-    ),
-    Slice(
-        "substeps-points",
-        "substeps against points per strand",
-        "still-dynamic",
-        (),
-        SUBSTEPS,
-        Axis("points", "P", (2, 4, 8, 16, 32, 64, 128), (2, 16, 128)),
-    ),
-    Slice(
-        "motion",
-        "nodding head: frequency against amplitude (S = 32)",
-        "still-dynamic",
-        (("--head-motion", "nod"), ("--substeps", 32)),
-        Axis("--motion-frequency", "f", (0.5, 1, 2, 4, 8, 16), (1, 4, 16), "Hz"),
-        Axis("--motion-amplitude", "A", (0.1, 0.25, 0.5, 1, 2, 3), (0.25, 1, 3), "rad"),
-    ),
-)
-SLICE_NAMES = tuple(s.name for s in SLICES)
 STRANDS = 16
 FRAMES = 60  # one second at the base scenes' Δt = 1/60 s
 
@@ -331,11 +261,10 @@ def run_study(
     gpu="auto",
     timeout=None,
     out_dir=None,
-    report_dir=None,
     log=print,
 ):
-    from harness.render import stability_report
-
+    """Measure the slices; write stability.csv and env.json into out_dir (the renderer,
+    render/stability_report.py, draws them) and return the CSV's path."""
     out_dir = Path(out_dir or RESULTS / "stability")
     rows, bes, seconds = measure(slices, quick, strands, frames, jobs, gpu, timeout, log)
     csv_path = write_csv(rows, out_dir / "stability.csv")
@@ -355,4 +284,4 @@ def run_study(
     tmp.write_text(json.dumps(info, indent=1) + "\n")
     os.replace(tmp, env_path)
     log(f"stability: {len(rows)} cells in {seconds:.1f} s; wrote {display(csv_path)} and {display(env_path)}")
-    return stability_report.report_from_csv(csv_path, report_dir=report_dir, log=log)
+    return csv_path
