@@ -26,8 +26,7 @@ from harness.core import env, runner, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display, output_dir
 from harness.io.sweepfile import load_sweep
 from harness.render import report_paper
-from harness.render.plots import ensure_figure_state
-from harness.studies.sweep import run_sweep, write_json
+from harness.studies.sweep import figure_state, run_sweep, write_json
 
 VALIDATION_STRANDS = 2000
 VALIDATION_POINTS = 32
@@ -188,7 +187,7 @@ def run(sweep_ref="default", out=None, gpu="auto", report_dir=None, log=None):
     _, failed = run_sweep(sweep_ref, out=out_dir, gpu="no" if gpu_note else gpu, log=say, announce_skips=False)
     if gpu_note:  # the sweep's record says why, for the report
         _note_gpu_skip(out_dir / "env.json", gpu_note)
-    ensure_figure_state(out_dir)
+    figure_state(out_dir)
     path = report_paper.build(out_dir, report_dir)
     say(f"harness: report in {display(path)}")
     return 1 if failed else 0

@@ -13,7 +13,7 @@ files stored the velocities of a compared step, they are judged by the same rule
 h·|Δv| (the position change a velocity makes in one substep). The observables of every
 compared frame are printed side by side (A, B, B − A) and judged by what the two states'
 difference allows (observables_ok). Each file's invariants (invariants_dynamic.py) are
-checked on its compared frames. The GPU tests (tests/test_gpu_dynamic.py) judge with this
+checked on its compared frames. The GPU tests (tests/gpu/test_gpu_dynamic.py) judge with this
 same function.
 
 stepdiff: for each chosen simulated frame k of a reference A written with --velocities

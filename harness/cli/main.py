@@ -314,9 +314,10 @@ def cmd_headline(args):
             out_dir=args.out,
         )
         return 0
+    from harness.render import headline_report
     from harness.studies import headline_paper
 
-    headline_paper.run(
+    result = headline_paper.run(
         strands=args.strands,
         points=args.points,
         repeat=args.repeat,
@@ -324,6 +325,7 @@ def cmd_headline(args):
         block_size=args.block_size,
         out_dir=args.out,
     )
+    print(headline_report.table(result))
     return 0
 
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field, replace
 
 from harness import HarnessError
 from harness.core import scenes_dynamic
-from harness.core.paths import SCENES, config_file, read_toml
+from harness.core.paths import SCENES, config_file, display, read_toml
 
 STAGES = ("init", "collide", "wind", "simulate")
 PRECISIONS = ("fp32", "fp64")
@@ -94,6 +94,12 @@ class Scene:
     # (harness/core/scenes_dynamic.py), flag → value text, in the order they were declared
     dynamic: dict = field(default_factory=dict)
     source: str = field(default="", compare=False)
+
+    @property
+    def file(self):
+        """The scene's TOML file relative to the repository when inside it ("" when made in code):
+        what results record, never a path of the machine that ran them."""
+        return display(self.source.removeprefix("scene ")) if self.source else ""
 
     @property
     def segment_length(self):

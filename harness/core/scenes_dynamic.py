@@ -179,3 +179,19 @@ def flags(scene):
 
 def frames(scene):
     return int(scene.dynamic.get("--frames", 1))
+
+
+# ---- the features of a dynamic scene (what the feature-cost study turns off one at a time) ----
+
+# feature → the flags that declare it (each followed by a value)
+DECLARING = {
+    "bend": ("--bend-compliance",),
+    "shape": ("--shape-compliance", "--shape-range"),
+    "wind": ("--wind-speed", "--gust-amplitude", "--gust-frequency", "--gust-wavelength"),
+    "gust": ("--gust-amplitude",),
+    "motion": ("--head-motion", "--motion-amplitude", "--motion-frequency"),
+    "drag": ("--drag", "--damping"),
+}
+FEATURES = ("bend", "shape", "wind", "gust", "motion", "collide", "drag")
+# a feature that needs another to exist at all (gusts ride on the wind, the wind on drag)
+NEEDS = {"gust": ("wind", "drag"), "wind": ("drag",)}

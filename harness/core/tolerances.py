@@ -282,7 +282,7 @@ DYN_STEP_WHY = (
     "one frame from the same input: FMA-contracted c_ref against c_ref ≤ 0.82·ε·E·S·I "
     "(xpbd and ftl, fp32 and fp64, S·I = 1 … 64, P = 32); 4 = margin 4.9×"
 )
-# fp32 against fp64 of the same scene over a short horizon (tests/test_dynamic.py): 64
+# fp32 against fp64 of the same scene over a short horizon (tests/cpu/test_dynamic.py): 64
 # strands × 16 points, S = I = 2, bend, shape, drag, damping, gusty wind, nod, seeds 1–3,
 # xpbd and ftl, collider on and off: max |x32 − x64| ≤ 1.43e-6·L over frames 1–10 (the
 # drift grows: up to 1.1e-5·L by frame 20, where a contact went the other way in fp32).
@@ -325,7 +325,7 @@ DYN_ACC_USES = {
 }
 
 # ---------------------------------------------------------------------------------------
-# ANALYTIC CHECKS of the dynamic model (docs/model.md §4; tests/test_analytic.py; the full
+# ANALYTIC CHECKS of the dynamic model (docs/model.md §4; tests/cpu/test_analytic.py; the full
 # S sweeps in docs/analytic.md, made by `python -m harness.studies.analytic_table`). Measured on the
 # C reference, fp64, --threads 1, Δt = 1/60 s, g0 = 981 cm/s², --iterations 1, at commit
 # 87dab6c's model (dynamics_impl.h). Relative errors are |measured − expected|/expected.
@@ -374,7 +374,7 @@ ANALYTIC_FP32_WIND_ANGLE_ABS = 5e-4  # rad at S ≤ 8 (worst 8.7e-5; below the 3
 
 
 # ---- the simd CPU variant's simulate stage against ref (docs/cpu_simd.md, "The dynamic
-# model"; tests/test_cpu_simd_dynamic.py) ----
+# model"; tests/cpu/test_cpu_simd_dynamic.py) ----
 # Without gusts simd is ref's bits (positions, velocities, observables): no tolerance, the
 # tests compare with np.array_equal. With gusts the sine is libmvec's (≤ 4 ulp) and the
 # runs drift by roundings: each quantity within k units, ε the precision's epsilon,
@@ -413,7 +413,7 @@ SIMD_DYN_GUST = SimdDynTolerance(
 SIMD_DYN_GUST_MAX_FRAMES = 10  # the horizon the bounds were measured for
 
 
-# ---- the dynamic model on the GPU (tests/test_gpu_dynamic.py, harness bench) -----------------
+# ---- the dynamic model on the GPU (tests/gpu/test_gpu_dynamic.py, harness bench) -----------------
 # One simulated frame on the GPU from the CPU's frame k (positions and velocities, --input
 # --input-frame), against the CPU's frame k+1, judged by harness.check.diff_dynamic.compare: the
 # DYN_STEP_K rule above on positions and on h·|Δv|, the observables within what the two
@@ -427,7 +427,7 @@ SIMD_DYN_GUST_MAX_FRAMES = 10  # the horizon the bounds were measured for
 # bit, observables included (GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS; the observables' reduction
 # is the CPU's, chunk by chunk in strand order); with gusts CUDA's sinf/sin (≤ 2 ulp from
 # the correctly rounded value) perturb the wind factor and the frame carries that along.
-# Measured on an H200 (tests/test_gpu_dynamic.py, 1500 strands × 32 and 45 points, S = 8,
+# Measured on an H200 (tests/gpu/test_gpu_dynamic.py, 1500 strands × 32 and 45 points, S = 8,
 # I = 4, every feature, both solvers, strand/warp/warpreg, blocks 32…1024;
 # build/gpu_dyn_test_errors.json): worst |Δx|/L 5.0e-7 (normal fp32), 6.3e-7 (fast-math
 # fp32), 2.3e-7 (strict fp32, gusts), 1.0e-15 (normal fp64); worst h·|Δv|/L 3.2e-7 (fp32),
@@ -438,7 +438,7 @@ SIMD_DYN_GUST_MAX_FRAMES = 10  # the horizon the bounds were measured for
 # (fp32), 1.3e-15 (fp64): margins of 15 and 11, the smallest seen.
 GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS = True
 # ---- beside a peer: Bender's PositionBasedDynamics (pypbd) on chains (harness/studies/peer.py,
-# tests/test_peer.py; the mapping and the differences in docs/decisions.md, "The peer") ----
+# tests/cpu/test_peer.py; the mapping and the differences in docs/decisions.md, "The peer") ----
 # The converged reference of `harness peer`: S doubles until the largest change of a point
 # from S to 2S is below this fraction of the smallest error the comparison reports.
 PEER_REF_FRACTION = 0.1

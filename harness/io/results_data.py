@@ -16,6 +16,9 @@ import pandas as pd
 from harness import HarnessError
 from harness.io import runlog
 
+# the small paper-scene state of Fig. 1/2, inside a sweep's results directory
+FIGURE_STATE = "states/figure-cpu-fp32.h5"
+
 CASE_KEYS = [
     "case_id",
     "scene",

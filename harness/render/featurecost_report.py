@@ -10,7 +10,7 @@ import csv
 from pathlib import Path
 
 from harness.core.paths import display
-from harness.studies.featurecost import FEATURES, NEEDS
+from harness.core.scenes_dynamic import FEATURES, NEEDS
 
 NONE_ROW = "none (gravity, stretch)"
 

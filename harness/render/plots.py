@@ -21,12 +21,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harness.core.paths import REPORT, binary_path, output_dir  # noqa: E402
+from harness.core.paths import REPORT, output_dir  # noqa: E402
 from harness.io import results_data  # noqa: E402
 
-FIGURE_STRANDS = 400  # strands in the Fig. 1/2 state
 FIGURE_DRAWN = 160  # strands drawn of them
-FIGURE_STATE = "states/figure-cpu-fp32.h5"
 
 
 def _save(fig, path):
@@ -188,24 +186,6 @@ def best_blocks(rows):
     return {v: int(tt.loc[tt["median_ms"].idxmin(), "block_size"]) for v, tt in t.groupby("variant")}
 
 
-def ensure_figure_state(results_dir):
-    """The small state Fig. 1/2 are drawn from; made with the cpu binary if absent."""
-    from harness.core import runner, scenes
-
-    path = Path(results_dir) / FIGURE_STATE
-    if path.exists():
-        return path
-    binary = binary_path("cpu")
-    if not binary.exists():
-        return None
-    path.parent.mkdir(parents=True, exist_ok=True)
-    scene = scenes.load_scene("paper").with_overrides(strands=FIGURE_STRANDS)
-    tmp = path.with_name(path.stem + f".part{os.getpid()}.h5")
-    runner.run_binary(binary, runner.run_flags(scene, "cpu", output=tmp, force=True))
-    os.replace(tmp, path)
-    return path
-
-
 def hair_figures(state_path, out_dir):
     """Fig. 1 (hair initialized) and Fig. 2 (hair after wind) from a paper-scene state."""
     from harness.io.states import open_state
@@ -256,7 +236,7 @@ def make_all(results_dir, report_dir=None):
         written.append(speedup_plot(cases, precision, points, out_dir, gpu_note))
         written.append(block_size_plot(cases, precision, points, out_dir, gpu_note))
         written.append(bandwidth_plot(rows, precision, points, out_dir, gpu_note))
-    state = ensure_figure_state(results_dir)
-    if state is not None:
+    state = Path(results_dir) / results_data.FIGURE_STATE  # made by the bench (studies/sweep.py)
+    if state.exists():
         written += hair_figures(state, out_dir)
     return written

@@ -16,6 +16,8 @@ from pathlib import Path
 from harness.core.paths import REPORT, display, output_dir
 from harness.io import results_data
 from harness.io.results_data import curve_of, interp_time, strands_at_time
+from harness.render.accuracy_paper_report import report_from_csv
+from harness.render.headline_report import table
 from harness.render.plots import make_all
 
 # The paper's Fig. 3 (release) and Fig. 4 (debug), milliseconds of "applying wind".
@@ -240,8 +242,6 @@ def headline_section(path):
     """The headline numbers (python -m harness headline), when they were measured."""
     if not path.exists():
         return []
-    from harness.studies.headline_paper import table
-
     h = json.loads(path.read_text())
     host = h.get("env", {})
     gpus = ", ".join(g.get("name", "?") for g in host.get("gpus") or []) or "no GPU"
@@ -305,8 +305,6 @@ def build(results_dir="results/default", report_dir=None):
     # beside this results directory, rendered again here so the report never mixes machines
     accuracy_csv = Path(results_dir).parent / "accuracy" / "accuracy.csv"
     if accuracy_csv.exists():
-        from harness.studies.accuracy_paper import report_from_csv
-
         md = report_from_csv(accuracy_csv, out_dir, log=lambda *_: None)
         lines += md.read_text().splitlines() + [""]
     else:

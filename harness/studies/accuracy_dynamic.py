@@ -483,7 +483,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         env.collect(),
         study=dict(
             asdict(plan),
-            scene_file=display(study.scene.source.removeprefix("scene ")),
+            scene_file=study.scene.file,
             scene_description=study.scene.description,
             frame_dt=study.frame_dt,
             frames=study.frames,

@@ -3,7 +3,7 @@
     python -m harness.studies.analytic_table [--binary build/hairsim-cpu] [--quick]
 
 Runs the C reference (fp64, one thread) on the hand-made states of
-harness/studies/analytic_runs.py (the same runs tests/test_analytic.py makes, over more S)
+harness/studies/analytic_runs.py (the same runs tests/cpu/test_analytic.py makes, over more S)
 and prints one table per check: solver, S, measured, expected, relative error, and what
 shows the damping. docs/analytic.md holds its output. About 30 s on 2 cores.
 """

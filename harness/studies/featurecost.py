@@ -19,19 +19,8 @@ from pathlib import Path
 from harness import HarnessError
 from harness.core import runner, scenes
 from harness.core.paths import binary_path
+from harness.core.scenes_dynamic import DECLARING, FEATURES, NEEDS
 
-# feature → the flags that declare it (each followed by a value)
-DECLARING = {
-    "bend": ("--bend-compliance",),
-    "shape": ("--shape-compliance", "--shape-range"),
-    "wind": ("--wind-speed", "--gust-amplitude", "--gust-frequency", "--gust-wavelength"),
-    "gust": ("--gust-amplitude",),
-    "motion": ("--head-motion", "--motion-amplitude", "--motion-frequency"),
-    "drag": ("--drag", "--damping"),
-}
-FEATURES = ("bend", "shape", "wind", "gust", "motion", "collide", "drag")
-# a feature that needs another to exist at all (gusts ride on the wind, the wind on drag)
-NEEDS = {"gust": ("wind", "drag"), "wind": ("drag",)}
 FIELDS = (
     "row",
     "features",

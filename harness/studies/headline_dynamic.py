@@ -190,7 +190,7 @@ def run(strands=4 * 1024 * 1024, repeat=5, frames=2, cpu_repeat=3, ncu=False, ou
         "model": "dynamic",
         "strands": strands,
         "points": scene.points,
-        "scene": scene.source or "dynamic",
+        "scene": scene.file or "dynamic",
         "env": env.collect(),
         "targets": {
             "memory_fraction": TARGET_MEMORY_FRACTION,
@@ -204,14 +204,14 @@ def run(strands=4 * 1024 * 1024, repeat=5, frames=2, cpu_repeat=3, ncu=False, ou
         "cpu": [],
     }
     cpu_bin = binary_path("cpu")
-    bw = runner.run_binary(cpu_bin, ["--measure-bandwidth"], expect_keys=("copy_gbps",))
+    bw = roofline.measure_bandwidth(cpu_bin)
     result["cpu_copy_gbps"] = bw["copy_gbps"]
     log(f"headline: CPU copy {bw['copy_gbps']:.1f} GB/s ({bw.get('threads')} threads)")
     timing = ["--repeat", repeat, "--warmup", 1]
 
     gpu_ok, why = env.gpu_status()
     if gpu_ok and binary_path("cuda").exists():
-        gbw = runner.run_binary(binary_path("cuda"), ["--measure-bandwidth"], expect_keys=("copy_gbps",))
+        gbw = roofline.measure_bandwidth(binary_path("cuda"))
         gpu_copy = result["gpu_copy_gbps"] = gbw["copy_gbps"]
         log(f"headline: GPU copy {gpu_copy:.1f} GB/s on {gbw.get('device')}")
         declared, names = _simulate_variants()

@@ -10,7 +10,7 @@ At one size (default 4M strands x 32 points, the paper scene) and on this node:
     fraction of the CPU copy bandwidth;
   - the speedup of the best GPU variant over each baseline (wind+collide, the pair the paper
     timed as "applying wind").
-Writes results/headline/headline.json and prints a table. Times are medians of --repeat
+Writes results/headline/headline.json (render/headline_report.py makes its table). Times are medians of --repeat
 runs after a warm-up, per-stage compute only (docs/interfaces.md).
 """
 
@@ -63,7 +63,7 @@ def run(strands=4 * 1024 * 1024, points=32, repeat=9, cpu_repeat=3, block_size=2
     base = ["--strands", strands, "--points", points, "--stages", STAGES]
     result = {"strands": strands, "points": points, "env": env.collect(), "rows": []}
     cpu = binary_path("cpu")
-    bw = runner.run_binary(cpu, ["--measure-bandwidth"], expect_keys=("copy_gbps",))
+    bw = roofline.measure_bandwidth(cpu)
     result["cpu_copy_gbps"], result["cpu_triad_gbps"] = bw["copy_gbps"], bw.get("triad_gbps")
     log(
         f"headline: CPU copy {bw['copy_gbps']:.1f} GB/s, triad {bw.get('triad_gbps') or 0:.1f} GB/s "
@@ -71,7 +71,7 @@ def run(strands=4 * 1024 * 1024, points=32, repeat=9, cpu_repeat=3, block_size=2
     )
     gpu_ok, why = env.gpu_status()
     if gpu_ok and binary_path("cuda").exists():
-        gbw = runner.run_binary(binary_path("cuda"), ["--measure-bandwidth"], expect_keys=("copy_gbps",))
+        gbw = roofline.measure_bandwidth(binary_path("cuda"))
         result["gpu_copy_gbps"] = gbw["copy_gbps"]
         log(f"headline: GPU copy {gbw['copy_gbps']:.1f} GB/s on {gbw.get('device')}")
         for build in CUDA_BUILDS:
@@ -101,13 +101,13 @@ def run(strands=4 * 1024 * 1024, points=32, repeat=9, cpu_repeat=3, block_size=2
     else:
         result["gpu_skipped"] = why
         log(f"headline: GPU rows skipped: {why}")
-    cpu = variants.declared("cpu")
-    oracle = cpu.default_variant
+    cpu_declared = variants.declared("cpu")
+    oracle = cpu_declared.default_variant
     cpu_cases = [
         (f"cpu {oracle}, 1 thread", ["--variant", oracle, "--threads", 1]),
         (f"cpu {oracle}, all cores", ["--variant", oracle]),
     ]
-    cpu_cases += [(f"cpu {v}, all cores", ["--variant", v]) for v in cpu.variants if v != oracle]
+    cpu_cases += [(f"cpu {v}, all cores", ["--variant", v]) for v in cpu_declared.variants if v != oracle]
     for label, extra in cpu_cases:
         rec = runner.run_binary(cpu, base + extra + ["--precision", "fp32", "--repeat", cpu_repeat, "--warmup", 1])
         result["rows"].append(_row(label, rec, bw["copy_gbps"]))
@@ -125,22 +125,5 @@ def run(strands=4 * 1024 * 1024, points=32, repeat=9, cpu_repeat=3, block_size=2
     tmp = path.with_name(f"headline.json.tmp.{os.getpid()}")
     tmp.write_text(json.dumps(result, indent=1) + "\n")
     os.replace(tmp, path)
-    log(table(result))
     log(f"wrote {display(path)}")
     return result
-
-
-def table(result):
-    pct = lambda v: "" if v is None else f"{100 * v:5.1f}%"  # noqa: E731
-    lines = [
-        f"{result['strands']:,} strands x {result['points']} points, paper scene; median ms",
-        f"{'case':34} {'init ms':>9} {'init %BW':>8} {'wind+coll ms':>13} {'w+c %BW':>8}",
-    ]
-    for r in result["rows"]:
-        lines.append(
-            f"{r['label']:34} {r['init_ms']:9.3f} {pct(r['init_fraction']):>8} "
-            f"{r['wind_collide_ms']:13.3f} {pct(r['wind_collide_fraction']):>8}"
-        )
-    for label, s in (result.get("speedups") or {}).items():
-        lines.append(f"speedup of {result['best_gpu']} over {label}: {s:.1f}x")
-    return "\n".join(lines)

@@ -1,4 +1,4 @@
-"""The roofline of DESIGN §7, in one place: the bytes each stage must move, and the copy
+"""The roofline, in one place: the bytes each stage must move, and the copy
 bandwidth measured on the device that ran it.
 
 Bytes a stage must move, for N strands of P points at s bytes per coordinate (4 for fp32,
@@ -63,10 +63,16 @@ def achieved_gbps(nbytes, ms):
     return nbytes / (ms * 1e-3) / 1e9
 
 
+def measure_bandwidth(binary, timeout=None):
+    """The record of `binary --measure-bandwidth --json` (copy_gbps; the CPU adds triad_gbps
+    and threads, the GPU its device); BackendError when it fails."""
+    return run_binary(binary, ["--measure-bandwidth"], timeout=timeout, expect_keys=("copy_gbps",))
+
+
 def measure_copy_bandwidth(binary, timeout=300):
-    """Run `binary --measure-bandwidth --json`; return (copy_gbps or None, note)."""
+    """measure_bandwidth for a sweep: (copy_gbps or None, note), never an error."""
     try:
-        rec = run_binary(binary, ["--measure-bandwidth"], timeout=timeout, expect_keys=("copy_gbps",))
+        rec = measure_bandwidth(binary, timeout=timeout)
     except BackendError as e:
         return None, (f"{binary.name} --measure-bandwidth failed ({e}); bandwidth fractions are left empty")
     gbps = rec.get("copy_gbps")

@@ -10,16 +10,17 @@ results/<name>/env.json, one entry per session (a resumed run adds one).
 
 import json
 import os
+from pathlib import Path
 
 import numpy as np
 
 from harness import HarnessError
-from harness.core import env
+from harness.core import env, scenes
 from harness.core.paths import RESULTS, binary_path, display, output_dir
 from harness.core.progress import Progress
 from harness.core.runner import BackendError, DoesNotFit, run_binary, run_flags
 from harness.core.scenes import SceneError
-from harness.io import runlog
+from harness.io import results_data, runlog
 from harness.io.sweepfile import load_sweep
 from harness.studies import roofline
 
@@ -277,3 +278,22 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
         f"{failed} failed; rows in {display(csv_path)}"
     )
     return out_dir, failed
+
+
+FIGURE_STRANDS = 400  # strands in the Fig. 1/2 state
+
+
+def figure_state(results_dir):
+    """The small state Fig. 1/2 are drawn from; made with the cpu binary if absent."""
+    path = Path(results_dir) / results_data.FIGURE_STATE
+    if path.exists():
+        return path
+    binary = binary_path("cpu")
+    if not binary.exists():
+        return None
+    path.parent.mkdir(parents=True, exist_ok=True)
+    scene = scenes.load_scene("paper").with_overrides(strands=FIGURE_STRANDS)
+    tmp = path.with_name(path.stem + f".part{os.getpid()}.h5")
+    run_binary(binary, run_flags(scene, "cpu", output=tmp, force=True))
+    os.replace(tmp, path)
+    return path

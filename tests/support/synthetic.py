@@ -118,7 +118,7 @@ def write_state(path, positions, stages, precision=None, params=None, skipped=No
     return path
 
 
-# Departures from H5MD that harness.io.h5md.problems must name (tests/test_readers.py).
+# Departures from H5MD that harness.io.h5md.problems must name (tests/cpu/test_readers.py).
 H5MD_BREAKS = {
     "variable_length_unit": "'unit' is not a fixed-length ASCII string",
     "no_unit_system": "no 'system' attribute",

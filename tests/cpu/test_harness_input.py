@@ -13,7 +13,7 @@ from harness.core import scenes
 from harness.core.scenes import SceneError
 from harness.io import sweepfile
 
-ROOT_DIR = Path(__file__).resolve().parent.parent
+ROOT_DIR = Path(__file__).resolve().parents[2]
 
 
 def run(binary, *args, check=True):

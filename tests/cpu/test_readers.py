@@ -18,7 +18,7 @@ from harness.io.states import open_state
 from harness.io.trajectory import OBSERVABLES, open_trajectory
 from support.synthetic import H5MD_BREAKS, break_h5md
 
-ROOT_DIR = Path(__file__).resolve().parent.parent
+ROOT_DIR = Path(__file__).resolve().parents[2]
 SCENE = ["--strands", "40", "--points", "8", "--hair-length", "6", "--quiet"]
 # the dynamic model: init and collide (no velocities, no observables), then 3 simulated frames
 DYNAMIC = [

@@ -326,15 +326,15 @@ def test_collide_at_the_slice_poles(cpu_bin, tmp_path, precision, backend):
 
 @pytest.fixture(scope="module")
 def drape_poles(tmp_path_factory):
-    """tests/c/drape_poles.c built against the C reference's model."""
+    """tests/cpu/c/drape_poles.c built against the C reference's model."""
     import shutil
     import subprocess
     from pathlib import Path
 
     cc = shutil.which("cc") or shutil.which("gcc")
     if cc is None:
-        pytest.skip("no C compiler to build tests/c/drape_poles.c")
-    root = Path(__file__).resolve().parent.parent
+        pytest.skip("no C compiler to build tests/cpu/c/drape_poles.c")
+    root = Path(__file__).resolve().parents[2]
     exe = tmp_path_factory.mktemp("poles") / "drape_poles"
     subprocess.run(
         [
@@ -344,7 +344,7 @@ def drape_poles(tmp_path_factory):
             "-O2",
             "-ffp-contract=off",
             f"-I{root / 'c_ref'}",
-            str(root / "tests/c/drape_poles.c"),
+            str(root / "tests/cpu/c/drape_poles.c"),
             str(root / "c_ref/model.c"),
             "-lm",
             "-o",
@@ -368,7 +368,7 @@ def test_drape_at_the_slice_poles(drape_poles, L):
         prec, i, stage, k, x, y, z = line.split()
         rows.setdefault((prec, int(i), stage), []).append([float.fromhex(v) for v in (x, y, z)])
     ell = L / 11
-    R, h = 10.0, 0.1  # tests/c/drape_poles.c's head and offset
+    R, h = 10.0, 0.1  # tests/cpu/c/drape_poles.c's head and offset
     for (prec, i, stage), pts in rows.items():
         s = np.asarray(pts)
         eps, tol = tolerances.EPS[prec], tolerances.invariant_tolerance(prec)

@@ -9,7 +9,7 @@ lanes that runs every parallel group in reverse lane order), with the feature se
 in and as a run-time mask; plus the bend rest lengths and the per-strand observables.
 
 What it cannot show: on the device, CUDA's sinf/sin (gust frames only) may differ from
-glibc's, and the normal build contracts a*b + c into FMAs; tests/test_gpu_dynamic.py
+glibc's, and the normal build contracts a*b + c into FMAs; tests/gpu/test_gpu_dynamic.py
 compares the GPU's frames with the CPU's there.
 
 Built here, independently of the Makefile, into a temporary folder: gcc compiles the C

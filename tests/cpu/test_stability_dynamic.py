@@ -24,7 +24,7 @@ from harness.studies import stability
 from support.statecheck import run
 
 # CI: 120 derandomized examples (about 30 s on the 2-core CI machine); a deeper search:
-# HAIRBENCH_DYN_STABILITY_EXAMPLES=2000 pytest tests/test_stability_dynamic.py -k search
+# HAIRBENCH_DYN_STABILITY_EXAMPLES=2000 pytest tests/cpu/test_stability_dynamic.py -k search
 CPU_SETTINGS = settings(
     max_examples=int(os.environ.get("HAIRBENCH_DYN_STABILITY_EXAMPLES", "120")),
     deadline=None,
@@ -225,7 +225,7 @@ def test_search_cpu_contract_holds_across_the_dynamic_scene_space(cpu_bin, tmp_p
 def test_search_gpu_frame_agrees_with_cpu(cpu_bin, tmp_path_factory, s, variant, block):
     """A drawn scene on the strict CUDA build: one frame from the CPU's state (positions and
     velocities, --input --input-frame) against the CPU's next frame, by the rule of
-    tests/test_gpu_dynamic.py (harness.check.diff_dynamic.compare: bit for bit without gusts, the
+    tests/gpu/test_gpu_dynamic.py (harness.check.diff_dynamic.compare: bit for bit without gusts, the
     DYN_STEP_K rule with them); a scene the CPU refuses must be refused by the GPU too."""
     from conftest import CUDA_STRICT_BIN
 
@@ -271,7 +271,7 @@ def test_search_gpu_frame_agrees_with_cpu(cpu_bin, tmp_path_factory, s, variant,
     assert g.returncode == 0, g.stderr
     what = f"strict {variant} block {block} {s['solver']} {s['precision']}"
     exact = tolerances.GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS and not gusts
-    if exact or blown == 0:  # the rule of tests/test_gpu_dynamic.py and the bench (harness.check.diff_dynamic)
+    if exact or blown == 0:  # the rule of tests/gpu/test_gpu_dynamic.py and the bench (harness.check.diff_dynamic)
         r = diff_dynamic.compare(cpu, gpu, frames=[step], exact=exact, check_paper=False)
         assert r.equivalent, f"{what}: " + "; ".join(r.failures()[:5])
     else:

@@ -196,13 +196,13 @@ def test_fp32_simd_agrees_with_fp64_ref(cpu_bin, tmp_path):
 )
 @given(s=scenes())
 def test_each_stage_matches_ref_across_the_scene_space(cpu_bin, tmp_path_factory, s):
-    """The stability suite's scene space (tests/test_stability.py): every stage from the
+    """The stability suite's scene space (tests/cpu/test_stability.py): every stage from the
     ref state matches ref, and whole simd runs keep the invariants. (Measured over 284 of
     its scenes: docs/cpu_simd.md.)"""
     d = tmp_path_factory.mktemp("space")
     args = scene_args(s)
     p = run(cpu_bin, *args, "--output", d / "ref.h5", "--quiet", check=False)
-    if p.returncode != 0:  # a scene ref refuses (cleanly: tests/test_stability.py checks that)
+    if p.returncode != 0:  # a scene ref refuses (cleanly: tests/cpu/test_stability.py checks that)
         return
     a = State(d / "ref.h5")
     run(cpu_bin, *args, "--variant", "simd", "--output", d / "simd.h5", "--quiet")

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from conftest import GPU_REASON
 
-ROOT_DIR = Path(__file__).resolve().parent.parent
+ROOT_DIR = Path(__file__).resolve().parents[2]
 SECTION = "## Running one simulation"
 
 

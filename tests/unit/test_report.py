@@ -2,13 +2,15 @@
 ran and what is absent, sets the paper's numbers beside ours, and every PNG is written."""
 
 import json
+import shutil
 
 import numpy as np
 import pytest
 
+from conftest import ROOT
 from harness.cli.main import main
 from harness.io import results_data, runlog
-from harness.render.plots import FIGURE_STATE
+from harness.io.results_data import FIGURE_STATE
 from support.synthetic import radial_strands, write_state
 
 STAGES = ["init", "collide", "wind", "collide"]
@@ -167,3 +169,21 @@ def test_plot_command_writes_only_pngs(tmp_path, capsys):
     written = sorted(p.name for p in out.iterdir())
     assert written and all(n.endswith(".png") for n in written)
     assert all(np.fromfile(out / n, dtype=np.uint8)[:4].tobytes() == b"\x89PNG" for n in written)
+
+
+def test_report_of_the_reference_run_with_its_accuracy_study(tmp_path, capsys):
+    """`make report REPORT_FROM=results/reference-h200/sweep` (a copy of it): the accuracy/ beside
+    the sweep is rendered into the page, the committed hair state draws Fig. 1/2, and nothing is
+    written into the results it reads."""
+    results = tmp_path / "reference-h200"
+    shutil.copytree(ROOT / "results" / "reference-h200", results)
+    before = {p: p.stat().st_mtime_ns for p in results.rglob("*")}
+    rep = tmp_path / "rep"
+    assert main(["report", str(results / "sweep"), "--report-dir", str(rep)]) == 0
+    md = (rep / "report.md").read_text()
+    assert "Which mode for which use" in md and "Not measured with these results" not in md
+    assert "## Headline: bandwidth fractions and speedups" in md
+    assert (rep / "accuracy_pareto.png").stat().st_size > 5000
+    assert (rep / "fig1_initialized.png").exists() and (rep / "fig2_after_wind.png").exists()
+    assert {p: p.stat().st_mtime_ns for p in results.rglob("*")} == before
+    assert capsys.readouterr().out.strip() == f"wrote {rep / 'report.md'}"

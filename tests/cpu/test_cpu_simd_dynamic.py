@@ -10,7 +10,7 @@ libmvec's (≤ 4 ulp) and the runs are compared with harness/core/tolerances.py'
 (the measurement behind it is written there).
 
 Both variants start from the same ref `init,collide` state (--input): simd's own paper
-stages differ from ref's by their libmvec rounding (tests/test_cpu_simd.py covers those).
+stages differ from ref's by their libmvec rounding (tests/cpu/test_cpu_simd.py covers those).
 N = 300 and 1000 are not multiples of the blocks (512/256 strands, 64 per dynamic block).
 """
 
