@@ -19,25 +19,23 @@
 Without a GPU the GPU rows and checks are skipped with one line saying why.
 """
 
-import shutil
-import tempfile
 from pathlib import Path
 
 from harness import HarnessError
-from harness.bench.paper import gpu_plan
+from harness.bench import validation
+from harness.bench.validation import gpu_plan
 from harness.check import diff_dynamic
-from harness.core import env, runner, scenes, variants
+from harness.core import runner, scenes, variants
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.scenes import with_frames
 from harness.io import results_data
 from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
 from harness.studies import accuracy_dynamic, animate, featurecost, peer, stability
-from harness.studies.sweep import run_sweep, write_json
+from harness.studies.sweep import run_sweep
 
 VALIDATION_STRANDS = 2000
 BLOCK_SIZES = (32, 256)
 SWEEP = "dynamic"
-SOLVERS = ("xpbd", "ftl")
 
 
 class DynValidator:
@@ -95,8 +93,9 @@ class DynValidator:
 
     def cpu_checks(self):
         refs = {}
-        for precision in ("fp32", "fp64"):
-            for solver in SOLVERS:
+        cpu = variants.declared("cpu")  # the solvers and precisions of --list-variants
+        for precision in cpu.precisions:
+            for solver in cpu.solvers:
                 ref = refs[(precision, solver)] = self.cpu_file(precision, solver)
                 one = self.cpu_file(precision, solver, threads=1)
                 self.record(
@@ -145,36 +144,10 @@ class DynValidator:
 
 
 def validate(out_dir, builds, gpu_note, say):
-    scratch_root = RESULTS / "_scratch"
-    scratch_root.mkdir(parents=True, exist_ok=True)
-    scratch = tempfile.mkdtemp(prefix="bench-dynamic-", dir=scratch_root)
-    v = DynValidator(scratch, say)
-    refs = v.cpu_checks()
-    if builds:
-        v.gpu_checks(builds, refs)
-    failed = [c for c in v.checks if not c["equivalent"]]
-    write_json(
-        out_dir / "validation.json",
-        {
-            "date": env.now(),
-            "model": "dynamic",
-            "strands": VALIDATION_STRANDS,
-            "points": v.scene.points,
-            "scene": v.scene.name,
-            "gpu_builds": builds,
-            "gpu_note": f"GPU not validated: {gpu_note}." if gpu_note else "",
-            "checks": v.checks,
-        },
-    )
-    if failed:
-        raise HarnessError(
-            f"dynamic validation failed: {len(failed)} of {len(v.checks)} comparisons not equivalent "
-            f"(details in {display(out_dir / 'validation.json')}, states kept in {display(scratch)}); "
-            "nothing was timed",
-            code=1,
-        )
-    shutil.rmtree(scratch, ignore_errors=True)
-    say(f"harness: dynamic validation: all {len(v.checks)} comparisons equivalent")
+    def header(v):
+        return {"model": "dynamic", "strands": VALIDATION_STRANDS, "points": v.scene.points, "scene": v.scene.name}
+
+    validation.validate(DynValidator, "dynamic validation", out_dir, builds, gpu_note, say, header)
 
 
 def fastest_gpu_variants(sweep_dir):

@@ -16,14 +16,14 @@ Without a GPU it runs the CPU rows and prints one line saying why the GPU rows a
 """
 
 import json
-import shutil
-import tempfile
 from pathlib import Path
 
 from harness import HarnessError
+from harness.bench import validation
+from harness.bench.validation import gpu_plan
 from harness.check import diff
-from harness.core import env, runner, variants
-from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display, output_dir
+from harness.core import runner, variants
+from harness.core.paths import RESULTS, binary_path, display, output_dir
 from harness.io.sweepfile import load_sweep
 from harness.render import report_paper
 from harness.studies.sweep import figure_state, run_sweep, write_json
@@ -32,25 +32,6 @@ VALIDATION_STRANDS = 2000
 VALIDATION_POINTS = 32
 BLOCK_SIZES = (32, 64, 128, 256, 512, 1024)
 RESUME_BLOCK = 64
-PRECISIONS = ("fp32", "fp64")
-
-
-def gpu_plan(gpu):
-    """(cuda builds to validate, None) or ([], the one-line reason there are none)."""
-    if gpu == "no":
-        return [], "--gpu no was given"
-    ok, why = env.gpu_status()
-    if not ok:
-        if gpu == "yes":
-            raise HarnessError(f"--gpu yes but no GPU is usable: {why}")
-        return [], why
-    builds = [b for b in CUDA_BUILDS if binary_path("cuda", b).exists()]
-    if not builds:
-        why = f"{display(binary_path('cuda'))} is not built (run make where nvcc is installed)"
-        if gpu == "yes":
-            raise HarnessError(why)
-        return [], why
-    return builds, None
 
 
 class Validator:
@@ -95,7 +76,7 @@ class Validator:
         return entry["equivalent"]
 
     def cpu_checks(self):
-        ref = {p: self.state("cpu", precision=p) for p in PRECISIONS}
+        ref = {p: self.state("cpu", precision=p) for p in variants.declared("cpu").precisions}
         one = self.state("cpu", precision="fp64", threads=1)
         self.compare("cpu fp64: 1 thread vs all cores (bit-identical)", ref["fp64"], one, exact=True)
         self.compare("cpu fp32 vs cpu fp64", ref["fp32"], ref["fp64"])
@@ -117,7 +98,7 @@ class Validator:
         prefixes = {}
         for build in builds:
             for variant in variants.names("cuda", build):
-                for precision in PRECISIONS:
+                for precision in variants.declared("cuda", build).precisions:
                     for block in BLOCK_SIZES:
                         g = self.state("cuda", build, precision, variant=variant, block_size=block)
                         self.compare(f"cuda {build} {variant} b{block} {precision} vs cpu", ref[precision], g)
@@ -144,35 +125,13 @@ class Validator:
 
 
 def validate(sweep, out_dir, builds, gpu_note, say):
-    scratch_root = RESULTS / "_scratch"
-    scratch_root.mkdir(parents=True, exist_ok=True)
-    scratch = tempfile.mkdtemp(prefix="bench-", dir=scratch_root)
-    v = Validator(sweep.scene, scratch, say)
-    ref = v.cpu_checks()
-    if builds:
-        v.gpu_checks(builds, ref)
-    failed = [c for c in v.checks if not c["equivalent"]]
-    write_json(
-        out_dir / "validation.json",
-        {
-            "date": env.now(),
-            "strands": VALIDATION_STRANDS,
-            "points": VALIDATION_POINTS,
-            "scene": sweep.scene.name,
-            "gpu_builds": builds,
-            "gpu_note": f"GPU not validated: {gpu_note}." if gpu_note else "",
-            "checks": v.checks,
-        },
-    )
-    if failed:
-        raise HarnessError(
-            f"validation failed: {len(failed)} of {len(v.checks)} comparisons not "
-            f"equivalent (details in {display(out_dir / 'validation.json')}, states kept "
-            f"in {display(scratch)}); nothing was timed",
-            code=1,
-        )
-    shutil.rmtree(scratch, ignore_errors=True)
-    say(f"harness: validation: all {len(v.checks)} comparisons equivalent")
+    def header(v):
+        return {"strands": VALIDATION_STRANDS, "points": VALIDATION_POINTS, "scene": sweep.scene.name}
+
+    def make(scratch, say):
+        return Validator(sweep.scene, scratch, say)
+
+    validation.validate(make, "validation", out_dir, builds, gpu_note, say, header)
 
 
 def run(sweep_ref="default", out=None, gpu="auto", report_dir=None, log=None):

@@ -106,26 +106,29 @@ class DiffResult:
         return out
 
     def as_dict(self) -> dict[str, Any]:
-        return {
-            "a": self.path_a,
-            "b": self.path_b,
-            "label_a": self.label_a,
-            "label_b": self.label_b,
-            "pair": self.pair,
-            "equivalent": self.equivalent,
-            "exit_code": self.exit_code,
-            "tolerance": {
-                "point_k": self.tolerance.point_k,
-                "point_limit_min": self.limit_range[0],
-                "point_limit_max": self.limit_range[1],
-                "max_over_fraction": self.tolerance.max_over_fraction,
-                "why": self.tolerance.why,
-            },
-            "frames": [f.as_dict() for f in self.frames],
-            "invariants_a": self.invariants_a.as_dict(),
-            "invariants_b": self.invariants_b.as_dict(),
-            "failures": self.failures(),
-        }
+        limits = {"point_limit_min": self.limit_range[0], "point_limit_max": self.limit_range[1]}
+        limits["max_over_fraction"] = self.tolerance.max_over_fraction
+        return result_dict(self, limits, [f.as_dict() for f in self.frames])
+
+
+def result_dict(r: Any, limits: dict[str, Any], frames: list[Any], **extra: Any) -> dict[str, Any]:
+    """The JSON of a comparison, the paper's (DiffResult) or the dynamic model's: `limits`
+    the tolerance's own numbers, `extra` what the model adds after the frames."""
+    return {
+        "a": r.path_a,
+        "b": r.path_b,
+        "label_a": r.label_a,
+        "label_b": r.label_b,
+        "pair": r.pair,
+        "equivalent": r.equivalent,
+        "exit_code": r.exit_code,
+        "tolerance": {"point_k": r.tolerance.point_k, **limits, "why": r.tolerance.why},
+        "frames": frames,
+        **extra,
+        "invariants_a": r.invariants_a.as_dict(),
+        "invariants_b": r.invariants_b.as_dict(),
+        "failures": r.failures(),
+    }
 
 
 def parse_frames(spec: str | None) -> str | list[int]:
@@ -342,11 +345,27 @@ def run(
 ) -> int:
     """`harness diff` on two paper-model files; returns the exit status (dynamic files:
     harness/check/diff_dynamic.py, picked by the command line)."""
+    chosen = parse_frames(frames) if isinstance(frames, str) else frames
+    return report(
+        lambda: compare(path_a, path_b, chosen, align_last, exact), format_result, path_a, path_b, as_json, out
+    )
+
+
+def report(
+    comparison: Callable[[], Any],
+    text: Callable[[Any], str],
+    path_a: str | Path,
+    path_b: str | Path,
+    as_json: bool,
+    out: Callable[[str], Any],
+) -> int:
+    """Run a comparison and print it (as text or JSON); its exit status. Either model's
+    files: a StateError is exit 2 (EXIT_CANNOT_COMPARE), in one line or in the JSON."""
     try:
-        result = compare(path_a, path_b, parse_frames(frames) if isinstance(frames, str) else frames, align_last, exact)
+        result = comparison()
     except StateError as e:
         if as_json:
             out(json.dumps({"a": str(path_a), "b": str(path_b), "exit_code": EXIT_CANNOT_COMPARE, "error": str(e)}))
         raise HarnessError(f"cannot compare: {e}", code=EXIT_CANNOT_COMPARE) from None
-    out(json.dumps(result.as_dict(), indent=1, ensure_ascii=False) if as_json else format_result(result))
-    return result.exit_code
+    out(json.dumps(result.as_dict(), indent=1, ensure_ascii=False) if as_json else text(result))
+    return int(result.exit_code)

@@ -23,7 +23,6 @@ directory and compare BIN's new frame with A's frame k + 1 by the rule above.
 Exit status as for diff: 0 equivalent, 1 not, 2 could not compare.
 """
 
-import json
 import math
 import shutil
 import subprocess
@@ -117,32 +116,9 @@ class DynDiffResult:
         return out
 
     def as_dict(self):
-        frames = []
-        for f in self.frames:
-            d = f.as_dict()
-            d["step"] = f.step
-            frames.append(d)
-        return {
-            "a": self.path_a,
-            "b": self.path_b,
-            "label_a": self.label_a,
-            "label_b": self.label_b,
-            "pair": self.pair,
-            "equivalent": self.equivalent,
-            "exit_code": self.exit_code,
-            "tolerance": {
-                "point_k": self.tolerance.point_k,
-                "unit": self.unit,
-                "point_limit": self.tolerance.point_k * self.unit,
-                "why": self.tolerance.why,
-            },
-            "frames": frames,
-            "observables": self.observables,
-            "notes": self.notes,
-            "invariants_a": self.invariants_a.as_dict(),
-            "invariants_b": self.invariants_b.as_dict(),
-            "failures": self.failures(),
-        }
+        frames = [dict(f.as_dict(), step=f.step) for f in self.frames]
+        limits = {"unit": self.unit, "point_limit": self.tolerance.point_k * self.unit}
+        return diff.result_dict(self, limits, frames, observables=self.observables, notes=self.notes)
 
 
 def _over(dist, finite, tol, unit):
@@ -333,16 +309,8 @@ def format_result(r):
 
 def run(path_a, path_b, frames="all", exact=False, as_json=False, out=print):
     """`harness diff` when either file is dynamic; `frames` numbers are steps here."""
-    try:
-        res = compare(path_a, path_b, diff.parse_frames(frames) if isinstance(frames, str) else frames, exact)
-    except StateError as e:
-        if as_json:
-            out(
-                json.dumps({"a": str(path_a), "b": str(path_b), "exit_code": diff.EXIT_CANNOT_COMPARE, "error": str(e)})
-            )
-        raise HarnessError(f"cannot compare: {e}", code=diff.EXIT_CANNOT_COMPARE) from None
-    out(json.dumps(res.as_dict(), indent=1, ensure_ascii=False) if as_json else format_result(res))
-    return res.exit_code
+    chosen = diff.parse_frames(frames) if isinstance(frames, str) else frames
+    return diff.report(lambda: compare(path_a, path_b, chosen, exact), format_result, path_a, path_b, as_json, out)
 
 
 # ---- stepdiff ----------------------------------------------------------------------------

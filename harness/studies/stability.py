@@ -40,8 +40,6 @@ from harness.core.progress import Progress
 from harness.io.trajectory import open_trajectory
 from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES
 
-SOLVERS = ("xpbd", "ftl")
-PRECISIONS = ("fp32", "fp64")
 STRANDS = 16
 FRAMES = 60  # one second at the base scenes' Δt = 1/60 s
 
@@ -214,17 +212,18 @@ def measure(
         raise HarnessError(f"stability: unknown slice(s) {', '.join(unknown)} (known: {', '.join(SLICE_NAMES)})")
     chosen = [s for s in SLICES if s.name in slices]
     bes = backends(gpu, log)
+    declared = {be: variants.declared(be.backend, be.build) for be in bes}  # solvers, precisions
     todo = [
         (slc, r, c, solver, precision, be)
         for be in bes
         for slc, r, c in cells(chosen, quick)
-        for solver in SOLVERS
-        for precision in PRECISIONS
+        for solver in declared[be].solvers
+        for precision in declared[be].precisions
     ]
     jobs = jobs or os.cpu_count() or 1
     log(
-        f"stability: {len(todo)} cells ({len(chosen)} slice(s) × {len(SOLVERS)} solvers × "
-        f"{len(PRECISIONS)} precisions × {len(bes)} backend(s)), {strands} strands, {frames} frames, {jobs} jobs"
+        f"stability: {len(todo)} cells ({len(chosen)} slice(s) × solvers × precisions × {len(bes)} backend(s)), "
+        f"{strands} strands, {frames} frames, {jobs} jobs"
     )
     t0 = time.perf_counter()
     bar = Progress(len(todo), "stability")
