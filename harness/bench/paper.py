@@ -24,9 +24,10 @@ from harness.bench.validation import gpu_plan
 from harness.check import diff
 from harness.core import runner, variants
 from harness.core.paths import RESULTS, binary_path, display, output_dir
+from harness.io.files import write_json
 from harness.io.sweepfile import load_sweep
 from harness.render import report_paper
-from harness.studies.sweep import figure_state, run_sweep, write_json
+from harness.studies.sweep import figure_state, run_sweep
 
 VALIDATION_STRANDS = 2000
 VALIDATION_POINTS = 32

@@ -7,7 +7,7 @@ import tempfile
 from harness import HarnessError
 from harness.core import env
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
-from harness.studies.sweep import write_json
+from harness.io.files import write_json
 
 
 def validate(make_validator, what, out_dir, builds, gpu_note, say, header):

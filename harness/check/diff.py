@@ -90,15 +90,7 @@ class DiffResult:
         return EXIT_EQUIVALENT if self.equivalent else EXIT_DIFFERENT
 
     def failures(self) -> list[str]:
-        out = []
-        for f in self.frames:
-            if not f.ok:
-                why = (
-                    f"{f.nonfinite} non-finite point(s)"
-                    if f.nonfinite
-                    else f"{f.over} point(s) over tolerance (allowed {f.allowed_over})"
-                )
-                out.append(f"frame {f.frame_b} ({f.stage}): {why}, max error {f.max_abs:.3g}")
+        out = [frame_failure(f, f"frame {f.frame_b}") for f in self.frames if not f.ok]
         for label, rep in (("A", self.invariants_a), ("B", self.invariants_b)):
             out += [f"{label} {v.message}" for v in rep.violations]
         if not any(f.compared for f in self.frames):
@@ -109,6 +101,15 @@ class DiffResult:
         limits = {"point_limit_min": self.limit_range[0], "point_limit_max": self.limit_range[1]}
         limits["max_over_fraction"] = self.tolerance.max_over_fraction
         return result_dict(self, limits, [f.as_dict() for f in self.frames])
+
+
+def frame_failure(f: Any, where: str) -> str:
+    """A frame over its tolerance in one line; `where` names it ("frame 3", "step 12")."""
+    if f.nonfinite:
+        why = f"{f.nonfinite} non-finite point(s)"
+    else:
+        why = f"{f.over} point(s) over tolerance (allowed {f.allowed_over})"
+    return f"{where} ({f.stage}): {why}, max error {f.max_abs:.3g}"
 
 
 def result_dict(r: Any, limits: dict[str, Any], frames: list[Any], **extra: Any) -> dict[str, Any]:

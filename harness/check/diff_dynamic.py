@@ -98,15 +98,7 @@ class DynDiffResult:
         return diff.EXIT_EQUIVALENT if self.equivalent else diff.EXIT_DIFFERENT
 
     def failures(self):
-        out = []
-        for f in self.frames:
-            if not f.ok:
-                why = (
-                    f"{f.nonfinite} non-finite point(s)"
-                    if f.nonfinite
-                    else f"{f.over} point(s) over tolerance (allowed {f.allowed_over})"
-                )
-                out.append(f"step {f.step} ({f.stage}): {why}, max error {f.max_abs:.3g}")
+        out = [diff.frame_failure(f, f"step {f.step}") for f in self.frames if not f.ok]
         for o in self.observables:
             out += [f"step {o['step']}: observable {m}" for m in o.get("failures", [])]
         for label, rep in (("A", self.invariants_a), ("B", self.invariants_b)):

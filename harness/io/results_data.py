@@ -19,18 +19,7 @@ from harness.io import runlog
 # the small paper-scene state of Fig. 1/2, inside a sweep's results directory
 FIGURE_STATE = "states/figure-cpu-fp32.h5"
 
-CASE_KEYS = [
-    "case_id",
-    "scene",
-    "backend",
-    "build",
-    "variant",
-    "precision",
-    "block_size",
-    "threads",
-    "strands",
-    "points",
-]
+CASE_KEYS = ["case_id", *runlog.CASE]
 
 
 def load(results_dir):

@@ -14,20 +14,14 @@ import os
 
 from harness import HarnessError
 
+# what makes a case (its rows, one a stage, share these)
+CASE = ["scene", "backend", "build", "variant", "precision", "block_size", "threads", "strands", "points"]
 COLUMNS = [
     "case_id",
     "stage_index",
     "n_stages",
     "stage",
-    "scene",
-    "backend",
-    "build",
-    "variant",
-    "precision",
-    "block_size",
-    "threads",
-    "strands",
-    "points",
+    *CASE,
     "repeat",
     "warmup",
     "skipped",

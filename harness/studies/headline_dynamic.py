@@ -33,8 +33,8 @@ from pathlib import Path
 from harness import HarnessError
 from harness.core import env, runner, scenes, variants
 from harness.core.paths import RESULTS, binary_path, display
+from harness.io.files import write_json
 from harness.studies import roofline
-from harness.studies.sweep import write_json
 
 # the targets (reported beside the numbers, never asserted)
 TARGET_MEMORY_FRACTION = 0.90

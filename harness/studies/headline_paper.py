@@ -14,11 +14,9 @@ Writes results/headline/headline.json (render/headline_report.py makes its table
 runs after a warm-up, per-stage compute only (docs/interfaces.md).
 """
 
-import json
-import os
-
 from harness.core import env, runner, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display, output_dir
+from harness.io.files import write_json
 from harness.studies import roofline
 
 STAGES = "init,collide,wind,collide"
@@ -122,8 +120,6 @@ def run(strands=4 * 1024 * 1024, points=32, repeat=9, cpu_repeat=3, block_size=2
             r["label"]: r["wind_collide_ms"] / best["wind_collide_ms"] for r in result["rows"] if r["backend"] == "cpu"
         }
     path = out_dir / "headline.json"
-    tmp = path.with_name(f"headline.json.tmp.{os.getpid()}")
-    tmp.write_text(json.dumps(result, indent=1) + "\n")
-    os.replace(tmp, path)
+    write_json(path, result)
     log(f"wrote {display(path)}")
     return result

@@ -24,7 +24,6 @@ report/stability_<slice>.png and writes report/dynamic_stability.md.
 """
 
 import csv
-import json
 import os
 import tempfile
 import time
@@ -37,6 +36,7 @@ from harness.check import invariants_dynamic
 from harness.core import env, runner, scenes, tolerances, variants
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
+from harness.io.files import write_json
 from harness.io.trajectory import open_trajectory
 from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES
 
@@ -279,8 +279,6 @@ def run_study(
         penetration_bound_rel=tolerances.STABILITY_PENETRATION_REL,
     )
     env_path = out_dir / "env.json"
-    tmp = env_path.with_name(f"env.json.tmp.{os.getpid()}")
-    tmp.write_text(json.dumps(info, indent=1) + "\n")
-    os.replace(tmp, env_path)
+    write_json(env_path, info)
     log(f"stability: {len(rows)} cells in {seconds:.1f} s; wrote {display(csv_path)} and {display(env_path)}")
     return csv_path

@@ -21,6 +21,7 @@ from harness.core.progress import Progress
 from harness.core.runner import BackendError, DoesNotFit, run_binary, run_flags
 from harness.core.scenes import SceneError
 from harness.io import results_data, runlog
+from harness.io.files import write_json
 from harness.io.sweepfile import load_sweep
 from harness.studies import roofline
 
@@ -156,14 +157,6 @@ def load_env(path):
         except (OSError, json.JSONDecodeError):
             raise HarnessError(f"{path}: not readable JSON; move it away to start a new record") from None
     return None
-
-
-def write_json(path, data):
-    tmp = f"{path}.tmp.{os.getpid()}"
-    with open(tmp, "w") as f:
-        json.dump(data, f, indent=1, default=str)
-        f.write("\n")
-    os.replace(tmp, path)
 
 
 def machine_of(host):
