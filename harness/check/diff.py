@@ -1,4 +1,4 @@
-"""Compare two state files frame by frame (DESIGN §6): `harness diff A.h5 B.h5`.
+"""Compare two state files frame by frame (docs/harness.md, "Equivalence"): `harness diff A.h5 B.h5`.
 
 Per compared frame: the stage, max and RMS absolute error (Euclidean distance of a point
 between the files, scene units), max error relative to the hair length L, the ULP

@@ -1,4 +1,4 @@
-"""The invariants of DESIGN §3, checked on every frame of a state file.
+"""The invariants of docs/model.md §2.7, checked on every frame of a state file.
 
   finite      no NaN or Inf anywhere
   roots       the root of every strand is bit-identical to frame 0's (roots never move

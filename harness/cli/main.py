@@ -1,7 +1,8 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
-Commands: run, diff, stepdiff, sweep, plot, report, bench, accuracy, headline, export, calibrate,
-featurecost, peer, animate, stability (`--help` on each). User errors print one line
+Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, accuracy, headline,
+export, calibrate, featurecost, peer, animate, stability, docs (`--help` on each; docs/harness.md
+lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
 
 import argparse
@@ -446,6 +447,12 @@ def cmd_calibrate(args):
     )
 
 
+def cmd_docs(args):
+    from harness.cli import docs
+
+    return docs.run(parser(), check=args.check)
+
+
 def parser():
     p = OneLineParser(
         prog="python -m harness",
@@ -516,7 +523,7 @@ def parser():
     d = sub.add_parser(
         "diff",
         help="compare two state files frame by frame (exit 0/1/2)",
-        description="Compare two HDF5 states frame by frame (DESIGN §6). Exit 0 = "
+        description="Compare two HDF5 states frame by frame (docs/harness.md, Equivalence). Exit 0 = "
         "equivalent, 1 = not equivalent, 2 = could not compare.",
     )
     d.add_argument("a", help="first state file (e.g. the CPU reference)")
@@ -837,6 +844,15 @@ def parser():
     sb.add_argument("--report-dir", default=None, help="where to write (default report/)")
     sb.add_argument("--from-csv", default=None, help="only redraw the report from an existing stability.csv")
     sb.set_defaults(func=cmd_stability)
+
+    dc = sub.add_parser(
+        "docs",
+        help="remake docs/harness.md's command and module reference",
+        description="Remake the command and module reference of docs/harness.md from this parser and the "
+        "modules' docstrings (what `make docs` runs); --check only says whether it is current (exit 1 if not).",
+    )
+    dc.add_argument("--check", action="store_true", help="write nothing; exit 1 when the page is out of date")
+    dc.set_defaults(func=cmd_docs)
     return p
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 CONFIGS = ROOT / "configs"
-SCENES = CONFIGS / "scenes"  # scene files (DESIGN §8)
+SCENES = CONFIGS / "scenes"  # scene files (docs/model.md §2.6)
 SWEEPS = CONFIGS / "sweeps"  # sweep files
 RESULTS = ROOT / "results"
 REPORT = ROOT / "report"

@@ -1,4 +1,4 @@
-"""Scene files (configs/scenes/*.toml, DESIGN §8) → validated Scene → backend flags.
+"""Scene files (configs/scenes/*.toml, docs/model.md §2.6) → validated Scene → backend flags.
 
 A scene file:
 

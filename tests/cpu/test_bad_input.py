@@ -1,4 +1,4 @@
-"""Bad input to the C reference (DESIGN §8): one clear line naming the flag or
+"""Bad input to the C reference (docs/interfaces.md: errors): one clear line naming the flag or
 file, a non-zero exit, and no output file (nor a temporary one) left behind."""
 
 import h5py

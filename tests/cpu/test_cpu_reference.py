@@ -1,4 +1,4 @@
-"""The C reference backend: DESIGN §3 invariants on every output, thread-count
+"""The C reference backend: the invariants of docs/model.md §2.7 on every output, thread-count
 independence, resume equivalence, fp32 against fp64, the HDF5 layout of §4, the JSON
 record, repeats and nil stages."""
 

@@ -1,6 +1,6 @@
 """The simd variant of the CPU backend: `hairsim-cpu --variant simd` against the
 `ref` oracle, one stage at a time (the ref state after frame k fed through --input into
-simd for the next stage only) and whole runs; DESIGN §3 invariants on its outputs; bits
+simd for the next stage only) and whole runs; the invariants of docs/model.md §2.7 on its outputs; bits
 independent of the thread count, of repeats and of resuming; nil stages; the refusal on a
 CPU without AVX2; the vector math really vectorised; the bandwidth record.
 

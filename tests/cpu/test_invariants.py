@@ -1,4 +1,4 @@
-"""The DESIGN §3 invariants as harness/check/invariants.py checks them: each planted violation
+"""The invariants of docs/model.md §2.7 as harness/check/invariants.py checks them: each planted violation
 is found and named, valid states pass, and the real C reference's outputs pass."""
 
 import subprocess

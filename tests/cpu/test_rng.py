@@ -1,4 +1,4 @@
-"""The counter-based RNG (DESIGN §3 Randomness): Random123's known-answer vectors, and an
+"""The counter-based RNG (docs/model.md §1.4): Random123's known-answer vectors, and an
 independent Python Philox4x32-10 that must reproduce the C roots bit for bit."""
 
 import numpy as np
@@ -49,7 +49,7 @@ def test_c_philox_self_test_passes_known_answers(cpu_bin):
 
 
 def roots_from_python(seed, n, R, m):
-    """DESIGN §3 root placement in float64 with the C file's operation order."""
+    """docs/model.md §2.2 root placement in float64 with the C file's operation order."""
     out = np.empty((n, 3))
     key = [seed & MASK, seed >> 32]
     for i in range(n):
@@ -111,7 +111,7 @@ def test_draws_differ_between_seeds_and_strands(cpu_bin, tmp_path):
         )
     ra, rb = State(a).frames[0, :, 0], State(b).frames[0, :, 0]
     assert not np.array_equal(ra, rb)
-    # strands draw distinct roots, except those whose z the DESIGN §3 clamp put at -R
+    # strands draw distinct roots, except those whose z the clamp of docs/model.md §2.2 put at -R
     # (u1 < m / 2R = 5%: they all sit at the back pole (0, 0, -R))
     free = ra[ra[:, 2] > -10.0]
     assert len(free) > 400 and len(np.unique(free[:, 2])) == len(free)

@@ -116,8 +116,8 @@ GPU_VARIANTS = variants.names("cuda", "strict") or ("not-built",)
     block=256,
 )
 def test_gpu_agrees_with_cpu_across_the_scene_space(cpu_bin, tmp_path_factory, s, variant, block):
-    """The same scene space on the strict CUDA build: the DESIGN §3 invariants on the GPU
-    output, and equivalence with the CPU under the harness's tolerance (DESIGN §6)."""
+    """The same scene space on the strict CUDA build: the invariants of docs/model.md §2.7 on the GPU
+    output, and equivalence with the CPU under the harness's tolerance (docs/harness.md, "Equivalence")."""
     from conftest import CUDA_STRICT_BIN
     from harness.check import diff
 
@@ -266,7 +266,7 @@ def _crafted(tmp_path, strands, precision="fp64", L=3.0):
 
 
 # Each hand-made state runs on the CPU and on every variant of the strict CUDA build; a GPU
-# result must also be equivalent to the CPU's (harness diff, DESIGN §6).
+# result must also be equivalent to the CPU's (harness diff; docs/harness.md, "Equivalence").
 BACKENDS = ["cpu"] + [pytest.param(v, marks=pytest.mark.gpu, id=f"gpu-{v}") for v in GPU_VARIANTS]
 
 
@@ -290,7 +290,7 @@ def _run_backend(cpu_bin, backend, args, out):
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_segment_exactly_opposite_to_the_wind_turns_through_plus_y(cpu_bin, tmp_path, precision, backend):
-    """DESIGN §3: an exactly opposite segment takes the arc through +y (wind lifts hair)."""
+    """docs/model.md §2.4: an exactly opposite segment takes the arc through +y (wind lifts hair)."""
     P, ell = 4, 1.0
     toward_face = [(0.0, 0.0, 10.0 + k * ell) for k in range(P)]  # φ = 0, wind ψ = π
     toward_back = [(1.0, 0.0, -math.sqrt(99.0) - k * ell) for k in range(P)]  # φ = π, wind ψ = 0

@@ -32,7 +32,7 @@ def State(path) -> LoadedState:  # noqa: N802 (reads like the type it returns)
 
 
 def assert_equivalent(path_a, path_b, frames="all", tolerance=None, what=""):
-    """harness diff's verdict on two files (DESIGN §6): every compared frame within the
+    """harness diff's verdict on two files (docs/harness.md, "Equivalence"): every compared frame within the
     tolerance and every invariant held in both; returns the DiffResult."""
     result = diff.compare(str(path_a), str(path_b), frames=frames, tolerance=tolerance)
     assert result.equivalent, f"{what}: " + diff.format_result(result)

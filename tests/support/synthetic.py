@@ -1,6 +1,6 @@
 """Write state files in the documented layout without a backend (for tests and examples).
 
-`radial_strands` makes a state that meets every invariant of DESIGN §3 by construction:
+`radial_strands` makes a state that meets every invariant of docs/model.md §2.7 by construction:
 each strand leaves its root on the head sphere and runs outward, tilted by a per-frame
 angle, with segments of exactly ℓ (up to rounding) and x constant. `write_state` writes
 any positions array [F][N][P][3] with the /h5md, /particles and /parameters layout of
