@@ -107,8 +107,9 @@ def quiet():
 def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, tmp_path, quiet, monkeypatch):
     monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
     out, rep = tmp_path / "out", tmp_path / "rep"
-    rc = accuracy_dynamic.run_study(accuracy_dynamic.Plan(**TINY), out, rep, log=quiet)
-    assert rc == 0
+    rc = accuracy_dynamic.run_study(accuracy_dynamic.Plan(**TINY), out, log=quiet)
+    assert rc == 0 and not rep.exists()  # measuring only: the renderer draws
+    accuracy_dynamic_report.write(out, rep)
     with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
         reader = csv.DictReader(fh)
         rows = list(reader)
@@ -146,14 +147,15 @@ def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, 
     assert (tmp_path / "r2" / accuracy_dynamic_report.PAGE).read_text() == page
     before = (out / accuracy_dynamic.CSV_NAME).read_bytes()
     with pytest.raises(accuracy_dynamic.HarnessError, match="exists: pass --force"):
-        accuracy_dynamic.run_study(accuracy_dynamic.Plan(**TINY), out, rep, log=quiet)
+        accuracy_dynamic.run_study(accuracy_dynamic.Plan(**TINY), out, log=quiet)
     assert (out / accuracy_dynamic.CSV_NAME).read_bytes() == before
 
 
 def test_the_reference_that_does_not_converge_says_so(cpu_bin, tmp_path, quiet, monkeypatch):
     monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
     plan = accuracy_dynamic.Plan(**{**TINY, "substeps": (1, 16), "ref_start": 32, "ref_max": 64})
-    assert accuracy_dynamic.run_study(plan, tmp_path / "o", tmp_path / "r", log=quiet) == 1
+    assert accuracy_dynamic.run_study(plan, tmp_path / "o", log=quiet) == 1
+    accuracy_dynamic_report.write(tmp_path / "o", tmp_path / "r")
     assert "**NOT converged**" in (tmp_path / "r" / accuracy_dynamic_report.PAGE).read_text()
 
 
@@ -203,7 +205,7 @@ def test_a_tiny_study_on_the_gpu(tmp_path, quiet):
     reference is validated against the CPU (or rejected, which the report then says)."""
     out = tmp_path / "out"
     plan = accuracy_dynamic.Plan(**{**TINY, "strands": 64, "time_strands": 4096})
-    assert accuracy_dynamic.run_study(plan, out, tmp_path / "rep", log=quiet) == 0
+    assert accuracy_dynamic.run_study(plan, out, log=quiet) == 0
     with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
         rows = list(csv.DictReader(fh))
     builds = {(r["build"], r["variant"]) for r in rows if r["study"] == "mode" and r["backend"] == "cuda"}

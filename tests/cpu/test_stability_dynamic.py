@@ -20,7 +20,7 @@ from harness.cli.main import main as harness_main
 from harness.core import tolerances, variants
 from harness.io.trajectory import open_trajectory
 from harness.render import stability_report
-from harness.studies import stability
+from harness.studies import stability, stability_slices
 from support.statecheck import run
 
 # CI: 120 derandomized examples (about 30 s on the 2-core CI machine); a deeper search:
@@ -282,7 +282,7 @@ def test_search_gpu_frame_agrees_with_cpu(cpu_bin, tmp_path_factory, s, variant,
 
 # ---- a slice of the map whose verdicts are known (measured: docs/decisions.md) -----------
 def slice_named(name):
-    return next(s for s in stability.SLICES if s.name == name)
+    return next(s for s in stability_slices.SLICES if s.name == name)
 
 
 CPU = stability.Backend("cpu", "default", variants.declared("cpu").default_variant if variants.names("cpu") else "")
@@ -347,7 +347,7 @@ def test_stability_command_writes_the_map(cpu_bin, tmp_path, capsys):
     assert "### nodding head" in md and "(stability_motion.png)" in md
     assert (rep / "stability_motion.png").stat().st_size > 0
     rows = stability_report.load(out / "stability.csv")
-    assert len(rows) == 3 * 3 * 2 * 2 and set(rows["verdict"]) <= set(stability.VERDICTS)
+    assert len(rows) == 3 * 3 * 2 * 2 and set(rows["verdict"]) <= set(stability_slices.VERDICTS)
     assert not list(out.glob("*.tmp*")) and not list(rep.glob("*.tmp*"))
 
 
