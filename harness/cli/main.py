@@ -564,7 +564,13 @@ def parser():
         ("plot", "draw the PNG plots of a results directory", cmd_plot),
         ("report", "write report/report.md (and its plots)", cmd_report),
     ):
-        q = sub.add_parser(name, help=helptext, description=helptext[0].upper() + helptext[1:] + ".")
+        description = (
+            helptext[0].upper()
+            + helptext[1:]
+            + " (rendering only: Fig. 1/2 come from the hair "
+            + ("state the bench leaves in RESULTS/states/, when it is there).")
+        )
+        q = sub.add_parser(name, help=helptext, description=description)
         q.add_argument(
             "results",
             nargs="?",
