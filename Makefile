@@ -66,7 +66,7 @@ NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DH
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
 
-.PHONY: all cpu cuda test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt
+.PHONY: all cpu cuda test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt docs
 
 # The Python that runs the tests and the harness: harness/setup.sh picks it (PYTHON when it has
 # the packages, else ./.venv) after installing what is missing, and writes its path here.
@@ -87,6 +87,7 @@ help:
 	@echo "make sanitize-gpu  compute-sanitizer memcheck + racecheck over every CUDA variant (GPU node)"
 	@echo "make lint     ruff check, ruff format --check, mypy (lint-py) and clang-format --dry-run (lint-c)"
 	@echo "make fmt      ruff format the Python and clang-format -i the C and CUDA sources"
+	@echo "make docs     remake docs/harness.md's command and module reference (python3 -m harness docs)"
 	@echo "make setup    install what is missing (apt as root/sudo, pip into .venv under PEP 668); nothing when all is there"
 	@echo "make clean    remove build/"
 
@@ -148,6 +149,10 @@ report: setup
 report-dynamic: setup
 	$(RUN_PY) -m harness report-dynamic $(DYNAMIC_FROM)
 
+# docs/harness.md's command and module reference, from the parser and the docstrings
+docs: setup
+	$(RUN_PY) -m harness docs
+
 # ASan + UBSan over the C reference: a separate build in build/asan, the C tests run on it.
 sanitize: setup check-hdf5
 	$(MAKE) BUILD=build/asan COPT="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" \
@@ -196,7 +201,7 @@ CLANG_FORMAT ?= clang-format
 lint: lint-py lint-c
 
 lint-py: setup
-	@$(RUN_PY) -c "import ruff, mypy" 2>/dev/null || $(RUN_PY) -m pip install -q --disable-pip-version-check -r requirements-dev.txt
+	@$(RUN_PY) -c "import ruff, mypy, xdist" 2>/dev/null || $(RUN_PY) -m pip install -q --disable-pip-version-check -r requirements-dev.txt
 	$(RUN_PY) -m ruff check $(PY_SRC)
 	$(RUN_PY) -m ruff format --check $(PY_SRC)
 	$(RUN_PY) -m mypy

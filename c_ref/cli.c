@@ -484,7 +484,7 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
     return 0;
 }
 
-/* The stage-list rule shared with the harness (harness/scenes.py parse_stages): no empty
+/* The stage-list rule shared with the harness (harness/core/scenes.py parse_stages): no empty
  * item, so "init,,wind", ",init" and "init," are refused instead of skipped. */
 int hb_stage_list_has_empty_item(const char *v)
 {

@@ -25,7 +25,7 @@
  *    (with or without -ffast-math): model_simd_impl.h puts them in two loops.
  *
  * Check that the calls are vectorised: objdump -dr build/obj/model_simd.o | grep _ZGV
- * (tests/test_cpu_simd.py fails on any scalar call to these functions).
+ * (tests/cpu/test_cpu_simd.py fails on any scalar call to these functions).
  */
 #include "model_simd.h"
 

@@ -5,7 +5,7 @@
  * Header-only so that the C reference and the CUDA port compile the *same* integer code:
  * every backend, thread count, block size and strand split draws identical bits. Checked
  * against Random123's published known-answer vectors by `hairsim-cpu --self-test rng`
- * (tests/test_rng.py).
+ * (tests/cpu/test_rng.py).
  *
  * Stream layout (docs/model.md §1.4):
  *   key     = { seed low 32 bits, seed high 32 bits }

@@ -10,7 +10,7 @@
 #include <sys/types.h>
 
 /* The temporary file's HDF5 user block (bytes) and the marker written at its start; the
- * harness (harness/tempfiles.py) keeps the same two. */
+ * harness (harness/core/tempfiles.py) keeps the same two. */
 #define HB_TMP_USERBLOCK 512
 #define HB_TMP_MARKER "HAIRSIM-TEMPORARY-OUTPUT\n"
 #define HB_TMP_PREFIX ".hairsim-"

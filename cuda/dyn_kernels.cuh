@@ -55,7 +55,7 @@ inline bool valid_features(unsigned f)
 
 /* The feature sets with kernels of their own: the configured scenes (configs/scenes/
  * dynamic.toml: every feature; still-dynamic.toml: the collider), the analytic checks
- * (gravity only, drag, wind), the masks harness/featurecost.py times (none, each feature
+ * (gravity only, drag, wind), the masks harness/studies/featurecost.py times (none, each feature
  * alone, each removed from the full scene; a wind needs drag, gusts need the wind) and a
  * few common runs. Masks: BEND 1, SHAPE 2, WIND 4, GUST 8, MOTION 16, COLLIDE 32, DRAG 64;
  * ALL = 127. */

@@ -20,9 +20,9 @@ CUDA_FASTMATH_BIN = BUILD / "hairsim-cuda-fastmath"
 
 
 def _gpu_reason():
-    """Return None when a GPU is usable here, else the reason it is not (harness.env's
+    """Return None when a GPU is usable here, else the reason it is not (harness.core.env's
     detection, the one the harness uses, plus the built CUDA binary)."""
-    from harness import env
+    from harness.core import env
 
     ok, why = env.gpu_status()
     if not ok:
@@ -57,7 +57,7 @@ def cuda_bin():
 
 
 def pytest_terminal_summary(terminalreporter):
-    """The fault probe's matrix (tests/test_fault_probe.py): its cases by test, and outcomes."""
+    """The fault probe's matrix (tests/cpu/test_fault_probe.py): its cases by test, and outcomes."""
     counts: dict[str, dict[str, int]] = {}
     for outcome in ("passed", "failed", "skipped", "error"):
         for rep in terminalreporter.stats.get(outcome, []):

@@ -6,7 +6,7 @@
  * call glibc's sqrtf/sinf (sqrt/sin), as the C reference does, so any difference is a
  * porting, layout, indexing or ordering bug. On the device, sinf/sin may differ from glibc
  * (gust frames only) and the normal build contracts FMAs: the GPU tests
- * (tests/test_gpu_dynamic.py) cover that.
+ * (tests/gpu/test_gpu_dynamic.py) cover that.
  *
  * Every valid feature set (96) x both solvers x fp32 and fp64 x P in {2, 3, 5, 8, 33, 70},
  * two frames each (the second from the port's own first frame), in the three ways the
@@ -22,7 +22,7 @@
  * it (dyn_kernels.cuh specialised_mask) and always as the run-time mask (DynF, the generic
  * kernel). Also the bend rest lengths and the per-strand observables (hb_dyn_observe_strand).
  *
- * Built by tests/test_cuda_dyn_host.py:
+ * Built by tests/native/test_cuda_dyn_host.py:
  *   gcc  -std=c11 -O2 -ffp-contract=off -fno-fast-math -Ic_ref -c c_ref/dynamics_f32.c
  *        c_ref/dynamics_f64.c c_ref/dynamics_host.c c_ref/params.c
  *   nvcc -std=c++17 -O2 -Ic_ref -Icuda -Xcompiler -ffp-contract=off,-fno-fast-math \

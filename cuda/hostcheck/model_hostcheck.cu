@@ -13,7 +13,7 @@
  * poisoned with a NaN pattern first and must come back untouched.
  *
  * Lives in cuda/hostcheck/ so that the Makefile's wildcard of cuda .cu files does not link it into
- * the hairsim binaries. Built by tests/test_cuda_port_host.py:
+ * the hairsim binaries. Built by tests/native/test_cuda_port_host.py:
  *   gcc  -std=c11 -O2 -ffp-contract=off -fno-fast-math -Ic_ref -c c_ref/model.c c_ref/params.c
  *   nvcc -std=c++17 -O2 -Ic_ref -Icuda -Xcompiler -ffp-contract=off \
  *        cuda/hostcheck/model_hostcheck.cu model.o params.o -o model_hostcheck

@@ -1,15 +1,16 @@
-"""DESIGN §3 invariants asserted on a state (a LoadedState of support/statecheck.py).
+"""The invariants of docs/model.md §2.7 asserted on a state (a LoadedState of support/statecheck.py).
 
 Every per-frame invariant (finite, roots fixed, x constant, segment lengths, shell after
-collide, skipped stages unchanged) is checked by harness/invariants.py with the tolerances
-of harness/tolerances.py. The tests add two facts of the root draw (DESIGN §3 init): roots
+collide, skipped stages unchanged) is checked by harness/check/invariants.py with the tolerances
+of harness/core/tolerances.py. The tests add two facts of the root draw (docs/model.md §2.2): roots
 lie on the head sphere, and none sits on the lower face.
 """
 
 import numpy as np
 
-from harness import invariants, tolerances
-from harness.states import open_state
+from harness.check import invariants
+from harness.core import tolerances
+from harness.io.states import open_state
 
 
 def assert_invariants(s, tol=None):

@@ -1,5 +1,5 @@
 """The worst errors a GPU test file measured, written to build/ for recalibrating
-harness/tolerances.py. Under pytest-xdist each worker measures a share of the tests, so the
+harness/core/tolerances.py. Under pytest-xdist each worker measures a share of the tests, so the
 workers of one run merge their maxima into the one file (under a lock); a new run starts the
 file afresh. The file stays a flat {key: worst value} JSON object."""
 

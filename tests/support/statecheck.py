@@ -1,15 +1,15 @@
 """Test helpers: run a hairsim binary, read its state, and judge two states.
 
-States are read by harness.states (the one reader), compared by harness.diff and checked
-by harness.invariants, with the tolerances of harness/tolerances.py.
+States are read by harness.io.states (the one reader), compared by harness.check.diff and checked
+by harness.check.invariants, with the tolerances of harness/core/tolerances.py.
 """
 
 import json
 import subprocess
 from pathlib import Path
 
-from harness import diff
-from harness.states import LoadedState, load_state
+from harness.check import diff
+from harness.io.states import LoadedState, load_state
 
 
 def run(binary, *args, check=True, timeout=600):
@@ -27,12 +27,12 @@ def run_json(binary, *args):
 
 
 def State(path) -> LoadedState:  # noqa: N802 (reads like the type it returns)
-    """The whole state at `path`, read by harness.states."""
+    """The whole state at `path`, read by harness.io.states."""
     return load_state(path)
 
 
 def assert_equivalent(path_a, path_b, frames="all", tolerance=None, what=""):
-    """harness diff's verdict on two files (DESIGN §6): every compared frame within the
+    """harness diff's verdict on two files (docs/harness.md, "Equivalence"): every compared frame within the
     tolerance and every invariant held in both; returns the DiffResult."""
     result = diff.compare(str(path_a), str(path_b), frames=frames, tolerance=tolerance)
     assert result.equivalent, f"{what}: " + diff.format_result(result)

@@ -1,6 +1,6 @@
 """Write state files in the documented layout without a backend (for tests and examples).
 
-`radial_strands` makes a state that meets every invariant of DESIGN §3 by construction:
+`radial_strands` makes a state that meets every invariant of docs/model.md §2.7 by construction:
 each strand leaves its root on the head sphere and runs outward, tilted by a per-frame
 angle, with segments of exactly ℓ (up to rounding) and x constant. `write_state` writes
 any positions array [F][N][P][3] with the /h5md, /particles and /parameters layout of
@@ -118,7 +118,7 @@ def write_state(path, positions, stages, precision=None, params=None, skipped=No
     return path
 
 
-# Departures from H5MD that harness.h5md.problems must name (tests/test_readers.py).
+# Departures from H5MD that harness.io.h5md.problems must name (tests/cpu/test_readers.py).
 H5MD_BREAKS = {
     "variable_length_unit": "'unit' is not a fixed-length ASCII string",
     "no_unit_system": "no 'system' attribute",

@@ -1,0 +1,215 @@
+"""The dynamic model's part of `make bench` (`python -m harness bench`, or alone with
+`--model dynamic`): validation before any timing, the sweep, the studies, the report.
+
+  1. validation, at VALIDATION_STRANDS strands of the default dynamic scene, 2 frames
+     written with every frame's velocities:
+     - always: the CPU oracle on one thread and on all cores bit-identical; a frame resumed
+       from the file (--input-frame) bit-identical to the same frame of the run; every
+       other CPU variant one frame from the oracle's state (harness.check.diff_dynamic's rule);
+     - with a usable GPU: every cuda build × simulate variant × precision × block size
+       one frame from the CPU's state, judged by the same rule (the strict build bit for
+       bit where the scene has no gusts); and the strict build's variants bit-identical
+       to each other;
+     anything not equivalent stops the bench before timing;
+  2. the sweep configs/sweeps/dynamic.toml (results/<out>/dynamic/runs.csv);
+  3. the studies, each into results/<out>/<study>/: what each feature costs (featurecost,
+     CPU and every cuda build), speed against accuracy (accuracy --model dynamic), stability at the
+     extremes (stability), the peer (pypbd, optional), the animation;
+  4. report/dynamic.md with all of it.
+Without a GPU the GPU rows and checks are skipped with one line saying why.
+"""
+
+from pathlib import Path
+
+from harness import HarnessError
+from harness.bench import validation
+from harness.bench.validation import gpu_plan
+from harness.check import diff_dynamic
+from harness.core import runner, scenes, variants
+from harness.core.paths import RESULTS, binary_path, display
+from harness.core.scenes import with_frames
+from harness.io import results_data
+from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
+from harness.studies import accuracy_dynamic, animate, featurecost, peer, stability
+from harness.studies.sweep import run_sweep
+
+VALIDATION_STRANDS = 2000
+BLOCK_SIZES = (32, 256)
+SWEEP = "dynamic"
+
+
+class DynValidator:
+    def __init__(self, scratch, say):
+        base = scenes.load_scene("dynamic").with_overrides(strands=VALIDATION_STRANDS)
+        self.scene = with_frames(base, 2)
+        self.scratch = Path(scratch)
+        self.say = say
+        self.checks = []
+        self.count = 0
+
+    def cpu_file(self, precision, solver, **opts):
+        self.count += 1
+        out = self.scratch / f"cpu{self.count}-{precision}-{solver}.h5"
+        scene = self.scene.with_overrides(precision=precision)
+        flags = runner.run_flags(scene, "cpu", output=out, **opts)
+        runner.run_binary(binary_path("cpu"), flags + ["--solver", solver, "--velocities", "all"], timeout=600)
+        return out
+
+    def record(self, what, fn):
+        try:
+            r = fn()
+        except HarnessError as e:
+            entry = {"what": what, "equivalent": False, "error": str(e)}
+        else:
+            f = r.frames[-1]
+            entry = {
+                "what": what,
+                "pair": r.pair,
+                "equivalent": r.equivalent,
+                "max_abs": f.max_abs,
+                "max_rel_L": f.max_rel_L,
+                "ulp_max": f.ulp_max,
+                "failures": r.failures()[:5],
+            }
+        self.checks.append(entry)
+        if not entry["equivalent"]:
+            why = entry.get("error") or "; ".join(entry.get("failures", []))
+            self.say(f"harness: NOT EQUIVALENT: {what}: {why}")
+        return entry["equivalent"]
+
+    def step(self, ref, binary, extra, tag):
+        """One frame from the reference's second-to-last frame; the new file."""
+        self.count += 1
+        out = self.scratch / f"step{self.count}-{tag}.h5"
+        with diff_dynamic.open_trajectory(ref) as t:
+            k = t.n_frames - 2
+        cmd = ["--input", ref, "--input-frame", k, "--stages", "simulate", "--frames", 1, *extra, "--output", out]
+        runner.run_binary(binary, cmd, timeout=600)
+        return out
+
+    def last_step(self, path):
+        with diff_dynamic.open_trajectory(path) as t:
+            return int(t.step[-1])
+
+    def cpu_checks(self):
+        refs = {}
+        cpu = variants.declared("cpu")  # the solvers and precisions of --list-variants
+        for precision in cpu.precisions:
+            for solver in cpu.solvers:
+                ref = refs[(precision, solver)] = self.cpu_file(precision, solver)
+                one = self.cpu_file(precision, solver, threads=1)
+                self.record(
+                    f"cpu {precision} {solver}: 1 thread vs all cores (bit-identical)",
+                    lambda a=ref, b=one: diff_dynamic.compare(a, b, exact=True),
+                )
+                oracle = variants.declared("cpu").default_variant
+                resumed = self.step(ref, binary_path("cpu"), ["--variant", oracle], f"cpu-{precision}-{solver}")
+                self.record(
+                    f"cpu {precision} {solver}: the last frame resumed from the file (bit-identical)",
+                    lambda a=ref, b=resumed: diff_dynamic.compare(a, b, frames=[self.last_step(b)], exact=True),
+                )
+                for v in variants.declared("cpu").variants:
+                    if v == oracle or not variants.declared("cpu").runs(v):
+                        continue
+                    other = self.step(ref, binary_path("cpu"), ["--variant", v], f"cpu-{v}-{precision}-{solver}")
+                    self.record(
+                        f"cpu {v} {precision} {solver}: one frame from the oracle's state",
+                        lambda a=ref, b=other: diff_dynamic.compare(a, b, frames=[self.last_step(b)]),
+                    )
+        return refs
+
+    def gpu_checks(self, builds, refs):
+        for (precision, solver), ref in refs.items():
+            strict = {}
+            for build in builds:
+                decl = variants.declared("cuda", build)
+                for v in (n for n in decl.variants if decl.runs(n, points=self.scene.points)):
+                    for block in (b for b in BLOCK_SIZES if decl.runs(v, points=self.scene.points, block=b)):
+                        tag = f"cuda-{build}-{v}-b{block}-{precision}-{solver}"
+                        g = self.step(ref, binary_path("cuda", build), ["--variant", v, "--block-size", block], tag)
+                        if build == "strict" and block == BLOCK_SIZES[-1]:
+                            strict[v] = g
+                        self.record(
+                            f"cuda {build} {v} b{block} {precision} {solver}: one frame from the cpu state",
+                            lambda a=ref, b=g: diff_dynamic.compare(a, b, frames=[self.last_step(b)]),
+                        )
+            names = list(strict)
+            for other in names[1:]:
+                self.record(
+                    f"cuda strict {precision} {solver}: {names[0]} and {other} bit-identical",
+                    lambda a=strict[names[0]], b=strict[other]: diff_dynamic.compare(
+                        a, b, frames=[self.last_step(b)], exact=True, check_paper=False
+                    ),
+                )
+
+
+def validate(out_dir, builds, gpu_note, say):
+    def header(v):
+        return {"model": "dynamic", "strands": VALIDATION_STRANDS, "points": v.scene.points, "scene": v.scene.name}
+
+    validation.validate(DynValidator, "dynamic validation", out_dir, builds, gpu_note, say, header)
+
+
+def fastest_gpu_variants(sweep_dir):
+    """The default build's simulate variant with the most point-substeps per second at the
+    sweep's largest fp32 strand count; every simulate variant when the sweep has no GPU row."""
+    decl = variants.declared("cuda")
+    every = list(decl.running("simulate", points=32))
+    try:
+        rows, _ = results_data.load(sweep_dir)
+    except HarnessError:
+        return every
+    g = rows[(rows["stage"] == "simulate") & (rows["backend"] == "cuda") & (rows["precision"] == "fp32")]
+    g = g[g["build"].isin(["", "default"])]
+    if g.empty:
+        return every
+    top = g[g["strands"] == g["strands"].max()]
+    best = top.loc[top["point_substeps_per_s"].astype(float).idxmax()]
+    return [str(best["variant"])]
+
+
+def studies(root, builds, say, report_dir=None, quick=False):
+    """The dynamic studies, each measured into root/<study> (`quick`: their small versions)
+    and rendered into report_dir."""
+    fc = root / "featurecost"
+    fc.mkdir(parents=True, exist_ok=True)
+    say("harness: featurecost --backend cpu")
+    featurecost.measure(backend="cpu", out=fc / "cpu.csv")
+    if builds:  # the sweep's fastest variant (else every one that simulates), at a size that fills the GPU
+        for v in fastest_gpu_variants(root / SWEEP):
+            say(f"harness: featurecost --backend cuda --variant {v} --strands 1000000")
+            featurecost.measure(backend="cuda", variant=v, strands=1_000_000, out=fc / f"cuda-{v}.csv")
+    acc_dir = root / accuracy_dynamic.RESULTS_NAME
+    gpu = "auto" if builds else "no"
+    plan = accuracy_dynamic.Plan.quick(gpu=gpu) if quick else accuracy_dynamic.Plan(gpu=gpu)
+    say(f"harness: accuracy --model dynamic{' --quick' if quick else ''} --gpu {gpu}")
+    accuracy_dynamic.run_study(plan, out_dir=acc_dir, force=True, command="python -m harness bench --model dynamic")
+    accuracy_dynamic_report.write(acc_dir, report_dir)
+    say(f"harness: stability{' --quick' if quick else ''} --gpu {gpu}")
+    csv_path = stability.run_study(quick=quick, gpu=gpu, out_dir=root / "stability")
+    stability_report.report_from_csv(csv_path, report_dir=report_dir, log=say)
+    say("harness: peer")
+    try:
+        peer.run_study(peer.Plan(out=str(root / "peer")), log=say)
+    except peer.PeerUnavailable as e:  # an optional dependency: skipped, not failed
+        say(f"harness: peer: skipped: {e}")
+    peer_report.write(root / "peer", root / "peer")
+    say("harness: animate")
+    animate.run(out=Path(report_dir) / "dynamic.gif" if report_dir else None, force=True, log=say)
+
+
+def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None):
+    say = log or (lambda m: print(m, flush=True))
+    runner.require_binary(binary_path("cpu"))
+    root = Path(out) if out else RESULTS
+    sweep_dir = root / SWEEP
+    sweep_dir.mkdir(parents=True, exist_ok=True)
+    builds, gpu_note = gpu_plan(gpu)
+    if gpu_note:
+        say(f"harness: dynamic GPU rows skipped: {gpu_note}")
+    validate(sweep_dir, builds, gpu_note, say)
+    _, failed = run_sweep(SWEEP, out=sweep_dir, gpu="no" if gpu_note else gpu, log=say, announce_skips=False)
+    studies(root, builds, say, report_dir=report_dir, quick=quick_studies)
+    path = report_dynamic.build(root, report_dir)
+    say(f"harness: dynamic report in {display(path)}")
+    return 1 if failed else 0

@@ -1,0 +1,55 @@
+"""The bench's first step for either model: a validator's CPU checks, then its GPU checks,
+recorded in validation.json; nothing is timed unless every comparison is equivalent."""
+
+import shutil
+import tempfile
+
+from harness import HarnessError
+from harness.core import env
+from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
+from harness.io.files import write_json
+
+
+def validate(make_validator, what, out_dir, builds, gpu_note, say, header):
+    """Run the validator `make_validator(scratch, say)` (cpu_checks(), gpu_checks(builds, ref),
+    checks); `what` names it in messages ("validation", "dynamic validation"), header(v) the
+    model's own fields of validation.json. HarnessError (exit 1) when a comparison fails, the
+    states kept for a look."""
+    scratch_root = RESULTS / "_scratch"
+    scratch_root.mkdir(parents=True, exist_ok=True)
+    scratch = tempfile.mkdtemp(prefix=f"bench-{what.replace(' ', '-')}-", dir=scratch_root)
+    v = make_validator(scratch, say)
+    ref = v.cpu_checks()
+    if builds:
+        v.gpu_checks(builds, ref)
+    failed = [c for c in v.checks if not c["equivalent"]]
+    record = {"date": env.now(), **header(v), "gpu_builds": builds}
+    record["gpu_note"] = f"GPU not validated: {gpu_note}." if gpu_note else ""
+    write_json(out_dir / "validation.json", dict(record, checks=v.checks))
+    if failed:
+        raise HarnessError(
+            f"{what} failed: {len(failed)} of {len(v.checks)} comparisons not equivalent "
+            f"(details in {display(out_dir / 'validation.json')}, states kept in {display(scratch)}); "
+            "nothing was timed",
+            code=1,
+        )
+    shutil.rmtree(scratch, ignore_errors=True)
+    say(f"harness: {what}: all {len(v.checks)} comparisons equivalent")
+
+
+def gpu_plan(gpu):
+    """(cuda builds to validate, None) or ([], the one-line reason there are none)."""
+    if gpu == "no":
+        return [], "--gpu no was given"
+    ok, why = env.gpu_status()
+    if not ok:
+        if gpu == "yes":
+            raise HarnessError(f"--gpu yes but no GPU is usable: {why}")
+        return [], why
+    builds = [b for b in CUDA_BUILDS if binary_path("cuda", b).exists()]
+    if not builds:
+        why = f"{display(binary_path('cuda'))} is not built (run make where nvcc is installed)"
+        if gpu == "yes":
+            raise HarnessError(why)
+        return [], why
+    return builds, None

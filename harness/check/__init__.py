@@ -1,0 +1,1 @@
+"""Layer 3: checking states — invariants, diff (paper and dynamic), stepdiff."""

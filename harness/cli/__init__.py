@@ -1,0 +1,1 @@
+"""Layer 6, on top: the command line (`python -m harness …`)."""

@@ -1,0 +1,891 @@
+"""`python -m harness COMMAND …`: the command line of the hairbench harness.
+
+Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, accuracy, headline,
+export, calibrate, featurecost, peer, animate, stability, docs (`--help` on each; docs/harness.md
+lists them). User errors print one line
+`harness: error: …` and exit non-zero, never a traceback."""
+
+import argparse
+import json
+import math
+import os
+import sys
+from pathlib import Path
+
+from harness import HarnessError, __version__
+from harness.studies import peer
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """Usage errors as the binaries print them: one line, exit 2."""
+
+    def error(self, message):
+        command = self.prog.split()[3:]  # "python -m harness run" → ["run"]
+        self.exit(2, f"harness: error: {' '.join(command + [''])[:-1] + ': ' if command else ''}{message}\n")
+
+
+def whole(low):
+    """An argparse type: a whole number ≥ low, refused in one line otherwise."""
+
+    def parse(text):
+        try:
+            value = int(text, 10)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"needs a whole number (got '{text}')") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"must be at least {low} (got {value})")
+        return value
+
+    return parse
+
+
+def seconds(text):
+    """An argparse type: a finite number of seconds > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs a number of seconds (got '{text}')") from None
+    if not 0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a finite number of seconds > 0 (got '{text}')")
+    return value
+
+
+def cmd_run(args):
+    from harness.core import runner, scenes
+    from harness.core.paths import binary_path
+
+    if args.backend == "cpu" and args.block_size is not None:
+        raise HarnessError("run: --block-size is a cuda flag; the cpu backend takes --threads")
+    if args.backend == "cuda" and args.threads is not None:
+        raise HarnessError("run: --threads is a cpu flag; the cuda backend takes --block-size")
+
+    scene = scenes.load_scene(args.scene).with_overrides(
+        strands=args.strands,
+        points=args.points,
+        precision=args.precision,
+        stages=scenes.parse_stages(args.stages, "run", "--stages") if args.stages else None,
+    )
+    binary = binary_path(args.backend, args.build)
+    flags = runner.run_flags(
+        scene,
+        args.backend,
+        variant=args.variant,
+        block_size=args.block_size,
+        threads=args.threads,
+        repeat=args.repeat,
+        warmup=args.warmup,
+        output=args.output,
+        force=args.force,
+    )
+    if scene.model == "dynamic":  # per-frame observables (harness/check/run_dynamic.py)
+        from harness.check import run_dynamic
+
+        if args.frames:
+            scene = scenes.with_frames(scene, args.frames)
+            flags = runner.run_flags(
+                scene,
+                args.backend,
+                variant=args.variant,
+                block_size=args.block_size,
+                threads=args.threads,
+                repeat=args.repeat,
+                warmup=args.warmup,
+                output=args.output,
+                force=args.force,
+            )
+        return run_dynamic.run(binary, flags, args.output, timeout=args.timeout, as_json=args.json, every=args.every)
+    record = runner.run_binary(binary, flags, timeout=args.timeout)
+    print(json.dumps(record, indent=1) if args.json else runner.summary(record))
+    return 0
+
+
+def cmd_diff(args):
+    from harness.check import diff, diff_dynamic
+
+    frames = ",".join(str(k) for k in args.frame) if args.frame else args.frames
+    if diff_dynamic.is_dynamic_file(args.a) or diff_dynamic.is_dynamic_file(args.b):
+        # dynamic files pair frames by step: --frame K names step K
+        return diff_dynamic.run(args.a, args.b, frames=frames, exact=args.exact, as_json=args.json)
+    return diff.run(args.a, args.b, frames=frames, align_last=args.align_last, exact=args.exact, as_json=args.json)
+
+
+def cmd_stepdiff(args):
+    from harness.check import diff_dynamic
+
+    flags = args.flags[1:] if args.flags[:1] == ["--"] else args.flags
+    return diff_dynamic.stepdiff(
+        args.reference,
+        args.binary,
+        flags=flags,
+        frames=args.frames,
+        exact=args.exact,
+        keep=args.keep,
+        timeout=args.timeout,
+    )
+
+
+def cmd_sweep(args):
+    from harness.studies import sweep
+
+    _, failed = sweep.run_sweep(args.sweep, out=args.out, gpu=args.gpu)
+    return 1 if failed else 0
+
+
+def cmd_plot(args):
+    from harness.render import plots
+
+    for path in plots.make_all(args.results, args.report_dir):
+        print(f"wrote {path}")
+    return 0
+
+
+def cmd_report(args):
+    from harness.render import report_paper
+
+    path = report_paper.build(args.results, args.report_dir)
+    print(f"wrote {path}")
+    return 0
+
+
+def cmd_report_dynamic(args):
+    from harness.core.paths import display
+    from harness.render import report_dynamic
+
+    root = Path(args.root)
+    if not root.is_dir():
+        raise HarnessError(f"{args.root}: not a directory (a dynamic bench root: dynamic/, featurecost/, ...)", code=2)
+    print(f"wrote {display(report_dynamic.build(root, args.report_dir))}")
+    return 0
+
+
+def cmd_bench(args):
+    from harness.bench import dynamic as bench_dynamic
+    from harness.bench import paper as bench_paper
+
+    code = 0
+    if args.model in ("all", "paper"):
+        code = bench_paper.run(args.sweep, out=args.out, gpu=args.gpu, report_dir=args.report_dir)
+    if args.model in ("all", "dynamic"):
+        # with both models the dynamic results sit beside the paper sweep's directory, as the
+        # headline and accuracy results do (results/ by default)
+        root = args.out if args.model == "dynamic" else (str(Path(args.out).parent) if args.out else None)
+        code = (
+            bench_dynamic.run(out=root, gpu=args.gpu, report_dir=args.report_dir, quick_studies=not args.full_studies)
+            or code
+        )
+    return code
+
+
+PAPER_ACCURACY = dict(
+    scene="paper",
+    strands=100_000,
+    points=32,
+    repeat=9,
+    resolution=[4, 8, 16, 32, 64, 128, 256],
+    resolution_strands=20_000,
+)
+PAPER_ONLY = ("resolution", "resolution_strands")
+DYNAMIC_ONLY = (
+    "quick",
+    "seconds",
+    "horizon",
+    "substeps",
+    "iterations",
+    "time_strands",
+    "time_frames",
+    "ref_start",
+    "ref_max",
+    "jobs",
+    "analytic",
+    "gpu",
+    "force",
+)
+
+
+def _flag(name):
+    return "--" + name.replace("_", "-")
+
+
+def accuracy_model(args):
+    """paper | dynamic: --model, else the model of --scene, else paper; a contradiction or
+    an option of the other model is refused."""
+    from harness.core import scenes
+
+    model = args.model
+    if args.from_csv and model is None:
+        from harness.studies.accuracy_dynamic import COLUMNS
+
+        try:
+            with open(args.from_csv, encoding="utf-8") as fh:
+                header = fh.readline().strip().split(",")
+        except (OSError, UnicodeDecodeError) as e:
+            raise HarnessError(f"accuracy: --from-csv {args.from_csv}: cannot read ({e})") from None
+        model = "dynamic" if header == list(COLUMNS) else "paper"
+    if args.scene is not None and not args.from_csv:
+        scene_model = scenes.load_scene(args.scene).model
+        if model is not None and model != scene_model:
+            raise HarnessError(f"accuracy: --model {model} but scene {args.scene} is a {scene_model}-model scene")
+        model = scene_model
+    model = model or "paper"
+    other = PAPER_ONLY if model == "dynamic" else DYNAMIC_ONLY
+    given = [_flag(k) for k in other if getattr(args, k) not in (None, False)]
+    if given:
+        what = "is an option" if len(given) == 1 else "are options"
+        theirs = "paper" if model == "dynamic" else "dynamic"
+        raise HarnessError(f"accuracy: {', '.join(given)} {what} of the {theirs} model's study, not of --model {model}")
+    return model
+
+
+def cmd_accuracy(args):
+    if accuracy_model(args) == "dynamic":
+        return accuracy_dynamic(args)
+    from harness.core.paths import RESULTS
+    from harness.render import accuracy_paper_report
+    from harness.studies import accuracy_paper
+
+    if args.from_csv:
+        accuracy_paper_report.report_from_csv(args.from_csv, report_dir=args.report_dir)
+        return 0
+    opt = {k: getattr(args, k) if getattr(args, k) is not None else v for k, v in PAPER_ACCURACY.items()}
+    accuracy_paper.run_study(
+        opt["scene"],
+        strands=opt["strands"],
+        points=opt["points"],
+        repeat=opt["repeat"],
+        resolution=tuple(opt["resolution"]),
+        res_strands=opt["resolution_strands"],
+        out_dir=args.out,
+    )
+    out = Path(args.out) if args.out else RESULTS / "accuracy"
+    accuracy_paper_report.report_from_csv(out / "accuracy.csv", report_dir=args.report_dir)
+    return 0
+
+
+def accuracy_dynamic(args):
+    from pathlib import Path
+
+    from harness.core.paths import RESULTS, display
+    from harness.render import accuracy_dynamic_report
+    from harness.studies import accuracy_dynamic
+
+    if args.from_csv:
+        csv_path = Path(args.from_csv)
+        for path in accuracy_dynamic_report.write(csv_path.parent, args.report_dir, csv_path=csv_path):
+            print(f"wrote {display(path)}")
+        return 0
+    given = {
+        k: getattr(args, k)
+        for k in (
+            "scene",
+            "strands",
+            "points",
+            "repeat",
+            "seconds",
+            "horizon",
+            "time_strands",
+            "time_frames",
+            "ref_start",
+            "ref_max",
+            "jobs",
+            "analytic",
+            "gpu",
+        )
+        if getattr(args, k) is not None
+    }
+    for k in ("substeps", "iterations"):
+        if getattr(args, k) is not None:
+            given[k] = tuple(sorted(set(getattr(args, k))))
+    plan = accuracy_dynamic.Plan.quick(**given) if args.quick else accuracy_dynamic.Plan(**given)
+    command = " ".join(["python -m harness", *sys.argv[1:]])
+    status = accuracy_dynamic.run_study(plan, out_dir=args.out, force=args.force, command=command)
+    for path in accuracy_dynamic_report.write(
+        Path(args.out or RESULTS / accuracy_dynamic.RESULTS_NAME), args.report_dir
+    ):
+        print(f"wrote {display(path)}")
+    return status
+
+
+def cmd_headline(args):
+    if args.model == "dynamic":
+        from harness.studies import headline_dynamic
+
+        headline_dynamic.run(
+            strands=args.strands,
+            repeat=min(args.repeat, 5),
+            cpu_repeat=args.cpu_repeat,
+            ncu=args.ncu,
+            out_dir=args.out,
+        )
+        return 0
+    from harness.render import headline_report
+    from harness.studies import headline_paper
+
+    result = headline_paper.run(
+        strands=args.strands,
+        points=args.points,
+        repeat=args.repeat,
+        cpu_repeat=args.cpu_repeat,
+        block_size=args.block_size,
+        out_dir=args.out,
+    )
+    print(headline_report.table(result))
+    return 0
+
+
+def cmd_export(args):
+    from harness.io import export
+
+    for path in export.run(args.state, xdmf=not args.usd_only, usd=args.usd or args.usd_only, out=args.out):
+        print(f"wrote {path}")
+    return 0
+
+
+def cmd_featurecost(args):
+    from harness.render import featurecost_report
+    from harness.studies import featurecost
+
+    rows = featurecost.measure(
+        scene_ref=args.scene,
+        backend=args.backend,
+        build=args.build,
+        variant=args.variant,
+        strands=args.strands,
+        points=args.points,
+        frames=args.frames,
+        repeat=args.repeat,
+        threads=args.threads,
+        block_size=args.block_size,
+        out=args.out,
+        timeout=args.timeout,
+        instructions=args.instructions,
+    )
+    print(featurecost_report.markdown(rows), end="")
+    return 0
+
+
+def setting(text):
+    """An argparse type: a setting 'SxI' (substeps × iterations), each a whole number ≥ 1."""
+    parts = text.lower().split("x")
+    try:
+        s, i = (int(v, 10) for v in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs SxI, e.g. 8x1 (got '{text}')") from None
+    if s < 1 or i < 1:
+        raise argparse.ArgumentTypeError(f"S and I must be at least 1 (got '{text}')")
+    return (s, i)
+
+
+def number(text):
+    """An argparse type: a finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs a number (got '{text}')") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"needs a finite number (got '{text}')")
+    return value
+
+
+def cmd_peer(args):
+    from harness.render import peer_report
+
+    if not args.report_only:
+        fields = peer.Plan.__dataclass_fields__
+        plan = peer.Plan(**{k: getattr(args, k) for k in fields if k != "argv"})
+        plan.argv = sys.argv[2:] if len(sys.argv) > 2 and sys.argv[1] == "peer" else None
+        try:
+            peer.run_study(plan)
+        except peer.PeerUnavailable as e:  # an optional dependency: skipped, not failed
+            print(f"harness: peer: skipped: {e}", file=sys.stderr)
+            return 0
+    path = peer_report.write(args.out, args.report_dir)
+    print(f"wrote {path}")
+    return 0
+
+
+def cmd_animate(args):
+    from harness.studies import animate
+
+    for path in animate.run(
+        args.state,
+        out=args.out,
+        max_strands=args.max_strands,
+        every=args.every,
+        fps=args.fps,
+        force=args.force,
+        strands=args.strands,
+        frames=args.frames,
+    ):
+        print(f"wrote {path}")
+    return 0
+
+
+def cmd_stability(args):
+    from harness.render import stability_report
+    from harness.studies import stability
+
+    if args.from_csv:
+        stability_report.report_from_csv(args.from_csv, report_dir=args.report_dir)
+        return 0
+    csv_path = stability.run_study(
+        slices=tuple(args.slice or stability.SLICE_NAMES),
+        quick=args.quick,
+        strands=args.strands,
+        frames=args.frames,
+        jobs=args.jobs,
+        gpu=args.gpu,
+        timeout=args.timeout,
+        out_dir=args.out,
+    )
+    stability_report.report_from_csv(csv_path, report_dir=args.report_dir)
+    return 0
+
+
+def cmd_calibrate(args):
+    from harness.studies import calibrate
+
+    return calibrate.run(
+        strands=args.strands, points=args.points, seeds=args.seeds, other=args.other, as_json=args.json
+    )
+
+
+def cmd_docs(args):
+    from harness.cli import docs
+
+    return docs.run(parser(), check=args.check)
+
+
+def parser():
+    p = OneLineParser(
+        prog="python -m harness",
+        description="hairbench harness: run, diff, sweep, plot and report the hair-strand backends (docs/harness.md)",
+    )
+    p.add_argument("--version", action="version", version=f"hairbench harness {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    r = sub.add_parser(
+        "run",
+        help="run one scene on a backend and print its record",
+        description="Run a scene (configs/scenes/NAME.toml or a path) on a backend binary "
+        "with --json; print a summary, or the JSON record with --json.",
+    )
+    r.add_argument("scene", help="scene name in configs/scenes/ (e.g. paper) or a .toml path")
+    r.add_argument("--backend", choices=("cpu", "cuda"), default="cpu")
+    r.add_argument(
+        "--build",
+        choices=("default", "strict", "fastmath"),
+        default="default",
+        help="cuda build: hairsim-cuda, -strict or -fastmath (default: default)",
+    )
+    r.add_argument(
+        "--variant",
+        help="a variant the binary declares (`hairsim-* --list-variants`; default: the binary's default variant)",
+    )
+    r.add_argument("--precision", choices=("fp32", "fp64"), help="override the scene's precision")
+    r.add_argument("--block-size", type=whole(32), help="cuda threads per block (32…1024)")
+    r.add_argument("--strands", type=whole(1), help="override the scene's strand count")
+    r.add_argument("--points", type=whole(2), help="override the scene's points per strand")
+    r.add_argument("--stages", help="override the scene's stages (comma-separated)")
+    r.add_argument("--threads", type=whole(1), help="cpu OpenMP threads (default: all cores)")
+    r.add_argument("--repeat", type=whole(1), help="timed repetitions per stage")
+    r.add_argument("--warmup", type=whole(0), help="untimed runs per stage before the timed ones")
+    r.add_argument("--output", help="write the HDF5 state here (refused if it exists, unless --force)")
+    r.add_argument("--force", action="store_true", help="allow replacing --output")
+    r.add_argument("--timeout", type=seconds, default=None, help="seconds before giving up")
+    r.add_argument("--json", action="store_true", help="print the binary's JSON record")
+    r.add_argument("--frames", type=whole(1), default=None, help="dynamic scenes: override dynamics.frames")
+    r.add_argument(
+        "--every",
+        type=whole(1),
+        default=None,
+        help="dynamic scenes: print every K-th frame's observables (default: about 30 lines)",
+    )
+    r.set_defaults(func=cmd_run)
+
+    sd = sub.add_parser(
+        "stepdiff",
+        help="validate a dynamic backend one frame at a time (exit 0/1/2)",
+        description="For each chosen simulated frame k of a reference written with "
+        "--velocities all, run BINARY --input REF --input-frame k --stages "
+        "simulate --frames 1 and compare its new frame with the reference's "
+        "frame k+1 by the dynamic per-frame tolerance (harness/check/diff_dynamic.py). "
+        "Exit 0 = equivalent, 1 = not, 2 = could not compare.",
+    )
+    sd.add_argument("--reference", required=True, help="dynamic state file (A)")
+    sd.add_argument("--binary", required=True, help="the binary to validate (e.g. build/hairsim-cuda)")
+    sd.add_argument("--frames", default="all", help="frame indices of A: all (default), K, K..L, K.., ..L")
+    sd.add_argument("--exact", action="store_true", help="require bit-identical frames")
+    sd.add_argument("--keep", help="keep the binary's outputs in this directory")
+    sd.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
+    sd.add_argument(
+        "flags", nargs=argparse.REMAINDER, help="further flags for the binary (after the options, e.g. -- --threads 1)"
+    )
+    sd.set_defaults(func=cmd_stepdiff)
+
+    d = sub.add_parser(
+        "diff",
+        help="compare two state files frame by frame (exit 0/1/2)",
+        description="Compare two HDF5 states frame by frame (docs/harness.md, Equivalence). Exit 0 = "
+        "equivalent, 1 = not equivalent, 2 = could not compare.",
+    )
+    d.add_argument("a", help="first state file (e.g. the CPU reference)")
+    d.add_argument("b", help="second state file")
+    d.add_argument(
+        "--frames",
+        default="all",
+        help="'all' (default; frame counts must match), 'last' (the last frame of "
+        "each), or frame numbers like '3' or '1,3'",
+    )
+    d.add_argument(
+        "--frame", type=int, action="append", help="compare only frame K (repeatable; negative counts from the end)"
+    )
+    d.add_argument(
+        "--align-last", action="store_true", help="with different frame counts, compare the last min(F_A, F_B) frames"
+    )
+    d.add_argument("--exact", action="store_true", help="require bit-identical positions")
+    d.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    d.set_defaults(func=cmd_diff)
+
+    s = sub.add_parser(
+        "sweep",
+        help="run a sweep file, appending rows to results/NAME/runs.csv",
+        description="Run every case of a sweep (configs/sweeps/NAME.toml), one row per "
+        "(case, stage) in results/NAME/runs.csv; a killed sweep resumes.",
+    )
+    s.add_argument("sweep", help="sweep name in configs/sweeps/ (e.g. quick) or a .toml path")
+    s.add_argument("--out", help="results directory (default results/<sweep name>)")
+    s.add_argument(
+        "--gpu",
+        choices=("auto", "yes", "no"),
+        default="auto",
+        help="run cuda cases: auto (if a GPU is usable), yes (fail without), no",
+    )
+    s.set_defaults(func=cmd_sweep)
+
+    for name, helptext, fn in (
+        ("plot", "draw the PNG plots of a results directory", cmd_plot),
+        ("report", "write report/report.md (and its plots)", cmd_report),
+    ):
+        description = (
+            helptext[0].upper()
+            + helptext[1:]
+            + " (rendering only: Fig. 1/2 come from the hair "
+            + ("state the bench leaves in RESULTS/states/, when it is there).")
+        )
+        q = sub.add_parser(name, help=helptext, description=description)
+        q.add_argument(
+            "results",
+            nargs="?",
+            default="results/default",
+            help="results directory with runs.csv and env.json (default results/default)",
+        )
+        q.add_argument("--report-dir", default=None, help="where to write (default report/)")
+        q.set_defaults(func=fn)
+
+    rd = sub.add_parser(
+        "report-dynamic",
+        help="write report/dynamic.md (and its plots) from a dynamic bench root",
+        description="Write report/dynamic.md and its plots from the results of the dynamic bench "
+        "(ROOT/dynamic/, featurecost/, dynamic-accuracy/, stability/, peer/, headline/): rendering only.",
+    )
+    rd.add_argument("root", nargs="?", default="results", help="the bench root (default results/)")
+    rd.add_argument("--report-dir", default=None, help="where to write (default report/)")
+    rd.set_defaults(func=cmd_report_dynamic)
+
+    b = sub.add_parser(
+        "bench",
+        help="the make bench pipeline: check, validate, sweep, report",
+        description="Check the binaries, validate every GPU variant against the CPU "
+        "(fail before timing), run the sweep, then plot and report.",
+    )
+    b.add_argument("--sweep", default="default", help="sweep name in configs/sweeps/ or a path (default: default)")
+    b.add_argument("--out", help="results directory (default results/<sweep name>)")
+    b.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto")
+    b.add_argument("--report-dir", default=None, help="where to write the report (default report/)")
+    b.add_argument(
+        "--model",
+        choices=("all", "paper", "dynamic"),
+        default="all",
+        help="all (default): the paper model's bench, then the dynamic model's; --out is the paper "
+        "sweep's directory (the dynamic results go beside it) with all, the dynamic bench's root with "
+        "dynamic (default results/)",
+    )
+    b.add_argument(
+        "--full-studies",
+        action="store_true",
+        help="dynamic: the full accuracy study and stability map (tens of minutes) instead of the "
+        "bench's size (accuracy --quick, stability --quick: minutes on a 16-core + H200 node)",
+    )
+    b.set_defaults(func=cmd_bench)
+
+    a = sub.add_parser(
+        "accuracy",
+        help="speed against accuracy: every mode against a reference (paper or dynamic model)",
+        description="Paper model (default): run the scene in every precision/build mode available "
+        "here and in several model resolutions, compare with hairsim-cpu --precision fp64, time "
+        "each mode apart, and write results/accuracy/ and report/accuracy.md with a Pareto plot. "
+        "Dynamic model (--model dynamic, or a dynamic --scene): every solver x substeps x "
+        "iterations x precision x build against a converged xpbd fp64 reference (substeps doubled "
+        "until S and 2S agree to a tenth of the smallest error), time per frame measured apart, "
+        "small steps against iterations, the analytic checks and a recommendation; writes "
+        "results/dynamic-accuracy/ and report/dynamic_accuracy.md with its plots "
+        "(docs/harness.md). Exit 0, or 1 when the dynamic reference did not converge.",
+    )
+    a.add_argument(
+        "--model", choices=("paper", "dynamic"), default=None, help="default: the --scene's model, else paper"
+    )
+    a.add_argument("--scene", default=None, help="scene name or .toml path (default paper, or dynamic)")
+    a.add_argument("--strands", type=whole(1), default=None, help="paper 100000; dynamic 256 (--quick 32)")
+    a.add_argument("--points", type=whole(2), default=None, help="default: paper 32; dynamic the scene's")
+    a.add_argument("--repeat", type=whole(1), default=None, help="timed repetitions (default: paper 9, dynamic 3)")
+    a.add_argument(
+        "--resolution",
+        type=whole(2),
+        nargs="+",
+        default=None,
+        help="paper: points per strand of the resolution study (the largest is the reference; default 4 … 256)",
+    )
+    a.add_argument("--resolution-strands", type=whole(1), default=None, help="paper: default 20000")
+    a.add_argument("--quick", action="store_true", help="dynamic: a small study (32 strands, 0.25 s, S 1 4 16, I 1 2)")
+    a.add_argument("--seconds", type=seconds, default=None, help="dynamic: simulated time (default 1; --quick 0.25)")
+    a.add_argument(
+        "--horizon", type=seconds, default=None, help="dynamic: time over which errors are compared (default 0.5)"
+    )
+    a.add_argument(
+        "--substeps", type=whole(1), nargs="+", default=None, help="dynamic: S values (default 1 2 4 8 16 32)"
+    )
+    a.add_argument("--iterations", type=whole(1), nargs="+", default=None, help="dynamic: I values (default 1 2 4)")
+    a.add_argument(
+        "--time-strands", type=whole(1), default=None, help="dynamic: strands of the timing runs (default 10000)"
+    )
+    a.add_argument("--time-frames", type=whole(1), default=None, help="dynamic: frames of a timing run (default 1)")
+    a.add_argument(
+        "--ref-start", type=whole(2), default=None, help="dynamic: first S of the reference (default 2 x max S)"
+    )
+    a.add_argument("--ref-max", type=whole(2), default=None, help="dynamic: largest S of the reference (default 16384)")
+    a.add_argument("--jobs", type=whole(1), default=None, help="dynamic: parallel checked runs (default: cores)")
+    a.add_argument(
+        "--analytic", choices=("full", "quick", "none"), default=None, help="dynamic: the analytic tables to run"
+    )
+    a.add_argument("--gpu", choices=("auto", "no"), default=None, help="dynamic: GPU modes and reference if usable")
+    a.add_argument("--force", action="store_true", help="dynamic: replace an existing results CSV")
+    a.add_argument(
+        "--out", default=None, help="results directory (default results/accuracy or results/dynamic-accuracy)"
+    )
+    a.add_argument("--report-dir", default=None, help="where to write (default report/)")
+    a.add_argument(
+        "--from-csv",
+        default=None,
+        help="only rewrite the report from an existing CSV (results/accuracy/accuracy.csv, or with "
+        "--model dynamic results/dynamic-accuracy/dynamic_accuracy.csv)",
+    )
+    a.set_defaults(func=cmd_accuracy)
+
+    h = sub.add_parser(
+        "headline",
+        help="the issues' headline numbers: bandwidth fractions and speedups",
+        description="At one size, measure the copy bandwidths, every CUDA variant's init and "
+        "wind+collide time and bandwidth fraction, and three CPU baselines "
+        "(ref 1 thread, ref all cores, simd all cores); write "
+        "results/headline/headline.json.",
+    )
+    h.add_argument("--strands", type=whole(1), default=4 * 1024 * 1024)
+    h.add_argument("--points", type=whole(2), default=32)
+    h.add_argument("--repeat", type=whole(1), default=9, help="GPU repetitions per stage (default 9)")
+    h.add_argument("--cpu-repeat", type=whole(1), default=3, help="CPU repetitions per stage (default 3)")
+    h.add_argument("--block-size", type=whole(32), default=256)
+    h.add_argument(
+        "--model",
+        choices=("paper", "dynamic"),
+        default="paper",
+        help="paper: the paper scene (default); dynamic: the dynamic model's four targets "
+        "(memory-bound case, default scene, real-time regime, CPU), results/headline/headline_dynamic.json",
+    )
+    h.add_argument("--ncu", action="store_true", help="dynamic: also profile the best kernel with Nsight Compute")
+    h.add_argument("--out", default=None, help="results directory (default results/headline)")
+    h.set_defaults(func=cmd_headline)
+
+    e = sub.add_parser(
+        "export",
+        help="sidecars that ParaView/VisIt (XDMF) and Blender/Houdini/usdview (USD) open",
+        description="Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions "
+        "referenced in STATE) and, with --usd, STATE.usdc (BasisCurves, one "
+        "time sample per frame; needs usd-core).",
+    )
+    e.add_argument("state", help="an HDF5 state written by a hairsim binary")
+    e.add_argument("--usd", action="store_true", help="also write the USD file")
+    e.add_argument("--usd-only", action="store_true", help="write only the USD file")
+    e.add_argument("--out", help="output prefix (default: the state's path)")
+    e.set_defaults(func=cmd_export)
+
+    c = sub.add_parser(
+        "calibrate",
+        help="measure fp32-vs-fp64 errors behind tolerances.py",
+        description="Run the cpu binary at fp32 and fp64 on the paper scene and print "
+        "the errors and invariant residuals that tolerances.py is set from.",
+    )
+    c.add_argument("--strands", type=whole(1), default=20000)
+    c.add_argument("--points", type=whole(2), nargs="+", default=[8, 32, 128])
+    c.add_argument("--seeds", type=whole(0), nargs="+", default=[1, 2, 3])
+    c.add_argument(
+        "--other",
+        help="a second binary to compare with the cpu reference at each "
+        "precision (e.g. build/hairsim-cuda on a GPU node)",
+    )
+    c.add_argument("--json", action="store_true")
+    c.set_defaults(func=cmd_calibrate)
+
+    fc = sub.add_parser(
+        "featurecost",
+        help="the dynamic model's time per frame with each feature undeclared, alone, and the full scene",
+        description="Run a dynamic scene with every feature undeclared, each alone, the full scene "
+        "less each, and the full scene (features are removed by their flags, so the binary compiles "
+        "them out); print a Markdown table and, with --out, write the rows as CSV.",
+    )
+    fc.add_argument("--scene", default="dynamic", help="a dynamic scene (default dynamic)")
+    fc.add_argument("--backend", choices=("cpu", "cuda"), default="cpu")
+    fc.add_argument("--build", default="default", help="cuda build: default | strict | fastmath")
+    fc.add_argument("--variant", default=None)
+    fc.add_argument("--strands", type=whole(1), default=100_000)
+    fc.add_argument("--points", type=whole(2), default=None)
+    fc.add_argument("--frames", type=whole(1), default=3, help="frames per case (default 3)")
+    fc.add_argument("--repeat", type=whole(1), default=3, help="timed repeats of each frame (default 3)")
+    fc.add_argument("--threads", type=whole(1), default=None, help="cpu threads (default: all cores)")
+    fc.add_argument("--block-size", type=whole(32), default=None)
+    fc.add_argument("--timeout", type=seconds, default=None)
+    fc.add_argument("--out", default=None, help="CSV file to write")
+    fc.add_argument(
+        "--instructions",
+        action="store_true",
+        help="cpu oracle: also count, under valgrind's callgrind, the instructions per point-substep of "
+        "the frame function (deterministic where times are noisy)",
+    )
+    fc.set_defaults(func=cmd_featurecost)
+
+    peer_plan = peer.Plan()
+    pe = sub.add_parser(
+        "peer",
+        help="the same chain scenes in Bender's PositionBasedDynamics (pypbd) beside ours",
+        description="Run chains released from rest in hairsim-cpu and in pypbd (XPBD distance constraints, "
+        "the parameters mapped as docs/decisions.md says), against our converged fp64 reference: error, "
+        "stretch and time per frame at several strand counts. Writes results/peer/ and report/peer.md. "
+        "Needs pypbd (optional): without it, one line says so and the exit status is 2.",
+    )
+    pe.add_argument(
+        "--points", type=whole(2), default=peer_plan.points, help="points per chain, root included (default 32)"
+    )
+    pe.add_argument("--length", type=number, default=peer_plan.length, help="chain length L, cm (default 30)")
+    pe.add_argument(
+        "--tilts",
+        type=number,
+        nargs="+",
+        default=list(peer_plan.tilts),
+        help="degrees from the downward vertical (30 60)",
+    )
+    pe.add_argument(
+        "--frames", type=whole(1), default=peer_plan.frames, help="accuracy horizon in frames (default 30: 0.5 s)"
+    )
+    pe.add_argument("--frame-dt", type=number, default=peer_plan.frame_dt, help="frame length Δt, s (default 1/60)")
+    pe.add_argument("--gravity", type=number, default=peer_plan.gravity, help="g0, cm/s² (default 981)")
+    pe.add_argument(
+        "--compliance", type=number, default=peer_plan.compliance, help="stretch compliance α (default 0: rigid)"
+    )
+    pe.add_argument(
+        "--settings", type=setting, nargs="+", default=list(peer_plan.settings), help="SxI pairs (8x1 32x1 8x4)"
+    )
+    pe.add_argument(
+        "--strands", type=whole(1), nargs="+", default=list(peer_plan.strands), help="chains timed (1 100 1000 10000)"
+    )
+    pe.add_argument("--threads", type=whole(1), default=peer_plan.threads, help="threads for both solvers (default 1)")
+    pe.add_argument(
+        "--time-frames", type=whole(1), default=peer_plan.time_frames, help="frames per timing run (default 5)"
+    )
+    pe.add_argument(
+        "--repeat", type=whole(1), default=peer_plan.repeat, help="our --repeat; the peer steps frames × repeat"
+    )
+    pe.add_argument(
+        "--ref-start", type=whole(1), default=peer_plan.ref_start, help="first S of the reference doubling (64)"
+    )
+    pe.add_argument("--ref-max", type=whole(2), default=peer_plan.ref_max, help="largest S of the reference (16384)")
+    pe.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
+    pe.add_argument("--out", default=None, help="results directory (default results/peer)")
+    pe.add_argument("--report-dir", default=None, help="where peer.md goes (default report/)")
+    pe.add_argument("--report-only", action="store_true", help="only re-render report/peer.md from --out")
+    pe.set_defaults(func=cmd_peer)
+
+    an = sub.add_parser(
+        "animate",
+        help="an animation of a dynamic state from the side and from the front",
+        description="Draw the frames of a dynamic HDF5 state (read through harness.io.trajectory) seen from "
+        "the side and from the front, the head sphere drawn, as a GIF (and an MP4 beside it where ffmpeg "
+        "is on PATH). Without STATE, runs configs/scenes/dynamic.toml on hairsim-cpu first.",
+    )
+    an.add_argument("state", nargs="?", default=None, help="a dynamic state file (default: run the dynamic scene)")
+    an.add_argument("--out", default=None, help="the GIF to write (default report/dynamic.gif)")
+    an.add_argument("--max-strands", type=whole(1), default=150, help="strands drawn at most (default 150)")
+    an.add_argument("--every", type=whole(1), default=None, help="draw every K-th frame (default: about 60 frames)")
+    an.add_argument("--fps", type=whole(1), default=None, help="frames per second of the GIF (default: real time)")
+    an.add_argument("--strands", type=whole(1), default=300, help="without STATE: strands simulated (default 300)")
+    an.add_argument("--frames", type=whole(1), default=120, help="without STATE: frames simulated (default 120)")
+    an.add_argument("--force", action="store_true", help="replace existing output files")
+    an.set_defaults(func=cmd_animate)
+
+    from harness.studies.stability import FRAMES, SLICE_NAMES, STRANDS
+
+    sb = sub.add_parser(
+        "stability",
+        help="the dynamic model's stability map: verdicts over 2-D slices of the scene space",
+        description="Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend "
+        "compliance and points; head-motion frequency against amplitude) for both solvers and precisions, "
+        "on the CPU and every built CUDA build where a GPU answers; judge each cell ok, over-stretched, "
+        "penetrating or blown up; write results/stability/, report/stability_*.png and "
+        "report/dynamic_stability.md.",
+    )
+    sb.add_argument("--quick", action="store_true", help="a coarser grid (about a quarter of the cells)")
+    sb.add_argument("--slice", action="append", choices=SLICE_NAMES, help="run only this slice (repeatable)")
+    sb.add_argument("--strands", type=whole(1), default=STRANDS, help=f"strands per cell (default {STRANDS})")
+    sb.add_argument("--frames", type=whole(1), default=FRAMES, help=f"frames per cell (default {FRAMES}: 1 s)")
+    sb.add_argument("--jobs", type=whole(1), default=None, help="cells run at once (default: all cores)")
+    sb.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto", help="run the CUDA builds too")
+    sb.add_argument("--timeout", type=seconds, default=None, help="seconds per cell before giving up")
+    sb.add_argument("--out", default=None, help="results directory (default results/stability)")
+    sb.add_argument("--report-dir", default=None, help="where to write (default report/)")
+    sb.add_argument("--from-csv", default=None, help="only redraw the report from an existing stability.csv")
+    sb.set_defaults(func=cmd_stability)
+
+    dc = sub.add_parser(
+        "docs",
+        help="remake docs/harness.md's command and module reference",
+        description="Remake the command and module reference of docs/harness.md from this parser and the "
+        "modules' docstrings (what `make docs` runs); --check only says whether it is current (exit 1 if not).",
+    )
+    dc.add_argument("--check", action="store_true", help="write nothing; exit 1 when the page is out of date")
+    dc.set_defaults(func=cmd_docs)
+    return p
+
+
+def main(argv=None):
+    args = parser().parse_args(argv)
+    try:
+        rc = args.func(args)
+        sys.stdout.flush()  # a closed pipe shows here, inside the handlers below
+        return rc
+    except HarnessError as e:
+        print(f"harness: error: {e}", file=sys.stderr)
+        return e.code if e.code else 2
+    except BrokenPipeError:  # the reader went away (`| head`): quiet, as other tools
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
+        return 141
+    except OSError as e:  # a path given that cannot be read or written, or a full disk: no traceback
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"harness: error: {where}{e.strerror or e}", file=sys.stderr)
+        return (
+            2
+            if isinstance(
+                e, (FileNotFoundError, FileExistsError, IsADirectoryError, NotADirectoryError, PermissionError)
+            )
+            else 4
+        )
+    except KeyboardInterrupt:
+        print("harness: interrupted", file=sys.stderr)
+        return 130

@@ -1,0 +1,111 @@
+"""The environment record of a sweep (results/<name>/env.json) and GPU detection.
+
+Every probe is best effort: a tool that is missing gives null, never an error."""
+
+import datetime
+import os
+import platform
+import shutil
+import subprocess
+import sys
+
+from harness.core.paths import ROOT
+
+
+def _cmd(args, timeout=20):
+    try:
+        out = subprocess.run(args, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return out.stdout.strip() if out.returncode == 0 else None
+
+
+def gpu_status():
+    """(usable, reason): whether an NVIDIA GPU answers here, else why not."""
+    if os.environ.get("HAIRBENCH_NO_GPU"):
+        return False, "HAIRBENCH_NO_GPU is set"
+    smi = shutil.which("nvidia-smi")
+    if smi is None:
+        return False, "no nvidia-smi on PATH: this machine has no NVIDIA GPU"
+    out = _cmd([smi, "-L"], timeout=30)
+    if not out or "GPU" not in out:
+        return False, "nvidia-smi lists no GPU"
+    return True, out.splitlines()[0]
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or None
+
+
+def gpu_info():
+    out = (
+        _cmd(["nvidia-smi", "--query-gpu=name,driver_version,memory.total", "--format=csv,noheader"])
+        if shutil.which("nvidia-smi")
+        else None
+    )
+    if not out:
+        return None
+    gpus = []
+    for line in out.splitlines():
+        parts = [p.strip() for p in line.split(",")]
+        if len(parts) == 3:
+            gpus.append({"name": parts[0], "driver": parts[1], "memory": parts[2]})
+    return gpus or None
+
+
+def first_line(text):
+    return text.splitlines()[0] if text else None
+
+
+def nvcc_version():
+    out = _cmd(["nvcc", "--version"])
+    if not out:
+        return None
+    lines = [ln for ln in out.splitlines() if "release" in ln]
+    return lines[-1].strip() if lines else first_line(out)
+
+
+def git_revision():
+    # A REVISION file wins (the Makefile's rule): it is written beside a tree copied to a
+    # GPU node, whose own .git, if any, can be stale.
+    try:
+        written = (ROOT / "REVISION").read_text().strip()
+    except OSError:
+        written = ""
+    if written:
+        return written + " (REVISION file)"
+    rev = _cmd(["git", "rev-parse", "--short", "HEAD"])
+    if rev is None:
+        return "unknown (no commit)"
+    dirty = _cmd(["git", "status", "--porcelain", "--untracked-files=no"])
+    return rev + ("-dirty" if dirty else "")
+
+
+def now():
+    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+
+
+def collect():
+    """The environment of this machine, now."""
+    gpus = gpu_info()
+    return {
+        "date": now(),
+        "hostname": platform.node(),
+        "os": platform.platform(),
+        "python": sys.version.split()[0],
+        "cpu_model": cpu_model(),
+        "cpu_cores": os.cpu_count(),
+        "gpus": gpus,
+        "device": gpus[0]["name"] if gpus else None,
+        "driver": gpus[0]["driver"] if gpus else None,
+        "nvcc": nvcc_version(),
+        "gcc": first_line(_cmd(["gcc", "--version"])),
+        "git_revision": git_revision(),
+    }

@@ -1,0 +1,161 @@
+"""Run a backend binary with --json and return its parsed record (docs/interfaces.md).
+
+A failure is one HarnessError line naming the binary, its exit status and the last line
+it wrote on stderr; exit status 3 (state does not fit in memory) is a `DoesNotFit`, so a
+sweep can skip the case and go on.
+"""
+
+import json
+import signal
+import subprocess
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+from harness import HarnessError
+from harness.core import tempfiles
+from harness.core.paths import display
+
+RECORD_KEYS = ("backend", "precision", "strands", "points", "stages")
+
+
+class BackendError(HarnessError):
+    """The binary failed or printed something that is not the documented record."""
+
+
+class DoesNotFit(BackendError):
+    """The binary refused the state as too large for memory (its exit status 3)."""
+
+
+class MissingBinary(HarnessError):
+    pass
+
+
+def require_binary(path: str | Path) -> Path:
+    path = Path(path)
+    if not path.exists():
+        raise MissingBinary(f"{display(path)} not found: run make")
+    return path
+
+
+def last_line(text: str) -> str:
+    lines = [ln for ln in (text or "").strip().splitlines() if ln.strip()]
+    return lines[-1].strip() if lines else ""
+
+
+def run_binary(
+    binary: str | Path, args: Sequence[Any], timeout: float | None = None, expect_keys: Iterable[str] = RECORD_KEYS
+) -> dict[str, Any]:
+    """Run `binary args… --json --quiet`; return the JSON object it prints."""
+    binary = require_binary(binary)
+    cmd = [str(binary), *map(str, args), "--json", "--quiet"]
+    try:
+        child = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    except OSError as e:
+        raise BackendError(f"cannot run {display(binary)}: {e.strerror}") from None
+    try:
+        stdout, stderr = child.communicate(timeout=timeout)
+    except BaseException as e:  # a timeout or an interrupt: the child dies, and what it left goes
+        child.kill()
+        child.wait()
+        tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(args))
+        if isinstance(e, subprocess.TimeoutExpired):
+            raise BackendError(f"{binary.name} did not finish within {timeout} s: {' '.join(cmd[1:])}") from None
+        raise
+    proc = subprocess.CompletedProcess(cmd, child.returncode, stdout, stderr)
+    if proc.returncode < 0:  # killed by a signal: the binary removes its own on these, SIGKILL aside
+        tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(args))
+    if proc.returncode == -signal.SIGINT:
+        raise KeyboardInterrupt
+    if proc.returncode != 0:
+        why = last_line(proc.stderr) or last_line(proc.stdout) or "no message"
+        cls = DoesNotFit if proc.returncode == 3 else BackendError
+        raise cls(f"{binary.name} exited with status {proc.returncode}: {why}", code=proc.returncode)
+    try:
+        record = json.loads(proc.stdout)
+    except json.JSONDecodeError:
+        raise BackendError(
+            f"{binary.name} printed no JSON record on stdout (got: {last_line(proc.stdout)[:120]!r})"
+        ) from None
+    if not isinstance(record, dict):
+        raise BackendError(f"{binary.name} printed JSON that is not an object")
+    missing = [k for k in expect_keys if k not in record]
+    if missing:
+        raise BackendError(f"{binary.name}: JSON record lacks {', '.join(missing)} (docs/interfaces.md)")
+    return record
+
+
+def run_flags(
+    scene: Any,
+    backend: str,
+    variant: str | None = None,
+    block_size: int | None = None,
+    threads: int | str | None = None,
+    repeat: int | None = None,
+    warmup: int | None = None,
+    output: str | Path | None = None,
+    force: bool = False,
+    input_file: str | Path | None = None,
+    stages: Sequence[str] | None = None,
+) -> list[str]:
+    """Backend flags for a scene and run options. With input_file, the geometry comes
+    from the file and only the wind flags and the stages are passed."""
+    if input_file:
+        flags = [
+            "--input",
+            str(input_file),
+            "--wind-strength",
+            repr(scene.wind_strength),
+            "--wind-angle",
+            repr(scene.wind_angle),
+        ]
+        flags += ["--stages", ",".join(stages or scene.stages)]
+    else:
+        flags = scene.flags()
+        if stages:
+            i = flags.index("--stages")
+            flags[i + 1] = ",".join(stages)
+    if variant:
+        flags += ["--variant", variant]
+    if backend == "cuda" and block_size:
+        flags += ["--block-size", str(block_size)]
+    if backend == "cpu" and threads:
+        flags += ["--threads", str(threads)]
+    if repeat:
+        flags += ["--repeat", str(repeat)]
+    if warmup is not None:
+        flags += ["--warmup", str(warmup)]
+    if output:
+        flags += ["--output", str(output)]
+        if force:
+            flags.append("--force")
+    return flags
+
+
+def summary(record: dict[str, Any]) -> str:
+    """A short human table of a record's stage times."""
+    where = (
+        f"block size {record.get('block_size')}"
+        if record.get("backend") == "cuda"
+        else f"{record.get('threads')} thread(s)"
+    )
+    lines = [
+        f"{record.get('backend')}/{record.get('variant')} {record.get('precision')}: "
+        f"{record.get('strands')} strands × {record.get('points')} points, {where}, "
+        f"repeat {record.get('repeat')}, on {record.get('device')}"
+    ]
+    lines.append(f"{'frame':>5} {'stage':8} {'median ms':>10} {'min ms':>10} {'max ms':>10} {'moved':>8}  note")
+    for s in record.get("stages", []):
+        note = "skipped (nil effect)" if s.get("skipped") else (s.get("fused") or "")
+        moved = s.get("moved_points")
+        lines.append(
+            f"{s.get('frame', ''):>5} {s.get('stage', ''):8} {s.get('median_ms', 0):10.3f} "
+            f"{s.get('min_ms', 0):10.3f} {s.get('max_ms', 0):10.3f} "
+            f"{'' if moved is None else moved:>8}  {note}"
+        )
+    for key in ("end_to_end_ms", "h2d_ms", "d2h_ms", "hdf5_write_ms"):
+        if record.get(key) is not None:
+            lines.append(f"{key}: {record[key]:.3f}")
+    if record.get("output"):
+        lines.append(f"wrote {record['output']}")
+    return "\n".join(lines)

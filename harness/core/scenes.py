@@ -1,0 +1,313 @@
+"""Scene files (configs/scenes/*.toml, docs/model.md §2.6) → validated Scene → backend flags.
+
+A scene file:
+
+    description = "…"            # optional, free text
+    model = "paper"              # optional; the only model so far
+    stages = ["init", "collide", "wind", "collide"]
+    precision = "fp32"           # fp32 | fp64
+    seed = 1
+    [head]
+    radius = 10.0                # R > 0
+    face_margin = 1.0            # m ≥ 0
+    [hair]
+    strands = 1000               # N ≥ 1
+    points = 32                  # P ≥ 2
+    length = 30.0                # L > 0
+    offset = 0.1                 # h > 0, and ℓ = L/(P−1) ≥ h
+    [wind]
+    strength = 0.5               # w in [0, 1]
+    angle = 3.141592653589793    # ψ in radians from +z toward +y
+
+Every key is optional except `stages`; missing ones take the backends' defaults (the
+values above). Anything else is refused before any work, naming the key: unknown keys,
+counts that are not whole numbers ≥ 1 (≥ 2 for points), NaN or infinite numbers, stages
+that do not exist or a list not starting with init, ℓ < h, and a state whose frame (times
+the copies a backend holds) would not fit in this machine's memory.
+"""
+
+import math
+import os
+import tomllib
+from dataclasses import dataclass, field, replace
+
+from harness import HarnessError
+from harness.core import scenes_dynamic
+from harness.core.paths import SCENES, config_file, display, read_toml
+
+STAGES = ("init", "collide", "wind", "simulate")
+PRECISIONS = ("fp32", "fp64")
+MODELS = ("paper", "dynamic")
+
+# table → key → (field name, kind); kinds: int_count, seed, pos, nonneg, unit, real
+SCHEMA = {
+    "": {
+        "description": ("description", "text"),
+        "model": ("model", "model"),
+        "stages": ("stages", "stages"),
+        "precision": ("precision", "precision"),
+        "seed": ("seed", "seed"),
+        "head": None,
+        "hair": None,
+        "wind": None,
+    },
+    "head": {"radius": ("head_radius", "pos"), "face_margin": ("face_margin", "nonneg")},
+    "hair": {
+        "strands": ("strands", "count1"),
+        "points": ("points", "count2"),
+        "length": ("hair_length", "pos"),
+        "offset": ("hair_offset", "pos"),
+    },
+    "wind": {"strength": ("wind_strength", "unit"), "angle": ("wind_angle", "real")},
+}
+
+# field name → kind, for overrides given on the command line
+FIELD_KINDS = {
+    spec[0]: spec[1]
+    for table in SCHEMA.values()
+    for spec in table.values()
+    if spec and spec[1] not in ("stages", "text")
+}
+
+
+class SceneError(HarnessError):
+    """A scene that is refused; the message names the file and the key."""
+
+
+@dataclass(frozen=True)
+class Scene:
+    name: str
+    stages: tuple
+    description: str = ""
+    model: str = "paper"
+    precision: str = "fp32"
+    seed: int = 1
+    head_radius: float = 10.0
+    face_margin: float = 1.0
+    strands: int = 1000
+    points: int = 32
+    hair_length: float = 30.0
+    hair_offset: float = 0.1
+    wind_strength: float = 0.5
+    wind_angle: float = math.pi
+    # model = "dynamic": the binary flags of [dynamics], [constraints], [wind] and [head]
+    # (harness/core/scenes_dynamic.py), flag → value text, in the order they were declared
+    dynamic: dict = field(default_factory=dict)
+    source: str = field(default="", compare=False)
+
+    @property
+    def file(self):
+        """The scene's TOML file relative to the repository when inside it ("" when made in code):
+        what results record, never a path of the machine that ran them."""
+        return display(self.source.removeprefix("scene ")) if self.source else ""
+
+    @property
+    def segment_length(self):
+        return self.hair_length / (self.points - 1)
+
+    @property
+    def real_size(self):
+        return 8 if self.precision == "fp64" else 4
+
+    def state_bytes(self):
+        return self.strands * self.points * 3 * self.real_size
+
+    def with_overrides(self, **overrides):
+        """A copy with the given fields replaced (None = keep), validated again."""
+        changes = {k: v for k, v in overrides.items() if v is not None}
+        for k, v in changes.items():
+            if k in FIELD_KINDS:
+                _convert(f"scene {self.name}", k, FIELD_KINDS[k], v)
+        scene = replace(self, **changes)
+        _check_values(scene, f"scene {self.name}")
+        return scene
+
+    def flags(self):
+        """The backend flags that run this scene (docs/interfaces.md)."""
+        return [
+            "--strands",
+            str(self.strands),
+            "--points",
+            str(self.points),
+            "--seed",
+            str(self.seed),
+            "--head-radius",
+            repr(self.head_radius),
+            "--hair-offset",
+            repr(self.hair_offset),
+            "--hair-length",
+            repr(self.hair_length),
+            "--face-margin",
+            repr(self.face_margin),
+            "--wind-strength",
+            repr(self.wind_strength),
+            "--wind-angle",
+            repr(self.wind_angle),
+            "--stages",
+            ",".join(self.stages),
+            "--precision",
+            self.precision,
+            *scenes_dynamic.flags(self),
+        ]
+
+
+def _number(where, key, value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SceneError(f"{where}: {key} must be a number, got {value!r}")
+    if math.isnan(value):
+        raise SceneError(f"{where}: {key} is NaN")
+    if math.isinf(value):
+        raise SceneError(f"{where}: {key} is infinite")
+    return float(value)
+
+
+def _convert(where, key, kind, value):
+    if kind == "text":
+        if not isinstance(value, str):
+            raise SceneError(f"{where}: {key} must be a string")
+        return value
+    if kind == "model":
+        if value not in MODELS:
+            raise SceneError(f"{where}: model '{value}' is not known (known: {', '.join(MODELS)})")
+        return value
+    if kind == "precision":
+        if value not in PRECISIONS:
+            raise SceneError(f"{where}: precision '{value}' is not fp32 or fp64")
+        return value
+    if kind == "stages":
+        return parse_stages(value, where, key)
+    if kind in ("count1", "count2", "seed"):
+        if isinstance(value, float):
+            _number(where, key, value)  # NaN/inf named as such
+        low = {"count1": 1, "count2": 2, "seed": 0}[kind]
+        if isinstance(value, bool) or not isinstance(value, int) or value < low:
+            raise SceneError(f"{where}: {key} must be a whole number ≥ {low}, got {value!r}")
+        if kind == "seed" and value >= 2**64:
+            raise SceneError(f"{where}: {key} must fit in 64 bits, got {value}")
+        return value
+    x = _number(where, key, value)
+    if kind == "pos" and not x > 0:
+        raise SceneError(f"{where}: {key} must be > 0, got {value!r}")
+    if kind == "nonneg" and not x >= 0:
+        raise SceneError(f"{where}: {key} must be ≥ 0, got {value!r}")
+    if kind == "unit" and not 0 <= x <= 1:
+        raise SceneError(f"{where}: {key} must be in [0, 1], got {value!r}")
+    return x
+
+
+MAX_STAGES = 64  # HB_MAX_STAGES in c_ref/params.h
+
+
+def parse_stages(value, where="scene", key="stages"):
+    """The stage-list rules of the binaries' --stages (c_ref/cli.c): known names, no empty
+    item (\"init,,wind\" is refused, not skipped), at most MAX_STAGES, init only first."""
+    if isinstance(value, str):
+        if value == "" or value.startswith(",") or value.endswith(",") or ",," in value:
+            raise SceneError(f"{where}: {key}: empty item in '{value}' (write e.g. init,collide,wind)")
+        value = value.split(",")
+    if not isinstance(value, list) or not value:
+        raise SceneError(f"{where}: {key} must be a non-empty list of stage names")
+    if len(value) > MAX_STAGES:
+        raise SceneError(f"{where}: {key}: at most {MAX_STAGES} stages")
+    for i, s in enumerate(value):
+        if not isinstance(s, str) or s not in STAGES:
+            raise SceneError(f"{where}: {key}[{i}] {s!r} is not a stage (known: {', '.join(STAGES)})")
+        if s == "init" and i > 0:
+            raise SceneError(f"{where}: {key}: init may only come first (it would replace the state)")
+    return tuple(value)
+
+
+# copies of one frame a backend holds: the state, its saved copy for --repeat/--warmup, and
+# the host frame written to the file (c_ref/driver.c)
+FRAME_COPIES = 3
+
+
+def memory_bytes():
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def _check_values(scene, where):
+    scenes_dynamic.check(scene, where, SceneError)
+    if scene.stages[0] != "init":
+        raise SceneError(f"{where}: stages must start with init (got '{scene.stages[0]}')")
+    if "init" in scene.stages[1:]:
+        raise SceneError(f"{where}: stages may contain init only first")
+    if scene.segment_length < scene.hair_offset:
+        raise SceneError(
+            f"{where}: hair.length/(hair.points − 1) = {scene.segment_length:g} is "
+            f"below hair.offset = {scene.hair_offset:g} (ℓ ≥ h is required)"
+        )
+    # frames are streamed to the file one at a time: a backend holds a few copies of one
+    # frame (FRAME_COPIES), never all of them; simulate adds velocities, rest shape and saved copies
+    need = scene.state_bytes() * (FRAME_COPIES + (3 if scene.model == "dynamic" else 0))
+    have = memory_bytes()
+    if have and need > have:
+        raise SceneError(
+            f"{where}: {scene.strands} strands × {scene.points} points need "
+            f"{need / 2**30:.1f} GiB ({FRAME_COPIES} copies of one frame), more than this "
+            f"machine's {have / 2**30:.1f} GiB (hair.strands too large)"
+        )
+
+
+def scene_from_dict(data, name, where):
+    values = {}
+    data, values["dynamic"] = scenes_dynamic.split(data, where, SceneError)
+    if "stages" not in data and values["dynamic"] is not None:
+        data = dict(data, stages=list(scenes_dynamic.DEFAULT_STAGES))
+    if values["dynamic"] is None:
+        values["dynamic"] = {}
+    for key, value in data.items():
+        if key not in SCHEMA[""]:
+            raise SceneError(f"{where}: unknown key '{key}' (known: {', '.join(SCHEMA[''])})")
+        if SCHEMA[""][key] is None:  # a table
+            if not isinstance(value, dict):
+                raise SceneError(f"{where}: '{key}' must be a table [{key}]")
+            for sub, subvalue in value.items():
+                if sub not in SCHEMA[key]:
+                    raise SceneError(f"{where}: unknown key '{key}.{sub}' (known in [{key}]: {', '.join(SCHEMA[key])})")
+                name_, kind = SCHEMA[key][sub]
+                values[name_] = _convert(where, f"{key}.{sub}", kind, subvalue)
+        else:
+            name_, kind = SCHEMA[""][key]
+            values[name_] = _convert(where, key, kind, value)
+    if "stages" not in values:
+        raise SceneError(f"{where}: missing key 'stages' (the ordered list of stages to run)")
+    scene = Scene(name=name, source=where, **values)
+    _check_values(scene, where)
+    return scene
+
+
+def find_scene_file(ref):
+    """A scene path, or a name looked up as configs/scenes/<name>.toml."""
+    found = config_file(ref, SCENES)
+    if found:
+        return found
+    known = sorted(q.stem for q in SCENES.glob("*.toml"))
+    raise SceneError(f"no scene '{ref}' (not a file; scenes in configs/scenes/: {', '.join(known) or 'none'})")
+
+
+def is_scene_file(path):
+    """A file with a `stages` key: a scene, not a sweep (a check; the directory is the rule)."""
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+        return "stages" in data or data.get("model") == "dynamic"
+    except (OSError, ValueError):  # TOMLDecodeError and UnicodeDecodeError are ValueErrors
+        return False
+
+
+def load_scene(ref):
+    path = find_scene_file(ref)
+    where = f"scene {path}"
+    data = read_toml(path, where, SceneError)
+    return scene_from_dict(data, path.stem, where)
+
+
+def with_frames(scene, n):
+    """A copy of a dynamic scene simulating n frames."""
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise SceneError(f"--frames must be a whole number ≥ 1, got {n!r}")
+    return replace(scene, dynamic={**scene.dynamic, "--frames": n})

@@ -1,0 +1,197 @@
+"""The dynamic model's part of a scene file (docs/model.md §3), for harness/core/scenes.py.
+
+A scene with `model = "dynamic"` may hold, besides the paper keys:
+
+    stages = ["init", "collide", "simulate"]   # optional here; must end with simulate
+    [dynamics]
+    frames = 300            # F ≥ 1             --frames
+    frame_dt = 0.016666…    # Δt > 0 (s)        --frame-dt
+    substeps = 8            # S ≥ 1             --substeps
+    iterations = 2          # I ≥ 1             --iterations
+    solver = "xpbd"         # xpbd | ftl        --solver
+    gravity = 981.0         # g0 ≥ 0            --gravity
+    drag = 0.5              # c_d ≥ 0           --drag
+    damping = 0.5           # β ≥ 0             --damping
+    ftl_damping = 0.9       # s in [0, 1]       --ftl-damping
+    output_every = 1        # K ≥ 1             --output-every
+    [constraints]
+    stretch_compliance = 0.0   # α_s ≥ 0        --stretch-compliance
+    bend_compliance = 1e-6     # α_b ≥ 0        --bend-compliance (declares bend)
+    shape_compliance = 1e-4    # α_g ≥ 0        --shape-compliance (declares shape)
+    shape_range = 0.5          # ρ_g in (0, 1]  --shape-range (needs shape_compliance)
+    collision_margin = 0.0     # c_m ≥ 0        --collision-margin
+    collider = true            # false → --no-collider
+    [wind]
+    speed = 150.0              # U ≥ 0 (cm/s)   --wind-speed
+    angle = 3.14159…           # ψ (shared with the paper wind)
+    gust_amplitude = 0.5       # A_g ≥ 0        --gust-amplitude
+    gust_frequency = 1.0       # f_g ≥ 0 (Hz)   --gust-frequency
+    gust_wavelength = 60.0     # λ_g > 0 (cm)   --gust-wavelength
+    [head]
+    motion = "nod"             # still | nod | shake | tilt   --head-motion
+    motion_amplitude = 0.25    # A ≥ 0 (rad)    --motion-amplitude
+    motion_frequency = 1.0     # f ≥ 0 (Hz)     --motion-frequency
+
+A key left out is not passed, so the binary's default (docs/model.md §3) applies. Unknown
+keys, wrong types, NaN/∞ and values out of range are refused naming the key; the dynamic
+keys in a scene whose model is not "dynamic" are refused too.
+"""
+
+import math
+
+DEFAULT_STAGES = ("init", "collide", "simulate")
+SOLVERS = ("xpbd", "ftl")
+MOTIONS = ("still", "nod", "shake", "tilt")
+
+# table → key → (flag, kind)
+TABLES = {
+    "dynamics": {
+        "frames": ("--frames", "count"),
+        "frame_dt": ("--frame-dt", "pos"),
+        "substeps": ("--substeps", "count"),
+        "iterations": ("--iterations", "count"),
+        "solver": ("--solver", SOLVERS),
+        "gravity": ("--gravity", "nonneg"),
+        "drag": ("--drag", "nonneg"),
+        "damping": ("--damping", "nonneg"),
+        "ftl_damping": ("--ftl-damping", "unit"),
+        "output_every": ("--output-every", "count"),
+    },
+    "constraints": {
+        "stretch_compliance": ("--stretch-compliance", "nonneg"),
+        "bend_compliance": ("--bend-compliance", "nonneg"),
+        "shape_compliance": ("--shape-compliance", "nonneg"),
+        "shape_range": ("--shape-range", "range"),
+        "collision_margin": ("--collision-margin", "nonneg"),
+        "collider": ("--no-collider", "bool"),
+    },
+}
+# dynamic keys inside the paper model's [wind] and [head] tables
+SHARED = {
+    "wind": {
+        "speed": ("--wind-speed", "nonneg"),
+        "gust_amplitude": ("--gust-amplitude", "nonneg"),
+        "gust_frequency": ("--gust-frequency", "nonneg"),
+        "gust_wavelength": ("--gust-wavelength", "pos"),
+    },
+    "head": {
+        "motion": ("--head-motion", MOTIONS),
+        "motion_amplitude": ("--motion-amplitude", "nonneg"),
+        "motion_frequency": ("--motion-frequency", "nonneg"),
+    },
+}
+MAX_COUNT = 10**6  # the binaries' bound on S and I (docs/model.md §3)
+
+
+def _value(where, key, kind, value, error):
+    if isinstance(kind, tuple):
+        if not isinstance(value, str) or value not in kind:
+            raise error(f"{where}: {key} must be one of {', '.join(kind)}, got {value!r}")
+        return value
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise error(f"{where}: {key} must be true or false, got {value!r}")
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise error(f"{where}: {key} must be a number, got {value!r}")
+    if isinstance(value, float) and math.isnan(value):
+        raise error(f"{where}: {key} is NaN")
+    if isinstance(value, float) and math.isinf(value):
+        raise error(f"{where}: {key} is infinite")
+    if kind == "count":
+        if not isinstance(value, int) or value < 1:
+            raise error(f"{where}: {key} must be a whole number ≥ 1, got {value!r}")
+        if key.endswith(("substeps", "iterations")) and value > MAX_COUNT:
+            raise error(f"{where}: {key} must be at most {MAX_COUNT}, got {value}")
+        return value
+    x = float(value)
+    ok = {"pos": x > 0, "nonneg": x >= 0, "unit": 0 <= x <= 1, "range": 0 < x <= 1}[kind]
+    if not ok:
+        want = {"pos": "> 0", "nonneg": "≥ 0", "unit": "in [0, 1]", "range": "in (0, 1]"}[kind]
+        raise error(f"{where}: {key} must be {want}, got {value!r}")
+    return value
+
+
+def split(data, where, error):
+    """(paper part of the scene dict, dynamic flags dict or None when the model is paper)."""
+    dynamic = data.get("model") == "dynamic"
+    paper = {}
+    flags = {}
+    for key, value in data.items():
+        if key in TABLES or key in SHARED:
+            if not isinstance(value, dict):
+                raise error(f"{where}: '{key}' must be a table [{key}]")
+        if key in TABLES:
+            if not dynamic:
+                raise error(f'{where}: table [{key}] belongs to model = "dynamic"')
+            for sub, v in value.items():
+                if sub not in TABLES[key]:
+                    raise error(f"{where}: unknown key '{key}.{sub}' (known in [{key}]: {', '.join(TABLES[key])})")
+                flag, kind = TABLES[key][sub]
+                flags[flag] = _value(where, f"{key}.{sub}", kind, v, error)
+            continue
+        if key in SHARED:
+            rest = {}
+            for sub, v in value.items():
+                if sub in SHARED[key]:
+                    if not dynamic:
+                        raise error(f"{where}: '{key}.{sub}' belongs to model = \"dynamic\"")
+                    flag, kind = SHARED[key][sub]
+                    flags[flag] = _value(where, f"{key}.{sub}", kind, v, error)
+                else:
+                    rest[sub] = v
+            paper[key] = rest
+            continue
+        paper[key] = value
+    if not dynamic:
+        return paper, None
+    if "--shape-range" in flags and "--shape-compliance" not in flags:
+        raise error(f"{where}: constraints.shape_range needs constraints.shape_compliance (shape is off without it)")
+    if "--frame-dt" in flags or "--substeps" in flags:
+        h = float(flags.get("--frame-dt", 1 / 60)) / int(flags.get("--substeps", 1))
+        if not 1e-12 <= h <= 1e3:
+            raise error(f"{where}: dynamics.frame_dt / dynamics.substeps = {h:g} s is outside [1e-12, 1e3] s")
+    return paper, flags
+
+
+def check(scene, where, error):
+    """The stage list rules of the dynamic model (called for every scene)."""
+    if scene.model == "dynamic":
+        if scene.stages[-1] != "simulate" or "simulate" in scene.stages[:-1]:
+            raise error(
+                f"{where}: stages of a dynamic scene must end with simulate, once (got {', '.join(scene.stages)})"
+            )
+    elif "simulate" in scene.stages:
+        raise error(f"{where}: stage 'simulate' needs model = \"dynamic\"")
+
+
+def flags(scene):
+    """The binary flags of a scene's dynamic part ([] for a paper scene)."""
+    out = []
+    for flag, value in scene.dynamic.items():
+        if flag == "--no-collider":
+            if value is False:
+                out.append(flag)
+            continue
+        out += [flag, value if isinstance(value, str) else repr(value)]
+    return out
+
+
+def frames(scene):
+    return int(scene.dynamic.get("--frames", 1))
+
+
+# ---- the features of a dynamic scene (what the feature-cost study turns off one at a time) ----
+
+# feature → the flags that declare it (each followed by a value)
+DECLARING = {
+    "bend": ("--bend-compliance",),
+    "shape": ("--shape-compliance", "--shape-range"),
+    "wind": ("--wind-speed", "--gust-amplitude", "--gust-frequency", "--gust-wavelength"),
+    "gust": ("--gust-amplitude",),
+    "motion": ("--head-motion", "--motion-amplitude", "--motion-frequency"),
+    "drag": ("--drag", "--damping"),
+}
+FEATURES = ("bend", "shape", "wind", "gust", "motion", "collide", "drag")
+# a feature that needs another to exist at all (gusts ride on the wind, the wind on drag)
+NEEDS = {"gust": ("wind", "drag"), "wind": ("drag",)}

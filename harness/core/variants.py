@@ -1,0 +1,126 @@
+"""The variants each binary declares: `hairsim-* --list-variants` (one JSON object).
+
+    {"backend": "cpu", "build": "default", "default_variant": "ref",
+     "precisions": ["fp32", "fp64"], "variants": [{"name": "ref", "stages": [...], ...}],
+     "solvers": ["xpbd", "ftl"]}
+
+The one place the harness and the tests learn variant names; read once per binary. Keys
+other than these are ignored, and missing optional ones get defaults, so a binary that
+declares more (solvers, stages) still reads.
+"""
+
+import json
+import subprocess
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+from harness import HarnessError
+from harness.core.paths import binary_path
+
+
+@dataclass(frozen=True)
+class Declared:
+    backend: str
+    build: str
+    default_variant: str
+    precisions: tuple
+    variants: tuple  # names, in the binary's order
+    stages: dict  # variant name -> tuple of the stages it runs
+    max_points: dict  # variant name -> the most points per strand it simulates (None: no limit)
+    solvers: tuple = ()  # the dynamic model's solvers, in the binary's order (none declared: ())
+    max_block: dict = field(default_factory=dict)  # variant -> most threads a block of its simulate (absent: 1024)
+
+    def runs(self, variant, stage="simulate", points=None, block=None):
+        """Whether `variant` runs `stage` (and, for simulate, strands of `points` points with
+        `block` threads a block)."""
+        if stage not in self.stages.get(variant, ()):
+            return False
+        limit = self.max_points.get(variant)
+        if points is not None and limit is not None and points > limit:
+            return False
+        most = self.max_block.get(variant)
+        return block is None or stage != "simulate" or most is None or int(block) <= most
+
+    def running(self, stage, points=None):
+        """The variants that run `stage` (at `points` points a strand), in the binary's order."""
+        return tuple(v for v in self.variants if self.runs(v, stage, points))
+
+
+@dataclass(frozen=True)
+class Runner:
+    """One binary (backend and build) and one of its variants."""
+
+    backend: str  # cpu | cuda
+    build: str  # default | strict | fastmath
+    variant: str | None  # None: the binary's default variant
+
+    @property
+    def binary(self):
+        return binary_path(self.backend, self.build)
+
+    @property
+    def label(self):
+        """ "cpu ref", "gpu normal fused": how the studies name it."""
+        if self.backend == "cpu":
+            return f"cpu {self.variant}"
+        return f"gpu {'normal' if self.build == 'default' else self.build} {self.variant}"
+
+
+def simulating(backend, build="default"):
+    """The first variant of a binary that simulates strands of any length (no max_points):
+    what a study that draws the point count runs."""
+    d = declared(backend, build)
+    for v in d.running("simulate"):
+        if d.max_points.get(v) is None:
+            return v
+    raise HarnessError(f"{binary_path(backend, build)} declares no variant that simulates any point count")
+
+
+@lru_cache(maxsize=None)
+def _read(path):
+    try:
+        p = subprocess.run([path, "--list-variants"], capture_output=True, text=True, timeout=60)
+    except OSError as e:
+        raise HarnessError(f"{path}: cannot run: {e.strerror}") from None
+    except subprocess.TimeoutExpired:
+        raise HarnessError(f"{path} --list-variants did not finish in 60 s") from None
+    if p.returncode != 0:
+        raise HarnessError(f"{path} --list-variants exited {p.returncode}: {p.stderr.strip()}")
+    try:
+        d = json.loads(p.stdout)
+        variants = [v for v in d["variants"] if isinstance(v, dict) and "name" in v]
+        names = tuple(str(v["name"]) for v in variants)
+        return Declared(
+            backend=str(d.get("backend", "")),
+            build=str(d.get("build", "default")),
+            default_variant=str(d.get("default_variant") or (names[0] if names else "")),
+            precisions=tuple(d.get("precisions", ("fp32", "fp64"))),
+            variants=names,
+            stages={str(v["name"]): tuple(v.get("stages", ())) for v in variants},
+            max_points={str(v["name"]): (int(v["max_points"]) if v.get("max_points") else None) for v in variants},
+            solvers=tuple(str(x) for x in d.get("solvers", ())),
+            max_block={str(v["name"]): int(v["max_block"]) for v in variants if v.get("max_block")},
+        )
+    except (ValueError, KeyError, TypeError, AttributeError):
+        raise HarnessError(f"{path} --list-variants did not print the documented JSON object") from None
+
+
+def declared(backend, build="default"):
+    """What the binary of `backend`/`build` declares; HarnessError if it is not built."""
+    path = binary_path(backend, build)
+    if not path.exists():
+        raise HarnessError(f"{path} not found: run make")
+    return _read(str(path))
+
+
+def names(backend, build="default"):
+    """The variant names of `backend`/`build`, or () when its binary is not built."""
+    try:
+        return declared(backend, build).variants
+    except HarnessError:
+        return ()
+
+
+def clear_cache():
+    """Forget what was read (a test that swaps the build directory)."""
+    _read.cache_clear()

@@ -1,0 +1,279 @@
+"""`python -m harness export STATE`: sidecars that other tools open (docs/interfaces.md,
+"Files other tools open").
+
+- XDMF (`STATE.xdmf` + `STATE.topo.h5`): ParaView and VisIt open the state as polylines
+  over time. The positions stay in STATE and are referenced frame by frame (hyperslabs);
+  the polyline connectivity is an HDF5 dataset in the small sidecar, so the XML stays a
+  few kilobytes at any strand count.
+- USD (`STATE.usdc`, needs PyPI `usd-core`): one `BasisCurves` prim, linear, with one time
+  sample per frame, for Blender, Houdini and usdview.
+
+A dynamic state's velocities go with the frames whose step has one (XDMF attribute
+`velocity`, USD `velocities`), and its rest shape with every frame (XDMF `rest_position`,
+USD primvar `rest`). Its observables are per-frame numbers, not geometry: they stay in the
+state (harness.io.trajectory reads them).
+"""
+
+import os
+from pathlib import Path
+from xml.sax.saxutils import escape
+
+import numpy as np
+
+from harness import HarnessError
+
+POSITION = "particles/hair/position"
+VELOCITY = "particles/hair/velocity"
+REST = "particles/hair/rest_position"
+BLOCK_ROWS = 1 << 20  # rows written or read at a time
+
+
+def _writable(path):
+    """Refuse, as the binaries do for --output, a target that is a symlink or exists and is
+    not a regular file; the caller writes PATH.tmp.<pid> and renames it over PATH."""
+    path = Path(path)
+    if path.is_symlink() or (path.exists() and not path.is_file()):
+        raise HarnessError(f"export: {path} is a symbolic link or not a regular file; refusing to replace it")
+    return path.with_name(f"{path.name}.tmp.{os.getpid()}")
+
+
+def _replace(tmp, path):
+    """fsync the finished temporary, then rename it over path (as the binaries do)."""
+    fd = os.open(tmp, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+    os.replace(tmp, path)
+    return Path(path)
+
+
+def _open_state(path):
+    import h5py
+
+    try:
+        f = h5py.File(path, "r")
+    except (OSError, ValueError) as e:
+        raise HarnessError(f"export: cannot open {path} as HDF5 ({e})") from None
+    try:
+        value = f[f"{POSITION}/value"]
+        n = int(f["parameters"].attrs["n_strands"])
+        p = int(f["parameters"].attrs["points_per_strand"])
+    except (KeyError, TypeError, ValueError):
+        f.close()
+        raise HarnessError(
+            f"export: {path} is not a hairbench state (no {POSITION}/value or /parameters n_strands, points_per_strand)"
+        ) from None
+    if value.ndim != 3 or value.shape[1] != n * p or value.shape[2] != 3:
+        f.close()
+        raise HarnessError(f"export: {path}: {POSITION}/value has shape {value.shape}, not [F][{n}·{p}][3]")
+    return f, n, p
+
+
+def frame_times(f):
+    """The time of each frame for viewers: the state's times when they increase, else the
+    frame index (the paper model's frames all sit at t = 0)."""
+    frames = f[f"{POSITION}/value"].shape[0]
+    if f"{POSITION}/time" in f:
+        t = np.asarray(f[f"{POSITION}/time"][:], dtype=np.float64)
+        if t.shape == (frames,) and (frames < 2 or np.all(np.diff(t) > 0)):
+            return t
+    return np.arange(frames, dtype=np.float64)
+
+
+def velocity_frames(f):
+    """{position frame index: velocity frame index} for the frames whose step has velocities."""
+    if f"{VELOCITY}/value" not in f:
+        return {}
+    at = {int(s): j for j, s in enumerate(f[f"{VELOCITY}/step"][()])}
+    return {k: at[int(s)] for k, s in enumerate(f[f"{POSITION}/step"][()]) if int(s) in at}
+
+
+def seconds_per_frame(f):
+    """The physical time between the last two frames of a state, or None (the paper
+    model's frames carry no time)."""
+    t = np.asarray(f[f"{POSITION}/time"][()], dtype=np.float64) if f"{POSITION}/time" in f else []
+    return float(t[-1] - t[-2]) if len(t) > 1 and t[-1] > t[-2] else None
+
+
+def write_connectivity(path, n, p):
+    """[N][P] point indices of each strand's polyline, compressed, written in blocks."""
+    import h5py
+
+    dtype = np.int32 if n * p < 2**31 else np.int64
+    strands_per_block = max(1, BLOCK_ROWS // p)
+    with h5py.File(path, "w") as f:
+        d = f.create_dataset(
+            "connectivity",
+            shape=(n, p),
+            dtype=dtype,
+            chunks=(min(n, strands_per_block), p),
+            compression="gzip",
+            compression_opts=1,
+            shuffle=True,
+        )
+        d.attrs["description"] = "row i: the point indices i*P … i*P + P-1 of strand i"
+        for start in range(0, n, strands_per_block):
+            stop = min(n, start + strands_per_block)
+            d[start:stop] = np.arange(start * p, stop * p, dtype=dtype).reshape(stop - start, p)
+    return dtype
+
+
+def _vector(name, state_ref, dataset, rows, float_bytes, index=None, count=None):
+    """An XDMF node attribute of 3-vectors: DATASET [rows][3], or its frame INDEX of COUNT."""
+    heavy = f'<DataItem Dimensions="{{dims}}" NumberType="Float" Precision="{float_bytes}" Format="HDF">{state_ref}:/{dataset}</DataItem>'
+    if index is None:
+        item = heavy.format(dims=f"{rows} 3")
+    else:
+        item = (
+            f'<DataItem ItemType="HyperSlab" Dimensions="{rows} 3" Type="HyperSlab">\n'
+            f'       <DataItem Dimensions="3 3" Format="XML">{index} 0 0 1 1 1 1 {rows} 3</DataItem>\n'
+            f"       {heavy.format(dims=f'{count} {rows} 3')}\n"
+            f"      </DataItem>"
+        )
+    return f'\n     <Attribute Name="{name}" AttributeType="Vector" Center="Node">\n      {item}\n     </Attribute>'
+
+
+def _xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_strand, dyn):
+    rows = n * p
+    grids = []
+    for k in range(frames):
+        extra = ""
+        if k in dyn["velocity"]:
+            extra += _vector(
+                "velocity", state_ref, f"{VELOCITY}/value", rows, float_bytes, dyn["velocity"][k], dyn["n_velocity"]
+            )
+        if dyn["rest"]:
+            extra += _vector("rest_position", state_ref, REST, rows, float_bytes)
+        strand = (
+            (
+                f'\n     <Attribute Name="strand" AttributeType="Scalar" Center="Node">\n'
+                f'      <DataItem Dimensions="{rows}" NumberType="Int" Precision="4" Format="HDF">'
+                f"{state_ref}:/particles/hair/strand</DataItem>\n     </Attribute>"
+            )
+            if has_strand
+            else ""
+        )
+        grids.append(f"""    <Grid Name="frame {k}" GridType="Uniform">
+     <Time Value="{float(times[k])!r}"/>
+     <Topology TopologyType="Polyline" NumberOfElements="{n}" NodesPerElement="{p}">
+      <DataItem Dimensions="{n} {p}" NumberType="Int" Precision="{int_bytes}" Format="HDF">{topo_ref}:/connectivity</DataItem>
+     </Topology>
+     <Geometry GeometryType="XYZ">
+      <DataItem ItemType="HyperSlab" Dimensions="{rows} 3" Type="HyperSlab">
+       <DataItem Dimensions="3 3" Format="XML">{k} 0 0 1 1 1 1 {rows} 3</DataItem>
+       <DataItem Dimensions="{frames} {rows} 3" NumberType="Float" Precision="{float_bytes}" Format="HDF">{state_ref}:/{POSITION}/value</DataItem>
+      </DataItem>
+     </Geometry>{strand}{extra}
+    </Grid>""")
+    body = "\n".join(grids)
+    return f"""<?xml version="1.0" ?>
+<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>
+<Xdmf Version="2.0">
+ <Domain>
+  <Grid Name="hair" GridType="Collection" CollectionType="Temporal">
+{body}
+  </Grid>
+ </Domain>
+</Xdmf>
+"""
+
+
+def export_xdmf(state, out_prefix=None):
+    """Write OUT.xdmf and OUT.topo.h5 beside the state (or at out_prefix); return both paths."""
+    state = Path(state)
+    prefix = Path(out_prefix) if out_prefix else state
+    xdmf_path = prefix.with_name(prefix.name + ".xdmf")
+    topo_path = prefix.with_name(prefix.name + ".topo.h5")
+    f, n, p = _open_state(state)
+    with f:
+        value = f[f"{POSITION}/value"]
+        frames, float_bytes = value.shape[0], value.dtype.itemsize
+        times = frame_times(f)
+        has_strand = "particles/hair/strand" in f
+        dyn = {
+            "velocity": velocity_frames(f),
+            "n_velocity": f[f"{VELOCITY}/value"].shape[0] if f"{VELOCITY}/value" in f else 0,
+            "rest": REST in f,
+        }
+    tmp_topo, tmp_xdmf = _writable(topo_path), _writable(xdmf_path)
+    try:
+        int_bytes = np.dtype(write_connectivity(tmp_topo, n, p)).itemsize
+    except BaseException:
+        tmp_topo.unlink(missing_ok=True)
+        raise
+    here = xdmf_path.parent.resolve()
+    state_ref = escape(os.path.relpath(state.resolve(), here))
+    topo_ref = escape(os.path.relpath(topo_path.resolve(), here))
+    tmp_xdmf.write_text(_xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_strand, dyn))
+    return _replace(tmp_xdmf, xdmf_path), _replace(tmp_topo, topo_path)
+
+
+def export_usd(state, out_prefix=None):
+    """Write OUT.usdc: /hair/strands, a linear BasisCurves with one time sample per frame
+    (points are float3 in USD: an fp64 state is rounded to fp32)."""
+    try:
+        from pxr import Sdf, Usd, UsdGeom, Vt
+    except ImportError:
+        raise HarnessError("export --usd needs the USD Python bindings: python3 -m pip install usd-core") from None
+    state = Path(state)
+    prefix = Path(out_prefix) if out_prefix else state
+    usd_path = prefix.with_name(prefix.name + ".usdc")
+    f, n, p = _open_state(state)
+    with f:
+        value = f[f"{POSITION}/value"]
+        frames = value.shape[0]
+        times = frame_times(f)
+        _writable(usd_path)
+        tmp = usd_path.with_name(f"{usd_path.stem}.tmp{os.getpid()}.usdc")  # USD picks the format by suffix
+        tmp.unlink(missing_ok=True)
+        stage = Usd.Stage.CreateNew(str(tmp))
+        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)  # column 1 is up
+        UsdGeom.SetStageMetersPerUnit(stage, 0.01)  # positions are in cm
+        stage.SetStartTimeCode(0)
+        stage.SetEndTimeCode(frames - 1)
+        dt = seconds_per_frame(f)
+        # time code = frame index; a dynamic state's frame rate makes its velocities (per second) agree
+        stage.SetTimeCodesPerSecond(1.0 / dt if dt else 24)
+        root = UsdGeom.Xform.Define(stage, "/hair")
+        stage.SetDefaultPrim(root.GetPrim())
+        curves = UsdGeom.BasisCurves.Define(stage, "/hair/strands")
+        curves.CreateTypeAttr(UsdGeom.Tokens.linear)
+        curves.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(n, p, dtype=np.int32)))
+        curves.CreateWidthsAttr(Vt.FloatArray([0.01]))
+        curves.SetWidthsInterpolation(UsdGeom.Tokens.constant)
+        points = curves.CreatePointsAttr()
+        for k in range(frames):
+            frame = np.ascontiguousarray(value[k], dtype=np.float32)
+            points.Set(Vt.Vec3fArray.FromNumpy(frame), Usd.TimeCode(k))
+        vel = velocity_frames(f)
+        if vel:
+            velocities = curves.CreateVelocitiesAttr()
+            for k, j in vel.items():
+                frame = np.ascontiguousarray(f[f"{VELOCITY}/value"][j], dtype=np.float32)
+                velocities.Set(Vt.Vec3fArray.FromNumpy(frame), Usd.TimeCode(k))
+        if REST in f:
+            rest = UsdGeom.PrimvarsAPI(curves).CreatePrimvar(
+                "rest", Sdf.ValueTypeNames.Point3fArray, UsdGeom.Tokens.vertex
+            )
+            rest.Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(f[REST][()], dtype=np.float32)))
+        prim = curves.GetPrim()
+        prim.CreateAttribute("hairbench:frameTime", Sdf.ValueTypeNames.DoubleArray).Set(Vt.DoubleArray.FromNumpy(times))
+        try:
+            stage.GetRootLayer().Save()
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+    del stage
+    return _replace(tmp, usd_path)
+
+
+def run(state, xdmf=True, usd=False, out=None):
+    if not Path(state).is_file():
+        raise HarnessError(f"export: {state}: no such file")
+    written = []
+    if xdmf:
+        written += export_xdmf(state, out)
+    if usd:
+        written.append(export_usd(state, out))
+    return written

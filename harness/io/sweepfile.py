@@ -1,0 +1,266 @@
+"""Sweep files (configs/sweeps/<sweep>.toml) → the list of cases to run.
+
+    name = "default"          # results/<name>/ (optional; defaults to the file's stem)
+    description = "…"
+    scene = "paper"           # a scene name in configs/scenes/ or a path
+    frames = 3                # dynamic scenes: simulated frames per case (else the scene's)
+    repeat = 9                # timed repetitions per stage (≥ 9: median and IQR)
+    warmup = 1                # untimed runs per stage before them
+    timeout_s = 600           # per case
+    [axes]                    # shared by every backend
+    strands = [1000, 10000]
+    points = [32]
+    precision = ["fp32", "fp64"]
+    solver = ["xpbd", "ftl"]  # dynamic scenes only (default: the scene's solver)
+    [cpu]                     # leave the table out to run no cpu case
+    variant = ["ref", "simd"]
+    threads = [1, "all"]      # "all" = every core (the binary's default)
+    [cuda]
+    build = ["default"]       # default | strict | fastmath (binaries hairsim-cuda[-…])
+    variant = ["paper", "soa", "fused"]
+    block_size = [32, 64, 128, 256, 512, 1024]
+
+A backend table may also set strands, points or precision, replacing the shared axis for
+that backend (e.g. fewer strands for the single-thread CPU). Write [[cpu]] / [[cuda]]
+(arrays of tables) for several groups of one backend, e.g. every block size for the
+default build but one for the fast-math build. The cases are the product of the axes of
+each group; a case that two groups both produce runs once.
+"""
+
+import itertools
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from harness import HarnessError
+from harness.core.paths import CUDA_BUILDS, SWEEPS, config_file, read_toml
+from harness.core.scenes import PRECISIONS, is_scene_file, load_scene, with_frames
+from harness.core.scenes_dynamic import SOLVERS
+from harness.core.variants import declared
+from harness.core.variants import names as declared_variants
+
+MIN_REPEAT = 9
+SHARED_AXES = ("strands", "points", "precision", "solver")  # solver: dynamic scenes only
+BACKEND_AXES = {"cpu": ("variant", "threads"), "cuda": ("build", "variant", "block_size")}
+DEFAULTS = {
+    "cpu": {"variant": ["ref"], "threads": ["all"]},
+    "cuda": {"build": ["default"], "variant": ["fused"], "block_size": [256]},
+}
+TOP_KEYS = ("name", "description", "scene", "frames", "repeat", "warmup", "timeout_s", "axes", "cpu", "cuda")
+
+
+class SweepError(HarnessError):
+    pass
+
+
+@dataclass(frozen=True)
+class Case:
+    scene: str
+    backend: str
+    build: str  # cuda build, "" for cpu
+    variant: str
+    precision: str
+    block_size: int  # 0 for cpu
+    threads: str  # "1", "2", … or "all"; "" for cuda
+    strands: int
+    points: int
+    repeat: int
+    warmup: int
+    solver: str = ""  # dynamic scenes: xpbd | ftl ("" = the scene's own)
+
+    @property
+    def case_id(self):
+        where = f"t{self.threads}" if self.backend == "cpu" else f"{self.build}:b{self.block_size}"
+        return (
+            f"{self.scene}:{self.backend}:{self.variant}:{where}:{self.precision}:"
+            f"N{self.strands}:P{self.points}:r{self.repeat}w{self.warmup}" + (f":{self.solver}" if self.solver else "")
+        )
+
+
+@dataclass
+class Sweep:
+    name: str
+    path: Path
+    scene: object
+    repeat: int
+    warmup: int
+    timeout_s: int
+    axes: list  # (backend, {axis: values}) per group; the cases are each group's product
+    description: str = ""
+
+    def cases(self):
+        out, seen = [], set()
+        for backend, axes in self.axes:
+            names = list(axes)
+            for values in itertools.product(*(axes[n] for n in names)):
+                v = dict(zip(names, values))
+                out.append(
+                    Case(
+                        scene=self.scene.name,
+                        backend=backend,
+                        build=v.get("build", ""),
+                        variant=v["variant"],
+                        precision=v["precision"],
+                        block_size=int(v.get("block_size", 0)),
+                        threads=str(v.get("threads", "")),
+                        strands=int(v["strands"]),
+                        points=int(v["points"]),
+                        repeat=self.repeat,
+                        warmup=self.warmup,
+                        solver=str(v.get("solver", "")),
+                    )
+                )
+                if out[-1].case_id in seen:
+                    out.pop()  # the same case from two groups runs once
+                else:
+                    seen.add(out[-1].case_id)
+        # cheap cases first, so a short run already covers every configuration
+        out.sort(key=lambda c: (c.strands * c.points, c.backend, c.case_id))
+        return out
+
+
+def _list(where, key, value):
+    if not isinstance(value, list):
+        value = [value]
+    if not value:
+        raise SweepError(f"{where}: {key} is an empty list")
+    return value
+
+
+def _check_axis(where, label, values, backend):
+    """Check the values of one axis; `label` names it in messages (e.g. cuda.block_size)."""
+    key = label.rsplit(".", 1)[-1]
+    for v in values:
+        if key in ("strands", "points", "block_size"):
+            low = {"strands": 1, "points": 2, "block_size": 1}[key]
+            if isinstance(v, bool) or not isinstance(v, int) or v < low:
+                raise SweepError(f"{where}: {label} values must be whole numbers ≥ {low}, got {v!r}")
+            if key == "block_size" and not (32 <= v <= 1024 and v % 32 == 0):
+                raise SweepError(f"{where}: {label} {v} is not a multiple of 32 in 32…1024")
+        elif key == "precision" and v not in PRECISIONS:
+            raise SweepError(f"{where}: {label} '{v}' is not fp32 or fp64")
+        elif key == "threads" and not (v == "all" or (isinstance(v, int) and not isinstance(v, bool) and v >= 1)):
+            raise SweepError(f'{where}: {label} values must be whole numbers ≥ 1 or "all", got {v!r}')
+        elif key == "build" and v not in CUDA_BUILDS:
+            raise SweepError(f"{where}: {label} '{v}' is not one of {', '.join(CUDA_BUILDS)}")
+        elif key == "solver" and v not in SOLVERS:
+            raise SweepError(f"{where}: {label} '{v}' is not one of {', '.join(SOLVERS)}")
+        elif key == "variant":
+            known = known_variants(backend)
+            if known and v not in known:
+                raise SweepError(f"{where}: {label} '{v}' is not one of {', '.join(known)}")
+    return values
+
+
+def known_variants(backend):
+    """The variants the backend's binaries declare (every cuda build's); () when none is
+    built here, so the cases are kept and later skipped as "not built"."""
+    builds = CUDA_BUILDS if backend == "cuda" else ("default",)
+    known = []
+    for build in builds:
+        known += [n for n in declared_variants(backend, build) if n not in known]
+    return tuple(known)
+
+
+def _results_name(where, name):
+    """A sweep's name is a directory under results/: one plain path component."""
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", name) or ".." in name:
+        raise SweepError(
+            f"{where}: name must be letters, digits, '.', '_' or '-' (a directory under results/), got {name!r}"
+        )
+    return name
+
+
+def find_sweep_file(ref):
+    found = config_file(ref, SWEEPS)
+    if found and is_scene_file(found):
+        raise SweepError(f"{ref} is a scene file (it has `stages`), not a sweep: sweeps live in configs/sweeps/")
+    if found:
+        return found
+    raise SweepError(f"no sweep file '{ref}'")
+
+
+def load_sweep(ref):
+    path = find_sweep_file(ref)
+    where = f"sweep {path}"
+    data = read_toml(path, where, SweepError)
+    for key in data:
+        if key not in TOP_KEYS:
+            raise SweepError(f"{where}: unknown key '{key}' (known: {', '.join(TOP_KEYS)})")
+    if "scene" not in data:
+        raise SweepError(f"{where}: missing key 'scene'")
+    scene = load_scene(data["scene"])
+    repeat = data.get("repeat", MIN_REPEAT)
+    if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < MIN_REPEAT:
+        raise SweepError(f"{where}: repeat must be a whole number ≥ {MIN_REPEAT} (median and IQR), got {repeat!r}")
+    warmup = data.get("warmup", 1)
+    if isinstance(warmup, bool) or not isinstance(warmup, int) or warmup < 0:
+        raise SweepError(f"{where}: warmup must be a whole number ≥ 0, got {warmup!r}")
+    if "frames" in data:  # a dynamic scene's frames per case (each timed on its own)
+        if scene.model != "dynamic":
+            raise SweepError(f"{where}: frames needs a dynamic scene (scene {scene.name} is the paper model)")
+        f = data["frames"]
+        if isinstance(f, bool) or not isinstance(f, int) or f < 1:
+            raise SweepError(f"{where}: frames must be a whole number ≥ 1, got {f!r}")
+        scene = with_frames(scene, f)
+    timeout = data.get("timeout_s", 600)
+    if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not timeout > 0:
+        raise SweepError(f"{where}: timeout_s must be a number > 0")
+    shared = data.get("axes", {})
+    for key in shared:
+        if key not in SHARED_AXES:
+            raise SweepError(f"{where}: unknown key 'axes.{key}' (known: {', '.join(SHARED_AXES)})")
+    shared_axes = {"strands": [scene.strands], "points": [scene.points], "precision": [scene.precision]}
+    if scene.model == "dynamic":
+        shared_axes["solver"] = [scene.dynamic.get("--solver", "xpbd")]
+    for key, value in shared.items():
+        shared_axes[key] = _check_axis(where, f"axes.{key}", _list(where, f"axes.{key}", value), None)
+    groups = []
+    for backend in ("cpu", "cuda"):
+        if backend not in data:
+            continue
+        tables = data[backend] if isinstance(data[backend], list) else [data[backend]]
+        for n, table in enumerate(tables):
+            label = backend if len(tables) == 1 else f"{backend}[{n}]"
+            if not isinstance(table, dict):
+                raise SweepError(f"{where}: '{backend}' must be a table [{backend}] or tables [[{backend}]]")
+            known = BACKEND_AXES[backend] + SHARED_AXES
+            for key in table:
+                if key not in known:
+                    raise SweepError(f"{where}: unknown key '{label}.{key}' (known: {', '.join(known)})")
+            b = dict(DEFAULTS[backend])
+            b.update(shared_axes)
+            for key, value in table.items():
+                b[key] = _check_axis(where, f"{label}.{key}", _list(where, f"{label}.{key}", value), backend)
+            groups.append((backend, b))
+    axes = groups
+    if not axes:
+        raise SweepError(f"{where}: no [cpu] or [cuda] table: nothing to run")
+    for backend, b in axes:
+        for p in b["points"]:
+            scene.with_overrides(points=p)  # ℓ ≥ h for every point count
+        if "solver" in b and scene.model != "dynamic":
+            raise SweepError(f"{where}: a solver axis needs a dynamic scene (scene {scene.name} is the paper model)")
+        if scene.model == "dynamic":  # every variant listed must run simulate, at every point count
+            for build in b.get("build", ["default"]):
+                try:
+                    decl = declared(backend, build)
+                except HarnessError:
+                    continue  # not built here: the case is skipped later, saying so
+                for v in b["variant"]:
+                    for p in b["points"]:
+                        if v in decl.variants and not decl.runs(v, points=p):
+                            raise SweepError(
+                                f"{where}: the {backend} variant {v} does not simulate {p} points a strand "
+                                "(see --list-variants)"
+                            )
+    return Sweep(
+        name=_results_name(where, data.get("name", path.stem)),
+        path=path,
+        scene=scene,
+        repeat=repeat,
+        warmup=warmup,
+        timeout_s=int(timeout),
+        axes=axes,
+        description=data.get("description", ""),
+    )

@@ -1,0 +1,676 @@
+"""Render the dynamic model's speed-against-accuracy study (studies/accuracy_dynamic.py measures it):
+read results/dynamic-accuracy/ (dynamic_accuracy.csv, env.json, analytic.md) and write
+report/dynamic_accuracy.md with its pictures (the Pareto plot, the error growth over time,
+small steps against iterations). Every number and sentence comes from those files.
+
+`section(results_dir, report_dir)` gives the main report (report.py) a short section with
+a link to the full page.
+"""
+
+import json
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from harness import HarnessError
+from harness.core import tolerances
+from harness.core.paths import REPORT, RESULTS, display
+from harness.studies.accuracy import ANALYTIC_NAME, COLUMNS, CSV_NAME, RESULTS_NAME, holds_until, smallest
+
+PAGE = "dynamic_accuracy.md"
+PARETO_PNG = "dynamic_accuracy_pareto.png"
+GROWTH_PNG = "dynamic_accuracy_growth.png"
+STEPS_PNG = "dynamic_accuracy_steps.png"
+KEYS = ("backend", "build", "variant", "solver", "substeps", "iterations", "precision")
+
+
+# ---- reading --------------------------------------------------------------------------
+
+
+def load(results_dir, csv_path=None):
+    """(rows DataFrame, study dict of env.json, env dict, analytic Markdown lines); the rows
+    from csv_path when given, else from results_dir's table."""
+    import pandas as pd
+
+    results_dir = Path(results_dir)
+    csv_path = Path(csv_path) if csv_path else results_dir / CSV_NAME
+    try:
+        rows = pd.read_csv(csv_path)
+    except FileNotFoundError:
+        raise HarnessError(f"{display(csv_path)} not found: run `python -m harness accuracy --model dynamic`") from None
+    except (OSError, ValueError) as e:
+        raise HarnessError(f"{display(csv_path)}: cannot read ({e})") from None
+    missing = [c for c in COLUMNS if c not in rows.columns]
+    if missing or rows.empty:
+        raise HarnessError(
+            f"{display(csv_path)}: not a dynamic accuracy table (missing {', '.join(missing) or 'rows'})"
+        )
+    try:
+        env = json.loads((results_dir / "env.json").read_text())
+        study = env["study"]
+    except (OSError, ValueError, KeyError, TypeError):
+        raise HarnessError(f"{display(results_dir / 'env.json')}: missing or not the study's record") from None
+    analytic = results_dir / ANALYTIC_NAME
+    lines = analytic.read_text().splitlines() if analytic.exists() else []
+    return rows, study, env, lines
+
+
+# ---- what the rows say ----------------------------------------------------------------
+
+
+def summary(rows, horizon_frames):
+    """One row per mode: worst RMS and max error, stretch and penetration over the frames up
+    to the horizon; blown = strands blown up in any frame of the run; time per frame."""
+    m = rows[rows["study"] == "mode"]
+    inside = m[m["frame"] <= horizon_frames]
+    g = inside.groupby("mode", sort=False)
+    out = g[list(KEYS) + ["time_per_frame_ms", "time_strands", "device"]].first()
+    out["rms"] = g["rms_err_L"].apply(lambda s: s.max(skipna=False))
+    out["max"] = g["max_err_L"].apply(lambda s: s.max(skipna=False))
+    out["stretch"] = g["stretch_max"].max()
+    out["penetration"] = g["penetration_max"].max()
+    out["blown"] = m.groupby("mode", sort=False)["blown_up_strands"].max()
+    out["usable"] = (out["blown"] == 0) & np.isfinite(out["rms"])
+    return out.reset_index()
+
+
+def smallest_errors(rows):
+    """Per frame, the smallest RMS and max error of the modes never blown up (as the study
+    decided convergence): two Series indexed by frame."""
+    m = rows[rows["study"] == "mode"]
+    blown = m.groupby("mode")["blown_up_strands"].max()
+    ok = m[m["mode"].isin(blown[blown == 0].index)]
+    out = []
+    for col in ("rms_err_L", "max_err_L"):
+        wide = ok.pivot(index="frame", columns="mode", values=col)
+        out.append(
+            (wide.index.to_numpy(), smallest({c: wide[c].to_numpy() for c in wide.columns}))
+            if not wide.empty
+            else (np.array([]), np.array([]))
+        )
+    return out
+
+
+def convergence_table(rows, horizon_frames):
+    """Per reference rung S: the worst over the horizon of its difference to 2S and of that
+    difference over the smallest mode error at the same frame, both measures; and the last
+    time up to which the RMS rule holds over the whole run."""
+    ref = rows[rows["study"] == "reference"]
+    (frames, min_rms), (_, min_max) = smallest_errors(rows)
+    factor = tolerances.DYN_ACC_REF_FACTOR
+    table = []
+    for S, r in ref.groupby("substeps"):
+        r = r.set_index("frame").reindex(frames)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            q_rms = r["rms_err_L"].to_numpy() / min_rms
+            q_max = r["max_err_L"].to_numpy() / min_max
+        inside = frames <= horizon_frames
+        table.append(
+            dict(
+                S=int(S),
+                S2=int(r["ref_substeps"].dropna().iloc[0]),
+                rms=float(np.nanmax(r["rms_err_L"].to_numpy()[inside])),
+                q_rms=float(np.nanmax(q_rms[inside])),
+                max=float(np.nanmax(r["max_err_L"].to_numpy()[inside])),
+                q_max=float(np.nanmax(q_max[inside])),
+                holds=bool((q_rms[inside] < factor).all()),
+                max_holds=bool((q_max[inside] < factor).all()),
+                until=holds_until(q_rms < factor, r["time_s"].to_numpy()),
+                stretch=float(r["stretch_max"].to_numpy()[inside].max()),
+            )
+        )
+    return table
+
+
+def pareto_front(times, errors, tie=0.0):
+    """Boolean mask of the points no other point beats: sorted by time, a point is on the
+    front when its error is below (1 − tie) × the smallest error of every faster point (ties
+    in time go to the smaller error). With tie > 0, errors that differ only by rounding
+    (fp32 against fp64, one build against another) do not make a slower mode a front point.
+    NaN points are never on the front."""
+    t = np.asarray(times, dtype=np.float64)
+    e = np.asarray(errors, dtype=np.float64)
+    good = np.isfinite(t) & np.isfinite(e)
+    front = np.zeros(len(t), dtype=bool)
+    best = math.inf
+    for i in sorted(np.flatnonzero(good), key=lambda i: (t[i], e[i])):
+        if e[i] < best * (1.0 - tie):
+            front[i] = True
+            best = e[i]
+    return front
+
+
+def front_of(summ):
+    """The usable modes on the front (tolerances.DYN_ACC_FRONT_TIE), fastest first."""
+    ok = summ[summ["usable"]]
+    mask = pareto_front(ok["time_per_frame_ms"], ok["rms"], tolerances.DYN_ACC_FRONT_TIE)
+    return ok[mask].sort_values("time_per_frame_ms")
+
+
+def oracle(summ, study):
+    """The rows of the study's first cpu build (the C reference's default variant) in fp64."""
+    first = study["builds"][0] if study.get("builds") else None
+    label = summ.apply(_label, axis=1)
+    return summ[(label == first) & (summ["precision"] == "fp64")] if first else summ.iloc[0:0]
+
+
+def _label(r):
+    if r["backend"] == "cpu":
+        return f"cpu {r['variant']}"
+    return f"gpu {'normal' if r['build'] == 'default' else r['build']} {r['variant']}"
+
+
+def small_steps(summ, study):
+    """Per solver: for each n > 1 of the grid, S = n × I = 1 against S = 1 × I = n (oracle
+    build, fp64). {solver: [dict(n, steps=row, iters=row)]}."""
+    o = oracle(summ, study)
+    out = {}
+    for solver, s in o.groupby("solver", sort=False):
+        pairs = []
+        for n in sorted(set(s["substeps"]) | set(s["iterations"])):
+            a = s[(s["substeps"] == n) & (s["iterations"] == 1)]
+            b = s[(s["substeps"] == 1) & (s["iterations"] == n)]
+            if n > 1 and len(a) and len(b):
+                pairs.append(dict(n=int(n), steps=a.iloc[0], iters=b.iloc[0]))
+        out[solver] = pairs
+    return out
+
+
+def small_steps_verdict(solver, pairs, ladder=None):
+    """Sentences on what the pairs show, from their numbers; `ladder`: the solver's I = 1
+    modes by S (the trend of the error with S alone)."""
+    if not pairs:
+        return [f"- {solver}: no pair S = n × I = 1 / S = 1 × I = n in this grid."]
+    wins = [p["n"] for p in pairs if _better(p["steps"], p["iters"])]
+    losses = [p["n"] for p in pairs if p["n"] not in wins]
+    blown_iters = [p["n"] for p in pairs if p["iters"]["blown"] > 0]
+    blown_steps = [p["n"] for p in pairs if p["steps"]["blown"] > 0]
+    last = pairs[-1]
+    a, b = last["steps"], last["iters"]
+    line = (
+        f"- **{solver}**: S substeps × 1 iteration had the smaller RMS error in {len(wins)} of "
+        f"{len(pairs)} pairs" + (f" (n = {_list(wins)})" if wins else "") + "."
+    )
+    if losses:
+        line += f" 1 substep × n iterations had it for n = {_list(losses)}."
+    if a["usable"] and b["usable"]:
+        line += (
+            f" At n = {last['n']}: {_e(a['rms'])} against {_e(b['rms'])} "
+            f"({max(a['rms'], b['rms']) / min(a['rms'], b['rms']):.3g}× "
+            f"{'smaller' if a['rms'] < b['rms'] else 'larger'} with substeps), "
+            f"stretch {_pct(a['stretch'])} against {_pct(b['stretch'])}, "
+            f"{a['time_per_frame_ms']:.3g} against {b['time_per_frame_ms']:.3g} ms per frame."
+        )
+    if blown_iters:
+        line += f" 1 substep × n iterations blew up for n = {_list(blown_iters)}."
+    if blown_steps:
+        line += f" n substeps × 1 iteration blew up for n = {_list(blown_steps)}."
+    if ladder is not None and len(ladder) > 1:
+        ok = ladder[ladder["usable"]]
+        if len(ok):
+            best = ok.loc[ok["rms"].idxmin()]
+            top = ladder.iloc[-1]
+            falls = bool(np.all(np.diff(ladder["rms"].to_numpy()) < 0))
+            line += (
+                f" With I = 1 alone its error falls with every doubling of S, to {_e(top['rms'])} at "
+                f"S = {int(top['substeps'])}."
+                if falls
+                else f" With I = 1 alone its error is smallest at S = {int(best['substeps'])} ({_e(best['rms'])}) "
+                f"and is {_e(top['rms'])} at S = {int(top['substeps'])}: more substeps do not bring it closer "
+                "to the reference."
+            )
+    line += (
+        " This agrees with Macklin et al. 2019."
+        if not losses
+        else " Where iterations won, that is against Macklin et al. 2019's finding, measured here."
+        if wins
+        else " This is the opposite of Macklin et al. 2019's finding, measured here."
+    )
+    return [line]
+
+
+def _list(ns):
+    return ", ".join(str(n) for n in ns)
+
+
+def _better(a, b):
+    """Mode a beats mode b: b blown up and a not, or both usable and a's RMS error smaller."""
+    if a["blown"] == 0 and b["blown"] > 0:
+        return True
+    return bool(a["usable"] and b["usable"] and a["rms"] < b["rms"])
+
+
+def recommend(summ):
+    """Per use (tolerances.DYN_ACC_USES) and per backend: the cheapest mode that meets the
+    use's budget. Lines of Markdown."""
+    lines = []
+    ok = summ[summ["usable"]]
+    for use, (rms_budget, stretch_budget, why) in tolerances.DYN_ACC_USES.items():
+        fits = ok[(ok["rms"] <= rms_budget) & (ok["stretch"] <= stretch_budget)]
+        picks = []
+        for backend, what in (("cpu", "CPU"), ("cuda", "GPU")):
+            if not (summ["backend"] == backend).any():
+                continue
+            f = fits[fits["backend"] == backend]
+            if f.empty:
+                mine = ok[ok["backend"] == backend]
+                near = mine.loc[mine["rms"].idxmin()] if len(mine) else None
+                picks.append(
+                    f"{what}: no mode of this grid meets it"
+                    + (
+                        f" (the most accurate, {near['mode']}, has RMS error {_e(near['rms'])} and stretch "
+                        f"{_pct(near['stretch'])}: more substeps than this grid holds are needed)"
+                        if near is not None
+                        else ""
+                    )
+                )
+                continue
+            best = f.loc[f["time_per_frame_ms"].idxmin()]
+            picks.append(
+                f"{what}: **{best['mode']}** ({best['time_per_frame_ms']:.3g} ms per frame at "
+                f"{int(best['time_strands']):,} strands; RMS error {_e(best['rms'])}, stretch {_pct(best['stretch'])}; "
+                f"{len(f)} modes meet it)"
+            )
+        lines.append(
+            f"- **{use}** (RMS error ≤ {rms_budget:g}·L and stretch ≤ {_pct(stretch_budget)} over the horizon, "
+            f"never blown up; {why}): " + "; ".join(picks) + "."
+        )
+    return lines
+
+
+def _e(x):
+    return "blown up" if x is None or not np.isfinite(x) else f"{x:.2e}·L"
+
+
+def _pct(x):
+    return "n/a" if x is None or not np.isfinite(x) else f"{100 * x:.3g} %"
+
+
+def _short(r):
+    return f"{r['solver']} S{int(r['substeps'])} I{int(r['iterations'])} {r['precision']}"
+
+
+# ---- pictures -------------------------------------------------------------------------
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, path):
+    tmp = path.with_name(f"{path.stem}.tmp.{os.getpid()}{path.suffix}")
+    fig.savefig(tmp, dpi=110)
+    os.replace(tmp, path)
+    return path
+
+
+def pareto_plot(summ, study, path):
+    plt = _plt()
+    ok = summ[summ["usable"]].reset_index(drop=True)
+    fig, ax = plt.subplots(figsize=(8.5, 5.5))
+    labels = list(dict.fromkeys(ok.apply(_label, axis=1)))
+    solvers = list(dict.fromkeys(ok["solver"]))
+    colors = {lab: f"C{i % 10}" for i, lab in enumerate(labels)}
+    markers = {s: "osD^v<>"[i % 7] for i, s in enumerate(solvers)}
+    for _, r in ok.iterrows():
+        c = colors[_label(r)]
+        filled = r["precision"] == "fp64"
+        ax.scatter(
+            r["time_per_frame_ms"],
+            r["rms"],
+            s=28,
+            marker=markers[r["solver"]],
+            facecolors=c if filled else "none",
+            edgecolors=c,
+            linewidths=1,
+            alpha=0.8,
+        )
+    front = front_of(summ)
+    ax.step(
+        front["time_per_frame_ms"],
+        front["rms"],
+        where="post",
+        color="k",
+        lw=0.9,
+        label="Pareto front (# as in the table)",
+    )
+    for k, (_, r) in enumerate(front.iterrows(), 1):
+        ax.annotate(str(k), (r["time_per_frame_ms"], r["rms"]), textcoords="offset points", xytext=(3, 3), fontsize=8)
+    for lab in labels:
+        ax.scatter([], [], color=colors[lab], marker="s", label=lab)
+    for s in solvers:
+        ax.scatter([], [], color="0.4", marker=markers[s], label=f"{s} (filled fp64, hollow fp32)")
+    blown = int((~summ["usable"]).sum())
+    if len(ok):
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+    ax.set_xlabel(f"time per frame (ms), {int(ok['time_strands'].iloc[0]) if len(ok) else 0:,} strands")
+    ax.set_ylabel(f"RMS position error / L, worst frame up to {study['horizon']:g} s")
+    ax.set_title(
+        f"Dynamic model: error against time per frame ({len(ok)} modes"
+        + (f"; {blown} blown up, not shown)" if blown else ")")
+    )
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, loc="upper right")
+    fig.tight_layout()
+    out = _save(fig, path)
+    plt.close(fig)
+    return out
+
+
+def growth_plot(rows, summ, study, path):
+    """RMS error against time for the oracle build's fp64, I = 1 modes, one panel per solver,
+    with the reference's own S-vs-2S difference and the horizon."""
+    plt = _plt()
+    o = oracle(summ, study)
+    o = o[o["iterations"] == 1]
+    solvers = list(dict.fromkeys(o["solver"])) or ["none"]
+    fig, axes = plt.subplots(1, len(solvers), figsize=(5.2 * len(solvers), 4.2), sharey=True, squeeze=False)
+    ref = rows[rows["study"] == "reference"]
+    finest = ref[ref["substeps"] == ref["substeps"].max()] if len(ref) else ref
+    m = rows[rows["study"] == "mode"]
+    for ax, solver in zip(axes[0], solvers):
+        for k, (_, r) in enumerate(o[o["solver"] == solver].sort_values("substeps").iterrows()):
+            d = m[m["mode"] == r["mode"]].sort_values("frame")
+            ax.plot(d["time_s"], d["rms_err_L"], color=f"C{k % 10}", lw=1.2, label=f"S = {int(r['substeps'])}")
+        if len(finest):
+            f = finest.sort_values("frame")
+            S = int(f["substeps"].iloc[0])
+            ax.plot(f["time_s"], f["rms_err_L"], "k--", lw=1, label=f"reference S = {S} vs {2 * S}")
+        ax.axvline(study["horizon"], color="0.5", lw=0.8, ls=":")
+        ax.text(study["horizon"], 0.02, " horizon", fontsize=7, color="0.4", transform=ax.get_xaxis_transform())
+        if any(np.nanmax(np.asarray(ln.get_ydata(), float), initial=0) > 0 for ln in ax.get_lines()[:-1]):
+            ax.set_yscale("log")
+        ax.set_xlabel("simulated time (s)")
+        ax.set_title(f"{solver}, fp64, I = 1 ({study['builds'][0] if study.get('builds') else ''})", fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0][0].set_ylabel("RMS position error / L against the reference")
+    handles, names = axes[0][-1].get_legend_handles_labels()
+    fig.legend(handles, names, loc="lower center", ncol=min(len(names), 8), fontsize=7, frameon=False)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    out = _save(fig, path)
+    plt.close(fig)
+    return out
+
+
+def steps_plot(pairs_by_solver, path):
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for k, (solver, pairs) in enumerate(pairs_by_solver.items()):
+        n = [p["n"] for p in pairs]
+        ax.plot(n, [p["steps"]["rms"] for p in pairs], "-o", color=f"C{k}", label=f"{solver}: S = n, I = 1")
+        ax.plot(
+            n, [p["iters"]["rms"] for p in pairs], "--s", color=f"C{k}", mfc="none", label=f"{solver}: S = 1, I = n"
+        )
+    if any(pairs_by_solver.values()):
+        ax.set_xscale("log", base=2)
+        ax.set_yscale("log")
+    else:
+        ax.text(0.5, 0.5, "no n > 1 in this grid", ha="center", transform=ax.transAxes)
+    ax.set_xlabel("n")
+    ax.set_ylabel("RMS position error / L (worst frame up to the horizon)")
+    ax.set_title("Small steps against iterations (blown-up runs leave gaps)", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    out = _save(fig, path)
+    plt.close(fig)
+    return out
+
+
+# ---- Markdown -------------------------------------------------------------------------
+
+
+def _header(study, env):
+    ref = study["reference"]
+    dev = env.get("device") or "no GPU"
+    command = study.get("command") or "python -m harness accuracy --model dynamic"
+    return [
+        f"Scene `{study['scene_file']}` ({study.get('scene_description') or 'no description'}) at "
+        f"{study['strands']:,} strands × "
+        f"{study['points']} points (strands are independent and keep their roots at any count: same seed), "
+        f"{study['frames']} frames of Δt = {study['frame_dt']:.4g} s ({study['seconds']:g} s). Errors are "
+        f"compared over the **horizon of {study['horizon']:g} s** ({study['horizon_frames']} frames): the "
+        f"worst frame of RMS and of max |x − x_ref| over all points, over L = {study['hair_length']:g} cm. "
+        f"Time per frame: a separate run of the same mode at {study['time_strands']:,} strands, "
+        f"{study['time_frames']} frame(s) × `--repeat {study['repeat']}`, no output file, the simulate stage's "
+        f"median (never a run that also checks). Reference: {ref['label']} {ref['solver']} {ref['precision']}, "
+        f"I = {ref['iterations']}, S = {ref['substeps']}.",
+        "",
+        f"Machine: {env.get('cpu_model')} ({env.get('cpu_cores')} cores), GPU: {dev}; revision "
+        f"{env.get('git_revision')}; {env.get('date')}. Command: `{command}` "
+        f"(the whole study took {study.get('wall_s', float('nan')):.0f} s).",
+        "",
+    ]
+
+
+def convergence_lines(rows, study):
+    ref = study["reference"]
+    table = convergence_table(rows, study["horizon_frames"])
+    factor = tolerances.DYN_ACC_REF_FACTOR
+    out = [
+        "### The converged reference",
+        "",
+        f"S doubled from {study['ref_start'] or table[0]['S'] if table else '?'}: each row compares S with 2S "
+        f"({ref['label']}, xpbd, fp64, I = {ref['iterations']}). The rule: at every frame up to the horizon the "
+        f"RMS difference is under {factor:g} × the smallest RMS error any mode (never blown up) has at that "
+        "frame. The max measure is shown against the same rule; it does not decide S.",
+        "",
+        "| S | 2S | RMS(S − 2S)/L, worst | ÷ smallest RMS error, worst | RMS rule over the horizon "
+        "| RMS rule holds until (s) | max(S − 2S)/L, worst | ÷ smallest max error, worst | max rule | "
+        "stretch_max of S |",
+        "| ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: | --- | ---: |",
+    ]
+    for t in table:
+        out.append(
+            f"| {t['S']} | {t['S2']} | {t['rms']:.2e} | {t['q_rms']:.3f} | {'holds' if t['holds'] else 'fails'} "
+            f"| {t['until']:.3f} | {t['max']:.2e} | {t['q_max']:.3f} | {'holds' if t['max_holds'] else 'fails'} "
+            f"| {t['stretch']:.2e} |"
+        )
+    out.append("")
+    if ref["converged"]:
+        out.append(
+            f"**Converged**: the rule holds over the whole horizon at S = {ref['substeps'] // 2} against "
+            f"{ref['substeps']}; the modes are compared with S = {ref['substeps']}. Over the whole run it holds "
+            f"until t = {ref['converged_until_s']:.3f} s"
+            + (
+                ": beyond that the reference is no longer ten times better than the best mode, and the "
+                "errors after it are not a measurement of the modes (they are drawn, not tabulated)."
+                if ref["converged_until_s"] < study["frames"] * study["frame_dt"] - 1e-9
+                else "."
+            )
+        )
+    else:
+        out.append(
+            f"**NOT converged**: by S = {ref['substeps']} (`--ref-max {study['ref_max']}`) the rule still fails "
+            "over the horizon; the errors below are bounded by the reference's own difference in the table, not "
+            "measured to a tenth. Raise `--ref-max` or shorten `--horizon`."
+        )
+    if table and not table[-1]["max_holds"]:
+        out.append(
+            f"The max measure does not meet the rule (worst ratio {table[-1]['q_max']:.2f} at the last rung): single "
+            "points near a contact or in a nearly straight bend triple converge far more slowly than the RMS "
+            '(docs/decisions.md, "The dynamic accuracy study"). Read the max errors below as uncertain by about '
+            f"{table[-1]['max']:.1e}·L."
+        )
+    check = rows[rows["study"] == "gpu_check"]
+    if len(check):
+        H = study["horizon_frames"]
+        c = check[check["frame"] <= H]
+        out.append(
+            f"GPU fp64 reference ({check['mode'].iloc[0]}): RMS difference from the CPU's at S = "
+            f"{int(check['substeps'].iloc[0])} up to {c['rms_err_L'].max():.2e}·L over the horizon "
+            f"(max {c['max_err_L'].max():.2e}·L), allowed {tolerances.DYN_ACC_GPU_REF_SHARE:g} × the margin; "
+            f"{ref.get('gpu_check')}."
+        )
+    else:
+        out.append(f"No GPU reference: {ref.get('gpu_check')}.")
+    out.append("")
+    return out
+
+
+def _mode_table(df, numbered=False):
+    out = [
+        ("| # " if numbered else "")
+        + "| mode | time/frame (ms) | RMS err / L | max err / L | stretch_max | penetration_max (cm) | blown up |",
+        ("| ---: " if numbered else "") + "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for k, (_, r) in enumerate(df.iterrows(), 1):
+        out.append(
+            (f"| {k} " if numbered else "")
+            + f"| {r['mode']} | {r['time_per_frame_ms']:.3g} | {_e(r['rms']) if r['blown'] == 0 else '—'} | "
+            f"{_e(r['max']) if r['blown'] == 0 else '—'} | {r['stretch']:.3g} | {r['penetration']:.2g} | "
+            f"{int(r['blown'])} |"
+        )
+    return out
+
+
+def _all_modes_lines(summ):
+    order = summ.assign(label=summ.apply(_label, axis=1)).sort_values(
+        ["label", "solver", "precision", "substeps", "iterations"]
+    )
+    return [
+        "### Every mode",
+        "",
+        "Errors, stretch and penetration: the worst frame up to the horizon; blown up: the most strands "
+        "blown up in any frame of the run (its errors are then not shown).",
+        "",
+        *_mode_table(order),
+        "",
+    ]
+
+
+def markdown(rows, study, env, analytic):
+    summ = summary(rows, study["horizon_frames"])
+    front = front_of(summ)
+    pairs = small_steps(summ, study)
+    out = ["## Speed against accuracy: the dynamic model", "", *_header(study, env)]
+    out += convergence_lines(rows, study)
+    out += [
+        "### Error against time per frame",
+        "",
+        f"{len(summ)} modes ({', '.join(study.get('builds', []))} × solver × S × I × precision); "
+        f"{int((~summ['usable']).sum())} blew up. The Pareto front (no other mode is both faster and more "
+        "accurate):",
+        "",
+        *_mode_table(front, numbered=True),
+        "",
+        f"![error against time per frame]({PARETO_PNG})",
+        "",
+        "### Error growth over time",
+        "",
+        "Trajectories of different modes part over time, and the reference's own S-against-2S difference "
+        "(dashed) grows too: a mode's error means something only while it is well above that line. The "
+        f"comparison is made over the horizon ({study['horizon']:g} s, dotted); "
+        f"the rule holds until t = {study['reference']['converged_until_s']:.3f} s.",
+        "",
+        f"![error growth over time]({GROWTH_PNG})",
+        "",
+        "### Small steps against iterations",
+        "",
+        "Macklin et al. 2019 found n substeps × 1 iteration more accurate than 1 substep × n iterations "
+        f"for the same cost. Here, {study['builds'][0] if study.get('builds') else ''}, fp64:",
+        "",
+    ]
+    for solver, ps in pairs.items():
+        out += [
+            f"| {solver}: n | S = n, I = 1: RMS err / L | stretch | ms/frame | S = 1, I = n: RMS err / L | stretch "
+            "| ms/frame |",
+            "| ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+        ]
+        for p in ps:
+            a, b = p["steps"], p["iters"]
+            out.append(
+                f"| {p['n']} | {_e(a['rms']) if a['blown'] == 0 else 'blown up'} | {_pct(a['stretch'])} | "
+                f"{a['time_per_frame_ms']:.3g} | {_e(b['rms']) if b['blown'] == 0 else 'blown up'} | "
+                f"{_pct(b['stretch'])} | {b['time_per_frame_ms']:.3g} |"
+            )
+        out.append("")
+    o = oracle(summ, study)
+    for solver, ps in pairs.items():
+        ladder = o[(o["solver"] == solver) & (o["iterations"] == 1)].sort_values("substeps")
+        out += small_steps_verdict(solver, ps, ladder)
+    out += ["", f"![small steps against iterations]({STEPS_PNG})", ""]
+    out += [
+        "### Which settings for which use",
+        "",
+        "Rule: for each use, the mode with the least time per frame among those never blown up whose RMS error "
+        "and stretch_max over the horizon are within the use's budget (harness/core/tolerances.py, DYN_ACC_USES), "
+        "on the CPU and on the GPU apart:",
+        "",
+        *recommend(summ),
+        "",
+    ]
+    if analytic:
+        out += [
+            "### Analytic checks against S",
+            "",
+            "docs/model.md §4 against the C reference (fp64 unless a table says fp32, `--threads 1`, no collider; "
+            "`harness/studies/analytic_table.py`, run by this study):",
+            "",
+            *[ln.replace("### ", "#### ", 1) if ln.startswith("### ") else ln for ln in analytic],
+            "",
+        ]
+    out += _all_modes_lines(summ)
+    return out, summ, front, pairs
+
+
+def write(results_dir=None, report_dir=None, csv_path=None):
+    """Write report/dynamic_accuracy.md and its pictures from a results directory (its table
+    or csv_path); return the paths written. Nothing is created when the input is refused."""
+    results_dir = Path(results_dir or RESULTS / RESULTS_NAME)
+    report_dir = Path(report_dir or REPORT)
+    rows, study, env, analytic = load(results_dir, csv_path)
+    report_dir.mkdir(parents=True, exist_ok=True)
+    lines, summ, _, pairs = markdown(rows, study, env, analytic)
+    pics = [
+        pareto_plot(summ, study, report_dir / PARETO_PNG),
+        growth_plot(rows, summ, study, report_dir / GROWTH_PNG),
+        steps_plot(pairs, report_dir / STEPS_PNG),
+    ]
+    page = report_dir / PAGE
+    tmp = page.with_name(f"{PAGE}.tmp.{os.getpid()}")
+    tmp.write_text("\n".join(lines) + "\n")
+    os.replace(tmp, page)
+    return [page, *pics]
+
+
+def section(results_dir=None, report_dir=None, write_page=True):
+    """Markdown lines for the main report: the front, the recommendation and a link to the
+    full page (written again into report_dir unless write_page=False), or how to measure it
+    when no results exist."""
+    results_dir = Path(results_dir or RESULTS / RESULTS_NAME)
+    report_dir = Path(report_dir or REPORT)
+    head = ["## Speed against accuracy: the dynamic model", ""]
+    if not (results_dir / CSV_NAME).exists():
+        return head + [
+            f"Not measured with these results (no `{display(results_dir / CSV_NAME)}`): run "
+            "`python3 -m harness accuracy --model dynamic` on this machine.",
+            "",
+        ]
+    if write_page:
+        write(results_dir, report_dir)
+    rows, study, env, _ = load(results_dir)
+    summ = summary(rows, study["horizon_frames"])
+    front = front_of(summ)
+    ref = study["reference"]
+    return head + [
+        f"{len(summ)} modes against {ref['label']} xpbd fp64 at S = {ref['substeps']} "
+        f"({'converged' if ref['converged'] else 'NOT converged'} over the {study['horizon']:g} s horizon); "
+        f"the full study, its convergence table, small steps against iterations and the analytic checks: "
+        f"[{PAGE}]({PAGE}).",
+        "",
+        *_mode_table(front, numbered=True),
+        "",
+        *recommend(summ),
+        "",
+        f"![error against time per frame]({PARETO_PNG})",
+        "",
+    ]

@@ -1,0 +1,268 @@
+"""The peer comparison (results/peer/, written by harness/studies/peer.py) as a Markdown section and
+one plot. Rendering only; `section(results_dir, out_dir)` is what report.py calls, and
+`write(results_dir, report_dir)` writes report/peer.md on its own.
+
+"Where the peer wins" is written from the numbers: time against our fastest fp64 run at
+each (S, I, N), error and stretch against ours at the same precision, and against our fp32.
+"""
+
+import json
+import math
+import os
+from pathlib import Path
+
+import pandas as pd
+
+from harness import HarnessError
+from harness.core import tolerances
+from harness.core.paths import REPORT, RESULTS, display
+
+PEER = "pypbd"
+OURS = "hairsim-cpu"
+
+
+def load(results_dir):
+    d = Path(results_dir)
+    need = [d / n for n in ("accuracy.csv", "timing.csv", "reference.csv", "peer.json")]
+    missing = [display(p) for p in need if not p.exists()]
+    if missing:
+        raise HarnessError(f"peer report: missing {', '.join(missing)} (run `python -m harness peer`)")
+    try:
+        return (
+            pd.read_csv(need[0]),
+            pd.read_csv(need[1]),
+            pd.read_csv(need[2]),
+            json.loads(need[3].read_text()),
+        )
+    except (ValueError, OSError) as e:
+        raise HarnessError(f"peer report: cannot read {display(d)}: {e}") from None
+
+
+def _label(r):
+    return f"{r['solver']} {r['variant']} {r['precision']}" if r["solver"] == OURS else f"{PEER} {r['precision']}"
+
+
+def accuracy_table(acc):
+    lines = [
+        "| S | I | solver | precision | max err / L | RMS err / L | last frame max / L | stretch max | "
+        "vs our fp64 run (max / L) |",
+        "| ---: | ---: | --- | --- | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for _, r in acc.sort_values(["substeps", "iterations", "solver", "precision"]).iterrows():
+        who = f"ours ({r['variant']})" if r["solver"] == OURS else PEER
+        blown = f" (**{int(r['blown_up'])} blown up**)" if r["blown_up"] else ""
+        lines.append(
+            f"| {r['substeps']} | {r['iterations']} | {who} | {r['precision']} | {r['err_max']:.3g} | "
+            f"{r['err_rms']:.3g} | {r['err_last']:.3g} | {r['stretch_max']:.3g}{blown} | {r['vs_ours_fp64']:.2g} |"
+        )
+    return lines
+
+
+def timing_table(tim):
+    tim = tim.assign(label=tim.apply(_label, axis=1))
+    labels = sorted(tim["label"].unique(), key=lambda s: (s.startswith(PEER), s))
+    lines = [
+        "| S | I | strands | " + " | ".join(labels) + " | pypbd ÷ our fastest fp64 |",
+        "| ---: | ---: | ---: |" + " ---: |" * (len(labels) + 1),
+    ]
+    for (s, i, n), g in tim.groupby(["substeps", "iterations", "strands"]):
+        cells = []
+        for lab in labels:
+            v = g[g["label"] == lab]["median_ms"]
+            cells.append(f"{float(v.iloc[0]):.3g}" if len(v) else "—")
+        lines.append(f"| {s} | {i} | {n:,} | " + " | ".join(cells) + f" | {_ratio(g):.2g}× |")
+    return lines
+
+
+def _ratio(g):
+    """pypbd's time over our fastest fp64 time in one (S, I, N) group."""
+    ours = g[(g["solver"] == OURS) & (g["precision"] == "fp64")]["median_ms"]
+    theirs = g[g["solver"] == PEER]["median_ms"]
+    return float(theirs.iloc[0]) / float(ours.min()) if len(ours) and len(theirs) else math.nan
+
+
+def _peer_faster_than_each(tim):
+    """{our runner label: [((S, I, N), how many times faster the peer is)]} where the peer wins."""
+    tim = tim.assign(label=tim.apply(_label, axis=1))
+    wins: dict[str, list] = {}
+    for key, g in tim.groupby(["substeps", "iterations", "strands"]):
+        theirs = g[g["solver"] == PEER]["median_ms"]
+        if not len(theirs):
+            continue
+        for _, r in g[g["solver"] == OURS].iterrows():
+            if float(theirs.iloc[0]) < r["median_ms"]:
+                wins.setdefault(r["label"], []).append((key, r["median_ms"] / float(theirs.iloc[0])))
+    return wins
+
+
+def where_the_peer_wins(acc, tim, frames, ref_uncertainty):
+    """Sentences from the numbers: time, then error and stretch (`frames`: the accuracy
+    horizon; `ref_uncertainty`: the reference's last change from S to 2S, ·L)."""
+    out = []
+    groups = [(k, _ratio(g)) for k, g in tim.groupby(["substeps", "iterations", "strands"])]
+    wins = [(k, r) for k, r in groups if r < 1]
+    ratios = [r for _, r in groups if math.isfinite(r)]
+    if wins:
+        out.append(
+            "**Time: the peer is faster** than our fastest fp64 run at "
+            + ", ".join(f"S = {s}, I = {i}, N = {n:,} ({1 / r:.2g}× faster)" for (s, i, n), r in wins)
+            + "."
+        )
+    if ratios and len(wins) < len(ratios):
+        lose = [r for _, r in groups if r >= 1]
+        out.append(
+            f"Time: {'elsewhere ' if wins else ''}our fastest fp64 run is {min(lose):.2g}–{max(lose):.2g}× faster "
+            f"than the peer ({len(lose)} of {len(ratios)} (S, I, N) cases)."
+        )
+    mine = acc[acc["solver"] == PEER]
+    if len(mine):
+        worst = float(mine["vs_ours_fp64"].max())
+        drift = mine["vs_ours_fp64"] / (mine["substeps"] * frames)  # ·L per substep taken
+        if float(drift.max()) <= tolerances.PEER_SAME_SCHEME_PER_SUBSTEP:
+            out.append(
+                f"Error and stretch: the peer's trajectories equal our fp64 runs to {worst:.2g}·L at worst, "
+                "the rounding drift of one scheme (docs/decisions.md), so neither wins on accuracy at equal "
+                "S and I."
+            )
+        else:
+            out.append(
+                f"Error and stretch: the peer's trajectories depart from our fp64 runs by up to {worst:.2g}·L, "
+                f"more than the rounding drift measured for ≤ 30 frames "
+                f"({tolerances.PEER_SAME_SCHEME_PER_SUBSTEP:g}·L per substep): the columns above tell which "
+                "is closer to the reference."
+            )
+    for lab, cases in _peer_faster_than_each(tim).items():
+        out.append(
+            f"Time: the peer is faster than our `{lab}` at "
+            + ", ".join(f"S = {s}, I = {i}, N = {n:,} ({r:.2g}×)" for (s, i, n), r in cases)
+            + "."
+        )
+    # error against our fp32 (pypbd has double only), where the gap exceeds the reference's own
+    # uncertainty (its last change from S to 2S)
+    p = acc[acc["solver"] == PEER].set_index(["substeps", "iterations"])
+    o32 = acc[(acc["solver"] == OURS) & (acc["precision"] == "fp32")].set_index(["substeps", "iterations"])
+    better = [k for k in p.index if k in o32.index and o32.loc[k, "err_max"] - p.loc[k, "err_max"] > ref_uncertainty]
+    if better:
+        out.append(
+            "Error: against our fp32 runs (pypbd runs in double only) the peer's is smaller by more than the "
+            "reference's uncertainty at "
+            + ", ".join(
+                f"S = {s}, I = {i} ({p.loc[(s, i), 'err_max']:.3g} vs {o32.loc[(s, i), 'err_max']:.3g}·L)"
+                for s, i in better
+            )
+            + "."
+        )
+    elif len(o32):
+        out.append(
+            "Error: our fp32 runs are within the reference's uncertainty "
+            f"({ref_uncertainty:.2g}·L) of the peer's double-precision error at every setting."
+        )
+    return out
+
+
+def plot(tim, out_dir):
+    """Time per frame against strands, one line per runner, the first setting."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    tim = tim.assign(label=tim.apply(_label, axis=1))
+    s, i = tim.iloc[0]["substeps"], tim.iloc[0]["iterations"]
+    g = tim[(tim["substeps"] == s) & (tim["iterations"] == i)]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for lab, h in g.groupby("label"):
+        h = h.sort_values("strands")
+        ax.plot(h["strands"], h["median_ms"], marker="o", label=lab, ls="--" if lab.startswith(PEER) else "-")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("chains (strands)")
+    ax.set_ylabel("ms per frame (median)")
+    ax.set_title(
+        f"chains of {int(g.iloc[0]['points'])} points, S = {s}, I = {i}, {int(g.iloc[0]['threads'])} thread(s)"
+    )
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    path = Path(out_dir) / "peer_time.png"
+    tmp = path.with_name(f"peer_time.tmp.{os.getpid()}.png")
+    fig.savefig(tmp, dpi=100, bbox_inches="tight")
+    plt.close(fig)
+    os.replace(tmp, path)
+    return path
+
+
+def section(results_dir, out_dir, missing_ok=False):
+    """The report's lines for the peer comparison (and its plot in out_dir). With
+    `missing_ok`, results that are absent give a short note saying why instead of an error."""
+    if missing_ok and not (Path(results_dir) / "peer.json").exists():
+        from harness.studies.peer_pypbd import unavailable
+
+        why = unavailable() or f"no {display(Path(results_dir) / 'peer.json')}: run `python -m harness peer`"
+        return ["## Beside a peer: PositionBasedDynamics (pypbd)", "", f"Not measured here: {why}.", ""]
+    acc, tim, ref, meta = load(results_dir)
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    png = plot(tim, out_dir)
+    m = meta.get("machine", {})
+    tilts = ", ".join(f"{t:g}°" for t in meta["tilts_deg"])
+    conv = "converged" if meta["reference_converged"] else "**not converged** (the errors below are bounded by it)"
+    last = ref.iloc[-1]
+    lines = [
+        "## Beside a peer: PositionBasedDynamics (pypbd)",
+        "",
+        f"The same chain scenes in Bender's PositionBasedDynamics (PyPI `pypbd` {meta['peer']['version']}, "
+        f"XPBD distance constraints, double precision) and in ours (`{meta['ours']['binary']}`, "
+        f"git {meta['ours']['git_revision']}). Chains of {meta['points']} points, L = {meta['length']:g} cm, a pinned "
+        f"root, unit masses, tilted {tilts} from the downward vertical and released from rest; compliance "
+        f"{meta['compliance']:g}, g0 = {meta['gravity']:g} cm/s², Δt = {meta['frame_dt']:.6g} s; no collider, wind, "
+        "bend or damping. Parameter mapping and what differs between the solvers: docs/decisions.md "
+        '("The peer"). Made by `'
+        + meta["command"].strip()
+        + f"` on {m.get('cpu')} ({m.get('cores')} CPUs visible, load "
+        f"average {', '.join(f'{x:.1f}' for x in m.get('load_average', []))} at the end), {meta['date']}.",
+        "",
+        f"**Reference:** our `xpbd` fp64, I = 1, at S = {meta['reference_substeps']}: the change from S = "
+        f"{int(last['substeps'])} was {last['change_to_2s']:.2g}·L, {conv} (criterion: below "
+        f"{meta['reference_fraction']:g} of the smallest error reported).",
+        "",
+        "| S | max change to 2S / L |",
+        "| ---: | ---: |",
+        *[f"| {int(r['substeps'])} | {r['change_to_2s']:.3g} |" for _, r in ref.iterrows()],
+        "",
+        f"### Accuracy over {meta['frames']} frames ({meta['frames'] * meta['frame_dt']:.3g} s)",
+        "",
+        "Errors are |x − x_ref| / L over every point of every simulated frame; stretch is max |len/ℓ − 1|.",
+        "",
+        *accuracy_table(acc),
+        "",
+        f"### Time per frame (ms, median), {meta['threads']} thread(s) each",
+        "",
+        f"Ours: the simulate stage's median over {meta['time_frames']} frames × {meta['repeat']} repeats "
+        f"(`--repeat`); pypbd: the median of {meta['time_frames'] * meta['repeat']} successive `step` calls "
+        f"(after one untimed step), OpenMP threads {meta['peer'].get('omp_threads')}.",
+        "",
+        *timing_table(tim),
+        "",
+        f"![peer time per frame]({os.path.relpath(png, out_dir)})",
+        "",
+        "### Where the peer wins",
+        "",
+        "Not measured here: what the peer offers that we do not (other constraint types, rigid bodies, "
+        "mesh collisions), listed in docs/decisions.md.",
+        "",
+        *[f"- {s}" for s in where_the_peer_wins(acc, tim, meta["frames"], float(last["change_to_2s"]))],
+        "",
+    ]
+    return lines
+
+
+def write(results_dir=None, report_dir=None):
+    """report/peer.md from results/peer/."""
+    results_dir = Path(results_dir) if results_dir else RESULTS / "peer"
+    out_dir = Path(report_dir) if report_dir else REPORT
+    lines = section(results_dir, out_dir)
+    path = out_dir / "peer.md"
+    tmp = path.with_name(f"peer.md.tmp.{os.getpid()}")
+    tmp.write_text("\n".join(lines) + "\n")
+    os.replace(tmp, path)
+    return path

@@ -1,0 +1,248 @@
+"""report/dynamic.md: the dynamic model's report, rendered from a bench root (the results
+of harness/bench/dynamic.py: <root>/dynamic/{runs.csv, env.json, validation.json},
+<root>/featurecost/*.csv, <root>/peer/, <root>/dynamic-accuracy/, <root>/stability/,
+<root>/headline/headline_dynamic.json). Rendering only: every number comes from those
+files, every missing piece is named with the command that makes it."""
+
+import json
+import os
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from harness.core.paths import REPORT, display  # noqa: E402
+from harness.io import results_data  # noqa: E402
+from harness.render import accuracy_dynamic_report, featurecost_report, peer_report, stability_report  # noqa: E402
+
+
+def _save(fig, path):
+    tmp = path.with_name(f"{path.stem}.tmp.{os.getpid()}{path.suffix}")
+    fig.savefig(tmp, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    os.replace(tmp, path)
+    return path
+
+
+def sim_rows(results_dir):
+    """The simulate rows of a dynamic sweep, with a `label` per configuration."""
+    rows, env = results_data.load(results_dir)
+    rows = rows[rows["stage"] == "simulate"].copy()
+    if rows.empty:
+        return rows, env
+    rows["point_substeps_per_s"] = pd.to_numeric(rows["point_substeps_per_s"], errors="coerce")
+
+    def label(r):
+        if r["backend"] == "cpu":
+            return f"cpu {r['variant']} {'1 thread' if str(r['threads']) == '1' else 'all cores'}"
+        build = "" if r["build"] in ("", "default") else f" {r['build']}"
+        return f"gpu {r['variant']}{build} b{int(r['block_size'])}"
+
+    rows["label"] = rows.apply(label, axis=1)
+    return rows, env
+
+
+def throughput_plot(rows, solver, precision, out_dir):
+    sel = rows[(rows["solver"] == solver) & (rows["precision"] == precision)]
+    if sel.empty:
+        return None
+    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    for lab, g in sorted(sel.groupby("label"), key=lambda kv: -kv[1]["point_substeps_per_s"].max()):
+        g = g.sort_values("strands")
+        ls = "--" if lab.startswith("cpu") else "-"
+        ax.plot(g["strands"], g["point_substeps_per_s"], ls, marker="o", ms=3, label=lab)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("strands (32 points)")
+    ax.set_ylabel("point-substeps per second")
+    ax.set_title(f"dynamic default scene, {solver}, {precision}: throughput per frame")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=6, ncol=2)
+    return _save(fig, Path(out_dir) / f"dynamic_throughput_{solver}_{precision}.png")
+
+
+def best_table(rows):
+    """Per solver and strand count: the best of each family (cpu 1 thread, cpu all cores,
+    gpu), its point-substeps/s and ms per frame, and the GPU's speedup over each CPU row."""
+    lines = [
+        "| solver | strands | best CPU, 1 thread | best CPU, all cores | best GPU | GPU over CPU all cores |",
+        "| --- | ---: | --- | --- | --- | ---: |",
+    ]
+    fp32 = rows[(rows["precision"] == "fp32") & (rows["build"].isin(["", "default"]))]
+    for (solver, n), g in fp32.groupby(["solver", "strands"]):
+        fam = {
+            "one": g[(g["backend"] == "cpu") & (g["threads"].astype(str) == "1")],
+            "all": g[(g["backend"] == "cpu") & (g["threads"].astype(str) != "1")],
+            "gpu": g[g["backend"] == "cuda"],
+        }
+        best = {k: (v.loc[v["point_substeps_per_s"].idxmax()] if not v.empty else None) for k, v in fam.items()}
+
+        def cell(r):
+            if r is None:
+                return "—"
+            return f"{r['label']}: {float(r['median_ms']):.3g} ms ({float(r['point_substeps_per_s']):.3g}/s)"
+
+        sp = "—"
+        if best["gpu"] is not None and best["all"] is not None:
+            sp = f"{best['gpu']['point_substeps_per_s'] / best['all']['point_substeps_per_s']:.1f}×"
+        cells = " | ".join(cell(best[k]) for k in ("one", "all", "gpu"))
+        lines.append(f"| {solver} | {int(n):,} | {cells} | {sp} |")
+    return lines
+
+
+def validation_lines(results_dir):
+    path = Path(results_dir) / "validation.json"
+    if not path.exists():
+        return [f"Not validated with these results (no `{display(path)}`)."]
+    v = json.loads(path.read_text())
+    checks = v.get("checks", [])
+    bad = [c for c in checks if not c.get("equivalent")]
+    lines = [
+        f"Before any timing, at {v.get('strands')} strands × {v.get('points')} points of the default scene: "
+        f"{len(checks)} comparisons, {len(checks) - len(bad)} equivalent"
+        + (f" ({len(bad)} NOT)" if bad else "")
+        + ". One frame from the same input state, judged by `harness.check.diff_dynamic` (the rule of "
+        "`harness stepdiff` and of the GPU tests); bit-identical where marked. " + (v.get("gpu_note") or ""),
+        "",
+        "| check | pair | max abs (cm) | max / L | ulp max | verdict |",
+        "| --- | --- | ---: | ---: | ---: | --- |",
+    ]
+    for c in checks:
+        why = c.get("error") or "; ".join(c.get("failures", []))
+        verdict = "equivalent" if c.get("equivalent") else "NOT: " + why
+        lines.append(
+            f"| {c['what']} | {c.get('pair', '')} | {c.get('max_abs', float('nan')):.3g} | "
+            f"{c.get('max_rel_L', float('nan')):.3g} | {c.get('ulp_max', float('nan')):.3g} | {verdict} |"
+        )
+    return lines
+
+
+def headline_lines(path):
+    if not path.exists():
+        cmd = "python -m harness headline --model dynamic"
+        return [f"Not measured with these results (no `{display(path)}`): `{cmd}`."]
+    h = json.loads(path.read_text())
+    s, t = h.get("summary", {}), h["targets"]
+    env = h.get("env", {})
+    gpus = ", ".join(g.get("name", "?") for g in env.get("gpus") or []) or "no GPU"
+    where = f"{gpus} (driver {env.get('driver') or '?'}), {env.get('cpu_model') or '?'} × {env.get('cpu_cores') or '?'}"
+    out = [
+        f"Measured by `python -m harness headline --model dynamic` on {where} "
+        f"(revision {env.get('git_revision', '?')}), {h['strands']:,} strands × {h['points']} points, fp32.",
+        "",
+        "| target | goal | measured | where | met |",
+        "| --- | --- | --- | --- | --- |",
+    ]
+    yes = lambda m: "yes" if m else "**no**"  # noqa: E731
+    if "memory" in s:
+        m = s["memory"]
+        out.append(
+            f"| memory-bound case (gravity + stretch, S = I = 1) | ≥ {100 * t['memory_fraction']:.0f}% of copy | "
+            f"{100 * m['fraction']:.1f}% | {m['row']} | {yes(m['met'])} |"
+        )
+    if "default" in s:
+        d = s["default"]
+        out.append(
+            f"| default scene | ≥ {t['point_substeps_per_s']:.0e} point-substeps/s | {d['point_substeps_per_s']:.3g} | "
+            f"{d['row']} | {yes(d['met'])} |"
+        )
+    if "realtime" in s:
+        r = s["realtime"]
+        out.append(
+            f"| 10,000 strands, default scene | ≤ {t['realtime_ms']} ms GPU time a frame | {r['kernel_ms']:.4f} ms "
+            f"(frame loop {r['frame_loop_ms']:.4f} ms, as a CUDA graph {r['frame_loop_graph_ms']:.4f} ms) | "
+            f"{r['row']} | {yes(r['met'])} |"
+        )
+    if "cpu" in s:
+        c = s["cpu"]
+        out.append(
+            f"| CPU fast variant, memory-bound case | ≥ {100 * t['cpu_fraction']:.0f}% of CPU copy | "
+            f"{100 * c['fraction']:.1f}% | {c['row']} | {yes(c['met'])} |"
+        )
+    for case, d in s.get("speedups", {}).items():
+        hl = d.get("headline")
+        if hl:
+            out.append(f"\nSpeedup ({case} case): {hl['gpu']} over {hl['cpu']}: {hl['speedup']:.1f}×.")
+    m = h.get("ncu")
+    if m and "skipped" not in m:
+        out.append(
+            f"\nNsight Compute on the {m['variant']} kernel of the default scene ({m['strands']:,} strands): "
+            f"SM throughput {m.get('sm__throughput.avg.pct_of_peak_sustained_elapsed')}% of peak, DRAM "
+            f"{m.get('dram__throughput.avg.pct_of_peak_sustained_elapsed')}%, "
+            f"{m.get('launch__registers_per_thread'):.0f} registers, "
+            f"{m.get('thread_instructions_per_point_substep', 0):.0f} thread instructions per point-substep."
+        )
+    return out
+
+
+def _study(root, name, module, what, command, out_dir):
+    """A study's section from its own renderer (section(results_dir, report_dir)), or a
+    line saying how to make it."""
+    d = Path(root) / name
+    if not d.exists():
+        return [f"## {what}", "", f"Not measured with these results (no `{display(d)}`): `{command}`.", ""]
+    return module.section(d, out_dir) + [""]
+
+
+def build(root, report_dir=None):
+    root = Path(root)
+    out_dir = Path(report_dir) if report_dir else REPORT
+    out_dir.mkdir(parents=True, exist_ok=True)
+    sweep_dir = root / "dynamic"
+    lines = ["# hairbench: the dynamic model", ""]
+    lines += [
+        "The time-stepped model of docs/model.md §3: XPBD and follow-the-leader strands under "
+        "gravity and a gusting wind on a nodding head (configs/scenes/dynamic.toml). Generated "
+        f"by `python -m harness bench` from `{display(root)}`; rendering only.",
+        "",
+        "## Validation",
+        "",
+    ]
+    lines += validation_lines(sweep_dir) + [""]
+    lines += ["## Headline targets", ""] + headline_lines(root / "headline" / "headline_dynamic.json") + [""]
+    lines += ["## Throughput over strand counts", ""]
+    if (sweep_dir / "runs.csv").exists():
+        rows, env = sim_rows(sweep_dir)
+        pics = [throughput_plot(rows, s, p, out_dir) for s in ("xpbd", "ftl") for p in ("fp32", "fp64")]
+        lines += [
+            "Time per frame of the default scene (S = 8, I = 2, every feature), kernel or loop time "
+            "only (docs/interfaces.md), the median of the sweep's repeats; point-substeps per "
+            "second = N·P·S over it. The best of each family per strand count:",
+            "",
+        ]
+        lines += best_table(rows) + [""]
+        for p in pics:
+            if p:
+                lines += [f"![{p.stem}]({os.path.relpath(p, out_dir)})", ""]
+        sess = (env.get("sessions") or [{}])[-1]
+        host = sess.get("host") or sess
+        where = {k: host.get(k) for k in ("cpu_model", "cpu_cores", "gpus", "git_revision") if k in host}
+        lines += [f"Sweep environment: {json.dumps(where)}", ""]
+    else:
+        cmd = "python -m harness bench --model dynamic"
+        lines += [f"Not measured (no `{display(sweep_dir / 'runs.csv')}`): `{cmd}`.", ""]
+    lines += featurecost_report.section(sorted((root / "featurecost").glob("*.csv"))) + [""]
+    lines += _study(
+        root,
+        "dynamic-accuracy",
+        accuracy_dynamic_report,
+        "Speed against accuracy",
+        "harness accuracy --model dynamic",
+        out_dir,
+    )
+    lines += _study(root, "stability", stability_report, "Stability at the extremes", "harness stability", out_dir)
+    lines += peer_report.section(root / "peer", out_dir, missing_ok=True) + [""]
+    gif = out_dir / "dynamic.gif"
+    lines += ["## The default scene in motion", ""]
+    if gif.exists():
+        lines += [f"![the default dynamic scene, side and front]({os.path.relpath(gif, out_dir)})", ""]
+    else:
+        lines += ["No animation here: `python -m harness animate`.", ""]
+    path = out_dir / "dynamic.md"
+    tmp = path.with_name(f"dynamic.md.tmp.{os.getpid()}")
+    tmp.write_text("\n".join(lines) + "\n")
+    os.replace(tmp, path)
+    return path

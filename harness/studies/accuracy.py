@@ -1,0 +1,129 @@
+"""Speed against accuracy, what the two models share: a mode (one binary and variant at a
+precision; the dynamic model adds solver, substeps S and iterations I) and the position
+error of a run against its reference. The measuring is studies/accuracy_paper.py and
+studies/accuracy_dynamic.py; nothing here runs a binary, so the renderers may read it."""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from harness.core.variants import Runner
+
+
+@dataclass(frozen=True)
+class Mode:
+    runner: Runner  # variant None: the binary's default variant (its --list-variants)
+    precision: str
+    solver: str | None = None
+    substeps: int | None = None
+    iterations: int | None = None
+    label: str | None = None  # a paper mode's own name
+    use: str = ""  # what a user would pick it for, in a few words
+
+    @property
+    def name(self):
+        if self.label is not None:
+            return self.label
+        return f"{self.runner.label} {self.solver} S{self.substeps} I{self.iterations} {self.precision}"
+
+    @property
+    def tag(self):
+        return self.name.replace(" ", "_")
+
+
+# the paper study's modes: the cpu ones run the cpu's default variant (the oracle), the gpu
+# ones each build's default variant; accuracy_paper.modes() adds one fp32 mode for each
+# other cpu variant the binary declares
+PAPER_REFERENCE = "cpu fp64 ref"
+PAPER_OTHER_CPU_USE = "fast CPU baseline"
+PAPER_MODES = tuple(
+    Mode(Runner(backend, build, None), precision, label=label, use=use)
+    for label, backend, build, precision, use in (
+        (PAPER_REFERENCE, "cpu", "default", "fp64", "ground truth"),
+        ("cpu fp32 ref", "cpu", "default", "fp32", "the readable fp32 oracle"),
+        ("gpu fp32 strict", "cuda", "strict", "fp32", "validation against the CPU"),
+        ("gpu fp32 normal", "cuda", "default", "fp32", "production"),
+        ("gpu fp32 fast-math", "cuda", "fastmath", "fp32", "previews"),
+        ("gpu fp64", "cuda", "default", "fp64", "reference on the GPU"),
+    )
+)
+
+
+def paper_uses():
+    """Paper mode name -> what it is for (also for modes read back from a CSV)."""
+    return {m.name: m.use for m in PAPER_MODES}
+
+
+def frame_errors(x, ref, L):
+    """RMS and max over the points of |x − ref| / L, for positions [..., N, P, 3]: one value
+    per leading index (a float for one frame); NaN where either is not finite."""
+    x = np.asarray(x, dtype=np.float64)
+    ref = np.asarray(ref, dtype=np.float64)
+    with np.errstate(invalid="ignore", over="ignore"):
+        d = np.linalg.norm(x - ref, axis=-1)
+        rms = np.sqrt(np.mean(d * d, axis=(-2, -1))) / L
+        mx = np.max(d, axis=(-2, -1)) / L
+    bad = ~np.isfinite(rms) | ~np.isfinite(mx)
+    if np.ndim(rms) == 0:
+        return (float("nan"), float("nan")) if bad else (float(rms), float(mx))
+    rms[bad] = np.nan
+    mx[bad] = np.nan
+    return rms, mx
+
+
+# ---- the dynamic study's results (results/dynamic-accuracy/), as the renderer reads them ----
+
+RESULTS_NAME = "dynamic-accuracy"
+CSV_NAME = "dynamic_accuracy.csv"
+ANALYTIC_NAME = "analytic.md"
+# the reference family of the contract (docs/model.md §3.6), in its working precision fp64
+REF_SOLVER, REF_PRECISION, REF_ITERATIONS = "xpbd", "fp64", 1
+
+COLUMNS = (
+    "study",  # mode | reference | gpu_check
+    "mode",
+    "backend",
+    "build",
+    "variant",
+    "solver",
+    "substeps",
+    "iterations",
+    "precision",
+    "strands",
+    "points",
+    "frame",  # simulated frame, counted from 1
+    "time_s",
+    "rms_err_L",
+    "max_err_L",
+    "stretch_max",
+    "penetration_max",
+    "blown_up_strands",
+    "time_per_frame_ms",  # the simulate stage's median over frames × repeats
+    "time_per_frame_min_ms",  # its fastest (on a shared machine the median can be preempted)
+    "time_strands",
+    "threads",
+    "block_size",
+    "device",
+    "ref_substeps",  # the reference rung compared with (mode, gpu_check) or 2S (reference)
+)
+
+
+def smallest(errors):
+    """Per frame, the smallest finite error over modes ({name: [F]}); NaN where none."""
+    stack = np.array([e for e in errors.values()], dtype=np.float64)
+    if stack.size == 0:
+        return np.array([])
+    with np.errstate(invalid="ignore"):
+        stack[~np.isfinite(stack)] = np.inf
+        out = stack.min(axis=0)
+    out[~np.isfinite(out)] = np.nan
+    return out
+
+
+def holds_until(ok, times):
+    """The last time up to which every frame passes; 0.0 when the first frame fails."""
+    ok = np.asarray(ok, dtype=bool)
+    bad = np.flatnonzero(~ok)
+    if bad.size == 0:
+        return float(times[-1]) if len(times) else 0.0
+    return float(times[bad[0] - 1]) if bad[0] > 0 else 0.0

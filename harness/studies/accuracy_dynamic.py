@@ -1,0 +1,587 @@
+"""`python -m harness accuracy --model dynamic`: speed against accuracy of the dynamic model,
+the measuring part (accuracy_dynamic_report.py renders it; docs/harness.md, "The dynamic
+accuracy study").
+
+Every mode, solver × substeps S × iterations I × precision × build (each cpu variant and,
+with a usable GPU, each cuda build's variants that run `simulate`; all read from the
+binaries), runs the same dynamic scene (same seed, so the same roots) for `seconds` of
+simulated time. Each run is compared frame by frame with a converged reference:
+
+  rms_err_L, max_err_L   RMS and max over all points of |x − x_ref|, over the hair length L
+  stretch_max, penetration_max, blown_up_strands   the mode's own observables (§3.8)
+
+The reference is xpbd, fp64, I = 1, with S doubled from `ref_start` until, at every frame
+up to the horizon, the RMS difference between S and 2S is under
+tolerances.DYN_ACC_REF_FACTOR times the smallest RMS error any mode (not blown up) has at
+that frame; modes are compared with the finer of the two. The max measure is shown against
+the same rule in the report but does not decide S: it is set by single points near
+contacts and nearly straight bend triples, which converge far more slowly
+(docs/decisions.md, "The dynamic accuracy study"). It runs on the C reference, or on the GPU in fp64
+where one is usable, once the GPU's rung S0 agrees with the CPU's within a share of that
+margin (tolerances.DYN_ACC_GPU_REF_SHARE); otherwise the CPU ladder is used.
+
+Time per frame is measured apart from the checked run: the same mode at `time_strands`
+strands, `time_frames` frames, `--repeat`, no output file (never a run that also checks);
+it is the simulate stage's median.
+
+Writes results/dynamic-accuracy/dynamic_accuracy.csv (one row per mode and frame, plus the
+reference ladder and the GPU check), analytic.md (harness/studies/analytic_table.py's tables) and
+env.json; then accuracy_dynamic_report.py writes report/dynamic_accuracy.md and its PNGs.
+"""
+
+import csv
+import itertools
+import json
+import os
+import shutil
+import time
+from concurrent.futures import ThreadPoolExecutor, as_completed
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from harness import HarnessError
+from harness.core import env, runner, scenes, scenes_dynamic, tolerances, variants
+from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
+from harness.io.trajectory import open_trajectory
+from harness.studies.accuracy import (
+    ANALYTIC_NAME,
+    COLUMNS,
+    CSV_NAME,
+    REF_ITERATIONS,
+    REF_PRECISION,
+    REF_SOLVER,
+    RESULTS_NAME,
+    Mode,
+    frame_errors,
+    holds_until,
+    smallest,
+)
+
+SIMULATE = "simulate"  # the stage a variant must run to take part
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What a study measures; Plan() is the full study, Plan.quick() the small one."""
+
+    scene: str = "dynamic"
+    strands: int = 256
+    points: int | None = None
+    seconds: float = 1.0
+    horizon: float = 0.5
+    substeps: tuple = (1, 2, 4, 8, 16, 32)
+    iterations: tuple = (1, 2, 4)
+    time_strands: int = 10_000
+    time_frames: int = 1
+    repeat: int = 3
+    ref_start: int | None = None  # None: 2 × the largest S of the grid
+    ref_max: int = 16384
+    jobs: int | None = None  # parallel checked runs (None: one per core)
+    analytic: str = "full"  # full | quick | none
+    gpu: str = "auto"  # auto | no
+
+    @classmethod
+    def quick(cls, **changes):
+        base = dict(
+            strands=32,
+            seconds=0.25,
+            horizon=0.25,
+            substeps=(1, 4, 16),
+            iterations=(1, 2),
+            time_strands=1000,
+            analytic="quick",
+        )
+        return cls(**{**base, **changes})
+
+    @property
+    def first_rung(self):
+        return self.ref_start or 2 * max(self.substeps)
+
+
+def grid(substeps, iterations):
+    """(S, I) pairs: every S with every I, plus S × 1 and 1 × S for each S (the small-steps
+    comparison of Macklin et al. 2019 needs both)."""
+    pairs = set(itertools.product(substeps, iterations))
+    pairs |= {(n, 1) for n in substeps} | {(1, n) for n in substeps}
+    return sorted(pairs)
+
+
+def check_plan(plan, frame_dt):
+    """Refuse a plan that cannot give a meaningful study (HarnessError, exit 2)."""
+    bad = []
+    if not 0 < plan.horizon <= plan.seconds:
+        bad.append(f"--horizon {plan.horizon:g} must be > 0 and at most --seconds {plan.seconds:g}")
+    if round(plan.horizon / frame_dt) < 1:
+        bad.append(f"--horizon {plan.horizon:g} s is shorter than one frame ({frame_dt:g} s)")
+    if not plan.substeps or not plan.iterations:
+        bad.append("--substeps and --iterations need at least one value each")
+    for flag, vals in (("--substeps", plan.substeps), ("--iterations", plan.iterations)):
+        if any(v < 1 or v > scenes_dynamic.MAX_COUNT for v in vals):
+            bad.append(f"{flag} values must lie in 1 … {scenes_dynamic.MAX_COUNT}")
+    if plan.substeps and plan.first_rung <= max(plan.substeps):
+        bad.append(f"--ref-start {plan.first_rung} must exceed the largest --substeps ({max(plan.substeps)})")
+    if plan.ref_max < 2 * plan.first_rung:
+        bad.append(f"--ref-max {plan.ref_max} must be at least twice --ref-start ({plan.first_rung})")
+    elif not frame_dt / plan.ref_max >= 1e-12:
+        bad.append(f"--ref-max {plan.ref_max} makes the substep {frame_dt / plan.ref_max:g} s, below 1e-12 s")
+    if plan.analytic not in ("full", "quick", "none"):
+        bad.append(f"--analytic must be full, quick or none (got '{plan.analytic}')")
+    if bad:
+        raise HarnessError("accuracy --model dynamic: " + "; ".join(bad))
+
+
+def study_builds(gpu_ok):
+    """Every binary × variant here that runs simulate: the cpu variants, then (with a GPU)
+    each cuda build present."""
+    out = [variants.Runner("cpu", "default", v) for v in variants.declared("cpu").running(SIMULATE)]
+    if gpu_ok:
+        for build in CUDA_BUILDS:
+            if binary_path("cuda", build).exists():
+                out += [variants.Runner("cuda", build, v) for v in variants.declared("cuda", build).running(SIMULATE)]
+    return out
+
+
+def study_modes(builds, plan):
+    pairs = grid(plan.substeps, plan.iterations)
+    out = []
+    for b in builds:
+        d = variants.declared(b.backend, b.build)
+        for solver, precision, (s, i) in itertools.product(d.solvers, d.precisions, pairs):
+            out.append(Mode(b, precision, solver, s, i))
+    return out
+
+
+def configured(scene, *, solver, substeps, iterations, precision, frames, strands):
+    """The dynamic scene with one mode's settings, every frame written."""
+    dyn = {
+        **scene.dynamic,
+        "--solver": solver,
+        "--substeps": int(substeps),
+        "--iterations": int(iterations),
+        "--frames": int(frames),
+        "--output-every": 1,
+    }
+    return replace(scene.with_overrides(strands=strands, precision=precision), dynamic=dyn)
+
+
+# ---- errors ---------------------------------------------------------------------------
+
+
+def reference_ok(diff, smallest_error, factor):
+    """Per frame: the reference's S-vs-2S difference under `factor` × the smallest mode
+    error (False where either is NaN)."""
+    with np.errstate(invalid="ignore"):
+        return np.asarray(diff) < factor * np.asarray(smallest_error)
+
+
+# ---- runs -----------------------------------------------------------------------------
+
+
+@dataclass
+class Run:
+    """A checked run read back: times [F], positions [F][N][P][3], observables per frame."""
+
+    times: np.ndarray
+    pos: np.ndarray
+    stretch: np.ndarray
+    penetration: np.ndarray
+    blown: np.ndarray
+
+
+def read_run(path):
+    with open_trajectory(path) as t:
+        sim = t.simulated
+        pos = np.stack([t.frame(f) for f in sim]).astype(np.float64)
+        obs = t.observables.set_index("step").reindex(t.step[sim])
+        return Run(
+            times=t.time[sim].copy(),
+            pos=pos,
+            stretch=obs["stretch_max"].to_numpy(np.float64),
+            penetration=obs["penetration_max"].to_numpy(np.float64),
+            blown=obs["blown_up_strands"].to_numpy(np.int64),
+        )
+
+
+class Study:
+    def __init__(self, plan, out_dir, log):
+        self.plan = plan
+        self.log = log
+        base = scenes.load_scene(plan.scene)
+        if base.model != "dynamic":
+            raise HarnessError(
+                f"accuracy --model dynamic: scene {plan.scene} is a {base.model}-model scene (its model key)"
+            )
+        self.scene = base.with_overrides(strands=plan.strands, points=plan.points)
+        self.frame_dt = float(self.scene.dynamic.get("--frame-dt", 1 / 60))
+        check_plan(plan, self.frame_dt)
+        self.frames = max(1, round(plan.seconds / self.frame_dt))
+        self.horizon_frames = min(self.frames, round(plan.horizon / self.frame_dt))
+        self.L = self.scene.hair_length
+        self.scratch = Path(out_dir) / "states"
+        self.cpu_threads = os.cpu_count() or 1
+
+    def path(self, tag):
+        return self.scratch / f"{tag}.h5"
+
+    def checked(self, build, solver, substeps, iterations, precision, tag, threads=None):
+        sc = configured(
+            self.scene,
+            solver=solver,
+            substeps=substeps,
+            iterations=iterations,
+            precision=precision,
+            frames=self.frames,
+            strands=self.plan.strands,
+        )
+        out = self.path(tag)
+        flags = runner.run_flags(sc, build.backend, variant=build.variant, threads=threads, output=out, force=True)
+        rec = runner.run_binary(build.binary, flags)
+        return out, rec
+
+    def timed(self, mode):
+        sc = configured(
+            self.scene,
+            solver=mode.solver,
+            substeps=mode.substeps,
+            iterations=mode.iterations,
+            precision=mode.precision,
+            frames=self.plan.time_frames,
+            strands=self.plan.time_strands,
+        )
+        flags = runner.run_flags(sc, mode.runner.backend, variant=mode.runner.variant, repeat=self.plan.repeat)
+        rec = runner.run_binary(mode.runner.binary, flags)
+        sim = [s for s in rec["stages"] if s.get("stage") == SIMULATE]
+        if not sim:
+            raise HarnessError(f"{mode.runner.binary.name}: its record has no simulate stage")
+        return float(sim[0]["median_ms"]), float(sim[0]["min_ms"]), rec
+
+    # the reference ladder ------------------------------------------------------------
+
+    def rung(self, build, S):
+        tag = f"ref_{build.label.replace(' ', '_')}_S{S}"
+        threads = self.cpu_threads if build.backend == "cpu" else None
+        t0 = time.monotonic()
+        path, _ = self.checked(build, REF_SOLVER, S, REF_ITERATIONS, REF_PRECISION, tag, threads=threads)
+        self.log(f"dynamic accuracy: reference {build.label} S = {S}: {time.monotonic() - t0:.1f} s")
+        return path
+
+    def mode_rms(self, paths, ref):
+        """{mode name: RMS error [F]} against ref positions; a mode blown up at any frame
+        gives NaN throughout (it takes no part in the smallest error)."""
+        out = {}
+        for name, p in paths.items():
+            r = read_run(p)
+            rms, _ = frame_errors(r.pos, ref.pos, self.L)
+            out[name] = np.full_like(rms, np.nan) if (r.blown > 0).any() else rms
+        return out
+
+    def ladder(self, build, mode_paths, first_path=None):
+        """Double S until the criterion holds up to the horizon or --ref-max is reached
+        (first_path: rung S0 already run on `build`).
+
+        Every mode is compared with the first finer rung; after that only the modes that can
+        still hold a frame's smallest error are compared again: the reference has moved by at
+        most B = the sum of the rung differences since (RMS obeys the triangle inequality), so
+        a mode can be the smallest at frame f only if its error then was within 2·B(f) of the
+        smallest then (candidates)."""
+        H = self.horizon_frames
+        factor = tolerances.DYN_ACC_REF_FACTOR
+        steps = []
+        S = self.plan.first_rung
+        prev_path = first_path or self.rung(build, S)
+        then, moved = None, None
+        while True:
+            cur_path = self.rung(build, 2 * S)
+            prev, cur = read_run(prev_path), read_run(cur_path)
+            d_rms, d_max = frame_errors(prev.pos, cur.pos, self.L)
+            steps.append(dict(S=S, S2=2 * S, rms=d_rms, max=d_max, run=replace(prev, pos=None)))
+            if then is None:
+                then, moved = self.mode_rms(mode_paths, cur), np.zeros_like(d_rms)
+                errs = then
+            else:
+                moved = moved + d_rms
+                low = smallest(then) + 2 * moved
+                cand = {k: mode_paths[k] for k, e in then.items() if np.any(e <= low)}
+                errs = self.mode_rms(cand, cur)
+            min_rms = smallest(errs)
+            ok = reference_ok(d_rms, min_rms, factor)
+            converged = bool(ok[:H].all())
+            self.log(
+                f"dynamic accuracy: reference S = {S} vs {2 * S}: criterion "
+                f"{'holds' if converged else 'fails'} up to the horizon; "
+                f"holds until t = {holds_until(ok, cur.times):.3f} s ({len(errs)} modes compared)"
+            )
+            os.unlink(prev_path)
+            if converged or 4 * S > self.plan.ref_max:
+                return dict(
+                    build=build,
+                    steps=steps,
+                    final_path=cur_path,
+                    final=cur,
+                    min_rms=min_rms,
+                    ok=ok,
+                    converged=converged,
+                )
+            prev_path, S = cur_path, 2 * S
+
+
+def _gpu_reference_build(gpu_ok, plan):
+    if not gpu_ok or not binary_path("cuda").exists():
+        return None
+    sim = variants.declared("cuda").running(SIMULATE)
+    return variants.Runner("cuda", "default", sim[0]) if sim else None
+
+
+def _row(**kw):
+    return {k: kw.get(k) for k in COLUMNS}
+
+
+def _frame_rows(run, rms, mx, **shared):
+    """One row per simulated frame of `run`, with its errors against a reference (rms, mx,
+    per frame) and the columns every frame shares."""
+    return [
+        _row(
+            **shared,
+            frame=f + 1,
+            time_s=run.times[f],
+            rms_err_L=rms[f],
+            max_err_L=mx[f],
+            stretch_max=run.stretch[f],
+            penetration_max=run.penetration[f],
+            blown_up_strands=run.blown[f],
+        )
+        for f in range(len(run.times))
+    ]
+
+
+def run_study(plan, out_dir=None, force=False, command=None, log=print):
+    """Measure, write the CSV, analytic.md and env.json (render/accuracy_dynamic_report.py
+    draws them); return the exit status (0: reference converged over the horizon, 1: it
+    did not)."""
+    started = time.monotonic()
+    out_dir = Path(out_dir or RESULTS / RESULTS_NAME)
+    csv_path = out_dir / CSV_NAME
+    if csv_path.exists() and not force:
+        raise HarnessError(f"{display(csv_path)} exists: pass --force to replace it")
+    study = Study(plan, out_dir, log)
+    if study.scratch.exists():
+        log(f"dynamic accuracy: removing the scratch states of an earlier run ({display(study.scratch)})")
+        shutil.rmtree(study.scratch)
+    study.scratch.mkdir(parents=True)
+    gpu_ok, gpu_why = env.gpu_status()
+    if gpu_ok and plan.gpu == "no":
+        gpu_ok, gpu_why = False, "--gpu no"
+    builds = study_builds(gpu_ok)
+    cpu_oracle = variants.Runner("cpu", "default", variants.declared("cpu").default_variant)
+    if REF_SOLVER not in variants.declared("cpu").solvers:
+        raise HarnessError(f"{display(cpu_oracle.binary)} declares no {REF_SOLVER} solver (--list-variants)")
+    modes = study_modes(builds, plan)
+    log(
+        f"dynamic accuracy: {len(modes)} modes ({', '.join(b.label for b in builds)}), "
+        f"{plan.strands} strands, {study.frames} frames of {study.frame_dt:.4g} s, horizon "
+        f"{study.horizon_frames} frames" + ("" if gpu_ok else f"; no GPU modes: {gpu_why}")
+    )
+
+    # 1. the checked runs (in parallel: nothing here is timed) and the analytic tables
+    analytic_lines = []
+    mode_paths, records = {}, {}
+    jobs = plan.jobs or os.cpu_count() or 1
+    try:
+        with ThreadPoolExecutor(max_workers=jobs) as pool:
+            futures = {}
+            if plan.analytic != "none":
+                from harness.studies import analytic_table
+
+                futures[pool.submit(analytic_table.tables, str(cpu_oracle.binary), plan.analytic == "quick")] = None
+            for m in modes:
+                threads = 1 if m.runner.backend == "cpu" else None
+                f = pool.submit(
+                    study.checked, m.runner, m.solver, m.substeps, m.iterations, m.precision, m.tag, threads
+                )
+                futures[f] = m
+            done = 0
+            for f in as_completed(futures):
+                m = futures[f]
+                if m is None:
+                    analytic_lines = f.result()
+                    log("dynamic accuracy: analytic tables done")
+                    continue
+                mode_paths[m.name], records[m.name] = f.result()
+                done += 1
+                if done % 20 == 0 or done == len(modes):
+                    log(f"dynamic accuracy: checked runs {done}/{len(modes)}")
+
+        # 2. the reference (GPU fp64 where usable and validated against the CPU)
+        gpu_ref = _gpu_reference_build(gpu_ok, plan)
+        check_rows, gpu_note = (
+            [],
+            f"not used: {gpu_why if not gpu_ok else 'the default cuda build is absent or runs no simulate variant'}",
+        )
+        if gpu_ref is not None:
+            S0 = plan.first_rung
+            cpu_path = study.rung(cpu_oracle, S0)
+            cpu_run = read_run(cpu_path)
+            gpu_path = study.rung(gpu_ref, S0)
+            gpu_run = read_run(gpu_path)
+            g_rms, g_max = frame_errors(gpu_run.pos, cpu_run.pos, study.L)
+            ref = study.ladder(gpu_ref, mode_paths, first_path=gpu_path)
+            share = tolerances.DYN_ACC_GPU_REF_SHARE * tolerances.DYN_ACC_REF_FACTOR
+            H = study.horizon_frames
+            valid = bool(reference_ok(g_rms[:H], ref["min_rms"][:H], share).all()) and not (gpu_run.blown > 0).any()
+            check_rows += _frame_rows(
+                gpu_run,
+                g_rms,
+                g_max,
+                study="gpu_check",
+                mode=f"{gpu_ref.label} vs {cpu_oracle.label} S{S0}",
+                backend="cuda",
+                build=gpu_ref.build,
+                variant=gpu_ref.variant,
+                solver=REF_SOLVER,
+                substeps=S0,
+                iterations=REF_ITERATIONS,
+                precision=REF_PRECISION,
+                strands=plan.strands,
+                points=study.scene.points,
+                ref_substeps=S0,
+            )
+            if valid:
+                gpu_note = "validated"
+            else:
+                gpu_note = "rejected: it differs from the CPU's by more than allowed; the CPU ladder is used"
+                log(f"dynamic accuracy: the GPU fp64 reference is {gpu_note}")
+                ref = study.ladder(cpu_oracle, mode_paths, first_path=cpu_path)
+        else:
+            ref = study.ladder(cpu_oracle, mode_paths)
+
+        # 3. timing, one mode at a time, nothing else running
+        timing = {}
+        for k, m in enumerate(modes, 1):
+            timing[m.name] = study.timed(m)
+            if k % 20 == 0 or k == len(modes):
+                log(f"dynamic accuracy: timed {k}/{len(modes)}")
+
+        rows = _rows(study, modes, mode_paths, ref, timing) + _ladder_rows(study, ref) + check_rows
+    finally:
+        shutil.rmtree(study.scratch, ignore_errors=True)
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    tmp = csv_path.with_suffix(".csv.tmp")
+    with open(tmp, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=COLUMNS)
+        w.writeheader()
+        w.writerows(rows)
+    os.replace(tmp, csv_path)
+    if analytic_lines:
+        (out_dir / ANALYTIC_NAME).write_text("\n".join(analytic_lines) + "\n")
+    elif (out_dir / ANALYTIC_NAME).exists():
+        (out_dir / ANALYTIC_NAME).unlink()  # a stale table must not be rendered with these rows
+    final_S = ref["steps"][-1]["S2"]
+    meta = dict(
+        env.collect(),
+        study=dict(
+            asdict(plan),
+            scene_file=study.scene.file,
+            scene_description=study.scene.description,
+            frame_dt=study.frame_dt,
+            frames=study.frames,
+            horizon_frames=study.horizon_frames,
+            points=study.scene.points,
+            hair_length=study.L,
+            builds=[b.label for b in builds],
+            gpu=gpu_why if not gpu_ok else "usable",
+            reference=dict(
+                backend=ref["build"].backend,
+                build=ref["build"].build,
+                variant=ref["build"].variant,
+                label=ref["build"].label,
+                solver=REF_SOLVER,
+                precision=REF_PRECISION,
+                iterations=REF_ITERATIONS,
+                substeps=final_S,
+                converged=ref["converged"],
+                converged_until_s=holds_until(ref["ok"], ref["final"].times),
+                factor=tolerances.DYN_ACC_REF_FACTOR,
+                gpu_check=gpu_note,
+                gpu_share=tolerances.DYN_ACC_GPU_REF_SHARE,
+            ),
+            wall_s=round(time.monotonic() - started, 1),
+            command=command,
+        ),
+    )
+    (out_dir / "env.json").write_text(json.dumps(meta, indent=1, default=str) + "\n")
+    log(f"wrote {display(csv_path)}")
+    if not ref["converged"]:
+        log(
+            f"dynamic accuracy: the reference did NOT converge over the horizon by S = {final_S} "
+            f"(--ref-max {plan.ref_max}); the report says so"
+        )
+        return 1
+    return 0
+
+
+def _rows(study, modes, mode_paths, ref, timing):
+    rows = []
+    final_S = ref["steps"][-1]["S2"]
+    for m in modes:
+        r = read_run(mode_paths[m.name])
+        rms, mx = frame_errors(r.pos, ref["final"].pos, study.L)
+        ms, ms_min, rec = timing[m.name]
+        rows += _frame_rows(
+            r,
+            rms,
+            mx,
+            study="mode",
+            mode=m.name,
+            backend=m.runner.backend,
+            build=m.runner.build,
+            variant=m.runner.variant,
+            solver=m.solver,
+            substeps=m.substeps,
+            iterations=m.iterations,
+            precision=m.precision,
+            strands=study.plan.strands,
+            points=study.scene.points,
+            time_per_frame_ms=ms,
+            time_per_frame_min_ms=ms_min,
+            time_strands=study.plan.time_strands,
+            threads=rec.get("threads") if m.runner.backend == "cpu" else None,
+            block_size=rec.get("block_size") if m.runner.backend == "cuda" else None,
+            device=rec.get("device"),
+            ref_substeps=final_S,
+        )
+    return rows
+
+
+def _ladder_rows(study, ref):
+    rows = []
+    b = ref["build"]
+    for st in ref["steps"]:
+        run = st["run"]
+        for f in range(len(st["rms"])):
+            rows.append(
+                _row(
+                    study="reference",
+                    mode=f"{b.label} {REF_SOLVER} S{st['S']} I{REF_ITERATIONS} {REF_PRECISION}",
+                    backend=b.backend,
+                    build=b.build,
+                    variant=b.variant,
+                    solver=REF_SOLVER,
+                    substeps=st["S"],
+                    iterations=REF_ITERATIONS,
+                    precision=REF_PRECISION,
+                    strands=study.plan.strands,
+                    points=study.scene.points,
+                    frame=f + 1,
+                    time_s=run.times[f],
+                    rms_err_L=st["rms"][f],
+                    max_err_L=st["max"][f],
+                    stretch_max=run.stretch[f],
+                    penetration_max=run.penetration[f],
+                    blown_up_strands=run.blown[f],
+                    ref_substeps=st["S2"],
+                )
+            )
+    return rows

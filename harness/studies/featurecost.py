@@ -1,0 +1,175 @@
+"""What each feature of the dynamic model costs (docs/model.md §3.9): time per frame of one
+scene with every feature undeclared, each alone, each removed from the full scene, and
+the full scene, on one binary and variant. Measures and writes CSV; the Markdown table is
+harness/render/featurecost_report.py.
+
+A feature is taken out by removing its flags from the scene's command line (so the binary
+compiles it out), never by setting it to zero:
+
+    bend     --bend-compliance            shape   --shape-compliance, --shape-range
+    wind     --wind-speed (and its gusts) gust    --gust-amplitude
+    motion   --head-motion, amplitude, frequency
+    collide  --no-collider added          drag    --drag, --damping (the wind's drag too)
+"""
+
+import csv
+import shutil
+from pathlib import Path
+
+from harness import HarnessError
+from harness.core import runner, scenes
+from harness.core.paths import binary_path
+from harness.core.scenes_dynamic import DECLARING, FEATURES, NEEDS
+
+FIELDS = (
+    "row",
+    "features",
+    "solver",
+    "substeps",
+    "iterations",
+    "strands",
+    "points",
+    "precision",
+    "backend",
+    "variant",
+    "threads",
+    "block_size",
+    "median_ms",
+    "min_ms",
+    "max_ms",
+    "point_substeps_per_s",
+    "device",
+    "instructions_per_point_substep",
+)
+
+
+def without(flags, features):
+    """The command line with `features` undeclared."""
+    drop = {f for feat in features for f in DECLARING.get(feat, ())}
+    out, i = [], 0
+    while i < len(flags):
+        if flags[i] in drop:
+            i += 2
+            continue
+        out.append(flags[i])
+        i += 1
+    if "collide" in features and "--no-collider" not in out:
+        out.append("--no-collider")
+    return out
+
+
+def declared(record):
+    """The features the binary compiled in for a run (its JSON record)."""
+    sim = [s for s in record["stages"] if s["stage"] == "simulate"]
+    if not sim:
+        raise HarnessError("featurecost: the binary's record has no simulate stage")
+    return sim[0]
+
+
+def cases(flags):
+    """(row name, flags) for the table: none, each alone, full minus each, full."""
+    rows = [("none (gravity, stretch)", without(flags, FEATURES))]
+    for feat in FEATURES:
+        keep = {feat, *NEEDS.get(feat, ())}
+        rows.append((f"only {'+'.join(sorted(keep))}", without(flags, [f for f in FEATURES if f not in keep])))
+    for feat in FEATURES:
+        rows.append((f"full − {feat}", without(flags, [feat])))
+    rows.append(("full", list(flags)))
+    return rows
+
+
+def measure(
+    scene_ref="dynamic",
+    backend="cpu",
+    build="default",
+    variant=None,
+    strands=100_000,
+    points=None,
+    frames=3,
+    repeat=3,
+    threads=None,
+    block_size=None,
+    out=None,
+    timeout=None,
+    progress=print,
+    instructions=False,
+):
+    scene = scenes.load_scene(scene_ref).with_overrides(strands=strands, points=points)
+    if scene.model != "dynamic":
+        raise HarnessError(f"featurecost: scene {scene_ref} is not a dynamic scene")
+    base = runner.run_flags(scene, backend, variant=variant, threads=threads, block_size=block_size, repeat=repeat)
+    base = _set(base, "--frames", str(frames))
+    binary = binary_path(backend, build)
+    rows = []
+    for name, flags in cases(base):
+        rec = runner.run_binary(binary, flags, timeout=timeout)
+        st = declared(rec)
+        ips = instructions_per_point_substep(binary, flags, rec, st, timeout) if instructions else None
+        row = {
+            "row": name,
+            "features": st["features"],
+            "solver": st["solver"],
+            "substeps": st["substeps"],
+            "iterations": st["iterations"],
+            "strands": rec["strands"],
+            "points": rec["points"],
+            "precision": rec["precision"],
+            "backend": rec["backend"],
+            "variant": rec["variant"],
+            "threads": rec.get("threads"),
+            "block_size": rec.get("block_size"),
+            "median_ms": st["median_ms"],
+            "min_ms": st["min_ms"],
+            "max_ms": st["max_ms"],
+            "point_substeps_per_s": st["point_substeps_per_s"],
+            "device": rec["device"],
+            "instructions_per_point_substep": ips,
+        }
+        progress(f"featurecost: {name:28s} {st['features']:44s} {st['median_ms']:10.3f} ms/frame")
+        rows.append(row)
+    if out:
+        path = Path(out)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with open(path, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=FIELDS)
+            w.writeheader()
+            w.writerows(rows)
+    return rows
+
+
+def instructions_per_point_substep(binary, flags, rec, st, timeout=None):
+    """CPU oracle only: the instructions executed inside the per-strand frame function
+    (hb_dyn_frame_strand_f32/_f64, the whole of a frame's model arithmetic) over the frames'
+    point-substeps, counted by valgrind's callgrind: deterministic, whatever else the machine
+    is doing, where wall times on a shared machine are not."""
+    import re
+    import subprocess
+    import tempfile
+
+    if rec["backend"] != "cpu" or rec.get("variant") not in (None, "ref"):
+        raise HarnessError("featurecost --instructions counts the CPU oracle (--backend cpu, variant ref) only")
+    valgrind = shutil.which("valgrind")
+    if not valgrind:
+        raise HarnessError("featurecost --instructions needs valgrind (apt-get install valgrind)")
+    fn = "hb_dyn_frame_strand_" + ("f64" if rec["precision"] == "fp64" else "f32")
+    args = [str(a) for a in flags]
+    timing = ("--repeat", "--warmup")
+    args = [a for i, a in enumerate(args) if a not in timing and args[i - 1] not in timing]
+    with tempfile.TemporaryDirectory() as d:
+        cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={d}/cg", f"--toggle-collect={fn}", str(binary)]
+        p = subprocess.run(cmd + args + ["--threads", "1", "--quiet"], capture_output=True, text=True, timeout=timeout)
+    m = re.search(r"Collected\s*:\s*([0-9]+)", p.stderr)
+    if p.returncode != 0 or not m:
+        raise HarnessError(f"callgrind failed on {binary.name}: {runner.last_line(p.stderr)}")
+    point_substeps = rec["strands"] * rec["points"] * st["substeps"] * st["frames"]
+    return int(m.group(1)) / point_substeps
+
+
+def _set(flags, flag, value):
+    """flags with `flag value` set (replaced when present)."""
+    out = list(flags)
+    if flag in out:
+        out[out.index(flag) + 1] = value
+    else:
+        out += [flag, value]
+    return out

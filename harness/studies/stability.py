@@ -1,0 +1,284 @@
+"""`python -m harness stability`: where the dynamic model is stable, the measuring part
+(render/stability_report.py renders it).
+
+A map, not anecdotes: 2-D slices through the dynamic scene space (substeps against wind
+speed, stretch compliance, bend compliance and points per strand; head-motion frequency
+against amplitude), each run for both solvers and both precisions, on the CPU and, where a
+GPU answers, on every CUDA build that is built (each build's default variant, as its
+`--list-variants` declares). Every cell is one run of a few strands over a horizon of
+about one second (strands are independent, so a few show what many would); its verdict,
+from the per-frame observables of the file (docs/model.md §3.8) and the bounds of
+harness/core/tolerances.py:
+
+  blown up        some frame has a blown-up strand (NaN/Inf, or a point beyond 2L)
+  penetrating     penetration_max > STABILITY_PENETRATION_REL · R_c in some frame
+  over-stretched  stretch_max > STABILITY_STRETCH_MAX in some frame
+  ok              none of these
+  refused         the binary refused the scene (exit 2); failed: any other failure
+
+(the first that applies). Each cell's last frame also goes through
+harness.check.invariants_dynamic; its violations are recorded beside the verdict.
+
+Writes results/stability/stability.csv and env.json, and render/stability_report.py draws
+report/stability_<slice>.png and writes report/dynamic_stability.md.
+"""
+
+import csv
+import os
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import replace
+from pathlib import Path
+
+from harness import HarnessError
+from harness.check import invariants_dynamic
+from harness.core import env, runner, scenes, tolerances, variants
+from harness.core.paths import RESULTS, binary_path, display
+from harness.core.progress import Progress
+from harness.io.files import write_json
+from harness.io.trajectory import open_trajectory
+from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES
+
+STRANDS = 16
+FRAMES = 60  # one second at the base scenes' Δt = 1/60 s
+
+COLUMNS = (
+    "slice",
+    "backend",
+    "build",
+    "variant",
+    "solver",
+    "precision",
+    "row_key",
+    "row",
+    "col_key",
+    "col",
+    "strands",
+    "points",
+    "frames",
+    "substeps",
+    "iterations",
+    "stretch_max",
+    "penetration_max",
+    "penetration_rel",
+    "blown_up_frames",
+    "first_blown_frame",
+    "verdict",
+    "violations",
+    "wall_s",
+    "message",
+)
+
+
+class Backend(variants.Runner):
+    @property
+    def label(self):
+        return "cpu" if self.backend == "cpu" else f"cuda-{self.build}"
+
+
+def verdict(stretch_max, penetration_rel, blown_up_frames):
+    """The verdict of a cell from its worst observables over the horizon (module docstring)."""
+    if blown_up_frames > 0:
+        return "blown up"
+    if penetration_rel > tolerances.STABILITY_PENETRATION_REL:
+        return "penetrating"
+    if stretch_max > tolerances.STABILITY_STRETCH_MAX:
+        return "over-stretched"
+    return "ok"
+
+
+def text(value):
+    """An axis value as the CSV and the report write it."""
+    return value if isinstance(value, str) else f"{value:g}"
+
+
+def backends(gpu="auto", log=print):
+    """The CPU oracle, and each built CUDA build's first variant that simulates any point
+    count (the map's P axis reaches 128) where a GPU answers."""
+    out = [Backend("cpu", "default", variants.declared("cpu").default_variant)]
+    if gpu == "no":
+        log("stability: GPU builds not run (--gpu no)")
+        return out
+    usable, why = env.gpu_status()
+    if not usable:
+        if gpu == "yes":
+            raise HarnessError(f"stability: --gpu yes but {why}")
+        log(f"stability: GPU builds not run: {why}")
+        return out
+    for build in ("default", "strict", "fastmath"):
+        if binary_path("cuda", build).exists():
+            out.append(Backend("cuda", build, variants.simulating("cuda", build)))
+        else:
+            log(f"stability: {display(binary_path('cuda', build))} not built: its cells are not run")
+    if gpu == "yes" and len(out) == 1:
+        raise HarnessError("stability: --gpu yes but no CUDA binary is built (run make)")
+    return out
+
+
+def cell_scene(slc, row, col, solver, precision, strands, frames):
+    """The scene of one cell: the slice's base scene with its fixed changes and the two axis values."""
+    base = scenes.load_scene(slc.scene)
+    points = None
+    dyn = dict(base.dynamic)
+    for flag, value in (*slc.fixed, ("--solver", solver), (slc.rows.key, row), (slc.cols.key, col)):
+        if flag == "points":
+            points = value
+        elif value == OFF:
+            dyn.pop(flag, None)
+        else:
+            dyn[flag] = value
+    dyn["--frames"] = frames
+    dyn["--output-every"] = frames  # every frame's observables, the last frame's positions
+    return replace(base.with_overrides(strands=strands, precision=precision, points=points), dynamic=dyn)
+
+
+def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None):
+    """Run one cell; return its CSV row."""
+    scene = cell_scene(slc, row, col, solver, precision, strands, frames)
+    out = {
+        "slice": slc.name,
+        "backend": be.backend,
+        "build": be.build,
+        "variant": be.variant,
+        "solver": solver,
+        "precision": precision,
+        "row_key": slc.rows.key,
+        "row": text(row),
+        "col_key": slc.cols.key,
+        "col": text(col),
+        "strands": strands,
+        "points": scene.points,
+        "frames": frames,
+        "substeps": scene.dynamic.get("--substeps", 1),
+        "iterations": scene.dynamic.get("--iterations", 1),
+        "violations": "",
+        "message": "",
+    }
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="hb-stab-") as tmp:
+        path = Path(tmp) / "cell.h5"
+        flags = runner.run_flags(
+            scene, be.backend, variant=be.variant, threads=1 if be.backend == "cpu" else None, output=path
+        )
+        try:
+            runner.run_binary(binary_path(be.backend, be.build), flags, timeout=timeout)
+        except runner.BackendError as e:
+            out.update(verdict="refused" if e.code == 2 else "failed", message=str(e), wall_s=time.perf_counter() - t0)
+            return out
+        with open_trajectory(path) as t:
+            obs = t.observables
+            stretch = float(obs["stretch_max"].max())
+            pen = float(obs["penetration_max"].max())
+            blown = obs["blown_up_strands"].to_numpy() > 0
+            rep = invariants_dynamic.check(t, exact=invariants_dynamic.is_reference_build(t), paper=False)
+            rel = pen / t.collide_radius
+    out.update(
+        stretch_max=stretch,
+        penetration_max=pen,
+        penetration_rel=rel,
+        blown_up_frames=int(blown.sum()),
+        first_blown_frame=int(blown.argmax()) + 1 if blown.any() else "",
+        verdict=verdict(stretch, rel, int(blown.sum())),
+        violations="+".join(sorted({v.invariant for v in rep.violations})),
+        wall_s=time.perf_counter() - t0,
+    )
+    return out
+
+
+def cells(slices, quick):
+    """(slice, row, col) of every cell, in the order the report draws them."""
+    for slc in slices:
+        rows = slc.rows.quick if quick else slc.rows.values
+        cols = slc.cols.quick if quick else slc.cols.values
+        for r in rows:
+            for c in cols:
+                yield slc, r, c
+
+
+def measure(
+    slices=SLICE_NAMES,
+    quick=False,
+    strands=STRANDS,
+    frames=FRAMES,
+    jobs=None,
+    gpu="auto",
+    timeout=None,
+    log=print,
+):
+    """Run the map; return (rows, backends run, seconds)."""
+    unknown = [s for s in slices if s not in SLICE_NAMES]
+    if unknown:
+        raise HarnessError(f"stability: unknown slice(s) {', '.join(unknown)} (known: {', '.join(SLICE_NAMES)})")
+    chosen = [s for s in SLICES if s.name in slices]
+    bes = backends(gpu, log)
+    declared = {be: variants.declared(be.backend, be.build) for be in bes}  # solvers, precisions
+    todo = [
+        (slc, r, c, solver, precision, be)
+        for be in bes
+        for slc, r, c in cells(chosen, quick)
+        for solver in declared[be].solvers
+        for precision in declared[be].precisions
+    ]
+    jobs = jobs or os.cpu_count() or 1
+    log(
+        f"stability: {len(todo)} cells ({len(chosen)} slice(s) × solvers × precisions × {len(bes)} backend(s)), "
+        f"{strands} strands, {frames} frames, {jobs} jobs"
+    )
+    t0 = time.perf_counter()
+    bar = Progress(len(todo), "stability")
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = [pool.submit(run_cell, *job, strands, frames, timeout) for job in todo]
+        rows = []
+        for f in futures:
+            rows.append(f.result())
+            bar.update()
+    bar.close()
+    return rows, bes, time.perf_counter() - t0
+
+
+def write_csv(rows, path):
+    """rows → CSV, written beside and renamed, so no partial file is left."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f"{path.name}.tmp.{os.getpid()}")
+    with open(tmp, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=COLUMNS)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: r.get(k, "") for k in COLUMNS})
+    os.replace(tmp, path)
+    return path
+
+
+def run_study(
+    slices=SLICE_NAMES,
+    quick=False,
+    strands=STRANDS,
+    frames=FRAMES,
+    jobs=None,
+    gpu="auto",
+    timeout=None,
+    out_dir=None,
+    log=print,
+):
+    """Measure the slices; write stability.csv and env.json into out_dir (the renderer,
+    render/stability_report.py, draws them) and return the CSV's path."""
+    out_dir = Path(out_dir or RESULTS / "stability")
+    rows, bes, seconds = measure(slices, quick, strands, frames, jobs, gpu, timeout, log)
+    csv_path = write_csv(rows, out_dir / "stability.csv")
+    info = dict(
+        env.collect(),
+        quick=quick,
+        strands=strands,
+        frames=frames,
+        jobs=jobs or os.cpu_count(),
+        seconds=round(seconds, 1),
+        backends=[b.label for b in bes],
+        stretch_bound=tolerances.STABILITY_STRETCH_MAX,
+        penetration_bound_rel=tolerances.STABILITY_PENETRATION_REL,
+    )
+    env_path = out_dir / "env.json"
+    write_json(env_path, info)
+    log(f"stability: {len(rows)} cells in {seconds:.1f} s; wrote {display(csv_path)} and {display(env_path)}")
+    return csv_path

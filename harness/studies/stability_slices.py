@@ -1,0 +1,76 @@
+"""What the stability study measures, as the study and its renderer both read it: the
+slices (two axes over a base scene each) and the verdicts of a cell. Runs nothing."""
+
+from dataclasses import dataclass
+
+VERDICTS = ("ok", "over-stretched", "penetrating", "blown up")  # mildest first
+OTHER = ("refused", "failed")
+OFF = "off"  # an axis value that leaves its feature undeclared
+
+
+@dataclass(frozen=True)
+class Axis:
+    key: str  # a flag of the simulate stage (--substeps, …) or "points"
+    label: str  # how the report names it
+    values: tuple  # OFF = leave the flag out (the feature undeclared)
+    quick: tuple  # the subset `--quick` runs
+    unit: str = ""
+
+
+@dataclass(frozen=True)
+class Slice:
+    name: str
+    title: str
+    scene: str  # base scene in configs/scenes/
+    fixed: tuple  # (flag, value) changes to the base scene
+    rows: Axis
+    cols: Axis
+
+
+SUBSTEPS = Axis("--substeps", "S", (1, 2, 4, 8, 16, 32, 64), (1, 4, 16, 64))
+# The base is the shipped still scene (gravity, the collider, damping 0.5, S = 8, I = 2),
+# so that one slice changes one or two things a user would; wind acts only through drag,
+# so the wind slice declares the default scene's drag and gusts.
+SLICES = (
+    Slice(
+        "substeps-wind",
+        "substeps against wind speed (drag 0.5/s, gusts 0.5)",
+        "still-dynamic",
+        (("--drag", 0.5), ("--gust-amplitude", 0.5), ("--gust-wavelength", 60.0)),
+        SUBSTEPS,
+        Axis("--wind-speed", "U", (0, 500, 1000, 2000, 4000, 8000), (0, 2000, 8000), "cm/s"),
+    ),
+    Slice(
+        "substeps-stretch",
+        "substeps against stretch compliance",
+        "still-dynamic",
+        (),
+        SUBSTEPS,
+        Axis("--stretch-compliance", "α_s", (0, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4), (0, 1e-6, 1e-4)),
+    ),
+    Slice(
+        "substeps-bend",
+        "substeps against bend compliance (off = bend undeclared)",
+        "still-dynamic",
+        (),
+        SUBSTEPS,
+        Axis("--bend-compliance", "α_b", (OFF, 0, 1e-8, 1e-6, 1e-4, 1e-2), (OFF, 0, 1e-4)),
+    ),
+    Slice(
+        "substeps-points",
+        "substeps against points per strand",
+        "still-dynamic",
+        (),
+        SUBSTEPS,
+        Axis("points", "P", (2, 4, 8, 16, 32, 64, 128), (2, 16, 128)),
+    ),
+    Slice(
+        "motion",
+        "nodding head: frequency against amplitude (S = 32)",
+        "still-dynamic",
+        (("--head-motion", "nod"), ("--substeps", 32)),
+        Axis("--motion-frequency", "f", (0.5, 1, 2, 4, 8, 16), (1, 4, 16), "Hz"),
+        Axis("--motion-amplitude", "A", (0.1, 0.25, 0.5, 1, 2, 3), (0.25, 1, 3), "rad"),
+    ),
+)
+SLICE_NAMES = tuple(s.name for s in SLICES)

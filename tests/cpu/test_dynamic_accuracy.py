@@ -1,0 +1,215 @@
+"""`python -m harness accuracy --model dynamic` (harness/studies/accuracy_dynamic.py measures,
+accuracy_dynamic_report.py renders): the machinery at a tiny size. The study itself (its numbers)
+belongs to `make bench`, not here."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from harness.cli import main as cli
+from harness.core import env, tolerances, variants
+from harness.render import accuracy_dynamic_report
+from harness.studies import accuracy_dynamic
+from support.cuda_standin import install
+
+
+def test_frame_errors_of_a_known_difference():
+    ref = np.zeros((3, 2, 3, 3))  # 3 frames, 2 strands × 3 points
+    x = ref.copy()
+    x[1, 0, 2] = (3.0, 4.0, 0.0)  # one point 5 away in frame 1
+    x[2, 1, 1, 0] = np.nan  # frame 2 not finite
+    rms, mx = accuracy_dynamic.frame_errors(x, ref, L=10.0)
+    assert rms[0] == 0 and mx[0] == 0
+    assert mx[1] == pytest.approx(0.5) and rms[1] == pytest.approx(np.sqrt(25 / 6) / 10)
+    assert np.isnan(rms[2]) and np.isnan(mx[2])
+
+
+def test_the_grid_holds_both_sides_of_small_steps_against_iterations():
+    assert accuracy_dynamic.grid((1, 4), (1, 2)) == [(1, 1), (1, 2), (1, 4), (4, 1), (4, 2)]
+    assert (1, 8) in accuracy_dynamic.grid((2, 8), (2,)) and (8, 1) in accuracy_dynamic.grid((2, 8), (2,))
+
+
+def test_convergence_is_detected_frame_by_frame():
+    errors = {
+        "a": np.array([1e-2, 2e-2, 4e-2, 8e-2]),
+        "b": np.array([2e-3, np.nan, 5e-2, 1e-2]),
+        "c": np.full(4, np.nan),
+    }
+    low = accuracy_dynamic.smallest(errors)
+    assert np.allclose(low, [2e-3, 2e-2, 4e-2, 1e-2])
+    diff = np.array([1e-4, 1e-3, 5e-3, 1e-3])  # the reference's S against 2S
+    ok = accuracy_dynamic.reference_ok(diff, low, 0.1)
+    assert ok.tolist() == [True, True, False, False]  # 1e-3 < 2e-3 holds; 5e-3 < 4e-3 does not; 1e-3 < 1e-3 does not
+    times = np.array([0.1, 0.2, 0.3, 0.4])
+    assert accuracy_dynamic.holds_until(ok, times) == 0.2
+    assert accuracy_dynamic.holds_until(np.ones(4, bool), times) == 0.4
+    assert accuracy_dynamic.holds_until(np.array([False, True, True, True]), times) == 0.0
+    assert not accuracy_dynamic.reference_ok(np.array([np.nan]), np.array([1.0]), 0.1)[0]
+
+
+def test_pareto_front_selection():
+    t = [1.0, 2.0, 3.0, 4.0, 4.0, 5.0, 6.0, np.nan]
+    e = [10.0, 5.0, 6.0, 1.0, 0.5, 0.499, np.nan, 0.1]
+    # (3, 6) is beaten by (2, 5); (4, 1) by (4, 0.5); NaNs are never on the front
+    assert accuracy_dynamic_report.pareto_front(t, e).tolist() == [True, True, False, False, True, True, False, False]
+    # with a tie of 1 %, 0.499 is no better than 0.5: the slower mode leaves the front
+    assert accuracy_dynamic_report.pareto_front(t, e, tie=0.01).tolist()[5] is False
+
+
+@pytest.mark.parametrize(
+    "argv, says",
+    [
+        (["--model", "dynamic", "--resolution", "4", "8"], "--resolution is an option of the paper"),
+        (["--quick"], "--quick is an option of the dynamic"),
+        (["--model", "paper", "--scene", "dynamic"], "dynamic-model scene"),
+        (["--model", "dynamic", "--scene", "paper"], "paper-model scene"),
+        (["--model", "dynamic", "--horizon", "2", "--seconds", "1"], "--horizon 2 must be > 0 and at most"),
+        (["--model", "dynamic", "--ref-start", "16"], "--ref-start 16 must exceed the largest --substeps (32)"),
+        (["--model", "dynamic", "--ref-start", "64", "--ref-max", "100"], "--ref-max 100 must be at least twice"),
+        (["--model", "dynamic", "--substeps", "0"], "must be at least 1"),
+        (["--model", "dynamic", "--seconds", "nan"], "finite number of seconds"),
+        (["--model", "dynamic", "--horizon", "0.001"], "shorter than one frame"),
+        (["--model", "dynamic", "--scene", "nonesuch"], "no scene 'nonesuch'"),
+    ],
+)
+def test_bad_options_are_refused_in_one_line_with_exit_2(argv, says, capsys, tmp_path):
+    try:
+        rc = cli.main(["accuracy", *argv, "--out", str(tmp_path / "out"), "--report-dir", str(tmp_path / "rep")])
+    except SystemExit as e:
+        rc = e.code
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and says in err[0], err
+    assert not (tmp_path / "out").exists() and not (tmp_path / "rep").exists()
+
+
+TINY = dict(
+    strands=4,
+    seconds=2 / 60,
+    horizon=2 / 60,
+    substeps=(1, 2),
+    iterations=(1,),
+    time_strands=8,
+    repeat=1,
+    ref_start=64,
+    ref_max=4096,
+    analytic="none",
+    jobs=2,
+)
+
+
+@pytest.fixture
+def quiet():
+    return lambda *_: None
+
+
+def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, tmp_path, quiet, monkeypatch):
+    monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
+    out, rep = tmp_path / "out", tmp_path / "rep"
+    rc = accuracy_dynamic.run_study(accuracy_dynamic.Plan(**TINY), out, log=quiet)
+    assert rc == 0 and not rep.exists()  # measuring only: the renderer draws
+    accuracy_dynamic_report.write(out, rep)
+    with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
+        reader = csv.DictReader(fh)
+        rows = list(reader)
+    assert tuple(reader.fieldnames) == accuracy_dynamic.COLUMNS
+    cpu = variants.declared("cpu")
+    n_modes = len(cpu.running("simulate")) * len(cpu.solvers) * len(cpu.precisions) * 3  # (1,1) (2,1) (1,2)
+    mode_rows = [r for r in rows if r["study"] == "mode"]
+    assert len(mode_rows) == n_modes * 2  # two frames each
+    assert all(float(r["time_per_frame_ms"]) > 0 and float(r["rms_err_L"]) > 0 for r in mode_rows)
+    ladder = [r for r in rows if r["study"] == "reference"]
+    assert ladder and all(int(r["ref_substeps"]) == 2 * int(r["substeps"]) for r in ladder)
+    meta = json.loads((out / "env.json").read_text())["study"]
+    assert meta["reference"]["converged"] and meta["reference"]["substeps"] == max(
+        int(r["ref_substeps"]) for r in ladder
+    )
+    page = (rep / accuracy_dynamic_report.PAGE).read_text()
+    for heading in ("The converged reference", "Small steps against iterations", "Which settings for which use"):
+        assert f"### {heading}" in page
+    assert "**Converged**" in page and "No GPU reference: not used: HAIRBENCH_NO_GPU is set" in page
+    for png in (
+        accuracy_dynamic_report.PARETO_PNG,
+        accuracy_dynamic_report.GROWTH_PNG,
+        accuracy_dynamic_report.STEPS_PNG,
+    ):
+        assert (rep / png).stat().st_size > 5000
+    assert not (out / "states").exists()
+    # the convergence table re-derived from the CSV agrees with what the study decided
+    table = accuracy_dynamic_report.section(out, rep, write_page=False)
+    assert any("converged over the" in ln for ln in table)
+    # --from-csv re-renders (the model read from the CSV's header), elsewhere
+    assert (
+        cli.main(["accuracy", "--from-csv", str(out / accuracy_dynamic.CSV_NAME), "--report-dir", str(tmp_path / "r2")])
+        == 0
+    )
+    assert (tmp_path / "r2" / accuracy_dynamic_report.PAGE).read_text() == page
+    before = (out / accuracy_dynamic.CSV_NAME).read_bytes()
+    with pytest.raises(accuracy_dynamic.HarnessError, match="exists: pass --force"):
+        accuracy_dynamic.run_study(accuracy_dynamic.Plan(**TINY), out, log=quiet)
+    assert (out / accuracy_dynamic.CSV_NAME).read_bytes() == before
+
+
+def test_the_reference_that_does_not_converge_says_so(cpu_bin, tmp_path, quiet, monkeypatch):
+    monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
+    plan = accuracy_dynamic.Plan(**{**TINY, "substeps": (1, 16), "ref_start": 32, "ref_max": 64})
+    assert accuracy_dynamic.run_study(plan, tmp_path / "o", log=quiet) == 1
+    accuracy_dynamic_report.write(tmp_path / "o", tmp_path / "r")
+    assert "**NOT converged**" in (tmp_path / "r" / accuracy_dynamic_report.PAGE).read_text()
+
+
+@pytest.fixture
+def standin_build(tmp_path, monkeypatch, cpu_bin):
+    def make(perturb):
+        d = tmp_path / ("build-perturbed" if perturb else "build")
+        install(d, cpu_bin, perturb=perturb)
+        monkeypatch.setenv("HAIRBENCH_BUILD_DIR", str(d))
+        monkeypatch.delenv("HAIRBENCH_NO_GPU", raising=False)
+        monkeypatch.setattr(env, "gpu_status", lambda: (True, "stand-in GPU"))
+        variants.clear_cache()
+        return d
+
+    yield make
+    variants.clear_cache()
+
+
+@pytest.mark.parametrize("perturb", [False, True], ids=["gpu-agrees", "gpu-disagrees"])
+def test_gpu_modes_and_the_gpu_reference_check(standin_build, tmp_path, quiet, perturb):
+    """The GPU path on a stand-in cuda binary (tests/support/cuda_standin.py): GPU modes of
+    the variant that runs simulate only, and a GPU fp64 reference used only when it agrees
+    with the CPU's (tolerances.DYN_ACC_GPU_REF_SHARE)."""
+    standin_build(perturb)
+    out = tmp_path / "out"
+    plan = accuracy_dynamic.Plan(**{**TINY, "iterations": (1,), "substeps": (1,)})
+    assert accuracy_dynamic.run_study(plan, out, log=quiet) == 0
+    with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    gpu = {r["variant"] for r in rows if r["study"] == "mode" and r["backend"] == "cuda"}
+    assert gpu == {"strand"}
+    check = [r for r in rows if r["study"] == "gpu_check"]
+    assert len(check) == 2
+    ref = json.loads((out / "env.json").read_text())["study"]["reference"]
+    if perturb:
+        assert float(check[-1]["rms_err_L"]) > 0
+        assert ref["backend"] == "cpu" and ref["gpu_check"].startswith("rejected")
+    else:
+        assert all(float(r["rms_err_L"]) == 0 for r in check)
+        assert ref["backend"] == "cuda" and ref["gpu_check"] == "validated"
+    assert ref["gpu_share"] == tolerances.DYN_ACC_GPU_REF_SHARE
+
+
+@pytest.mark.gpu
+def test_a_tiny_study_on_the_gpu(tmp_path, quiet):
+    """With a real GPU: every cuda build's simulate variants take part, and the GPU fp64
+    reference is validated against the CPU (or rejected, which the report then says)."""
+    out = tmp_path / "out"
+    plan = accuracy_dynamic.Plan(**{**TINY, "strands": 64, "time_strands": 4096})
+    assert accuracy_dynamic.run_study(plan, out, log=quiet) == 0
+    with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    builds = {(r["build"], r["variant"]) for r in rows if r["study"] == "mode" and r["backend"] == "cuda"}
+    assert builds and all(v in variants.declared("cuda", b).running("simulate") for b, v in builds)
+    assert [r for r in rows if r["study"] == "gpu_check"]
+    ref = json.loads((out / "env.json").read_text())["study"]["reference"]
+    assert ref["gpu_check"] in ("validated",) or ref["gpu_check"].startswith("rejected")

@@ -1,0 +1,460 @@
+"""Stability of the dynamic model at the extremes (docs/model.md §3): a property-based
+search over the dynamic scene space on the CPU (and, marked `gpu`, on the strict CUDA
+build against the CPU), a slice of the stability map whose verdicts are known, and the
+map's verdict and wording rules. The map itself is `python -m harness stability`
+(harness/studies/stability.py); what the searches found and the regressions named after it are in
+docs/decisions.md ("Stability search of the dynamic model").
+"""
+
+import math
+import os
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, event, example, given, settings
+from hypothesis import strategies as st
+
+from harness import HarnessError
+from harness.check import diff_dynamic, invariants_dynamic
+from harness.cli.main import main as harness_main
+from harness.core import tolerances, variants
+from harness.io.trajectory import open_trajectory
+from harness.render import stability_report
+from harness.studies import stability, stability_slices
+from support.statecheck import run
+
+# CI: 120 derandomized examples (about 30 s on the 2-core CI machine); a deeper search:
+# HAIRBENCH_DYN_STABILITY_EXAMPLES=2000 pytest tests/cpu/test_stability_dynamic.py -k search
+CPU_SETTINGS = settings(
+    max_examples=int(os.environ.get("HAIRBENCH_DYN_STABILITY_EXAMPLES", "120")),
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+# the GPU part: 60 examples in the suite; HAIRBENCH_GPU_DYN_STABILITY_EXAMPLES=300 for more
+GPU_SETTINGS = settings(
+    max_examples=int(os.environ.get("HAIRBENCH_GPU_DYN_STABILITY_EXAMPLES", "60")),
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+
+
+def _gpu_variants():
+    """The strict build's variants that simulate, and their point limits."""
+    try:
+        d = variants.declared("cuda", "strict")
+    except HarnessError:
+        return ("not-built",), {}  # the GPU tests skip without it
+    return d.running("simulate"), d.max_points
+
+
+GPU_VARIANTS, GPU_MAX_POINTS = _gpu_variants()
+
+HAIR_LENGTH = 30.0
+HUGE = (1e10, 1e30, 1e38, 1e300)  # compliances, drag and damping far past any physical value
+
+
+def loguniform(lo, hi):
+    return st.floats(lo, hi).map(lambda e: 10.0**e)
+
+
+def compliance():
+    return st.one_of(st.just(0.0), loguniform(-12, 2), st.sampled_from(HUGE))
+
+
+@st.composite
+def dyn_scenes(draw):
+    """A dynamic scene (docs/model.md §3 table) over its allowed ranges and their edges.
+    Values the model leaves undeclared are None (the flag is not passed)."""
+    s = {
+        "precision": draw(st.sampled_from(["fp32", "fp64"])),
+        "solver": draw(st.sampled_from(["xpbd", "ftl"])),
+        "strands": draw(st.integers(1, 4)),
+        "points": draw(st.one_of(st.sampled_from([2, 3, 4, 32, 128]), st.integers(2, 128))),
+        "seed": draw(st.integers(0, 2**32)),
+        "frames": draw(st.integers(1, 4)),
+        "substeps": draw(st.one_of(st.sampled_from([1, 2, 64]), st.integers(1, 64))),
+        "iterations": draw(st.integers(1, 8)),
+        "frame_dt": draw(st.one_of(st.sampled_from([1 / 60, 1 / 24, 1 / 240, 1.0]), loguniform(-5, 0.5))),
+        "gravity": draw(st.one_of(st.just(0.0), st.floats(0, 5000), st.sampled_from([981.0, 1e5, *HUGE]))),
+        "stretch_compliance": draw(st.one_of(st.none(), compliance())),
+        "bend_compliance": draw(st.one_of(st.none(), compliance())),
+        "shape_compliance": draw(st.one_of(st.none(), compliance())),
+        "drag": draw(st.one_of(st.none(), st.just(0.0), loguniform(-3, 3), st.sampled_from(HUGE))),
+        "damping": draw(st.one_of(st.none(), st.just(0.0), loguniform(-3, 3), st.sampled_from(HUGE))),
+        "wind_speed": draw(st.one_of(st.just(0.0), st.floats(0, 2000), st.sampled_from([2000.0, 8000.0, 1e5]))),
+        "wind_angle": draw(st.one_of(st.sampled_from([math.pi, 0.0, math.pi / 2]), st.floats(-7, 7))),
+        "gust_amplitude": draw(st.one_of(st.just(0.0), st.floats(0, 2), st.sampled_from([10.0, 1e39]))),
+        "gust_frequency": draw(st.floats(0, 50)),
+        "gust_wavelength": draw(st.one_of(loguniform(-2, 4), st.just(1e-40))),
+        "motion": draw(st.sampled_from(["still", "nod", "shake", "tilt"])),
+        "motion_amplitude": draw(st.one_of(st.floats(0, 4), st.just(0.0))),
+        "motion_frequency": draw(st.one_of(st.floats(0, 30), st.just(0.0))),
+        "collision_margin": draw(st.one_of(st.just(0.0), st.floats(0, 5), st.sampled_from([30.0, 100.0, 1e30]))),
+        "collider": draw(st.booleans()),
+        "ftl_damping": draw(st.floats(0, 1)),
+    }
+    s["shape_range"] = (
+        draw(st.one_of(st.just(1.0), st.floats(1e-3, 1), st.just(1e-3))) if s["shape_compliance"] is not None else None
+    )
+    return s
+
+
+def scene_args(s):
+    """The binary's flags of a drawn scene: the geometry, then dynamic_args."""
+    geometry = ["--strands", s["strands"], "--points", s["points"], "--seed", s["seed"], "--hair-length", HAIR_LENGTH]
+    return [*geometry, "--precision", s["precision"], *dynamic_args(s)]
+
+
+def dynamic_args(s):
+    """The simulate stage's flags of a drawn scene (None: the flag is left out)."""
+    args = ["--solver", s["solver"], "--head-motion", s["motion"]]
+    for key in (
+        "frames",
+        "substeps",
+        "iterations",
+        "frame_dt",
+        "gravity",
+        "stretch_compliance",
+        "bend_compliance",
+        "shape_compliance",
+        "shape_range",
+        "drag",
+        "damping",
+        "wind_speed",
+        "wind_angle",
+        "gust_amplitude",
+        "gust_frequency",
+        "gust_wavelength",
+        "motion_amplitude",
+        "motion_frequency",
+        "collision_margin",
+        "ftl_damping",
+    ):
+        if s[key] is not None:
+            args += ["--" + key.replace("_", "-"), repr(s[key]) if isinstance(s[key], float) else s[key]]
+    if not s["collider"]:
+        args.append("--no-collider")
+    return args
+
+
+def simulate(cpu_bin, s, out, *extra):
+    """Run a drawn scene on the CPU; the CompletedProcess (exit 2 = refused)."""
+    return run(cpu_bin, *scene_args(s), "--stages", "init,collide,simulate", *extra, "--output", out, check=False)
+
+
+def refused_cleanly(p):
+    """A refusal is exit 2, one line on stderr that names a flag, and no file."""
+    lines = p.stderr.strip().splitlines()
+    return p.returncode == 2 and len(lines) == 1 and "--" in lines[0]
+
+
+def check_contract(path):
+    """harness.check.invariants_dynamic on every frame (the reference's roots bit for bit); the report."""
+    with open_trajectory(path) as t:
+        rep = invariants_dynamic.check(t, exact=True)
+        blown = int(t.observables["blown_up_strands"].max())
+    assert rep.ok, "; ".join(v.message for v in rep.all_violations()[:4])
+    return blown
+
+
+# The examples the search found and that are fixed now (docs/decisions.md): each failed
+# before its fix and is kept as an explicit example besides its named regression test.
+BASE = dict(
+    precision="fp32",
+    solver="xpbd",
+    strands=2,
+    points=8,
+    seed=1,
+    frames=2,
+    substeps=1,
+    iterations=1,
+    frame_dt=1 / 60,
+    gravity=981.0,
+    stretch_compliance=None,
+    bend_compliance=None,
+    shape_compliance=None,
+    shape_range=None,
+    drag=None,
+    damping=None,
+    wind_speed=0.0,
+    wind_angle=math.pi,
+    gust_amplitude=0.0,
+    gust_frequency=1.0,
+    gust_wavelength=100.0,
+    motion="still",
+    motion_amplitude=0.25,
+    motion_frequency=1.0,
+    collision_margin=0.0,
+    collider=True,
+    ftl_damping=0.9,
+)
+
+
+@CPU_SETTINGS
+@given(s=dyn_scenes())
+@example(s=dict(BASE, stretch_compliance=1e36))
+@example(s=dict(BASE, solver="ftl", bend_compliance=1e300, substeps=64, precision="fp64", frame_dt=1e-3))
+@example(s=dict(BASE, drag=1e30, wind_speed=1e10))
+@example(s=dict(BASE, drag=0.5, wind_speed=150.0, gust_amplitude=0.5, gust_wavelength=1e-40))
+def test_search_cpu_contract_holds_across_the_dynamic_scene_space(cpu_bin, tmp_path_factory, s):
+    """Every drawn scene is refused cleanly (exit 2, one line naming a flag, no file) or
+    runs with every frame within the contract: no NaN/Inf, roots bit for bit at Q(t)·X̄0,
+    no point inside the collider, FTL segments of length ℓ, observables that agree with
+    the positions. A blow-up (a point beyond 2L) is the solver's limit, not a failure,
+    except where it cannot happen: FTL sets every segment to ℓ and the collider (margin 0)
+    at most doubles one, so an ftl strand never reaches 2L."""
+    out = tmp_path_factory.mktemp("dynstab") / "s.h5"
+    p = simulate(cpu_bin, s, out, "--velocities", "all")
+    if p.returncode != 0:
+        assert refused_cleanly(p), (p.returncode, p.stderr)
+        assert not out.exists()
+        event("refused")
+        return
+    blown = check_contract(out)
+    event("blown up" if blown else "not blown up")
+    if s["solver"] == "ftl" and (s["collision_margin"] == 0.0 or not s["collider"]):
+        assert blown == 0, "an ftl strand blew up, which FTL's segment lengths rule out"
+
+
+@pytest.mark.gpu
+@GPU_SETTINGS
+@given(s=dyn_scenes(), variant=st.sampled_from(GPU_VARIANTS), block=st.sampled_from([32, 96, 256, 1024]))
+@example(s=dict(BASE, points=33, substeps=4, iterations=2), variant=GPU_VARIANTS[0], block=32)
+def test_search_gpu_frame_agrees_with_cpu(cpu_bin, tmp_path_factory, s, variant, block):
+    """A drawn scene on the strict CUDA build: one frame from the CPU's state (positions and
+    velocities, --input --input-frame) against the CPU's next frame, by the rule of
+    tests/gpu/test_gpu_dynamic.py (harness.check.diff_dynamic.compare: bit for bit without gusts, the
+    DYN_STEP_K rule with them); a scene the CPU refuses must be refused by the GPU too."""
+    from conftest import CUDA_STRICT_BIN
+
+    d = tmp_path_factory.mktemp("dynstabgpu")
+    cpu, gpu = d / "cpu.h5", d / "gpu.h5"
+    s = dict(s, frames=max(2, s["frames"]))
+    p = simulate(cpu_bin, s, cpu, "--velocities", "all")
+    if p.returncode != 0:
+        q = run(CUDA_STRICT_BIN, *scene_args(s), "--stages", "init,collide,simulate", "--output", gpu, check=False)
+        assert p.returncode == q.returncode == 2, (p.stderr, q.stderr)
+        return
+    with open_trajectory(cpu) as t:
+        k = t.n_frames - 2  # resume from the before-last frame
+        gusts = "gust" in t.features.split("+")
+        step = int(t.step[k + 1])
+        blown = int(t.observables.set_index("step").loc[step, "blown_up_strands"])
+    g = run(
+        CUDA_STRICT_BIN,
+        "--input",
+        cpu,
+        "--input-frame",
+        k,
+        "--stages",
+        "simulate",
+        *dynamic_args(dict(s, frames=1)),
+        "--variant",
+        variant,
+        "--block-size",
+        block,
+        "--output",
+        gpu,
+        "--quiet",
+        check=False,
+    )
+    if g.returncode == 2 and "shared memory" in g.stderr:  # the warp variant's block does not fit: refused
+        event("warp variant: block too large for shared memory, refused")
+        return
+    limit = GPU_MAX_POINTS.get(variant)
+    if limit and s["points"] > limit:  # a variant's declared point limit: refused, naming --points
+        assert g.returncode == 2 and "--points" in g.stderr, (g.returncode, g.stderr)
+        event(f"{variant}: more than {limit} points, refused")
+        return
+    assert g.returncode == 0, g.stderr
+    what = f"strict {variant} block {block} {s['solver']} {s['precision']}"
+    exact = tolerances.GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS and not gusts
+    if exact or blown == 0:  # the rule of tests/gpu/test_gpu_dynamic.py and the bench (harness.check.diff_dynamic)
+        r = diff_dynamic.compare(cpu, gpu, frames=[step], exact=exact, check_paper=False)
+        assert r.equivalent, f"{what}: " + "; ".join(r.failures()[:5])
+    else:
+        event("gusts and a blown-up CPU frame: compared for finiteness only")
+        with open_trajectory(gpu) as tg, open_trajectory(cpu) as tc:
+            assert np.isfinite(tg.frame(-1)).all() == np.isfinite(tc.frame(k + 1)).all()
+
+
+# ---- a slice of the map whose verdicts are known (measured: docs/decisions.md) -----------
+def slice_named(name):
+    return next(s for s in stability_slices.SLICES if s.name == name)
+
+
+CPU = stability.Backend("cpu", "default", variants.declared("cpu").default_variant if variants.names("cpu") else "")
+KNOWN_CELLS = [
+    # slice, row, col, solver, precision, verdict (worst measured value, margin to its bound)
+    ("substeps-points", 64, 32, "xpbd", "fp32", "ok"),  # stretch 0.0094, 10× under 0.1
+    ("substeps-points", 8, 32, "xpbd", "fp64", "over-stretched"),  # 0.40, 4× over
+    ("substeps-points", 1, 32, "xpbd", "fp32", "blown up"),  # from frame 15, in 46 of 60 frames
+    ("substeps-wind", 1, 0, "ftl", "fp32", "ok"),  # a stiff chain at S = 1: 0.051, 2× under
+    ("substeps-wind", 1, 8000, "ftl", "fp64", "over-stretched"),  # a gale at S = 1: 0.20, 2× over
+]
+
+
+@pytest.mark.parametrize("name,row,col,solver,precision,want", KNOWN_CELLS)
+def test_map_cells_with_known_verdicts(cpu_bin, name, row, col, solver, precision, want):
+    cell = stability.run_cell(slice_named(name), row, col, solver, precision, CPU, stability.STRANDS, stability.FRAMES)
+    assert cell["verdict"] == want, cell
+    assert cell["violations"] == "", cell
+
+
+def test_verdict_takes_the_worst_that_applies():
+    s_max, p_rel = tolerances.STABILITY_STRETCH_MAX, tolerances.STABILITY_PENETRATION_REL
+    assert stability.verdict(0.0, 0.0, 0) == "ok"
+    assert stability.verdict(s_max, p_rel, 0) == "ok"  # at the bound is still ok
+    assert stability.verdict(s_max * 1.01, 0.0, 0) == "over-stretched"
+    assert stability.verdict(s_max * 1.01, p_rel * 1.01, 0) == "penetrating"
+    assert stability.verdict(0.0, 0.0, 1) == "blown up"
+    assert stability.verdict(float("nan"), float("nan"), 3) == "blown up"
+
+
+def _panel(verdicts, rows=(1, 2, 4, 8), cols=(0, 1000)):
+    import pandas as pd
+
+    return pd.DataFrame(
+        [
+            dict(row=str(r), col=str(c), row_key="--substeps", col_key="--wind-speed", verdict=verdicts[i][j])
+            for i, r in enumerate(rows)
+            for j, c in enumerate(cols)
+        ]
+    )
+
+
+def test_boundaries_are_named_from_the_data():
+    b, o, k = "blown up", "over-stretched", "ok"
+    words = stability_report.boundaries(_panel([[b, b], [o, b], [k, o], [k, k]]), "substeps-wind")
+    assert words == (
+        "blows up at S = 1 (U = 0 cm/s); S ≤ 2 (U = 1000 cm/s); over-stretches at S = 2 (U = 0 cm/s); "
+        "S = 4 (U = 1000 cm/s)"
+    )
+    assert stability_report.boundaries(_panel([[k, k]] * 4), "substeps-wind") == "ok in every cell"
+    assert stability_report.boundaries(_panel([[b, b]] * 4), "substeps-wind") == (
+        "blows up at every S (every U); ok in no cell"
+    )
+
+
+def test_stability_command_writes_the_map(cpu_bin, tmp_path, capsys):
+    """The command end to end on a small grid: CSV, env.json, heatmap and Markdown."""
+    out, rep = tmp_path / "res", tmp_path / "rep"
+    args = ["stability", "--quick", "--slice", "motion", "--strands", "2", "--frames", "3", "--jobs", "2"]
+    assert harness_main([*args, "--gpu", "no", "--out", str(out), "--report-dir", str(rep)]) == 0
+    md = (rep / "dynamic_stability.md").read_text()
+    assert "### nodding head" in md and "(stability_motion.png)" in md
+    assert (rep / "stability_motion.png").stat().st_size > 0
+    rows = stability_report.load(out / "stability.csv")
+    assert len(rows) == 3 * 3 * 2 * 2 and set(rows["verdict"]) <= set(stability_slices.VERDICTS)
+    assert not list(out.glob("*.tmp*")) and not list(rep.glob("*.tmp*"))
+
+
+def test_stability_bad_input_is_one_line(tmp_path, capsys):
+    assert harness_main(["stability", "--from-csv", str(tmp_path / "none.csv")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("harness: error:")
+
+
+# ---- regression tests, one per instability the search found -------------------------------
+# dynamic_constant_overflow: a derived constant of docs/model.md §3.4 (α/h², c_d·U, κ, A_g,
+# −g0) rounded to Inf in the working precision, or a length the model squares (R + c_m, the
+# fall of one substep) left its range; the first substep then made NaN in every strand.
+# Such scenes are refused now, naming the flags; a neighbour just inside the range runs, and
+# a scene refused in fp32 runs in fp64.
+SIM = ["--stages", "init,collide,simulate", "--strands", 2, "--points", 8, "--frames", 2]
+OVERFLOW = [
+    # (id, flags refused, words the message holds, precision, flags of a neighbour that runs)
+    (
+        "stretch",
+        ["--stretch-compliance", "1e36"],
+        "--stretch-compliance / h^2",
+        "fp32",
+        ["--stretch-compliance", "1e30"],
+    ),
+    (
+        "bend-fp64",
+        ["--bend-compliance", "1e300", "--frame-dt", "1e-3", "--substeps", 64],
+        "--bend-compliance / h^2",
+        "fp64",
+        ["--bend-compliance", "1e280", "--frame-dt", "1e-3", "--substeps", 64],
+    ),
+    ("shape", ["--shape-compliance", "1e36"], "--shape-compliance / h^2", "fp32", ["--shape-compliance", "1e34"]),
+    (
+        "drag-wind",
+        ["--drag", "1e30", "--wind-speed", "1e10"],
+        "--drag x --wind-speed",
+        "fp32",
+        ["--drag", "1e30", "--wind-speed", "1e3"],
+    ),
+    (
+        "gust-wavelength",
+        ["--drag", "0.5", "--wind-speed", "150", "--gust-amplitude", "0.5", "--gust-wavelength", "1e-40"],
+        "2 pi / --gust-wavelength",
+        "fp32",
+        ["--drag", "0.5", "--wind-speed", "150", "--gust-amplitude", "0.5", "--gust-wavelength", "1e-30"],
+    ),
+    (
+        "gust-amplitude",
+        ["--drag", "0.5", "--wind-speed", "150", "--gust-amplitude", "1e39"],
+        "--gust-amplitude",
+        "fp32",
+        ["--drag", "0.5", "--wind-speed", "150", "--gust-amplitude", "1e3"],
+    ),
+    (
+        "wind-times-gust",
+        ["--drag", "1e36", "--wind-speed", "100", "--gust-amplitude", "5"],
+        "--drag x --wind-speed x (1 + --gust-amplitude)",
+        "fp32",
+        ["--drag", "1e36", "--wind-speed", "100", "--gust-amplitude", "1"],
+    ),
+    (
+        "gust-phase",
+        ["--drag", "0.5", "--wind-speed", "150", "--gust-amplitude", "0.5", "--gust-wavelength", "1e-37"],
+        "2 pi / --gust-wavelength x",
+        "fp32",
+        ["--drag", "0.5", "--wind-speed", "150", "--gust-amplitude", "0.5", "--gust-wavelength", "1e-35"],
+    ),
+    ("gravity", ["--gravity", "1e39"], "--gravity", "fp32", ["--gravity", "1e5"]),
+    ("fall", ["--gravity", "1e30"], "one substep moves a point", "fp32", ["--gravity", "1e30", "--substeps", 100000]),
+    ("margin", ["--collision-margin", "1e30"], "--collision-margin", "fp32", ["--collision-margin", "1e17"]),
+]
+
+
+@pytest.mark.parametrize("refused,words,precision,runs", [o[1:] for o in OVERFLOW], ids=[o[0] for o in OVERFLOW])
+def test_regression_dynamic_constant_overflow_is_refused(cpu_bin, tmp_path, refused, words, precision, runs):
+    out = tmp_path / "s.h5"
+    p = run(cpu_bin, *SIM, "--precision", precision, *refused, "--output", out, check=False)
+    assert refused_cleanly(p) and words in p.stderr, p.stderr
+    assert not out.exists()
+    run(cpu_bin, *SIM, "--precision", precision, *runs, "--velocities", "all", "--output", out, "--quiet")
+    check_contract(out)
+    if precision == "fp32":  # the message's advice: the same scene runs in fp64, within the contract
+        assert "--precision fp64" in p.stderr, p.stderr
+        wide = tmp_path / "fp64.h5"
+        run(cpu_bin, *SIM, "--precision", "fp64", *refused, "--velocities", "all", "--output", wide, "--quiet")
+        check_contract(wide)
+
+
+@pytest.mark.parametrize(
+    "flags",
+    [
+        ["--damping", "1e300"],  # 1 + h·β is Inf in fp32: v/Inf = 0, the limit of infinite damping
+        ["--points", 2, "--bend-compliance", "1e300"],  # P = 2 has no bend constraint
+        ["--shape-compliance", "1e300", "--shape-range", "0.1"],  # K = ⌊0.1·7⌋ = 0 shape constraints
+        ["--solver", "ftl", "--stretch-compliance", "1e300"],  # ftl has no stretch constraint
+    ],
+    ids=["damping", "bend-at-P2", "shape-K0", "ftl-stretch"],
+)
+def test_regression_dynamic_constant_overflow_unused_constant_is_accepted(cpu_bin, tmp_path, flags):
+    """The overflow rule checks only the constants a run evaluates: these overflow fp32 but
+    are never used, so they run, within the contract."""
+    out = tmp_path / "s.h5"
+    run(cpu_bin, *SIM, *flags, "--velocities", "all", "--output", out, "--quiet")
+    check_contract(out)
+    if flags[0] == "--damping":  # infinitely damped: no point falls (rounding of the constraints aside)
+        with open_trajectory(out) as t:
+            moved = np.abs(t.frame(-1).astype(np.float64) - t.frame(t.paper_frames - 1)).max()
+        free_fall = 0.5 * 981.0 * (2 / 60) ** 2  # 2 frames of the default gravity and Δt, undamped
+        assert moved < 1e-3 * free_fall, moved

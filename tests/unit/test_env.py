@@ -1,0 +1,34 @@
+"""harness.core.env.git_revision: which code a result says it came from (docs/harness.md,
+"Which code a result came from")."""
+
+import shutil
+import subprocess
+
+import pytest
+
+from harness.core import env
+
+
+def test_revision_file_wins_over_git(tmp_path, monkeypatch):
+    # a copied tree with a stale .git would give git's HEAD; the REVISION file must win
+    monkeypatch.setattr(env, "ROOT", tmp_path)
+    (tmp_path / "REVISION").write_text("c0ba5d78c75c\n")
+    assert env.git_revision() == "c0ba5d78c75c (REVISION file)"
+
+
+def test_without_revision_file_or_git_the_revision_is_unknown(tmp_path, monkeypatch):
+    monkeypatch.setattr(env, "ROOT", tmp_path)
+    assert env.git_revision() == "unknown (no commit)"
+    (tmp_path / "REVISION").write_text("  \n")  # an empty file says nothing
+    assert env.git_revision() == "unknown (no commit)"
+
+
+def test_in_this_checkout_git_gives_the_head():
+    if (env.ROOT / "REVISION").exists():
+        pytest.skip("a REVISION file is present in this tree (a copied tree on a GPU node)")
+    if shutil.which("git") is None:
+        pytest.skip("git is not installed here: the revision cannot come from git")
+    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=env.ROOT, capture_output=True, text=True)
+    if head.returncode != 0:
+        pytest.skip("this tree is not a git checkout")
+    assert env.git_revision().removesuffix("-dirty") == head.stdout.strip()

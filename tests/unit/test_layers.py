@@ -1,0 +1,159 @@
+"""harness/ in layers with one-way imports: no import cycle inside the package (imports inside
+functions count), each layer imports only itself and the layers below it, and no renderer
+reaches the runner (the one module that starts a binary). Read statically with ast, so an
+import hidden in a function cannot slip through."""
+
+import ast
+
+import pytest
+
+from conftest import ROOT
+
+PACKAGE = ROOT / "harness"
+# bottom to top; the package root (HarnessError, __version__) sits under all of them
+LAYERS = ("core", "io", "check", "studies", "render", "bench", "cli")
+RUNNER = "harness.core.runner"
+
+
+def module_name(path):
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def package_modules():
+    return {module_name(p): p for p in PACKAGE.rglob("*.py")}
+
+
+def imports_of(name, path, modules):
+    """The package modules `name` imports, anywhere in its file (line numbers for messages)."""
+    is_package = path.name == "__init__.py"
+    here = name.split(".") if is_package else name.split(".")[:-1]
+    found = {}
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                base = ".".join(here[: len(here) - node.level + 1] + ([base] if base else []))
+            targets = [f"{base}.{a.name}" if f"{base}.{a.name}" in modules else base for a in node.names]
+        else:
+            continue
+        for t in targets:
+            # `import harness.a.b` also runs harness.a's __init__: count the deepest module named
+            while t and t not in modules:
+                t = t.rpartition(".")[0]
+            if t and t != name:
+                found.setdefault(t, node.lineno)
+    return found
+
+
+def import_graph():
+    modules = package_modules()
+    return {name: imports_of(name, path, modules) for name, path in modules.items()}
+
+
+def cycles(graph):
+    """The strongly connected components of more than one module (Tarjan), or a module that
+    imports itself."""
+    index, low, stack, on_stack, out = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                out.append(sorted(component))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def reaches(graph, start, target):
+    """The import chain from start to target, or None."""
+    seen, todo = {start: None}, [start]
+    while todo:
+        v = todo.pop()
+        if v == target:
+            chain = []
+            while v is not None:
+                chain.append(v)
+                v = seen[v]
+            return chain[::-1]
+        for w in graph[v]:
+            if w not in seen:
+                seen[w] = v
+                todo.append(w)
+    return None
+
+
+def layer(name):
+    parts = name.split(".")
+    return LAYERS.index(parts[1]) if len(parts) > 1 and parts[1] in LAYERS else -1
+
+
+def test_every_module_is_in_a_layer():
+    loose = [n for n in package_modules() if layer(n) < 0 and n not in ("harness", "harness.__main__")]
+    assert not loose, f"modules outside the layers {LAYERS}: {loose}"
+
+
+def test_no_import_cycle_in_harness():
+    found = cycles(import_graph())
+    assert not found, f"import cycles in harness/: {found}"
+
+
+def test_layers_import_downwards_only():
+    graph = import_graph()
+    upward = [
+        f"{m} (line {line}) imports {t}"
+        for m, targets in graph.items()
+        for t, line in targets.items()
+        if m != "harness.__main__" and layer(t) > layer(m)
+    ]
+    assert not upward, "imports of a higher layer:\n" + "\n".join(upward)
+
+
+def test_renderers_never_reach_the_runner():
+    graph = import_graph()
+    render = [m for m in graph if m.startswith("harness.render")]
+    assert render, "no module under harness/render"
+    chains = [" -> ".join(c) for m in render if (c := reaches(graph, m, RUNNER))]
+    assert not chains, "renderers that import the runner:\n" + "\n".join(chains)
+
+
+def test_the_checks_see_a_hidden_cycle(tmp_path):
+    """The graph counts an import inside a function, and finds the cycle it closes."""
+    modules = {"harness.a": tmp_path / "a.py", "harness.b": tmp_path / "b.py"}
+    modules["harness.a"].write_text("from harness import b\n")
+    modules["harness.b"].write_text("def f():\n    from . import a\n    return a\n")
+    graph = {n: imports_of(n, p, modules) for n, p in modules.items()}
+    assert graph["harness.b"] == {"harness.a": 2}
+    assert cycles(graph) == [["harness.a", "harness.b"]]
+    assert reaches(graph, "harness.b", "harness.a") == ["harness.b", "harness.a"]
+
+
+@pytest.mark.parametrize("command", ["report", "report-dynamic", "plot"])
+def test_rendering_commands_live_in_render(command):
+    """The rendering commands call only harness.render (and the paths they print)."""
+    graph = import_graph()
+    tree = ast.parse((PACKAGE / "cli" / "main.py").read_text())
+    func = next(f for f in tree.body if isinstance(f, ast.FunctionDef) and f.name == f"cmd_{command.replace('-', '_')}")
+    used = {n.module for n in ast.walk(func) if isinstance(n, ast.ImportFrom)}
+    assert used and all(m in ("harness.render", "harness.core.paths") for m in used), used
+    assert graph["harness.cli.main"]
