@@ -125,9 +125,17 @@ def _row(label, case, pss, fraction=None, ms=1.0, **kw):
 
 def test_headline_summary_picks_the_best_and_says_met_or_not():
     result = {
-        "targets": {"memory_fraction": 0.9, "point_substeps_per_s": 1e11, "realtime_ms": 0.03, "cpu_fraction": 0.6},
+        "targets": {
+            "memory_fraction": 0.9,
+            "point_substeps_per_s": 6.5e10,
+            "stretch_point_substeps_per_s": 1e11,
+            "ftl_point_substeps_per_s": 3e10,
+            "realtime_ms": 0.05,
+            "cpu_fraction": 0.8,
+        },
         "memory": [_row("gpu a", None, 4e10, 0.5), _row("gpu b", None, 5e10, 0.95)],
         "default": [_row("gpu a", None, 2e10), _row("gpu b (fastmath)", None, 9e10, build="fastmath")],
+        "ftl": [_row("gpu a ftl", None, 2e10), _row("gpu b ftl", None, 3.5e10)],
         "realtime": [_row("gpu a b32", None, 1e9, ms=0.02), _row("gpu a b64", None, 1e9, ms=0.05)],
         "realtime_loop": {"frame_loop_ms": 0.021, "frame_loop_graph_ms": 0.02},
         "cpu": [
@@ -140,13 +148,15 @@ def test_headline_summary_picks_the_best_and_says_met_or_not():
     s = headline_dynamic.summarise(result)
     assert s["memory"]["row"] == "gpu b" and s["memory"]["met"]
     assert s["default"]["row"] == "gpu a" and not s["default"]["met"]  # fast-math is not the default build
+    assert not s["default"]["stretch_met"]
+    assert s["ftl"]["row"] == "gpu b ftl" and s["ftl"]["met"]
     assert s["realtime"]["row"] == "gpu a b32" and s["realtime"]["met"]
     assert s["cpu"]["row"] == "cpu simd, all cores" and not s["cpu"]["met"]
     assert s["speedups"]["memory"]["headline"]["cpu"] == "cpu simd, all cores"
     assert s["speedups"]["memory"]["headline"]["speedup"] == pytest.approx(50.0)
     assert s["speedups"]["default"]["headline"]["speedup"] == pytest.approx(200.0)
     text = headline_dynamic.table({**result, "points": 32, "summary": s})
-    assert "target 1" in text and "NOT met" in text
+    assert "target 1" in text and "NOT met" in text and "target ftl" in text and "stretch goal" in text
 
 
 def test_frame_loop_refusals(tmp_path):
