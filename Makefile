@@ -170,7 +170,7 @@ SAN_SIM := --strands 300 --points 45 --hair-length 10 --stages init,simulate --f
   --gust-amplitude 0.5 --head-motion nod --quiet
 sanitize-gpu: cuda
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
-	@set -e; for v in $$($(PYTHON) -c "from harness import variants; print(*variants.names('cuda'))"); do for p in fp32 fp64; do \
+	@set -e; for v in $$($(PYTHON) -c "from harness.core import variants; print(*variants.names('cuda'))"); do for p in fp32 fp64; do \
 	  echo "memcheck $$v $$p"; \
 	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_RUN) \
 	    --variant $$v --precision $$p --output $(BUILD)/san-$$v-$$p.h5 --force; \
@@ -180,7 +180,7 @@ sanitize-gpu: cuda
 	  echo "racecheck $$v"; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_RUN) --variant $$v; \
 	done; \
-	for vp in $$($(PYTHON) -c "from harness import variants; d = variants.declared('cuda'); print(*(f'{v}:{min(45, d.max_points.get(v) or 45)}' for v in d.running('simulate')))"); do \
+	for vp in $$($(PYTHON) -c "from harness.core import variants; d = variants.declared('cuda'); print(*(f'{v}:{min(45, d.max_points.get(v) or 45)}' for v in d.running('simulate')))"); do \
 	  v=$${vp%%:*}; np=$${vp##*:}; for p in fp32 fp64; do for s in xpbd ftl; do \
 	  echo "memcheck simulate $$v $$p $$s ($$np points)"; \
 	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --points $$np \
