@@ -62,7 +62,7 @@ CUDA_SRC  := $(wildcard cuda/*.cu)
 CUDA_HDR  := $(wildcard cuda/*.cuh cuda/*.h)
 NVCC_BASE := -arch=$(CUDA_ARCH) -O3 -std=c++17 -Ic_ref -lineinfo -Xcompiler -Wall
 NVCC_MODE_normal   :=
-NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false
+NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DHB_REFERENCE_ARITHMETIC=1
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
 
