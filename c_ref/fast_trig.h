@@ -35,7 +35,7 @@
 HB_HD float hb_atan2_fast(float y, float x)
 {
     const float ax = fabsf(x), ay = fabsf(y);
-    const float hi = fmaxf(ax, ay), lo = fminf(ax, ay);
+    const float hi = ay > ax ? ay : ax, lo = ay > ax ? ax : ay;
     const float a = hi > 0.0f ? HB_FAST_QUOT(lo, hi) : 0.0f; /* in [0, 1] */
     const float s = a * a;
     float p = 2.84985569e-3f;

@@ -32,6 +32,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "fast_trig.h"
 #include "philox.h"
 
 #if !defined(__x86_64__) || !defined(__GLIBC__)
@@ -72,6 +73,7 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #define ASIN asinf
 #define ATAN2 atan2f
 #define EPS 0x1p-23f
+#define FAST_TRIG 1
 #include "model_simd_impl.h"
 #undef REAL
 #undef ITYPE
@@ -84,6 +86,7 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #undef ASIN
 #undef ATAN2
 #undef EPS
+#undef FAST_TRIG
 
 #define REAL double
 #define ITYPE int64_t
@@ -96,4 +99,5 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #define ASIN asin
 #define ATAN2 atan2
 #define EPS 0x1p-52
+#define FAST_TRIG 0
 #include "model_simd_impl.h"

@@ -37,8 +37,12 @@ extern "C" {
 #endif
 /* collide runs its pull (or its projection) on a chunk of this many lanes only at a point
  * where one lane of the chunk has moved (or penetrates); a multiple of every vector width,
- * so no lane is ever left to a scalar remainder loop */
-#define HB_SIMD_CHUNK 16
+ * so no lane is ever left to a scalar remainder loop. 64 rather than 16: after a wind most
+ * chunks take the pull anyway, and the longer loops cost less control (docs/cpu_simd.md).
+ * Overridable with -D for experiments; it changes no bit. */
+#ifndef HB_SIMD_CHUNK
+#define HB_SIMD_CHUNK 64
+#endif
 
 /* init: roots (strands first … first + block − 1) and drape; writes X, Y, Z. */
 void hb_simd_init_block_f32(const hb_model_f32 *m, uint64_t first, float *X, float *Y, float *Z, int64_t stride);
