@@ -17,8 +17,9 @@
  *
  * The free arithmetic (docs/cpu_simd.md): the same decisions as model_impl.h, computed more
  * cheaply and judged by tolerance, like the CUDA normal build (cuda/model.cuh). In every
- * precision: t = k·(w/(P−1)), and collide multiplies by one reciprocal instead of dividing
- * two or three times. With FAST_TRIG (fp32) the drape's step angles are computed once per
+ * precision: t = k·(w/(P−1)), and collide's pull multiplies by one quotient ℓ/len instead
+ * of dividing twice (its projection keeps model_impl.h's operations: where the circle of
+ * radius ℓ about the root only touches the shell, ℓ = h, √h² turns an ulp into √ε). With FAST_TRIG (fp32) the drape's step angles are computed once per
  * strand (every step after the first goes from the shell to the shell), θ advances by
  * additions as in model_impl.h, and a point's sin and cos are fast_trig.h's inline
  * polynomials (one loop per point). The wind keeps libmvec's atan2, sin and cos: measured,
@@ -318,12 +319,11 @@ int64_t SFX(hb_simd_collide_block)(const MODEL *m, int real, REAL *Y, REAL *Z, i
                     const REAL d2 = y * y + z * z;
                     const REAL d = SQRT(d2);
                     const ITYPE proj = inside[j] & (d > (REAL)0);
-                    const REAL inv_d = (REAL)1 / d; /* one division (model_impl.h: three) */
-                    const REAL t = ((d - c) * (d + c) + ell * ell) * ((REAL)0.5 * inv_d);
+                    const REAL t = ((d - c) * (d + c) + ell * ell) / ((REAL)2 * d);
                     const REAL a = d - t;
                     const REAL h2 = ((c - d) + t) * (c + a);
                     const REAL hh = SQRT(h2 > (REAL)0 ? h2 : (REAL)0);
-                    const REAL uy = y * inv_d, uz = z * inv_d;
+                    const REAL uy = y / d, uz = z / d;
                     const REAL fy = a * uy, fz = a * uz;
                     const REAL y1 = fy + hh * uz, z1 = fz - hh * uy;
                     const REAL y2 = fy - hh * uz, z2 = fz + hh * uy;
