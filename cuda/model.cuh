@@ -317,6 +317,7 @@ template <typename T, class V> HB_HD void drape_free(const Model<T> &m, const V 
     const T alpha_first = step_angle(r0, &fits_first);
     const T alpha_shell = step_angle(rc, &fits_shell);
 
+    HB_NO_UNROLL
     for (int64_t k = 1; k < P; k++) {
         if (!hanging) {
             const int fits = k == 1 ? fits_first : fits_shell;
