@@ -9,10 +9,11 @@
  * must be 64-byte aligned; every lane of the block is computed (lanes past the last real
  * strand are padding: computed, never read back, never counted).
  *
- * The formulas are those of model_impl.h, operation for operation (including the two
+ * The formulas and decisions are those of model_impl.h (including the two
  * better-conditioned evaluations of docs/decisions.md), with its branches turned into
- * selects; the only difference is that sin/cos/asin/atan2 are glibc's libmvec vector
- * functions. model_simd.c is compiled for x86-64-v3 (AVX2 + FMA): call these only after
+ * selects, in the free arithmetic of model_simd_impl.h (fewer operations, judged by
+ * tolerance); sin/cos/asin/atan2 are glibc's libmvec vector functions or, for the fp32
+ * drape, c_ref/fast_trig.h's. model_simd.c is compiled for x86-64-v3 (AVX2 + FMA): call these only after
  * hb_simd_cpu_ok() in a file compiled for the baseline ISA (backend_cpu.c does).
  */
 #ifndef HB_MODEL_SIMD_H
