@@ -47,9 +47,9 @@ HB_HD float hb_atan2_fast(float y, float x)
     p = fmaf(p, s, 1.99926198e-1f);
     p = fmaf(p, s, -3.33330721e-1f);
     p = fmaf(p, s, 1.0f);
-    float r = a * p;                                  /* atan(lo / hi) in [0, π/4] */
-    r = ay > ax ? 1.57079632679489661923f - r : r;    /* [0, π/2] */
-    r = x < 0.0f ? 3.14159265358979323846f - r : r;   /* [0, π] */
+    float r = a * p;                                /* atan(lo / hi) in [0, π/4] */
+    r = ay > ax ? 1.57079632679489661923f - r : r;  /* [0, π/2] */
+    r = x < 0.0f ? 3.14159265358979323846f - r : r; /* [0, π] */
     return copysignf(r, y);
 }
 
@@ -65,7 +65,7 @@ HB_HD void hb_sincos_fast(float x, float *sn, float *cs)
 #endif
     const float j = shifted - 12582912.0f;
     float r = fmaf(j, -1.57079637050628662109f, x); /* fl(π/2) */
-    r = fmaf(j, 4.37113900018624283e-8f, r);         /* π/2 − fl(π/2) */
+    r = fmaf(j, 4.37113900018624283e-8f, r);        /* π/2 − fl(π/2) */
     const float r2 = r * r;
     float ps = -1.94956403e-4f;
     ps = fmaf(ps, r2, 8.33197869e-3f);

@@ -18,8 +18,9 @@
  *  - -fno-trapping-math: GCC may then if-convert the branches of a loop, evaluating FP
  *    operations whose result a select discards (we never enable FP traps). No value
  *    changes. Without it only the branch-free loops are vectorised.
- *  - -ffp-contract=off stays (the reference's flags): no FMA contraction, so the
- *    arithmetic between the calls is the reference's, operation for operation.
+ *  - -ffp-contract=off stays (the reference's flags): no FMA contraction; the arithmetic
+ *    between the calls is model_simd_impl.h's free arithmetic as written (the roots, x
+ *    and the decisions stay the reference's bits).
  *  - A sin and a cos of the same angle in one loop are merged by GCC into a sincos call,
  *    which has no vector variant it can use, and the loop is then not vectorised at all
  *    (with or without -ffast-math): model_simd_impl.h puts them in two loops.

@@ -66,8 +66,20 @@ def hostcheck(tmp_path_factory):
     exes = {}
     for mode, defines in (("reference", ["-DHB_REFERENCE_ARITHMETIC=1"]), ("free", [])):
         exes[mode] = d / f"model_hostcheck_{mode}"
-        _run([nvcc, *NVCC_FLAGS, *defines, "-Ic_ref", "-Icuda", "cuda/hostcheck/model_hostcheck.cu", *objs, "-o",
-              exes[mode], "-lm"])
+        _run(
+            [
+                nvcc,
+                *NVCC_FLAGS,
+                *defines,
+                "-Ic_ref",
+                "-Icuda",
+                "cuda/hostcheck/model_hostcheck.cu",
+                *objs,
+                "-o",
+                exes[mode],
+                "-lm",
+            ]
+        )
     return exes
 
 
