@@ -18,8 +18,9 @@
  *  - -fno-trapping-math: GCC may then if-convert the branches of a loop, evaluating FP
  *    operations whose result a select discards (we never enable FP traps). No value
  *    changes. Without it only the branch-free loops are vectorised.
- *  - -ffp-contract=off stays (the reference's flags): no FMA contraction, so the
- *    arithmetic between the calls is the reference's, operation for operation.
+ *  - -ffp-contract=off stays (the reference's flags): no FMA contraction; the arithmetic
+ *    between the calls is model_simd_impl.h's free arithmetic as written (the roots, x
+ *    and the decisions stay the reference's bits).
  *  - A sin and a cos of the same angle in one loop are merged by GCC into a sincos call,
  *    which has no vector variant it can use, and the loop is then not vectorised at all
  *    (with or without -ffast-math): model_simd_impl.h puts them in two loops.
@@ -32,6 +33,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "fast_trig.h"
 #include "philox.h"
 
 #if !defined(__x86_64__) || !defined(__GLIBC__)
@@ -72,6 +74,7 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #define ASIN asinf
 #define ATAN2 atan2f
 #define EPS 0x1p-23f
+#define FAST_TRIG 1
 #include "model_simd_impl.h"
 #undef REAL
 #undef ITYPE
@@ -84,6 +87,7 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #undef ASIN
 #undef ATAN2
 #undef EPS
+#undef FAST_TRIG
 
 #define REAL double
 #define ITYPE int64_t
@@ -96,4 +100,5 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #define ASIN asin
 #define ATAN2 atan2
 #define EPS 0x1p-52
+#define FAST_TRIG 0
 #include "model_simd_impl.h"

@@ -9,10 +9,11 @@
  * must be 64-byte aligned; every lane of the block is computed (lanes past the last real
  * strand are padding: computed, never read back, never counted).
  *
- * The formulas are those of model_impl.h, operation for operation (including the two
+ * The formulas and decisions are those of model_impl.h (including the two
  * better-conditioned evaluations of docs/model.md §2.3, §2.5), with its branches turned into
- * selects; the only difference is that sin/cos/asin/atan2 are glibc's libmvec vector
- * functions. model_simd.c is compiled for x86-64-v3 (AVX2 + FMA): call these only after
+ * selects, in the free arithmetic of model_simd_impl.h (fewer operations, judged by
+ * tolerance); sin/cos/asin/atan2 are glibc's libmvec vector functions or, for the fp32
+ * drape, c_ref/fast_trig.h's. model_simd.c is compiled for x86-64-v3 (AVX2 + FMA): call these only after
  * hb_simd_cpu_ok() in a file compiled for the baseline ISA (backend_cpu.c does).
  */
 #ifndef HB_MODEL_SIMD_H
@@ -37,8 +38,12 @@ extern "C" {
 #endif
 /* collide runs its pull (or its projection) on a chunk of this many lanes only at a point
  * where one lane of the chunk has moved (or penetrates); a multiple of every vector width,
- * so no lane is ever left to a scalar remainder loop */
-#define HB_SIMD_CHUNK 16
+ * so no lane is ever left to a scalar remainder loop. 64 rather than 16: after a wind most
+ * chunks take the pull anyway, and the longer loops cost less control (docs/cpu_simd.md).
+ * Overridable with -D for experiments; it changes no bit. */
+#ifndef HB_SIMD_CHUNK
+#define HB_SIMD_CHUNK 64
+#endif
 
 /* init: roots (strands first … first + block − 1) and drape; writes X, Y, Z. */
 void hb_simd_init_block_f32(const hb_model_f32 *m, uint64_t first, float *X, float *Y, float *Z, int64_t stride);

@@ -14,6 +14,16 @@
  * Where model_impl.h evaluates X in a branch, the lanes here evaluate X everywhere and
  * discard it where the branch was not taken; such values may be Inf or NaN (e.g. s² with
  * ρ = 0) and are never selected.
+ *
+ * The free arithmetic (docs/cpu_simd.md): the same decisions as model_impl.h, computed more
+ * cheaply and judged by tolerance, like the CUDA normal build (cuda/model.cuh). In every
+ * precision: t = k·(w/(P−1)), and collide's pull multiplies by one quotient ℓ/len instead
+ * of dividing twice (its projection keeps model_impl.h's operations: where the circle of
+ * radius ℓ about the root only touches the shell, ℓ = h, √h² turns an ulp into √ε). With FAST_TRIG (fp32) the drape's step angles are computed once per
+ * strand (every step after the first goes from the shell to the shell), θ advances by
+ * additions as in model_impl.h, and a point's sin and cos are fast_trig.h's inline
+ * polynomials (one loop per point). The wind keeps libmvec's atan2, sin and cos: measured,
+ * fast_trig.h's polynomials there were no faster (docs/cpu_simd.md).
  */
 
 #define PI_R ((REAL)3.14159265358979323846)
@@ -35,6 +45,11 @@ void SFX(hb_simd_init_block)(const MODEL *m, uint64_t first, REAL *X, REAL *Y, R
     /* within one point: whether the lane stepped onto the shell, and its y if it did not */
     ITYPE stepped[BLOCK] HB_ALIGNED;
     REAL ynot[BLOCK] HB_ALIGNED;
+#if FAST_TRIG
+    /* the step angles, once per strand: from the root (ρ = r0) and from the shell (ρ = rc) */
+    REAL alpha0[BLOCK] HB_ALIGNED, alpha1[BLOCK] HB_ALIGNED;
+    ITYPE fits0[BLOCK] HB_ALIGNED, fits1[BLOCK] HB_ALIGNED;
+#endif
 
     /* Roots: integer Philox draws and IEEE arithmetic only, so they are the bits of
      * place_root whether this loop is vectorised or not. */
@@ -74,9 +89,53 @@ void SFX(hb_simd_init_block)(const MODEL *m, uint64_t first, REAL *X, REAL *Y, R
             X0[j] = x0[j];
             Y0[j] = y;
             Z0[j] = z;
+#if FAST_TRIG
+            /* model_impl.h's s² and 2·asin(√s²) for ρ = r0 and for ρ = rc (g = 0) */
+            const REAL c = rc[j], g = c - r0;
+            const REAL s20 = ((ell - g) * (ell + g)) / ((REAL)4 * r0 * c);
+            const REAL s21 = ((ell - (REAL)0) * (ell + (REAL)0)) / ((REAL)4 * c * c);
+            const ITYPE f0 = (r0 > (REAL)0) & (s20 <= (REAL)1), f1 = (c > (REAL)0) & (s21 <= (REAL)1);
+            const REAL s20c = f0 & (s20 >= (REAL)0) ? s20 : (REAL)0, s21c = f1 & (s21 >= (REAL)0) ? s21 : (REAL)0;
+            alpha0[j] = (REAL)2 * ASIN(SQRT(s20c));
+            alpha1[j] = (REAL)2 * ASIN(SQRT(s21c));
+            fits0[j] = f0;
+            fits1[j] = f1;
+#endif
         }
     }
 
+#if FAST_TRIG
+    for (int64_t k = 1; k < P; k++) {
+        REAL *restrict Xk = HB_ASSUME_ALIGNED(ROW(X, k)), *restrict Yk = HB_ASSUME_ALIGNED(ROW(Y, k)),
+                       *restrict Zk = HB_ASSUME_ALIGNED(ROW(Z, k));
+        const REAL *alpha = k == 1 ? alpha0 : alpha1;
+        const ITYPE *fits = k == 1 ? fits0 : fits1;
+#pragma omp simd
+        for (int j = 0; j < BLOCK; j++) {
+            const REAL th = theta[j], y = py[j], z = pz[j], c = rc[j];
+            const ITYPE hg = hang[j];
+            const REAL next = th + alpha[j];
+            const ITYPE step = (hg == 0) & fits[j] & (next <= PI_R);
+            REAL sn, cs;
+            hb_sincos_fast(next, &sn, &cs);
+            const REAL dz = z + c;
+            const REAL dy2 = ell * ell - dz * dz;
+            const REAL tangent = y - SQRT(dy2 > (REAL)0 ? dy2 : (REAL)0), down = y - ell, mc = -c;
+            const REAL nz = step ? c * cs : (hg ? z : mc);
+            const REAL ny = step ? c * sn : (hg ? down : tangent);
+            theta[j] = step ? next : th;
+            hang[j] = step ? 0 : 1;
+            py[j] = ny;
+            pz[j] = nz;
+            Xk[j] = x0[j];
+            Yk[j] = ny;
+            Zk[j] = nz;
+        }
+    }
+    (void)rho;
+    (void)stepped;
+    (void)ynot;
+#else
     for (int64_t k = 1; k < P; k++) {
         REAL *restrict Xk = HB_ASSUME_ALIGNED(ROW(X, k)), *restrict Yk = HB_ASSUME_ALIGNED(ROW(Y, k)),
                        *restrict Zk = HB_ASSUME_ALIGNED(ROW(Z, k));
@@ -122,6 +181,7 @@ void SFX(hb_simd_init_block)(const MODEL *m, uint64_t first, REAL *X, REAL *Y, R
             Yk[j] = ny;
         }
     }
+#endif
 }
 
 /* ---- wind (model_impl.h hb_wind_strand) ----------------------------------------------- */
@@ -143,9 +203,10 @@ void SFX(hb_simd_wind_block)(const MODEL *m, REAL *Y, REAL *Z, int64_t stride)
             oz[j] = nz[j] = Z0[j];
         }
     }
+    const REAL w_per_point = w / last;
     for (int64_t k = 1; k < P; k++) {
         REAL *restrict Yk = HB_ASSUME_ALIGNED(ROW(Y, k)), *restrict Zk = HB_ASSUME_ALIGNED(ROW(Z, k));
-        const REAL t = (w * (REAL)k) / last;
+        const REAL t = (REAL)k * w_per_point;
         /* Two loops per point, the cos in the first and the sin in the second (see init). */
 #pragma omp simd
         for (int j = 0; j < BLOCK; j++) {
@@ -227,7 +288,8 @@ int64_t SFX(hb_simd_collide_block)(const MODEL *m, int real, REAL *Y, REAL *Z, i
                     const REAL dy = qy - y, dz = qz - z;
                     const REAL len = SQRT(dy * dy + dz * dz);
                     const ITYPE dir = len > (REAL)0;
-                    const REAL fy = y + ell * (dy / len), fz = z + ell * (dz / len), down = y - ell;
+                    const REAL scale = ell / len; /* one division (model_impl.h: two) */
+                    const REAL fy = y + dy * scale, fz = z + dz * scale, down = y - ell;
                     const REAL cy = moved[j] ? (dir ? fy : down) : qy;
                     const REAL cz = moved[j] ? (dir ? fz : z) : qz;
                     const ITYPE in = cy * cy + cz * cz < inner2[j];

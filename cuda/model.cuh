@@ -1,14 +1,23 @@
 /* model.cuh — the paper model (docs/model.md §2) for the CUDA port: c_ref/model_impl.h written as
  * `__host__ __device__` templates over the floating type T and the memory layout.
  *
- * This file follows c_ref/model_impl.h operation by operation: the same expressions in the
- * same order, the same constants, the same branches. A build without FMA contraction and
- * with IEEE division and square root (hairsim-cuda-strict) therefore differs from the C
- * reference only where CUDA's sinf/cosf/asinf/atan2f (sin/cos/asin/atan2) differ from
- * glibc's. Compiled for the host (cuda/hostcheck/model_hostcheck.cu) the same templates call
- * glibc and must reproduce c_ref/model.c bit for bit.
+ * Two arithmetics, chosen when the file is compiled (the builds of docs/cuda.md):
+ *   - the reference arithmetic (HB_REFERENCE_ARITHMETIC=1, the strict build): this file
+ *     follows c_ref/model_impl.h operation by operation: the same expressions in the same
+ *     order, the same constants, the same branches. Without FMA contraction and with IEEE
+ *     division and square root it therefore differs from the C reference only where CUDA's
+ *     sinf/cosf/asinf/atan2f (sin/cos/asin/atan2) differ from glibc's; compiled for the
+ *     host (cuda/hostcheck/model_hostcheck.cu) it must reproduce c_ref/model.c bit for bit;
+ *   - the free arithmetic (the default: normal and fast-math builds): the same model and
+ *     the same decisions (hanging, the wind's wrap and exactly-opposite rule, collide's
+ *     threshold and tie), computed more cheaply, judged by the paper model's tolerances
+ *     (harness/tolerances.py) instead of bits. Per point it has no IEEE division, no asin
+ *     and no library atan2/sincos in fp32: drape steps by an angle computed once per strand,
+ *     wind uses c_ref/fast_trig.h's polynomials and t = k·(w/(P−1)), collide uses
+ *     reciprocal square roots (see each stage's `if constexpr (kFree)`).
  *
- * The only departures from the C file are in *when memory is read*, never in arithmetic:
+ * The only departures of the reference arithmetic from the C file are in *when memory is
+ * read*, never in arithmetic:
  *   - with a prefetch depth D ≥ 1 (walk_points; the soa and fused variants) the walks load
  *     point k+D before they compute point k (the addresses differ from the ones written,
  *     so the values are the same); D = 0 (the paper variant) loads as the C code does;
@@ -29,8 +38,9 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "model.h"  /* HB_SHELL_ULPS, hb_model_f32/f64 */
-#include "philox.h" /* hb_draw_block, hb_u01, HB_HD = __host__ __device__ __forceinline__ */
+#include "fast_trig.h" /* hb_atan2_fast, hb_sincos_fast (the free arithmetic, fp32) */
+#include "model.h"     /* HB_SHELL_ULPS, hb_model_f32/f64 */
+#include "philox.h"    /* hb_draw_block, hb_u01, HB_HD = __host__ __device__ __forceinline__ */
 
 /* #pragma unroll for the device pass only (the host compiler does not know it) */
 #if defined(__CUDA_ARCH__)
@@ -42,6 +52,12 @@
 #endif
 
 namespace hb {
+
+#if defined(HB_REFERENCE_ARITHMETIC) && HB_REFERENCE_ARITHMETIC
+constexpr bool kFree = false;
+#else
+constexpr bool kFree = true;
+#endif
 
 /* The scene's numbers rounded once to the working precision (the fields of hb_model_f32/
  * hb_model_f64, as backend_cpu.c's round_scene makes them). Passed to kernels by value. */
@@ -112,6 +128,40 @@ HB_HD void m_sincos(double x, double *s, double *c)
     *c = cos(x);
 #endif
 }
+/* ---- the free arithmetic's functions: fp32 fast_trig.h, fp64 the library's ---------- */
+HB_HD float m_atan2_free(float y, float x)
+{
+    return hb_atan2_fast(y, x);
+}
+HB_HD double m_atan2_free(double y, double x)
+{
+    return atan2(y, x);
+}
+HB_HD void m_sincos_free(float x, float *s, float *c)
+{
+    hb_sincos_fast(x, s, c);
+}
+HB_HD void m_sincos_free(double x, double *s, double *c)
+{
+    m_sincos(x, s, c);
+}
+/* 1/√x: the device's rsqrtf (2 ulp) and rsqrt (1 ulp); 1/sqrt on the host */
+HB_HD float m_rsqrt(float x)
+{
+#if defined(__CUDA_ARCH__)
+    return rsqrtf(x);
+#else
+    return 1.0f / sqrtf(x);
+#endif
+}
+HB_HD double m_rsqrt(double x)
+{
+#if defined(__CUDA_ARCH__)
+    return rsqrt(x);
+#else
+    return 1.0 / sqrt(x);
+#endif
+}
 /* the machine epsilon EPS of model.c: 2^-23 / 2^-52 */
 HB_HD float m_eps(float)
 {
@@ -176,7 +226,7 @@ template <typename T> struct PointMajor {
 
 /* ---- docs/model.md §2.3 drape (model_impl.h: hb_drape_strand) ------------------------------------ */
 /* The root (x0, py, pz) is already stored; writes points 1 … P−1. */
-template <typename T, class V> HB_HD void drape(const Model<T> &m, const V &s, const T x0, T py, T pz)
+template <typename T, class V> HB_HD void drape_reference(const Model<T> &m, const V &s, const T x0, T py, T pz)
 {
     const int64_t P = m.points;
     const T ell = m.seg_len;
@@ -236,6 +286,73 @@ template <typename T, class V> HB_HD void drape(const Model<T> &m, const V &s, c
     }
 }
 
+/* The free arithmetic's drape: the reference's decisions on the reference's angles, fewer
+ * operations. Only the first step starts off the shell (ρ = r0); every later one goes from
+ * the shell to the shell (ρ = rc, g = 0), so its s² and its angle 2·asin(√s²) are the same
+ * at every point: both angles are computed once, with the reference's expressions, and
+ * θ advances by additions exactly as in the reference (so the step that starts the hanging
+ * is the reference's). A point on the shell is rc·(cos θ, sin θ) through m_sincos_free. */
+template <typename T, class V> HB_HD void drape_free(const Model<T> &m, const V &s, const T x0, T py, T pz)
+{
+    const int64_t P = m.points;
+    const T ell = m.seg_len;
+    const T r0 = m_sqrt(py * py + pz * pz);
+    const T rc = r0 + m.hair_offset;
+    T theta = m_atan2(py, pz);
+    if (theta <= -half_pi_r<T>()) theta += two_pi_r<T>();
+    int hanging = theta > pi_r<T>();
+    /* the step angle from slice radius rho onto the shell; fits: the step exists (s² ≤ 1) */
+    auto step_angle = [&](const T rho, int *fits) {
+        *fits = 0;
+        T s2 = 0;
+        if (rho > (T)0) {
+            const T g = rc - rho;
+            s2 = ((ell - g) * (ell + g)) / ((T)4 * rho * rc);
+            *fits = s2 <= (T)1;
+        }
+        if (s2 < (T)0) s2 = (T)0;
+        return (T)2 * m_asin(m_sqrt(*fits ? s2 : (T)0));
+    };
+    int fits_first, fits_shell;
+    const T alpha_first = step_angle(r0, &fits_first);
+    const T alpha_shell = step_angle(rc, &fits_shell);
+
+    HB_NO_UNROLL
+    for (int64_t k = 1; k < P; k++) {
+        if (!hanging) {
+            const int fits = k == 1 ? fits_first : fits_shell;
+            const T next = theta + (k == 1 ? alpha_first : alpha_shell);
+            if (fits && next <= pi_r<T>()) {
+                theta = next;
+                T sin_n, cos_n;
+                m_sincos_free(next, &sin_n, &cos_n);
+                pz = rc * cos_n;
+                py = rc * sin_n;
+                s.x(k) = x0;
+                s.y(k) = py;
+                s.z(k) = pz;
+                continue;
+            }
+            const T dz = pz + rc;
+            const T dy2 = ell * ell - dz * dz;
+            py = py - m_sqrt(dy2 > (T)0 ? dy2 : (T)0);
+            pz = -rc;
+            hanging = 1;
+        } else {
+            py = py - ell;
+        }
+        s.x(k) = x0;
+        s.y(k) = py;
+        s.z(k) = pz;
+    }
+}
+
+template <typename T, class V> HB_HD void drape(const Model<T> &m, const V &s, const T x0, T py, T pz)
+{
+    if constexpr (kFree) drape_free(m, s, x0, py, pz);
+    else drape_reference(m, s, x0, py, pz);
+}
+
 /* ---- docs/model.md §2.2, §2.3 init: roots (model_impl.h: place_root) then the drape -------- */
 template <typename T, class Layout> HB_HD void init_strand(const Model<T> &m, const Layout &lay, int64_t i)
 {
@@ -275,8 +392,9 @@ template <typename T, class Layout> HB_HD void drape_strand(const Model<T> &m, c
 /* Keeps the predecessor before the wind (oy, oz) and after it (ny, nz). */
 template <typename T> struct WindWalk {
     T ell, w, psi, last;
-    T oy, oz; /* the predecessor before the wind */
-    T ny, nz; /* the predecessor after the wind (the root never moves) */
+    T w_per_point, kf; /* free arithmetic: w/(P−1), and k as a T (exact while k < 2^24) */
+    T oy, oz;          /* the predecessor before the wind */
+    T ny, nz;          /* the predecessor after the wind (the root never moves) */
 
     HB_HD WindWalk(const Model<T> &m, T y0, T z0)
     {
@@ -284,15 +402,36 @@ template <typename T> struct WindWalk {
         w = m.wind_strength;
         psi = m.wind_angle; /* already reduced to (−π, π] */
         last = (T)(m.points - 1);
+        w_per_point = w / last;
+        kf = (T)0;
         oy = y0;
         oz = z0;
         ny = oy;
         nz = oz;
     }
 
-    /* Point k was (cy, cz) before the wind; afterwards it is (ny, nz). */
+    /* Point k was (cy, cz) before the wind; afterwards it is (ny, nz). The free arithmetic
+     * keeps the reference's angles, wrap and exactly-opposite rule (m_atan2_free returns
+     * the axes' angles exactly), with the polynomial atan2 and sincos, and t by a product. */
     HB_HD void step(int64_t k, const T cy, const T cz)
     {
+        if constexpr (kFree) {
+            const T dy = cy - oy, dz = cz - oz;
+            const T phi = m_atan2_free(dy, dz);
+            T delta = psi - phi;
+            if (delta > pi_r<T>()) delta -= two_pi_r<T>();
+            else if (delta <= -pi_r<T>()) delta += two_pi_r<T>();
+            if (delta == pi_r<T>()) delta = dz >= (T)0 ? pi_r<T>() : -pi_r<T>();
+            kf += (T)1;
+            const T turned = phi + (kf * w_per_point) * delta;
+            T sin_t, cos_t;
+            m_sincos_free(turned, &sin_t, &cos_t);
+            nz = nz + ell * cos_t;
+            ny = ny + ell * sin_t;
+            oy = cy;
+            oz = cz;
+            return;
+        }
         const T dy = cy - oy, dz = cz - oz;
         const T phi = m_atan2(dy, dz);
         T delta = psi - phi; /* in [−2π, 2π]: wrap to (−π, π] */
@@ -314,7 +453,7 @@ template <typename T> struct WindWalk {
 
 /* ---- docs/model.md §2.5 collide: one step of the walk (model_impl.h: hb_collide_strand)  */
 template <typename T> struct CollideWalk {
-    T ell, rc, inner2;
+    T ell, ell2, rc, inner2;
     T py, pz; /* the predecessor, after collision */
     int moved;
     int64_t changed;
@@ -322,6 +461,7 @@ template <typename T> struct CollideWalk {
     HB_HD CollideWalk(const Model<T> &m, T y0, T z0)
     {
         ell = m.seg_len;
+        ell2 = ell * ell;
         const T r0 = m_sqrt(y0 * y0 + z0 * z0);
         rc = r0 + m.hair_offset;
         const T inner = rc - rc * ((T)HB_SHELL_ULPS * m_eps(T())); /* rounding allowance */
@@ -336,6 +476,7 @@ template <typename T> struct CollideWalk {
      * the point changed (the C code writes it back exactly then). */
     HB_HD int step(T &cy, T &cz)
     {
+        if constexpr (kFree) return step_free(cy, cz);
         if (moved) {
             /* Follow the leader: p_k ← p_{k−1} + ℓ·unit(p_k − p_{k−1}). */
             const T dy = cy - py, dz = cz - pz;
@@ -384,6 +525,45 @@ template <typename T> struct CollideWalk {
         py = cy;
         pz = cz;
         return write;
+    }
+
+    /* The free arithmetic: the same decisions, reciprocal square roots instead of square
+     * roots and divisions; the pull is written as selects (no branch inside it). */
+    HB_HD int step_free(T &cy, T &cz)
+    {
+        if (moved) {
+            const T dy = cy - py, dz = cz - pz;
+            const T len2 = dy * dy + dz * dz;
+            const int dir = len2 > (T)0;
+            const T scale = dir ? ell * m_rsqrt(len2) : (T)0;
+            cy = dir ? py + dy * scale : py - ell;
+            cz = dir ? pz + dz * scale : pz;
+        }
+        if (cy * cy + cz * cz < inner2) {
+            const T d2 = py * py + pz * pz;
+            if (d2 > (T)0) {
+                const T inv_d = m_rsqrt(d2);
+                const T d = d2 * inv_d;
+                const T t = ((d - rc) * (d + rc) + ell2) * ((T)0.5 * inv_d);
+                const T a = d - t;
+                const T h2 = ((rc - d) + t) * (rc + a);
+                const T hh = h2 > (T)0 ? h2 * m_rsqrt(h2) : (T)0;
+                const T uy = py * inv_d, uz = pz * inv_d;
+                const T fy = a * uy, fz = a * uz;
+                const T y1 = fy + hh * uz, z1 = fz - hh * uy;
+                const T y2 = fy - hh * uz, z2 = fz + hh * uy;
+                const T e1 = (y1 - cy) * (y1 - cy) + (z1 - cz) * (z1 - cz);
+                const T e2 = (y2 - cy) * (y2 - cy) + (z2 - cz) * (z2 - cz);
+                const int upper = e1 < e2 || (e1 == e2 && y1 >= y2);
+                cy = upper ? y1 : y2;
+                cz = upper ? z1 : z2;
+                moved = 1;
+            }
+        }
+        if (moved) changed++;
+        py = cy;
+        pz = cz;
+        return moved;
     }
 };
 

@@ -5,8 +5,9 @@ independent of the thread count, of repeats and of resuming; nil stages; the ref
 CPU without AVX2; the vector math really vectorised; the bandwidth record.
 
 TOLERANCE: the "simd" pair of harness/core/tolerances.py (the measurements behind it are in
-docs/cpu_simd.md); every comparison goes through harness diff. collide calls no libm
-function, so there simd must give ref's bits, as asserted below.
+docs/cpu_simd.md); every comparison goes through harness diff. simd computes with the free
+arithmetic (one reciprocal where ref divides; docs/cpu_simd.md), so collide too is judged
+by the tolerance, and its moved-point count by MOVED_COUNT_FRACTION.
 
 Not compared point for point: whole runs with strong wind at angles other than the default,
 where the shorter-arc rule of the wind is discontinuous at an exactly opposite segment and
@@ -69,6 +70,12 @@ def assert_close(ref_path, simd_path, precision, frames, what):
     )
 
 
+def assert_moved_close(got, want, points, what):
+    """Collide counts of two equivalent states: a point within rounding of the shell
+    allowance may be moved by one and not the other (tolerances.MOVED_COUNT_FRACTION)."""
+    assert abs(int(got) - int(want)) <= tolerances.MOVED_COUNT_FRACTION * points, (what, got, want)
+
+
 def moved_from_frames(before, after):
     """Points a collide pass changed, counted from the frames: from the first point it
     changed to the tip of each strand (every later point is pulled)."""
@@ -125,12 +132,9 @@ def test_each_stage_from_the_ref_state_matches_ref(cpu_bin, tmp_path, precision,
         run(cpu_bin, "--input", prefix, "--variant", "simd", "--stages", PAPER[k], "--output", one, "--quiet")
         b = State(one)
         assert b.frames.shape[0] == k + 1 and np.array_equal(b.frames[:k], a.frames[:k])
+        assert_close(whole, one, precision, [k], f"{PAPER[k]} (frame {k}) from the ref state")
         if PAPER[k] == "collide":
-            # collide calls no libm function: simd is ref's arithmetic, bit for bit
-            assert np.array_equal(b.frames[k], a.frames[k]), f"collide (frame {k}) is not ref's bits"
-            assert b.moved[k] == a.moved[k]
-        else:
-            assert_close(whole, one, precision, [k], f"{PAPER[k]} (frame {k}) from the ref state")
+            assert_moved_close(b.moved[k], a.moved[k], b.frames[k].shape[0] * points, f"collide (frame {k})")
 
 
 @needs_simd
@@ -217,8 +221,6 @@ def test_each_stage_matches_ref_across_the_scene_space(cpu_bin, tmp_path_factory
         b = State(one)
         if b.skipped[k]:
             assert np.array_equal(b.frames[k], b.frames[k - 1])
-        elif PAPER[k] == "collide":
-            assert np.array_equal(b.frames[k], a.frames[k]), f"collide of {s} is not ref's bits"
         else:
             assert_close(d / "ref.h5", one, a.precision, [k], f"{PAPER[k]} of {s}")
 
@@ -258,7 +260,7 @@ def test_exactly_opposite_segments_turn_through_plus_y(cpu_bin, tmp_path, precis
 
 @needs_simd
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
-def test_collide_at_the_slice_poles_is_refs_bits(cpu_bin, tmp_path, precision):
+def test_collide_at_the_slice_poles_matches_ref(cpu_bin, tmp_path, precision):
     """Roots at r0 = 0, at θ0 = π and θ0 = −π/2 with points planted inside the shell (the
     d = 0 and zero-length branches of collide as selects)."""
     P, ell = 5, 1.0
@@ -272,7 +274,12 @@ def test_collide_at_the_slice_poles_is_refs_bits(cpu_bin, tmp_path, precision):
     run(cpu_bin, "--input", src, "--stages", "collide", "--variant", "simd", "--output", simd, "--quiet")
     a, b = State(ref), State(simd)
     assert np.isfinite(b.frames).all()
-    assert np.array_equal(a.frames, b.frames) and b.moved[-1] == a.moved[-1] > 0
+    # the hand-made frame breaks the invariants harness diff checks, so the rule of the
+    # "simd" pair directly: roots are identical, so u = ε·P·E
+    u = tolerances.EPS[precision] * P * tolerances.extent(10.0, 0.1, (P - 1) * ell)
+    err = np.abs(b.frames[-1].astype(np.float64) - a.frames[-1].astype(np.float64)).max()
+    assert err <= tolerances.named_pair("simd", precision).point_k * u, (err, u)
+    assert b.moved[-1] == a.moved[-1] > 0
 
 
 # ---- bits that must not change -------------------------------------------------------------
