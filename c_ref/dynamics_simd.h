@@ -33,6 +33,11 @@ extern "C" {
 #define HB_SIMD_DYN_BLOCK 64
 #endif
 
+/* 1: the last substep of a block requests the next block's rows of x and v (docs/cpu_simd.md). */
+#ifndef HB_SIMD_DYN_PREFETCH
+#define HB_SIMD_DYN_PREFETCH 1
+#endif
+
 /* Reals of scratch one block needs (allocate 64-byte aligned). */
 int64_t hb_simd_dyn_scratch_reals(int64_t points);
 
