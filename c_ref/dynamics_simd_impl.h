@@ -32,7 +32,7 @@
 
 /* The constant denominators' reciprocals and the constants beside them. */
 typedef struct {
-    REAL h, ih, iden;        /* h, 1/h, 1/(1 + h(c_d + β)) */
+    REAL h, ih, iden;         /* h, 1/h, 1/(1 + h(c_d + β)) */
     REAL st_at, st_w1, st_w2; /* stretch α̃, 1/(1 + α̃) (one end the root), 1/(2 + α̃) */
     REAL bd_at, bd_w1, bd_w2; /* the same for bend */
     REAL sh_at, sh_w1;        /* shape α̃, 1/(1 + α̃) */
@@ -89,14 +89,10 @@ HB_ALWAYS_INLINE void SFX(distance_lanes)(const DMODEL *m, REAL *scratch, const 
     }
     INV_SQRT_ROW(l2r, inv);
     const int move_a = a != 0;
-    if (lam && move_a)
-        SFX(distance_solve)(ax, ay, az, bx, by, bz, 1, per_lane, rr, rs, at, rw, AL(lam), 1, l2r, inv);
-    else if (lam)
-        SFX(distance_solve)(ax, ay, az, bx, by, bz, 0, per_lane, rr, rs, at, rw, AL(lam), 1, l2r, inv);
-    else if (move_a)
-        SFX(distance_solve)(ax, ay, az, bx, by, bz, 1, per_lane, rr, rs, at, rw, NULL, 0, l2r, inv);
-    else
-        SFX(distance_solve)(ax, ay, az, bx, by, bz, 0, per_lane, rr, rs, at, rw, NULL, 0, l2r, inv);
+    if (lam && move_a) SFX(distance_solve)(ax, ay, az, bx, by, bz, 1, per_lane, rr, rs, at, rw, AL(lam), 1, l2r, inv);
+    else if (lam) SFX(distance_solve)(ax, ay, az, bx, by, bz, 0, per_lane, rr, rs, at, rw, AL(lam), 1, l2r, inv);
+    else if (move_a) SFX(distance_solve)(ax, ay, az, bx, by, bz, 1, per_lane, rr, rs, at, rw, NULL, 0, l2r, inv);
+    else SFX(distance_solve)(ax, ay, az, bx, by, bz, 0, per_lane, rr, rs, at, rw, NULL, 0, l2r, inv);
 }
 
 /* §3.5 head collision of row k of p (dynamics_impl.h collide_sphere): inside when
@@ -218,9 +214,9 @@ HB_ALWAYS_INLINE void SFX(bend_lanes)(const DMODEL *m, const SFX(dyn_consts) * K
     const int64_t P = m->points;
     for (int64_t k = 1; k + 1 < P; k++)
         if ((((k - 1) / 2) & 1) == parity)
-            SFX(distance_lanes)(m, scratch, k - 1, k + 1, 1, AL(ROWP(BR, k - 1)), (REAL)0, K->bd_at,
-                                k - 1 != 0 ? K->bd_w2 : K->bd_w1,
-                                K->bd_at != (REAL)0 ? SROW(3 * P + P + (k - 1)) : NULL);
+            SFX(distance_lanes)
+            (m, scratch, k - 1, k + 1, 1, AL(ROWP(BR, k - 1)), (REAL)0, K->bd_at, k - 1 != 0 ? K->bd_w2 : K->bd_w1,
+             K->bd_at != (REAL)0 ? SROW(3 * P + P + (k - 1)) : NULL);
 }
 
 /* §3.5 shape pulls toward T_k = Q·X̄_k (X̄_k without motion), k = 1…K. */
@@ -319,11 +315,12 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
     if (m->solver == HB_SOLVER_XPBD) {
         for (int64_t it = 0; it < m->iterations; it++) {
             for (int64_t k = 1; k < P; k += 2) /* stretch, k odd */
-                SFX(distance_lanes)(m, scratch, k - 1, k, 0, NULL, ell, K->st_at, k - 1 != 0 ? K->st_w2 : K->st_w1,
-                                    lam_s ? lam_s + (k - 1) * DB : NULL);
+                SFX(distance_lanes)
+                (m, scratch, k - 1, k, 0, NULL, ell, K->st_at, k - 1 != 0 ? K->st_w2 : K->st_w1,
+                 lam_s ? lam_s + (k - 1) * DB : NULL);
             for (int64_t k = 2; k < P; k += 2) /* stretch, k even */
-                SFX(distance_lanes)(m, scratch, k - 1, k, 0, NULL, ell, K->st_at, K->st_w2,
-                                    lam_s ? lam_s + (k - 1) * DB : NULL);
+                SFX(distance_lanes)
+                (m, scratch, k - 1, k, 0, NULL, ell, K->st_at, K->st_w2, lam_s ? lam_s + (k - 1) * DB : NULL);
             if (F & HB_F_BEND) {
                 SFX(bend_lanes)(m, K, scratch, BR, stride, 0);
                 SFX(bend_lanes)(m, K, scratch, BR, stride, 1);
@@ -387,18 +384,15 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
      (((i)&8) ? HB_F_MOTION : 0u))
 #define CASE16(C) C(0) C(1) C(2) C(3) C(4) C(5) C(6) C(7) C(8) C(9) C(10) C(11) C(12) C(13) C(14) C(15)
 
-static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q,
-                              const REAL phase, REAL *X, REAL *Y, REAL *Z, REAL *VX, REAL *VY, REAL *VZ,
-                              const REAL *RX, const REAL *RY, const REAL *RZ, const int64_t stride, REAL *scratch,
-                              const int prefetch)
+static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, const REAL phase,
+                              REAL *X, REAL *Y, REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY,
+                              const REAL *RZ, const int64_t stride, REAL *scratch, const int prefetch)
 {
 #define VCASE(i)                                                                                                       \
     case (i):                                                                                                          \
         if (((i)&2) && !((i)&1)) break; /* no gusts without wind (hb_dyn_features) */                                  \
-        if (prefetch)                                                                                                  \
-            SFX(vel_phase)(m, K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, 1, VEL_F(i));           \
-        else                                                                                                           \
-            SFX(vel_phase)(m, K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, 0, VEL_F(i));           \
+        if (prefetch) SFX(vel_phase)(m, K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, 1, VEL_F(i));   \
+        else SFX(vel_phase)(m, K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, 0, VEL_F(i));            \
         break;
     switch (idx) {
         CASE16(VCASE)
@@ -407,9 +401,9 @@ static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_const
 #undef VCASE
 }
 
-static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, REAL *X,
-                              REAL *Y, REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY,
-                              const REAL *RZ, const REAL *BR, const int64_t stride, REAL *scratch)
+static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, REAL *X, REAL *Y,
+                              REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ,
+                              const REAL *BR, const int64_t stride, REAL *scratch)
 {
 #define CCASE(i)                                                                                                       \
     case (i):                                                                                                          \
@@ -450,8 +444,8 @@ void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, REAL 
     K.ell = m->seg_len;
     K.s_ih = m->ftl_s / m->h;
     for (int64_t j = 0; j < m->substeps; j++) {
-        const REAL *q = QTABLE(fr) + 9 * j; /* Q(t + h) */
-        const REAL phase = PHASE(fr)[j];    /* φ(t) */
+        const REAL *q = QTABLE(fr) + 9 * j;                            /* Q(t + h) */
+        const REAL phase = PHASE(fr)[j];                               /* φ(t) */
         const int last = HB_SIMD_DYN_PREFETCH && j + 1 == m->substeps; /* the next block's rows arrive meanwhile */
         SFX(vel_dispatch)(vi, m, &K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, last);
         SFX(con_dispatch)(ci, m, &K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, stride, scratch);
