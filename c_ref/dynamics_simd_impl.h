@@ -212,11 +212,12 @@ HB_ALWAYS_INLINE void SFX(bend_lanes)(const DMODEL *m, const SFX(dyn_consts) * K
                                       const int64_t stride, const int parity)
 {
     const int64_t P = m->points;
-    for (int64_t k = 1; k + 1 < P; k++)
-        if ((((k - 1) / 2) & 1) == parity)
-            SFX(distance_lanes)
-            (m, scratch, k - 1, k + 1, 1, AL(ROWP(BR, k - 1)), (REAL)0, K->bd_at, k - 1 != 0 ? K->bd_w2 : K->bd_w1,
-             K->bd_at != (REAL)0 ? SROW(3 * P + P + (k - 1)) : NULL);
+    for (int64_t k = 1; k + 1 < P; k++) {
+        if ((((k - 1) / 2) & 1) != parity) continue;
+        const REAL rw = k - 1 != 0 ? K->bd_w2 : K->bd_w1;
+        REAL *lam = K->bd_at != (REAL)0 ? SROW(3 * P + P + (k - 1)) : NULL;
+        SFX(distance_lanes)(m, scratch, k - 1, k + 1, 1, AL(ROWP(BR, k - 1)), (REAL)0, K->bd_at, rw, lam);
+    }
 }
 
 /* §3.5 shape pulls toward T_k = Q·X̄_k (X̄_k without motion), k = 1…K. */
@@ -314,13 +315,14 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
     REAL *const lam_s = K->st_at != (REAL)0 ? SROW(3 * P) : NULL;
     if (m->solver == HB_SOLVER_XPBD) {
         for (int64_t it = 0; it < m->iterations; it++) {
+            // clang-format off
             for (int64_t k = 1; k < P; k += 2) /* stretch, k odd */
-                SFX(distance_lanes)
-                (m, scratch, k - 1, k, 0, NULL, ell, K->st_at, k - 1 != 0 ? K->st_w2 : K->st_w1,
-                 lam_s ? lam_s + (k - 1) * DB : NULL);
+                SFX(distance_lanes)(m, scratch, k - 1, k, 0, NULL, ell, K->st_at, k - 1 != 0 ? K->st_w2 : K->st_w1,
+                                    lam_s ? lam_s + (k - 1) * DB : NULL);
             for (int64_t k = 2; k < P; k += 2) /* stretch, k even */
-                SFX(distance_lanes)
-                (m, scratch, k - 1, k, 0, NULL, ell, K->st_at, K->st_w2, lam_s ? lam_s + (k - 1) * DB : NULL);
+                SFX(distance_lanes)(m, scratch, k - 1, k, 0, NULL, ell, K->st_at, K->st_w2,
+                                    lam_s ? lam_s + (k - 1) * DB : NULL);
+            // clang-format on
             if (F & HB_F_BEND) {
                 SFX(bend_lanes)(m, K, scratch, BR, stride, 0);
                 SFX(bend_lanes)(m, K, scratch, BR, stride, 1);
