@@ -172,9 +172,12 @@ HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
     (void)phase;
     for (int64_t k = 0; k < P; k++) {
         if (prefetch) {
+            /* addresses as integers: past the last block they point nowhere, and a prefetch
+             * of nowhere is harmless */
             const REAL *rows[6] = {ROWP(X, k), ROWP(Y, k), ROWP(Z, k), ROWP(VX, k), ROWP(VY, k), ROWP(VZ, k)};
             for (int a = 0; a < 6; a++)
-                for (int l = 0; l < DB; l += 64 / (int)sizeof(REAL)) __builtin_prefetch(rows[a] + DB + l, 0, 2);
+                for (uintptr_t b = DB * sizeof(REAL); b < 2 * DB * sizeof(REAL); b += 64)
+                    __builtin_prefetch((const void *)((uintptr_t)rows[a] + b), 0, 2);
         }
         if (k == 0) continue;
         const REAL *restrict x = AL(ROWP(X, k)), *restrict y = AL(ROWP(Y, k)), *restrict z = AL(ROWP(Z, k));

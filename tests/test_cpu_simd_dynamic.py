@@ -11,7 +11,7 @@ simulated frame but one. Every feature set, both solvers, fp32 and fp64.
 
 Both variants start from the same ref `init,collide` state (--input): simd's own paper
 stages differ from ref's by their libmvec rounding (tests/test_cpu_simd.py covers those).
-N = 300 and 1000 are not multiples of the blocks (512/256 strands, 128 per dynamic block).
+N = 300 and 1000 are not multiples of the blocks (512/256 strands, 256 per dynamic block).
 """
 
 import platform
