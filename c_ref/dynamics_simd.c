@@ -4,16 +4,18 @@
  *
  * Built with model_simd.c's flags (Makefile, SIMD_CFLAGS): -O3 -march=x86-64-v3
  * -fopenmp-simd -fno-math-errno -fno-trapping-math, on top of the reference's
- * -ffp-contract=off and without -ffast-math: the arithmetic is dynamics_impl.h's,
- * operation for operation (IEEE sqrt and division, no FMA contraction), so without gusts
- * the result is the `ref` variant's bits. The one libm call, the sine of the gusts, is
- * glibc's libmvec vector sine (≤ 4 ulp), declared here with the attribute glibc's
- * <math.h> gives it only under -ffast-math (model_simd.c explains why).
+ * -ffp-contract=off and without -ffast-math. The free arithmetic is written out in
+ * dynamics_simd_impl.h (reciprocals, products), not left to the compiler: the reciprocal
+ * square roots are below. The one libm call, the sine of the gusts, is glibc's libmvec
+ * vector sine (≤ 4 ulp), declared here with the attribute glibc's <math.h> gives it only
+ * under -ffast-math (model_simd.c explains why).
  *
  * Check: objdump -dr build/obj/dynamics_simd.o | grep _ZGV lists the vector sines.
  */
 #include "dynamics_simd.h"
 
+#include <float.h>
+#include <immintrin.h>
 #include <math.h>
 #include <stddef.h>
 
@@ -36,7 +38,28 @@ HB_SIMD_DECL double sin(double);
 
 int64_t hb_simd_dyn_scratch_reals(int64_t points)
 {
-    return (6 * points + 3) * (int64_t)HB_SIMD_DYN_BLOCK;
+    return (6 * points + 8) * (int64_t)HB_SIMD_DYN_BLOCK;
+}
+
+/* out = 1/√in over one row of lanes. fp32: the hardware estimate (relative error ≤ 1.5·2⁻¹²)
+ * and one Newton step y·(1.5 − ½·x·y²), about 2e-7 relative; the callers treat |e|² below
+ * FLT_MIN as zero, so the estimate's flush of subnormal inputs does not matter. fp64 (AVX2
+ * has no estimate for doubles): a square root and one division instead of one of each per
+ * component. */
+static inline __attribute__((always_inline)) void inv_sqrt_row_f32(const float *restrict in, float *restrict out)
+{
+    const __m256 half = _mm256_set1_ps(0.5f), three_halves = _mm256_set1_ps(1.5f);
+    for (int j = 0; j < HB_SIMD_DYN_BLOCK; j += 8) {
+        const __m256 x = _mm256_load_ps(in + j), y = _mm256_rsqrt_ps(x);
+        const __m256 hxy = _mm256_mul_ps(_mm256_mul_ps(half, x), y);
+        _mm256_store_ps(out + j, _mm256_mul_ps(y, _mm256_fnmadd_ps(hxy, y, three_halves)));
+    }
+}
+
+static inline __attribute__((always_inline)) void inv_sqrt_row_f64(const double *restrict in, double *restrict out)
+{
+#pragma omp simd
+    for (int j = 0; j < HB_SIMD_DYN_BLOCK; j++) out[j] = 1.0 / sqrt(in[j]);
 }
 
 #define REAL float
@@ -46,7 +69,11 @@ int64_t hb_simd_dyn_scratch_reals(int64_t points)
 #define SIN sinf
 #define QTABLE(fr) ((fr)->q32)
 #define PHASE(fr) ((fr)->phase32)
+#define INV_SQRT_ROW(in, out) inv_sqrt_row_f32(in, out)
+#define TINY FLT_MIN
 #include "dynamics_simd_impl.h"
+#undef INV_SQRT_ROW
+#undef TINY
 #undef REAL
 #undef SFX
 #undef DMODEL
@@ -62,4 +89,6 @@ int64_t hb_simd_dyn_scratch_reals(int64_t points)
 #define SIN sin
 #define QTABLE(fr) ((fr)->q64)
 #define PHASE(fr) ((fr)->phase64)
+#define INV_SQRT_ROW(in, out) inv_sqrt_row_f64(in, out)
+#define TINY DBL_MIN
 #include "dynamics_simd_impl.h"

@@ -9,10 +9,11 @@
  * whole block, one strand per SIMD lane, with the lane state of the block (the predicted
  * positions of all P points, the multipliers) in a block-sized scratch array.
  *
- * The arithmetic is dynamics_impl.h's, operation for operation (docs/model.md §3.10), its
- * branches turned into selects; only the sine of the gusts is libmvec's. Without gusts the
- * result is bit-identical to the `ref` variant. dynamics_simd.c is compiled for x86-64-v3:
- * call these only after the CPU check of backend_cpu.c.
+ * The model is dynamics_impl.h's, its branches turned into selects; the arithmetic is free
+ * (reciprocal square roots, reciprocals of the constant denominators; docs/cpu_simd.md), so
+ * the result is judged against the `ref` variant by the one-frame rule, not bit for bit.
+ * dynamics_simd.c is compiled for x86-64-v3: call these only after the CPU check of
+ * backend_cpu.c.
  */
 #ifndef HB_DYNAMICS_SIMD_H
 #define HB_DYNAMICS_SIMD_H
@@ -26,11 +27,17 @@ extern "C" {
 #endif
 
 /* Strands per dynamic block (a multiple of 64, dividing 256). The block's scratch is
- * (6P + 3) reals per lane (p: 3P, multipliers: up to 3P, the ftl correction of one point:
- * 3): at P = 32 that is 50 KiB (fp32) or 100 KiB (fp64) for 64 lanes, in L1/L2, where a
- * block of the paper stages' 512 lanes would need 400 KiB (docs/cpu_simd.md). */
+ * (6P + 8) reals per lane (p: 3P, multipliers: up to 3P, the ftl correction of one point:
+ * 3, one constraint's |e|², 1/|e| and e: 5): at P = 32, 200 KiB (fp32) or 400 KiB (fp64)
+ * for 256 lanes, in L2. 256 lanes were faster than 64 and 128 on the dev machine in both
+ * the memory-bound and the default scene (docs/cpu_simd.md, "The dynamic model"). */
 #ifndef HB_SIMD_DYN_BLOCK
-#define HB_SIMD_DYN_BLOCK 64
+#define HB_SIMD_DYN_BLOCK 256
+#endif
+
+/* 1: the last substep of a block requests the next block's rows of x and v (docs/cpu_simd.md). */
+#ifndef HB_SIMD_DYN_PREFETCH
+#define HB_SIMD_DYN_PREFETCH 1
 #endif
 
 /* Reals of scratch one block needs (allocate 64-byte aligned). */

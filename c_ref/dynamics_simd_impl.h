@@ -1,24 +1,26 @@
 /* dynamics_simd_impl.h — the dynamic model on the point-major layout, one strand per SIMD
  * lane (dynamics_simd.h), written once for a floating type REAL; dynamics_simd.c includes
- * it for float and for double (SFX, DMODEL, SQRT, SIN, QTABLE, PHASE).
+ * it for float and for double (SFX, DMODEL, SQRT, SIN, QTABLE, PHASE, INV_SQRT_ROW, TINY).
  *
- * The normative text is dynamics_impl.h (docs/model.md §3.10): every value here is computed
- * by the same operations in the same order; what changes is the loop nest. The oracle runs
- * one strand through a substep point by point; here every step of it (one constraint, one
- * point's prediction …) is one loop over the DB lanes of the block, so the strands of a
- * block advance together, constraint by constraint. A branch of the oracle (|e| = 0, the
- * collision test, the ftl direction) becomes a select: every lane computes the branch
- * (perhaps an Inf or NaN that is then discarded) and keeps the oracle's value.
+ * The model is dynamics_impl.h's (docs/model.md §3): the same steps, constraints, groups
+ * and order. The arithmetic is free (docs/cpu_simd.md, "Free arithmetic"): a length's
+ * reciprocal comes from INV_SQRT_ROW (fp32: rsqrt and one Newton step), every constant
+ * denominator (h, the drag factor, w_a + w_b + α̃) is a reciprocal computed once per block
+ * and frame, and products replace divisions. So the result is not the oracle's bits; it is
+ * judged by the one-frame rule (tests/test_cpu_simd_dynamic.py). What stays exact: the
+ * roots (the oracle's rotation), the bend rest lengths and the observables' arithmetic.
  *
- * The feature set is a compile-time constant in every loop, as in the oracle; the frame is
+ * Every step of the oracle (one constraint, one point's prediction …) is one loop over the
+ * DB lanes of the block, so the strands of a block advance together, constraint by
+ * constraint. A branch of the oracle (|e| = 0, the collision test, the ftl direction)
+ * becomes a select. The feature set is a compile-time constant in every loop; the frame is
  * cut into two phases that each depend on a few features (velocities: wind, gust, drag,
  * motion; constraints: bend, shape, collide, motion), each instantiated for its own
- * features only (16 + 16 bodies per precision instead of the oracle's 96).
+ * features only.
  *
  * Scratch of a block, rows of DB lanes: p [P][3] (predicted positions), λ [3P] (stretch at
- * row 0, bend at row P, shape at row 2P, as the oracle's), d [3] (the ftl correction of the
- * current point: the velocity update of point k−1 is done as soon as d_k is known, which
- * is the oracle's arithmetic in another order of independent values).
+ * row 0, bend at row P, shape at row 2P; a kind with α̃ = 0 needs none), d [3] (the ftl
+ * correction of the current point), and 5 rows for one constraint's |e|², 1/|e| and e.
  */
 
 #define HB_ALWAYS_INLINE static inline __attribute__((always_inline))
@@ -26,57 +28,91 @@
 #define ROWP(a, k) ((a) + (int64_t)(k)*stride)
 #define SROW(r) HB_ASSUME_ALIGNED(scratch + (int64_t)(r)*DB)
 #define AL(p) HB_ASSUME_ALIGNED(p)
+#define TMP(m, i) SROW(6 * (m)->points + 3 + (i)) /* 0: |e|², 1: 1/|e|, 2–4: e */
 
-/* §3.5 distance constraint between rows a and b of p, lane by lane (dynamics_impl.h
- * distance): rest length rr[j] (per_lane) or rs, α̃ = at; a moves unless it is the root. */
-HB_ALWAYS_INLINE void SFX(distance_lanes)(REAL *restrict ax, REAL *restrict ay, REAL *restrict az, REAL *restrict bx,
+/* The constant denominators' reciprocals and the constants beside them. */
+typedef struct {
+    REAL h, ih, iden;         /* h, 1/h, 1/(1 + h(c_d + β)) */
+    REAL st_at, st_w1, st_w2; /* stretch α̃, 1/(1 + α̃) (one end the root), 1/(2 + α̃) */
+    REAL bd_at, bd_w1, bd_w2; /* the same for bend */
+    REAL sh_at, sh_w1;        /* shape α̃, 1/(1 + α̃) */
+    REAL rc, rc2, ell, s_ih;  /* R_c, R_c², ℓ, s/h */
+} SFX(dyn_consts);
+
+/* §3.5 distance constraint between rows a and b of p, lane by lane: rest length rr[j]
+ * (per_lane) or rs, α̃ = at, rw = 1/(w_a + w_b + α̃); lam = NULL when α̃ = 0 (the
+ * multiplier then never enters Δλ). a moves unless it is the root. */
+HB_ALWAYS_INLINE void SFX(distance_solve)(REAL *restrict ax, REAL *restrict ay, REAL *restrict az, REAL *restrict bx,
                                           REAL *restrict by, REAL *restrict bz, const int move_a, const int per_lane,
-                                          const REAL *restrict rr, const REAL rs, const REAL at, REAL *restrict lam)
+                                          const REAL *restrict rr, const REAL rs, const REAL at, const REAL rw,
+                                          REAL *restrict lam, const int use_lam, const REAL *restrict l2r,
+                                          const REAL *restrict inv)
 {
-    ax = AL(ax);
-    ay = AL(ay);
-    az = AL(az);
-    bx = AL(bx);
-    by = AL(by);
-    bz = AL(bz);
-    lam = AL(lam);
-    const REAL wsum = move_a ? (REAL)2 : (REAL)1;
-    const REAL wa = wsum + at;
 #pragma omp simd
     for (int j = 0; j < DB; j++) {
         const REAL pax = ax[j], pay = ay[j], paz = az[j], pbx = bx[j], pby = by[j], pbz = bz[j];
         const REAL ex = pbx - pax, ey = pby - pay, ez = pbz - paz;
-        const REAL len = SQRT(ex * ex + ey * ey + ez * ez);
-        const REAL r = per_lane ? rr[j] : rs;
-        const REAL c = len - r;
-        const REAL l0 = lam[j];
-        const REAL dl = (-c - at * l0) / wa;
-        const REAL nx = ex / len, ny = ey / len, nz = ez / len;
-        const int zero = len == (REAL)0; /* no direction: nothing moves */
-        lam[j] = zero ? l0 : l0 + dl;
-        if (move_a) {
-            ax[j] = zero ? pax : pax - dl * nx;
-            ay[j] = zero ? pay : pay - dl * ny;
-            az[j] = zero ? paz : paz - dl * nz;
+        const REAL l2 = l2r[j], iv = inv[j];
+        const int zero = l2 < TINY; /* no direction: nothing moves */
+        const REAL c = l2 * iv - (per_lane ? rr[j] : rs);
+        REAL dl;
+        if (use_lam) {
+            const REAL l0 = lam[j];
+            dl = (-c - at * l0) * rw;
+            lam[j] = zero ? l0 : l0 + dl;
+        } else {
+            dl = -c * rw;
         }
-        bx[j] = zero ? pbx : pbx + dl * nx;
-        by[j] = zero ? pby : pby + dl * ny;
-        bz[j] = zero ? pbz : pbz + dl * nz;
+        const REAL g = zero ? (REAL)0 : dl * iv; /* Δλ/|e|: the step along e */
+        if (move_a) {
+            ax[j] = pax - g * ex;
+            ay[j] = pay - g * ey;
+            az[j] = paz - g * ez;
+        }
+        bx[j] = pbx + g * ex;
+        by[j] = pby + g * ey;
+        bz[j] = pbz + g * ez;
     }
 }
 
-/* §3.5 head collision of row k of p (dynamics_impl.h collide_sphere). */
-HB_ALWAYS_INLINE void SFX(collide_lanes)(REAL *restrict px, REAL *restrict py, REAL *restrict pz, const REAL rc)
+HB_ALWAYS_INLINE void SFX(distance_lanes)(const DMODEL *m, REAL *scratch, const int64_t a, const int64_t b,
+                                          const int per_lane, const REAL *rr, const REAL rs, const REAL at,
+                                          const REAL rw, REAL *lam)
 {
-    px = AL(px);
-    py = AL(py);
-    pz = AL(pz);
+    REAL *restrict ax = SROW(3 * a), *restrict ay = SROW(3 * a + 1), *restrict az = SROW(3 * a + 2);
+    REAL *restrict bx = SROW(3 * b), *restrict by = SROW(3 * b + 1), *restrict bz = SROW(3 * b + 2);
+    REAL *restrict l2r = TMP(m, 0), *restrict inv = TMP(m, 1);
+#pragma omp simd
+    for (int j = 0; j < DB; j++) {
+        const REAL ex = bx[j] - ax[j], ey = by[j] - ay[j], ez = bz[j] - az[j];
+        l2r[j] = ex * ex + ey * ey + ez * ez;
+    }
+    INV_SQRT_ROW(l2r, inv);
+    const int move_a = a != 0;
+    if (lam && move_a) SFX(distance_solve)(ax, ay, az, bx, by, bz, 1, per_lane, rr, rs, at, rw, AL(lam), 1, l2r, inv);
+    else if (lam) SFX(distance_solve)(ax, ay, az, bx, by, bz, 0, per_lane, rr, rs, at, rw, AL(lam), 1, l2r, inv);
+    else if (move_a) SFX(distance_solve)(ax, ay, az, bx, by, bz, 1, per_lane, rr, rs, at, rw, NULL, 0, l2r, inv);
+    else SFX(distance_solve)(ax, ay, az, bx, by, bz, 0, per_lane, rr, rs, at, rw, NULL, 0, l2r, inv);
+}
+
+/* §3.5 head collision of row k of p (dynamics_impl.h collide_sphere): inside when
+ * |p|² < R_c²; the centre itself (|p|² below TINY) goes to (0, R_c, 0). */
+HB_ALWAYS_INLINE void SFX(collide_lanes)(const DMODEL *m, REAL *scratch, const int64_t k, const SFX(dyn_consts) * K)
+{
+    REAL *restrict px = SROW(3 * k), *restrict py = SROW(3 * k + 1), *restrict pz = SROW(3 * k + 2);
+    REAL *restrict l2r = TMP(m, 0), *restrict inv = TMP(m, 1);
+    const REAL rc = K->rc, rc2 = K->rc2;
 #pragma omp simd
     for (int j = 0; j < DB; j++) {
         const REAL x = px[j], y = py[j], z = pz[j];
-        const REAL len = SQRT(x * x + y * y + z * z);
-        const int in = len < rc, zero = len == (REAL)0;
-        const REAL sc = rc / len;
+        l2r[j] = x * x + y * y + z * z;
+    }
+    INV_SQRT_ROW(l2r, inv);
+#pragma omp simd
+    for (int j = 0; j < DB; j++) {
+        const REAL x = px[j], y = py[j], z = pz[j], l2 = l2r[j];
+        const int in = l2 < rc2, zero = l2 < TINY;
+        const REAL sc = rc * inv[j];
         const REAL nx = zero ? (REAL)0 : x * sc, ny = zero ? rc : y * sc, nz = zero ? (REAL)0 : z * sc;
         px[j] = in ? nx : x;
         py[j] = in ? ny : y;
@@ -85,13 +121,16 @@ HB_ALWAYS_INLINE void SFX(collide_lanes)(REAL *restrict px, REAL *restrict py, R
 }
 
 /* Phase 1 of a substep (steps 1 and 2 of dynamics_impl.h frame_body): the root on the head,
- * the velocities, the prediction p. Features: WIND, GUST, DRAG, MOTION. */
-HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const REAL *q, const REAL phase, REAL *X, REAL *Y, REAL *Z,
-                                     REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ,
-                                     const int64_t stride, REAL *scratch, const unsigned F)
+ * the velocities, the prediction p. Features: WIND, GUST, DRAG, MOTION. With `prefetch`,
+ * the rows of the next block's x and v are requested (into L2) row by row, so that they
+ * arrive while this block computes. */
+HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, const REAL phase,
+                                     REAL *X, REAL *Y, REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX,
+                                     const REAL *RY, const REAL *RZ, const int64_t stride, REAL *scratch,
+                                     const int prefetch, const unsigned F)
 {
     const int64_t P = m->points;
-    const REAL h = m->h;
+    const REAL h = K->h, ih = K->ih;
     if (F & HB_F_MOTION) {
         REAL *restrict x = AL(X), *restrict y = AL(Y), *restrict z = AL(Z);
         REAL *restrict vx = AL(VX), *restrict vy = AL(VY), *restrict vz = AL(VZ);
@@ -100,14 +139,14 @@ HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const REAL *q, const REAL 
 #pragma omp simd
         for (int j = 0; j < DB; j++) {
             const REAL a0 = rx[j], a1 = ry[j], a2 = rz[j];
-            const REAL r0 = q0 * a0 + q1 * a1 + q2 * a2;
+            const REAL r0 = q0 * a0 + q1 * a1 + q2 * a2; /* the oracle's rotation: roots stay exact */
             const REAL r1 = q3 * a0 + q4 * a1 + q5 * a2;
             const REAL r2 = q6 * a0 + q7 * a1 + q8 * a2;
-            vx[j] = (r0 - x[j]) / h;
+            vx[j] = (r0 - x[j]) * ih;
             x[j] = r0;
-            vy[j] = (r1 - y[j]) / h;
+            vy[j] = (r1 - y[j]) * ih;
             y[j] = r1;
-            vz[j] = (r2 - z[j]) / h;
+            vz[j] = (r2 - z[j]) * ih;
             z[j] = r2;
         }
     }
@@ -121,17 +160,26 @@ HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const REAL *q, const REAL 
             pz[j] = z[j];
         }
     }
-    const REAL gy = m->gravity_y, wy = m->wind_y, wz = m->wind_z, den = m->den;
+    const REAL gy = m->gravity_y, wy = m->wind_y, wz = m->wind_z, iden = K->iden;
     const REAL gust = m->gust, kappa = m->kappa, dy = m->dir_y, dz = m->dir_z;
     (void)wy;
     (void)wz;
-    (void)den;
+    (void)iden;
     (void)gust;
     (void)kappa;
     (void)dy;
     (void)dz;
     (void)phase;
-    for (int64_t k = 1; k < P; k++) {
+    for (int64_t k = 0; k < P; k++) {
+        if (prefetch) {
+            /* addresses as integers: past the last block they point nowhere, and a prefetch
+             * of nowhere is harmless */
+            const REAL *rows[6] = {ROWP(X, k), ROWP(Y, k), ROWP(Z, k), ROWP(VX, k), ROWP(VY, k), ROWP(VZ, k)};
+            for (int a = 0; a < 6; a++)
+                for (uintptr_t b = DB * sizeof(REAL); b < 2 * DB * sizeof(REAL); b += 64)
+                    __builtin_prefetch((const void *)((uintptr_t)rows[a] + b), 0, 2);
+        }
+        if (k == 0) continue;
         const REAL *restrict x = AL(ROWP(X, k)), *restrict y = AL(ROWP(Y, k)), *restrict z = AL(ROWP(Z, k));
         REAL *restrict vxr = AL(ROWP(VX, k)), *restrict vyr = AL(ROWP(VY, k)), *restrict vzr = AL(ROWP(VZ, k));
         REAL *restrict px = SROW(3 * k), *restrict py = SROW(3 * k + 1), *restrict pz = SROW(3 * k + 2);
@@ -148,9 +196,9 @@ HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const REAL *q, const REAL 
                 vy = vy + h * gy;
             }
             if (F & HB_F_DRAG) {
-                vx = vx / den;
-                vy = vy / den;
-                vz = vz / den;
+                vx = vx * iden;
+                vy = vy * iden;
+                vz = vz * iden;
             }
             vxr[j] = vx;
             vyr[j] = vy;
@@ -163,25 +211,27 @@ HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const REAL *q, const REAL 
 }
 
 /* §3.6 bend constraints of one parity group (dynamics_impl.h bend_group). */
-HB_ALWAYS_INLINE void SFX(bend_lanes)(const DMODEL *m, REAL *scratch, const REAL *BR, const int64_t stride,
-                                      const int parity)
+HB_ALWAYS_INLINE void SFX(bend_lanes)(const DMODEL *m, const SFX(dyn_consts) * K, REAL *scratch, const REAL *BR,
+                                      const int64_t stride, const int parity)
 {
     const int64_t P = m->points;
-    for (int64_t k = 1; k + 1 < P; k++)
-        if ((((k - 1) / 2) & 1) == parity) {
-            const int64_t a = k - 1, b = k + 1;
-            SFX(distance_lanes)
-            (SROW(3 * a), SROW(3 * a + 1), SROW(3 * a + 2), SROW(3 * b), SROW(3 * b + 1), SROW(3 * b + 2), a != 0, 1,
-             ROWP(BR, k - 1), (REAL)0, m->bend_at, SROW(3 * P + P + (k - 1)));
-        }
+    for (int64_t k = 1; k + 1 < P; k++) {
+        if ((((k - 1) / 2) & 1) != parity) continue;
+        const REAL rw = k - 1 != 0 ? K->bd_w2 : K->bd_w1;
+        REAL *lam = K->bd_at != (REAL)0 ? SROW(3 * P + P + (k - 1)) : NULL;
+        SFX(distance_lanes)(m, scratch, k - 1, k + 1, 1, AL(ROWP(BR, k - 1)), (REAL)0, K->bd_at, rw, lam);
+    }
 }
 
 /* §3.5 shape pulls toward T_k = Q·X̄_k (X̄_k without motion), k = 1…K. */
-HB_ALWAYS_INLINE void SFX(shape_lanes)(const DMODEL *m, REAL *scratch, const REAL *q, const REAL *RX, const REAL *RY,
-                                       const REAL *RZ, const int64_t stride, const unsigned F)
+HB_ALWAYS_INLINE void SFX(shape_lanes)(const DMODEL *m, const SFX(dyn_consts) * K, REAL *scratch, const REAL *q,
+                                       const REAL *RX, const REAL *RY, const REAL *RZ, const int64_t stride,
+                                       const unsigned F)
 {
     const int64_t P = m->points;
-    const REAL at = m->shape_at, wa = (REAL)1 + at;
+    const REAL at = K->sh_at, rw = K->sh_w1;
+    REAL *restrict l2r = TMP(m, 0), *restrict inv = TMP(m, 1);
+    REAL *restrict exr = TMP(m, 2), *restrict eyr = TMP(m, 3), *restrict ezr = TMP(m, 4);
     for (int64_t k = 1; k <= m->shape_count; k++) {
         REAL *restrict px = SROW(3 * k), *restrict py = SROW(3 * k + 1), *restrict pz = SROW(3 * k + 2);
         REAL *restrict lam = SROW(3 * P + 2 * P + (k - 1));
@@ -199,153 +249,135 @@ HB_ALWAYS_INLINE void SFX(shape_lanes)(const DMODEL *m, REAL *scratch, const REA
                 t1 = a1;
                 t2 = a2;
             }
-            const REAL x = px[j], y = py[j], z = pz[j];
-            const REAL ex = x - t0, ey = y - t1, ez = z - t2;
-            const REAL c = SQRT(ex * ex + ey * ey + ez * ez);
-            const REAL l0 = lam[j];
-            const REAL dl = (-c - at * l0) / wa;
-            const int zero = c == (REAL)0;
-            lam[j] = zero ? l0 : l0 + dl;
-            px[j] = zero ? x : x + dl * (ex / c);
-            py[j] = zero ? y : y + dl * (ey / c);
-            pz[j] = zero ? z : z + dl * (ez / c);
+            const REAL ex = px[j] - t0, ey = py[j] - t1, ez = pz[j] - t2;
+            exr[j] = ex;
+            eyr[j] = ey;
+            ezr[j] = ez;
+            l2r[j] = ex * ex + ey * ey + ez * ez;
         }
+        INV_SQRT_ROW(l2r, inv);
+#pragma omp simd
+        for (int j = 0; j < DB; j++) {
+            const REAL l2 = l2r[j], iv = inv[j];
+            const int zero = l2 < TINY;
+            const REAL l0 = lam[j];
+            const REAL dl = (-(l2 * iv) - at * l0) * rw;
+            lam[j] = zero ? l0 : l0 + dl;
+            const REAL g = zero ? (REAL)0 : dl * iv;
+            px[j] = px[j] + g * exr[j];
+            py[j] = py[j] + g * eyr[j];
+            pz[j] = pz[j] + g * ezr[j];
+        }
+    }
+}
+
+/* x ← p and v ← (p − x)/h − (s/h)·d (d = NULL: no correction) for row k. */
+HB_ALWAYS_INLINE void SFX(update_row)(const SFX(dyn_consts) * K, REAL *scratch, REAL *X, REAL *Y, REAL *Z, REAL *VX,
+                                      REAL *VY, REAL *VZ, const int64_t stride, const int64_t k,
+                                      const REAL *restrict dx, const REAL *restrict dy, const REAL *restrict dz)
+{
+    REAL *restrict x = AL(ROWP(X, k)), *restrict y = AL(ROWP(Y, k)), *restrict z = AL(ROWP(Z, k));
+    REAL *restrict vx = AL(ROWP(VX, k)), *restrict vy = AL(ROWP(VY, k)), *restrict vz = AL(ROWP(VZ, k));
+    const REAL *restrict px = SROW(3 * k), *restrict py = SROW(3 * k + 1), *restrict pz = SROW(3 * k + 2);
+    const REAL ih = K->ih, s_ih = K->s_ih;
+    (void)s_ih;
+#pragma omp simd
+    for (int j = 0; j < DB; j++) {
+        const REAL nx = px[j], ny = py[j], nz = pz[j];
+        REAL wx = (nx - x[j]) * ih, wy = (ny - y[j]) * ih, wz = (nz - z[j]) * ih;
+        if (dx) {
+            wx = wx - s_ih * dx[j];
+            wy = wy - s_ih * dy[j];
+            wz = wz - s_ih * dz[j];
+        }
+        vx[j] = wx;
+        vy[j] = wy;
+        vz[j] = wz;
+        x[j] = nx;
+        y[j] = ny;
+        z[j] = nz;
     }
 }
 
 /* Phase 2 of a substep (steps 3 and 4): the constraints of the solver, then the velocities
  * from the motion and the positions. Features: BEND, SHAPE, COLLIDE, MOTION (for shape). */
-HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const REAL *q, REAL *X, REAL *Y, REAL *Z, REAL *VX, REAL *VY,
-                                     REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ, const REAL *BR,
-                                     const int64_t stride, REAL *scratch, const unsigned F)
+HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, REAL *X, REAL *Y,
+                                     REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY,
+                                     const REAL *RZ, const REAL *BR, const int64_t stride, REAL *scratch,
+                                     const unsigned F)
 {
     const int64_t P = m->points;
-    const REAL h = m->h, ell = m->seg_len;
-    /* every multiplier in use starts the substep at 0 */
+    const REAL ell = K->ell;
+    /* every multiplier in use starts the substep at 0 (stretch rows P…, bend 2P…, shape 3P…) */
     {
+        const int64_t from = K->st_at != (REAL)0 ? 0 : (F & HB_F_BEND) && K->bd_at != (REAL)0 ? P : 2 * P;
+        const int64_t to = (F & HB_F_SHAPE) ? 3 * P : (F & HB_F_BEND) ? 2 * P : P;
         REAL *restrict lam = SROW(3 * P);
-        const int64_t rows = (F & HB_F_SHAPE) ? 3 * P : (F & HB_F_BEND) ? 2 * P : P;
-        for (int64_t i = 0; i < rows * DB; i++) lam[i] = (REAL)0;
+        for (int64_t i = from * DB; i < to * DB; i++) lam[i] = (REAL)0;
     }
+    REAL *const lam_s = K->st_at != (REAL)0 ? SROW(3 * P) : NULL;
     if (m->solver == HB_SOLVER_XPBD) {
         for (int64_t it = 0; it < m->iterations; it++) {
             // clang-format off
             for (int64_t k = 1; k < P; k += 2) /* stretch, k odd */
-                SFX(distance_lanes)(SROW(3 * (k - 1)), SROW(3 * (k - 1) + 1), SROW(3 * (k - 1) + 2), SROW(3 * k),
-                                    SROW(3 * k + 1), SROW(3 * k + 2), k - 1 != 0, 0, NULL, ell, m->stretch_at,
-                                    SROW(3 * P + (k - 1)));
+                SFX(distance_lanes)(m, scratch, k - 1, k, 0, NULL, ell, K->st_at, k - 1 != 0 ? K->st_w2 : K->st_w1,
+                                    lam_s ? lam_s + (k - 1) * DB : NULL);
             for (int64_t k = 2; k < P; k += 2) /* stretch, k even */
-                SFX(distance_lanes)(SROW(3 * (k - 1)), SROW(3 * (k - 1) + 1), SROW(3 * (k - 1) + 2), SROW(3 * k),
-                                    SROW(3 * k + 1), SROW(3 * k + 2), 1, 0, NULL, ell, m->stretch_at,
-                                    SROW(3 * P + (k - 1)));
+                SFX(distance_lanes)(m, scratch, k - 1, k, 0, NULL, ell, K->st_at, K->st_w2,
+                                    lam_s ? lam_s + (k - 1) * DB : NULL);
             // clang-format on
             if (F & HB_F_BEND) {
-                SFX(bend_lanes)(m, scratch, BR, stride, 0);
-                SFX(bend_lanes)(m, scratch, BR, stride, 1);
+                SFX(bend_lanes)(m, K, scratch, BR, stride, 0);
+                SFX(bend_lanes)(m, K, scratch, BR, stride, 1);
             }
-            if (F & HB_F_SHAPE) SFX(shape_lanes)(m, scratch, q, RX, RY, RZ, stride, F);
+            if (F & HB_F_SHAPE) SFX(shape_lanes)(m, K, scratch, q, RX, RY, RZ, stride, F);
             if (F & HB_F_COLLIDE)
-                for (int64_t k = 1; k < P; k++)
-                    SFX(collide_lanes)(SROW(3 * k), SROW(3 * k + 1), SROW(3 * k + 2), m->collide_r);
+                for (int64_t k = 1; k < P; k++) SFX(collide_lanes)(m, scratch, k, K);
         }
         /* 4. v = (p − x)/h, then x = p */
-        for (int64_t k = 1; k < P; k++) {
-            REAL *restrict x = AL(ROWP(X, k)), *restrict y = AL(ROWP(Y, k)), *restrict z = AL(ROWP(Z, k));
-            REAL *restrict vx = AL(ROWP(VX, k)), *restrict vy = AL(ROWP(VY, k)), *restrict vz = AL(ROWP(VZ, k));
-            const REAL *restrict px = SROW(3 * k), *restrict py = SROW(3 * k + 1), *restrict pz = SROW(3 * k + 2);
-#pragma omp simd
-            for (int j = 0; j < DB; j++) {
-                const REAL nx = px[j], ny = py[j], nz = pz[j];
-                vx[j] = (nx - x[j]) / h;
-                vy[j] = (ny - y[j]) / h;
-                vz[j] = (nz - z[j]) / h;
-                x[j] = nx;
-                y[j] = ny;
-                z[j] = nz;
-            }
-        }
+        for (int64_t k = 1; k < P; k++) SFX(update_row)(K, scratch, X, Y, Z, VX, VY, VZ, stride, k, NULL, NULL, NULL);
         return;
     }
     for (int64_t it = 0; it < m->iterations; it++) {
         if (F & HB_F_BEND) {
-            SFX(bend_lanes)(m, scratch, BR, stride, 0);
-            SFX(bend_lanes)(m, scratch, BR, stride, 1);
+            SFX(bend_lanes)(m, K, scratch, BR, stride, 0);
+            SFX(bend_lanes)(m, K, scratch, BR, stride, 1);
         }
-        if (F & HB_F_SHAPE) SFX(shape_lanes)(m, scratch, q, RX, RY, RZ, stride, F);
+        if (F & HB_F_SHAPE) SFX(shape_lanes)(m, K, scratch, q, RX, RY, RZ, stride, F);
     }
     /* §3.7 follow the leader, point by point; as soon as d_k is known, point k − 1 is final:
-     * v_{k−1} = (p − x)/h − (s·d_k)/h and x_{k−1} = p (the oracle's step 4 for that point) */
-    const REAL s = m->ftl_s, rc = m->collide_r;
-    (void)rc;
+     * v_{k−1} = (p − x)/h − (s/h)·d_k and x_{k−1} = p (the oracle's step 4 for that point) */
     REAL *restrict dx = SROW(6 * P), *restrict dy = SROW(6 * P + 1), *restrict dz = SROW(6 * P + 2);
+    REAL *restrict l2r = TMP(m, 0), *restrict inv = TMP(m, 1);
     for (int64_t k = 1; k < P; k++) {
-        {
-            REAL *restrict px = SROW(3 * k), *restrict py = SROW(3 * k + 1), *restrict pz = SROW(3 * k + 2);
-            const REAL *restrict ppx = SROW(3 * (k - 1)), *restrict ppy = SROW(3 * (k - 1) + 1),
-                                 *restrict ppz = SROW(3 * (k - 1) + 2);
-#pragma omp simd
-            for (int j = 0; j < DB; j++) {
-                const REAL ax = ppx[j], ay = ppy[j], az = ppz[j], bx = px[j], by = py[j], bz = pz[j];
-                const REAL ex = bx - ax, ey = by - ay, ez = bz - az;
-                const REAL len = SQRT(ex * ex + ey * ey + ez * ez);
-                const int pos = len > (REAL)0;
-                const REAL fx = ax + ell * (ex / len), fy = ay + ell * (ey / len), fz = az + ell * (ez / len);
-                const REAL down = ay - ell;
-                REAL qx = pos ? fx : ax, qy = pos ? fy : down, qz = pos ? fz : az;
-                dx[j] = qx - bx;
-                dy[j] = qy - by;
-                dz[j] = qz - bz;
-                if (F & HB_F_COLLIDE) {
-                    const REAL cl = SQRT(qx * qx + qy * qy + qz * qz);
-                    const int in = cl < rc, zero = cl == (REAL)0;
-                    const REAL sc = rc / cl;
-                    const REAL nx = zero ? (REAL)0 : qx * sc, ny = zero ? rc : qy * sc, nz = zero ? (REAL)0 : qz * sc;
-                    qx = in ? nx : qx;
-                    qy = in ? ny : qy;
-                    qz = in ? nz : qz;
-                }
-                px[j] = qx;
-                py[j] = qy;
-                pz[j] = qz;
-            }
-        }
-        if (k >= 2) {
-            const int64_t k1 = k - 1;
-            REAL *restrict x = AL(ROWP(X, k1)), *restrict y = AL(ROWP(Y, k1)), *restrict z = AL(ROWP(Z, k1));
-            REAL *restrict vx = AL(ROWP(VX, k1)), *restrict vy = AL(ROWP(VY, k1)), *restrict vz = AL(ROWP(VZ, k1));
-            const REAL *restrict px = SROW(3 * k1), *restrict py = SROW(3 * k1 + 1), *restrict pz = SROW(3 * k1 + 2);
-#pragma omp simd
-            for (int j = 0; j < DB; j++) {
-                const REAL nx = px[j], ny = py[j], nz = pz[j];
-                REAL wx = (nx - x[j]) / h, wy = (ny - y[j]) / h, wz = (nz - z[j]) / h;
-                wx = wx - (s * dx[j]) / h;
-                wy = wy - (s * dy[j]) / h;
-                wz = wz - (s * dz[j]) / h;
-                vx[j] = wx;
-                vy[j] = wy;
-                vz[j] = wz;
-                x[j] = nx;
-                y[j] = ny;
-                z[j] = nz;
-            }
-        }
-    }
-    { /* the last point: no correction */
-        const int64_t k1 = P - 1;
-        REAL *restrict x = AL(ROWP(X, k1)), *restrict y = AL(ROWP(Y, k1)), *restrict z = AL(ROWP(Z, k1));
-        REAL *restrict vx = AL(ROWP(VX, k1)), *restrict vy = AL(ROWP(VY, k1)), *restrict vz = AL(ROWP(VZ, k1));
-        const REAL *restrict px = SROW(3 * k1), *restrict py = SROW(3 * k1 + 1), *restrict pz = SROW(3 * k1 + 2);
+        REAL *restrict px = SROW(3 * k), *restrict py = SROW(3 * k + 1), *restrict pz = SROW(3 * k + 2);
+        const REAL *restrict ppx = SROW(3 * (k - 1)), *restrict ppy = SROW(3 * (k - 1) + 1),
+                             *restrict ppz = SROW(3 * (k - 1) + 2);
 #pragma omp simd
         for (int j = 0; j < DB; j++) {
-            const REAL nx = px[j], ny = py[j], nz = pz[j];
-            vx[j] = (nx - x[j]) / h;
-            vy[j] = (ny - y[j]) / h;
-            vz[j] = (nz - z[j]) / h;
-            x[j] = nx;
-            y[j] = ny;
-            z[j] = nz;
+            const REAL ex = px[j] - ppx[j], ey = py[j] - ppy[j], ez = pz[j] - ppz[j];
+            l2r[j] = ex * ex + ey * ey + ez * ez;
         }
+        INV_SQRT_ROW(l2r, inv);
+#pragma omp simd
+        for (int j = 0; j < DB; j++) {
+            const REAL ax = ppx[j], ay = ppy[j], az = ppz[j], bx = px[j], by = py[j], bz = pz[j];
+            const REAL ex = bx - ax, ey = by - ay, ez = bz - az;
+            const int pos = l2r[j] >= TINY; /* the oracle's |e| > 0 */
+            const REAL g = ell * inv[j];
+            const REAL qx = pos ? ax + g * ex : ax, qy = pos ? ay + g * ey : ay - ell, qz = pos ? az + g * ez : az;
+            dx[j] = qx - bx;
+            dy[j] = qy - by;
+            dz[j] = qz - bz;
+            px[j] = qx;
+            py[j] = qy;
+            pz[j] = qz;
+        }
+        if (F & HB_F_COLLIDE) SFX(collide_lanes)(m, scratch, k, K);
+        if (k >= 2) SFX(update_row)(K, scratch, X, Y, Z, VX, VY, VZ, stride, k - 1, dx, dy, dz);
     }
+    /* the last point: no correction */
+    SFX(update_row)(K, scratch, X, Y, Z, VX, VY, VZ, stride, P - 1, NULL, NULL, NULL);
 }
 
 /* The two phases, one function per feature subset (the switches' constants specialise). */
@@ -357,14 +389,15 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const REAL *q, REAL *X, RE
      (((i)&8) ? HB_F_MOTION : 0u))
 #define CASE16(C) C(0) C(1) C(2) C(3) C(4) C(5) C(6) C(7) C(8) C(9) C(10) C(11) C(12) C(13) C(14) C(15)
 
-static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const REAL *q, const REAL phase, REAL *X, REAL *Y, REAL *Z,
-                              REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ,
-                              const int64_t stride, REAL *scratch)
+static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, const REAL phase,
+                              REAL *X, REAL *Y, REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY,
+                              const REAL *RZ, const int64_t stride, REAL *scratch, const int prefetch)
 {
 #define VCASE(i)                                                                                                       \
     case (i):                                                                                                          \
         if (((i)&2) && !((i)&1)) break; /* no gusts without wind (hb_dyn_features) */                                  \
-        SFX(vel_phase)(m, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, VEL_F(i));                       \
+        if (prefetch) SFX(vel_phase)(m, K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, 1, VEL_F(i));   \
+        else SFX(vel_phase)(m, K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, 0, VEL_F(i));            \
         break;
     switch (idx) {
         CASE16(VCASE)
@@ -373,14 +406,14 @@ static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const REAL *q, cons
 #undef VCASE
 }
 
-static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const REAL *q, REAL *X, REAL *Y, REAL *Z, REAL *VX,
-                              REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ, const REAL *BR,
-                              const int64_t stride, REAL *scratch)
+static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, REAL *X, REAL *Y,
+                              REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ,
+                              const REAL *BR, const int64_t stride, REAL *scratch)
 {
 #define CCASE(i)                                                                                                       \
     case (i):                                                                                                          \
         if (((i)&8) && !((i)&2)) break; /* motion matters here only through shape */                                   \
-        SFX(con_phase)(m, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, stride, scratch, CON_F(i));                          \
+        SFX(con_phase)(m, K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, stride, scratch, CON_F(i));                       \
         break;
     switch (idx) {
         CASE16(CCASE)
@@ -398,11 +431,29 @@ void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, REAL 
                         ((F & HB_F_DRAG) ? 4u : 0u) | ((F & HB_F_MOTION) ? 8u : 0u);
     const unsigned ci = ((F & HB_F_BEND) ? 1u : 0u) | ((F & HB_F_SHAPE) ? 2u : 0u) | ((F & HB_F_COLLIDE) ? 4u : 0u) |
                         ((F & HB_F_SHAPE) && (F & HB_F_MOTION) ? 8u : 0u);
+    const REAL one = (REAL)1, two = (REAL)2;
+    SFX(dyn_consts) K;
+    K.h = m->h;
+    K.ih = one / m->h;
+    K.iden = one / m->den;
+    K.st_at = m->stretch_at;
+    K.st_w1 = one / (one + m->stretch_at);
+    K.st_w2 = one / (two + m->stretch_at);
+    K.bd_at = m->bend_at;
+    K.bd_w1 = one / (one + m->bend_at);
+    K.bd_w2 = one / (two + m->bend_at);
+    K.sh_at = m->shape_at;
+    K.sh_w1 = one / (one + m->shape_at);
+    K.rc = m->collide_r;
+    K.rc2 = m->collide_r * m->collide_r;
+    K.ell = m->seg_len;
+    K.s_ih = m->ftl_s / m->h;
     for (int64_t j = 0; j < m->substeps; j++) {
-        const REAL *q = QTABLE(fr) + 9 * j; /* Q(t + h) */
-        const REAL phase = PHASE(fr)[j];    /* φ(t) */
-        SFX(vel_dispatch)(vi, m, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch);
-        SFX(con_dispatch)(ci, m, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, stride, scratch);
+        const REAL *q = QTABLE(fr) + 9 * j;                            /* Q(t + h) */
+        const REAL phase = PHASE(fr)[j];                               /* φ(t) */
+        const int last = HB_SIMD_DYN_PREFETCH && j + 1 == m->substeps; /* the next block's rows arrive meanwhile */
+        SFX(vel_dispatch)(vi, m, &K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, last);
+        SFX(con_dispatch)(ci, m, &K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, stride, scratch);
     }
 }
 
@@ -506,3 +557,4 @@ void SFX(hb_simd_dyn_observe)(const hb_scene *s, const REAL *X, const REAL *Y, c
 #undef ROWP
 #undef SROW
 #undef AL
+#undef TMP

@@ -1,17 +1,17 @@
 """The simulate stage of the simd CPU variant (c_ref/dynamics_simd*.{h,c}; docs/cpu_simd.md,
 "The dynamic model") against the `ref` oracle (c_ref/dynamics_impl.h).
 
-simd evaluates the dynamic model with ref's operations in ref's order (docs/model.md §3.10):
-no FMA contraction, IEEE sqrt and division, selects where ref branches. So from the same
-input state it must give ref's bits wherever no libm function is called, i.e. without
-gusts: positions of every frame, velocities and observables (the per-strand observables
-are ref's bits and are combined over ref's chunks in ref's order). With gusts the sine is
-libmvec's (≤ 4 ulp) and the runs are compared with harness/core/tolerances.py's SIMD_DYN_GUST
-(the measurement behind it is written there).
+simd computes the model with free arithmetic (reciprocal square roots, reciprocals of the
+constant denominators), so it is judged as the GPU normal build is: one frame advanced from
+the same input, compared with ref's next frame by harness.check.diff_dynamic.compare (the one-frame
+rule DYN_STEP_K of harness/core/tolerances.py on positions and h·|Δv|, the observables within
+what the states' difference allows, each file's invariants). ref writes a few frames with
+--velocities all; simd steps from its last paper frame (velocities zero) and from its last
+simulated frame but one. Every feature set, both solvers, fp32 and fp64.
 
 Both variants start from the same ref `init,collide` state (--input): simd's own paper
 stages differ from ref's by their libmvec rounding (tests/cpu/test_cpu_simd.py covers those).
-N = 300 and 1000 are not multiples of the blocks (512/256 strands, 64 per dynamic block).
+N = 300 and 1000 are not multiples of the blocks (512/256 strands, 256 per dynamic block).
 """
 
 import platform
@@ -23,12 +23,13 @@ import numpy as np
 import pytest
 from test_cpu_simd import NO_SIMD, needs_simd
 
-from harness.core.tolerances import SIMD_DYN_GUST, SIMD_DYN_GUST_MAX_FRAMES
+from harness.check import diff_dynamic as dyndiff
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run
 
 STRANDS = 300
 FRAMES = 10
+REF_FRAMES = 3
 GUST = ["--wind-speed", 300, "--drag", 1, "--gust-amplitude", 0.8, "--gust-frequency", 3, "--gust-wavelength", 20]
 # feature sets (docs/model.md §3.9): none, each alone (wind needs a drag, so it comes with
 # one; gust needs wind), all but the gusts, all
@@ -37,9 +38,11 @@ FEATURES = {
     "bend": ["--no-collider", "--bend-compliance", 1e-6],
     "shape": ["--no-collider", "--shape-compliance", 1e-5, "--shape-range", 0.7],
     "wind+drag": ["--no-collider", "--wind-speed", 300, "--drag", 1],
+    "gust": GUST,
     "motion": ["--no-collider", "--head-motion", "nod", "--motion-amplitude", 0.5],
     "collide": ["--collision-margin", 0.3],
     "drag": ["--no-collider", "--damping", 2],
+    "stretch-compliance": ["--no-collider", "--stretch-compliance", 1e-7],
     "all-but-gust": [
         "--bend-compliance",
         1e-6,
@@ -56,6 +59,7 @@ FEATURES = {
     ],
 }
 ALL = FEATURES["all-but-gust"] + ["--gust-amplitude", 0.8, "--gust-frequency", 3, "--gust-wavelength", 20]
+FEATURES["all"] = ALL
 SOLVE = ["--substeps", 3, "--iterations", 2]
 
 
@@ -113,21 +117,18 @@ def simulate(cpu_bin, inp, out, variant, *args, frames=FRAMES):
 
 
 def read(path):
-    """positions [F][N][P][3], velocities, observables, the scene's E = R + h + L and h."""
+    """positions [F][N][P][3], velocities, observables."""
     with open_trajectory(path) as s:
         pos = np.stack([s.frame(f) for f in range(s.n_frames)])
         vel = np.stack([s.velocity(i) for i in range(len(s.velocity_steps))])
         obs = {k: s.observables[k].to_numpy() for k in s.observables.columns if k not in ("step", "time")}
-        p = s.params
-        extent = float(p["head_radius"]) + float(p["hair_offset"]) + float(p["hair_length"])
-        h = float(p["frame_dt"]) / float(p["substeps"])
         assert s.stages[-1] == "simulate"
-        return pos, vel, obs, extent, h, s.segment_length
+        return pos, vel, obs
 
 
 def assert_same_bits(a, b, what):
-    pa, va, oa = read(a)[:3]
-    pb, vb, ob = read(b)[:3]
+    pa, va, oa = read(a)
+    pb, vb, ob = read(b)
     assert pa.shape == pb.shape and pa.dtype == pb.dtype, what
     for f in range(len(pa)):
         bad = int((pa[f] != pb[f]).any(axis=2).any(axis=1).sum())
@@ -138,57 +139,88 @@ def assert_same_bits(a, b, what):
         assert np.array_equal(oa[k], ob[k]), f"{what}: observable {k} differs: {oa[k]} vs {ob[k]}"
 
 
+def assert_one_frame_rule(cpu_bin, inp, tmp_path, what, args, frames=REF_FRAMES):
+    """ref runs `frames` frames; simd steps one frame from two of them; each is judged by
+    harness.dyndiff.compare against ref's next frame. Returns the worst max/u seen."""
+    ref = simulate(cpu_bin, inp, tmp_path / "ref.h5", "ref", *args, "--velocities", "all", frames=frames)
+    with open_trajectory(ref) as t:
+        cand = dyndiff.step_candidates(t)
+        steps = {k: int(t.step[k + 1]) for k in cand}
+    assert len(cand) == frames, f"{what}: frames to step from: {cand}"
+    worst = 0.0
+    for k in (cand[0], cand[-2]):
+        out = tmp_path / f"simd_{k}.h5"
+        run(
+            cpu_bin,
+            "--input",
+            ref,
+            "--input-frame",
+            k,
+            "--stages",
+            "simulate",
+            "--frames",
+            1,
+            "--variant",
+            "simd",
+            *SOLVE,
+            *args,
+            "--velocities",
+            "all",
+            "--output",
+            out,
+            "--force",
+            "--quiet",
+        )
+        r = dyndiff.compare(ref, out, frames=[steps[k]], check_paper=False)
+        f = r.frames[0]
+        assert getattr(f, "velocity_compared", False), f"{what}: velocities of step {steps[k]} not compared"
+        assert r.equivalent, f"{what}, from frame {k}: " + "; ".join(r.failures()[:5])
+        worst = max(worst, f.max_k)
+    return worst
+
+
 @needs_simd
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 @pytest.mark.parametrize("solver", ["xpbd", "ftl"])
 @pytest.mark.parametrize("features", list(FEATURES))
-def test_without_gusts_simd_is_ref_bit_for_bit(cpu_bin, inputs, tmp_path, precision, solver, features):
+def test_one_frame_within_the_rule(cpu_bin, inputs, tmp_path, precision, solver, features):
     points = 33 if features != "none" else 16
     inp = inputs(precision, points)
-    args = ["--solver", solver, *FEATURES[features]]
-    a = simulate(cpu_bin, inp, tmp_path / "ref.h5", "ref", *args)
-    b = simulate(cpu_bin, inp, tmp_path / "simd.h5", "simd", *args)
-    assert_same_bits(a, b, f"{precision} {solver} {features}")
+    assert_one_frame_rule(
+        cpu_bin, inp, tmp_path, f"{precision} {solver} {features}", ["--solver", solver, *FEATURES[features]]
+    )
 
 
 @needs_simd
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 @pytest.mark.parametrize("points", [2, 3, 16])
-def test_short_strands_bit_for_bit(cpu_bin, inputs, tmp_path, precision, points):
-    """P = 2 (no bend constraint), 3 (one), 16; all features but the gusts, both solvers."""
+def test_short_strands_within_the_rule(cpu_bin, inputs, tmp_path, precision, points):
+    """P = 2 (no bend constraint), 3 (one), 16; every feature, both solvers."""
     inp = inputs(precision, points)
     for solver in ("xpbd", "ftl"):
-        args = ["--solver", solver, *FEATURES["all-but-gust"]]
-        a = simulate(cpu_bin, inp, tmp_path / "ref.h5", "ref", *args, frames=4)
-        b = simulate(cpu_bin, inp, tmp_path / "simd.h5", "simd", *args, frames=4)
-        assert_same_bits(a, b, f"{precision} P={points} {solver}")
+        assert_one_frame_rule(cpu_bin, inp, tmp_path, f"{precision} P={points} {solver}", ["--solver", solver, *ALL])
 
 
 @needs_simd
-@pytest.mark.parametrize("precision", ["fp32", "fp64"])
-@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
-@pytest.mark.parametrize("features", ["gust", "all"])
-def test_with_gusts_simd_is_within_the_tolerance(cpu_bin, inputs, tmp_path, precision, solver, features):
-    assert FRAMES <= SIMD_DYN_GUST_MAX_FRAMES  # the tolerance's horizon
-    inp = inputs(precision, 33)
-    args = ["--solver", solver, *(GUST if features == "gust" else ALL), "--velocities", "all"]
-    pa, va, oa, extent, h, ell = read(simulate(cpu_bin, inp, tmp_path / "ref.h5", "ref", *args))
-    pb, vb, ob, _, _, _ = read(simulate(cpu_bin, inp, tmp_path / "simd.h5", "simd", *args))
-    t = SIMD_DYN_GUST
-    eps = float(np.finfo(pa.dtype).eps)
-    assert np.isfinite(pb).all() and np.isfinite(vb).all()
-    assert np.array_equal(pa[:2], pb[:2])  # the input's frames
-    dx = float(np.abs(pa.astype(np.float64) - pb).max())
-    assert dx <= t.position_k * eps * extent, f"positions: {dx / (eps * extent):.2f} ε·E > {t.position_k}"
-    dv = float(np.abs(va.astype(np.float64) - vb).max())
-    assert dv <= t.velocity_k * eps * extent / h, f"velocities: {dv / (eps * extent / h):.2f} ε·E/h > {t.velocity_k}"
-    ke = np.abs(oa["kinetic_energy"] - ob["kinetic_energy"]) / (eps * oa["kinetic_energy"])
-    assert ke.max() <= t.kinetic_energy_k, f"kinetic energy: {ke.max():.2f} ε relative > {t.kinetic_energy_k}"
-    st = np.abs(oa["stretch_max"] - ob["stretch_max"]).max() / (eps * extent / ell)
-    assert st <= t.stretch_k, f"stretch_max: {st:.2f} ε·E/ℓ > {t.stretch_k}"
-    pen = np.abs(oa["penetration_max"] - ob["penetration_max"]).max() / (eps * extent)
-    assert pen <= t.penetration_k, f"penetration_max: {pen:.2f} ε·E > {t.penetration_k}"
-    assert np.array_equal(oa["blown_up_strands"], ob["blown_up_strands"])
+def test_a_wrong_frame_fails_the_rule(cpu_bin, inputs, tmp_path):
+    """The judge is not vacuous: simd's frame with one point moved by 1e-3 cm (about 35
+    units ε·E·S·I here, the rule allows 4) is over."""
+    import h5py
+
+    ref = simulate(cpu_bin, inputs("fp32", 16), tmp_path / "ref.h5", "ref", "--velocities", "all", frames=REF_FRAMES)
+    out = tmp_path / "moved.h5"
+    run(
+        cpu_bin,
+        *("--input", ref, "--input-frame", 2, "--stages", "simulate", "--frames", 1, "--variant", "simd", *SOLVE),
+        *("--velocities", "all", "--output", out, "--force", "--quiet"),
+    )
+    with open_trajectory(ref) as t:
+        step = int(t.step[3])
+    assert dyndiff.compare(ref, out, frames=[step], check_paper=False).equivalent
+    with h5py.File(out, "r+") as f:
+        f["particles/hair/position/value"][-1, 5 * 16 + 10, 1] += np.float32(1e-3)
+    r = dyndiff.compare(ref, out, frames=[step], check_paper=False)
+    assert not r.equivalent and any("1 point(s) over tolerance" in m for m in r.failures()), r.failures()
 
 
 @needs_simd
