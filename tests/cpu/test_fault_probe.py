@@ -111,7 +111,17 @@ def test_checked_multiply_at_the_boundaries(tmp_path):
         pytest.skip("no C compiler")
     exe = tmp_path / "checked"
     subprocess.run(
-        [cc, "-std=c11", "-Wall", "-Werror", "-I", ROOT / "c_ref", ROOT / "tests/cpu/c/checked_boundaries.c", "-o", exe],
+        [
+            cc,
+            "-std=c11",
+            "-Wall",
+            "-Werror",
+            "-I",
+            ROOT / "c_ref",
+            ROOT / "tests/cpu/c/checked_boundaries.c",
+            "-o",
+            exe,
+        ],
         check=True,
     )
     p = subprocess.run([exe], capture_output=True, text=True)

@@ -251,7 +251,8 @@ def test_frame_matches_cpu(cpu_run, gpu_frame, build, variant, scene, solver, pr
 @pytest.mark.parametrize("build", tuple(BUILDS))
 def test_bits_do_not_depend_on_block_size_or_repeats(gpu_frame, build, variant, solver, precision):
     ref = gpu_frame(build, variant, "all", solver, precision, BLOCKS[0])
-    for b in (b for b in BLOCKS[1:] if DECLARED.runs(variant, block=b)):  # the warp variant at 1024, P = 32, fp64: 32 strands x 3.75 KB = 120 KB of shared memory
+    # the warp variant at 1024, P = 32, fp64: 32 strands x 3.75 KB = 120 KB of shared memory
+    for b in (b for b in BLOCKS[1:] if DECLARED.runs(variant, block=b)):
         other = gpu_frame(build, variant, "all", solver, precision, b)
         assert same_bits(ref, other), (
             f"{build} {variant} {solver} {precision}: block {b} differs from block {BLOCKS[0]}"
