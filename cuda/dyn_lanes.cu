@@ -42,6 +42,7 @@ constexpr bool kFree = true;
 #define HB_LANES_FTL_G 4
 #endif
 constexpr int kFtlG = HB_LANES_FTL_G, kFtlL = 32 / HB_LANES_FTL_G;
+static_assert(kFtlG == 4 || kFtlG == 8, "ftl at P ≤ 32 runs 4 or 8 points a lane");
 constexpr unsigned kAll = 0xffffffffu;
 
 __device__ __forceinline__ float rsq(float x)
@@ -73,6 +74,11 @@ template <typename T, int G, int L, bool Ftl> constexpr int lanes_min_blocks()
 template <typename T> struct V3 {
     T x, y, z;
 };
+/* c ? a : b by components (a selected array element would force the array into local memory) */
+template <typename T> __device__ __forceinline__ V3<T> pick(bool c, const V3<T> &a, const V3<T> &b)
+{
+    return V3<T>{c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z};
+}
 /* shuffles within a strand's L lanes */
 template <int L, typename T> __device__ __forceinline__ V3<T> up(const V3<T> &a)
 {
@@ -282,22 +288,31 @@ __device__ __forceinline__ void gather(T *buf, const T *__restrict__ src, int64_
         if (lane + 32 * u < n) buf[lane + 32 * u] = r[u];
 }
 
+/* Slot i of a lane holds point k0 + i, or with two points a lane on an odd lane (sw) k0 + 1 − i:
+ * then every lane of a bend pair finds its own point and the one its partner needs in the
+ * same slots (the bend groups below). */
+template <int G> __device__ __forceinline__ int point_of(int k0, bool sw, int i)
+{
+    return k0 + (G == 2 && sw ? 1 - i : i);
+}
+
 template <typename T, int G>
-__device__ __forceinline__ void unpack(const T *s, int k0, int P, bool live, V3<T> (&dst)[G])
+__device__ __forceinline__ void unpack(const T *s, int k0, bool sw, int P, bool live, V3<T> (&dst)[G])
 {
 #pragma unroll
     for (int i = 0; i < G; i++) {
-        const int k = k0 + i;
+        const int k = point_of<G>(k0, sw, i);
         if (live && k < P) dst[i] = V3<T>{s[3 * k], s[3 * k + 1], s[3 * k + 2]};
         else dst[i] = V3<T>{(T)0, (T)0, (T)0};
     }
 }
 
-template <typename T, int G> __device__ __forceinline__ void pack(T *s, int k0, int P, bool live, const V3<T> (&src)[G])
+template <typename T, int G>
+__device__ __forceinline__ void pack(T *s, int k0, bool sw, int P, bool live, const V3<T> (&src)[G])
 {
 #pragma unroll
     for (int i = 0; i < G; i++) {
-        const int k = k0 + i;
+        const int k = point_of<G>(k0, sw, i);
         if (live && k < P) {
             s[3 * k] = src[i].x;
             s[3 * k + 1] = src[i].y;
@@ -318,8 +333,10 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
     const Feat has = MakeFeat<Feat>::make(m.features);
     const int lane = (int)(threadIdx.x & 31u), w = (int)(threadIdx.x >> 5), wpb = (int)(blockDim.x >> 5);
     const int seg = lane / L, l = lane % L;
+    static_assert(G > 2 || !Ftl, "the follow-the-leader pass takes a lane's slots in point order");
     const int P = (int)m.points, K = (int)m.shape_count, k0 = G * l;
-    const int row = 3 * P; /* reals of a strand */
+    const bool sw = G == 2 && (l & 1); /* slots in reverse point order (point_of) */
+    const int row = 3 * P;             /* reals of a strand */
     T *xv = (T *)hb_lanes_smem + (int64_t)w * lanes_warp_reals<T, G, L>(P);
     T *rs = xv + 2 * SPW * row; /* the rest shape of the warp's strands */
     const bool need_rest = has(HB_F_MOTION) || has(HB_F_SHAPE);
@@ -349,8 +366,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
         }
         if (need_rest) gather<T, G>(rs, rest, base, n, lane);
         __syncwarp();
-        unpack<T, G>(xv + seg * row, k0, P, live, X);
-        unpack<T, G>(xv + SPW * row + seg * row, k0, P, live, V);
+        unpack<T, G>(xv + seg * row, k0, sw, P, live, X);
+        unpack<T, G>(xv + SPW * row + seg * row, k0, sw, P, live, V);
         T br[G], brp = (T)0;
         if (has(HB_F_BEND)) { /* [N][P−2]: this lane's (k0+i, k0+i+2), i ≤ G−2, and (k0−1, k0+1) */
             __syncwarp();     /* x and v unpacked: their rows take the bend rest lengths */
@@ -388,12 +405,12 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
             const T phase = has(HB_F_GUST) ? phtab[j] : (T)0;
 #pragma unroll
             for (int i = 0; i < G; i++)
-                if (k0 + i >= 1 && k0 + i < P) predict(m, has, phase, X[i], V[i], Q[i]);
+                if (point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P) predict(m, has, phase, X[i], V[i], Q[i]);
             /* the shape targets T_k = Q(t+h)·X̄_k of this substep (the same in every iteration) */
             V3<T> S[G];
 #pragma unroll
             for (int i = 0; i < G; i++) {
-                const int k = k0 + i;
+                const int k = point_of<G>(k0, sw, i);
                 S[i] = V3<T>{(T)0, (T)0, (T)0};
                 if (has(HB_F_SHAPE) && k >= 1 && k <= K) {
                     S[i] = V3<T>{R[3 * k], R[3 * k + 1], R[3 * k + 2]};
@@ -409,18 +426,31 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
             for (int i = 0; i < G; i++) lbi[i] = lg[i] = (T)0;
 
             auto stretch = [&]() {
+                if constexpr (G == 2) { /* (k0, k0+1) inside the lane; (k0 − 1, k0) across */
+                    if (k0 + 1 < P) dist_sym(Q[0], Q[1], l == 0, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lso[0]);
+                    V3<T> a = up<L>(pick(sw, Q[0], Q[1])); /* the lower lane's last point */
+                    V3<T> own = pick(sw, Q[1], Q[0]);      /* this lane's first */
+                    if (l >= 1 && k0 < P) dist(a, own, false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lsx);
+                    Q[0] = pick(sw, Q[0], own);
+                    Q[1] = pick(sw, own, Q[1]);
+                    const V3<T> na = down<L>(a);
+                    const bool back_on = l + 1 < L && k0 + G < P;
+                    Q[0] = pick(back_on && sw, na, Q[0]);
+                    Q[1] = pick(back_on && !sw, na, Q[1]);
+                } else {
 #pragma unroll
-                for (int i = 0; i + 1 < G; i += 2) /* k odd: inside the lane */
-                    if (k0 + i + 1 < P)
-                        dist(Q[i], Q[i + 1], k0 + i == 0, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lso[i / 2]);
+                    for (int i = 0; i + 1 < G; i += 2) /* k odd: inside the lane */
+                        if (k0 + i + 1 < P)
+                            dist(Q[i], Q[i + 1], k0 + i == 0, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lso[i / 2]);
 #pragma unroll
-                for (int i = 1; i + 1 < G; i += 2) /* k even: inside the lane … */
-                    if (k0 + i + 1 < P)
-                        dist(Q[i], Q[i + 1], false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lse[i / 2]);
-                V3<T> a = up<L>(Q[G - 1]); /* … and (k0 − 1, k0) on this lane, the lower end sent back */
-                if (l >= 1 && k0 < P) dist(a, Q[0], false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lsx);
-                const V3<T> na = down<L>(a);
-                if (l + 1 < L && k0 + G < P) Q[G - 1] = na;
+                    for (int i = 1; i + 1 < G; i += 2) /* k even: inside the lane … */
+                        if (k0 + i + 1 < P)
+                            dist(Q[i], Q[i + 1], false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lse[i / 2]);
+                    V3<T> a = up<L>(Q[G - 1]); /* … and (k0 − 1, k0) on this lane, the lower end sent back */
+                    if (l >= 1 && k0 < P) dist(a, Q[0], false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lsx);
+                    const V3<T> na = down<L>(a);
+                    if (l + 1 < L && k0 + G < P) Q[G - 1] = na;
+                }
             };
             /* bend group g (⌊(k−1)/2⌋ ≡ g mod 2): the constraints (a, a+2) with (a>>1)&1 = g */
             auto bend = [&](int g) {
@@ -430,26 +460,20 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
                         dist(Q[i], Q[i + 2], k0 + i == 0, br[i], m.bend_at, m.inv_b1, m.inv_b2, lbi[i]);
                 if constexpr (G == 2) {
                     /* lanes pair up: l is the lower lane of (2l, 2l+2), (2l+1, 2l+3) when l ≡ g
-                     * (mod 2) and computes the first; its partner l+1 computes the second */
+                     * (mod 2) and computes the first, its partner l+1 the second. With the
+                     * slots of point_of, in group 0 every lane's own end is in slot 0 and the
+                     * end its partner needs in slot 1; in group 1 the other way round. */
                     const bool lower = (l & 1) == g;
                     const int partner = lower ? (l + 1 < L ? l + 1 : l) : (l >= 1 ? l - 1 : l);
                     const bool act = lower ? l + 1 < L && k0 + 2 < P : l >= 1 && k0 + 1 < P;
-                    V3<T> own{lower ? Q[0].x : Q[1].x, lower ? Q[0].y : Q[1].y, lower ? Q[0].z : Q[1].z};
-                    const V3<T> mine{lower ? Q[1].x : Q[0].x, lower ? Q[1].y : Q[0].y, lower ? Q[1].z : Q[0].z};
-                    V3<T> o = from<L>(mine, partner);
-                    T lam = lower ? lc1 : lc2;
-                    if (act)
-                        dist_sym(own, o, lower && k0 == 0, lower ? br[0] : brp, m.bend_at, m.inv_b1, m.inv_b2, lam);
-                    if (lower) {
-                        Q[0] = own;
-                        lc1 = lam;
-                    } else {
-                        Q[1] = own;
-                        lc2 = lam;
-                    }
+                    const bool back_on = lower ? l + 1 < L && k0 + 3 < P : l >= 1 && k0 < P;
+                    const T r = lower ? br[0] : brp;
+                    V3<T> &own = g == 0 ? Q[0] : Q[1];
+                    V3<T> &sent = g == 0 ? Q[1] : Q[0];
+                    V3<T> o = from<L>(sent, partner);
+                    if (act) dist_sym(own, o, g == 0 && l == 0, r, m.bend_at, m.inv_b1, m.inv_b2, g == 0 ? lc1 : lc2);
                     const V3<T> back = from<L>(o, partner);
-                    if (lower && l + 1 < L && k0 + 3 < P) Q[1] = back; /* the partner's constraint */
-                    if (!lower && l >= 1 && k0 < P) Q[0] = back;
+                    if (back_on) sent = back;
                 } else {
                     /* every boundary (l, l+1) in group 1: (k0+G−2, k0+G) on the lower lane,
                      * (k0+G−1, k0+G+1) on the upper */
@@ -467,7 +491,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
             auto shapes = [&]() {
 #pragma unroll
                 for (int i = 0; i < G; i++) {
-                    const int k = k0 + i;
+                    const int k = point_of<G>(k0, sw, i);
                     if (k >= 1 && k <= K) shape(m, Q[i], S[i], lg[i]);
                 }
             };
@@ -482,7 +506,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
                     if (has(HB_F_COLLIDE)) {
 #pragma unroll
                         for (int i = 0; i < G; i++)
-                            if (k0 + i >= 1 && k0 + i < P) collide(m, Q[i]);
+                            if (point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P) collide(m, Q[i]);
                     }
                 }
             } else {
@@ -510,14 +534,14 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
             if constexpr (Ftl) dn = down<L>(D[0]);
 #pragma unroll
             for (int i = 0; i < G; i++) {
-                const int k = k0 + i;
+                const int k = point_of<G>(k0, sw, i);
                 if (k >= 1 && k < P)
                     update(m, Ftl && k + 1 < P, i + 1 < G ? D[i + 1 < G ? i + 1 : i] : dn, X[i], V[i], Q[i]);
             }
         }
         __syncwarp();
-        pack<T, G>(xv + seg * row, k0, P, live, X);
-        pack<T, G>(xv + SPW * row + seg * row, k0, P, live, V);
+        pack<T, G>(xv + seg * row, k0, sw, P, live, X);
+        pack<T, G>(xv + SPW * row + seg * row, k0, sw, P, live, V);
         __syncwarp();
 #pragma unroll
         for (int u = 0; u < 3 * G; u++)
