@@ -484,8 +484,9 @@ const hb_variant cuda_variants[] = {
      "neighbours through warp shuffles",
      hb::dyn::kWarpregMaxPoints, 0},
     {"lanes", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
-     "strand-major like paper; simulate: a half-warp per strand, 2, 4 or 8 consecutive points a lane in registers "
-     "(at most 128 points), every lane busy in every constraint group",
+     "strand-major like paper; simulate: L lanes a strand (16 for xpbd, 8 for ftl), 2 to 8 points a lane in "
+     "registers (at most 128 points), nearly every lane busy in every constraint group; free arithmetic outside "
+     "the strict build",
      hb::dyn::kLanesMaxPoints, hb::dyn::kLanesMaxBlock},
     {NULL, 0, NULL, 0, 0},
 };

@@ -238,6 +238,24 @@ def test_cleanup_needs_name_and_marker(cpu_bin, tmp_path):
 # ---- signals x moments ------------------------------------------------------------------
 
 
+def wait_for_child(proc, name, timeout=30):
+    """Whether a child of proc whose command line names `name` appears within timeout (Linux /proc)."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end and proc.poll() is None:
+        for pid in filter(str.isdigit, os.listdir("/proc")):
+            try:
+                with open(f"/proc/{pid}/stat") as fh:
+                    ppid = int(fh.read().rsplit(")", 1)[1].split()[1])
+                with open(f"/proc/{pid}/cmdline", "rb") as fh:
+                    cmd = fh.read()
+            except (OSError, ValueError, IndexError):
+                continue
+            if ppid == proc.pid and name.encode() in cmd:
+                return True
+        time.sleep(0.01)
+    return False
+
+
 def wait_for_temporary(directory, proc, timeout=30):
     end = time.monotonic() + timeout
     while time.monotonic() < end and proc.poll() is None:
@@ -368,14 +386,16 @@ def test_run_timeout_removes_the_childs_temporary(cpu_bin, tmp_path):
 
 def test_interrupted_run_says_so(cpu_bin, tmp_path):
     proc = subprocess.Popen(
-        [sys.executable, "-m", "harness", "run", "dynamic", "--strands", "2000", "--frames", "400"]
+        [sys.executable, "-m", "harness", "run", "dynamic", "--strands", "2000", "--frames", "4000"]
         + ["--output", str(tmp_path / "o.h5")],
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
     )
-    assert wait_for_temporary(tmp_path, proc, timeout=60)
+    # the binary may create its temporary only when it writes, at the end: interrupt while it computes
+    assert wait_for_child(proc, "hairsim-cpu", timeout=60)
+    time.sleep(0.5)
     proc.send_signal(signal.SIGINT)  # Ctrl-C reaching Python only
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130 and err.strip() == "harness: interrupted", err
