@@ -391,14 +391,14 @@ def table(result):
         lines.append(f"target 1 (memory-bound >= {goal}): {pct(m['fraction'])} {m['row']}: {yes(m['met'])}")
     if "default" in s:
         d = s["default"]
-        goal = f"{t['point_substeps_per_s']:.0e} pt-substeps/s"
+        goal = f"{t['point_substeps_per_s']:.2g} pt-substeps/s"
         lines.append(f"target 2 (default scene >= {goal}): {d['point_substeps_per_s']:.3e} {d['row']}: {yes(d['met'])}")
         stretch = t.get("stretch_point_substeps_per_s")
         if stretch:
-            lines.append(f"  stretch goal {stretch:.0e} pt-substeps/s: {yes(d.get('stretch_met'))}")
+            lines.append(f"  stretch goal {stretch:.2g} pt-substeps/s: {yes(d.get('stretch_met'))}")
     if "ftl" in s:
         f = s["ftl"]
-        goal = f"{t['ftl_point_substeps_per_s']:.0e} pt-substeps/s"
+        goal = f"{t['ftl_point_substeps_per_s']:.2g} pt-substeps/s"
         got = f"{f['point_substeps_per_s']:.3e} {f['row']}"
         lines.append(f"target ftl (default scene, ftl >= {goal}): {got}: {yes(f['met'])}")
     if "realtime" in s:
