@@ -3,10 +3,11 @@ recorded in validation.json; nothing is timed unless every comparison is equival
 
 import shutil
 import tempfile
+from pathlib import Path
 
 from harness import HarnessError
 from harness.core import env
-from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
+from harness.core.paths import CUDA_BUILDS, binary_path, display
 from harness.io.files import write_json
 
 
@@ -14,14 +15,20 @@ def validate(make_validator, what, out_dir, builds, gpu_note, say, header):
     """Run the validator `make_validator(scratch, say)` (cpu_checks(), gpu_checks(builds, ref),
     checks); `what` names it in messages ("validation", "dynamic validation"), header(v) the
     model's own fields of validation.json. HarnessError (exit 1) when a comparison fails, the
-    states kept for a look."""
-    scratch_root = RESULTS / "_scratch"
+    states kept for a look. The validator's states live in a temporary directory under
+    OUT_DIR/_scratch (never under results/ unless OUT_DIR is there), removed when the
+    comparisons pass or the validator stops with an error."""
+    scratch_root = Path(out_dir) / "_scratch"
     scratch_root.mkdir(parents=True, exist_ok=True)
     scratch = tempfile.mkdtemp(prefix=f"bench-{what.replace(' ', '-')}-", dir=scratch_root)
-    v = make_validator(scratch, say)
-    ref = v.cpu_checks()
-    if builds:
-        v.gpu_checks(builds, ref)
+    try:
+        v = make_validator(scratch, say)
+        ref = v.cpu_checks()
+        if builds:
+            v.gpu_checks(builds, ref)
+    except BaseException:
+        _remove(scratch, scratch_root)
+        raise
     failed = [c for c in v.checks if not c["equivalent"]]
     record = {"date": env.now(), **header(v), "gpu_builds": builds}
     record["gpu_note"] = f"GPU not validated: {gpu_note}." if gpu_note else ""
@@ -33,8 +40,17 @@ def validate(make_validator, what, out_dir, builds, gpu_note, say, header):
             "nothing was timed",
             code=1,
         )
-    shutil.rmtree(scratch, ignore_errors=True)
+    _remove(scratch, scratch_root)
     say(f"harness: {what}: all {len(v.checks)} comparisons equivalent")
+
+
+def _remove(scratch, scratch_root):
+    """Remove the scratch directory, and OUT_DIR/_scratch when that leaves it empty."""
+    shutil.rmtree(scratch, ignore_errors=True)
+    try:
+        scratch_root.rmdir()
+    except OSError:
+        pass  # other runs' kept states
 
 
 def gpu_plan(gpu):

@@ -41,9 +41,12 @@ def bench(tmp_path, *extra, env=None):
 
 @needs_cpu
 def test_bench_end_to_end_on_cpu(tmp_path):
+    before = scratch_listing()
     p = bench(tmp_path, env={"HAIRBENCH_NO_GPU": "1"})
     assert p.returncode == 0, p.stdout + p.stderr
     assert "Traceback" not in p.stderr
+    # the validator's states went to a scratch under --out and are gone
+    assert scratch_listing() == before and not (tmp_path / "results" / "_scratch").exists()
     gpu_lines = [ln for ln in p.stdout.splitlines() if "GPU" in ln]
     assert gpu_lines == ["harness: GPU rows skipped: HAIRBENCH_NO_GPU is set"]
     results = tmp_path / "results"
@@ -79,8 +82,15 @@ def test_bench_without_binaries_says_run_make(tmp_path):
     assert p.stderr.count("\n") == 1 and not (tmp_path / "results").exists()
 
 
+def scratch_listing():
+    """What the repository's results/_scratch holds (a bench with --out must add nothing)."""
+    d = ROOT / "results" / "_scratch"
+    return sorted(str(q) for q in d.rglob("*")) if d.exists() else []
+
+
 def test_bench_fails_before_timing_when_not_equivalent(tmp_path):
     build = install(tmp_path / "build", ["hairsim-cpu"])
+    before = scratch_listing()
     p = bench(tmp_path, env={"HAIRBENCH_BUILD_DIR": str(build), "HAIRBENCH_NO_GPU": "1", "FAKE_SHIFT_FP32": "0.01"})
     assert p.returncode == 1, p.stdout + p.stderr
     assert "harness: error: validation failed" in p.stderr and "nothing was timed" in p.stderr
@@ -89,6 +99,10 @@ def test_bench_fails_before_timing_when_not_equivalent(tmp_path):
     assert not (results / "runs.csv").exists()
     checks = json.loads((results / "validation.json").read_text())["checks"]
     assert not next(c for c in checks if c["what"] == "cpu fp32 vs cpu fp64")["equivalent"]
+    # the states are kept for a look under --out, nothing under the repository's results/
+    assert scratch_listing() == before
+    kept = list((results / "_scratch").glob("bench-validation-*/*.h5"))
+    assert kept and str(kept[0].parent.relative_to(results)) in p.stderr.replace("\\", "/")
 
 
 @pytest.mark.gpu
