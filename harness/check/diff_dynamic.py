@@ -2,7 +2,9 @@
 
 diff: frames of A and B are paired by **step** (the simulation's frame clock), not by
 position in the file, so files written with different --output-every compare at their
-common steps. Paper frames are compared as today (diff.compare_frame, the paper
+common steps. Files of different solvers, or (for --frames all) whose trajectories end at
+different steps, cannot be compared (exit 2, as the paper model's different frame counts).
+Paper frames are compared as today (diff.compare_frame, the paper
 tolerance); simulated frames with the dynamic per-frame rule: a point is over when A and
 B put it farther apart than DYN_STEP_K·u, u = ε·E·S·I (E = R + h + L, ε of the coarser
 precision, S substeps and I iterations of A), or when either is non-finite. That rule is for ONE frame advanced from the
@@ -182,6 +184,22 @@ def observables_ok(row, fd, seg_len, exact):
     return bad
 
 
+def check_same_run(a, b, frames):
+    """Raise StateError when A and B cannot be compared (exit 2): other solvers, or, for
+    frames 'all', trajectories of different lengths (the paper model's 'frame counts
+    differ'); a different --output-every alone is compared at the common steps."""
+    sa, sb = (as_text(t.dynamic_params.get("solver", "")) for t in (a, b))
+    if a.is_dynamic and b.is_dynamic and sa != sb:
+        raise StateError(f"different solvers: A is {sa}, B is {sb} (compare solvers with harness accuracy)")
+    if frames == "all" and (a.is_dynamic or b.is_dynamic):
+        la, lb = int(a.step[-1]), int(b.step[-1])
+        if la != lb:
+            raise StateError(
+                f"frame counts differ: A has {a.n_frames} frames to step {la}, B has {b.n_frames} to step "
+                f"{lb} (missing frames; use --frames last or --frame K to compare a part)"
+            )
+
+
 def _pick_steps(a, b, frames):
     common = sorted(set(a.step.tolist()) & set(b.step.tolist()))
     if not common:
@@ -200,6 +218,7 @@ def compare(path_a, path_b, frames="all", exact=False, check_paper=True):
     """Compare two files (either may be dynamic) at their common steps; DynDiffResult."""
     with open_trajectory(path_a) as a, open_trajectory(path_b) as b:
         diff.check_comparable(a, b)
+        check_same_run(a, b, frames)
         steps = _pick_steps(a, b, frames)
         kind_a = tolerances.kind_of(a.precision, a.fast_math)
         kind_b = tolerances.kind_of(b.precision, b.fast_math)
@@ -310,7 +329,9 @@ def run(path_a, path_b, frames="all", exact=False, as_json=False, out=print):
 
 def parse_frame_range(spec, candidates):
     """'all' | 'K' | 'K..' | 'K..L' | '..L' | comma list of those; numbers are frame indices
-    of A; returns the chosen members of `candidates` (sorted)."""
+    of A; returns the chosen members of `candidates` (sorted). Every frame a selection names
+    or spans must be a candidate, in both forms (K, and each frame of K..L): one that cannot
+    be stepped from is an error, never dropped; an open end is the first or last candidate."""
     spec = (spec or "all").strip()
     if spec == "all":
         return list(candidates)
@@ -322,18 +343,20 @@ def parse_frame_range(spec, candidates):
                 lo, hi = part.split("..", 1)
                 lo = int(lo) if lo.strip() else min(candidates, default=0)
                 hi = int(hi) if hi.strip() else max(candidates, default=-1)
-                chosen |= {k for k in candidates if lo <= k <= hi}
+                picked = list(range(lo, hi + 1))
             else:
-                k = int(part)
-                if k not in candidates:
-                    raise HarnessError(
-                        f"--frames: frame {k} of the reference cannot be stepped from (it must be a "
-                        f"simulated frame with stored velocities whose next frame is written; "
-                        f"candidates: {_span(candidates)})"
-                    )
-                chosen.add(k)
+                picked = [int(part)]
         except ValueError:
             raise HarnessError(f"--frames must be 'all', K, K..L, K.. or ..L (frame indices), not '{spec}'") from None
+        bad = [k for k in picked if k not in candidates]
+        if bad:
+            named = _span(bad) if len(bad) > 2 else ", ".join(map(str, bad))
+            raise HarnessError(
+                f"--frames {part}: frame(s) {named} of the reference cannot be stepped from (each must be "
+                f"a simulated frame, or the last paper frame, with stored velocities whose next frame is "
+                f"written; candidates: {_span(candidates)})"
+            )
+        chosen |= set(picked)
     if not chosen:
         raise HarnessError(f"--frames {spec} selects no frame (candidates: {_span(candidates)})")
     return sorted(chosen)

@@ -513,7 +513,13 @@ def parser():
     )
     sd.add_argument("--reference", required=True, help="dynamic state file (A)")
     sd.add_argument("--binary", required=True, help="the binary to validate (e.g. build/hairsim-cuda)")
-    sd.add_argument("--frames", default="all", help="frame indices of A: all (default), K, K..L, K.., ..L")
+    sd.add_argument(
+        "--frames",
+        default="all",
+        help="frame indices of A: all (default), K, K..L, K.., ..L (comma-separated); every frame named or "
+        "spanned must be one to step from (a simulated frame or the last paper frame, with velocities), "
+        "else exit 2",
+    )
     sd.add_argument("--exact", action="store_true", help="require bit-identical frames")
     sd.add_argument("--keep", help="keep the binary's outputs in this directory")
     sd.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
@@ -533,8 +539,9 @@ def parser():
     d.add_argument(
         "--frames",
         default="all",
-        help="'all' (default; frame counts must match), 'last' (the last frame of "
-        "each), or frame numbers like '3' or '1,3'",
+        help="'all' (default; frame counts must match: dynamic files must run to the same step, "
+        "and be of one solver), 'last' (the last frame of each), or frame numbers like '3' or '1,3' "
+        "(dynamic files: steps)",
     )
     d.add_argument(
         "--frame", type=int, action="append", help="compare only frame K (repeatable; negative counts from the end)"

@@ -411,6 +411,37 @@ def test_diff_of_dynamic_files_with_other_physics_fails(cpu_bin, reference, tmp_
     assert harness_main(["diff", str(reference["fp64"]), str(small)]) == 2
 
 
+def test_diff_refuses_other_solvers_and_other_frame_counts(cpu_bin, reference, tmp_path, capsys):
+    """As the paper model: files that cannot be compared exit 2 with one line naming why."""
+    fp64 = str(reference["fp64"])
+    common = [*FULL, "--precision", "fp64", "--velocities", "all"]
+    ftl = simulate(cpu_bin, tmp_path / "ftl.h5", *common, "--solver", "ftl", frames=4)
+    shorter = simulate(cpu_bin, tmp_path / "short.h5", *common, frames=4)
+    for other, why in ((ftl, "different solvers: A is xpbd, B is ftl"), (shorter, "frame counts differ")):
+        capsys.readouterr()
+        assert harness_main(["diff", fp64, str(other)]) == 2
+        err = capsys.readouterr().err
+        assert why in err and err.count("\n") == 1 and err.startswith("harness: error: cannot compare:")
+    # a part of the shorter run is still comparable
+    assert harness_main(["diff", fp64, str(shorter), "--frames", "last"]) == 0
+    assert harness_main(["diff", fp64, str(shorter), "--frame", "3"]) == 0
+
+
+def test_stepdiff_frame_ranges_refuse_what_cannot_be_stepped(cpu_bin, reference, capsys):
+    """A frame that cannot be stepped from is an error whether named alone or in a range."""
+    with open_trajectory(reference["fp64"]) as t:
+        cand = diff_dynamic.step_candidates(t)
+        n = t.n_frames
+    assert 0 not in cand and cand
+    for frames in ("0", "0..2", f"{n}", f"{cand[0]}..{n + 3}", f"..{n}"):
+        args = ["--reference", str(reference["fp64"]), "--binary", str(cpu_bin), "--frames", frames]
+        assert harness_main(["stepdiff", *args]) == 2, frames
+        err = capsys.readouterr().err
+        assert "cannot be stepped from" in err and err.count("\n") == 1, frames
+    assert diff_dynamic.parse_frame_range(f"{cand[0]}..{cand[1]}", cand) == cand[:2]
+    assert diff_dynamic.parse_frame_range(f"{cand[-2]}..", cand) == cand[-2:]
+
+
 def test_stepdiff_thread_counts(cpu_bin, reference, capsys):
     code = harness_main(
         ["stepdiff", "--reference", str(reference["fp64"]), "--binary", str(cpu_bin), "--exact", "--", "--threads", "1"]
