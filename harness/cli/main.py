@@ -335,7 +335,8 @@ def cmd_headline(args):
 def cmd_export(args):
     from harness.io import export
 
-    for path in export.run(args.state, xdmf=not args.usd_only, usd=args.usd or args.usd_only, out=args.out):
+    usd = args.usd or args.usd_only
+    for path in export.run(args.state, xdmf=not args.usd_only, usd=usd, out=args.out, force=args.force):
         print(f"wrote {path}")
     return 0
 
@@ -717,12 +718,14 @@ def parser():
         help="sidecars that ParaView/VisIt (XDMF) and Blender/Houdini/usdview (USD) open",
         description="Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions "
         "referenced in STATE) and, with --usd, STATE.usdc (BasisCurves, one "
-        "time sample per frame; needs usd-core).",
+        "time sample per frame; needs usd-core). A dynamic state's times are in seconds. "
+        "Existing sidecars are replaced only with --force; every refusal comes before anything is written.",
     )
     e.add_argument("state", help="an HDF5 state written by a hairsim binary")
     e.add_argument("--usd", action="store_true", help="also write the USD file")
     e.add_argument("--usd-only", action="store_true", help="write only the USD file")
     e.add_argument("--out", help="output prefix (default: the state's path)")
+    e.add_argument("--force", action="store_true", help="replace sidecars that exist (else refused, nothing written)")
     e.set_defaults(func=cmd_export)
 
     c = sub.add_parser(

@@ -11,9 +11,14 @@
 A dynamic state's velocities go with the frames whose step has one (XDMF attribute
 `velocity`, USD `velocities`), and its rest shape with every frame (XDMF `rest_position`,
 USD primvar `rest`). Its observables are per-frame numbers, not geometry: they stay in the
-state (harness.io.trajectory reads them).
+state (harness.io.trajectory reads them). A dynamic state's frame times are in seconds
+(frame_times); its USD frame rate is exact (time_codes_per_second).
+
+Sidecars that exist are replaced only with --force; every refusal (no state, --usd
+without usd-core, a symlinked target, an existing one) comes before anything is written.
 """
 
+import math
 import os
 from pathlib import Path
 from xml.sax.saxutils import escape
@@ -70,15 +75,55 @@ def _open_state(path):
     return f, n, p
 
 
+def _dynamic(f):
+    """The dynamic model's (frame_dt, paper_frames), or None for a paper-model state."""
+    from harness.io.states import as_text
+
+    params = f["parameters"].attrs if "parameters" in f else {}
+    if as_text(params.get("model", "paper")) != "dynamic":
+        return None
+    try:
+        dt = float(params["frame_dt"])
+        paper = int(params["paper_frames"])
+    except (KeyError, TypeError, ValueError):
+        raise HarnessError("export: a dynamic state's /parameters lacks frame_dt or paper_frames") from None
+    if not (math.isfinite(dt) and dt > 0):
+        raise HarnessError(f"export: frame_dt = {dt} is not a positive time")
+    return dt, paper
+
+
 def frame_times(f):
-    """The time of each frame for viewers: the state's times when they increase, else the
-    frame index (the paper model's frames all sit at t = 0)."""
+    """The time of each frame for viewers, increasing. A dynamic state: its times in
+    seconds, and the paper stages before the simulation (all stored at t = 0) one frame
+    interval apart, the last at 0 (e.g. init −Δt, collide 0, simulated frames Δt, 2Δt, …),
+    so that each frame stays its own time step. A paper-model state (every frame at t = 0):
+    the frame index."""
     frames = f[f"{POSITION}/value"].shape[0]
-    if f"{POSITION}/time" in f:
+    dyn = _dynamic(f)
+    if dyn and f"{POSITION}/time" in f:
+        dt, paper = dyn
         t = np.asarray(f[f"{POSITION}/time"][:], dtype=np.float64)
-        if t.shape == (frames,) and (frames < 2 or np.all(np.diff(t) > 0)):
-            return t
+        if t.shape == (frames,) and 1 <= paper <= frames:
+            t = t.copy()
+            t[:paper] = t[paper - 1] - dt * np.arange(paper - 1, -1, -1, dtype=np.float64)
+            if frames < 2 or np.all(np.diff(t) > 0):
+                return t
+        raise HarnessError(f"export: the dynamic state's {POSITION}/time does not increase frame by frame")
     return np.arange(frames, dtype=np.float64)
+
+
+def time_codes_per_second(f):
+    """USD timeCodesPerSecond (time code = frame index): a dynamic state's frame rate 1/Δt,
+    exactly n when Δt is the double nearest 1/n (60, not 59.999999999999815, for 1/60);
+    24 for the paper model's timeless frames."""
+    dyn = _dynamic(f)
+    return time_codes_per_second_of(dyn[0]) if dyn else 24.0
+
+
+def time_codes_per_second_of(dt):
+    """1/dt, exactly n where dt is the double nearest 1/n."""
+    n = round(1.0 / dt)
+    return float(n) if n >= 1 and 1.0 / n == dt else 1.0 / dt
 
 
 def velocity_frames(f):
@@ -87,13 +132,6 @@ def velocity_frames(f):
         return {}
     at = {int(s): j for j, s in enumerate(f[f"{VELOCITY}/step"][()])}
     return {k: at[int(s)] for k, s in enumerate(f[f"{POSITION}/step"][()]) if int(s) in at}
-
-
-def seconds_per_frame(f):
-    """The physical time between the last two frames of a state, or None (the paper
-    model's frames carry no time)."""
-    t = np.asarray(f[f"{POSITION}/time"][()], dtype=np.float64) if f"{POSITION}/time" in f else []
-    return float(t[-1] - t[-2]) if len(t) > 1 and t[-1] > t[-2] else None
 
 
 def write_connectivity(path, n, p):
@@ -182,9 +220,7 @@ def _xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_
 def export_xdmf(state, out_prefix=None):
     """Write OUT.xdmf and OUT.topo.h5 beside the state (or at out_prefix); return both paths."""
     state = Path(state)
-    prefix = Path(out_prefix) if out_prefix else state
-    xdmf_path = prefix.with_name(prefix.name + ".xdmf")
-    topo_path = prefix.with_name(prefix.name + ".topo.h5")
+    xdmf_path, topo_path = targets(state, out_prefix, xdmf=True)
     f, n, p = _open_state(state)
     with f:
         value = f[f"{POSITION}/value"]
@@ -212,13 +248,9 @@ def export_xdmf(state, out_prefix=None):
 def export_usd(state, out_prefix=None):
     """Write OUT.usdc: /hair/strands, a linear BasisCurves with one time sample per frame
     (points are float3 in USD: an fp64 state is rounded to fp32)."""
-    try:
-        from pxr import Sdf, Usd, UsdGeom, Vt
-    except ImportError:
-        raise HarnessError("export --usd needs the USD Python bindings: python3 -m pip install usd-core") from None
+    Sdf, Usd, UsdGeom, Vt = _pxr()
     state = Path(state)
-    prefix = Path(out_prefix) if out_prefix else state
-    usd_path = prefix.with_name(prefix.name + ".usdc")
+    (usd_path,) = targets(state, out_prefix, usd=True)
     f, n, p = _open_state(state)
     with f:
         value = f[f"{POSITION}/value"]
@@ -232,9 +264,8 @@ def export_usd(state, out_prefix=None):
         UsdGeom.SetStageMetersPerUnit(stage, 0.01)  # positions are in cm
         stage.SetStartTimeCode(0)
         stage.SetEndTimeCode(frames - 1)
-        dt = seconds_per_frame(f)
         # time code = frame index; a dynamic state's frame rate makes its velocities (per second) agree
-        stage.SetTimeCodesPerSecond(1.0 / dt if dt else 24)
+        stage.SetTimeCodesPerSecond(time_codes_per_second(f))
         root = UsdGeom.Xform.Define(stage, "/hair")
         stage.SetDefaultPrim(root.GetPrim())
         curves = UsdGeom.BasisCurves.Define(stage, "/hair/strands")
@@ -268,9 +299,36 @@ def export_usd(state, out_prefix=None):
     return _replace(tmp, usd_path)
 
 
-def run(state, xdmf=True, usd=False, out=None):
+def _pxr():
+    try:
+        from pxr import Sdf, Usd, UsdGeom, Vt
+    except ImportError:
+        raise HarnessError("export --usd needs the USD Python bindings: python3 -m pip install usd-core") from None
+    return Sdf, Usd, UsdGeom, Vt
+
+
+def targets(state, out_prefix=None, xdmf=False, usd=False):
+    """The files an export writes: OUT.xdmf and OUT.topo.h5, OUT.usdc (OUT: out_prefix, else the state)."""
+    prefix = Path(out_prefix) if out_prefix else Path(state)
+    names = ([".xdmf", ".topo.h5"] if xdmf else []) + ([".usdc"] if usd else [])
+    return [prefix.with_name(prefix.name + suffix) for suffix in names]
+
+
+def run(state, xdmf=True, usd=False, out=None, force=False):
+    """Write the sidecars; return their paths. Everything that can refuse does so before
+    anything is written: no such state, USD asked for without usd-core, a target that is a
+    symbolic link or not a regular file, or one that exists without `force`."""
     if not Path(state).is_file():
         raise HarnessError(f"export: {state}: no such file")
+    if usd:
+        _pxr()
+    paths = targets(state, out, xdmf, usd)
+    for path in paths:
+        _writable(path)
+    if not force:
+        there = [str(p) for p in paths if p.exists()]
+        if there:
+            raise HarnessError(f"export: {', '.join(there)} exist(s); use --force to replace")
     written = []
     if xdmf:
         written += export_xdmf(state, out)

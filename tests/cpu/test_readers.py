@@ -3,6 +3,7 @@ H5MD reader, and the `harness export` sidecars read back by VTK's XDMF reader (P
 VisIt) and by pxr (USD: Blender, Houdini, usdview), compared bit for bit. The readers are
 optional: each test skips, with the reason, where its package is absent."""
 
+import os
 import shutil
 import subprocess
 import sys
@@ -13,6 +14,7 @@ import numpy as np
 import pytest
 
 from harness import HarnessError
+from harness.io import export as export_mod
 from harness.io import h5md, mdanalysis
 from harness.io.states import open_state
 from harness.io.trajectory import OBSERVABLES, open_trajectory
@@ -149,10 +151,19 @@ def test_mdanalysis_refuses_a_dynamic_state_in_one_line(dynamic_state):
         r.close()
 
 
-def export(state, *args):
-    p = subprocess.run(
-        [sys.executable, "-m", "harness", "export", str(state), *args], cwd=ROOT_DIR, capture_output=True, text=True
+def export_cmd(state, *args, env=None):
+    return subprocess.run(
+        [sys.executable, "-m", "harness", "export", str(state), *args],
+        cwd=ROOT_DIR,
+        capture_output=True,
+        text=True,
+        env=env,
     )
+
+
+def export(state, *args):
+    """Export beside the state (the module's states are exported by several tests: --force)."""
+    p = export_cmd(state, "--force", *args)
     assert p.returncode == 0, p.stderr
     return p
 
@@ -261,7 +272,7 @@ def test_usd_of_a_dynamic_state_carries_velocities_and_rest_shape(dynamic_state)
         velocity = {k: t.velocity_at_step(int(t.step[k])) for k in range(t.n_frames)}
         frame_dt = float(t.dynamic_params["frame_dt"])
     # time code = frame index, at the simulation's frame rate: velocities (cm/s) agree with it
-    assert stage.GetTimeCodesPerSecond() == pytest.approx(1.0 / frame_dt, rel=1e-9)
+    assert stage.GetTimeCodesPerSecond() == export_mod.time_codes_per_second_of(frame_dt)
     points = curves.GetPointsAttr()
     for k in range(len(ref)):
         assert np.array(points.Get(k), dtype=np.float32).tobytes() == ref[k].astype(np.float32).tobytes(), k
@@ -299,3 +310,52 @@ def test_export_refuses_a_symlinked_target(state, tmp_path):
         assert not [q for q in Path(state).parent.iterdir() if ".tmp" in q.name]
     finally:
         link.unlink()
+
+
+def test_export_refuses_to_replace_sidecars_without_force(state, tmp_path):
+    out = tmp_path / "x"
+    assert export_cmd(state, "--out", str(out)).returncode == 0
+    sidecars = [tmp_path / "x.xdmf", tmp_path / "x.topo.h5"]
+    for q in sidecars:
+        q.write_text("keep")
+    p = export_cmd(state, "--out", str(out))
+    assert p.returncode == 2 and p.stderr.count("\n") == 1 and "--force" in p.stderr, p.stderr
+    assert "Traceback" not in p.stderr and all(q.read_text() == "keep" for q in sidecars)
+    assert sorted(q.name for q in tmp_path.iterdir()) == ["x.topo.h5", "x.xdmf"]
+    assert export_cmd(state, "--out", str(out), "--force").returncode == 0
+    assert "<Xdmf" in sidecars[0].read_text()
+
+
+def test_export_usd_without_usd_core_writes_nothing(state, tmp_path):
+    """Refused before anything is written (a pxr that cannot be imported stands in for none)."""
+    fake = tmp_path / "nopxr" / "pxr"
+    fake.mkdir(parents=True)
+    (fake / "__init__.py").write_text("raise ImportError('no usd-core here')\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(fake.parent), os.environ.get("PYTHONPATH")])))
+    out = tmp_path / "out" / "x"
+    out.parent.mkdir()
+    p = export_cmd(state, "--usd", "--out", str(out), env=env)
+    assert p.returncode == 2 and p.stderr.count("\n") == 1 and "usd-core" in p.stderr, p.stderr
+    assert list(out.parent.iterdir()) == []
+
+
+def test_xdmf_times_of_a_dynamic_state_are_seconds(dynamic_state, tmp_path):
+    import re
+
+    out = tmp_path / "d"
+    assert export_cmd(dynamic_state, "--out", str(out)).returncode == 0
+    times = [float(t) for t in re.findall(r'<Time Value="([^"]+)"/>', (tmp_path / "d.xdmf").read_text())]
+    with open_trajectory(dynamic_state) as t:
+        stored, paper, dt = t.time, t.paper_frames, float(t.dynamic_params["frame_dt"])
+    assert len(times) == len(stored) and np.all(np.diff(times) > 0)
+    assert times[paper:] == [float(v) for v in stored[paper:]]  # seconds, as stored
+    assert times[paper - 1] == 0.0 and times[0] == pytest.approx(-(paper - 1) * dt)
+    assert times[paper] == pytest.approx(dt)
+
+
+def test_usd_frame_rate_is_exact():
+    """1/Δt exactly where Δt is the double nearest 1/n (1/(1/60) = 60, not 59.999999999999815)."""
+    for n in (24, 30, 60, 120, 240, 1000):
+        assert export_mod.time_codes_per_second_of(1.0 / n) == float(n)
+    assert export_mod.time_codes_per_second_of(0.0125) == 80.0
+    assert export_mod.time_codes_per_second_of(0.3) == 1.0 / 0.3
