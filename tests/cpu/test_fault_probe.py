@@ -392,6 +392,9 @@ def test_interrupted_run_says_so(cpu_bin, tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        # a shell's background job ignores SIGINT, and Python then never raises KeyboardInterrupt:
+        # the harness gets Ctrl-C as a user's terminal delivers it
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     # the binary may create its temporary only when it writes, at the end: interrupt while it computes
     assert wait_for_child(proc, "hairsim-cpu", timeout=60)
