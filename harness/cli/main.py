@@ -65,6 +65,8 @@ def cmd_run(args):
         precision=args.precision,
         stages=scenes.parse_stages(args.stages, "run", "--stages") if args.stages else None,
     )
+    if scene.model == "dynamic" and args.frames:
+        scene = scenes.with_frames(scene, args.frames)
     binary = binary_path(args.backend, args.build)
     flags = runner.run_flags(
         scene,
@@ -80,19 +82,6 @@ def cmd_run(args):
     if scene.model == "dynamic":  # per-frame observables (harness/check/run_dynamic.py)
         from harness.check import run_dynamic
 
-        if args.frames:
-            scene = scenes.with_frames(scene, args.frames)
-            flags = runner.run_flags(
-                scene,
-                args.backend,
-                variant=args.variant,
-                block_size=args.block_size,
-                threads=args.threads,
-                repeat=args.repeat,
-                warmup=args.warmup,
-                output=args.output,
-                force=args.force,
-            )
         return run_dynamic.run(binary, flags, args.output, timeout=args.timeout, as_json=args.json, every=args.every)
     record = runner.run_binary(binary, flags, timeout=args.timeout)
     print(json.dumps(record, indent=1) if args.json else runner.summary(record))
