@@ -14,8 +14,8 @@
  * coefficients were fitted for this file (Lawson's minimax in double, rounded to float).
  *
  * Plain C (static inline, vectorisable in `omp simd` loops: selects, no calls but fmaf) and
- * CUDA (__host__ __device__). HB_FAST_QUOT is the one division: on the device the
- * approximate __fdividef (2 ulp), elsewhere IEEE.
+ * CUDA (__host__ __device__). HB_FAST_QUOT is the one division: on the device a product with
+ * the approximate reciprocal (1 ulp), elsewhere IEEE.
  */
 #ifndef HB_FAST_TRIG_H
 #define HB_FAST_TRIG_H
@@ -26,17 +26,44 @@
 
 #include "philox.h" /* HB_HD */
 
+/* The device's approximate reciprocal and reciprocal square root (the MUFU's, one instruction
+ * each: their .ftz forms skip the subnormal-input fix-up that rcpf/rsqrtf add in a build without
+ * -ftz; a subnormal input reads as 0); elsewhere IEEE. */
+HB_HD float hb_rcp_fast(float x)
+{
 #if defined(__CUDA_ARCH__)
-#define HB_FAST_QUOT(a, b) __fdividef((a), (b))
+    float r;
+    asm("rcp.approx.ftz.f32 %0, %1;" : "=f"(r) : "f"(x));
+    return r;
+#else
+    return 1.0f / x;
+#endif
+}
+HB_HD float hb_rsqrt_fast(float x)
+{
+#if defined(__CUDA_ARCH__)
+    float r;
+    asm("rsqrt.approx.ftz.f32 %0, %1;" : "=f"(r) : "f"(x));
+    return r;
+#else
+    return 1.0f / sqrtf(x);
+#endif
+}
+/* HB_FAST_FLOOR: the least input hb_rcp_fast and hb_rsqrt_fast take as positive (callers test
+ * x > HB_FAST_FLOOR, not x > 0): on the device the least normal float, elsewhere 0. */
+#if defined(__CUDA_ARCH__)
+#define HB_FAST_QUOT(a, b) ((a) * hb_rcp_fast(b))
+#define HB_FAST_FLOOR 1.17549435e-38f
 #else
 #define HB_FAST_QUOT(a, b) ((a) / (b))
+#define HB_FAST_FLOOR 0.0f
 #endif
 
 HB_HD float hb_atan2_fast(float y, float x)
 {
     const float ax = fabsf(x), ay = fabsf(y);
     const float hi = ay > ax ? ay : ax, lo = ay > ax ? ax : ay;
-    const float a = hi > 0.0f ? HB_FAST_QUOT(lo, hi) : 0.0f; /* in [0, 1] */
+    const float a = hi > HB_FAST_FLOOR ? HB_FAST_QUOT(lo, hi) : 0.0f; /* in [0, 1] */
     const float s = a * a;
     float p = 2.84985569e-3f;
     p = fmaf(p, s, -1.60685014e-2f);

@@ -313,6 +313,7 @@ int cuda_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, cha
                             cudaMemcpyHostToDevice, 0));
     HB_CUDA(cudaMemcpyAsync(d->ph, fp32 ? (const void *)f->phase32 : (const void *)f->phase64, (size_t)d->S * rs,
                             cudaMemcpyHostToDevice, 0));
+    HB_CUDA_AS(hold_stream(0), "the hold kernel launch");
     HB_CUDA(cudaEventRecord(c->ev0, 0));
     const cudaError_t e =
         fp32 ? dyn_launch<float>(c, d->m32, d->q, d->ph, 0) : dyn_launch<double>(c, d->m64, d->q, d->ph, 0);

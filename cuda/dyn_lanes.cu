@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "dyn_kernels.cuh"
+#include "fast_trig.h" /* hb_rsqrt_fast */
 
 namespace hb {
 namespace dyn {
@@ -47,11 +48,16 @@ constexpr unsigned kAll = 0xffffffffu;
 
 __device__ __forceinline__ float rsq(float x)
 {
-    return rsqrtf(x);
+    return hb_rsqrt_fast(x);
 }
 __device__ __forceinline__ double rsq(double x)
 {
     return rsqrt(x);
+}
+/* the least input rsq takes as positive (free arithmetic: below it a length counts as zero) */
+template <typename T> __device__ __forceinline__ constexpr T floor_of()
+{
+    return sizeof(T) == 4 ? (T)HB_FAST_FLOOR : (T)0;
 }
 /* the gust's sine: the phase table is reduced to [0, 2π) on the host (§3.3), so the argument
  * stays within a few radians, where __sinf is within 2^-21 of sin */
@@ -102,7 +108,7 @@ __device__ __forceinline__ void dist(V3<T> &a, V3<T> &b, bool root_a, T r, T at,
     if constexpr (kFree) {
         const T ex = b.x - a.x, ey = b.y - a.y, ez = b.z - a.z;
         const T q = ex * ex + ey * ey + ez * ez;
-        if (q == (T)0) return;
+        if (!(q > floor_of<T>())) return;
         const T inv = rsq(q);
         const T dl = ((r - q * inv) - at * lam) * (root_a ? inv1 : inv2);
         lam = lam + dl;
@@ -139,7 +145,7 @@ __device__ __forceinline__ void dist_sym(V3<T> &own, V3<T> &other, bool own_root
     const T ex = other.x - own.x, ey = other.y - own.y, ez = other.z - own.z;
     const T q = ex * ex + ey * ey + ez * ez;
     if constexpr (kFree) {
-        if (q == (T)0) return;
+        if (!(q > floor_of<T>())) return;
         const T inv = rsq(q);
         const T dl = ((r - q * inv) - at * lam) * (own_root ? inv1 : inv2);
         lam = lam + dl;
@@ -164,7 +170,7 @@ template <typename T> __device__ __forceinline__ void collide(const DModel<T> &m
     if constexpr (kFree) {
         const T q = p.x * p.x + p.y * p.y + p.z * p.z;
         if (!(q < m.rc2)) return;
-        if (q == (T)0) {
+        if (!(q > floor_of<T>())) {
             p = V3<T>{(T)0, m.collide_r, (T)0};
             return;
         }
@@ -180,7 +186,7 @@ template <typename T> __device__ __forceinline__ void shape(const DModel<T> &m, 
     if constexpr (kFree) {
         const T ex = p.x - t.x, ey = p.y - t.y, ez = p.z - t.z;
         const T q = ex * ex + ey * ey + ez * ez;
-        if (q == (T)0) return;
+        if (!(q > floor_of<T>())) return;
         const T inv = rsq(q);
         const T dl = (-(q * inv) - m.shape_at * lam) * m.inv_g;
         lam = lam + dl;
@@ -227,7 +233,7 @@ __device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, const V
         const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
         const T q = ex * ex + ey * ey + ez * ez;
         V3<T> n;
-        if (q > (T)0) {
+        if (q > floor_of<T>()) {
             const T f = m.seg_len * rsq(q);
             n = V3<T>{a.x + f * ex, a.y + f * ey, a.z + f * ez};
         } else {
@@ -268,24 +274,11 @@ template <typename T> __device__ __forceinline__ V3<T> rotated(const T *q, const
                  q[6] * a.x + q[7] * a.y + q[8] * a.z};
 }
 
-/* Shared memory of a warp: its strands' x and v ([N][P][3] rows, staged together so that
- * every load of both is in flight at once), then their rest shape (kept for the frame). */
+/* Shared memory of a warp: its strands' x and v ([N][P][3] rows), their rest shape and their
+ * bend rest lengths ([N][P−2]), staged together so that every load is in flight at once. */
 template <typename T, int G, int L> __host__ __device__ constexpr int64_t lanes_warp_reals(int64_t P)
 {
-    return 3 * (32 / L) * 3 * P;
-}
-
-/* src[base + e] for e < n into buf: the loads first, 3G a lane at most (n ≤ (32/L)·3P ≤ 96G). */
-template <typename T, int G>
-__device__ __forceinline__ void gather(T *buf, const T *__restrict__ src, int64_t base, int n, int lane)
-{
-    T r[3 * G];
-#pragma unroll
-    for (int u = 0; u < 3 * G; u++) /* past n: a repeated load of the last real, not stored */
-        r[u] = src[base + (lane + 32 * u < n ? lane + 32 * u : n - 1)];
-#pragma unroll
-    for (int u = 0; u < 3 * G; u++)
-        if (lane + 32 * u < n) buf[lane + 32 * u] = r[u];
+    return 3 * (32 / L) * 3 * P + (32 / L) * (P - 2);
 }
 
 /* Slot i of a lane holds point k0 + i, or with two points a lane on an odd lane (sw) k0 + 1 − i:
@@ -349,31 +342,38 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
         const int64_t base = s0 * row;
         const int n = ns * row;
         V3<T> X[G], V[G], Q[G], D[G];
-        { /* x and v: every load of both in flight at once */
-            T rx[3 * G], rv[3 * G];
+        T *bs = rs + SPW * row; /* the bend rest lengths of the warp's strands */
+        const bool need_bend = has(HB_F_BEND) && P > 2;
+        const int nb = ns * (P - 2);
+        { /* x, v, the rest shape and the bend rest lengths: every load in flight at once */
+            T rx[3 * G], rv[3 * G], rr[3 * G], rb[G];
 #pragma unroll
             for (int u = 0; u < 3 * G; u++) {
                 const int e = lane + 32 * u < n ? lane + 32 * u : n - 1;
                 rx[u] = x[base + e];
                 rv[u] = v[base + e];
+                if (need_rest) rr[u] = rest[base + e];
             }
+#pragma unroll
+            for (int u = 0; u < G; u++) /* nb ≤ (32/L)·(G·L − 2) < 32·G */
+                if (need_bend) rb[u] = bend_rest[s0 * (int64_t)(P - 2) + (lane + 32 * u < nb ? lane + 32 * u : nb - 1)];
 #pragma unroll
             for (int u = 0; u < 3 * G; u++)
                 if (lane + 32 * u < n) {
                     xv[lane + 32 * u] = rx[u];
                     xv[SPW * row + lane + 32 * u] = rv[u];
+                    if (need_rest) rs[lane + 32 * u] = rr[u];
                 }
+#pragma unroll
+            for (int u = 0; u < G; u++)
+                if (need_bend && lane + 32 * u < nb) bs[lane + 32 * u] = rb[u];
         }
-        if (need_rest) gather<T, G>(rs, rest, base, n, lane);
         __syncwarp();
         unpack<T, G>(xv + seg * row, k0, sw, P, live, X);
         unpack<T, G>(xv + SPW * row + seg * row, k0, sw, P, live, V);
         T br[G], brp = (T)0;
-        if (has(HB_F_BEND)) { /* [N][P−2]: this lane's (k0+i, k0+i+2), i ≤ G−2, and (k0−1, k0+1) */
-            __syncwarp();     /* x and v unpacked: their rows take the bend rest lengths */
-            gather<T, G>(xv, bend_rest, s0 * (int64_t)(P - 2), ns * (P - 2), lane);
-            __syncwarp();
-            const T *sb = xv + seg * (P - 2);
+        if (need_bend) { /* this lane's (k0+i, k0+i+2), i ≤ G−2, and (k0−1, k0+1) */
+            const T *sb = bs + seg * (P - 2);
 #pragma unroll
             for (int i = 0; i < G; i++) br[i] = live && k0 + i + 2 < P ? sb[k0 + i] : (T)0;
             brp = live && l >= 1 && k0 + 1 < P ? sb[k0 - 1] : (T)0;
@@ -385,7 +385,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
             Q[i] = X[i];
         }
 
-        for (int64_t j = 0; j < m.substeps; j++) {
+        for (int j = 0; j < (int)m.substeps; j++) {
             const T *q = qtab + 9 * j;
             /* 1. the root on the head, then p0 = x0 */
             if (l == 0) {
@@ -496,7 +496,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
                 }
             };
             if constexpr (!Ftl) {
-                for (int64_t it = 0; it < m.iterations; it++) {
+                for (int it = 0; it < (int)m.iterations; it++) {
                     stretch();
                     if (has(HB_F_BEND)) {
                         bend(0);
@@ -510,7 +510,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
                     }
                 }
             } else {
-                for (int64_t it = 0; it < m.iterations; it++) {
+                for (int it = 0; it < (int)m.iterations; it++) {
                     if (has(HB_F_BEND)) {
                         bend(0);
                         bend(1);

@@ -35,9 +35,21 @@ constexpr int kMaxThreads = 1024;
  * builds) caps the registers instead, to measure occupancy against spills. */
 #if defined(HB_MAXNREG)
 #define HB_STAGE_BOUNDS __maxnreg__(HB_MAXNREG)
+#define HB_POINT_BOUNDS(T) __maxnreg__(HB_MAXNREG)
 #else
 #define HB_STAGE_BOUNDS __launch_bounds__(kMaxThreads)
+#define HB_POINT_BOUNDS(T) __maxnreg__(PointRegs<T>::value)
 #endif
+
+/* The fused wind+collide and the init kernels' register cap: fp32 HB_POINT_REGS_F32 (more warps a
+ * SM hide the walks' latencies better than the registers saved cost; measured, docs/cuda.md),
+ * fp64 the 64 of any 1024-thread block. */
+#ifndef HB_POINT_REGS_F32
+#define HB_POINT_REGS_F32 40
+#endif
+template <typename T> struct PointRegs {
+    static constexpr int value = sizeof(T) == 4 ? HB_POINT_REGS_F32 : 64;
+};
 
 /* Prefetch depth of the point-major kernels, per precision: D points of y and z in flight
  * per thread. Measured on an H100 (4M strands x 32 points, block 256, fused wind+collide):
@@ -107,7 +119,7 @@ unsigned grid_for(int64_t N, int block)
 /* a, b, c: StrandMajor: the canonical array (b, c unused); PointMajor: X, Y, Z. */
 
 template <typename T, class Layout>
-__global__ void HB_STAGE_BOUNDS k_init(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c,
+__global__ void HB_POINT_BOUNDS(T) k_init(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c,
                                        const int64_t N)
 {
     const Layout lay = Layout::make(a, b, c, N, m.points);
@@ -133,8 +145,9 @@ __global__ void HB_STAGE_BOUNDS k_collide(const Model<T> m, T *__restrict__ a, T
     block_add(changed, count);
 }
 
-template <typename T, bool Keep>
-__global__ void HB_STAGE_BOUNDS k_wind_collide(const Model<T> m, T *__restrict__ X, T *__restrict__ Y,
+/* Idx: the type of a point's offset within its array (int when N·P fits, see the launcher) */
+template <typename T, bool Keep, class Idx>
+__global__ void HB_POINT_BOUNDS(T) k_wind_collide(const Model<T> m, T *__restrict__ X, T *__restrict__ Y,
                                                T *__restrict__ Z, const int64_t N, T *__restrict__ inter,
                                                unsigned long long *__restrict__ count)
 {
@@ -142,7 +155,8 @@ __global__ void HB_STAGE_BOUNDS k_wind_collide(const Model<T> m, T *__restrict__
     const StrandMajor<T> keep = {inter, m.points};
     unsigned long long changed = 0;
     for (int64_t i = first_strand(); i < N; i += grid_stride())
-        changed += (unsigned long long)wind_collide_strand<Keep, Prefetch<T>::value>(m, lay, i, keep);
+        changed += (unsigned long long)wind_collide_strand<Keep, Prefetch<T>::value, T, PointMajor<T>, Idx>(m, lay, i,
+                                                                                                        keep);
     block_add(changed, count);
 }
 
@@ -179,10 +193,14 @@ template <typename T>
 cudaError_t launch_wind_collide(const Model<T> &m, const PointMajor<T> &lay, int64_t N, T *inter,
                                 unsigned long long *count, int block, cudaStream_t stream)
 {
+    const bool narrow = N * m.points < (int64_t)INT32_MAX; /* every offset of a point fits an int */
+    const unsigned grid = grid_for(N, block);
     if (inter) {
-        k_wind_collide<T, true><<<grid_for(N, block), block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, inter, count);
+        k_wind_collide<T, true, int64_t><<<grid, block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, inter, count);
+    } else if (narrow) {
+        k_wind_collide<T, false, int><<<grid, block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, nullptr, count);
     } else {
-        k_wind_collide<T, false><<<grid_for(N, block), block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, nullptr, count);
+        k_wind_collide<T, false, int64_t><<<grid, block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, nullptr, count);
     }
     return cudaGetLastError();
 }

@@ -129,6 +129,9 @@ HB_HD void m_sincos(double x, double *s, double *c)
 #endif
 }
 /* ---- the free arithmetic's functions: fp32 fast_trig.h, fp64 the library's ---------- */
+#ifndef HB_PAPER_MUFU
+#define HB_PAPER_MUFU 1
+#endif
 HB_HD float m_atan2_free(float y, float x)
 {
     return hb_atan2_fast(y, x);
@@ -139,20 +142,20 @@ HB_HD double m_atan2_free(double y, double x)
 }
 HB_HD void m_sincos_free(float x, float *s, float *c)
 {
+#if defined(__CUDA_ARCH__) && HB_PAPER_MUFU
+    __sincosf(x, s, c);
+#else
     hb_sincos_fast(x, s, c);
+#endif
 }
 HB_HD void m_sincos_free(double x, double *s, double *c)
 {
     m_sincos(x, s, c);
 }
-/* 1/√x: the device's rsqrtf (2 ulp) and rsqrt (1 ulp); 1/sqrt on the host */
+/* 1/√x: the device's approximate rsqrt (fast_trig.h; fp64: rsqrt, 1 ulp); 1/sqrt on the host */
 HB_HD float m_rsqrt(float x)
 {
-#if defined(__CUDA_ARCH__)
-    return rsqrtf(x);
-#else
-    return 1.0f / sqrtf(x);
-#endif
+    return hb_rsqrt_fast(x);
 }
 HB_HD double m_rsqrt(double x)
 {
@@ -161,6 +164,11 @@ HB_HD double m_rsqrt(double x)
 #else
     return 1.0 / sqrt(x);
 #endif
+}
+/* the least input m_rsqrt takes as positive: fp32 HB_FAST_FLOOR, fp64 any */
+template <typename T> HB_HD constexpr T rsqrt_floor()
+{
+    return sizeof(T) == 4 ? (T)HB_FAST_FLOOR : (T)0;
 }
 /* the machine epsilon EPS of model.c: 2^-23 / 2^-52 */
 HB_HD float m_eps(float)
@@ -317,30 +325,27 @@ template <typename T, class V> HB_HD void drape_free(const Model<T> &m, const V 
     const T alpha_first = step_angle(r0, &fits_first);
     const T alpha_shell = step_angle(rc, &fits_shell);
 
+    /* One path for every thread (the reference's branches as selects, so a warp whose strands
+     * are partly on the shell and partly hanging does not run both): the shell candidate is
+     * computed at every point, the first hanging point's square root only where a strand
+     * starts to hang. */
     HB_NO_UNROLL
     for (int64_t k = 1; k < P; k++) {
-        if (!hanging) {
-            const int fits = k == 1 ? fits_first : fits_shell;
-            const T next = theta + (k == 1 ? alpha_first : alpha_shell);
-            if (fits && next <= pi_r<T>()) {
-                theta = next;
-                T sin_n, cos_n;
-                m_sincos_free(next, &sin_n, &cos_n);
-                pz = rc * cos_n;
-                py = rc * sin_n;
-                s.x(k) = x0;
-                s.y(k) = py;
-                s.z(k) = pz;
-                continue;
-            }
+        const int fits = k == 1 ? fits_first : fits_shell;
+        const T next = theta + (k == 1 ? alpha_first : alpha_shell);
+        const int shell = !hanging && fits && next <= pi_r<T>();
+        T sin_n = (T)0, cos_n = (T)0;
+        if (sizeof(T) == 4 || shell) m_sincos_free(next, &sin_n, &cos_n); /* fp32: the MUFU's, cheap */
+        T drop = ell; /* a hanging point: ℓ below its predecessor */
+        if (!hanging && !shell) { /* the first hanging point, on the vertical tangent z = −rc */
             const T dz = pz + rc;
             const T dy2 = ell * ell - dz * dz;
-            py = py - m_sqrt(dy2 > (T)0 ? dy2 : (T)0);
-            pz = -rc;
-            hanging = 1;
-        } else {
-            py = py - ell;
+            drop = m_sqrt(dy2 > (T)0 ? dy2 : (T)0);
         }
+        theta = shell ? next : theta;
+        py = shell ? rc * sin_n : py - drop;
+        pz = shell ? rc * cos_n : hanging ? pz : -rc;
+        hanging = !shell;
         s.x(k) = x0;
         s.y(k) = py;
         s.z(k) = pz;
@@ -418,10 +423,9 @@ template <typename T> struct WindWalk {
         if constexpr (kFree) {
             const T dy = cy - oy, dz = cz - oz;
             const T phi = m_atan2_free(dy, dz);
-            T delta = psi - phi;
-            if (delta > pi_r<T>()) delta -= two_pi_r<T>();
-            else if (delta <= -pi_r<T>()) delta += two_pi_r<T>();
-            if (delta == pi_r<T>()) delta = dz >= (T)0 ? pi_r<T>() : -pi_r<T>();
+            const T d0 = psi - phi;
+            T delta = d0 > pi_r<T>() ? d0 - two_pi_r<T>() : d0 <= -pi_r<T>() ? d0 + two_pi_r<T>() : d0;
+            delta = delta == pi_r<T>() && dz < (T)0 ? -pi_r<T>() : delta;
             kf += (T)1;
             const T turned = phi + (kf * w_per_point) * delta;
             T sin_t, cos_t;
@@ -452,11 +456,12 @@ template <typename T> struct WindWalk {
 };
 
 /* ---- docs/model.md §2.5 collide: one step of the walk (model_impl.h: hb_collide_strand)  */
-template <typename T> struct CollideWalk {
+/* Count: the type of the points-changed count (int where the strand's points fit one) */
+template <typename T, class Count = int64_t> struct CollideWalk {
     T ell, ell2, rc, inner2;
     T py, pz; /* the predecessor, after collision */
     int moved;
-    int64_t changed;
+    Count changed;
 
     HB_HD CollideWalk(const Model<T> &m, T y0, T z0)
     {
@@ -534,29 +539,38 @@ template <typename T> struct CollideWalk {
         if (moved) {
             const T dy = cy - py, dz = cz - pz;
             const T len2 = dy * dy + dz * dz;
-            const int dir = len2 > (T)0;
+            const int dir = len2 > rsqrt_floor<T>();
             const T scale = dir ? ell * m_rsqrt(len2) : (T)0;
             cy = dir ? py + dy * scale : py - ell;
             cz = dir ? pz + dz * scale : pz;
         }
         if (cy * cy + cz * cz < inner2) {
             const T d2 = py * py + pz * pz;
-            if (d2 > (T)0) {
+            if (d2 > rsqrt_floor<T>()) {
                 const T inv_d = m_rsqrt(d2);
                 const T d = d2 * inv_d;
                 const T t = ((d - rc) * (d + rc) + ell2) * ((T)0.5 * inv_d);
                 const T a = d - t;
                 const T h2 = ((rc - d) + t) * (rc + a);
-                const T hh = h2 > (T)0 ? h2 * m_rsqrt(h2) : (T)0;
+                const T hh = h2 > rsqrt_floor<T>() ? h2 * m_rsqrt(h2) : (T)0;
                 const T uy = py * inv_d, uz = pz * inv_d;
                 const T fy = a * uy, fz = a * uz;
-                const T y1 = fy + hh * uz, z1 = fz - hh * uy;
-                const T y2 = fy - hh * uz, z2 = fz + hh * uy;
-                const T e1 = (y1 - cy) * (y1 - cy) + (z1 - cz) * (z1 - cz);
-                const T e2 = (y2 - cy) * (y2 - cy) + (z2 - cz) * (z2 - cz);
-                const int upper = e1 < e2 || (e1 == e2 && y1 >= y2);
-                cy = upper ? y1 : y2;
-                cz = upper ? z1 : z2;
+                int upper;
+                if constexpr (sizeof(T) == 4) {
+                    /* e1 − e2 = 4·hh·(uy·cz − uz·cy): the nearer candidate from one cross product
+                     * (fp32; fp64, whose rule allows no decision to differ, compares e1, e2) */
+                    const T cross = uy * cz - uz * cy;
+                    upper = hh == (T)0 || cross < (T)0 || (cross == (T)0 && uz >= (T)0);
+                } else {
+                    const T y1 = fy + hh * uz, z1 = fz - hh * uy;
+                    const T y2 = fy - hh * uz, z2 = fz + hh * uy;
+                    const T e1 = (y1 - cy) * (y1 - cy) + (z1 - cz) * (z1 - cz);
+                    const T e2 = (y2 - cy) * (y2 - cy) + (z2 - cz) * (z2 - cz);
+                    upper = e1 < e2 || (e1 == e2 && y1 >= y2);
+                }
+                const T sh = upper ? hh : -hh;
+                cy = fy + sh * uz;
+                cz = fz - sh * uy;
                 moved = 1;
             }
         }
@@ -576,9 +590,10 @@ template <typename T> struct CollideWalk {
  * where the memory-level parallelism of one thread comes from). The loads wait in a queue
  * of D registers that shifts by one each step (the loop is not unrolled: one copy of the
  * step's code, and the queue is indexed with constants only, so it stays in registers).
- * The addresses advance by the layout's stride instead of being recomputed from k.
+ * The offsets from point 0 advance by the layout's stride (in Idx: int where they all fit).
  * Loading early is safe: point k + D is not written before its turn. */
-template <int D, typename T, class V, class F> HB_HD void walk_points(const V &s, const int64_t P, F &&f)
+template <int D, typename T, class Idx = int64_t, class V, class F>
+HB_HD void walk_points(const V &s, const int64_t P, F &&f)
 {
     if constexpr (D == 0) {
         for (int64_t k = 1; k < P; k++) {
@@ -586,30 +601,32 @@ template <int D, typename T, class V, class F> HB_HD void walk_points(const V &s
             f(k, cy, cz, s.y(k), s.z(k));
         }
     } else {
-        const int64_t step = s.stride(), ahead = D * step;
-        T *py = s.yp(1), *pz = s.zp(1); /* point k's y and z */
-        T qy[D] = {}, qz[D] = {};       /* q[j] = point k + j, loaded */
+        /* Idx: the offsets' type (int where every offset fits, which saves the 64-bit adds) */
+        const Idx step = (Idx)s.stride(), ahead = (Idx)D * step;
+        T *const y0 = s.yp(0), *const z0 = s.zp(0);
+        Idx at = step;            /* point k's offset from point 0 */
+        T qy[D] = {}, qz[D] = {}; /* q[j] = point k + j, loaded */
         HB_UNROLL
         for (int j = 0; j < D; j++)
             if (1 + j < P) {
-                qy[j] = py[j * step];
-                qz[j] = pz[j * step];
+                qy[j] = y0[at + (Idx)j * step];
+                qz[j] = z0[at + (Idx)j * step];
             }
+        const Idx last = (Idx)P;
         HB_NO_UNROLL
-        for (int64_t k = 1; k < P; k++) {
+        for (Idx k = 1; k < last; k++) {
             const T cy = qy[0], cz = qz[0];
             HB_UNROLL
             for (int j = 0; j + 1 < D; j++) {
                 qy[j] = qy[j + 1];
                 qz[j] = qz[j + 1];
             }
-            if (k + D < P) {
-                qy[D - 1] = py[ahead];
-                qz[D - 1] = pz[ahead];
+            if (k + D < last) {
+                qy[D - 1] = y0[at + ahead];
+                qz[D - 1] = z0[at + ahead];
             }
-            f(k, cy, cz, *py, *pz);
-            py += step;
-            pz += step;
+            f((int64_t)k, cy, cz, y0[at], z0[at]);
+            at += step;
         }
     }
 }
@@ -654,7 +671,7 @@ template <int D, typename T, class Layout> HB_HD int64_t collide_strand(const Mo
  * point is read once and written once; with Keep the post-wind state (the frame between
  * the two stages) is also stored, canonically, into `inter` (x included, so then x is read
  * too); without Keep x is neither read nor written. Returns the points collide changed. */
-template <bool Keep, int D, typename T, class Layout>
+template <bool Keep, int D, typename T, class Layout, class Idx = int64_t>
 HB_HD int64_t wind_collide_strand(const Model<T> &m, const Layout &lay, int64_t i, const StrandMajor<T> &inter)
 {
     const int64_t P = m.points;
@@ -669,8 +686,8 @@ HB_HD int64_t wind_collide_strand(const Model<T> &m, const Layout &lay, int64_t 
         q.z(0) = z0;
     }
     WindWalk<T> wind(m, y0, z0);
-    CollideWalk<T> col(m, y0, z0);
-    walk_points<D, T>(s, P, [&](int64_t k, T cy, T cz, T &y, T &z) {
+    CollideWalk<T, Idx> col(m, y0, z0);
+    walk_points<D, T, Idx>(s, P, [&](int64_t k, T cy, T cz, T &y, T &z) {
         wind.step(k, cy, cz);
         T wy = wind.ny, wz = wind.nz;
         if (Keep) {
