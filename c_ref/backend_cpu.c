@@ -16,15 +16,15 @@
 #include <sys/mman.h>
 #include <time.h>
 
-#include "backend.h"
-#include "checked.h"
-#include "cli.h"
-#include "dynamics.h"
-#include "dynamics_simd.h"
-#include "host.h"
-#include "model.h"
-#include "model_simd.h"
-#include "record.h"
+#include "runtime/backend.h"
+#include "runtime/checked.h"
+#include "runtime/cli.h"
+#include "dynamic/dynamics.h"
+#include "simd/dynamics_simd.h"
+#include "runtime/host.h"
+#include "paper/model.h"
+#include "simd/model_simd.h"
+#include "runtime/record.h"
 
 typedef struct {
     hb_scene scene;

@@ -11,7 +11,7 @@
  * sends its new position back, so every point is written by one lane.
  *
  * Arithmetic (docs/cuda.md "Builds and arithmetic"): the strict build (HB_REFERENCE_ARITHMETIC)
- * calls dyn_model.cuh's reference helpers, the same operations as c_ref/dynamics_impl.h, so
+ * calls dyn_model.cuh's reference helpers, the same operations as c_ref/dynamic/dynamics_impl.h, so
  * it gives the CPU's bits; the normal and fast-math builds use reciprocal square roots and
  * the scene's precomputed reciprocals (DModel::inv_*), judged by the one-frame rule.
  */

@@ -1,9 +1,9 @@
 /* model.c — instantiates model_impl.h for float and for double. */
-#include "model.h"
+#include "paper/model.h"
 
 #include <math.h>
 
-#include "philox.h"
+#include "runtime/philox.h"
 
 #define REAL float
 #define SFX(name) name##_f32
@@ -14,7 +14,7 @@
 #define ASIN asinf
 #define ATAN2 atan2f
 #define EPS 0x1p-23f
-#include "model_impl.h"
+#include "paper/model_impl.h"
 #undef REAL
 #undef SFX
 #undef MODEL
@@ -34,4 +34,4 @@
 #define ASIN asin
 #define ATAN2 atan2
 #define EPS 0x1p-52
-#include "model_impl.h"
+#include "paper/model_impl.h"

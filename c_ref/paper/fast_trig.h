@@ -24,7 +24,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "philox.h" /* HB_HD */
+#include "runtime/philox.h" /* HB_HD */
 
 #if defined(__CUDA_ARCH__)
 #define HB_FAST_QUOT(a, b) __fdividef((a), (b))

@@ -12,14 +12,14 @@
  *
  * Check: objdump -dr build/obj/dynamics_simd.o | grep _ZGV lists the vector sines.
  */
-#include "dynamics_simd.h"
+#include "simd/dynamics_simd.h"
 
 #include <float.h>
 #include <immintrin.h>
 #include <math.h>
 #include <stddef.h>
 
-#include "model_simd.h"
+#include "simd/model_simd.h"
 
 #if !defined(__x86_64__) || !defined(__GLIBC__)
 #error "dynamics_simd.c needs x86_64 and glibc's libmvec"
@@ -71,7 +71,7 @@ static inline __attribute__((always_inline)) void inv_sqrt_row_f64(const double 
 #define PHASE(fr) ((fr)->phase32)
 #define INV_SQRT_ROW(in, out) inv_sqrt_row_f32(in, out)
 #define TINY FLT_MIN
-#include "dynamics_simd_impl.h"
+#include "simd/dynamics_simd_impl.h"
 #undef INV_SQRT_ROW
 #undef TINY
 #undef REAL
@@ -91,4 +91,4 @@ static inline __attribute__((always_inline)) void inv_sqrt_row_f64(const double 
 #define PHASE(fr) ((fr)->phase64)
 #define INV_SQRT_ROW(in, out) inv_sqrt_row_f64(in, out)
 #define TINY DBL_MIN
-#include "dynamics_simd_impl.h"
+#include "simd/dynamics_simd_impl.h"

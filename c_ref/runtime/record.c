@@ -1,5 +1,5 @@
 /* record.c — the run record as JSON (docs/interfaces.md) and as a short summary. */
-#include "record.h"
+#include "runtime/record.h"
 
 #include <math.h>
 #include <stdlib.h>

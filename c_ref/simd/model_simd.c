@@ -28,13 +28,13 @@
  * Check that the calls are vectorised: objdump -dr build/obj/model_simd.o | grep _ZGV
  * (tests/cpu/test_cpu_simd.py fails on any scalar call to these functions).
  */
-#include "model_simd.h"
+#include "simd/model_simd.h"
 
 #include <math.h>
 #include <stddef.h>
 
-#include "fast_trig.h"
-#include "philox.h"
+#include "paper/fast_trig.h"
+#include "runtime/philox.h"
 
 #if !defined(__x86_64__) || !defined(__GLIBC__)
 #error "model_simd.c needs x86_64 and glibc's libmvec"
@@ -75,7 +75,7 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #define ATAN2 atan2f
 #define EPS 0x1p-23f
 #define FAST_TRIG 1
-#include "model_simd_impl.h"
+#include "simd/model_simd_impl.h"
 #undef REAL
 #undef ITYPE
 #undef BLOCK
@@ -101,4 +101,4 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #define ATAN2 atan2
 #define EPS 0x1p-52
 #define FAST_TRIG 0
-#include "model_simd_impl.h"
+#include "simd/model_simd_impl.h"

@@ -1,5 +1,5 @@
 /* dynamics_f64.c — dynamics_impl.h for double (one file per precision: they compile in parallel). */
-#include "dynamics.h"
+#include "dynamic/dynamics.h"
 
 #include <math.h>
 
@@ -10,4 +10,4 @@
 #define SIN sin
 #define QTABLE(fr) ((fr)->q64)
 #define PHASE(fr) ((fr)->phase64)
-#include "dynamics_impl.h"
+#include "dynamic/dynamics_impl.h"

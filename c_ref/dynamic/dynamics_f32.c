@@ -1,5 +1,5 @@
 /* dynamics_f32.c — dynamics_impl.h for float (one file per precision: they compile in parallel). */
-#include "dynamics.h"
+#include "dynamic/dynamics.h"
 
 #include <math.h>
 
@@ -10,4 +10,4 @@
 #define SIN sinf
 #define QTABLE(fr) ((fr)->q32)
 #define PHASE(fr) ((fr)->phase32)
-#include "dynamics_impl.h"
+#include "dynamic/dynamics_impl.h"
