@@ -225,6 +225,22 @@ template <typename T> struct PointMajor {
 };
 
 /* ---- docs/model.md §2.3 drape (model_impl.h: hb_drape_strand) ------------------------------------ */
+/* A point the shell step does not reach: the first hanging point goes onto the vertical
+ * tangent line z = −rc, at distance ℓ below its predecessor; every later point hangs
+ * straight down, p_k = p_{k−1} − ℓŷ. */
+template <typename T> HB_HD void hang_step(const T ell, const T rc, int &hanging, T &py, T &pz)
+{
+    if (!hanging) {
+        const T dz = pz + rc;
+        const T dy2 = ell * ell - dz * dz;
+        py = py - m_sqrt(dy2 > (T)0 ? dy2 : (T)0);
+        pz = -rc;
+        hanging = 1;
+    } else {
+        py = py - ell;
+    }
+}
+
 /* The root (x0, py, pz) is already stored; writes points 1 … P−1. */
 template <typename T, class V> HB_HD void drape_reference(const Model<T> &m, const V &s, const T x0, T py, T pz)
 {
@@ -269,17 +285,8 @@ template <typename T, class V> HB_HD void drape_reference(const Model<T> &m, con
                     continue;
                 }
             }
-            /* The strand starts to hang: the first hanging point goes onto the vertical
-             * tangent line z = −rc, at distance ℓ below its predecessor. */
-            const T dz = pz + rc;
-            const T dy2 = ell * ell - dz * dz;
-            py = py - m_sqrt(dy2 > (T)0 ? dy2 : (T)0);
-            pz = -rc;
-            hanging = 1;
-        } else {
-            /* Every later point hangs straight down: p_k = p_{k−1} − ℓŷ. */
-            py = py - ell;
         }
+        hang_step(ell, rc, hanging, py, pz);
         s.x(k) = x0;
         s.y(k) = py;
         s.z(k) = pz;
@@ -333,14 +340,8 @@ template <typename T, class V> HB_HD void drape_free(const Model<T> &m, const V 
                 s.z(k) = pz;
                 continue;
             }
-            const T dz = pz + rc;
-            const T dy2 = ell * ell - dz * dz;
-            py = py - m_sqrt(dy2 > (T)0 ? dy2 : (T)0);
-            pz = -rc;
-            hanging = 1;
-        } else {
-            py = py - ell;
         }
+        hang_step(ell, rc, hanging, py, pz);
         s.x(k) = x0;
         s.y(k) = py;
         s.z(k) = pz;

@@ -3,11 +3,5 @@
 
 #include <math.h>
 
-#define REAL double
-#define SFX(name) name##_f64
-#define DMODEL hb_dyn_model_f64
-#define SQRT sqrt
-#define SIN sin
-#define QTABLE(fr) ((fr)->q64)
-#define PHASE(fr) ((fr)->phase64)
+#include "dynamic/precision_f64.h"
 #include "dynamic/dynamics_impl.h"

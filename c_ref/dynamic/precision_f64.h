@@ -1,0 +1,8 @@
+/* precision_f64.h — as precision_f32.h, for double. */
+#define REAL double
+#define SFX(name) name##_f64
+#define DMODEL hb_dyn_model_f64
+#define SQRT sqrt
+#define SIN sin
+#define QTABLE(fr) ((fr)->q64)
+#define PHASE(fr) ((fr)->phase64)
