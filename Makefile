@@ -47,26 +47,31 @@ CFLAGS_REF := $(CSTD) $(COPT) -ffp-contract=off -fno-fast-math $(CWARN)
 # The simd variant's file only (docs/cpu_simd.md): AVX2 code checked for at run time, glibc's
 # vector math, and of -ffast-math's flags only the two that change no value.
 SIMD_CFLAGS := -O3 -march=x86-64-v3 -fopenmp-simd -fno-math-errno -fno-trapping-math
-CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (model_simd.c, dynamics_simd.c) adds: $(SIMD_CFLAGS)
+CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (c_ref/simd/) adds: $(SIMD_CFLAGS)
 
-SHARED_SRC := c_ref/params.c c_ref/cli.c c_ref/state_io.c c_ref/safe_write.c c_ref/h5md_meta.c c_ref/record.c \
-              c_ref/driver.c c_ref/dynamics_host.c c_ref/host.c
+# c_ref/: runtime/ (the host runtime both binaries link: command line, driver, HDF5 and JSON
+# output), paper/ and dynamic/ (the two models' reference), simd/ (the CPU simd variant), and
+# backend_cpu.c (the CPU backend that puts them together). Included as "runtime/params.h".
+SHARED_SRC := $(wildcard c_ref/runtime/*.c) c_ref/paper/model_host.c c_ref/dynamic/dynamics_host.c
 SHARED_OBJ := $(SHARED_SRC:c_ref/%.c=$(OBJ)/%.o)
-CPU_SRC    := c_ref/model.c c_ref/model_simd.c c_ref/dynamics_simd.c c_ref/dynamics_f32.c c_ref/dynamics_f64.c c_ref/backend_cpu.c
+CPU_SRC    := c_ref/paper/model.c c_ref/dynamic/dynamics_f32.c c_ref/dynamic/dynamics_f64.c $(wildcard c_ref/simd/*.c) \
+              c_ref/backend_cpu.c
 CPU_OBJ    := $(CPU_SRC:c_ref/%.c=$(OBJ)/%.o)
-C_HEADERS  := $(wildcard c_ref/*.h)
+C_HEADERS  := $(wildcard c_ref/*/*.h)
 
 # ---- CUDA: three builds of one source; the flags are recorded in every output ----
 HAVE_NVCC := $(shell command -v $(NVCC) >/dev/null 2>&1 && echo yes)
 CUDA_SRC  := $(wildcard cuda/*.cu)
-CUDA_HDR  := $(wildcard cuda/*.cuh cuda/*.h)
+CUDA_HDR  := $(wildcard cuda/*.cuh)
 NVCC_BASE := -arch=$(CUDA_ARCH) -O3 -std=c++17 -Ic_ref -lineinfo -Xcompiler -Wall
 NVCC_MODE_normal   :=
 NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DHB_REFERENCE_ARITHMETIC=1
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
+HOSTCHECK_BINS := $(BUILD)/hostcheck/model_hostcheck_reference $(BUILD)/hostcheck/model_hostcheck_free \
+                  $(BUILD)/hostcheck/dyn_hostcheck
 
-.PHONY: all cpu cuda test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt docs
+.PHONY: all cpu cuda hostcheck test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt docs
 
 # The Python that runs the tests and the harness: harness/setup.sh picks it (PYTHON when it has
 # the packages, else ./.venv) after installing what is missing, and writes its path here.
@@ -89,6 +94,7 @@ help:
 	@echo "make fmt      ruff format the Python and clang-format -i the C and CUDA sources"
 	@echo "make docs     remake docs/harness.md's command and module reference (python3 -m harness docs)"
 	@echo "make setup    install what is missing (apt as root/sudo, pip into .venv under PEP 668); nothing when all is there"
+	@echo "make hostcheck  build the CUDA port's host checks (cuda/hostcheck/, run by tests/native)"
 	@echo "make clean    remove build/"
 
 check-hdf5:
@@ -103,12 +109,11 @@ setup:
 check-python: setup
 
 $(OBJ)/%.o: c_ref/%.c $(C_HEADERS) | check-hdf5
-	@mkdir -p $(OBJ)
-	$(CC) $(CFLAGS_REF) -fopenmp $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' -DHB_FLAGS='"$(CPU_FLAGS_STR)"' -c $< -o $@
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_REF) -fopenmp -Ic_ref $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' -DHB_FLAGS='"$(CPU_FLAGS_STR)"' -c $< -o $@
 
-$(OBJ)/model_simd.o: CFLAGS_REF += $(SIMD_CFLAGS)
-$(OBJ)/dynamics_simd.o: CFLAGS_REF += $(SIMD_CFLAGS)
-$(OBJ)/record.o: $(REV_STAMP)
+$(OBJ)/simd/%.o: CFLAGS_REF += $(SIMD_CFLAGS)
+$(OBJ)/runtime/record.o: $(REV_STAMP)
 
 $(BUILD)/hairsim-cpu: $(SHARED_OBJ) $(CPU_OBJ)
 	$(CC) -fopenmp $^ -o $@ $(HDF5_LIBS) -lm
@@ -124,7 +129,26 @@ $(CUDA_BINS): $(CUDA_SRC) $(CUDA_HDR) $(C_HEADERS) $(SHARED_OBJ)
 	$(NVCC) $(NVCC_BASE) $(NVCC_MODE_$(MODE)) $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' \
 	  -DHB_FLAGS='"$(NVCC) $(NVCC_BASE) $(NVCC_MODE_$(MODE))"' -DHB_MATH_MODE='"$(MODE)"' \
 	  $(CUDA_SRC) $(SHARED_OBJ) -o $@ $(HDF5_LIBS)
+
+# The host checks (tests/native): the CUDA port's model templates compiled for the host and
+# run against the reference's objects; host code only, with the host compiler told the
+# reference's rules (no FMA contraction, no fast math). The dynamic one at -O1: its many
+# instantiations compile faster, and without contraction the level changes no IEEE result.
+HOSTCHECK_NVCC := $(NVCC) -std=c++17 -Ic_ref -Icuda -Xcompiler -ffp-contract=off,-fno-fast-math
+hostcheck: $(HOSTCHECK_BINS)
+$(BUILD)/hostcheck/model_hostcheck_reference: HOSTCHECK_MODE := -O2 -DHB_REFERENCE_ARITHMETIC=1
+$(BUILD)/hostcheck/model_hostcheck_free: HOSTCHECK_MODE := -O2
+$(BUILD)/hostcheck/model_hostcheck_%: cuda/hostcheck/model_hostcheck.cu cuda/model.cuh $(C_HEADERS) \
+  $(OBJ)/paper/model.o $(OBJ)/runtime/params.o
+	@mkdir -p $(@D)
+	$(HOSTCHECK_NVCC) $(HOSTCHECK_MODE) $< $(OBJ)/paper/model.o $(OBJ)/runtime/params.o -o $@ -lm
+$(BUILD)/hostcheck/dyn_hostcheck: cuda/hostcheck/dyn_hostcheck.cu cuda/dyn_model.cuh cuda/dyn_kernels.cuh $(C_HEADERS) \
+  $(OBJ)/dynamic/dynamics_f32.o $(OBJ)/dynamic/dynamics_f64.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o
+	@mkdir -p $(@D)
+	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
 else
+hostcheck:
+	@echo "error: nvcc not found: the host checks (cuda/hostcheck/) need it"; exit 1
 cuda:
 	@if [ -n "$(REQUIRE_NVCC)" ]; then echo "error: nvcc not found: the CUDA sources must compile here (install the CUDA toolkit or put nvcc on PATH)"; exit 1; fi
 	@echo "note: nvcc not found: CUDA binaries not built (install the CUDA toolkit to build them)"
@@ -134,7 +158,7 @@ endif
 # on every core: the CUDA binaries and the C reference's feature instantiations take minutes
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 test: setup
-	@$(MAKE) --no-print-directory -j$(JOBS) all
+	@$(MAKE) --no-print-directory -j$(JOBS) all $(if $(HAVE_NVCC),hostcheck)
 	$(RUN_PY) -m pytest tests -q -ra
 
 bench: setup
@@ -195,7 +219,7 @@ sanitize-gpu: cuda
 
 # ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----
 PY_SRC     := harness tests
-C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*.h cuda/*.cu cuda/*.cuh)
+C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*/*.c c_ref/*/*.h cuda/*.cu cuda/*.cuh cuda/hostcheck/*.cu tests/cpu/c/*.c)
 CLANG_FORMAT ?= clang-format
 
 lint: lint-py lint-c

@@ -16,15 +16,15 @@
 #include <sys/mman.h>
 #include <time.h>
 
-#include "backend.h"
-#include "checked.h"
-#include "cli.h"
-#include "dynamics.h"
-#include "dynamics_simd.h"
-#include "host.h"
-#include "model.h"
-#include "model_simd.h"
-#include "record.h"
+#include "runtime/backend.h"
+#include "runtime/checked.h"
+#include "runtime/cli.h"
+#include "dynamic/dynamics.h"
+#include "simd/dynamics_simd.h"
+#include "runtime/host.h"
+#include "paper/model.h"
+#include "simd/model_simd.h"
+#include "runtime/record.h"
 
 typedef struct {
     hb_scene scene;
@@ -220,11 +220,11 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
     return HB_EXIT_OK;
 }
 
-/* canonical [N][P][3] → X, Y, Z [P][stride], parallel over blocks; padding lanes keep what
- * they hold (they are computed, never read back) */
+/* canonical [N][P][3] ↔ a[0..2] as X, Y, Z [P][stride] (positions, velocities, rest shape),
+ * parallel over blocks; padding lanes keep what they hold (computed, never read back) */
 #define PM_CONVERT(T, TO_PM)                                                                                           \
     do {                                                                                                               \
-        T *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2];                                                                 \
+        T *X = a[0], *Y = a[1], *Z = a[2];                                                                             \
         T *cs = (T *)canonical;                                                                                        \
         _Pragma("omp parallel for schedule(static)") for (int64_t blk = 0; blk < c->nblocks; blk++)                    \
         {                                                                                                              \
@@ -247,7 +247,7 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
         }                                                                                                              \
     } while (0)
 
-static void simd_convert(cpu_impl *c, void *canonical, int to_pm)
+static void simd_convert(cpu_impl *c, void *const a[3], void *canonical, int to_pm)
 {
     const int64_t N = c->scene.n_strands, P = c->scene.points, S = c->stride;
     if (c->scene.precision == HB_FP32) {
@@ -337,52 +337,13 @@ static int simd_dyn_setup(cpu_impl *c, int need_save, uint64_t need, char *err, 
     return HB_EXIT_OK;
 }
 
-/* canonical [N][P][3] ↔ a[0..2] as [P][stride] (simd_convert for any three arrays) */
-#define PM_CONVERT_ARRAYS(T, TO_PM)                                                                                    \
-    do {                                                                                                               \
-        T *X = a[0], *Y = a[1], *Z = a[2];                                                                             \
-        T *cs = (T *)canonical;                                                                                        \
-        _Pragma("omp parallel for schedule(static)") for (int64_t blk = 0; blk < c->nblocks; blk++)                    \
-        {                                                                                                              \
-            const int64_t i1 = (blk + 1) * c->block < N ? (blk + 1) * c->block : N;                                    \
-            for (int64_t i = blk * c->block; i < i1; i++) {                                                            \
-                T *q = cs + (size_t)i * (size_t)P * 3u;                                                                \
-                for (int64_t k = 0; k < P; k++) {                                                                      \
-                    const size_t e = (size_t)k * (size_t)S + (size_t)i;                                                \
-                    if (TO_PM) {                                                                                       \
-                        X[e] = q[3 * k + 0];                                                                           \
-                        Y[e] = q[3 * k + 1];                                                                           \
-                        Z[e] = q[3 * k + 2];                                                                           \
-                    } else {                                                                                           \
-                        q[3 * k + 0] = X[e];                                                                           \
-                        q[3 * k + 1] = Y[e];                                                                           \
-                        q[3 * k + 2] = Z[e];                                                                           \
-                    }                                                                                                  \
-                }                                                                                                      \
-            }                                                                                                          \
-        }                                                                                                              \
-    } while (0)
-
-static void simd_dyn_convert(cpu_impl *c, void *const a[3], void *canonical, int to_pm)
-{
-    const int64_t N = c->scene.n_strands, P = c->scene.points, S = c->stride;
-    if (c->scene.precision == HB_FP32) {
-        if (to_pm) PM_CONVERT_ARRAYS(float, 1);
-        else PM_CONVERT_ARRAYS(float, 0);
-    } else {
-        if (to_pm) PM_CONVERT_ARRAYS(double, 1);
-        else PM_CONVERT_ARRAYS(double, 0);
-    }
-}
-#undef PM_CONVERT_ARRAYS
-
 /* Velocities (zero without) and the rest shape to point-major, then the bend rest lengths:
  * outside the timed frames, as positions are in load. Padding lanes keep their zeros. */
 static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
 {
-    if (velocity) simd_dyn_convert(c, c->pv, (void *)velocity, 1);
+    if (velocity) simd_convert(c, c->pv, (void *)velocity, 1);
     else pm_first_touch(c, c->pv);
-    simd_dyn_convert(c, c->pr, (void *)rest, 1);
+    simd_convert(c, c->pr, (void *)rest, 1);
     const int64_t DB = HB_SIMD_DYN_BLOCK, nb = c->stride / HB_SIMD_DYN_BLOCK, S = c->stride;
     if (c->scene.precision == HB_FP32) {
         const float *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2];
@@ -486,7 +447,7 @@ static int cpu_load(hb_backend *b, const void *canonical, double *ms, char *err,
     cpu_impl *c = b->impl;
     double t0 = hb_now_ms();
     if (c->simd) {
-        simd_convert(c, (void *)canonical, 1);
+        simd_convert(c, c->pm, (void *)canonical, 1);
         *ms = hb_now_ms() - t0;
         return 0;
     }
@@ -502,7 +463,7 @@ static int cpu_fetch(hb_backend *b, void *canonical, double *ms, char *err, size
     cpu_impl *c = b->impl;
     double t0 = hb_now_ms();
     if (c->simd) {
-        simd_convert(c, canonical, 0);
+        simd_convert(c, c->pm, canonical, 0);
         *ms = hb_now_ms() - t0;
         return 0;
     }
@@ -689,7 +650,7 @@ static int cpu_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, siz
     (void)errlen;
     cpu_impl *c = b->impl;
     if (c->simd) {
-        simd_dyn_convert(c, c->pv, canonical, 0);
+        simd_convert(c, c->pv, canonical, 0);
         return 0;
     }
     memcpy(canonical, c->vel, c->bytes);

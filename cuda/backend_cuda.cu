@@ -1,5 +1,5 @@
 /* backend_cuda.cu — the CUDA backend (docs/model.md §5.1): the hb_backend the shared driver
- * (c_ref/driver.c) runs, and main().
+ * (c_ref/runtime/driver.c) runs, and main().
  *
  * Variants (docs/cuda.md):
  *   paper  the paper's scheme, kept as the baseline and not tuned: the canonical
@@ -10,7 +10,7 @@
  *   fused  (default) point-major; a wind immediately followed by collide in the stage list
  *          runs as one kernel (run_stage returns consumed = 2).
  *   strand, warp, warpreg  the variants that also run simulate (the dynamic model;
- *          backend_dyn.cuh): strand point-major as soa, warp and warpreg strand-major as
+ *          backend_dyn.cu): strand point-major as soa, warp and warpreg strand-major as
  *          paper for the other stages.
  *
  * Memory on the device: the state (one state's bytes; point-major: X|Y|Z in one
@@ -32,57 +32,23 @@
 #include <string.h>
 #include <vector>
 
-#include "backend.h"
-#include "checked.h"
+#include "runtime/backend.h"
+#include "runtime/checked.h"
+#include "backend_cuda.cuh"
 #include "check.cuh"
 #include "dyn_kernels.cuh"
-#include "host.h"
+#include "runtime/host.h"
 #include "kernels.cuh"
-#include "model.h"
+#include "paper/model.h"
 
 using hb::Model;
 using hb::PointMajor;
 using hb::StrandMajor;
+using namespace hb_cuda;
 
 namespace {
 
-enum Variant {
-    V_PAPER = 0,
-    V_SOA = 1,
-    V_FUSED = 2,
-    V_STRAND = 3,
-    V_WARP = 4,
-    V_WARPREG = 5,
-    V_LANES = 6
-}; /* strand, warp, warpreg: backend_dyn.cuh */
-struct DynState;
-
-struct cuda_impl {
-    hb_scene scene;
-    Model<float> m32;
-    Model<double> m64;
-    Variant variant;
-    int block;
-    int64_t N, P;
-    uint64_t bytes;              /* one state [N·P][3] in the run's precision */
-    void *state;                 /* paper: canonical; soa, fused: X | Y | Z, each [P][N] */
-    void *saved;                 /* a copy of state for repeats (need_save) */
-    void *staging;               /* soa, fused: canonical; load/fetch and the fused intermediate */
-    unsigned long long *d_count; /* collide: points changed */
-    cudaEvent_t ev0, ev1;
-    int have_events;
-    int keep;        /* keep_intermediate(1): fused calls write the wind frame to staging */
-    int inter_valid; /* staging holds the last fused call's wind frame */
-    char device[256];
-    DynState *dyn; /* simulate (backend_dyn.cuh); NULL when the run does not simulate */
-};
-
-uint64_t sat_add(uint64_t a, uint64_t b)
-{
-    return a > UINT64_MAX - b ? UINT64_MAX : a + b;
-}
-
-/* The scene's numbers rounded once to the working precision (host.c, shared with the CPU). */
+/* The scene's numbers rounded once to the working precision (paper/model_host.c, shared with the CPU). */
 void round_scene(cuda_impl *c, const hb_scene *s)
 {
     hb_model_f64 d;
@@ -90,18 +56,6 @@ void round_scene(cuda_impl *c, const hb_scene *s)
     hb_model_round(s, &f, &d);
     c->m64 = hb::model_from<hb_model_f64, double>(d);
     c->m32 = hb::model_from<hb_model_f32, float>(f);
-}
-
-template <typename T> PointMajor<T> point_major(const cuda_impl *c, void *base)
-{
-    T *p = (T *)base;
-    const int64_t np = c->N * c->P;
-    return PointMajor<T>{p, p + np, p + 2 * np, c->N};
-}
-
-template <typename T> StrandMajor<T> strand_major(const cuda_impl *c, void *base)
-{
-    return StrandMajor<T>{(T *)base, c->P};
 }
 
 /* Device 0, refused cleanly when there is none. */
@@ -124,7 +78,9 @@ int pick_device(char *name, size_t n, char *err, size_t errlen)
     return 0;
 }
 
-int device_alloc(void **p, uint64_t bytes, const cuda_impl *c, const char *what, char *err, size_t errlen)
+} /* namespace */
+
+int hb_cuda::device_alloc(void **p, uint64_t bytes, const cuda_impl *c, const char *what, char *err, size_t errlen)
 {
     cudaError_t e = cudaMalloc(p, (size_t)bytes);
     if (e != cudaSuccess) {
@@ -146,7 +102,7 @@ int device_alloc(void **p, uint64_t bytes, const cuda_impl *c, const char *what,
  * never too short). The frame loop (--frame-loop) times launches and all, as an application. */
 constexpr unsigned long long kHoldNs = 50000;
 
-__global__ void k_hold(unsigned long long ns)
+static __global__ void k_hold(unsigned long long ns)
 {
     unsigned long long t0, t;
     asm volatile("mov.u64 %0, %%globaltimer;" : "=l"(t0));
@@ -156,13 +112,14 @@ __global__ void k_hold(unsigned long long ns)
     } while (t - t0 < ns);
 }
 
-cudaError_t hold_stream(cudaStream_t stream)
+cudaError_t hb_cuda::hold_stream(cudaStream_t stream)
 {
     k_hold<<<1, 1, 0, stream>>>(kHoldNs);
     return cudaGetLastError();
 }
 
-#include "backend_dyn.cuh"
+namespace {
+
 
 int setup_inner(hb_backend *b, cuda_impl *c, const hb_options *o, int need_save, uint64_t driver_bytes, char *err,
                 size_t errlen)

@@ -11,7 +11,7 @@
  * sends its new position back, so every point is written by one lane.
  *
  * Arithmetic (docs/cuda.md "Builds and arithmetic"): the strict build (HB_REFERENCE_ARITHMETIC)
- * calls dyn_model.cuh's reference helpers, the same operations as c_ref/dynamics_impl.h, so
+ * calls dyn_model.cuh's reference helpers, the same operations as c_ref/dynamic/dynamics_impl.h, so
  * it gives the CPU's bits; the normal and fast-math builds use reciprocal square roots and
  * the scene's precomputed reciprocals (DModel::inv_*), judged by the one-frame rule.
  */
@@ -100,51 +100,18 @@ template <int L, typename T> __device__ __forceinline__ V3<T> from(const V3<T> &
     return V3<T>{__shfl_sync(kAll, a.x, src, L), __shfl_sync(kAll, a.y, src, L), __shfl_sync(kAll, a.z, src, L)};
 }
 
-/* §3.5 distance constraint between a and b with rest r: moves a (unless it is the root) and b.
- * inv1, inv2: 1/(1 + α̃) and 1/(2 + α̃) (free arithmetic only). */
+/* §3.5 distance constraint with rest r, written from one end: e = other − own; own moves by
+ * −Δλ·n (unless it is the root, which is always the lower end), other by +Δλ·n. Called with
+ * own = the lower end a, or (the G = 2 bend pairs) with own = b: e and n change sign exactly,
+ * so every value is the same bit for bit, and both lanes of a pair run this one path on their
+ * own operands, so the warp does not diverge. inv1, inv2: 1/(1 + α̃) and 1/(2 + α̃) (free
+ * arithmetic only). */
 template <typename T>
-__device__ __forceinline__ void dist(V3<T> &a, V3<T> &b, bool root_a, T r, T at, T inv1, T inv2, T &lam)
+__device__ __forceinline__ void dist(V3<T> &own, V3<T> &other, bool own_root, T r, T at, T inv1, T inv2, T &lam)
 {
     if constexpr (kFree) {
-        const T ex = b.x - a.x, ey = b.y - a.y, ez = b.z - a.z;
+        const T ex = other.x - own.x, ey = other.y - own.y, ez = other.z - own.z;
         const T q = ex * ex + ey * ey + ez * ez;
-        if (!(q > floor_of<T>())) return;
-        const T inv = rsq(q);
-        const T dl = ((r - q * inv) - at * lam) * (root_a ? inv1 : inv2);
-        lam = lam + dl;
-        const T s = dl * inv;
-        if (!root_a) {
-            a.x = a.x - s * ex;
-            a.y = a.y - s * ey;
-            a.z = a.z - s * ez;
-        }
-        b.x = b.x + s * ex;
-        b.y = b.y + s * ey;
-        b.z = b.z + s * ez;
-    } else {
-        T dl, nx, ny, nz;
-        if (!distance_step(a.x, a.y, a.z, b.x, b.y, b.z, !root_a, r, at, lam, dl, nx, ny, nz)) return;
-        if (!root_a) {
-            a.x = a.x - dl * nx;
-            a.y = a.y - dl * ny;
-            a.z = a.z - dl * nz;
-        }
-        b.x = b.x + dl * nx;
-        b.y = b.y + dl * ny;
-        b.z = b.z + dl * nz;
-    }
-}
-
-/* The same constraint written from one end: e = other − own; own moves by −Δλ·n (unless it
- * is the root, which is always the lower end a), other by +Δλ·n. With own = a this is dist;
- * with own = b, e and n change sign exactly, so every value is the same bit for bit. Both
- * lanes of a pair run this one path on their own operands, so the warp does not diverge. */
-template <typename T>
-__device__ __forceinline__ void dist_sym(V3<T> &own, V3<T> &other, bool own_root, T r, T at, T inv1, T inv2, T &lam)
-{
-    const T ex = other.x - own.x, ey = other.y - own.y, ez = other.z - own.z;
-    const T q = ex * ex + ey * ey + ez * ez;
-    if constexpr (kFree) {
         if (!(q > floor_of<T>())) return;
         const T inv = rsq(q);
         const T dl = ((r - q * inv) - at * lam) * (own_root ? inv1 : inv2);
@@ -153,13 +120,9 @@ __device__ __forceinline__ void dist_sym(V3<T> &own, V3<T> &other, bool own_root
         if (!own_root) own = V3<T>{own.x - s * ex, own.y - s * ey, own.z - s * ez};
         other = V3<T>{other.x + s * ex, other.y + s * ey, other.z + s * ez};
     } else {
-        const T len = d_sqrt(q);
-        if (len == (T)0) return;
-        const T c = len - r;
-        const T wsum = own_root ? (T)1 : (T)2;
-        const T dl = (-c - at * lam) / (wsum + at);
-        lam = lam + dl;
-        const T nx = ex / len, ny = ey / len, nz = ez / len;
+        T dl, nx, ny, nz;
+        if (!distance_step(own.x, own.y, own.z, other.x, other.y, other.z, !own_root, r, at, lam, dl, nx, ny, nz))
+            return;
         if (!own_root) own = V3<T>{own.x - dl * nx, own.y - dl * ny, own.z - dl * nz};
         other = V3<T>{other.x + dl * nx, other.y + dl * ny, other.z + dl * nz};
     }
@@ -427,7 +390,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
 
             auto stretch = [&]() {
                 if constexpr (G == 2) { /* (k0, k0+1) inside the lane; (k0 − 1, k0) across */
-                    if (k0 + 1 < P) dist_sym(Q[0], Q[1], l == 0, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lso[0]);
+                    if (k0 + 1 < P) dist(Q[0], Q[1], l == 0, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lso[0]);
                     V3<T> a = up<L>(pick(sw, Q[0], Q[1])); /* the lower lane's last point */
                     V3<T> own = pick(sw, Q[1], Q[0]);      /* this lane's first */
                     if (l >= 1 && k0 < P) dist(a, own, false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lsx);
@@ -471,7 +434,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
                     V3<T> &own = g == 0 ? Q[0] : Q[1];
                     V3<T> &sent = g == 0 ? Q[1] : Q[0];
                     V3<T> o = from<L>(sent, partner);
-                    if (act) dist_sym(own, o, g == 0 && l == 0, r, m.bend_at, m.inv_b1, m.inv_b2, g == 0 ? lc1 : lc2);
+                    if (act) dist(own, o, g == 0 && l == 0, r, m.bend_at, m.inv_b1, m.inv_b2, g == 0 ? lc1 : lc2);
                     const V3<T> back = from<L>(o, partner);
                     if (back_on) sent = back;
                 } else {

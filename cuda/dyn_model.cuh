@@ -1,14 +1,14 @@
-/* dyn_model.cuh — the dynamic model (docs/model.md §3) for the CUDA port: c_ref/dynamics_impl.h
+/* dyn_model.cuh — the dynamic model (docs/model.md §3) for the CUDA port: c_ref/dynamic/dynamics_impl.h
  * written as `__host__ __device__` templates over the floating type T, the feature set, the
  * memory layout of the strand and the way a loop over points or constraints is executed.
  *
- * This file follows c_ref/dynamics_impl.h operation by operation: the same expressions in
+ * This file follows c_ref/dynamic/dynamics_impl.h operation by operation: the same expressions in
  * the same order (no reassociation, the same divisions, the same branches). A build without
  * FMA contraction and with IEEE division and square root (hairsim-cuda-strict) therefore
  * differs from the C reference only where CUDA's sinf/sin differ from glibc's (gusts only;
  * the rest uses +, −, ×, ÷ and sqrt, all correctly rounded). Compiled for the host
  * (cuda/hostcheck/dyn_hostcheck.cu) the same templates call glibc and must reproduce
- * c_ref/dynamics_f32.c / dynamics_f64.c bit for bit. The normal build contracts a·b + c into
+ * c_ref/dynamic/dynamics_f32.c / dynamics_f64.c bit for bit. The normal build contracts a·b + c into
  * FMAs and the fast-math build uses approximate sinf, division and square root: both differ.
  *
  * The three policies:
@@ -33,8 +33,8 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "dynamics.h" /* HB_F_*, hb_dyn_model_f32/f64 */
-#include "params.h"   /* HB_SOLVER_* */
+#include "dynamic/dynamics.h" /* HB_F_*, hb_dyn_model_f32/f64 */
+#include "runtime/params.h"   /* HB_SOLVER_* */
 
 #if defined(__CUDACC__)
 #define HB_DHD __host__ __device__ __forceinline__

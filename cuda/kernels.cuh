@@ -14,7 +14,7 @@
 #include <stdint.h>
 
 #include "model.cuh"
-#include "params.h" /* hb_stage */
+#include "runtime/params.h" /* hb_stage */
 
 namespace hb {
 

@@ -1,19 +1,19 @@
-/* model.cuh — the paper model (docs/model.md §2) for the CUDA port: c_ref/model_impl.h written as
+/* model.cuh — the paper model (docs/model.md §2) for the CUDA port: c_ref/paper/model_impl.h written as
  * `__host__ __device__` templates over the floating type T and the memory layout.
  *
  * Two arithmetics, chosen when the file is compiled (the builds of docs/cuda.md):
  *   - the reference arithmetic (HB_REFERENCE_ARITHMETIC=1, the strict build): this file
- *     follows c_ref/model_impl.h operation by operation: the same expressions in the same
+ *     follows c_ref/paper/model_impl.h operation by operation: the same expressions in the same
  *     order, the same constants, the same branches. Without FMA contraction and with IEEE
  *     division and square root it therefore differs from the C reference only where CUDA's
  *     sinf/cosf/asinf/atan2f (sin/cos/asin/atan2) differ from glibc's; compiled for the
- *     host (cuda/hostcheck/model_hostcheck.cu) it must reproduce c_ref/model.c bit for bit;
+ *     host (cuda/hostcheck/model_hostcheck.cu) it must reproduce c_ref/paper/model.c bit for bit;
  *   - the free arithmetic (the default: normal and fast-math builds): the same model and
  *     the same decisions (hanging, the wind's wrap and exactly-opposite rule, collide's
  *     threshold and tie), computed more cheaply, judged by the paper model's tolerances
  *     (harness/tolerances.py) instead of bits. Per point it has no IEEE division, no asin
  *     and no library atan2/sincos in fp32: drape steps by an angle computed once per strand,
- *     wind uses c_ref/fast_trig.h's polynomials and t = k·(w/(P−1)), collide uses
+ *     wind uses c_ref/paper/fast_trig.h's polynomials and t = k·(w/(P−1)), collide uses
  *     reciprocal square roots (see each stage's `if constexpr (kFree)`).
  *
  * The only departures of the reference arithmetic from the C file are in *when memory is
@@ -38,9 +38,9 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "fast_trig.h" /* hb_atan2_fast, hb_sincos_fast (the free arithmetic, fp32) */
-#include "model.h"     /* HB_SHELL_ULPS, hb_model_f32/f64 */
-#include "philox.h"    /* hb_draw_block, hb_u01, HB_HD = __host__ __device__ __forceinline__ */
+#include "paper/fast_trig.h" /* hb_atan2_fast, hb_sincos_fast (the free arithmetic, fp32) */
+#include "paper/model.h"     /* HB_SHELL_ULPS, hb_model_f32/f64 */
+#include "runtime/philox.h"  /* hb_draw_block, hb_u01, HB_HD = __host__ __device__ __forceinline__ */
 
 /* #pragma unroll for the device pass only (the host compiler does not know it) */
 #if defined(__CUDA_ARCH__)
@@ -233,6 +233,22 @@ template <typename T> struct PointMajor {
 };
 
 /* ---- docs/model.md §2.3 drape (model_impl.h: hb_drape_strand) ------------------------------------ */
+/* A point the shell step does not reach: the first hanging point goes onto the vertical
+ * tangent line z = −rc, at distance ℓ below its predecessor; every later point hangs
+ * straight down, p_k = p_{k−1} − ℓŷ. */
+template <typename T> HB_HD void hang_step(const T ell, const T rc, int &hanging, T &py, T &pz)
+{
+    if (!hanging) {
+        const T dz = pz + rc;
+        const T dy2 = ell * ell - dz * dz;
+        py = py - m_sqrt(dy2 > (T)0 ? dy2 : (T)0);
+        pz = -rc;
+        hanging = 1;
+    } else {
+        py = py - ell;
+    }
+}
+
 /* The root (x0, py, pz) is already stored; writes points 1 … P−1. */
 template <typename T, class V> HB_HD void drape_reference(const Model<T> &m, const V &s, const T x0, T py, T pz)
 {
@@ -277,17 +293,8 @@ template <typename T, class V> HB_HD void drape_reference(const Model<T> &m, con
                     continue;
                 }
             }
-            /* The strand starts to hang: the first hanging point goes onto the vertical
-             * tangent line z = −rc, at distance ℓ below its predecessor. */
-            const T dz = pz + rc;
-            const T dy2 = ell * ell - dz * dz;
-            py = py - m_sqrt(dy2 > (T)0 ? dy2 : (T)0);
-            pz = -rc;
-            hanging = 1;
-        } else {
-            /* Every later point hangs straight down: p_k = p_{k−1} − ℓŷ. */
-            py = py - ell;
         }
+        hang_step(ell, rc, hanging, py, pz);
         s.x(k) = x0;
         s.y(k) = py;
         s.z(k) = pz;

@@ -1,6 +1,6 @@
 /* dyn_hostcheck.cu — runs the CUDA port's dynamic model (cuda/dyn_model.cuh,
  * __host__ __device__) on the HOST and compares it bit for bit with the C reference
- * (c_ref/dynamics_impl.h via dynamics_f32.c / dynamics_f64.c).
+ * (c_ref/dynamic/dynamics_impl.h via dynamics_f32.c / dynamics_f64.c).
  *
  * No kernel is launched, so it runs on a machine without a GPU. On the host the templates
  * call glibc's sqrtf/sinf (sqrt/sin), as the C reference does, so any difference is a
@@ -22,11 +22,8 @@
  * it (dyn_kernels.cuh specialised_mask) and always as the run-time mask (DynF, the generic
  * kernel). Also the bend rest lengths and the per-strand observables (hb_dyn_observe_strand).
  *
- * Built by tests/native/test_cuda_dyn_host.py:
- *   gcc  -std=c11 -O2 -ffp-contract=off -fno-fast-math -Ic_ref -c c_ref/dynamics_f32.c
- *        c_ref/dynamics_f64.c c_ref/dynamics_host.c c_ref/params.c
- *   nvcc -std=c++17 -O2 -Ic_ref -Icuda -Xcompiler -ffp-contract=off,-fno-fast-math \
- *        cuda/hostcheck/dyn_hostcheck.cu *.o -o dyn_hostcheck -lm
+ * Built by `make hostcheck` (build/hostcheck/dyn_hostcheck, against the reference's objects),
+ * run by tests/native/test_cuda_dyn_host.py.
  * Exit status 0 = all identical; the last line counts the cases and mismatches.
  */
 #include <math.h>
@@ -40,8 +37,8 @@
 
 #include "dyn_kernels.cuh"
 #include "dyn_model.cuh"
-#include "dynamics.h"
-#include "params.h"
+#include "dynamic/dynamics.h"
+#include "runtime/params.h"
 
 using namespace hb::dyn;
 

@@ -1,5 +1,5 @@
 /* model_hostcheck.cu — runs the CUDA port's model (cuda/model.cuh, __host__ __device__) on
- * the HOST against the C reference (c_ref/model.c).
+ * the HOST against the C reference (c_ref/paper/model.c).
  *
  * Built twice (tests/test_cuda_port_host.py):
  *   - with -DHB_REFERENCE_ARITHMETIC=1 (the strict build's arithmetic): bit for bit. On the
@@ -21,11 +21,8 @@
  * (without the intermediate) must not write x: X is poisoned with a NaN pattern first and
  * must come back untouched.
  *
- * Lives in cuda/hostcheck/ so that the Makefile's wildcard of cuda .cu files does not link it into
- * the hairsim binaries. Built by tests/native/test_cuda_port_host.py:
- *   gcc  -std=c11 -O2 -ffp-contract=off -fno-fast-math -Ic_ref -c c_ref/model.c c_ref/params.c
- *   nvcc -std=c++17 -O2 -Ic_ref -Icuda -Xcompiler -ffp-contract=off [-DHB_REFERENCE_ARITHMETIC=1] \
- *        cuda/hostcheck/model_hostcheck.cu model.o params.o -o model_hostcheck
+ * Built by `make hostcheck` twice (build/hostcheck/model_hostcheck_{reference,free}, with and
+ * without -DHB_REFERENCE_ARITHMETIC=1), run by tests/native/test_cuda_port_host.py.
  * Usage: model_hostcheck [N [k32 over32 k64 over64 moved]]   (default 2000 strands; the
  * tolerances only for the free arithmetic). Exit status 0 = all checks pass.
  */
@@ -40,8 +37,8 @@
 #include <vector>
 
 #include "model.cuh"
-#include "model.h"
-#include "params.h"
+#include "paper/model.h"
+#include "runtime/params.h"
 
 using hb::Model;
 using hb::PointMajor;
@@ -50,35 +47,76 @@ using hb::StrandMajor;
 namespace {
 
 /* ---- the C reference, overloaded on the model type ---------------------------------------- */
-void ref_init(const hb_model_f32 *m, uint64_t i, float *s) { hb_init_strand_f32(m, i, s); }
-void ref_init(const hb_model_f64 *m, uint64_t i, double *s) { hb_init_strand_f64(m, i, s); }
-void ref_drape(const hb_model_f32 *m, float *s) { hb_drape_strand_f32(m, s); }
-void ref_drape(const hb_model_f64 *m, double *s) { hb_drape_strand_f64(m, s); }
-void ref_wind(const hb_model_f32 *m, float *s) { hb_wind_strand_f32(m, s); }
-void ref_wind(const hb_model_f64 *m, double *s) { hb_wind_strand_f64(m, s); }
-int64_t ref_collide(const hb_model_f32 *m, float *s) { return hb_collide_strand_f32(m, s); }
-int64_t ref_collide(const hb_model_f64 *m, double *s) { return hb_collide_strand_f64(m, s); }
+void ref_init(const hb_model_f32 *m, uint64_t i, float *s)
+{
+    hb_init_strand_f32(m, i, s);
+}
+void ref_init(const hb_model_f64 *m, uint64_t i, double *s)
+{
+    hb_init_strand_f64(m, i, s);
+}
+void ref_drape(const hb_model_f32 *m, float *s)
+{
+    hb_drape_strand_f32(m, s);
+}
+void ref_drape(const hb_model_f64 *m, double *s)
+{
+    hb_drape_strand_f64(m, s);
+}
+void ref_wind(const hb_model_f32 *m, float *s)
+{
+    hb_wind_strand_f32(m, s);
+}
+void ref_wind(const hb_model_f64 *m, double *s)
+{
+    hb_wind_strand_f64(m, s);
+}
+int64_t ref_collide(const hb_model_f32 *m, float *s)
+{
+    return hb_collide_strand_f32(m, s);
+}
+int64_t ref_collide(const hb_model_f64 *m, double *s)
+{
+    return hb_collide_strand_f64(m, s);
+}
 
 template <typename T> struct CModel;
-template <> struct CModel<float> { typedef hb_model_f32 type; };
-template <> struct CModel<double> { typedef hb_model_f64 type; };
+template <> struct CModel<float> {
+    typedef hb_model_f32 type;
+};
+template <> struct CModel<double> {
+    typedef hb_model_f64 type;
+};
 
 /* backend_cpu.c's round_scene */
 void round_scene(const hb_scene *s, hb_model_f32 *m32, hb_model_f64 *m64)
 {
-    const hb_model_f64 d = {s->seed, s->points, s->head_radius, s->hair_offset, s->face_margin,
-                            hb_segment_length(s), s->wind_strength, hb_wind_angle_reduced(s)};
-    const hb_model_f32 f = {s->seed, s->points, (float)d.head_radius, (float)d.hair_offset, (float)d.face_margin,
-                            (float)d.seg_len, (float)d.wind_strength, (float)d.wind_angle};
+    const hb_model_f64 d = {s->seed,          s->points,
+                            s->head_radius,   s->hair_offset,
+                            s->face_margin,   hb_segment_length(s),
+                            s->wind_strength, hb_wind_angle_reduced(s)};
+    const hb_model_f32 f = {s->seed,
+                            s->points,
+                            (float)d.head_radius,
+                            (float)d.hair_offset,
+                            (float)d.face_margin,
+                            (float)d.seg_len,
+                            (float)d.wind_strength,
+                            (float)d.wind_angle};
     *m64 = d;
     *m32 = f;
 }
-void pick(const hb_model_f32 &a, const hb_model_f64 &, hb_model_f32 *out) { *out = a; }
-void pick(const hb_model_f32 &, const hb_model_f64 &b, hb_model_f64 *out) { *out = b; }
+void pick(const hb_model_f32 &a, const hb_model_f64 &, hb_model_f32 *out)
+{
+    *out = a;
+}
+void pick(const hb_model_f32 &, const hb_model_f64 &b, hb_model_f64 *out)
+{
+    *out = b;
+}
 
 /* ---- the port's layouts in host memory ----------------------------------------------------- */
-template <typename T>
-struct StrandBuf {
+template <typename T> struct StrandBuf {
     static const char *name() { return "strand-major"; }
     int64_t N, P;
     std::vector<T> s;
@@ -107,8 +145,7 @@ template <> double poison<double>()
     return d;
 }
 
-template <typename T>
-struct PointBuf {
+template <typename T> struct PointBuf {
     static const char *name() { return "point-major"; }
     int64_t N, P;
     std::vector<T> a; /* X | Y | Z, each [P][N] */
@@ -172,8 +209,7 @@ struct FreeRule {
 };
 FreeRule g_free;
 
-template <typename T>
-long mismatches(const std::vector<T> &a, const std::vector<T> &b, long *first)
+template <typename T> long mismatches(const std::vector<T> &a, const std::vector<T> &b, long *first)
 {
     long n = 0;
     *first = -1;
@@ -266,34 +302,29 @@ void expect_true(Tally &t, const std::string &what, bool ok)
 }
 
 /* ---- the port's stages over all strands ------------------------------------------------------ */
-template <typename T, class Buf>
-void port_init(const Model<T> &m, Buf &b)
+template <typename T, class Buf> void port_init(const Model<T> &m, Buf &b)
 {
     const auto lay = b.lay();
     for (int64_t i = 0; i < b.N; i++) hb::init_strand(m, lay, i);
 }
-template <typename T, class Buf>
-void port_drape(const Model<T> &m, Buf &b)
+template <typename T, class Buf> void port_drape(const Model<T> &m, Buf &b)
 {
     const auto lay = b.lay();
     for (int64_t i = 0; i < b.N; i++) hb::drape_strand(m, lay, i);
 }
-template <int D, typename T, class Buf>
-void port_wind(const Model<T> &m, Buf &b)
+template <int D, typename T, class Buf> void port_wind(const Model<T> &m, Buf &b)
 {
     const auto lay = b.lay();
     for (int64_t i = 0; i < b.N; i++) hb::wind_strand<D>(m, lay, i);
 }
-template <int D, typename T, class Buf>
-int64_t port_collide(const Model<T> &m, Buf &b)
+template <int D, typename T, class Buf> int64_t port_collide(const Model<T> &m, Buf &b)
 {
     const auto lay = b.lay();
     int64_t n = 0;
     for (int64_t i = 0; i < b.N; i++) n += hb::collide_strand<D>(m, lay, i);
     return n;
 }
-template <bool Keep, int D, typename T, class Buf>
-int64_t port_fused(const Model<T> &m, Buf &b, std::vector<T> *inter)
+template <bool Keep, int D, typename T, class Buf> int64_t port_fused(const Model<T> &m, Buf &b, std::vector<T> *inter)
 {
     const auto lay = b.lay();
     const StrandMajor<T> keep = {inter ? inter->data() : nullptr, b.P};
@@ -341,8 +372,8 @@ void check_layout(Tally &t, const std::string &tag, const Model<T> &m, int64_t N
     }
 
     for (int j = 2; j <= 4; j += 2) {
-        const std::string what = at + " fused wind+collide (frames " + std::to_string(j) + "," +
-                                 std::to_string(j + 1) + ")";
+        const std::string what =
+            at + " fused wind+collide (frames " + std::to_string(j) + "," + std::to_string(j + 1) + ")";
         /* with the intermediate: x is read (and copied), not written */
         std::vector<T> inter((size_t)(N * P * 3), poison<T>());
         b.load(f[j - 1]);
@@ -377,8 +408,7 @@ void check_layout(Tally &t, const std::string &tag, const Model<T> &m, int64_t N
     expect_count(t, at + " chain fused 5", n5, moved[5], NP);
 }
 
-template <typename T>
-void check_case(Tally &t, const hb_scene &scene, const char *scene_name)
+template <typename T> void check_case(Tally &t, const hb_scene &scene, const char *scene_name)
 {
     hb_model_f32 m32;
     hb_model_f64 m64;
@@ -489,8 +519,10 @@ int main(int argc, char **argv)
     if (hb::kFree)
         printf("free arithmetic against the reference: worst %.3f u fp32 (tolerance %.1f u), %.3f u fp64 (tolerance "
                "%.1f u); %lld and %lld points over\n",
-               g_free.worst[0], g_free.k[0], g_free.worst[1], g_free.k[1], g_free.over_points[0], g_free.over_points[1]);
-    printf("host check (%s arithmetic): %ld comparisons, %ld mismatches (%lld strands a case, reference collide moved %lld points "
+               g_free.worst[0], g_free.k[0], g_free.worst[1], g_free.k[1], g_free.over_points[0],
+               g_free.over_points[1]);
+    printf("host check (%s arithmetic): %ld comparisons, %ld mismatches (%lld strands a case, reference collide moved "
+           "%lld points "
            "in all)\n",
            hb::kFree ? "free" : "reference", t.checks, t.failures, (long long)N, t.moved);
     if (t.moved == 0) {

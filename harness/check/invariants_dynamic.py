@@ -6,9 +6,9 @@ frame f (at step s, simulated frame number g = s − paper_frames + 1) is checke
   finite       no NaN or Inf in the positions, nor in the velocities stored for f
   roots        the root is at Q(t)·X̄_0 (§3.2), t = (g·S)·h with h = Δt/S in double as
                the binary computes it; Q in double with the formula of
-               c_ref/dynamics_host.c hb_head_rotation, each entry rounded once to the working
+               c_ref/dynamic/dynamics_host.c hb_head_rotation, each entry rounded once to the working
                precision, and the product row by row, left to right, in the working
-               precision (c_ref/dynamics_impl.h rotate). With head motion `still` the root
+               precision (c_ref/dynamic/dynamics_impl.h rotate). With head motion `still` the root
                is X̄_0 itself. Bit-exact for the reference (`exact=True`, the default);
                otherwise each coordinate within DYN_ROOT_K·ε·R.
   collider     (collider on) no non-root point inside the sphere R_c = R + c_m by more than
@@ -75,7 +75,7 @@ class DynamicReport:
 
 
 def head_rotation(motion, amplitude, frequency, t):
-    """Q(t) of §3.2 in double, row-major, as c_ref/dynamics_host.c hb_head_rotation."""
+    """Q(t) of §3.2 in double, row-major, as c_ref/dynamic/dynamics_host.c hb_head_rotation."""
     th = amplitude * math.sin(2.0 * math.pi * frequency * t)
     c, s = math.cos(th), math.sin(th)
     q = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]

@@ -195,11 +195,11 @@ def _convert(where, key, kind, value):
     return x
 
 
-MAX_STAGES = 64  # HB_MAX_STAGES in c_ref/params.h
+MAX_STAGES = 64  # HB_MAX_STAGES in c_ref/runtime/params.h
 
 
 def parse_stages(value, where="scene", key="stages"):
-    """The stage-list rules of the binaries' --stages (c_ref/cli.c): known names, no empty
+    """The stage-list rules of the binaries' --stages (c_ref/runtime/cli.c): known names, no empty
     item (\"init,,wind\" is refused, not skipped), at most MAX_STAGES, init only first."""
     if isinstance(value, str):
         if value == "" or value.startswith(",") or value.endswith(",") or ",," in value:
@@ -218,7 +218,7 @@ def parse_stages(value, where="scene", key="stages"):
 
 
 # copies of one frame a backend holds: the state, its saved copy for --repeat/--warmup, and
-# the host frame written to the file (c_ref/driver.c)
+# the host frame written to the file (c_ref/runtime/driver.c)
 FRAME_COPIES = 3
 
 

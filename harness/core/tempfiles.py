@@ -2,7 +2,7 @@
 on the Python side, for which files the harness may remove after a child it killed or that
 was interrupted. A file is a binary's temporary only with both its name
 (`.hairsim-<pid>-<16 hex>.tmp`) and its marker (the first bytes of its HDF5 user block);
-c_ref/safe_write.h holds the same two."""
+c_ref/runtime/safe_write.h holds the same two."""
 
 import os
 import re

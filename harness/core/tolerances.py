@@ -29,7 +29,7 @@ by up to a segment. None such was seen in the measurements; fp64↔fp64 allows n
 INVARIANTS (invariants.py), per kind: |segment length − ℓ| ≤ segment_k · ε·E, and after
 collide no non-root point inside its shell circle by more than shell_k · ε·rc. The
 binaries' own collide test leaves points up to 16 ε·rc inside alone (HB_SHELL_ULPS in
-c_ref/model.h), so shell_k must be above 16.
+c_ref/paper/model.h), so shell_k must be above 16.
 
 The measurements behind every number (`python -m harness calibrate` on the dev machine and
 on an H200, `harness bench`, the simd and GPU test runs) are in docs/harness.md
@@ -168,7 +168,7 @@ EXACT = PairTolerance(point_k=0.0, max_over_fraction=0.0, why="bit-identical req
 # of the same precision. A named pair may be tighter than its precisions' rule, never looser.
 NAMED_PAIRS = {
     # simd vs ref, same precision: the free arithmetic (docs/cpu_simd.md) with ref's decisions;
-    # sin, cos, asin and atan2 from libmvec or c_ref/fast_trig.h; the roots are bit-identical,
+    # sin, cos, asin and atan2 from libmvec or c_ref/paper/fast_trig.h; the roots are bit-identical,
     # so u = ε·P·E.
     ("simd", "fp32"): PairTolerance(
         point_k=4.0,
@@ -394,7 +394,7 @@ ANALYTIC_FP32_WIND_ANGLE_ABS = 5e-4  # rad at S ≤ 8 (worst 8.7e-5; below the 3
 #
 # The strict build (no FMA contraction, IEEE division and square root, no flush to zero)
 # evaluates the model with +, −, ×, ÷ and sqrt only, each correctly rounded, in the order of
-# c_ref/dynamics_impl.h (cuda/dyn_model.cuh; the host check shows the port reproduces the
+# c_ref/dynamic/dynamics_impl.h (cuda/dyn_model.cuh; the host check shows the port reproduces the
 # C reference bit for bit with glibc's libm). So without gusts it must equal the CPU bit for
 # bit, observables included (GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS; the observables' reduction
 # is the CPU's, chunk by chunk in strand order); with gusts CUDA's sinf/sin (≤ 2 ulp from

@@ -1,5 +1,5 @@
-"""The simulate stage of the simd CPU variant (c_ref/dynamics_simd*.{h,c}; docs/cpu_simd.md,
-"The dynamic model") against the `ref` oracle (c_ref/dynamics_impl.h).
+"""The simulate stage of the simd CPU variant (c_ref/simd/dynamics_simd*.{h,c}; docs/cpu_simd.md,
+"The dynamic model") against the `ref` oracle (c_ref/dynamic/dynamics_impl.h).
 
 simd computes the model with free arithmetic (reciprocal square roots, reciprocals of the
 constant denominators), so it is judged as the GPU normal build is: one frame advanced from

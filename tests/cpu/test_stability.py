@@ -345,7 +345,7 @@ def drape_poles(tmp_path_factory):
             "-ffp-contract=off",
             f"-I{root / 'c_ref'}",
             str(root / "tests/cpu/c/drape_poles.c"),
-            str(root / "c_ref/model.c"),
+            str(root / "c_ref/paper/model.c"),
             "-lm",
             "-o",
             str(exe),

@@ -1,5 +1,5 @@
 """The CUDA port's model math (cuda/model.cuh) run on the HOST against the C reference
-(c_ref/model.c). No GPU needed: model.cuh is `__host__ __device__`, so a host-only program
+(c_ref/paper/model.c). No GPU needed: model.cuh is `__host__ __device__`, so a host-only program
 (cuda/hostcheck/model_hostcheck.cu, no kernel launches) runs the very templates the kernels
 run, on the CPU, with glibc's libm like model.c. Both layouts, fp32 and fp64, P = 2, 3, 16,
 64, four scenes, every stage, the fused wind+collide with and without the kept
@@ -8,14 +8,13 @@ intermediate, prefetch depths 0-4. Built twice:
 - the reference arithmetic (-DHB_REFERENCE_ARITHMETIC=1, the strict build's): bit for bit;
   any difference is a porting, layout or indexing bug;
 - the free arithmetic (the normal build's): every frame within the paper model's
-  tolerances of harness/tolerances.py (the fp32 and fp64 same-precision pairs, and
+  tolerances of harness/core/tolerances.py (the fp32 and fp64 same-precision pairs, and
   MOVED_COUNT_FRACTION for collide's counts), and the port's layouts and depths
   bit-identical to each other.
 
-Built here, independently of the Makefile, into a temporary folder: gcc compiles
-c_ref/model.c and c_ref/params.c with the reference's flags (no FMA contraction, no fast
-math), nvcc compiles the host check with the host compiler told the same. Skipped, with the
-reason, where nvcc or gcc is missing.
+Built by the Makefile (`make hostcheck`: the reference's objects, and nvcc with the host
+compiler told the reference's rules, no FMA contraction, no fast math); the fixture runs make,
+which does nothing when they are current. Skipped, with the reason, where nvcc is missing.
 """
 
 import os
@@ -29,11 +28,6 @@ from harness.core import tolerances
 
 ROOT = Path(__file__).resolve().parents[2]
 
-# The Makefile's CFLAGS_REF (the oracle's flags), minus warnings and OpenMP.
-C_FLAGS = ["-std=c11", "-D_DEFAULT_SOURCE", "-O2", "-ffp-contract=off", "-fno-fast-math"]
-# Host code only: the host compiler gets the same no-contraction, no-fast-math rules.
-NVCC_FLAGS = ["-std=c++17", "-O2", "-Xcompiler", "-ffp-contract=off,-fno-fast-math"]
-
 
 def _tool(env, default, *fallbacks):
     for name in (os.environ.get(env), default, *fallbacks):
@@ -42,45 +36,29 @@ def _tool(env, default, *fallbacks):
     return None
 
 
-def _run(cmd, timeout=600):
-    p = subprocess.run([str(c) for c in cmd], cwd=ROOT, capture_output=True, text=True, timeout=timeout)
+def build_hostcheck(*names):
+    """`make` the host checks named (build/hostcheck/<name>) and return their paths; skips
+    where nvcc is missing."""
+    nvcc = _tool("NVCC", "nvcc", "/usr/local/cuda/bin/nvcc")
+    if nvcc is None:
+        pytest.skip("nvcc not found (set NVCC or put it on PATH): the CUDA port's host checks cannot be built")
+    targets = [f"build/hostcheck/{n}" for n in names]
+    p = subprocess.run(
+        ["make", "--no-print-directory", f"NVCC={nvcc}", *targets],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=1800,
+    )
     if p.returncode != 0:
-        raise AssertionError(f"{' '.join(map(str, cmd))} exited {p.returncode}:\n{p.stdout}\n{p.stderr}")
-    return p
+        raise AssertionError(f"make {' '.join(targets)} exited {p.returncode}:\n{p.stdout[-4000:]}\n{p.stderr[-4000:]}")
+    return [ROOT / t for t in targets]
 
 
 @pytest.fixture(scope="module")
-def hostcheck(tmp_path_factory):
-    nvcc = _tool("NVCC", "nvcc", "/usr/local/cuda/bin/nvcc")
-    if nvcc is None:
-        pytest.skip("nvcc not found (set NVCC or put it on PATH): the CUDA port's host check cannot be built")
-    cc = _tool("CC", "gcc", "cc")
-    if cc is None:
-        pytest.skip("no C compiler (gcc/cc) found: the C reference cannot be built for the host check")
-    d = tmp_path_factory.mktemp("hostcheck")
-    objs = []
-    for src in ("model.c", "params.c"):
-        obj = d / (Path(src).stem + ".o")
-        _run([cc, *C_FLAGS, "-Ic_ref", "-c", f"c_ref/{src}", "-o", obj])
-        objs.append(obj)
-    exes = {}
-    for mode, defines in (("reference", ["-DHB_REFERENCE_ARITHMETIC=1"]), ("free", [])):
-        exes[mode] = d / f"model_hostcheck_{mode}"
-        _run(
-            [
-                nvcc,
-                *NVCC_FLAGS,
-                *defines,
-                "-Ic_ref",
-                "-Icuda",
-                "cuda/hostcheck/model_hostcheck.cu",
-                *objs,
-                "-o",
-                exes[mode],
-                "-lm",
-            ]
-        )
-    return exes
+def hostcheck():
+    ref, free = build_hostcheck("model_hostcheck_reference", "model_hostcheck_free")
+    return {"reference": ref, "free": free}
 
 
 def _check(exe, *args):

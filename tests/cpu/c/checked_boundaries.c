@@ -1,7 +1,7 @@
-/* checked_boundaries.c — c_ref/checked.h at the edges of 64 bits; exits non-zero on a miss. */
+/* checked_boundaries.c — c_ref/runtime/checked.h at the edges of 64 bits; exits non-zero on a miss. */
 #include <stdio.h>
 
-#include "checked.h"
+#include "runtime/checked.h"
 
 static int misses;
 #define EXPECT(cond)                                                                                                   \

@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "model.h"
+#include "paper/model.h"
 
 #define P 12
 

@@ -5,7 +5,7 @@
 
 #include <hdf5.h>
 
-#include "params.h"
+#include "runtime/params.h"
 
 /* A fixed-length, NUL-terminated ASCII string attribute: scalar, or n values. <0 on failure. */
 int hb_h5md_str_attr(hid_t loc, const char *name, const char *value);

@@ -20,7 +20,7 @@
 
 #include <stdint.h>
 
-#include "dynamics.h"
+#include "dynamic/dynamics.h"
 
 #ifdef __cplusplus
 extern "C" {

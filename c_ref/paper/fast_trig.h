@@ -24,7 +24,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "philox.h" /* HB_HD */
+#include "runtime/philox.h" /* HB_HD */
 
 /* The device's approximate reciprocal and reciprocal square root (the MUFU's, one instruction
  * each: their .ftz forms skip the subnormal-input fix-up that rcpf/rsqrtf add in a build without

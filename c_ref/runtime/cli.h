@@ -4,7 +4,7 @@
 
 #include <stdio.h>
 
-#include "params.h"
+#include "runtime/params.h"
 
 #ifdef __cplusplus
 extern "C" {

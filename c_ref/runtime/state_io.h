@@ -7,8 +7,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "dynamics.h"
-#include "params.h"
+#include "dynamic/dynamics.h"
+#include "runtime/params.h"
 
 #ifdef __cplusplus
 extern "C" {

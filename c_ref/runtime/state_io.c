@@ -1,8 +1,8 @@
 /* state_io.c — HDF5 states, H5MD 1.1 shaped (layout in docs/interfaces.md). */
-#include "state_io.h"
-#include "safe_write.h"
-#include "checked.h"
-#include "h5md_meta.h"
+#include "runtime/state_io.h"
+#include "runtime/safe_write.h"
+#include "runtime/checked.h"
+#include "runtime/h5md_meta.h"
 
 #include <errno.h>
 #include <stddef.h>

@@ -1,8 +1,8 @@
 /* dynamics_host.c — the host-side numbers of the dynamic model that every backend shares
  * (docs/model.md §3.10): the features of a run, its constants rounded once, and each
  * frame's table of head rotations and gust phases, computed in double. */
-#include "dynamics.h"
-#include "checked.h"
+#include "dynamic/dynamics.h"
+#include "runtime/checked.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,5 +1,5 @@
 /* h5md_meta.c — see h5md_meta.h. */
-#include "h5md_meta.h"
+#include "runtime/h5md_meta.h"
 
 #include <stdint.h>
 #include <stdlib.h>

@@ -5,8 +5,8 @@
 
 #include <stdio.h>
 
-#include "params.h"
-#include "state_io.h"
+#include "runtime/params.h"
+#include "runtime/state_io.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -1,7 +1,7 @@
 /* params.c — scene validation (docs/model.md §2.6: bad scenes are refused before any work, with a
  * message naming the flag). */
-#include "params.h"
-#include "checked.h"
+#include "runtime/params.h"
+#include "runtime/checked.h"
 
 #include <float.h>
 #include <math.h>

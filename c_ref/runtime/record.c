@@ -1,5 +1,5 @@
 /* record.c — the run record as JSON (docs/interfaces.md) and as a short summary. */
-#include "record.h"
+#include "runtime/record.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -92,38 +92,41 @@ static void json_num(FILE *f, double v)
     else fputs("null", f);
 }
 
+/* `, "key": value` */
+static void json_key_num(FILE *f, const char *key, double v)
+{
+    fprintf(f, ", \"%s\": ", key);
+    json_num(f, v);
+}
+
+static void json_key_str(FILE *f, const char *key, const char *v)
+{
+    fprintf(f, ", \"%s\": ", key);
+    json_str(f, v);
+}
+
 void hb_record_json(FILE *f, const hb_record *r)
 {
     const hb_scene *s = &r->opt->scene;
     fputs("{\"backend\": ", f);
     json_str(f, r->backend);
-    fputs(", \"variant\": ", f);
-    json_str(f, r->variant);
-    fputs(", \"precision\": ", f);
-    json_str(f, hb_precision_name(s->precision));
+    json_key_str(f, "variant", r->variant);
+    json_key_str(f, "precision", hb_precision_name(s->precision));
     fprintf(f, ", \"strands\": %lld, \"points\": %lld, \"seed\": %llu", (long long)s->n_strands, (long long)s->points,
             (unsigned long long)s->seed);
-    fputs(", \"head_radius\": ", f);
-    json_num(f, s->head_radius);
-    fputs(", \"hair_offset\": ", f);
-    json_num(f, s->hair_offset);
-    fputs(", \"hair_length\": ", f);
-    json_num(f, s->hair_length);
-    fputs(", \"face_margin\": ", f);
-    json_num(f, s->face_margin);
-    fputs(", \"wind_strength\": ", f);
-    json_num(f, s->wind_strength);
-    fputs(", \"wind_angle\": ", f);
-    json_num(f, s->wind_angle);
+    json_key_num(f, "head_radius", s->head_radius);
+    json_key_num(f, "hair_offset", s->hair_offset);
+    json_key_num(f, "hair_length", s->hair_length);
+    json_key_num(f, "face_margin", s->face_margin);
+    json_key_num(f, "wind_strength", s->wind_strength);
+    json_key_num(f, "wind_angle", s->wind_angle);
     if (r->threads > 0) fprintf(f, ", \"threads\": %d", r->threads);
     else fputs(", \"threads\": null", f);
     if (r->block_size > 0) fprintf(f, ", \"block_size\": %d", r->block_size);
     else fputs(", \"block_size\": null", f);
     fprintf(f, ", \"repeat\": %d, \"warmup\": %d", r->opt->repeat, r->opt->warmup);
-    fputs(", \"input\": ", f);
-    json_str(f, r->opt->input);
-    fputs(", \"output\": ", f);
-    json_str(f, r->opt->output);
+    json_key_str(f, "input", r->opt->input);
+    json_key_str(f, "output", r->opt->output);
     fputs(", \"stages\": [", f);
     for (int i = 0; i < r->n_stages; i++) {
         const hb_stage_record *st = &r->stages[i];
@@ -131,12 +134,9 @@ void hb_record_json(FILE *f, const hb_record *r)
         json_str(f, st->meta.stage);
         fprintf(f, ", \"skipped\": %s, \"fused\": ", st->meta.skipped ? "true" : "false");
         json_str(f, st->meta.fused[0] ? st->meta.fused : NULL);
-        fputs(", \"median_ms\": ", f);
-        json_num(f, st->meta.median_ms);
-        fputs(", \"min_ms\": ", f);
-        json_num(f, st->meta.min_ms);
-        fputs(", \"max_ms\": ", f);
-        json_num(f, st->meta.max_ms);
+        json_key_num(f, "median_ms", st->meta.median_ms);
+        json_key_num(f, "min_ms", st->meta.min_ms);
+        json_key_num(f, "max_ms", st->meta.max_ms);
         fputs(", \"times_ms\": [", f);
         for (int k = 0; k < st->n_times; k++) {
             if (k) fputs(", ", f);
@@ -149,52 +149,35 @@ void hb_record_json(FILE *f, const hb_record *r)
             const hb_dynamics *d = &s->dyn;
             fprintf(f, ", \"frames\": %lld, \"substeps\": %lld, \"iterations\": %lld, \"solver\": \"%s\"",
                     (long long)st->frames, (long long)d->substeps, (long long)d->iterations, hb_solver_name(d->solver));
-            fputs(", \"features\": ", f);
-            json_str(f, st->features);
-            fputs(", \"frame_dt\": ", f);
-            json_num(f, d->frame_dt);
+            json_key_str(f, "features", st->features);
+            json_key_num(f, "frame_dt", d->frame_dt);
             /* point-substeps per second of the median frame */
-            fputs(", \"point_substeps_per_s\": ", f);
-            json_num(f, (double)s->n_strands * (double)s->points * (double)d->substeps / (1e-3 * st->meta.median_ms));
-            fputs(", \"observe_ms\": ", f);
-            json_num(f, st->observe_ms);
-            fputs(", \"frame_loop_ms\": ", f);
-            json_num(f, st->loop_ms);
-            fputs(", \"frame_loop_graph_ms\": ", f);
-            json_num(f, st->loop_graph_ms);
+            json_key_num(f, "point_substeps_per_s",
+                         (double)s->n_strands * (double)s->points * (double)d->substeps / (1e-3 * st->meta.median_ms));
+            json_key_num(f, "observe_ms", st->observe_ms);
+            json_key_num(f, "frame_loop_ms", st->loop_ms);
+            json_key_num(f, "frame_loop_graph_ms", st->loop_graph_ms);
             fputs(", \"last_observables\": {\"stretch_max\": ", f);
             json_num(f, st->last.stretch_max);
-            fputs(", \"penetration_max\": ", f);
-            json_num(f, st->last.penetration_max);
-            fputs(", \"kinetic_energy\": ", f);
-            json_num(f, st->last.kinetic_energy);
+            json_key_num(f, "penetration_max", st->last.penetration_max);
+            json_key_num(f, "kinetic_energy", st->last.kinetic_energy);
             fprintf(f, ", \"blown_up_strands\": %lld}, \"blown_up_frames\": %lld", (long long)st->last.blown_up_strands,
                     (long long)st->blown_frames);
         }
         fputc('}', f);
     }
     fputs("]", f);
-    fputs(", \"end_to_end_ms\": ", f);
-    json_num(f, r->end_to_end_ms);
-    fputs(", \"h2d_ms\": ", f);
-    json_num(f, r->h2d_ms);
-    fputs(", \"d2h_ms\": ", f);
-    json_num(f, r->d2h_ms);
-    fputs(", \"hdf5_write_ms\": ", f);
-    json_num(f, r->hdf5_write_ms);
+    json_key_num(f, "end_to_end_ms", r->end_to_end_ms);
+    json_key_num(f, "h2d_ms", r->h2d_ms);
+    json_key_num(f, "d2h_ms", r->d2h_ms);
+    json_key_num(f, "hdf5_write_ms", r->hdf5_write_ms);
     fprintf(f, ", \"state_bytes\": %llu", (unsigned long long)hb_state_bytes(s));
-    fputs(", \"git_revision\": ", f);
-    json_str(f, r->git_revision);
-    fputs(", \"compiler\": ", f);
-    json_str(f, r->compiler);
-    fputs(", \"flags\": ", f);
-    json_str(f, r->flags);
-    fputs(", \"device\": ", f);
-    json_str(f, r->device);
-    fputs(", \"driver\": ", f);
-    json_str(f, r->driver[0] ? r->driver : NULL);
-    fputs(", \"version\": ", f);
-    json_str(f, HB_VERSION);
+    json_key_str(f, "git_revision", r->git_revision);
+    json_key_str(f, "compiler", r->compiler);
+    json_key_str(f, "flags", r->flags);
+    json_key_str(f, "device", r->device);
+    json_key_str(f, "driver", r->driver[0] ? r->driver : NULL);
+    json_key_str(f, "version", HB_VERSION);
     fputs("}\n", f);
 }
 

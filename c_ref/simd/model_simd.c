@@ -28,13 +28,13 @@
  * Check that the calls are vectorised: objdump -dr build/obj/model_simd.o | grep _ZGV
  * (tests/cpu/test_cpu_simd.py fails on any scalar call to these functions).
  */
-#include "model_simd.h"
+#include "simd/model_simd.h"
 
 #include <math.h>
 #include <stddef.h>
 
-#include "fast_trig.h"
-#include "philox.h"
+#include "paper/fast_trig.h"
+#include "runtime/philox.h"
 
 #if !defined(__x86_64__) || !defined(__GLIBC__)
 #error "model_simd.c needs x86_64 and glibc's libmvec"
@@ -63,42 +63,18 @@ const char hb_simd_isa[] = "x86-64-v3 (AVX2 + FMA)";
 const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #endif
 
-#define REAL float
+#include "paper/precision_f32.h"
 #define ITYPE int32_t
 #define BLOCK HB_SIMD_BLOCK_F32
-#define SFX(name) name##_f32
-#define MODEL hb_model_f32
-#define SQRT sqrtf
-#define SIN sinf
-#define COS cosf
-#define ASIN asinf
-#define ATAN2 atan2f
-#define EPS 0x1p-23f
 #define FAST_TRIG 1
-#include "model_simd_impl.h"
-#undef REAL
+#include "simd/model_simd_impl.h"
+#include "paper/precision_end.h"
 #undef ITYPE
 #undef BLOCK
-#undef SFX
-#undef MODEL
-#undef SQRT
-#undef SIN
-#undef COS
-#undef ASIN
-#undef ATAN2
-#undef EPS
 #undef FAST_TRIG
 
-#define REAL double
+#include "paper/precision_f64.h"
 #define ITYPE int64_t
 #define BLOCK HB_SIMD_BLOCK_F64
-#define SFX(name) name##_f64
-#define MODEL hb_model_f64
-#define SQRT sqrt
-#define SIN sin
-#define COS cos
-#define ASIN asin
-#define ATAN2 atan2
-#define EPS 0x1p-52
 #define FAST_TRIG 0
-#include "model_simd_impl.h"
+#include "simd/model_simd_impl.h"

@@ -1,6 +1,6 @@
 /* cli.c — strict command-line parsing: every number is checked whole (no trailing junk,
  * no NaN, no overflow) and every error names its flag. */
-#include "cli.h"
+#include "runtime/cli.h"
 
 #include <errno.h>
 #include <inttypes.h>

@@ -12,14 +12,14 @@
  *
  * Check: objdump -dr build/obj/dynamics_simd.o | grep _ZGV lists the vector sines.
  */
-#include "dynamics_simd.h"
+#include "simd/dynamics_simd.h"
 
 #include <float.h>
 #include <immintrin.h>
 #include <math.h>
 #include <stddef.h>
 
-#include "model_simd.h"
+#include "simd/model_simd.h"
 
 #if !defined(__x86_64__) || !defined(__GLIBC__)
 #error "dynamics_simd.c needs x86_64 and glibc's libmvec"
@@ -62,33 +62,15 @@ static inline __attribute__((always_inline)) void inv_sqrt_row_f64(const double 
     for (int j = 0; j < HB_SIMD_DYN_BLOCK; j++) out[j] = 1.0 / sqrt(in[j]);
 }
 
-#define REAL float
-#define SFX(name) name##_f32
-#define DMODEL hb_dyn_model_f32
-#define SQRT sqrtf
-#define SIN sinf
-#define QTABLE(fr) ((fr)->q32)
-#define PHASE(fr) ((fr)->phase32)
+#include "dynamic/precision_f32.h"
 #define INV_SQRT_ROW(in, out) inv_sqrt_row_f32(in, out)
 #define TINY FLT_MIN
-#include "dynamics_simd_impl.h"
+#include "simd/dynamics_simd_impl.h"
 #undef INV_SQRT_ROW
 #undef TINY
-#undef REAL
-#undef SFX
-#undef DMODEL
-#undef SQRT
-#undef SIN
-#undef QTABLE
-#undef PHASE
+#include "dynamic/precision_end.h"
 
-#define REAL double
-#define SFX(name) name##_f64
-#define DMODEL hb_dyn_model_f64
-#define SQRT sqrt
-#define SIN sin
-#define QTABLE(fr) ((fr)->q64)
-#define PHASE(fr) ((fr)->phase64)
+#include "dynamic/precision_f64.h"
 #define INV_SQRT_ROW(in, out) inv_sqrt_row_f64(in, out)
 #define TINY DBL_MIN
-#include "dynamics_simd_impl.h"
+#include "simd/dynamics_simd_impl.h"

@@ -1,8 +1,4 @@
-/* dynamics_f64.c — dynamics_impl.h for double (one file per precision: they compile in parallel). */
-#include "dynamics.h"
-
-#include <math.h>
-
+/* precision_f64.h — as precision_f32.h, for double. */
 #define REAL double
 #define SFX(name) name##_f64
 #define DMODEL hb_dyn_model_f64
@@ -10,4 +6,3 @@
 #define SIN sin
 #define QTABLE(fr) ((fr)->q64)
 #define PHASE(fr) ((fr)->phase64)
-#include "dynamics_impl.h"

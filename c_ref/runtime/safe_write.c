@@ -1,6 +1,6 @@
 /* safe_write.c — see safe_write.h. */
 #define _GNU_SOURCE /* program_invocation_short_name */
-#include "safe_write.h"
+#include "runtime/safe_write.h"
 
 #include <dirent.h>
 #include <errno.h>

@@ -5,8 +5,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "model.h"
-#include "params.h"
+#include "runtime/params.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -14,10 +13,6 @@ extern "C" {
 
 /* Monotonic wall-clock time in milliseconds. */
 double hb_now_ms(void);
-
-/* The paper model's numbers rounded once to the working precision (docs/model.md §1.3):
- * derived values in double, then each rounded once to float. */
-void hb_model_round(const hb_scene *s, hb_model_f32 *m32, hb_model_f64 *m64);
 
 /* The one-line "does not fit" message: "the state needs X GB of <kind> memory (N strands x
  * P points, fp32<detail>) but only Y GB is <available | free on DEVICE>". */

@@ -12,7 +12,7 @@
 
 #include <stdint.h>
 
-#include "params.h"
+#include "runtime/params.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -11,6 +11,8 @@
 
 #include <stdint.h>
 
+#include "runtime/params.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -32,6 +34,10 @@ typedef struct {
  * only when its slice radius is below rc·(1 − HB_SHELL_ULPS·ε) (docs/model.md §2.5;
  * docs/decisions/testing.md). */
 #define HB_SHELL_ULPS 16
+
+/* The scene's numbers rounded once to the working precision (docs/model.md §1.3): derived
+ * values in double, then each rounded once to float (model_host.c). */
+void hb_model_round(const hb_scene *s, hb_model_f32 *m32, hb_model_f64 *m64);
 
 /* init = place the root from the RNG, then drape; drape alone re-drapes from s[0..2]. */
 void hb_init_strand_f32(const hb_model_f32 *m, uint64_t strand, float *s);

@@ -1,7 +1,6 @@
-/* backend_dyn.cuh — the simulate stage of the CUDA backend (the hb_backend hooks dyn_load,
- * dyn_frame, dyn_observe, dyn_fetch_velocity; docs/cuda.md "The dynamic model"). Included by
- * backend_cuda.cu inside its anonymous namespace, after cuda_impl (it is not a translation
- * unit of its own, hence .cuh).
+/* backend_dyn.cu — the simulate stage of the CUDA backend (the hb_backend hooks dyn_load,
+ * dyn_frame, dyn_observe, dyn_fetch_velocity, dyn_loop; docs/cuda.md "The dynamic model"),
+ * on the backend state of backend_cuda.cuh.
  *
  * Variants that run simulate:
  *   strand  one thread per strand; the state, velocities and rest shape point-major
@@ -23,7 +22,21 @@
  * then records the events immediately around the one kernel launch.
  */
 
+#include <cuda_runtime.h>
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "backend_cuda.cuh"
+#include "check.cuh"
+#include "dyn_kernels.cuh"
+#include "runtime/checked.h"
+#include "runtime/host.h"
+
 namespace hbd = hb::dyn;
+
+namespace hb_cuda {
 
 struct DynState {
     int64_t S;
@@ -43,18 +56,18 @@ int dyn_is_strand_major(const cuda_impl *c)
     return c->variant == V_PAPER || c->variant == V_WARP || c->variant == V_WARPREG || c->variant == V_LANES;
 }
 
-int dyn_is_warp(const cuda_impl *c)
+static int dyn_is_warp(const cuda_impl *c)
 {
     return c->variant == V_WARP || c->variant == V_WARPREG || c->variant == V_LANES;
 }
 
 /* The variant's layouts of the state (and of velocities and rest shape). */
-hbd::Layout dyn_layout(const cuda_impl *c)
+static hbd::Layout dyn_layout(const cuda_impl *c)
 {
     if (dyn_is_warp(c)) return hbd::Layout{3 * c->P, 3, 1};
     return hbd::Layout{1, c->N, c->N * c->P};
 }
-hbd::Layout1 dyn_bend_layout(const cuda_impl *c)
+static hbd::Layout1 dyn_bend_layout(const cuda_impl *c)
 {
     if (dyn_is_warp(c)) return hbd::Layout1{c->P - 2 > 0 ? c->P - 2 : 0, 1};
     return hbd::Layout1{1, c->N};
@@ -62,7 +75,7 @@ hbd::Layout1 dyn_bend_layout(const cuda_impl *c)
 
 /* Grid of the strand variant: one thread a strand, at most as many threads as the device
  * holds at once (the scratch is sized for them). */
-int dyn_strand_grid(int64_t N, int block, int64_t resident)
+static int dyn_strand_grid(int64_t N, int block, int64_t resident)
 {
     int64_t g = (N + block - 1) / block;
     const int64_t cap = resident / block > 0 ? resident / block : 1;
@@ -221,7 +234,7 @@ int dyn_restore(cuda_impl *c, char *err, size_t errlen)
 /* canonical host array -> the variant's layout in `dst` (through the staging buffer for
  * the point-major strand variant) */
 template <typename T>
-int dyn_upload(cuda_impl *c, void *dst, const void *canonical, const char *what, char *err, size_t errlen)
+static int dyn_upload(cuda_impl *c, void *dst, const void *canonical, const char *what, char *err, size_t errlen)
 {
     if (dyn_is_warp(c)) {
         HB_CUDA_AS(cudaMemcpy(dst, canonical, (size_t)c->bytes, cudaMemcpyHostToDevice), what);
@@ -235,7 +248,8 @@ int dyn_upload(cuda_impl *c, void *dst, const void *canonical, const char *what,
     return 0;
 }
 
-template <typename T> int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char *err, size_t errlen)
+template <typename T>
+static int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char *err, size_t errlen)
 {
     DynState *d = c->dyn;
     if (velocity) {
@@ -271,7 +285,7 @@ int cuda_dyn_load(hb_backend *b, const void *velocity, const void *rest, char *e
 
 /* One frame's kernel on `stream`, with the frame's tables q [S][9] and ph [S] on the device. */
 template <typename T>
-cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m, const void *q, const void *ph, cudaStream_t stream)
+static cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m, const void *q, const void *ph, cudaStream_t stream)
 {
     DynState *d = c->dyn;
     if (c->variant == V_STRAND)
@@ -289,7 +303,7 @@ cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m, const void *q, con
                                      (const T *)d->bend_rest, c->N, d->grid, c->block, stream);
 }
 
-const char *dyn_launch_name(const cuda_impl *c)
+static const char *dyn_launch_name(const cuda_impl *c)
 {
     return c->variant == V_STRAND    ? "the simulate kernel launch (strand)"
            : c->variant == V_WARPREG ? "the simulate kernel launch (warpreg)"
@@ -389,7 +403,7 @@ struct LoopRes {
 };
 
 /* Enqueues n frames on r.st: each frame's tables from pinned host memory, then its kernel. */
-cudaError_t dyn_enqueue_loop(cuda_impl *c, LoopRes &r, int n, size_t tq, size_t tp)
+static cudaError_t dyn_enqueue_loop(cuda_impl *c, LoopRes &r, int n, size_t tq, size_t tp)
 {
     const int fp32 = c->scene.precision == HB_FP32;
     for (int i = 0; i < n; i++) {
@@ -447,3 +461,5 @@ int cuda_dyn_loop(hb_backend *b, const hb_dyn_frame *plans, int n, double *ms, d
     }
     return 0;
 }
+
+} // namespace hb_cuda

@@ -8,14 +8,14 @@
 #include <string.h>
 #include <time.h>
 
-#include "backend.h"
-#include "checked.h"
-#include "cli.h"
-#include "host.h"
-#include "philox.h"
-#include "record.h"
-#include "safe_write.h"
-#include "state_io.h"
+#include "runtime/backend.h"
+#include "runtime/checked.h"
+#include "runtime/cli.h"
+#include "runtime/host.h"
+#include "runtime/philox.h"
+#include "runtime/record.h"
+#include "runtime/safe_write.h"
+#include "runtime/state_io.h"
 
 static const char *g_prog = "hairsim";
 

@@ -13,7 +13,7 @@
  * better-conditioned evaluations of docs/model.md §2.3, §2.5), with its branches turned into
  * selects, in the free arithmetic of model_simd_impl.h (fewer operations, judged by
  * tolerance); sin/cos/asin/atan2 are glibc's libmvec vector functions or, for the fp32
- * drape, c_ref/fast_trig.h's. model_simd.c is compiled for x86-64-v3 (AVX2 + FMA): call these only after
+ * drape, c_ref/paper/fast_trig.h's. model_simd.c is compiled for x86-64-v3 (AVX2 + FMA): call these only after
  * hb_simd_cpu_ok() in a file compiled for the baseline ISA (backend_cpu.c does).
  */
 #ifndef HB_MODEL_SIMD_H
@@ -21,7 +21,7 @@
 
 #include <stdint.h>
 
-#include "model.h"
+#include "paper/model.h"
 
 #ifdef __cplusplus
 extern "C" {

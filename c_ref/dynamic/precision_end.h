@@ -1,0 +1,8 @@
+/* precision_end.h — removes the names of precision_f32.h / precision_f64.h. */
+#undef REAL
+#undef SFX
+#undef DMODEL
+#undef SQRT
+#undef SIN
+#undef QTABLE
+#undef PHASE

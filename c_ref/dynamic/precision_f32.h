@@ -1,0 +1,10 @@
+/* precision_f32.h — the names the dynamic model's math is written in (dynamic/dynamics_impl.h,
+ * simd/dynamics_simd_impl.h), for float; precision_end.h removes them. Included by the files
+ * that instantiate the math (dynamic/dynamics_f32.c, simd/dynamics_simd.c). */
+#define REAL float
+#define SFX(name) name##_f32
+#define DMODEL hb_dyn_model_f32
+#define SQRT sqrtf
+#define SIN sinf
+#define QTABLE(fr) ((fr)->q32)
+#define PHASE(fr) ((fr)->phase32)

@@ -1,0 +1,14 @@
+/* model.c — instantiates model_impl.h for float and for double. */
+#include "paper/model.h"
+
+#include <math.h>
+
+#include "runtime/philox.h"
+
+#include "paper/precision_f32.h"
+#include "paper/model_impl.h"
+#include "paper/precision_end.h"
+
+#include "paper/precision_f64.h"
+#include "paper/model_impl.h"
+#include "paper/precision_end.h"
