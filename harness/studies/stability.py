@@ -217,7 +217,7 @@ def measure(
         (slc, r, c, solver, precision, be)
         for be in bes
         for slc, r, c in cells(chosen, quick)
-        for solver in declared[be].solvers
+        for solver in declared[be].dynamic_solvers
         for precision in declared[be].precisions
     ]
     jobs = jobs or os.cpu_count() or 1
