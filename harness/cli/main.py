@@ -228,14 +228,14 @@ def accuracy_model(args):
 
     model = args.model
     if args.from_csv and model is None:
-        from harness.studies.accuracy_dynamic import COLUMNS
+        from harness.studies.accuracy import REQUIRED_COLUMNS
 
         try:
             with open(args.from_csv, encoding="utf-8") as fh:
                 header = fh.readline().strip().split(",")
         except (OSError, UnicodeDecodeError) as e:
             raise HarnessError(f"accuracy: --from-csv {args.from_csv}: cannot read ({e})") from None
-        model = "dynamic" if header == list(COLUMNS) else "paper"
+        model = "dynamic" if set(REQUIRED_COLUMNS) <= set(header) else "paper"
     if args.scene is not None and not args.from_csv:
         scene_model = scenes.load_scene(args.scene).model
         if model is not None and model != scene_model:
@@ -713,9 +713,7 @@ def parser():
         default=None,
         help="dynamic: simulated time of the long runs (energy, tip motion, jitter, distributions; default 10; 0: none)",
     )
-    a.add_argument(
-        "--long-strands", type=whole(2), default=None, help="dynamic: strands of the long runs (default 8)"
-    )
+    a.add_argument("--long-strands", type=whole(2), default=None, help="dynamic: strands of the long runs (default 8)")
     a.add_argument("--force", action="store_true", help="dynamic: replace an existing results CSV")
     a.add_argument(
         "--out", default=None, help="results directory (default results/accuracy or results/dynamic-accuracy)"

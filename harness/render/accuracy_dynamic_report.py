@@ -19,9 +19,10 @@ from harness.core import tolerances
 from harness.core.paths import REPORT, RESULTS, display
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
-    COLUMNS,
     CSV_NAME,
+    LATER_COLUMNS,
     NO_SIMULATION,
+    REQUIRED_COLUMNS,
     RESULTS_NAME,
     holds_until,
     scheme_name,
@@ -52,11 +53,16 @@ def load(results_dir, csv_path=None):
         raise HarnessError(f"{display(csv_path)} not found: run `python -m harness accuracy --model dynamic`") from None
     except (OSError, ValueError) as e:
         raise HarnessError(f"{display(csv_path)}: cannot read ({e})") from None
-    missing = [c for c in COLUMNS if c not in rows.columns]
+    missing = [c for c in REQUIRED_COLUMNS if c not in rows.columns]
     if missing or rows.empty:
         raise HarnessError(
             f"{display(csv_path)}: not a dynamic accuracy table (missing {', '.join(missing) or 'rows'})"
         )
+    for c in LATER_COLUMNS:
+        if c not in rows.columns:
+            rows[c] = np.nan
+    if rows["verdict"].isna().all():  # written before the split by cause
+        rows["verdict"] = np.where(rows["blown_up_strands"] > 0, "blown up", "ok")
     try:
         env = json.loads((results_dir / "env.json").read_text())
         study = env["study"]
@@ -106,9 +112,13 @@ def summary(rows, horizon_frames):
 
 
 def _worst_verdict(s):
-    """diverged before escaped before ok, over a mode's frames."""
+    """diverged before escaped before ok, over a mode's frames ("blown up": a table written
+    before the split by cause)."""
     v = set(s.dropna().astype(str))
-    return "diverged" if "diverged" in v else "escaped" if "escaped" in v else "ok"
+    for worst in ("diverged", "escaped", "blown up"):
+        if worst in v:
+            return worst
+    return "ok"
 
 
 def baseline(summ):
@@ -584,7 +594,9 @@ def pareto_plot(summ, study, path):
     markers = {s: "osD^v<>"[i % 7] for i, s in enumerate(solvers)}
     base = baseline(summ)
     if base is not None and np.isfinite(base["rms"]):
-        ax.axhline(base["rms"], color="0.3", lw=0.9, ls="--", label=f"no simulation ({NO_SIMULATION}): {_e(base['rms'])}")
+        ax.axhline(
+            base["rms"], color="0.3", lw=0.9, ls="--", label=f"no simulation ({NO_SIMULATION}): {_e(base['rms'])}"
+        )
     for _, r in ok.iterrows():
         c = colors[_label(r)]
         filled = r["precision"] == "fp64"
@@ -793,7 +805,8 @@ def _mode_table(df, numbered=False, base=None):
         ("| # " if numbered else "")
         + "| mode | time/frame (ms) | RMS err / L | ÷ no-sim RMS | p99 err / L | max err / L | stretch_max | "
         "stretch p99 | IoU min | penetration_max (cm) | verdict (blown-up strands) |",
-        ("| ---: " if numbered else "") + "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |",
+        ("| ---: " if numbered else "")
+        + "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |",
     ]
     b = base["rms"] if base is not None and np.isfinite(base["rms"]) and base["rms"] > 0 else None
     for k, (_, r) in enumerate(df.iterrows(), 1):

@@ -141,7 +141,9 @@ def check_plan(plan, frame_dt):
     if plan.long_seconds < 0 or (plan.long_seconds > 0 and plan.long_seconds < 4 * frame_dt):
         bad.append(f"--long-seconds must be 0 (none) or at least 4 frames (got {plan.long_seconds:g})")
     if plan.long_strands < 2:
-        bad.append(f"--long-strands must be at least 2 (its noise is the two halves' difference; got {plan.long_strands})")
+        bad.append(
+            f"--long-strands must be at least 2 (its noise is the two halves' difference; got {plan.long_strands})"
+        )
     if bad:
         raise HarnessError("accuracy --model dynamic: " + "; ".join(bad))
 
@@ -236,9 +238,7 @@ def frame_metrics(run, ref, L, gravity):
     `ref` (a Run, or None), stretch p99, kinetic and potential energy per particle."""
     F = len(run.times)
     out = {k: [np.nan] * F for k in ("err_p50_L", "err_p95_L", "err_p99_L", "iou_front", "iou_side")}
-    out["verdict"] = [
-        observables.verdict(run.pos[f], L, None if run.vel is None else run.vel[f]) for f in range(F)
-    ]
+    out["verdict"] = [observables.verdict(run.pos[f], L, None if run.vel is None else run.vel[f]) for f in range(F)]
     out["stretch_p99"] = [observables.stretch_stats(run.pos[f], L)[1] for f in range(F)]
     if run.vel is not None:
         k, p, _ = observables.energy(run.pos, run.vel, gravity)

@@ -156,7 +156,9 @@ class LongRuns:
         rows, refs = [], {}
         for scene in SCENES:
             runs = [
-                self.run(scene, self.ref_build, REF_SOLVER, S, REF_ITERATIONS, REF_PRECISION, None, f"ref_S{S}", threads)
+                self.run(
+                    scene, self.ref_build, REF_SOLVER, S, REF_ITERATIONS, REF_PRECISION, None, f"ref_S{S}", threads
+                )
                 for S in (self.ref_S, 2 * self.ref_S)
             ]
             dt = st.frame_dt
