@@ -711,7 +711,8 @@ def parser():
         "--long-seconds",
         type=nonneg_seconds,
         default=None,
-        help="dynamic: simulated time of the long runs (energy, tip motion, jitter, distributions; default 10; 0: none)",
+        help="dynamic: simulated time of the long runs (energy, tip motion, jitter, distributions; "
+        "default 10; 0: none)",
     )
     a.add_argument("--long-strands", type=whole(2), default=None, help="dynamic: strands of the long runs (default 8)")
     a.add_argument("--force", action="store_true", help="dynamic: replace an existing results CSV")
@@ -884,9 +885,10 @@ def parser():
         "stability",
         help="the dynamic model's stability map: verdicts over 2-D slices of the scene space",
         description="Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend "
-        "compliance and points; head-motion frequency against amplitude) for both solvers and precisions, "
-        "on the CPU and every built CUDA build where a GPU answers; judge each cell ok, over-stretched, "
-        "penetrating or blown up; write results/stability/, report/stability_*.png and "
+        "compliance, points and iterations; head-motion frequency against amplitude) for both solvers and "
+        "precisions, on the CPU and every built CUDA build where a GPU answers; judge each cell ok, "
+        "over-stretched, penetrating, escaped (a point past 2L) or diverged (NaN/Inf); write "
+        "results/stability/, report/stability_*.png and "
         "report/dynamic_stability.md.",
     )
     sb.add_argument("--quick", action="store_true", help="a coarser grid (about a quarter of the cells)")

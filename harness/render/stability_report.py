@@ -227,7 +227,8 @@ def write_markdown(rows, path, info, pngs):
         "**diverged** (a strand blown up in some frame, docs/model.md §3.8, and a NaN or Inf in the last "
         "frame), **escaped** (a strand blown up in some frame by a point farther than 2L from its root, every "
         "number finite: large but bounded, as an iteration-starved run is; the substeps-iterations slice shows "
-        "where more iterations bring it back), **penetrating** (penetration_max > {bound_p:g}·R_c), **over-stretched** "
+        "where more iterations bring it back), "
+        f"**penetrating** (penetration_max > {bound_p:g}·R_c), **over-stretched** "
         f"(stretch_max > {bound_s:g}, i.e. {100 * bound_s:.0f} %), else **ok** (bounds and their reasons: "
         "harness/core/tolerances.py STABILITY_*).",
         "",

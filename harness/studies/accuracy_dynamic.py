@@ -42,9 +42,9 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
+from harness.check import observables
 from harness.core import env, runner, scenes, scenes_dynamic, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
-from harness.check import observables
 from harness.io.trajectory import open_trajectory
 from harness.studies.accuracy import (
     ANALYTIC_NAME,

@@ -129,14 +129,14 @@ class LongRuns:
         release = scenes.load_scene(RELEASE_SCENE).with_overrides(points=study.scene.points)
         self.scenes = {"motion": study.scene, "release": release}
 
-    def run(self, scene, build, solver, S, I, precision, ftl_damping, tag, threads):
+    def run(self, scene, build, solver, substeps, iterations, precision, ftl_damping, tag, threads):
         from harness.studies.accuracy_dynamic import configured
 
         sc = configured(
             self.scenes[scene],
             solver=solver,
-            substeps=S,
-            iterations=I,
+            substeps=substeps,
+            iterations=iterations,
             precision=precision,
             frames=self.frames,
             strands=self.plan.long_strands,
