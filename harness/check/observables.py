@@ -59,6 +59,31 @@ def tip_displacement(pos, axis=1):
     return tip - tip.mean()
 
 
+def tip_swing(pos):
+    """Per strand, the tip's horizontal displacement from its root along the horizontal
+    direction it starts in (the plane a released strand swings in): [F][N]. A strand whose
+    tip starts straight below its root uses x."""
+    x = _f64(pos)
+    rel = x[:, :, -1, :] - x[:, :, :1, :].squeeze(2)
+    h0 = rel[0].copy()
+    h0[:, 1] = 0.0
+    norm = np.linalg.norm(h0, axis=-1)
+    h0[norm == 0] = (1.0, 0.0, 0.0)
+    h0 /= np.linalg.norm(h0, axis=-1, keepdims=True)
+    return np.einsum("fnc,nc->fn", rel, h0)
+
+
+def swing(pos, dt):
+    """The median over strands of the dominant frequency (Hz) and of the damping ratio of each
+    strand's tip swing (tip_swing): the strands' own motion, not their average (strands that
+    swing in opposite phase would cancel in a mean). NaN where no strand gives a value."""
+    s = tip_swing(pos)
+    f = [dominant_frequency(s[:, n], dt) for n in range(s.shape[1])]
+    z = [damping_ratio(s[:, n], dt) for n in range(s.shape[1])]
+    z = [v for v in z if np.isfinite(v)]
+    return float(np.median(f)) if f else float("nan"), float(np.median(z)) if z else float("nan")
+
+
 def dominant_frequency(signal, dt):
     """The frequency (Hz) of the largest peak of the signal's spectrum (mean removed, Hann
     window), refined by a parabola through the peak's log magnitudes; 0 for a flat signal."""

@@ -4,11 +4,15 @@ accuracy study").
 
 Every mode, solver × substeps S × iterations I × precision × build (each cpu variant and,
 with a usable GPU, each cuda build's variants that run `simulate`; all read from the
-binaries), runs the same dynamic scene (same seed, so the same roots) for `seconds` of
-simulated time. Each run is compared frame by frame with a converged reference:
+binaries; ftl once per s of `ftl_damping`; the no-simulation baseline, solver `rigid`, once
+per precision where a variant declares it), runs the same dynamic scene (same seed, so the
+same roots) for `seconds` of simulated time. Each run is compared frame by frame with a
+converged reference:
 
   rms_err_L, max_err_L   RMS and max over all points of |x − x_ref|, over the hair length L
+  err_p50/p95/p99_L, iou_front, iou_side   error percentiles, silhouette overlap
   stretch_max, penetration_max, blown_up_strands   the mode's own observables (§3.8)
+  stretch_p99, kinetic, potential, verdict   (harness/check/observables.py)
 
 The reference is xpbd, fp64, I = 1, with S doubled from `ref_start` until, at every frame
 up to the horizon, the RMS difference between S and 2S is under
@@ -19,6 +23,10 @@ contacts and nearly straight bend triples, which converge far more slowly
 (docs/decisions.md, "The dynamic accuracy study"). It runs on the C reference, or on the GPU in fp64
 where one is usable, once the GPU's rung S0 agrees with the CPU's within a share of that
 margin (tolerances.DYN_ACC_GPU_REF_SHARE); otherwise the CPU ladder is used.
+
+After the ladder, `ref_extra` more doublings measure the reference's own error
+(Study.reference_error), and the long runs (studies/observables_long.py, observables.csv)
+measure what a user sees over `long_seconds`.
 
 Time per frame is measured apart from the checked run: the same mode at `time_strands`
 strands, `time_frames` frames, `--repeat`, no output file (never a run that also checks);
@@ -87,6 +95,7 @@ class Plan:
     ref_extra: int = 2  # doublings past the converged rung that measure the reference's own error
     long_seconds: float = 10.0  # the long runs' simulated time (0: no long runs)
     long_strands: int = 8
+    long_ref_max: int = 512  # the long runs' reference S at most (its change to 2S is reported)
 
     @classmethod
     def quick(cls, **changes):

@@ -180,3 +180,16 @@ def test_gpu_and_simd_refuse_rigid_with_one_line(cpu_bin, tmp_path):
     )
     assert p.returncode == 2
     assert p.stderr.strip().count("\n") == 0 and "does not run it" in p.stderr
+
+
+def test_swing_frequency_of_a_hanging_chain(cpu_bin, tmp_path):
+    """A chain of 32 points displaced along its first mode swings at the linearised discrete
+    chain's ω1 (docs/model.md §4.3)."""
+    from harness.studies.analytic_runs import chain_positions
+
+    inp = write_paper_state(tmp_path / "chain.h5", chain_positions(32, LENGTH, 0.3), LENGTH)
+    out = simulate(cpu_bin, inp, tmp_path / "chain_out.h5", 300, 256, "xpbd", extra=["--velocities", "all"])
+    _, x, _ = read(out)
+    f, _ = ob.swing(x, DT)
+    expected = an.discrete_chain_omega1(32, LENGTH, G0) / (2 * math.pi)
+    assert abs(f / expected - 1) <= tol.OBS_CHAIN_SWING_FREQUENCY_REL, f"{f} Hz against {expected} Hz"

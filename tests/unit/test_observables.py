@@ -138,3 +138,20 @@ def test_split_half_noise():
 
     assert ob.split_half(mean, x) == 0.5
     assert math.isnan(ob.split_half(mean, x[:, :1]))
+
+
+def test_swing_of_strands_in_opposite_phase_and_other_planes():
+    """Two strands swing in the x and the z plane, in opposite phase: their mean would cancel,
+    each strand's own swing does not."""
+    dt, f0, zeta = 1 / 60, 0.9, 0.04
+    t = np.arange(600) * dt
+    w0 = 2 * math.pi * f0
+    a = 2.0 * np.exp(-zeta * w0 * t) * np.cos(w0 * math.sqrt(1 - zeta**2) * t)
+    pos = np.zeros((len(t), 2, 3, 3))
+    pos[:, :, :, 1] = -np.array([0.0, 15.0, 30.0])  # hanging; roots at the origin
+    pos[:, 0, -1, 0] = a + 0.5  # starts displaced: the swing's plane is its start's
+    pos[:, 1, -1, 2] = -a - 0.5
+    assert np.allclose(ob.tip_displacement(pos, axis=0) + ob.tip_displacement(pos, axis=2), 0)
+    f, z = ob.swing(pos, dt)
+    assert f == pytest.approx(f0, rel=2e-3)
+    assert z == pytest.approx(zeta, rel=0.02)
