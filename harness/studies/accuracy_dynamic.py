@@ -54,6 +54,7 @@ from harness.check import observables
 from harness.core import env, runner, scenes, scenes_dynamic, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.io.trajectory import open_trajectory
+from harness.studies import observables_long
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     COLUMNS,
@@ -564,10 +565,8 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         # the long runs: what a user sees over seconds (studies/observables_long.py)
         long_rows = []
         if plan.long_seconds > 0:
-            from harness.studies import observables_long
-
             oracle_modes = [m for m in modes if m.runner == builds[0]]
-            long = observables_long.LongRuns(study, ref["build"], ref["steps"][-1]["S2"], log)
+            long = observables_long.LongRuns(study, ref["build"], ref["steps"][-1]["S2"], log, configured, read_run)
             long_rows = long.measure(oracle_modes, jobs)
 
         # 3. timing, one mode at a time, nothing else running
@@ -589,13 +588,11 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         w.writeheader()
         w.writerows(rows)
     os.replace(tmp, csv_path)
-    long_path = out_dir / "observables.csv"
+    long_path = out_dir / observables_long.CSV_NAME
     if long_rows:
-        from harness.studies.observables_long import COLUMNS as LONG_COLUMNS
-
         tmp = long_path.with_suffix(".csv.tmp")
         with open(tmp, "w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=LONG_COLUMNS)
+            w = csv.DictWriter(fh, fieldnames=observables_long.COLUMNS)
             w.writeheader()
             w.writerows(long_rows)
         os.replace(tmp, long_path)

@@ -119,11 +119,11 @@ def metrics(scene, pos, vel, ref, L, gravity, dt):
 
 
 class LongRuns:
-    def __init__(self, study, ref_build, ref_S, log):
-        from harness.studies.accuracy_dynamic import read_run
-
+    def __init__(self, study, ref_build, ref_S, log, configure, read_run):
+        """study: accuracy_dynamic.Study; configure and read_run: its scene-with-a-mode and
+        its reader (passed in, so that this module does not import the study back)."""
         self.study, self.plan, self.log = study, study.plan, log
-        self.read_run = read_run
+        self.configure, self.read_run = configure, read_run
         self.ref_build = ref_build
         self.frames = max(4, round(self.plan.long_seconds / study.frame_dt))
         release = scenes.load_scene(RELEASE_SCENE).with_overrides(points=study.scene.points)
@@ -133,9 +133,7 @@ class LongRuns:
         self.ref_S = min(ref_S, self.plan.long_ref_max)
 
     def run(self, scene, build, solver, substeps, iterations, precision, ftl_damping, tag, threads):
-        from harness.studies.accuracy_dynamic import configured
-
-        sc = configured(
+        sc = self.configure(
             self.scenes[scene],
             solver=solver,
             substeps=substeps,
