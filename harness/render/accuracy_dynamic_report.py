@@ -894,7 +894,7 @@ def markdown(rows, study, env, analytic, long=None):
     for solver, ps in pairs.items():
         ladder = o[(o["scheme"] == solver) & (o["iterations"] == 1)].sort_values("substeps")
         out += small_steps_verdict(solver, ps, ladder)
-    out += ["", f"![small steps against iterations]({STEPS_PNG})", ""]
+    out += ["", reference_error_line(study), "", f"![small steps against iterations]({STEPS_PNG})", ""]
     out += long_lines(long, study)
     out += [
         "### Which settings for which use",
@@ -974,6 +974,7 @@ def section(results_dir=None, report_dir=None, write_page=True):
         "",
         reference_error_line(study),
         "",
+        *baseline_lines(summ, study)[2:3],
         *recommend(summ, load_long(results_dir)),
         "",
         f"![error against time per frame]({PARETO_PNG})",
