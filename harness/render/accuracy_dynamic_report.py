@@ -497,8 +497,8 @@ LONG_COLUMNS = (
     ("iou_side", "IoU side", "motion"),
     ("tip_frequency_hz", "tip frequency (Hz)", "release"),
     ("tip_damping_ratio", "damping ratio ζ", "release"),
-    ("jitter_rms_velocity", "rest jitter RMS v (cm/s)", "release"),
-    ("jitter_max_move", "largest rest move (cm)", "release"),
+    ("jitter_rms_velocity", "rest jitter RMS v (cm/s)", "rest"),
+    ("jitter_max_move", "largest rest move (cm)", "rest"),
 )
 
 
@@ -525,9 +525,11 @@ def long_lines(long, study):
         "### What a user sees over seconds",
         "",
         f"Long runs ({first['seconds']:g} s, {int(first['strands'])} strands × {int(first['points'])} points, "
-        "harness/studies/observables_long.py): **motion** is the study's scene, **release** the still-dynamic "
-        "scene let go from its rest shape (frequency and damping ratio of the tip's swing over the first half, "
-        "rest jitter over the last fifth). Distances (W1 of the tip's distribution, total variation of its "
+        "harness/studies/observables_long.py): **motion** is the study's scene; **release** the still-dynamic "
+        "scene without its collider let go from its rest shape (each strand's swing frequency and damping ratio "
+        "over the first half, the median over strands); **rest** the still-dynamic scene with a strong damping "
+        "over half the time (RMS frame-to-frame velocity and the largest move over its last fifth, settled: what "
+        "flickers). Distances (W1 of the tip's distribution, total variation of its "
         "spectrum, IoU of the silhouettes) compare statistics, not phases: pointwise error means little after "
         "about half a second (the horizon's table). Each value ± its noise (half the difference between the "
         "even and the odd strands); the reference row gives ± the change from S to 2S (its own uncertainty) "
