@@ -766,10 +766,11 @@ static void cpu_teardown(hb_backend *b)
 #define CPU_PAPER_STAGES ((1u << HB_STAGE_INIT) | (1u << HB_STAGE_COLLIDE) | (1u << HB_STAGE_WIND))
 static const hb_variant cpu_variants[] = {
     {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
-     "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands", 0, 0},
+     "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands", 0, 0,
+     (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL) | (1u << HB_SOLVER_RIGID)},
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
-     "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks", 0, 0},
-    {NULL, 0, NULL, 0, 0},
+     "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks", 0, 0, 0},
+    {NULL, 0, NULL, 0, 0, 0},
 };
 
 #ifndef HB_FLAGS

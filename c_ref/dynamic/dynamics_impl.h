@@ -99,7 +99,7 @@ HB_ALWAYS_INLINE void SFX(shape_all)(const DMODEL *m, REAL *p, const REAL *rest,
     }
 }
 
-/* One frame of one strand: S substeps of §3.4, the solver of §3.6 or §3.7. */
+/* One frame of one strand: S substeps of §3.4, the solver of §3.6, §3.7 or §3.13 (rigid). */
 HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, REAL *x, REAL *v, const REAL *rest,
                                       const REAL *bend_rest, REAL *scratch, const unsigned F)
 {
@@ -124,6 +124,24 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
                 v[c] = (r[c] - x[c]) / h;
                 x[c] = r[c];
             }
+        }
+        /* rigid (no dynamics): every point is carried with the head like the root,
+         * x_k ← Q(t+h)·X̄_k (X̄_k when still), v_k ← (x_k_new − x_k_old)/h */
+        if (m->solver == HB_SOLVER_RIGID) {
+            for (int64_t k = 1; k < P; k++) {
+                REAL r[3];
+                if (F & HB_F_MOTION) SFX(rotate)(q, rest + 3 * k, r);
+                else {
+                    r[0] = rest[3 * k];
+                    r[1] = rest[3 * k + 1];
+                    r[2] = rest[3 * k + 2];
+                }
+                for (int c = 0; c < 3; c++) {
+                    v[3 * k + c] = (r[c] - x[3 * k + c]) / h;
+                    x[3 * k + c] = r[c];
+                }
+            }
+            continue;
         }
         p[0] = x[0];
         p[1] = x[1];

@@ -31,7 +31,14 @@ typedef struct {
     const char *summary;
     int64_t max_points;
     int max_block;
+    unsigned solvers; /* the dynamic solvers it runs, bit 1 << hb_solver (0: xpbd and ftl) */
 } hb_variant;
+
+/* The solvers a variant runs (its `solvers`, or xpbd and ftl where it declares none). */
+static inline unsigned hb_variant_solvers(const hb_variant *v)
+{
+    return v->solvers ? v->solvers : (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL);
+}
 
 /* The result of running one stage (or a fused group) once. */
 typedef struct {

@@ -51,7 +51,7 @@ static const dyn_flag dyn_flags[] = {
     {"--frame-dt", DF_REAL, DYN(frame_dt), 0, "frame length Δt, s (default 1/60)"},
     {"--substeps", DF_COUNT, DYN(substeps), 0, "substeps S per frame (default 1)"},
     {"--iterations", DF_COUNT, DYN(iterations), 0, "solver iterations I per substep (default 1)"},
-    {"--solver", DF_SOLVER, DYN(solver), 0, "xpbd | ftl (default xpbd)"},
+    {"--solver", DF_SOLVER, DYN(solver), 0, "xpbd | ftl | rigid (no dynamics; default xpbd)"},
     {"--gravity", DF_REAL, DYN(gravity), 0, "gravity g0, cm/s² (default 981)"},
     {"--drag", DF_REAL, DYN(drag), DYN(drag_declared), "air drag c_d toward the wind velocity, 1/s (default: none)"},
     {"--damping", DF_REAL, DYN(damping), DYN(drag_declared), "velocity damping β, 1/s (default: none)"},
@@ -271,7 +271,8 @@ static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err
     case DF_SOLVER:
         if (strcmp(v, "xpbd") == 0) o->scene.dyn.solver = HB_SOLVER_XPBD;
         else if (strcmp(v, "ftl") == 0) o->scene.dyn.solver = HB_SOLVER_FTL;
-        else FAIL("--solver must be xpbd or ftl (got '%s')", v);
+        else if (strcmp(v, "rigid") == 0) o->scene.dyn.solver = HB_SOLVER_RIGID;
+        else FAIL("--solver must be xpbd, ftl or rigid (got '%s')", v);
         break;
     case DF_MOTION:
         if (strcmp(v, "still") == 0) o->scene.dyn.motion = HB_MOTION_STILL;

@@ -72,6 +72,19 @@ static int self_test_rng(void)
     return failed ? 1 : 0;
 }
 
+/* A JSON list of the solvers in the bit set `set` (bit 1 << hb_solver), after `key`. */
+static void print_solvers(const char *key, unsigned set)
+{
+    printf("%s[", key);
+    int first = 1;
+    for (int s = 0; s < HB_SOLVER_COUNT; s++)
+        if (set & (1u << s)) {
+            printf("%s\"%s\"", first ? "" : ", ", hb_solver_name((hb_solver)s));
+            first = 0;
+        }
+    printf("]");
+}
+
 /* --list-variants: the backend's variants, declared once in the backend, as one JSON
  * object (docs/interfaces.md); the harness reads it instead of spelling the names. */
 static int list_variants(const hb_backend *b)
@@ -91,9 +104,15 @@ static int list_variants(const hb_backend *b)
         printf("], \"summary\": \"%s\"", v->summary);
         if (v->max_points > 0) printf(", \"max_points\": %lld", (long long)v->max_points);
         if (v->max_block > 0) printf(", \"max_block\": %d", v->max_block);
+        if (v->stages & (1u << HB_STAGE_SIMULATE)) print_solvers(", \"solvers\": ", hb_variant_solvers(v));
         printf("}");
     }
-    printf("], \"solvers\": [\"xpbd\", \"ftl\"], \"features\": [");
+    unsigned any = 0;
+    for (const hb_variant *v = b->variants; v->name; v++)
+        if (v->stages & (1u << HB_STAGE_SIMULATE)) any |= hb_variant_solvers(v);
+    printf("]");
+    print_solvers(", \"solvers\": ", any);
+    printf(", \"features\": [");
     for (unsigned i = 0; (1u << i) < HB_F_COUNT; i++) {
         char name[32];
         hb_dyn_feature_names(1u << i, name, sizeof name);
@@ -457,6 +476,11 @@ int hb_main(int argc, char **argv, hb_backend *b)
             snprintf(err, sizeof err,
                      "--points %lld: the %s variant %s simulates at most %lld points a strand (see --list-variants)",
                      (long long)o.scene.points, b->name, var->name, (long long)var->max_points);
+            CHECK(1, HB_EXIT_USAGE);
+        }
+        if (!(hb_variant_solvers(var) & (1u << o.scene.dyn.solver))) {
+            snprintf(err, sizeof err, "--solver %s: the %s variant %s does not run it (see --list-variants)",
+                     hb_solver_name(o.scene.dyn.solver), b->name, var->name);
             CHECK(1, HB_EXIT_USAGE);
         }
         if (var->max_block > 0 && o.block_size > var->max_block) {

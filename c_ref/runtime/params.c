@@ -109,7 +109,7 @@ int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
 
 const char *hb_solver_name(hb_solver s)
 {
-    return s == HB_SOLVER_FTL ? "ftl" : "xpbd";
+    return s == HB_SOLVER_FTL ? "ftl" : s == HB_SOLVER_RIGID ? "rigid" : "xpbd";
 }
 
 const char *hb_motion_name(hb_motion m)

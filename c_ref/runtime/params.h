@@ -19,7 +19,8 @@ enum { HB_EXIT_OK = 0, HB_EXIT_USAGE = 2, HB_EXIT_MEMORY = 3, HB_EXIT_RUNTIME = 
 
 typedef enum { HB_FP32 = 0, HB_FP64 = 1 } hb_precision;
 typedef enum { HB_STAGE_INIT = 0, HB_STAGE_WIND = 1, HB_STAGE_COLLIDE = 2, HB_STAGE_SIMULATE = 3 } hb_stage;
-typedef enum { HB_SOLVER_XPBD = 0, HB_SOLVER_FTL = 1 } hb_solver;
+/* rigid: no dynamics, every point carried with the head (docs/model.md §3.13) */
+typedef enum { HB_SOLVER_XPBD = 0, HB_SOLVER_FTL = 1, HB_SOLVER_RIGID = 2, HB_SOLVER_COUNT = 3 } hb_solver;
 typedef enum { HB_MOTION_STILL = 0, HB_MOTION_NOD = 1, HB_MOTION_SHAKE = 2, HB_MOTION_TILT = 3 } hb_motion;
 
 /* The dynamic model's physics (docs/model.md §3): everything that decides the bits of a

@@ -816,6 +816,7 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
     d->drag_declared = drag_declared != 0;
     if (strcmp(solver, "xpbd") == 0) d->solver = HB_SOLVER_XPBD;
     else if (strcmp(solver, "ftl") == 0) d->solver = HB_SOLVER_FTL;
+    else if (strcmp(solver, "rigid") == 0) d->solver = HB_SOLVER_RIGID;
     else return snprintf(err, errlen, "--input %s: unknown solver '%s'", path, solver), -1;
     if (strcmp(motion, "still") == 0) d->motion = HB_MOTION_STILL;
     else if (strcmp(motion, "nod") == 0) d->motion = HB_MOTION_NOD;

@@ -95,7 +95,7 @@ class DynValidator:
         refs = {}
         cpu = variants.declared("cpu")  # the solvers and precisions of --list-variants
         for precision in cpu.precisions:
-            for solver in cpu.solvers:
+            for solver in cpu.dynamic_solvers:
                 ref = refs[(precision, solver)] = self.cpu_file(precision, solver)
                 one = self.cpu_file(precision, solver, threads=1)
                 self.record(

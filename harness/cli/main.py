@@ -50,6 +50,28 @@ def seconds(text):
     return value
 
 
+def unit_interval(text):
+    """An argparse type: a number in [0, 1]."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs a number in [0, 1] (got '{text}')") from None
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"must lie in [0, 1] (got '{text}')")
+    return value
+
+
+def nonneg_seconds(text):
+    """An argparse type: a finite number of seconds ≥ 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs a number of seconds (got '{text}')") from None
+    if not 0 <= value < float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a finite number of seconds ≥ 0 (got '{text}')")
+    return value
+
+
 def cmd_run(args):
     from harness.core import runner, scenes
     from harness.core.paths import binary_path
@@ -188,6 +210,10 @@ DYNAMIC_ONLY = (
     "analytic",
     "gpu",
     "force",
+    "ftl_damping",
+    "ref_extra",
+    "long_seconds",
+    "long_strands",
 )
 
 
@@ -202,14 +228,14 @@ def accuracy_model(args):
 
     model = args.model
     if args.from_csv and model is None:
-        from harness.studies.accuracy_dynamic import COLUMNS
+        from harness.studies.accuracy import REQUIRED_COLUMNS
 
         try:
             with open(args.from_csv, encoding="utf-8") as fh:
                 header = fh.readline().strip().split(",")
         except (OSError, UnicodeDecodeError) as e:
             raise HarnessError(f"accuracy: --from-csv {args.from_csv}: cannot read ({e})") from None
-        model = "dynamic" if header == list(COLUMNS) else "paper"
+        model = "dynamic" if set(REQUIRED_COLUMNS) <= set(header) else "paper"
     if args.scene is not None and not args.from_csv:
         scene_model = scenes.load_scene(args.scene).model
         if model is not None and model != scene_model:
@@ -278,10 +304,13 @@ def accuracy_dynamic(args):
             "jobs",
             "analytic",
             "gpu",
+            "ref_extra",
+            "long_seconds",
+            "long_strands",
         )
         if getattr(args, k) is not None
     }
-    for k in ("substeps", "iterations"):
+    for k in ("substeps", "iterations", "ftl_damping"):
         if getattr(args, k) is not None:
             given[k] = tuple(sorted(set(getattr(args, k))))
     plan = accuracy_dynamic.Plan.quick(**given) if args.quick else accuracy_dynamic.Plan(**given)
@@ -665,6 +694,27 @@ def parser():
         "--analytic", choices=("full", "quick", "none"), default=None, help="dynamic: the analytic tables to run"
     )
     a.add_argument("--gpu", choices=("auto", "no"), default=None, help="dynamic: GPU modes and reference if usable")
+    a.add_argument(
+        "--ftl-damping",
+        type=unit_interval,
+        nargs="+",
+        default=None,
+        help="dynamic: ftl's s values, an axis of the study (default 0 0.5 0.9 1)",
+    )
+    a.add_argument(
+        "--ref-extra",
+        type=whole(0),
+        default=None,
+        help="dynamic: doublings past the converged reference that measure its own error (default 2)",
+    )
+    a.add_argument(
+        "--long-seconds",
+        type=nonneg_seconds,
+        default=None,
+        help="dynamic: simulated time of the long runs (energy, tip motion, jitter, distributions; "
+        "default 10; 0: none)",
+    )
+    a.add_argument("--long-strands", type=whole(2), default=None, help="dynamic: strands of the long runs (default 8)")
     a.add_argument("--force", action="store_true", help="dynamic: replace an existing results CSV")
     a.add_argument(
         "--out", default=None, help="results directory (default results/accuracy or results/dynamic-accuracy)"
@@ -835,9 +885,10 @@ def parser():
         "stability",
         help="the dynamic model's stability map: verdicts over 2-D slices of the scene space",
         description="Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend "
-        "compliance and points; head-motion frequency against amplitude) for both solvers and precisions, "
-        "on the CPU and every built CUDA build where a GPU answers; judge each cell ok, over-stretched, "
-        "penetrating or blown up; write results/stability/, report/stability_*.png and "
+        "compliance, points and iterations; head-motion frequency against amplitude) for both solvers and "
+        "precisions, on the CPU and every built CUDA build where a GPU answers; judge each cell ok, "
+        "over-stretched, penetrating, escaped (a point past 2L) or diverged (NaN/Inf); write "
+        "results/stability/, report/stability_*.png and "
         "report/dynamic_stability.md.",
     )
     sb.add_argument("--quick", action="store_true", help="a coarser grid (about a quarter of the cells)")

@@ -8,7 +8,7 @@ A scene with `model = "dynamic"` may hold, besides the paper keys:
     frame_dt = 0.016666…    # Δt > 0 (s)        --frame-dt
     substeps = 8            # S ≥ 1             --substeps
     iterations = 2          # I ≥ 1             --iterations
-    solver = "xpbd"         # xpbd | ftl        --solver
+    solver = "xpbd"         # xpbd | ftl | rigid  --solver
     gravity = 981.0         # g0 ≥ 0            --gravity
     drag = 0.5              # c_d ≥ 0           --drag
     damping = 0.5           # β ≥ 0             --damping
@@ -40,7 +40,7 @@ keys in a scene whose model is not "dynamic" are refused too.
 import math
 
 DEFAULT_STAGES = ("init", "collide", "simulate")
-SOLVERS = ("xpbd", "ftl")
+SOLVERS = ("xpbd", "ftl", "rigid")  # rigid: no dynamics (docs/model.md §3.13)
 MOTIONS = ("still", "nod", "shake", "tilt")
 
 # table → key → (flag, kind)

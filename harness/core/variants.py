@@ -2,7 +2,11 @@
 
     {"backend": "cpu", "build": "default", "default_variant": "ref",
      "precisions": ["fp32", "fp64"], "variants": [{"name": "ref", "stages": [...], ...}],
-     "solvers": ["xpbd", "ftl"]}
+     "solvers": ["xpbd", "ftl", "rigid"]}
+
+A simulating variant may list its own "solvers" (a subset of the binary's); one that lists
+none runs every solver the binary declares. "rigid" (NO_DYNAMICS) is the no-simulation
+baseline: hair carried with the head, nothing solved (docs/model.md §3.13).
 
 The one place the harness and the tests learn variant names; read once per binary. Keys
 other than these are ignored, and missing optional ones get defaults, so a binary that
@@ -17,6 +21,8 @@ from functools import lru_cache
 from harness import HarnessError
 from harness.core.paths import binary_path
 
+NO_DYNAMICS = "rigid"  # the solver that simulates nothing: the accuracy study's baseline
+
 
 @dataclass(frozen=True)
 class Declared:
@@ -29,6 +35,16 @@ class Declared:
     max_points: dict  # variant name -> the most points per strand it simulates (None: no limit)
     solvers: tuple = ()  # the dynamic model's solvers, in the binary's order (none declared: ())
     max_block: dict = field(default_factory=dict)  # variant -> most threads a block of its simulate (absent: 1024)
+    variant_solvers: dict = field(default_factory=dict)  # variant -> its solvers (absent: all of `solvers`)
+
+    def solvers_of(self, variant):
+        """The solvers `variant` runs, in the binary's order."""
+        return tuple(self.variant_solvers.get(variant, self.solvers))
+
+    @property
+    def dynamic_solvers(self):
+        """The solvers that simulate (every one but the no-simulation baseline)."""
+        return tuple(s for s in self.solvers if s != NO_DYNAMICS)
 
     def runs(self, variant, stage="simulate", points=None, block=None):
         """Whether `variant` runs `stage` (and, for simulate, strands of `points` points with
@@ -100,6 +116,7 @@ def _read(path):
             max_points={str(v["name"]): (int(v["max_points"]) if v.get("max_points") else None) for v in variants},
             solvers=tuple(str(x) for x in d.get("solvers", ())),
             max_block={str(v["name"]): int(v["max_block"]) for v in variants if v.get("max_block")},
+            variant_solvers={str(v["name"]): tuple(str(x) for x in v["solvers"]) for v in variants if "solvers" in v},
         )
     except (ValueError, KeyError, TypeError, AttributeError):
         raise HarnessError(f"{path} --list-variants did not print the documented JSON object") from None

@@ -17,13 +17,24 @@ import numpy as np
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, RESULTS, display
-from harness.studies.accuracy import ANALYTIC_NAME, COLUMNS, CSV_NAME, RESULTS_NAME, holds_until, smallest
+from harness.studies.accuracy import (
+    ANALYTIC_NAME,
+    CSV_NAME,
+    LATER_COLUMNS,
+    NO_SIMULATION,
+    REQUIRED_COLUMNS,
+    RESULTS_NAME,
+    holds_until,
+    scheme_name,
+    smallest,
+)
 
 PAGE = "dynamic_accuracy.md"
 PARETO_PNG = "dynamic_accuracy_pareto.png"
 GROWTH_PNG = "dynamic_accuracy_growth.png"
 STEPS_PNG = "dynamic_accuracy_steps.png"
-KEYS = ("backend", "build", "variant", "solver", "substeps", "iterations", "precision")
+KEYS = ("backend", "build", "variant", "solver", "ftl_damping", "substeps", "iterations", "precision")
+LONG_CSV = "observables.csv"  # studies/observables_long.py's table
 
 
 # ---- reading --------------------------------------------------------------------------
@@ -42,11 +53,16 @@ def load(results_dir, csv_path=None):
         raise HarnessError(f"{display(csv_path)} not found: run `python -m harness accuracy --model dynamic`") from None
     except (OSError, ValueError) as e:
         raise HarnessError(f"{display(csv_path)}: cannot read ({e})") from None
-    missing = [c for c in COLUMNS if c not in rows.columns]
+    missing = [c for c in REQUIRED_COLUMNS if c not in rows.columns]
     if missing or rows.empty:
         raise HarnessError(
             f"{display(csv_path)}: not a dynamic accuracy table (missing {', '.join(missing) or 'rows'})"
         )
+    for c in LATER_COLUMNS:
+        if c not in rows.columns:
+            rows[c] = np.nan
+    if rows["verdict"].isna().all():  # written before the split by cause
+        rows["verdict"] = np.where(rows["blown_up_strands"] > 0, "blown up", "ok")
     try:
         env = json.loads((results_dir / "env.json").read_text())
         study = env["study"]
@@ -55,6 +71,19 @@ def load(results_dir, csv_path=None):
     analytic = results_dir / ANALYTIC_NAME
     lines = analytic.read_text().splitlines() if analytic.exists() else []
     return rows, study, env, lines
+
+
+def load_long(results_dir):
+    """The long runs' table (observables.csv) as a DataFrame, or None where the study ran none."""
+    import pandas as pd
+
+    path = Path(results_dir) / LONG_CSV
+    if not path.exists():
+        return None
+    try:
+        return pd.read_csv(path)
+    except (OSError, ValueError) as e:
+        raise HarnessError(f"{display(path)}: cannot read ({e})") from None
 
 
 # ---- what the rows say ----------------------------------------------------------------
@@ -67,13 +96,56 @@ def summary(rows, horizon_frames):
     inside = m[m["frame"] <= horizon_frames]
     g = inside.groupby("mode", sort=False)
     out = g[list(KEYS) + ["time_per_frame_ms", "time_strands", "device"]].first()
+    out["scheme"] = [scheme_name(s, d) for s, d in zip(out["solver"], out["ftl_damping"])]
     out["rms"] = g["rms_err_L"].apply(lambda s: s.max(skipna=False))
     out["max"] = g["max_err_L"].apply(lambda s: s.max(skipna=False))
+    out["p99"] = g["err_p99_L"].apply(lambda s: s.max(skipna=False))
     out["stretch"] = g["stretch_max"].max()
+    out["stretch_p99"] = g["stretch_p99"].max()
+    out["iou"] = g[["iou_front", "iou_side"]].min().min(axis=1)
     out["penetration"] = g["penetration_max"].max()
     out["blown"] = m.groupby("mode", sort=False)["blown_up_strands"].max()
+    verdicts = m.groupby("mode", sort=False)["verdict"]
+    out["verdict"] = verdicts.apply(_worst_verdict)
     out["usable"] = (out["blown"] == 0) & np.isfinite(out["rms"])
     return out.reset_index()
+
+
+def _worst_verdict(s):
+    """diverged before escaped before ok, over a mode's frames ("blown up": a table written
+    before the split by cause)."""
+    v = set(s.dropna().astype(str))
+    for worst in ("diverged", "escaped", "blown up"):
+        if worst in v:
+            return worst
+    return "ok"
+
+
+def baseline(summ):
+    """The no-simulation mode's row (the oracle build's fp64 if present, else any), or None."""
+    b = summ[summ["solver"] == NO_SIMULATION]
+    if b.empty:
+        return None
+    fp64 = b[b["precision"] == "fp64"]
+    return (fp64 if len(fp64) else b).iloc[0]
+
+
+def reference_error_line(study):
+    """The reference's own error, measured (two more doublings and the estimated tail)."""
+    e = study["reference"].get("error")
+    if not e:
+        return "The reference's own error was not measured (`--ref-extra 0`)."
+    q = e.get("ratio_per_doubling")
+    return (
+        f"The reference's own error (S = {study['reference']['substeps']} against S = {e['against_substeps']}, "
+        f"worst over the horizon): RMS {_e(e['rms_horizon'])}, max {_e(e['max_horizon'])}; with the tail the "
+        f"last doublings predict (change ratio {q:.3g} per doubling): RMS {_e(e['est_rms_horizon'])}, max "
+        f"{_e(e['est_max_horizon'])}. A mode's error below these is not resolved."
+        if q == q and q < 1
+        else f"The reference's own error (S = {study['reference']['substeps']} against S = "
+        f"{e['against_substeps']}, worst over the horizon): RMS {_e(e['rms_horizon'])}, max {_e(e['max_horizon'])}; "
+        "the last doublings did not shrink the change, so no tail is estimated: read it as a lower bound."
+    )
 
 
 def smallest_errors(rows):
@@ -166,8 +238,9 @@ def small_steps(summ, study):
     """Per solver: for each n > 1 of the grid, S = n × I = 1 against S = 1 × I = n (oracle
     build, fp64). {solver: [dict(n, steps=row, iters=row)]}."""
     o = oracle(summ, study)
+    o = o[o["solver"] != NO_SIMULATION]
     out = {}
-    for solver, s in o.groupby("solver", sort=False):
+    for solver, s in o.groupby("scheme", sort=False):
         pairs = []
         for n in sorted(set(s["substeps"]) | set(s["iterations"])):
             a = s[(s["substeps"] == n) & (s["iterations"] == 1)]
@@ -242,42 +315,244 @@ def _better(a, b):
     return bool(a["usable"] and b["usable"] and a["rms"] < b["rms"])
 
 
-def recommend(summ):
-    """Per use (tolerances.DYN_ACC_USES) and per backend: the cheapest mode that meets the
-    use's budget. Lines of Markdown."""
+def long_metrics(long):
+    """{(scheme, S, I, precision): {metric: (value, noise, reference, ref_uncertainty)}} of the
+    long runs' modes (one build ran them; the same settings of another build are the same model),
+    and the reference's {metric: (value, noise, reference, ref_uncertainty)}."""
+    out, ref = {}, {}
+    if long is None or long.empty:
+        return out, ref
+    for _, r in long.iterrows():
+        cell = (r["value"], r["noise"], r["reference"], r["ref_uncertainty"])
+        if r["study"] == "reference":
+            ref[r["metric"]] = cell
+            continue
+        key = (scheme_name(r["solver"], r["ftl_damping"]), int(r["substeps"]), int(r["iterations"]), r["precision"])
+        out.setdefault(key, {})[r["metric"]] = cell
+    return out, ref
+
+
+def _setting(r):
+    return (r["scheme"], int(r["substeps"]), int(r["iterations"]), r["precision"])
+
+
+def _within(cell, budget_rel):
+    """A relative error within budget once the mode's noise, the reference's and its
+    uncertainty are allowed for; None where not measured."""
+    if cell is None:
+        return None
+    v, noise, ref, unc = cell
+    if not (np.isfinite(v) and np.isfinite(ref)) or ref == 0:
+        return False if not np.isfinite(v) else None
+    slack = sum(x for x in (noise, unc) if np.isfinite(x)) / abs(ref)
+    return abs(v / ref - 1) <= budget_rel + slack
+
+
+def _within_factor(cell, factor):
+    """value/reference within [1/factor, factor], the bounds widened by the noise and the
+    reference's uncertainty; None where not measured."""
+    if cell is None:
+        return None
+    v, noise, ref, unc = cell
+    if not np.isfinite(v):
+        return False
+    if not np.isfinite(ref) or ref <= 0:
+        return None
+    slack = sum(x for x in (noise, unc) if np.isfinite(x))
+    return bool(ref / factor - slack <= v <= ref * factor + slack)
+
+
+def checks(r, use, longm):
+    """{metric: passes} of mode row r against the use's budgets (None: not measured)."""
+    rms_budget, stretch_budget, _ = tolerances.DYN_ACC_USES[use]
+    out = {"RMS error": bool(r["usable"] and r["rms"] <= rms_budget), "stretch": bool(r["stretch"] <= stretch_budget)}
+    lb = tolerances.DYN_ACC_USES_LONG.get(use)
+    m = longm.get(_setting(r))
+    if lb and m is not None:
+        out["tip frequency"] = _within(m.get("tip_frequency_hz"), lb["freq_rel"])
+        out["kinetic energy"] = _within_factor(m.get("kinetic_mean"), lb["kinetic_factor"])
+        j = m.get("jitter_rms_velocity")
+        if j is not None:
+            v, noise, ref, unc = j
+            lim = lb["jitter_factor"] * ref + tolerances.DYN_ACC_JITTER_FLOOR
+            out["rest jitter"] = bool(np.isfinite(v) and v <= lim + (noise if np.isfinite(noise) else 0))
+    return out
+
+
+def recommend(summ, long=None):
+    """Per use (tolerances.DYN_ACC_USES and DYN_ACC_USES_LONG) and per backend: the cheapest
+    mode that meets every budget measured for it, naming its solver, s, S, I, precision and
+    build, and the metric that decided it (the one that rejected most of the faster modes).
+    Lines of Markdown."""
     lines = []
-    ok = summ[summ["usable"]]
+    longm, _ = long_metrics(long)
+    base = baseline(summ)
     for use, (rms_budget, stretch_budget, why) in tolerances.DYN_ACC_USES.items():
-        fits = ok[(ok["rms"] <= rms_budget) & (ok["stretch"] <= stretch_budget)]
+        verdicts = {r["mode"]: checks(r, use, longm) for _, r in summ.iterrows()}
+        passes = summ[[all(v is not False for v in verdicts[m].values()) for m in summ["mode"]]]
+        passes = passes[passes["usable"]]
         picks = []
         for backend, what in (("cpu", "CPU"), ("cuda", "GPU")):
             if not (summ["backend"] == backend).any():
                 continue
-            f = fits[fits["backend"] == backend]
+            mine = summ[summ["backend"] == backend]
+            f = passes[passes["backend"] == backend]
             if f.empty:
-                mine = ok[ok["backend"] == backend]
-                near = mine.loc[mine["rms"].idxmin()] if len(mine) else None
+                ok = mine[mine["usable"]]
+                near = ok.loc[ok["rms"].idxmin()] if len(ok) else None
                 picks.append(
                     f"{what}: no mode of this grid meets it"
                     + (
                         f" (the most accurate, {near['mode']}, has RMS error {_e(near['rms'])} and stretch "
-                        f"{_pct(near['stretch'])}: more substeps than this grid holds are needed)"
+                        f"{_pct(near['stretch'])}; it fails "
+                        + ", ".join(k for k, v in verdicts[near["mode"]].items() if v is False)
+                        + ")"
                         if near is not None
                         else ""
                     )
                 )
                 continue
             best = f.loc[f["time_per_frame_ms"].idxmin()]
+            faster = mine[mine["time_per_frame_ms"] < best["time_per_frame_ms"]]
+            failed = {}
+            for m in faster["mode"]:
+                for k, v in verdicts[m].items():
+                    if v is False:
+                        failed[k] = failed.get(k, 0) + 1
+            decided = max(failed, key=failed.get) if failed else None
+            long_note = "" if _setting(best) in longm else "; no long runs at these settings"
             picks.append(
-                f"{what}: **{best['mode']}** ({best['time_per_frame_ms']:.3g} ms per frame at "
-                f"{int(best['time_strands']):,} strands; RMS error {_e(best['rms'])}, stretch {_pct(best['stretch'])}; "
-                f"{len(f)} modes meet it)"
+                f"{what}: **{best['mode']}** (solver {best['solver']}"
+                + (f", s = {best['ftl_damping']:g}" if best["solver"] == "ftl" else "")
+                + f", S = {int(best['substeps'])}, I = {int(best['iterations'])}, {best['precision']}, build "
+                f"{_label(best)}; {best['time_per_frame_ms']:.3g} ms per frame at {int(best['time_strands']):,} "
+                f"strands; RMS error {_e(best['rms'])}, stretch {_pct(best['stretch'])}{long_note}; "
+                + (
+                    f"decided by {decided}, which rejected {failed[decided]} of the {len(faster)} faster modes"
+                    if decided
+                    else "the fastest mode of all"
+                )
+                + ")"
             )
+        base_note = ""
+        if base is not None and np.isfinite(base["rms"]):
+            tighter = rms_budget < base["rms"]
+            base_note = (
+                f"; the RMS budget is {base['rms'] / rms_budget:.3g}× tighter than not simulating at all "
+                f"({_e(base['rms'])})"
+                if tighter
+                else f"; **the RMS budget is not tighter than not simulating at all** ({_e(base['rms'])})"
+            )
+        lb = tolerances.DYN_ACC_USES_LONG.get(use)
+        long_txt = (
+            f", tip frequency within {100 * lb['freq_rel']:g} %, mean kinetic energy within ×{lb['kinetic_factor']:g}"
+            f" and rest jitter at most ×{lb['jitter_factor']:g} + {tolerances.DYN_ACC_JITTER_FLOOR:g} cm/s of the "
+            "reference's (long runs, noise allowed)"
+            if lb and longm
+            else ""
+        )
         lines.append(
-            f"- **{use}** (RMS error ≤ {rms_budget:g}·L and stretch ≤ {_pct(stretch_budget)} over the horizon, "
-            f"never blown up; {why}): " + "; ".join(picks) + "."
+            f"- **{use}** (RMS error ≤ {rms_budget:g}·L and stretch ≤ {_pct(stretch_budget)} over the horizon"
+            f"{long_txt}, never blown up; {why}{base_note}): " + "; ".join(picks) + "."
         )
     return lines
+
+
+def baseline_lines(summ, study):
+    """The no-simulation baseline: its errors, and each use's budget against it."""
+    base = baseline(summ)
+    if base is None:
+        return [
+            "### The no-simulation baseline",
+            "",
+            f"Not measured: no build here declares the `{NO_SIMULATION}` solver (--list-variants).",
+            "",
+        ]
+    out = [
+        "### The no-simulation baseline",
+        "",
+        f"`{base['mode']}`: the hair carried rigidly with the head, nothing simulated (docs/model.md §3.13). "
+        f"Over the horizon its RMS error is {_e(base['rms'])}, p99 {_e(base['p99'])}, max {_e(base['max'])}, "
+        f"silhouette IoU at worst {base['iou']:.3f}. A mode is worth its time only where it is well below "
+        "this; the tables give every mode's RMS error as a multiple of it.",
+        "",
+        "| use | RMS budget / L | budget ÷ no-sim RMS | tighter than no simulation |",
+        "| --- | ---: | ---: | --- |",
+    ]
+    for use, (rms_budget, _, _) in tolerances.DYN_ACC_USES.items():
+        ratio = rms_budget / base["rms"] if base["rms"] > 0 else float("nan")
+        out.append(f"| {use} | {rms_budget:g} | {ratio:.3g} | {'yes' if ratio < 1 else '**no**'} |")
+    out.append("")
+    return out
+
+
+LONG_COLUMNS = (
+    ("kinetic_mean", "KE mean (cm²/s²)", "motion"),
+    ("energy_drift", "energy drift (cm²/s³)", "motion"),
+    ("stretch_p99", "stretch p99", "motion"),
+    ("err_p99_L", "p99 err / L (whole run)", "motion"),
+    ("tip_distribution_L", "tip distribution W1 / L", "motion"),
+    ("tip_spectrum", "tip spectrum TV", "motion"),
+    ("iou_front", "IoU front", "motion"),
+    ("iou_side", "IoU side", "motion"),
+    ("tip_frequency_hz", "tip frequency (Hz)", "release"),
+    ("tip_damping_ratio", "damping ratio ζ", "release"),
+    ("jitter_rms_velocity", "rest jitter RMS v (cm/s)", "rest"),
+    ("jitter_max_move", "largest rest move (cm)", "rest"),
+)
+
+
+def _pm(v, n):
+    if v is None or not np.isfinite(v):
+        return "—"
+    return f"{v:.3g} ± {n:.2g}" if n is not None and np.isfinite(n) else f"{v:.3g}"
+
+
+def long_lines(long, study):
+    """The long runs' section: one table, the reference first (± its S-against-2S change),
+    then every mode (± its noise)."""
+    if long is None or long.empty:
+        return [
+            "### What a user sees over seconds",
+            "",
+            "Not measured with these results (`--long-seconds 0`).",
+            "",
+        ]
+    longm, ref = long_metrics(long)
+    first = long.iloc[0]
+    head = "| mode | " + " | ".join(c[1] for c in LONG_COLUMNS) + " | verdict |"
+    out = [
+        "### What a user sees over seconds",
+        "",
+        f"Long runs ({first['seconds']:g} s, {int(first['strands'])} strands × {int(first['points'])} points, "
+        "harness/studies/observables_long.py): **motion** is the study's scene; **release** the still-dynamic "
+        "scene without its collider let go from its rest shape (each strand's swing frequency and damping ratio "
+        "over the first half, the median over strands); **rest** the still-dynamic scene with a strong damping "
+        "over half the time (RMS frame-to-frame velocity and the largest move over its last fifth, settled: what "
+        "flickers). Distances (W1 of the tip's distribution, total variation of its "
+        "spectrum, IoU of the silhouettes) compare statistics, not phases: pointwise error means little after "
+        "about half a second (the horizon's table). Each value ± its noise (half the difference between the "
+        "even and the odd strands); the reference row gives ± the change from S to 2S (its own uncertainty) "
+        "and, after a /, its noise.",
+        "",
+        head,
+        "|" + " --- |" * (len(LONG_COLUMNS) + 2),
+    ]
+    cells = []
+    for metric, _, _ in LONG_COLUMNS:
+        v, noise, _, unc = ref.get(metric, (np.nan, np.nan, np.nan, np.nan))
+        cells.append("—" if not np.isfinite(v) else f"{v:.3g} ± {unc:.2g} / {noise:.2g}")
+    rr = long[long["study"] == "reference"]
+    out.append(f"| reference: {rr['mode'].iloc[0] if len(rr) else '?'} | " + " | ".join(cells) + " | ok |")
+    modes = long[long["study"] == "mode"]
+    for mode, g in modes.groupby("mode", sort=False):
+        cell = {r["metric"]: (r["value"], r["noise"]) for _, r in g.iterrows()}
+        verdict = _worst_verdict(g["verdict"])
+        out.append(
+            f"| {mode} | " + " | ".join(_pm(*cell.get(m, (None, None))) for m, _, _ in LONG_COLUMNS) + f" | {verdict} |"
+        )
+    out.append("")
+    return out
 
 
 def _e(x):
@@ -316,9 +591,14 @@ def pareto_plot(summ, study, path):
     ok = summ[summ["usable"]].reset_index(drop=True)
     fig, ax = plt.subplots(figsize=(8.5, 5.5))
     labels = list(dict.fromkeys(ok.apply(_label, axis=1)))
-    solvers = list(dict.fromkeys(ok["solver"]))
+    solvers = list(dict.fromkeys(ok["scheme"]))
     colors = {lab: f"C{i % 10}" for i, lab in enumerate(labels)}
     markers = {s: "osD^v<>"[i % 7] for i, s in enumerate(solvers)}
+    base = baseline(summ)
+    if base is not None and np.isfinite(base["rms"]):
+        ax.axhline(
+            base["rms"], color="0.3", lw=0.9, ls="--", label=f"no simulation ({NO_SIMULATION}): {_e(base['rms'])}"
+        )
     for _, r in ok.iterrows():
         c = colors[_label(r)]
         filled = r["precision"] == "fp64"
@@ -326,7 +606,7 @@ def pareto_plot(summ, study, path):
             r["time_per_frame_ms"],
             r["rms"],
             s=28,
-            marker=markers[r["solver"]],
+            marker=markers[r["scheme"]],
             facecolors=c if filled else "none",
             edgecolors=c,
             linewidths=1,
@@ -370,16 +650,20 @@ def growth_plot(rows, summ, study, path):
     with the reference's own S-vs-2S difference and the horizon."""
     plt = _plt()
     o = oracle(summ, study)
-    o = o[o["iterations"] == 1]
-    solvers = list(dict.fromkeys(o["solver"])) or ["none"]
+    base = o[o["solver"] == NO_SIMULATION]
+    o = o[(o["iterations"] == 1) & (o["solver"] != NO_SIMULATION)]
+    solvers = list(dict.fromkeys(o["scheme"])) or ["none"]
     fig, axes = plt.subplots(1, len(solvers), figsize=(5.2 * len(solvers), 4.2), sharey=True, squeeze=False)
     ref = rows[rows["study"] == "reference"]
     finest = ref[ref["substeps"] == ref["substeps"].max()] if len(ref) else ref
     m = rows[rows["study"] == "mode"]
     for ax, solver in zip(axes[0], solvers):
-        for k, (_, r) in enumerate(o[o["solver"] == solver].sort_values("substeps").iterrows()):
+        for k, (_, r) in enumerate(o[o["scheme"] == solver].sort_values("substeps").iterrows()):
             d = m[m["mode"] == r["mode"]].sort_values("frame")
             ax.plot(d["time_s"], d["rms_err_L"], color=f"C{k % 10}", lw=1.2, label=f"S = {int(r['substeps'])}")
+        if len(base):
+            d = m[m["mode"] == base["mode"].iloc[0]].sort_values("frame")
+            ax.plot(d["time_s"], d["rms_err_L"], color="0.3", lw=1.4, ls="-.", label="no simulation")
         if len(finest):
             f = finest.sort_values("frame")
             S = int(f["substeps"].iloc[0])
@@ -516,43 +800,56 @@ def convergence_lines(rows, study):
     return out
 
 
-def _mode_table(df, numbered=False):
+def _mode_table(df, numbered=False, base=None):
+    """Markdown rows of modes; `base`: the no-simulation row, against which the RMS is also
+    given as a ratio (below 1: closer to the reference than not simulating at all)."""
     out = [
         ("| # " if numbered else "")
-        + "| mode | time/frame (ms) | RMS err / L | max err / L | stretch_max | penetration_max (cm) | blown up |",
-        ("| ---: " if numbered else "") + "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+        + "| mode | time/frame (ms) | RMS err / L | ÷ no-sim RMS | p99 err / L | max err / L | stretch_max | "
+        "stretch p99 | IoU min | penetration_max (cm) | verdict (blown-up strands) |",
+        ("| ---: " if numbered else "")
+        + "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |",
     ]
+    b = base["rms"] if base is not None and np.isfinite(base["rms"]) and base["rms"] > 0 else None
     for k, (_, r) in enumerate(df.iterrows(), 1):
+        ok = r["blown"] == 0
         out.append(
             (f"| {k} " if numbered else "")
-            + f"| {r['mode']} | {r['time_per_frame_ms']:.3g} | {_e(r['rms']) if r['blown'] == 0 else '—'} | "
-            f"{_e(r['max']) if r['blown'] == 0 else '—'} | {r['stretch']:.3g} | {r['penetration']:.2g} | "
-            f"{int(r['blown'])} |"
+            + f"| {r['mode']} | {r['time_per_frame_ms']:.3g} | {_e(r['rms']) if ok else '—'} | "
+            f"{f'{r.rms / b:.3g}' if ok and b else '—'} | {_e(r['p99']) if ok else '—'} | "
+            f"{_e(r['max']) if ok else '—'} | {r['stretch']:.3g} | {r['stretch_p99']:.3g} | "
+            f"{f'{r.iou:.3f}' if ok and np.isfinite(r['iou']) else '—'} | {r['penetration']:.2g} | "
+            f"{r['verdict']} ({int(r['blown'])}) |"
         )
     return out
 
 
 def _all_modes_lines(summ):
     order = summ.assign(label=summ.apply(_label, axis=1)).sort_values(
-        ["label", "solver", "precision", "substeps", "iterations"]
+        ["label", "scheme", "precision", "substeps", "iterations"]
     )
     return [
         "### Every mode",
         "",
-        "Errors, stretch and penetration: the worst frame up to the horizon; blown up: the most strands "
-        "blown up in any frame of the run (its errors are then not shown).",
+        "Errors, stretch, silhouette overlap (IoU, front and side, the smaller) and penetration: the worst "
+        "frame up to the horizon; verdict: the worst frame of the run, split by cause (diverged: a NaN or "
+        "Inf; escaped: a point farther than 2L from its root), with the most strands blown up in any frame "
+        "(its errors are then not shown).",
         "",
-        *_mode_table(order),
+        *_mode_table(order, base=baseline(summ)),
         "",
     ]
 
 
-def markdown(rows, study, env, analytic):
+def markdown(rows, study, env, analytic, long=None):
     summ = summary(rows, study["horizon_frames"])
     front = front_of(summ)
     pairs = small_steps(summ, study)
+    base = baseline(summ)
     out = ["## Speed against accuracy: the dynamic model", "", *_header(study, env)]
     out += convergence_lines(rows, study)
+    out += [reference_error_line(study), ""]
+    out += baseline_lines(summ, study)
     out += [
         "### Error against time per frame",
         "",
@@ -560,7 +857,9 @@ def markdown(rows, study, env, analytic):
         f"{int((~summ['usable']).sum())} blew up. The Pareto front (no other mode is both faster and more "
         "accurate):",
         "",
-        *_mode_table(front, numbered=True),
+        *_mode_table(front, numbered=True, base=base),
+        "",
+        reference_error_line(study),
         "",
         f"![error against time per frame]({PARETO_PNG})",
         "",
@@ -595,17 +894,21 @@ def markdown(rows, study, env, analytic):
         out.append("")
     o = oracle(summ, study)
     for solver, ps in pairs.items():
-        ladder = o[(o["solver"] == solver) & (o["iterations"] == 1)].sort_values("substeps")
+        ladder = o[(o["scheme"] == solver) & (o["iterations"] == 1)].sort_values("substeps")
         out += small_steps_verdict(solver, ps, ladder)
-    out += ["", f"![small steps against iterations]({STEPS_PNG})", ""]
+    out += ["", reference_error_line(study), "", f"![small steps against iterations]({STEPS_PNG})", ""]
+    out += long_lines(long, study)
     out += [
         "### Which settings for which use",
         "",
         "Rule: for each use, the mode with the least time per frame among those never blown up whose RMS error "
-        "and stretch_max over the horizon are within the use's budget (harness/core/tolerances.py, DYN_ACC_USES), "
-        "on the CPU and on the GPU apart:",
+        "and stretch_max over the horizon are within the use's budget (harness/core/tolerances.py, DYN_ACC_USES) "
+        "and, where the long runs measured its settings, whose tip frequency, mean kinetic energy and rest "
+        "jitter are within the use's allowance of the reference's (DYN_ACC_USES_LONG, each widened by the "
+        "measured noise), on the CPU and on the GPU apart. ftl's s is part of the setting: s < 1 converges to "
+        "another motion and adds energy (docs/model.md §3.7).",
         "",
-        *recommend(summ),
+        *recommend(summ, long),
         "",
     ]
     if analytic:
@@ -619,6 +922,7 @@ def markdown(rows, study, env, analytic):
             "",
         ]
     out += _all_modes_lines(summ)
+    out += [reference_error_line(study), ""]
     return out, summ, front, pairs
 
 
@@ -628,8 +932,9 @@ def write(results_dir=None, report_dir=None, csv_path=None):
     results_dir = Path(results_dir or RESULTS / RESULTS_NAME)
     report_dir = Path(report_dir or REPORT)
     rows, study, env, analytic = load(results_dir, csv_path)
+    long = load_long(Path(csv_path).parent if csv_path else results_dir)
     report_dir.mkdir(parents=True, exist_ok=True)
-    lines, summ, _, pairs = markdown(rows, study, env, analytic)
+    lines, summ, _, pairs = markdown(rows, study, env, analytic, long)
     pics = [
         pareto_plot(summ, study, report_dir / PARETO_PNG),
         growth_plot(rows, summ, study, report_dir / GROWTH_PNG),
@@ -667,9 +972,12 @@ def section(results_dir=None, report_dir=None, write_page=True):
         f"the full study, its convergence table, small steps against iterations and the analytic checks: "
         f"[{PAGE}]({PAGE}).",
         "",
-        *_mode_table(front, numbered=True),
+        *_mode_table(front, numbered=True, base=baseline(summ)),
         "",
-        *recommend(summ),
+        reference_error_line(study),
+        "",
+        *baseline_lines(summ, study)[2:3],
+        *recommend(summ, load_long(results_dir)),
         "",
         f"![error against time per frame]({PARETO_PNG})",
         "",

@@ -11,26 +11,30 @@ import pandas as pd
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, display
-from harness.studies.stability_slices import OTHER, SLICES, VERDICTS
+from harness.studies.stability_slices import BLOWN_UP, LEGACY, OTHER, SLICES, VERDICTS
 
-ORDER = VERDICTS + OTHER
+ORDER = VERDICTS + LEGACY + OTHER
 COLOURS = {
     "ok": "#9fd89f",
     "over-stretched": "#f5c05a",
     "penetrating": "#b58ad9",
-    "blown up": "#d9534f",
+    "escaped": "#e8896a",
+    "diverged": "#b52b27",
     "refused": "#bbbbbb",
+    "blown up": "#d9534f",
     "failed": "#555555",
 }
 # how the words name a verdict ("xpbd fp32 blows up at …")
 VERBS = {
-    "blown up": "blows up",
+    "escaped": "escapes (a point past 2L, finite)",
+    "diverged": "diverges (NaN/Inf)",
     "penetrating": "penetrates the head",
     "over-stretched": "over-stretches",
     "refused": "is refused",
+    "blown up": "blows up (a map measured before the split by cause)",
     "failed": "fails",
 }
-WORST_FIRST = ("blown up", "penetrating", "over-stretched", *OTHER)
+WORST_FIRST = ("diverged", "escaped", *LEGACY, "penetrating", "over-stretched", *OTHER)
 
 
 def load(csv_path):
@@ -163,7 +167,7 @@ def heatmap(rows, slice_name, path):
                     if cell is None:
                         continue
                     s = cell.stretch_max
-                    note = "–" if cell.verdict in OTHER else "×" if cell.verdict == "blown up" else percent(s)
+                    note = "–" if cell.verdict in OTHER else "×" if cell.verdict in BLOWN_UP + LEGACY else percent(s)
                     ax.text(x, y, note, ha="center", va="center", fontsize=6.5)
             ax.set_xticks(range(len(cv)), cv, fontsize=7, rotation=45)
             ax.set_yticks(range(len(rv)), rv, fontsize=7)
@@ -220,8 +224,11 @@ def write_markdown(rows, path, info, pngs):
         "",
         f"Each cell is one run of {info.get('strands', '?')} strands over {info.get('frames', '?')} frames "
         "(Δt = 1/60 s) of the base scene with one or two parameters changed; its verdict is the first of: "
-        "**blown up** (a strand with NaN/Inf or a point farther than 2L from its root in some frame, "
-        f"docs/model.md §3.8), **penetrating** (penetration_max > {bound_p:g}·R_c), **over-stretched** "
+        "**diverged** (a strand blown up in some frame, docs/model.md §3.8, and a NaN or Inf in the last "
+        "frame), **escaped** (a strand blown up in some frame by a point farther than 2L from its root, every "
+        "number finite: large but bounded, as an iteration-starved run is; the substeps-iterations slice shows "
+        "where more iterations bring it back), "
+        f"**penetrating** (penetration_max > {bound_p:g}·R_c), **over-stretched** "
         f"(stretch_max > {bound_s:g}, i.e. {100 * bound_s:.0f} %), else **ok** (bounds and their reasons: "
         "harness/core/tolerances.py STABILITY_*).",
         "",

@@ -7,7 +7,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from harness.core.variants import Runner
+from harness.core.variants import NO_DYNAMICS, Runner
+
+NO_SIMULATION = NO_DYNAMICS  # hair carried rigidly with the head (docs/model.md §3.13)
+
+
+def scheme_name(solver, ftl_damping=None):
+    """ "xpbd", "ftl s=0.9" (ftl names its s), "rigid"."""
+    if solver == "ftl" and ftl_damping is not None and ftl_damping == ftl_damping:
+        return f"ftl s={float(ftl_damping):g}"
+    return str(solver)
 
 
 @dataclass(frozen=True)
@@ -19,12 +28,20 @@ class Mode:
     iterations: int | None = None
     label: str | None = None  # a paper mode's own name
     use: str = ""  # what a user would pick it for, in a few words
+    ftl_damping: float | None = None  # ftl's s (docs/model.md §3.7); None for the other solvers
+
+    @property
+    def scheme(self):
+        """The solver as the study names it: "xpbd", "ftl s=0.9", "rigid"."""
+        return scheme_name(self.solver, self.ftl_damping)
 
     @property
     def name(self):
         if self.label is not None:
             return self.label
-        return f"{self.runner.label} {self.solver} S{self.substeps} I{self.iterations} {self.precision}"
+        if self.solver == NO_SIMULATION:
+            return f"{self.runner.label} {self.solver} {self.precision}"
+        return f"{self.runner.label} {self.scheme} S{self.substeps} I{self.iterations} {self.precision}"
 
     @property
     def tag(self):
@@ -106,6 +123,24 @@ COLUMNS = (
     "device",
     "ref_substeps",  # the reference rung compared with (mode, gpu_check) or 2S (reference)
 )
+# added with the no-simulation baseline and ftl's s axis: a table written before them (a
+# committed reference run) still reads, these columns empty
+LATER_COLUMNS = (
+    "ftl_damping",  # ftl's s; empty for the other solvers
+    "verdict",  # ok | diverged (NaN/Inf) | escaped (a point past 2L): blown up, split by cause
+    "err_p50_L",  # percentiles over the points of |x − x_ref|/L
+    "err_p95_L",
+    "err_p99_L",
+    "stretch_p99",  # 99th percentile over the segments of |len/ℓ − 1|
+    "kinetic",  # per non-root particle: ½|v|² (cm²/s²)
+    "potential",  # per non-root particle: g0·y (cm²/s²)
+    "iou_front",  # silhouette overlap with the reference, seen from the front and the side
+    "iou_side",
+)
+REQUIRED_COLUMNS = COLUMNS
+COLUMNS = COLUMNS + LATER_COLUMNS
+# the rows' `study`: mode | reference (the ladder, S against 2S) | gpu_check | ref_error (the
+# final rung against two more doublings, and the Richardson estimate of what is left)
 
 
 def smallest(errors):

@@ -4,11 +4,15 @@ accuracy study").
 
 Every mode, solver × substeps S × iterations I × precision × build (each cpu variant and,
 with a usable GPU, each cuda build's variants that run `simulate`; all read from the
-binaries), runs the same dynamic scene (same seed, so the same roots) for `seconds` of
-simulated time. Each run is compared frame by frame with a converged reference:
+binaries; ftl once per s of `ftl_damping`; the no-simulation baseline, solver `rigid`, once
+per precision where a variant declares it), runs the same dynamic scene (same seed, so the
+same roots) for `seconds` of simulated time. Each run is compared frame by frame with a
+converged reference:
 
   rms_err_L, max_err_L   RMS and max over all points of |x − x_ref|, over the hair length L
+  err_p50/p95/p99_L, iou_front, iou_side   error percentiles, silhouette overlap
   stretch_max, penetration_max, blown_up_strands   the mode's own observables (§3.8)
+  stretch_p99, kinetic, potential, verdict   (harness/check/observables.py)
 
 The reference is xpbd, fp64, I = 1, with S doubled from `ref_start` until, at every frame
 up to the horizon, the RMS difference between S and 2S is under
@@ -19,6 +23,10 @@ contacts and nearly straight bend triples, which converge far more slowly
 (docs/decisions.md, "The dynamic accuracy study"). It runs on the C reference, or on the GPU in fp64
 where one is usable, once the GPU's rung S0 agrees with the CPU's within a share of that
 margin (tolerances.DYN_ACC_GPU_REF_SHARE); otherwise the CPU ladder is used.
+
+After the ladder, `ref_extra` more doublings measure the reference's own error
+(Study.reference_error), and the long runs (studies/observables_long.py, observables.csv)
+measure what a user sees over `long_seconds`.
 
 Time per frame is measured apart from the checked run: the same mode at `time_strands`
 strands, `time_frames` frames, `--repeat`, no output file (never a run that also checks);
@@ -42,13 +50,16 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
+from harness.check import observables
 from harness.core import env, runner, scenes, scenes_dynamic, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.io.trajectory import open_trajectory
+from harness.studies import observables_long
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     COLUMNS,
     CSV_NAME,
+    NO_SIMULATION,
     REF_ITERATIONS,
     REF_PRECISION,
     REF_SOLVER,
@@ -81,6 +92,11 @@ class Plan:
     jobs: int | None = None  # parallel checked runs (None: one per core)
     analytic: str = "full"  # full | quick | none
     gpu: str = "auto"  # auto | no
+    ftl_damping: tuple = (0.0, 0.5, 0.9, 1.0)  # ftl's s, an axis of the study (docs/model.md §3.7)
+    ref_extra: int = 2  # doublings past the converged rung that measure the reference's own error
+    long_seconds: float = 10.0  # the long runs' simulated time (0: no long runs)
+    long_strands: int = 8
+    long_ref_max: int = 512  # the long runs' reference S at most (its change to 2S is reported)
 
     @classmethod
     def quick(cls, **changes):
@@ -128,6 +144,16 @@ def check_plan(plan, frame_dt):
         bad.append(f"--ref-max {plan.ref_max} makes the substep {frame_dt / plan.ref_max:g} s, below 1e-12 s")
     if plan.analytic not in ("full", "quick", "none"):
         bad.append(f"--analytic must be full, quick or none (got '{plan.analytic}')")
+    if not plan.ftl_damping or any(not 0.0 <= s <= 1.0 for s in plan.ftl_damping):
+        bad.append("--ftl-damping needs at least one value, each in [0, 1]")
+    if plan.ref_extra < 0 or plan.ref_extra > 4:
+        bad.append(f"--ref-extra must lie in 0 … 4 (got {plan.ref_extra})")
+    if plan.long_seconds < 0 or (plan.long_seconds > 0 and plan.long_seconds < 4 * frame_dt):
+        bad.append(f"--long-seconds must be 0 (none) or at least 4 frames (got {plan.long_seconds:g})")
+    if plan.long_strands < 2:
+        bad.append(
+            f"--long-strands must be at least 2 (its noise is the two halves' difference; got {plan.long_strands})"
+        )
     if bad:
         raise HarnessError("accuracy --model dynamic: " + "; ".join(bad))
 
@@ -144,16 +170,23 @@ def study_builds(gpu_ok):
 
 
 def study_modes(builds, plan):
+    """Every variant's solvers (its own list in --list-variants) × precision × (S, I); ftl
+    once for each s of the plan; the no-simulation baseline once per precision (S = I = 1:
+    it solves nothing)."""
     pairs = grid(plan.substeps, plan.iterations)
     out = []
     for b in builds:
         d = variants.declared(b.backend, b.build)
-        for solver, precision, (s, i) in itertools.product(d.solvers, d.precisions, pairs):
-            out.append(Mode(b, precision, solver, s, i))
+        for solver, precision in itertools.product(d.solvers_of(b.variant or d.default_variant), d.precisions):
+            if solver == NO_SIMULATION:
+                out.append(Mode(b, precision, solver, 1, 1))
+                continue
+            for damping in plan.ftl_damping if solver == "ftl" else (None,):
+                out += [Mode(b, precision, solver, s, i, ftl_damping=damping) for s, i in pairs]
     return out
 
 
-def configured(scene, *, solver, substeps, iterations, precision, frames, strands):
+def configured(scene, *, solver, substeps, iterations, precision, frames, strands, ftl_damping=None):
     """The dynamic scene with one mode's settings, every frame written."""
     dyn = {
         **scene.dynamic,
@@ -163,6 +196,8 @@ def configured(scene, *, solver, substeps, iterations, precision, frames, strand
         "--frames": int(frames),
         "--output-every": 1,
     }
+    if ftl_damping is not None:
+        dyn["--ftl-damping"] = float(ftl_damping)
     return replace(scene.with_overrides(strands=strands, precision=precision), dynamic=dyn)
 
 
@@ -181,19 +216,22 @@ def reference_ok(diff, smallest_error, factor):
 
 @dataclass
 class Run:
-    """A checked run read back: times [F], positions [F][N][P][3], observables per frame."""
+    """A checked run read back: times [F], positions and velocities [F][N][P][3] (velocities
+    None where the file stores only the last), observables per frame."""
 
     times: np.ndarray
     pos: np.ndarray
     stretch: np.ndarray
     penetration: np.ndarray
     blown: np.ndarray
+    vel: np.ndarray | None = None
 
 
 def read_run(path):
     with open_trajectory(path) as t:
         sim = t.simulated
         pos = np.stack([t.frame(f) for f in sim]).astype(np.float64)
+        vel = [t.velocity_at_step(s) for s in t.step[sim]]
         obs = t.observables.set_index("step").reindex(t.step[sim])
         return Run(
             times=t.time[sim].copy(),
@@ -201,7 +239,28 @@ def read_run(path):
             stretch=obs["stretch_max"].to_numpy(np.float64),
             penetration=obs["penetration_max"].to_numpy(np.float64),
             blown=obs["blown_up_strands"].to_numpy(np.int64),
+            vel=np.stack(vel).astype(np.float64) if all(v is not None for v in vel) else None,
         )
+
+
+def frame_metrics(run, ref, L, gravity):
+    """Per frame of `run`: the verdict, error percentiles and silhouette overlaps against
+    `ref` (a Run, or None), stretch p99, kinetic and potential energy per particle."""
+    F = len(run.times)
+    out = {k: [np.nan] * F for k in ("err_p50_L", "err_p95_L", "err_p99_L", "iou_front", "iou_side")}
+    out["verdict"] = [observables.verdict(run.pos[f], L, None if run.vel is None else run.vel[f]) for f in range(F)]
+    out["stretch_p99"] = [observables.stretch_stats(run.pos[f], L)[1] for f in range(F)]
+    if run.vel is not None:
+        k, p, _ = observables.energy(run.pos, run.vel, gravity)
+        out["kinetic"], out["potential"] = list(k), list(p)
+    for f in range(F):
+        if ref is None or out["verdict"][f] == observables.DIVERGED:
+            continue
+        e = observables.error_percentiles(run.pos[f], ref.pos[f], L)
+        out["err_p50_L"][f], out["err_p95_L"][f], out["err_p99_L"][f] = e["p50"], e["p95"], e["p99"]
+        iou = observables.silhouette_iou(run.pos[f], ref.pos[f])
+        out["iou_front"][f], out["iou_side"][f] = iou["front"], iou["side"]
+    return out
 
 
 class Study:
@@ -219,13 +278,14 @@ class Study:
         self.frames = max(1, round(plan.seconds / self.frame_dt))
         self.horizon_frames = min(self.frames, round(plan.horizon / self.frame_dt))
         self.L = self.scene.hair_length
+        self.gravity = float(self.scene.dynamic.get("--gravity", 981.0))
         self.scratch = Path(out_dir) / "states"
         self.cpu_threads = os.cpu_count() or 1
 
     def path(self, tag):
         return self.scratch / f"{tag}.h5"
 
-    def checked(self, build, solver, substeps, iterations, precision, tag, threads=None):
+    def checked(self, build, solver, substeps, iterations, precision, tag, threads=None, ftl_damping=None):
         sc = configured(
             self.scene,
             solver=solver,
@@ -234,9 +294,11 @@ class Study:
             precision=precision,
             frames=self.frames,
             strands=self.plan.strands,
+            ftl_damping=ftl_damping,
         )
         out = self.path(tag)
         flags = runner.run_flags(sc, build.backend, variant=build.variant, threads=threads, output=out, force=True)
+        flags += ["--velocities", "all"]  # the energy of every frame
         rec = runner.run_binary(build.binary, flags)
         return out, rec
 
@@ -249,6 +311,7 @@ class Study:
             precision=mode.precision,
             frames=self.plan.time_frames,
             strands=self.plan.time_strands,
+            ftl_damping=mode.ftl_damping,
         )
         flags = runner.run_flags(sc, mode.runner.backend, variant=mode.runner.variant, repeat=self.plan.repeat)
         rec = runner.run_binary(mode.runner.binary, flags)
@@ -296,7 +359,8 @@ class Study:
             cur_path = self.rung(build, 2 * S)
             prev, cur = read_run(prev_path), read_run(cur_path)
             d_rms, d_max = frame_errors(prev.pos, cur.pos, self.L)
-            steps.append(dict(S=S, S2=2 * S, rms=d_rms, max=d_max, run=replace(prev, pos=None)))
+            extra = frame_metrics(prev, cur, self.L, self.gravity)
+            steps.append(dict(S=S, S2=2 * S, rms=d_rms, max=d_max, run=replace(prev, pos=None, vel=None), extra=extra))
             if then is None:
                 then, moved = self.mode_rms(mode_paths, cur), np.zeros_like(d_rms)
                 errs = then
@@ -326,6 +390,37 @@ class Study:
                 )
             prev_path, S = cur_path, 2 * S
 
+    def reference_error(self, ref):
+        """The reference's own error, measured: its final rung against plan.ref_extra more
+        doublings. Per frame the RMS and max difference from the finest rung, and (with two or
+        more) a Richardson-style estimate: that difference plus the tail the last two
+        differences predict if each doubling keeps shrinking the change by their ratio q
+        (q = worst over the horizon of the last over the one before; no estimate if q ≥ 1)."""
+        if self.plan.ref_extra < 1:
+            return None
+        S = ref["steps"][-1]["S2"]
+        prev, prev_S, diffs = ref["final"], S, []
+        for _ in range(self.plan.ref_extra):
+            path = self.rung(ref["build"], 2 * prev_S)
+            cur = read_run(path)
+            os.unlink(path)
+            diffs.append((prev_S, 2 * prev_S, *frame_errors(prev.pos, cur.pos, self.L)))
+            prev, prev_S = cur, 2 * prev_S
+        rms, mx = frame_errors(ref["final"].pos, prev.pos, self.L)
+        H = self.horizon_frames
+        q = float("nan")
+        tail_rms = tail_max = np.full_like(rms, np.nan)
+        if len(diffs) >= 2:
+            with np.errstate(invalid="ignore", divide="ignore"):
+                q = float(np.nanmax(diffs[-1][2][:H]) / np.nanmax(diffs[-2][2][:H]))
+            if q < 1:
+                tail_rms, tail_max = diffs[-1][2] * q / (1 - q), diffs[-1][3] * q / (1 - q)
+        self.log(
+            f"dynamic accuracy: the reference S = {S} against S = {prev_S}: RMS {np.nanmax(rms[:H]):.2e}·L, max "
+            f"{np.nanmax(mx[:H]):.2e}·L over the horizon; change ratio per doubling {q:.3g}"
+        )
+        return dict(S=S, finest=prev_S, rms=rms, max=mx, est_rms=rms + tail_rms, est_max=mx + tail_max, ratio=q)
+
 
 def _gpu_reference_build(gpu_ok, plan):
     if not gpu_ok or not binary_path("cuda").exists():
@@ -338,12 +433,13 @@ def _row(**kw):
     return {k: kw.get(k) for k in COLUMNS}
 
 
-def _frame_rows(run, rms, mx, **shared):
+def _frame_rows(run, rms, mx, extra, **shared):
     """One row per simulated frame of `run`, with its errors against a reference (rms, mx,
-    per frame) and the columns every frame shares."""
+    per frame), frame_metrics' columns (extra) and the columns every frame shares."""
     return [
         _row(
             **shared,
+            **{k: v[f] for k, v in extra.items()},
             frame=f + 1,
             time_s=run.times[f],
             rms_err_L=rms[f],
@@ -398,7 +494,15 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
             for m in modes:
                 threads = 1 if m.runner.backend == "cpu" else None
                 f = pool.submit(
-                    study.checked, m.runner, m.solver, m.substeps, m.iterations, m.precision, m.tag, threads
+                    study.checked,
+                    m.runner,
+                    m.solver,
+                    m.substeps,
+                    m.iterations,
+                    m.precision,
+                    m.tag,
+                    threads,
+                    m.ftl_damping,
                 )
                 futures[f] = m
             done = 0
@@ -434,6 +538,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                 gpu_run,
                 g_rms,
                 g_max,
+                frame_metrics(gpu_run, cpu_run, study.L, study.gravity),
                 study="gpu_check",
                 mode=f"{gpu_ref.label} vs {cpu_oracle.label} S{S0}",
                 backend="cuda",
@@ -455,6 +560,14 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                 ref = study.ladder(cpu_oracle, mode_paths, first_path=cpu_path)
         else:
             ref = study.ladder(cpu_oracle, mode_paths)
+        ref_err = study.reference_error(ref)
+
+        # the long runs: what a user sees over seconds (studies/observables_long.py)
+        long_rows = []
+        if plan.long_seconds > 0:
+            oracle_modes = [m for m in modes if m.runner == builds[0]]
+            long = observables_long.LongRuns(study, ref["build"], ref["steps"][-1]["S2"], log, configured, read_run)
+            long_rows = long.measure(oracle_modes, jobs)
 
         # 3. timing, one mode at a time, nothing else running
         timing = {}
@@ -464,6 +577,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                 log(f"dynamic accuracy: timed {k}/{len(modes)}")
 
         rows = _rows(study, modes, mode_paths, ref, timing) + _ladder_rows(study, ref) + check_rows
+        rows += _ref_error_rows(study, ref, ref_err)
     finally:
         shutil.rmtree(study.scratch, ignore_errors=True)
 
@@ -474,6 +588,16 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         w.writeheader()
         w.writerows(rows)
     os.replace(tmp, csv_path)
+    long_path = out_dir / observables_long.CSV_NAME
+    if long_rows:
+        tmp = long_path.with_suffix(".csv.tmp")
+        with open(tmp, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=observables_long.COLUMNS)
+            w.writeheader()
+            w.writerows(long_rows)
+        os.replace(tmp, long_path)
+    elif long_path.exists():
+        long_path.unlink()  # stale long runs must not be rendered with these rows
     if analytic_lines:
         (out_dir / ANALYTIC_NAME).write_text("\n".join(analytic_lines) + "\n")
     elif (out_dir / ANALYTIC_NAME).exists():
@@ -506,6 +630,16 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                 factor=tolerances.DYN_ACC_REF_FACTOR,
                 gpu_check=gpu_note,
                 gpu_share=tolerances.DYN_ACC_GPU_REF_SHARE,
+                error=None
+                if ref_err is None
+                else dict(
+                    against_substeps=ref_err["finest"],
+                    rms_horizon=float(np.nanmax(ref_err["rms"][: study.horizon_frames])),
+                    max_horizon=float(np.nanmax(ref_err["max"][: study.horizon_frames])),
+                    est_rms_horizon=float(np.nanmax(ref_err["est_rms"][: study.horizon_frames])),
+                    est_max_horizon=float(np.nanmax(ref_err["est_max"][: study.horizon_frames])),
+                    ratio_per_doubling=ref_err["ratio"],
+                ),
             ),
             wall_s=round(time.monotonic() - started, 1),
             command=command,
@@ -533,6 +667,8 @@ def _rows(study, modes, mode_paths, ref, timing):
             r,
             rms,
             mx,
+            frame_metrics(r, ref["final"], study.L, study.gravity),
+            ftl_damping=m.ftl_damping,
             study="mode",
             mode=m.name,
             backend=m.runner.backend,
@@ -582,6 +718,41 @@ def _ladder_rows(study, ref):
                     penetration_max=run.penetration[f],
                     blown_up_strands=run.blown[f],
                     ref_substeps=st["S2"],
+                    **{k: v[f] for k, v in st["extra"].items()},
+                )
+            )
+    return rows
+
+
+def _ref_error_rows(study, ref, err):
+    """The reference's own error per frame: its final rung against the finest extra doubling
+    (study ref_error) and with the estimated tail (ref_error_est)."""
+    if err is None:
+        return []
+    b = ref["build"]
+    run = ref["final"]
+    rows = []
+    for name, rms, mx in (("ref_error", err["rms"], err["max"]), ("ref_error_est", err["est_rms"], err["est_max"])):
+        for f in range(len(rms)):
+            rows.append(
+                _row(
+                    study=name,
+                    mode=f"{b.label} {REF_SOLVER} S{err['S']} against S{err['finest']}"
+                    + (" + tail" if name == "ref_error_est" else ""),
+                    backend=b.backend,
+                    build=b.build,
+                    variant=b.variant,
+                    solver=REF_SOLVER,
+                    substeps=err["S"],
+                    iterations=REF_ITERATIONS,
+                    precision=REF_PRECISION,
+                    strands=study.plan.strands,
+                    points=study.scene.points,
+                    frame=f + 1,
+                    time_s=run.times[f],
+                    rms_err_L=rms[f],
+                    max_err_L=mx[f],
+                    ref_substeps=err["finest"],
                 )
             )
     return rows

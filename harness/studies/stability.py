@@ -10,7 +10,9 @@ about one second (strands are independent, so a few show what many would); its v
 from the per-frame observables of the file (docs/model.md §3.8) and the bounds of
 harness/core/tolerances.py:
 
-  blown up        some frame has a blown-up strand (NaN/Inf, or a point beyond 2L)
+  diverged        some frame has a blown-up strand and the run ends with a NaN or Inf
+  escaped         some frame has a blown-up strand (a point beyond 2L) and every number
+                  of the last frame is finite: large but bounded, e.g. iteration-starved
   penetrating     penetration_max > STABILITY_PENETRATION_REL · R_c in some frame
   over-stretched  stretch_max > STABILITY_STRETCH_MAX in some frame
   ok              none of these
@@ -30,6 +32,8 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
+
+import numpy as np
 
 from harness import HarnessError
 from harness.check import invariants_dynamic
@@ -77,10 +81,11 @@ class Backend(variants.Runner):
         return "cpu" if self.backend == "cpu" else f"cuda-{self.build}"
 
 
-def verdict(stretch_max, penetration_rel, blown_up_frames):
-    """The verdict of a cell from its worst observables over the horizon (module docstring)."""
-    if blown_up_frames > 0:
-        return "blown up"
+def verdict(stretch_max, penetration_rel, blown_up_frames, diverged=False):
+    """The verdict of a cell from its worst observables over the horizon (module docstring);
+    `diverged`: the last frame holds a NaN or Inf."""
+    if blown_up_frames > 0 or diverged:
+        return "diverged" if diverged else "escaped"
     if penetration_rel > tolerances.STABILITY_PENETRATION_REL:
         return "penetrating"
     if stretch_max > tolerances.STABILITY_STRETCH_MAX:
@@ -173,13 +178,14 @@ def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None
             blown = obs["blown_up_strands"].to_numpy() > 0
             rep = invariants_dynamic.check(t, exact=invariants_dynamic.is_reference_build(t), paper=False)
             rel = pen / t.collide_radius
+            diverged = not (np.isfinite(t.frame(-1)).all() and np.isfinite(t.velocity(-1)).all())
     out.update(
         stretch_max=stretch,
         penetration_max=pen,
         penetration_rel=rel,
         blown_up_frames=int(blown.sum()),
         first_blown_frame=int(blown.argmax()) + 1 if blown.any() else "",
-        verdict=verdict(stretch, rel, int(blown.sum())),
+        verdict=verdict(stretch, rel, int(blown.sum()), diverged),
         violations="+".join(sorted({v.invariant for v in rep.violations})),
         wall_s=time.perf_counter() - t0,
     )
@@ -217,7 +223,7 @@ def measure(
         (slc, r, c, solver, precision, be)
         for be in bes
         for slc, r, c in cells(chosen, quick)
-        for solver in declared[be].solvers
+        for solver in declared[be].dynamic_solvers
         for precision in declared[be].precisions
     ]
     jobs = jobs or os.cpu_count() or 1

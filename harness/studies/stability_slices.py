@@ -3,8 +3,12 @@ slices (two axes over a base scene each) and the verdicts of a cell. Runs nothin
 
 from dataclasses import dataclass
 
-VERDICTS = ("ok", "over-stretched", "penetrating", "blown up")  # mildest first
+# mildest first; a blown-up cell (docs/model.md §3.8) is split by cause: escaped (a point
+# farther than 2L from its root, every number finite) or diverged (a NaN or Inf)
+VERDICTS = ("ok", "over-stretched", "penetrating", "escaped", "diverged")
+BLOWN_UP = ("escaped", "diverged")
 OTHER = ("refused", "failed")
+LEGACY = ("blown up",)  # a map measured before the split by cause still reads
 OFF = "off"  # an axis value that leaves its feature undeclared
 
 
@@ -63,6 +67,14 @@ SLICES = (
         (),
         SUBSTEPS,
         Axis("points", "P", (2, 4, 8, 16, 32, 64, 128), (2, 16, 128)),
+    ),
+    Slice(
+        "substeps-iterations",
+        "substeps against iterations (the default dynamic scene: wind, gusts, nodding head)",
+        "dynamic",
+        (),
+        SUBSTEPS,
+        Axis("--iterations", "I", (1, 2, 4, 8, 16, 32, 64, 128), (1, 8, 128)),
     ),
     Slice(
         "motion",

@@ -11,7 +11,7 @@ import pytest
 from harness.cli import main as cli
 from harness.core import env, tolerances, variants
 from harness.render import accuracy_dynamic_report
-from harness.studies import accuracy_dynamic
+from harness.studies import accuracy_dynamic, observables_long
 from support.cuda_standin import install
 
 
@@ -96,6 +96,9 @@ TINY = dict(
     ref_max=4096,
     analytic="none",
     jobs=2,
+    ftl_damping=(0.9, 1.0),
+    long_seconds=6 / 60,
+    long_strands=2,
 )
 
 
@@ -115,10 +118,23 @@ def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, 
         rows = list(reader)
     assert tuple(reader.fieldnames) == accuracy_dynamic.COLUMNS
     cpu = variants.declared("cpu")
-    n_modes = len(cpu.running("simulate")) * len(cpu.solvers) * len(cpu.precisions) * 3  # (1,1) (2,1) (1,2)
+    # per variant and precision: xpbd at (1,1) (2,1) (1,2), ftl there at each s, the no-simulation mode once
+    per = {"xpbd": 3, "ftl": 3 * len(TINY["ftl_damping"]), "rigid": 1}
+    n_modes = sum(per[s] for v in cpu.running("simulate") for s in cpu.solvers_of(v)) * len(cpu.precisions)
     mode_rows = [r for r in rows if r["study"] == "mode"]
     assert len(mode_rows) == n_modes * 2  # two frames each
     assert all(float(r["time_per_frame_ms"]) > 0 and float(r["rms_err_L"]) > 0 for r in mode_rows)
+    assert {r["verdict"] for r in mode_rows} == {"ok"}
+    assert {r["ftl_damping"] for r in mode_rows if r["solver"] == "ftl"} == {"0.9", "1.0"}
+    rigid = [r for r in mode_rows if r["solver"] == "rigid"]
+    assert {r["variant"] for r in rigid} == {cpu.default_variant}  # the only variant that declares it
+    assert all(0 < float(r["iou_front"]) <= 1 and float(r["kinetic"]) >= 0 for r in mode_rows)
+    errs = [r for r in rows if r["study"] == "ref_error"]
+    assert len(errs) == 2 and all(float(r["rms_err_L"]) >= 0 for r in errs)
+    with open(out / "observables.csv", newline="") as fh:
+        long = list(csv.DictReader(fh))
+    assert {r["study"] for r in long} == {"mode", "reference"}
+    assert {r["metric"] for r in long} == set(observables_long.METRICS)
     ladder = [r for r in rows if r["study"] == "reference"]
     assert ladder and all(int(r["ref_substeps"]) == 2 * int(r["substeps"]) for r in ladder)
     meta = json.loads((out / "env.json").read_text())["study"]
@@ -126,7 +142,13 @@ def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, 
         int(r["ref_substeps"]) for r in ladder
     )
     page = (rep / accuracy_dynamic_report.PAGE).read_text()
-    for heading in ("The converged reference", "Small steps against iterations", "Which settings for which use"):
+    for heading in (
+        "The converged reference",
+        "The no-simulation baseline",
+        "Small steps against iterations",
+        "What a user sees over seconds",
+        "Which settings for which use",
+    ):
         assert f"### {heading}" in page
     assert "**Converged**" in page and "No GPU reference: not used: HAIRBENCH_NO_GPU is set" in page
     for png in (
@@ -153,7 +175,9 @@ def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, 
 
 def test_the_reference_that_does_not_converge_says_so(cpu_bin, tmp_path, quiet, monkeypatch):
     monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
-    plan = accuracy_dynamic.Plan(**{**TINY, "substeps": (1, 16), "ref_start": 32, "ref_max": 64})
+    plan = accuracy_dynamic.Plan(
+        **{**TINY, "substeps": (1, 16), "ref_start": 32, "ref_max": 64, "long_seconds": 0, "ref_extra": 0}
+    )
     assert accuracy_dynamic.run_study(plan, tmp_path / "o", log=quiet) == 1
     accuracy_dynamic_report.write(tmp_path / "o", tmp_path / "r")
     assert "**NOT converged**" in (tmp_path / "r" / accuracy_dynamic_report.PAGE).read_text()
@@ -181,7 +205,9 @@ def test_gpu_modes_and_the_gpu_reference_check(standin_build, tmp_path, quiet, p
     with the CPU's (tolerances.DYN_ACC_GPU_REF_SHARE)."""
     standin_build(perturb)
     out = tmp_path / "out"
-    plan = accuracy_dynamic.Plan(**{**TINY, "iterations": (1,), "substeps": (1,)})
+    plan = accuracy_dynamic.Plan(
+        **{**TINY, "iterations": (1,), "substeps": (1,), "ftl_damping": (1.0,), "long_seconds": 0, "ref_extra": 0}
+    )
     assert accuracy_dynamic.run_study(plan, out, log=quiet) == 0
     with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
         rows = list(csv.DictReader(fh))

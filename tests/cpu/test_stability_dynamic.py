@@ -290,7 +290,10 @@ KNOWN_CELLS = [
     # slice, row, col, solver, precision, verdict (worst measured value, margin to its bound)
     ("substeps-points", 64, 32, "xpbd", "fp32", "ok"),  # stretch 0.0094, 10× under 0.1
     ("substeps-points", 8, 32, "xpbd", "fp64", "over-stretched"),  # 0.40, 4× over
-    ("substeps-points", 1, 32, "xpbd", "fp32", "blown up"),  # from frame 15, in 46 of 60 frames
+    ("substeps-points", 1, 32, "xpbd", "fp32", "escaped"),  # from frame 15, in 46 of 60 frames; all finite
+    # iteration starvation at S = 1 in the default scene: I = 1 stretches 300 %, I = 128 2.1 %
+    ("substeps-iterations", 1, 1, "xpbd", "fp64", "over-stretched"),  # 3.0, 30× over
+    ("substeps-iterations", 1, 128, "xpbd", "fp64", "ok"),  # 0.021, 4.7× under
     ("substeps-wind", 1, 0, "ftl", "fp32", "ok"),  # a stiff chain at S = 1: 0.051, 2× under
     ("substeps-wind", 1, 8000, "ftl", "fp64", "over-stretched"),  # a gale at S = 1: 0.20, 2× over
 ]
@@ -309,8 +312,8 @@ def test_verdict_takes_the_worst_that_applies():
     assert stability.verdict(s_max, p_rel, 0) == "ok"  # at the bound is still ok
     assert stability.verdict(s_max * 1.01, 0.0, 0) == "over-stretched"
     assert stability.verdict(s_max * 1.01, p_rel * 1.01, 0) == "penetrating"
-    assert stability.verdict(0.0, 0.0, 1) == "blown up"
-    assert stability.verdict(float("nan"), float("nan"), 3) == "blown up"
+    assert stability.verdict(0.0, 0.0, 1) == "escaped"  # blown up, every number finite
+    assert stability.verdict(float("nan"), float("nan"), 3, diverged=True) == "diverged"
 
 
 def _panel(verdicts, rows=(1, 2, 4, 8), cols=(0, 1000)):
@@ -326,15 +329,20 @@ def _panel(verdicts, rows=(1, 2, 4, 8), cols=(0, 1000)):
 
 
 def test_boundaries_are_named_from_the_data():
-    b, o, k = "blown up", "over-stretched", "ok"
+    b, o, k = "escaped", "over-stretched", "ok"
     words = stability_report.boundaries(_panel([[b, b], [o, b], [k, o], [k, k]]), "substeps-wind")
     assert words == (
-        "blows up at S = 1 (U = 0 cm/s); S ≤ 2 (U = 1000 cm/s); over-stretches at S = 2 (U = 0 cm/s); "
-        "S = 4 (U = 1000 cm/s)"
+        "escapes (a point past 2L, finite) at S = 1 (U = 0 cm/s); S ≤ 2 (U = 1000 cm/s); over-stretches at "
+        "S = 2 (U = 0 cm/s); S = 4 (U = 1000 cm/s)"
+    )
+    d = "diverged"
+    assert stability_report.boundaries(_panel([[d, b]] * 4), "substeps-wind") == (
+        "diverges (NaN/Inf) at every S (U = 0 cm/s); escapes (a point past 2L, finite) at every S (U = 1000 cm/s); "
+        "ok in no cell"
     )
     assert stability_report.boundaries(_panel([[k, k]] * 4), "substeps-wind") == "ok in every cell"
     assert stability_report.boundaries(_panel([[b, b]] * 4), "substeps-wind") == (
-        "blows up at every S (every U); ok in no cell"
+        "escapes (a point past 2L, finite) at every S (every U); ok in no cell"
     )
 
 

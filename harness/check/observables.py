@@ -1,0 +1,256 @@
+"""What a hair user sees of a run, as numbers (numpy only): energy, tip motion, rest jitter,
+stretch, position error percentiles, long-run distributions and spectra, silhouettes, and
+the verdict of a run (docs/harness.md, "The dynamic accuracy study"; docs/model.md §3.8).
+
+Positions are [F][N][P][3] (frames, strands, points, xyz), velocities the same, in cm and
+cm/s; L is the hair length. Point 0 of a strand is its root. Nothing here runs a binary.
+"""
+
+import numpy as np
+
+OK, DIVERGED, ESCAPED = "ok", "diverged", "escaped"
+
+
+def _f64(a):
+    return np.asarray(a, dtype=np.float64)
+
+
+# ---- verdicts -------------------------------------------------------------------------
+
+
+def verdict(pos, L, vel=None):
+    """'diverged' when any position (or velocity) is NaN or Inf, else 'escaped' when a
+    non-root point is farther than 2L from its strand's root, else 'ok' (the split of §3.8's
+    blown up by cause)."""
+    x = _f64(pos)
+    if not np.isfinite(x).all() or (vel is not None and not np.isfinite(_f64(vel)).all()):
+        return DIVERGED
+    far = np.linalg.norm(x[..., 1:, :] - x[..., :1, :], axis=-1)
+    return ESCAPED if (far > 2.0 * L).any() else OK
+
+
+# ---- energy ---------------------------------------------------------------------------
+
+
+def energy(pos, vel, gravity):
+    """Per frame, per non-root particle (unit masses): kinetic ½|v|², gravitational potential
+    g0·y, and their sum. Returns three arrays [F]."""
+    x, v = _f64(pos)[..., 1:, :], _f64(vel)[..., 1:, :]
+    kinetic = 0.5 * np.mean(np.sum(v * v, axis=-1), axis=(-2, -1))
+    potential = float(gravity) * np.mean(x[..., 1], axis=(-2, -1))
+    return kinetic, potential, kinetic + potential
+
+
+def drift(series, times):
+    """Least-squares slope of a series against time (units per second): how fast it drifts."""
+    t, y = _f64(times), _f64(series)
+    if len(t) < 2:
+        return 0.0
+    return float(np.polyfit(t, y, 1)[0])
+
+
+# ---- tip motion -----------------------------------------------------------------------
+
+
+def tip_displacement(pos, axis=1):
+    """Per frame, the mean over strands of the tip's coordinate `axis` less its mean over the
+    frames: the signal whose oscillation is the strands' swing."""
+    tip = _f64(pos)[:, :, -1, axis].mean(axis=1)
+    return tip - tip.mean()
+
+
+def tip_swing(pos):
+    """Per strand, the tip's horizontal displacement from its root along the horizontal
+    direction it starts in (the plane a released strand swings in): [F][N]. A strand whose
+    tip starts straight below its root uses x."""
+    x = _f64(pos)
+    rel = x[:, :, -1, :] - x[:, :, :1, :].squeeze(2)
+    h0 = rel[0].copy()
+    h0[:, 1] = 0.0
+    norm = np.linalg.norm(h0, axis=-1)
+    h0[norm == 0] = (1.0, 0.0, 0.0)
+    h0 /= np.linalg.norm(h0, axis=-1, keepdims=True)
+    return np.einsum("fnc,nc->fn", rel, h0)
+
+
+def swing(pos, dt):
+    """The median over strands of the dominant frequency (Hz) and of the damping ratio of each
+    strand's tip swing (tip_swing): the strands' own motion, not their average (strands that
+    swing in opposite phase would cancel in a mean). NaN where no strand gives a value."""
+    s = tip_swing(pos)
+    f = [dominant_frequency(s[:, n], dt) for n in range(s.shape[1])]
+    z = [damping_ratio(s[:, n], dt) for n in range(s.shape[1])]
+    z = [v for v in z if np.isfinite(v)]
+    return float(np.median(f)) if f else float("nan"), float(np.median(z)) if z else float("nan")
+
+
+def dominant_frequency(signal, dt):
+    """The frequency (Hz) of the largest peak of the signal's spectrum (mean removed, Hann
+    window), refined by a parabola through the peak's log magnitudes; 0 for a flat signal."""
+    y = _f64(signal)
+    y = y - y.mean()
+    n = len(y)
+    if n < 4 or not np.any(y):
+        return 0.0
+    pad = 8 * n  # zero padding: a finer grid for the parabola to refine
+    mag = np.abs(np.fft.rfft(y * np.hanning(n), pad))
+    k = int(np.argmax(mag[1:])) + 1
+    shift = 0.0
+    if 1 <= k < len(mag) - 1 and mag[k - 1] > 0 and mag[k + 1] > 0:
+        a, b, c = np.log(mag[k - 1]), np.log(mag[k]), np.log(mag[k + 1])
+        den = a - 2 * b + c
+        shift = 0.5 * (a - c) / den if den != 0 else 0.0
+    return float((k + shift) / (pad * dt))
+
+
+def damping_ratio(signal, dt):
+    """ζ from the logarithmic decrement of the swing: the heights between successive extrema
+    of the signal (so its offset does not matter) fall by e^(−δ) per half period, δ fitted by
+    least squares on their logarithms; ζ = δ/√(π² + δ²). NaN with fewer than 3 heights."""
+    y = _f64(signal)
+    dy = np.diff(y)
+    ext = [i for i in range(1, len(y) - 1) if dy[i - 1] * dy[i] < 0 or (dy[i - 1] != 0 and dy[i] == 0)]
+    heights = np.abs(np.diff(y[ext]))
+    heights = heights[heights > 0]
+    if len(heights) < 3:
+        return float("nan")
+    delta = -float(np.polyfit(np.arange(len(heights)), np.log(heights), 1)[0])
+    return float(delta / np.sqrt(np.pi**2 + delta**2))
+
+
+# ---- jitter, stretch, errors ------------------------------------------------------------
+
+
+def jitter(pos, dt):
+    """Rest jitter of a still scene: RMS over points and frames of the frame-to-frame
+    velocity |x_{f+1} − x_f|/dt (cm/s), and the largest frame-to-frame move (cm)."""
+    x = _f64(pos)[..., 1:, :]
+    if len(x) < 2:
+        return 0.0, 0.0
+    step = np.linalg.norm(np.diff(x, axis=0), axis=-1)
+    return float(np.sqrt(np.mean(step * step)) / dt), float(step.max())
+
+
+def stretch_stats(pos, L):
+    """Max and 99th percentile of |len/ℓ − 1| over every segment of every frame (ℓ = L/(P−1))."""
+    x = _f64(pos)
+    ell = L / (x.shape[-2] - 1)
+    s = np.abs(np.linalg.norm(np.diff(x, axis=-2), axis=-1) / ell - 1.0).ravel()
+    s = s[np.isfinite(s)]
+    if s.size == 0:
+        return float("nan"), float("nan")
+    return float(s.max()), float(np.percentile(s, 99))
+
+
+def error_percentiles(pos, ref, L):
+    """|x − x_ref|/L over every point and frame given: RMS, p50, p95, p99 and max (NaN where
+    either is not finite)."""
+    d = np.linalg.norm(_f64(pos) - _f64(ref), axis=-1).ravel() / L
+    if d.size == 0 or not np.isfinite(d).all():
+        return dict(rms=np.nan, p50=np.nan, p95=np.nan, p99=np.nan, max=np.nan)
+    p50, p95, p99 = np.percentile(d, (50, 95, 99))
+    return dict(rms=float(np.sqrt(np.mean(d * d))), p50=float(p50), p95=float(p95), p99=float(p99), max=float(d.max()))
+
+
+# ---- long runs: distributions and spectra ------------------------------------------------
+
+
+def wasserstein_1d(a, b):
+    """The 1-D Wasserstein (earth mover's) distance between two samples: the mean absolute
+    difference of their quantiles on a common grid."""
+    a, b = np.sort(_f64(a).ravel()), np.sort(_f64(b).ravel())
+    q = (np.arange(512) + 0.5) / 512
+    return float(np.mean(np.abs(np.quantile(a, q) - np.quantile(b, q))))
+
+
+def tip_distribution_distance(pos, ref, L):
+    """Over a long run: the Wasserstein distance, over L, between the distributions (over
+    frames and strands) of the tip's position relative to its root, summed over x, y, z.
+    Zero for the same statistics whatever the phase of the motion."""
+    x, r = _f64(pos), _f64(ref)
+    a = x[:, :, -1, :] - x[:, :, 0, :]
+    b = r[:, :, -1, :] - r[:, :, 0, :]
+    return float(sum(wasserstein_1d(a[..., c], b[..., c]) for c in range(3)) / L)
+
+
+def spectrum(signal, dt, bands=16, fmax=None):
+    """Power of the signal (mean removed) in `bands` equal frequency bands up to fmax (default
+    Nyquist): a coarse spectrum two runs can be compared on. Returns (band edges, power)."""
+    y = _f64(signal)
+    y = y - y.mean()
+    p = np.abs(np.fft.rfft(y * np.hanning(len(y)))) ** 2
+    f = np.fft.rfftfreq(len(y), dt)
+    edges = np.linspace(0.0, fmax or f[-1], bands + 1)
+    power = np.array([p[(f >= lo) & (f < hi)].sum() for lo, hi in zip(edges[:-1], edges[1:])])
+    return edges, power
+
+
+def spectrum_distance(signal, ref_signal, dt, bands=16):
+    """Total variation between the two normalised band spectra (0: the same shape, 1:
+    disjoint), of signals of equal length."""
+    _, a = spectrum(signal, dt, bands)
+    _, b = spectrum(ref_signal, dt, bands)
+    if a.sum() == 0 or b.sum() == 0:
+        return float(a.sum() != b.sum())
+    return float(0.5 * np.abs(a / a.sum() - b / b.sum()).sum())
+
+
+# ---- silhouettes ------------------------------------------------------------------------
+
+VIEWS = {"front": (0, 1), "side": (2, 1)}  # image axes: front looks along z (x, y), side along x (z, y)
+
+
+def rasterise(pos, axes, lo, hi, pixels=64):
+    """Occupancy image [pixels][pixels] of the strands [N][P][3] projected on `axes` within the
+    box lo … hi: every segment sampled finer than a pixel."""
+    x = _f64(pos)[..., axes]
+    img = np.zeros((pixels, pixels), dtype=bool)
+    seg = np.diff(x, axis=-2)
+    span = np.maximum(np.asarray(hi, float) - np.asarray(lo, float), 1e-300)
+    n = int(np.ceil(np.nanmax(np.abs(seg) / span * pixels, initial=0.0) * 2)) + 1
+    t = np.linspace(0.0, 1.0, n + 1)
+    pts = x[..., :-1, None, :] + seg[..., None, :] * t[:, None]
+    pts = pts.reshape(-1, 2)
+    pts = pts[np.isfinite(pts).all(axis=1)]
+    ij = np.floor((pts - lo) / span * pixels).astype(np.int64)
+    keep = ((ij >= 0) & (ij < pixels)).all(axis=1)
+    img[ij[keep, 1], ij[keep, 0]] = True
+    return img
+
+
+def iou(a, b):
+    """Intersection over union of two occupancy images (1 when both are empty)."""
+    a, b = np.asarray(a, bool), np.asarray(b, bool)
+    union = np.count_nonzero(a | b)
+    return 1.0 if union == 0 else float(np.count_nonzero(a & b) / union)
+
+
+def silhouette_iou(pos, ref, pixels=64):
+    """Per view (front, side): IoU of the strands' silhouettes [N][P][3] of a frame against the
+    reference's, rasterised in one box around both."""
+    x, r = _f64(pos), _f64(ref)
+    both = np.concatenate([x.reshape(-1, 3), r.reshape(-1, 3)])
+    both = both[np.isfinite(both).all(axis=1)]
+    out = {}
+    for view, axes in VIEWS.items():
+        if both.size == 0:
+            out[view] = float("nan")
+            continue
+        lo, hi = both[:, axes].min(axis=0), both[:, axes].max(axis=0)
+        pad = 0.02 * max(float((hi - lo).max()), 1e-12)
+        lo, hi = lo - pad, hi + pad
+        out[view] = iou(rasterise(x, axes, lo, hi, pixels), rasterise(r, axes, lo, hi, pixels))
+    return out
+
+
+# ---- noise ---------------------------------------------------------------------------------
+
+
+def split_half(metric, *arrays):
+    """A metric's sampling noise: half the difference between its value on the even strands and
+    on the odd ones (arrays [F][N]…, the strand axis second). NaN with fewer than 2 strands."""
+    if _f64(arrays[0]).shape[1] < 2:
+        return float("nan")
+    a = metric(*[_f64(x)[:, 0::2] for x in arrays])
+    b = metric(*[_f64(x)[:, 1::2] for x in arrays])
+    return float(abs(a - b) / 2)

@@ -1,0 +1,83 @@
+"""The dynamic accuracy page's recommendation (harness/render/accuracy_dynamic_report.py) on a
+hand-made summary: the pick names solver, s, S, I, precision and build and the metric that
+decided it; a long-run measurement can veto a mode; the budgets are compared with the
+no-simulation baseline."""
+
+import math
+
+import pandas as pd
+
+from harness.core import tolerances
+from harness.render import accuracy_dynamic_report as rep
+
+RMS_GAMES = tolerances.DYN_ACC_USES["games"][0]
+
+
+def mode(name, solver, s, S, I, ms, rms, stretch=0.001, damping=math.nan):  # noqa: E741, N803
+    return dict(
+        mode=name,
+        backend="cpu",
+        build="default",
+        variant="ref",
+        solver=solver,
+        ftl_damping=damping,
+        scheme=rep.scheme_name(solver, damping),
+        substeps=S,
+        iterations=I,
+        precision="fp32",
+        time_per_frame_ms=ms,
+        time_strands=1000,
+        rms=rms,
+        stretch=stretch,
+        blown=0,
+        usable=True,
+    )
+
+
+SUMM = pd.DataFrame(
+    [
+        mode("cpu ref rigid fp32", "rigid", None, 1, 1, 0.01, 10 * RMS_GAMES, stretch=0.0),
+        mode("cpu ref xpbd S1 I1 fp32", "xpbd", None, 1, 1, 0.1, 5 * RMS_GAMES),
+        mode("cpu ref ftl s=0.9 S4 I1 fp32", "ftl", 0.9, 4, 1, 0.2, 0.5 * RMS_GAMES, damping=0.9),
+        mode("cpu ref ftl s=1 S4 I1 fp32", "ftl", 1.0, 4, 1, 0.3, 0.6 * RMS_GAMES, damping=1.0),
+    ]
+)
+
+
+def long_table(kinetic_s09):
+    """observables.csv rows: the reference and the two ftl settings' mean kinetic energy."""
+    rows = [dict(study="reference", solver="xpbd", ftl_damping=math.nan, substeps=1024, iterations=1)]
+    rows += [dict(study="mode", solver="ftl", ftl_damping=s, substeps=4, iterations=1) for s in (0.9, 1.0)]
+    out = []
+    for r, ke in zip(rows, (100.0, kinetic_s09, 110.0)):
+        out.append(dict(r, precision="fp32", metric="kinetic_mean", value=ke, noise=1.0, reference=100.0,
+                        ref_uncertainty=0.5))  # fmt: skip
+    return pd.DataFrame(out)
+
+
+def games_line(long=None):
+    return next(ln for ln in rep.recommend(SUMM, long) if ln.startswith("- **games**"))
+
+
+def test_the_pick_names_its_settings_and_what_decided_it():
+    line = games_line()
+    assert "**cpu ref ftl s=0.9 S4 I1 fp32** (solver ftl, s = 0.9, S = 4, I = 1, fp32, build cpu ref;" in line
+    assert "decided by RMS error, which rejected 2 of the 2 faster modes" in line
+    assert "10× tighter than not simulating at all" in line
+
+
+def test_a_long_run_measurement_vetoes_a_mode_that_adds_energy():
+    line = games_line(long_table(kinetic_s09=600.0))  # 6× the reference's kinetic energy
+    assert "**cpu ref ftl s=1 S4 I1 fp32**" in line
+    assert "decided by RMS error, which rejected 2 of the 3 faster modes" in line
+    assert "**cpu ref ftl s=0.9 S4 I1 fp32**" in games_line(long_table(kinetic_s09=105.0))
+
+
+def test_a_budget_not_tighter_than_no_simulation_is_flagged():
+    loose = SUMM.copy()
+    loose.loc[0, "rms"] = 0.5 * RMS_GAMES
+    assert "**the RMS budget is not tighter than not simulating at all**" in games_line_of(loose)
+
+
+def games_line_of(summ):
+    return next(ln for ln in rep.recommend(summ) if ln.startswith("- **games**"))
