@@ -18,7 +18,7 @@
 #include <utility>
 
 #include "dyn_kernels.cuh"
-#include "fast_trig.h" /* hb_rsqrt_fast */
+#include "runtime/approx.h" /* hb_rsqrt_fast, HB_FAST_FLOOR */
 
 namespace hb {
 namespace dyn {

@@ -119,8 +119,8 @@ unsigned grid_for(int64_t N, int block)
 /* a, b, c: StrandMajor: the canonical array (b, c unused); PointMajor: X, Y, Z. */
 
 template <typename T, class Layout>
-__global__ void HB_POINT_BOUNDS(T) k_init(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c,
-                                       const int64_t N)
+__global__ void HB_POINT_BOUNDS(T)
+    k_init(const Model<T> m, T *__restrict__ a, T *__restrict__ b, T *__restrict__ c, const int64_t N)
 {
     const Layout lay = Layout::make(a, b, c, N, m.points);
     for (int64_t i = first_strand(); i < N; i += grid_stride()) init_strand(m, lay, i);
@@ -147,16 +147,16 @@ __global__ void HB_STAGE_BOUNDS k_collide(const Model<T> m, T *__restrict__ a, T
 
 /* Idx: the type of a point's offset within its array (int when N·P fits, see the launcher) */
 template <typename T, bool Keep, class Idx>
-__global__ void HB_POINT_BOUNDS(T) k_wind_collide(const Model<T> m, T *__restrict__ X, T *__restrict__ Y,
-                                               T *__restrict__ Z, const int64_t N, T *__restrict__ inter,
-                                               unsigned long long *__restrict__ count)
+__global__ void HB_POINT_BOUNDS(T)
+    k_wind_collide(const Model<T> m, T *__restrict__ X, T *__restrict__ Y, T *__restrict__ Z, const int64_t N,
+                   T *__restrict__ inter, unsigned long long *__restrict__ count)
 {
     const PointMajor<T> lay = {X, Y, Z, N};
     const StrandMajor<T> keep = {inter, m.points};
     unsigned long long changed = 0;
     for (int64_t i = first_strand(); i < N; i += grid_stride())
-        changed += (unsigned long long)wind_collide_strand<Keep, Prefetch<T>::value, T, PointMajor<T>, Idx>(m, lay, i,
-                                                                                                        keep);
+        changed +=
+            (unsigned long long)wind_collide_strand<Keep, Prefetch<T>::value, T, PointMajor<T>, Idx>(m, lay, i, keep);
     block_add(changed, count);
 }
 

@@ -343,7 +343,7 @@ template <typename T, class V> HB_HD void drape_free(const Model<T> &m, const V 
         const int shell = !hanging && fits && next <= pi_r<T>();
         T sin_n = (T)0, cos_n = (T)0;
         if (sizeof(T) == 4 || shell) m_sincos_free(next, &sin_n, &cos_n); /* fp32: the MUFU's, cheap */
-        T drop = ell; /* a hanging point: ℓ below its predecessor */
+        T drop = ell;             /* a hanging point: ℓ below its predecessor */
         if (!hanging && !shell) { /* the first hanging point, on the vertical tangent z = −rc */
             const T dz = pz + rc;
             const T dy2 = ell * ell - dz * dz;

@@ -24,39 +24,13 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "runtime/approx.h" /* hb_rcp_fast, HB_FAST_FLOOR */
 #include "runtime/philox.h" /* HB_HD */
 
-/* The device's approximate reciprocal and reciprocal square root (the MUFU's, one instruction
- * each: their .ftz forms skip the subnormal-input fix-up that rcpf/rsqrtf add in a build without
- * -ftz; a subnormal input reads as 0); elsewhere IEEE. */
-HB_HD float hb_rcp_fast(float x)
-{
 #if defined(__CUDA_ARCH__)
-    float r;
-    asm("rcp.approx.ftz.f32 %0, %1;" : "=f"(r) : "f"(x));
-    return r;
-#else
-    return 1.0f / x;
-#endif
-}
-HB_HD float hb_rsqrt_fast(float x)
-{
-#if defined(__CUDA_ARCH__)
-    float r;
-    asm("rsqrt.approx.ftz.f32 %0, %1;" : "=f"(r) : "f"(x));
-    return r;
-#else
-    return 1.0f / sqrtf(x);
-#endif
-}
-/* HB_FAST_FLOOR: the least input hb_rcp_fast and hb_rsqrt_fast take as positive (callers test
- * x > HB_FAST_FLOOR, not x > 0): on the device the least normal float, elsewhere 0. */
-#if defined(__CUDA_ARCH__)
-#define HB_FAST_QUOT(a, b) ((a) * hb_rcp_fast(b))
-#define HB_FAST_FLOOR 1.17549435e-38f
+#define HB_FAST_QUOT(a, b) ((a)*hb_rcp_fast(b))
 #else
 #define HB_FAST_QUOT(a, b) ((a) / (b))
-#define HB_FAST_FLOOR 0.0f
 #endif
 
 HB_HD float hb_atan2_fast(float y, float x)
