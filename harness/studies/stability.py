@@ -205,6 +205,7 @@ def measure(
     gpu="auto",
     timeout=None,
     log=print,
+    shard=None,
 ):
     """Run the map; return (rows, backends run, seconds)."""
     unknown = [s for s in slices if s not in SLICE_NAMES]
@@ -220,6 +221,8 @@ def measure(
         for solver in declared[be].solvers
         for precision in declared[be].precisions
     ]
+    if shard is not None:  # a share of the cells (harness merge joins the shards' rows)
+        todo = shard.share(todo)
     jobs = jobs or os.cpu_count() or 1
     log(
         f"stability: {len(todo)} cells ({len(chosen)} slice(s) × solvers × precisions × {len(bes)} backend(s)), "
@@ -261,11 +264,12 @@ def run_study(
     timeout=None,
     out_dir=None,
     log=print,
+    shard=None,
 ):
     """Measure the slices; write stability.csv and env.json into out_dir (the renderer,
     render/stability_report.py, draws them) and return the CSV's path."""
     out_dir = Path(out_dir or RESULTS / "stability")
-    rows, bes, seconds = measure(slices, quick, strands, frames, jobs, gpu, timeout, log)
+    rows, bes, seconds = measure(slices, quick, strands, frames, jobs, gpu, timeout, log, shard)
     csv_path = write_csv(rows, out_dir / "stability.csv")
     info = dict(
         env.collect(),
@@ -277,6 +281,7 @@ def run_study(
         backends=[b.label for b in bes],
         stretch_bound=tolerances.STABILITY_STRETCH_MAX,
         penetration_bound_rel=tolerances.STABILITY_PENETRATION_REL,
+        shard=str(shard) if shard else None,
     )
     env_path = out_dir / "env.json"
     write_json(env_path, info)

@@ -10,12 +10,13 @@ results/<name>/env.json, one entry per session (a resumed run adds one).
 
 import json
 import os
+import time
 from pathlib import Path
 
 import numpy as np
 
 from harness import HarnessError
-from harness.core import env, scenes
+from harness.core import budget, env, scenes
 from harness.core.paths import RESULTS, binary_path, display, output_dir
 from harness.core.progress import Progress
 from harness.core.runner import BackendError, DoesNotFit, run_binary, run_flags
@@ -181,8 +182,10 @@ def check_same_machine(before, now, out_dir):
         )
 
 
-def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
-    """Run (or resume) a sweep; return (results dir, number of failed cases)."""
+def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, shard=None, gate=None):
+    """Run (or resume) a sweep; return (results dir, number of failed cases). `shard` (a
+    core.shards.Shard): only its share of the cases; `gate` (a core.budget.TierGate): the
+    cases run smallest size first and a tier that does not fit is left out with every larger one."""
     sweep = load_sweep(sweep_ref)
     out_dir = output_dir(out if out else RESULTS / sweep.name)
     csv_path = out_dir / "runs.csv"
@@ -199,6 +202,9 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
     if done and record.get("sessions"):
         check_same_machine(record["sessions"][-1].get("host") or {}, env.collect(), out_dir)
     cases = sweep.cases()
+    if shard is not None:
+        cases = shard.share(cases)
+        record["shard"] = str(shard)
     reasons = backend_reasons(cases, gpu)
     skipped = []
     for why in sorted(set(reasons.values())):
@@ -239,31 +245,22 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
         say(f"harness: {note}")
     write_json(env_path, record)
 
+    groups = budget.tiers(todo, case_size) if gate is not None else [(None, todo)]
     progress = Progress(len(todo), f"sweep {sweep.name}")
     failed = 0
     try:
-        for case in todo:
-            key = (case.backend, case.build or "default")
-            binary = binary_path(*key)
-            try:
-                rec = run_binary(binary, case_flags(sweep, case), timeout=sweep.timeout_s)
-            except (DoesNotFit, SceneError) as e:
-                session["skipped"].append({"case": case.case_id, "reason": str(e)})
-                progress.write(f"harness: skipping {case.case_id}: {e}")
-            except BackendError as e:
-                failed += 1
-                session["failed"].append({"case": case.case_id, "error": str(e)})
-                progress.write(f"harness: case {case.case_id} failed: {e}")
-            else:
-                runlog.append_case(csv_path, rows_of_record(case, rec, bandwidth.get(key), session_index, binary))
-                session["cases_run"] += 1
-                session["binaries"].setdefault(
-                    binary.name,
-                    {k: rec.get(k) for k in ("version", "git_revision", "compiler", "flags", "device", "driver")},
-                )
-            progress.update()
-            session["finished_at"] = env.now()
-            write_json(env_path, record)
+        for size, tier in groups:
+            if gate is not None:
+                fits, why = gate.admit(size, len(tier))
+                if not fits:
+                    session["skipped"].append({"cases": len(tier), "size": size, "reason": why, "budget": True})
+                    progress.write(f"harness: sweep {sweep.name}: {len(tier)} case(s) of size {size} {why}")
+                    progress.update(len(tier))
+                    continue
+            t0 = time.monotonic()
+            failed += _run_cases(tier, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress)
+            if gate is not None:
+                gate.measured(size, len(tier), time.monotonic() - t0)
     finally:
         progress.close()
     say(
@@ -271,6 +268,39 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
         f"{failed} failed; rows in {display(csv_path)}"
     )
     return out_dir, failed
+
+
+def case_size(case):
+    """A case's rung on the budget's size ladder: strands × points."""
+    return case.strands * case.points
+
+
+def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress):
+    """Run the cases, appending their rows; the number that failed."""
+    failed = 0
+    for case in todo:
+        key = (case.backend, case.build or "default")
+        binary = binary_path(*key)
+        try:
+            rec = run_binary(binary, case_flags(sweep, case), timeout=sweep.timeout_s)
+        except (DoesNotFit, SceneError) as e:
+            session["skipped"].append({"case": case.case_id, "reason": str(e)})
+            progress.write(f"harness: skipping {case.case_id}: {e}")
+        except BackendError as e:
+            failed += 1
+            session["failed"].append({"case": case.case_id, "error": str(e)})
+            progress.write(f"harness: case {case.case_id} failed: {e}")
+        else:
+            runlog.append_case(csv_path, rows_of_record(case, rec, bandwidth.get(key), session_index, binary))
+            session["cases_run"] += 1
+            session["binaries"].setdefault(
+                binary.name,
+                {k: rec.get(k) for k in ("version", "git_revision", "compiler", "flags", "device", "driver")},
+            )
+        progress.update()
+        session["finished_at"] = env.now()
+        write_json(env_path, record)
+    return failed
 
 
 FIGURE_STRANDS = 400  # strands in the Fig. 1/2 state
