@@ -760,7 +760,7 @@ def parser():
 
     h = sub.add_parser(
         "headline",
-        help="the issues' headline numbers: bandwidth fractions and speedups",
+        help="the headline numbers: bandwidth fractions and speedups (--model dynamic: the dynamic model's targets)",
         description="At one size, measure the copy bandwidths, every CUDA variant's init and "
         "wind+collide time and bandwidth fraction, and three CPU baselines "
         "(ref 1 thread, ref all cores, simd all cores); write "
