@@ -49,8 +49,17 @@ def write_record(folder, shard, sweep_files, command):
         "hostname": host["hostname"],
         "date": host["date"],
     }
+    path = Path(folder) / RECORD
+    if path.exists():  # a resumed shard: the same shard of the same run, or refused
+        before = _read_record(folder)
+        differs = [k for k in ("shard",) + MATCH if before.get(k) != record[k]]
+        if differs:
+            raise HarnessError(
+                f"{display(folder)} holds shard {before.get('shard')} of another run or share "
+                f"({', '.join(differs)} differ): give another --out"
+            )
     Path(folder).mkdir(parents=True, exist_ok=True)
-    write_json(Path(folder) / RECORD, record)
+    write_json(path, record)
     return record
 
 

@@ -202,6 +202,13 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
     if done and record.get("sessions"):
         check_same_machine(record["sessions"][-1].get("host") or {}, env.collect(), out_dir)
     cases = sweep.cases()
+    if done and record.get("shard") != (str(shard) if shard else None):
+        was = f"shard {record['shard']}" if record.get("shard") else "the whole sweep"
+        raise HarnessError(
+            f"{display(out_dir)} holds rows of {was}; this run is "
+            + (f"shard {shard}" if shard else "the whole sweep")
+            + ": give another --out"
+        )
     if shard is not None:
         cases = shard.share(cases)
         record["shard"] = str(shard)

@@ -175,3 +175,12 @@ def test_merge_never_writes_into_an_existing_folder(runs, tmp_path):
     p = harness("merge", out, *parts)
     assert p.returncode == 2 and "exists and is not an empty folder" in p.stderr
     assert [q.name for q in out.iterdir()] == ["mine.txt"]
+
+
+@needs_cpu
+def test_a_folder_of_one_share_is_not_resumed_as_another(runs):
+    d, whole, (p1, _, _) = runs
+    for folder, shard in ((p1, "2/3"), (whole, "1/3")):
+        p = harness("sweep", d / "shard-t.toml", "--out", folder, "--shard", shard)
+        assert p.returncode == 2 and "give another --out" in p.stderr and p.stderr.count("\n") == 1
+    assert json.loads((p1 / "shard.json").read_text())["shard"] == "1/3"  # its record kept
