@@ -26,7 +26,7 @@ from harness.bench import validation
 from harness.bench.validation import gpu_plan
 from harness.check import diff_dynamic
 from harness.core import runner, scenes, variants
-from harness.core.budget import TierGate
+from harness.core.budget import TierGate, largest_that_fits
 from harness.core.paths import LOCAL_RUN, REPORT, binary_path, display
 from harness.core.scenes import with_frames
 from harness.io import results_data
@@ -189,6 +189,34 @@ def fastest_gpu_variants(sweep_dir):
     return [str(best["variant"])]
 
 
+FEATURECOST_STRANDS = (100_000, 30_000, 10_000, 3_000, 1_000)  # the CPU rows' size ladder; the first is the full run's
+FEATURECOST_FRAMES_A_CASE = 3 * (3 + 1)  # featurecost.measure's frames × (repeat + the untimed first)
+
+
+def featurecost_size(sweep_dir, allowance_s):
+    """The largest FEATURECOST_STRANDS whose CPU rows should fit allowance_s, estimated from
+    the dynamic sweep's slowest point-substep rate of the CPU oracle on all cores at its
+    largest size (the smallest size when the sweep has no such row)."""
+    scene = scenes.load_scene("dynamic")
+    work = scene.points * int(scene.dynamic.get("--substeps", 1))  # point-substeps a strand a frame
+    try:
+        rows, _ = results_data.load(sweep_dir)
+    except HarnessError:
+        return FEATURECOST_STRANDS[-1]
+    oracle = variants.declared("cpu").default_variant
+    cpu = rows[(rows["backend"] == "cpu") & (rows["variant"] == oracle) & (rows["threads"].astype(str) == "all")]
+    cpu = cpu[cpu["stage"] == "simulate"]
+    if cpu.empty:
+        return FEATURECOST_STRANDS[-1]
+    rate = float(cpu[cpu["strands"] == cpu["strands"].max()]["point_substeps_per_s"].astype(float).min())
+    cases = len(featurecost.FEATURES) * 2 + 2
+
+    def seconds(n):
+        return cases * FEATURECOST_FRAMES_A_CASE * n * work / rate
+
+    return largest_that_fits(FEATURECOST_STRANDS, seconds, allowance_s)
+
+
 def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=None):
     """The dynamic studies, each measured into root/<study> (`quick`: their small versions)
     and rendered into report_dir (none with `shard` of several). A shard runs its share of the
@@ -207,8 +235,17 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
     if first and fits("featurecost"):
         fc = root / "featurecost"
         fc.mkdir(parents=True, exist_ok=True)
-        say("harness: featurecost --backend cpu")
-        featurecost.measure(backend="cpu", out=fc / "cpu.csv")
+        strands = FEATURECOST_STRANDS[0]
+        if budget is not None:  # its share of the time left: a quarter (four studies follow the sweep)
+            strands = featurecost_size(root / SWEEP, budget.left() / 4)
+            if strands != FEATURECOST_STRANDS[0]:
+                budget.leave_out(
+                    "featurecost",
+                    f"the CPU rows at {FEATURECOST_STRANDS[0]} strands (measured at {strands})",
+                    "left out to fit the budget: the larger size's estimate did not fit",
+                )
+        say(f"harness: featurecost --backend cpu --strands {strands}")
+        featurecost.measure(backend="cpu", strands=strands, out=fc / "cpu.csv")
         if builds:  # the sweep's fastest variant (else every one that simulates), at a size that fills the GPU
             for v in fastest_gpu_variants(root / SWEEP):
                 say(f"harness: featurecost --backend cuda --variant {v} --strands 1000000")

@@ -115,3 +115,10 @@ class TierGate:
     def measured(self, size, n, seconds):
         if n:
             self.last = (size, n, seconds)
+
+
+def largest_that_fits(ladder, seconds_at, allowance_s):
+    """The largest size of `ladder` whose estimate seconds_at(size) fits allowance_s; the
+    smallest when none does (a study's smallest size still says something)."""
+    fitting = [n for n in ladder if seconds_at(n) <= allowance_s]
+    return max(fitting) if fitting else min(ladder)

@@ -92,3 +92,11 @@ def test_the_budget_shares_what_is_left_and_records_what_it_left_out():
         "used_s": 700.0,
         "left_out": [{"step": "peer", "what": "the whole study", "reason": "no time left"}],
     }
+
+
+def test_a_study_takes_the_largest_size_that_fits():
+    ladder = (100_000, 30_000, 10_000, 1_000)
+    per_strand = 0.002  # s: 100 000 strands take 200 s
+    assert budget.largest_that_fits(ladder, lambda n: n * per_strand, 500.0) == 100_000
+    assert budget.largest_that_fits(ladder, lambda n: n * per_strand, 100.0) == 30_000
+    assert budget.largest_that_fits(ladder, lambda n: n * per_strand, 1.0) == 1_000  # none fits: the smallest
