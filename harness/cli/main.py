@@ -202,6 +202,10 @@ def cmd_bench(args):
             )
             or code
         )
+    if plan and args.model == "all" and not (shard and shard.n > 1):
+        from harness.render import report_paper
+
+        report_paper.build(root / "sweep", report_dir)  # again: its time-budget section now lists the dynamic part too
     return code
 
 
