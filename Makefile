@@ -152,6 +152,7 @@ report: setup
 	@[ -d "$(REPORT_FROM)" ] || { echo "error: $(REPORT_FROM) is not a run folder (run make bench, or give REPORT_FROM=results/reference-h200)"; exit 2; }
 	@if [ -f "$(REPORT_FROM)/sweep/runs.csv" ]; then $(RUN_PY) -m harness report "$(REPORT_FROM)/sweep" --report-dir "$(REPORT_TO)"; fi
 	@if [ -d "$(REPORT_FROM)/dynamic" ]; then $(RUN_PY) -m harness report-dynamic "$(REPORT_FROM)" --report-dir "$(REPORT_TO)"; fi
+	@[ -f "$(REPORT_FROM)/sweep/runs.csv" ] || [ -d "$(REPORT_FROM)/dynamic" ] || { echo "error: $(REPORT_FROM) has neither sweep/runs.csv nor dynamic/: nothing to render"; exit 2; }
 
 report-dynamic: setup
 	$(RUN_PY) -m harness report-dynamic $(REPORT_FROM) --report-dir $(REPORT_TO)
