@@ -269,7 +269,8 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
             peer.run_study(peer.Plan(out=str(root / "peer")), log=say)
         except peer.PeerUnavailable as e:  # an optional dependency: skipped, not failed
             say(f"harness: peer: skipped: {e}")
-        peer_report.write(root / "peer", root / "peer")
+        else:
+            peer_report.write(root / "peer", root / "peer")
     if render and fits("animate"):
         say("harness: animate")
         animate.run(out=Path(report_dir) / "dynamic.gif", force=True, log=say)
