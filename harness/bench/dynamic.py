@@ -273,7 +273,7 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
             peer_report.write(root / "peer", root / "peer")
     if render and fits("animate"):
         say("harness: animate")
-        animate.run(out=Path(report_dir) / "dynamic.gif", force=True, log=say)
+        animate.run(out=Path(report_dir) / "dynamic.gif", force=True, log=say, state_dir=root / "animation")
 
 
 def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, shard=None, budget=None):

@@ -157,12 +157,24 @@ def render(traj, paths, max_strands=150, every=None, fps=None, log=print):
     return written
 
 
-def run(state=None, out=None, max_strands=150, every=None, fps=None, force=False, strands=300, frames=120, log=print):
-    """The `animate` command: the written paths."""
+def run(
+    state=None,
+    out=None,
+    max_strands=150,
+    every=None,
+    fps=None,
+    force=False,
+    strands=300,
+    frames=120,
+    log=print,
+    state_dir=None,
+):
+    """The `animate` command: the written paths (`state_dir`: where the simulated state goes,
+    default results/animation)."""
     paths = _outputs(out, force)
     with Progress(2 if state is None else 1, "animate: simulate and draw") as bar:
         if state is None:
-            state = simulate_default(strands, frames, log=log)
+            state = simulate_default(strands, frames, out_dir=state_dir, log=log)
             bar.update()
         with open_trajectory(state) as traj:
             if not traj.is_dynamic:
