@@ -2,8 +2,8 @@
 #
 #   make          build build/hairsim-cpu and, where nvcc is present, the CUDA binaries
 #   make test     build, then run the pytest suite (GPU tests skip with a reason without a GPU)
-#   make bench    build, validate the GPU variants against the CPU, sweep, plot, report
-#   make report   rebuild report/ from the results already in results/
+#   make bench    build, validate the GPU variants against the CPU, sweep, studies, report (results/local/)
+#   make report   re-render a run folder's report (the committed one: REPORT_FROM=results/reference-h200 REPORT_TO=report)
 
 SHELL := /bin/bash
 CC      ?= gcc
@@ -85,9 +85,10 @@ cpu: $(BUILD)/hairsim-cpu
 help:
 	@echo "make          build build/hairsim-cpu (and the CUDA binaries where nvcc is present)"
 	@echo "make test     build and run the pytest suite (GPU tests skip with a reason without a GPU)"
-	@echo "make bench    validate GPU variants against the CPU, sweep, plot and report (python3 -m harness bench)"
-	@echo "make report   rebuild report/ from results/default (REPORT_FROM=results/reference-h200/sweep for the committed H200 run)"
-	@echo "make report-dynamic  rebuild report/dynamic.md from results/ (DYNAMIC_FROM=results/reference-h200 for the committed H200 run)"
+	@echo "make bench    validate GPU variants against the CPU, sweep, studies, report into results/local/ (OUT=results/NAME; BUDGET=10m fits the sizes to a time; SHARD=K/N runs a share)"
+	@echo "make report   re-render a run folder's report (REPORT_FROM=results/local, REPORT_TO=REPORT_FROM/report;"
+	@echo "             the committed one: REPORT_FROM=results/reference-h200 REPORT_TO=report)"
+	@echo "make report-dynamic  only the dynamic report of REPORT_FROM into REPORT_TO"
 	@echo "make sanitize build the C reference with ASan+UBSan and run the CPU tests under it"
 	@echo "make sanitize-gpu  compute-sanitizer memcheck + racecheck over every CUDA variant (GPU node)"
 	@echo "make lint     ruff check, ruff format --check, mypy (lint-py) and clang-format --dry-run (lint-c)"
@@ -161,17 +162,24 @@ test: setup
 	@$(MAKE) --no-print-directory -j$(JOBS) all $(if $(HAVE_NVCC),hostcheck)
 	$(RUN_PY) -m pytest tests -q -ra
 
+# make bench's run folder (untracked): results, then the report in $(OUT)/report
+OUT ?= results/local
 bench: setup
 	@$(MAKE) --no-print-directory -j$(JOBS) all
-	$(RUN_PY) -m harness bench $(if $(OUT),--out $(OUT))
+	$(RUN_PY) -m harness bench --out $(OUT)$(if $(BUDGET), --budget $(BUDGET))$(if $(SHARD), --shard $(SHARD))
 
-# REPORT_FROM: the results to render (default results/default; the committed reference run
-# from an H200 is results/reference-h200/sweep)
+# REPORT_FROM: the run folder to render (default results/local, make bench's); REPORT_TO: where
+# (default REPORT_FROM/report). The committed H200 report: make report REPORT_FROM=results/reference-h200 REPORT_TO=report
+REPORT_FROM ?= $(OUT)
+REPORT_TO ?= $(REPORT_FROM)/report
 report: setup
-	$(RUN_PY) -m harness report $(REPORT_FROM)
+	@[ -d "$(REPORT_FROM)" ] || { echo "error: $(REPORT_FROM) is not a run folder (run make bench, or give REPORT_FROM=results/reference-h200)"; exit 2; }
+	@if [ -f "$(REPORT_FROM)/sweep/runs.csv" ]; then $(RUN_PY) -m harness report "$(REPORT_FROM)/sweep" --report-dir "$(REPORT_TO)"; fi
+	@if [ -d "$(REPORT_FROM)/dynamic" ]; then $(RUN_PY) -m harness report-dynamic "$(REPORT_FROM)" --report-dir "$(REPORT_TO)"; fi
+	@[ -f "$(REPORT_FROM)/sweep/runs.csv" ] || [ -d "$(REPORT_FROM)/dynamic" ] || { echo "error: $(REPORT_FROM) has neither sweep/runs.csv nor dynamic/: nothing to render"; exit 2; }
 
 report-dynamic: setup
-	$(RUN_PY) -m harness report-dynamic $(DYNAMIC_FROM)
+	$(RUN_PY) -m harness report-dynamic $(REPORT_FROM) --report-dir $(REPORT_TO)
 
 # docs/harness.md's command and module reference, from the parser and the docstrings
 docs: setup

@@ -26,9 +26,11 @@ from harness.bench import validation
 from harness.bench.validation import gpu_plan
 from harness.check import diff_dynamic
 from harness.core import runner, scenes, variants
-from harness.core.paths import RESULTS, binary_path, display
+from harness.core.budget import TierGate, largest_that_fits
+from harness.core.paths import LOCAL_RUN, REPORT, binary_path, display
 from harness.core.scenes import with_frames
 from harness.io import results_data
+from harness.io.files import write_json
 from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
 from harness.studies import accuracy_dynamic, animate, featurecost, peer, stability
 from harness.studies.sweep import run_sweep
@@ -46,6 +48,29 @@ class DynValidator:
         self.say = say
         self.checks = []
         self.count = 0
+        self.on_check = lambda: None  # called after each comparison (progress)
+
+    def cpu_others(self):
+        """The CPU variants other than the oracle that simulate: each is stepped one frame."""
+        cpu = variants.declared("cpu")
+        return [v for v in cpu.variants if v != cpu.default_variant and cpu.runs(v)]
+
+    def gpu_cases(self, builds):
+        """(build, variant, block) of every GPU comparison of one precision and solver."""
+        out = []
+        for build in builds:
+            decl = variants.declared("cuda", build)
+            for v in (n for n in decl.variants if decl.runs(n, points=self.scene.points)):
+                out += [(build, v, b) for b in BLOCK_SIZES if decl.runs(v, points=self.scene.points, block=b)]
+        return out
+
+    def planned(self, builds):
+        """How many comparisons cpu_checks and gpu_checks(builds) make."""
+        cpu = variants.declared("cpu")
+        pairs = len(cpu.precisions) * len(cpu.solvers)
+        cases = self.gpu_cases(builds)
+        strict = {v for b, v, blk in cases if b == "strict" and blk == BLOCK_SIZES[-1]}
+        return pairs * (2 + len(self.cpu_others()) + len(cases) + max(0, len(strict) - 1))
 
     def cpu_file(self, precision, solver, **opts):
         self.count += 1
@@ -72,6 +97,7 @@ class DynValidator:
                 "failures": r.failures()[:5],
             }
         self.checks.append(entry)
+        self.on_check()
         if not entry["equivalent"]:
             why = entry.get("error") or "; ".join(entry.get("failures", []))
             self.say(f"harness: NOT EQUIVALENT: {what}: {why}")
@@ -108,9 +134,7 @@ class DynValidator:
                     f"cpu {precision} {solver}: the last frame resumed from the file (bit-identical)",
                     lambda a=ref, b=resumed: diff_dynamic.compare(a, b, frames=[self.last_step(b)], exact=True),
                 )
-                for v in variants.declared("cpu").variants:
-                    if v == oracle or not variants.declared("cpu").runs(v):
-                        continue
+                for v in self.cpu_others():
                     other = self.step(ref, binary_path("cpu"), ["--variant", v], f"cpu-{v}-{precision}-{solver}")
                     self.record(
                         f"cpu {v} {precision} {solver}: one frame from the oracle's state",
@@ -121,18 +145,15 @@ class DynValidator:
     def gpu_checks(self, builds, refs):
         for (precision, solver), ref in refs.items():
             strict = {}
-            for build in builds:
-                decl = variants.declared("cuda", build)
-                for v in (n for n in decl.variants if decl.runs(n, points=self.scene.points)):
-                    for block in (b for b in BLOCK_SIZES if decl.runs(v, points=self.scene.points, block=b)):
-                        tag = f"cuda-{build}-{v}-b{block}-{precision}-{solver}"
-                        g = self.step(ref, binary_path("cuda", build), ["--variant", v, "--block-size", block], tag)
-                        if build == "strict" and block == BLOCK_SIZES[-1]:
-                            strict[v] = g
-                        self.record(
-                            f"cuda {build} {v} b{block} {precision} {solver}: one frame from the cpu state",
-                            lambda a=ref, b=g: diff_dynamic.compare(a, b, frames=[self.last_step(b)]),
-                        )
+            for build, v, block in self.gpu_cases(builds):
+                tag = f"cuda-{build}-{v}-b{block}-{precision}-{solver}"
+                g = self.step(ref, binary_path("cuda", build), ["--variant", v, "--block-size", block], tag)
+                if build == "strict" and block == BLOCK_SIZES[-1]:
+                    strict[v] = g
+                self.record(
+                    f"cuda {build} {v} b{block} {precision} {solver}: one frame from the cpu state",
+                    lambda a=ref, b=g: diff_dynamic.compare(a, b, frames=[self.last_step(b)]),
+                )
             names = list(strict)
             for other in names[1:]:
                 self.record(
@@ -168,48 +189,128 @@ def fastest_gpu_variants(sweep_dir):
     return [str(best["variant"])]
 
 
-def studies(root, builds, say, report_dir=None, quick=False):
-    """The dynamic studies, each measured into root/<study> (`quick`: their small versions)
-    and rendered into report_dir."""
-    fc = root / "featurecost"
-    fc.mkdir(parents=True, exist_ok=True)
-    say("harness: featurecost --backend cpu")
-    featurecost.measure(backend="cpu", out=fc / "cpu.csv")
-    if builds:  # the sweep's fastest variant (else every one that simulates), at a size that fills the GPU
-        for v in fastest_gpu_variants(root / SWEEP):
-            say(f"harness: featurecost --backend cuda --variant {v} --strands 1000000")
-            featurecost.measure(backend="cuda", variant=v, strands=1_000_000, out=fc / f"cuda-{v}.csv")
-    acc_dir = root / accuracy_dynamic.RESULTS_NAME
-    gpu = "auto" if builds else "no"
-    plan = accuracy_dynamic.Plan.quick(gpu=gpu) if quick else accuracy_dynamic.Plan(gpu=gpu)
-    say(f"harness: accuracy --model dynamic{' --quick' if quick else ''} --gpu {gpu}")
-    accuracy_dynamic.run_study(plan, out_dir=acc_dir, force=True, command="python -m harness bench --model dynamic")
-    accuracy_dynamic_report.write(acc_dir, report_dir)
-    say(f"harness: stability{' --quick' if quick else ''} --gpu {gpu}")
-    csv_path = stability.run_study(quick=quick, gpu=gpu, out_dir=root / "stability")
-    stability_report.report_from_csv(csv_path, report_dir=report_dir, log=say)
-    say("harness: peer")
+FEATURECOST_STRANDS = (100_000, 30_000, 10_000, 3_000, 1_000)  # the CPU rows' size ladder; the first is the full run's
+FEATURECOST_FRAMES_A_CASE = 3 * (3 + 1)  # featurecost.measure's frames × (repeat + the untimed first)
+
+
+def featurecost_size(sweep_dir, allowance_s):
+    """The largest FEATURECOST_STRANDS whose CPU rows should fit allowance_s, estimated from
+    the dynamic sweep's slowest point-substep rate of the CPU oracle on all cores at its
+    largest size (the smallest size when the sweep has no such row)."""
+    scene = scenes.load_scene("dynamic")
+    work = scene.points * int(scene.dynamic.get("--substeps", 1))  # point-substeps a strand a frame
     try:
-        peer.run_study(peer.Plan(out=str(root / "peer")), log=say)
-    except peer.PeerUnavailable as e:  # an optional dependency: skipped, not failed
-        say(f"harness: peer: skipped: {e}")
-    peer_report.write(root / "peer", root / "peer")
-    say("harness: animate")
-    animate.run(out=Path(report_dir) / "dynamic.gif" if report_dir else None, force=True, log=say)
+        rows, _ = results_data.load(sweep_dir)
+    except HarnessError:
+        return FEATURECOST_STRANDS[-1]
+    oracle = variants.declared("cpu").default_variant
+    cpu = rows[(rows["backend"] == "cpu") & (rows["variant"] == oracle) & (rows["threads"].astype(str) == "all")]
+    cpu = cpu[cpu["stage"] == "simulate"]
+    if cpu.empty:
+        return FEATURECOST_STRANDS[-1]
+    rate = float(cpu[cpu["strands"] == cpu["strands"].max()]["point_substeps_per_s"].astype(float).min())
+    cases = len(featurecost.FEATURES) * 2 + 2
+
+    def seconds(n):
+        return cases * FEATURECOST_FRAMES_A_CASE * n * work / rate
+
+    return largest_that_fits(FEATURECOST_STRANDS, seconds, allowance_s)
 
 
-def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None):
+def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=None):
+    """The dynamic studies, each measured into root/<study> (`quick`: their small versions)
+    and rendered into report_dir (none with `shard` of several). A shard runs its share of the
+    stability map; the one-measurement studies run on shard 1 only. With `budget`, a study
+    that starts after the budget is spent is left out (and said so)."""
+    render = report_dir is not None
+
+    def fits(study):
+        if budget is None or budget.left() > 0:
+            return True
+        budget.leave_out(study, "the whole study", "left out to fit the budget: no time left when it was due")
+        say(f"harness: {study}: left out to fit the budget (no time left)")
+        return False
+
+    first = shard is None or shard.first
+    if first and fits("featurecost"):
+        fc = root / "featurecost"
+        fc.mkdir(parents=True, exist_ok=True)
+        strands = FEATURECOST_STRANDS[0]
+        if budget is not None:  # its share of the time left: a quarter (four studies follow the sweep)
+            strands = featurecost_size(root / SWEEP, budget.left() / 4)
+            if strands != FEATURECOST_STRANDS[0]:
+                budget.leave_out(
+                    "featurecost",
+                    f"the CPU rows at {FEATURECOST_STRANDS[0]} strands (measured at {strands})",
+                    "left out to fit the budget: the larger size's estimate did not fit",
+                )
+        say(f"harness: featurecost --backend cpu --strands {strands}")
+        featurecost.measure(backend="cpu", strands=strands, out=fc / "cpu.csv")
+        if builds:  # the sweep's fastest variant (else every one that simulates), at a size that fills the GPU
+            for v in fastest_gpu_variants(root / SWEEP):
+                say(f"harness: featurecost --backend cuda --variant {v} --strands 1000000")
+                featurecost.measure(backend="cuda", variant=v, strands=1_000_000, out=fc / f"cuda-{v}.csv")
+    gpu = "auto" if builds else "no"
+    if first and fits("accuracy"):
+        acc_dir = root / accuracy_dynamic.RESULTS_NAME
+        plan = accuracy_dynamic.Plan.quick(gpu=gpu) if quick else accuracy_dynamic.Plan(gpu=gpu)
+        say(f"harness: accuracy --model dynamic{' --quick' if quick else ''} --gpu {gpu}")
+        accuracy_dynamic.run_study(plan, out_dir=acc_dir, force=True, command="python -m harness bench --model dynamic")
+        if render:
+            accuracy_dynamic_report.write(acc_dir, report_dir)
+    if fits("stability"):
+        say(f"harness: stability{' --quick' if quick else ''} --gpu {gpu}" + (f" (shard {shard})" if shard else ""))
+        csv_path = stability.run_study(quick=quick, gpu=gpu, out_dir=root / "stability", shard=shard)
+        if render:
+            stability_report.report_from_csv(csv_path, report_dir=report_dir, log=say)
+    if first and fits("peer"):
+        say("harness: peer")
+        try:
+            peer.run_study(peer.Plan(out=str(root / "peer")), log=say)
+        except peer.PeerUnavailable as e:  # an optional dependency: skipped, not failed
+            say(f"harness: peer: skipped: {e}")
+        else:
+            peer_report.write(root / "peer", root / "peer")
+    if render and fits("animate"):
+        say("harness: animate")
+        animate.run(out=Path(report_dir) / "dynamic.gif", force=True, log=say, state_dir=root / "animation")
+
+
+def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, shard=None, budget=None):
+    """`shard`: its share of the sweep and the stability map, the other studies on shard 1,
+    no report; `budget` (core.budget.Budget): the sweep fits its share of the time left, the
+    studies run while time is left; what is left out goes to OUT/budget.json and the report."""
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
-    root = Path(out) if out else RESULTS
+    root = Path(out) if out else LOCAL_RUN
     sweep_dir = root / SWEEP
     sweep_dir.mkdir(parents=True, exist_ok=True)
     builds, gpu_note = gpu_plan(gpu)
     if gpu_note:
         say(f"harness: dynamic GPU rows skipped: {gpu_note}")
     validate(sweep_dir, builds, gpu_note, say)
-    _, failed = run_sweep(SWEEP, out=sweep_dir, gpu="no" if gpu_note else gpu, log=say, announce_skips=False)
-    studies(root, builds, say, report_dir=report_dir, quick=quick_studies)
+    gate = TierGate(budget.allowance("dynamic sweep")) if budget else None
+    if gate:
+        say(f"harness: budget: the dynamic sweep gets {gate.allowance:.0f} s of the {budget.left():.0f} s left")
+    gpu_sweep = "no" if gpu_note else gpu
+    _, failed = run_sweep(SWEEP, out=sweep_dir, gpu=gpu_sweep, log=say, announce_skips=False, shard=shard, gate=gate)
+    if gate and gate.summary():
+        budget.leave_out(f"sweep {SWEEP}", gate.summary(), gate.closed)
+    several = shard is not None and shard.n > 1
+    studies(
+        root,
+        builds,
+        say,
+        report_dir=None if several else report_dir or REPORT,
+        quick=quick_studies,
+        shard=shard,
+        budget=budget,
+    )
+    if budget:
+        write_json(root / "budget.json", budget.record())
+    if several:
+        say(f"harness: shard {shard}: no report (harness merge OUT SHARD... joins the shards, then make report)")
+        return 1 if failed else 0
     path = report_dynamic.build(root, report_dir)
     say(f"harness: dynamic report in {display(path)}")
     return 1 if failed else 0

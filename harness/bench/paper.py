@@ -23,6 +23,7 @@ from harness.bench import validation
 from harness.bench.validation import gpu_plan
 from harness.check import diff
 from harness.core import runner, variants
+from harness.core.budget import TierGate
 from harness.core.paths import RESULTS, binary_path, display, output_dir
 from harness.io.files import write_json
 from harness.io.sweepfile import load_sweep
@@ -44,6 +45,17 @@ class Validator:
         self.say = say
         self.checks = []
         self.count = 0
+        self.on_check = lambda: None  # called after each comparison (progress)
+
+    def planned(self, builds):
+        """How many comparisons cpu_checks and gpu_checks(builds) make."""
+        resumes = len(self.scene.stages) - 1
+        gpu = sum(
+            len(variants.declared("cuda", b).precisions) * (len(BLOCK_SIZES) + resumes)
+            for b in builds
+            for _ in variants.names("cuda", b)
+        )
+        return 2 + resumes + gpu
 
     def state(self, backend, build="default", precision="fp32", stages=None, input_file=None, **opts):
         self.count += 1
@@ -70,6 +82,7 @@ class Validator:
                 "failures": r.failures()[:5],
             }
         self.checks.append(entry)
+        self.on_check()
         if not entry["equivalent"]:
             self.say(
                 f"harness: NOT EQUIVALENT: {what}: " + (entry.get("error") or "; ".join(entry.get("failures", [])))
@@ -135,18 +148,36 @@ def validate(sweep, out_dir, builds, gpu_note, say):
     validation.validate(make, "validation", out_dir, builds, gpu_note, say, header)
 
 
-def run(sweep_ref="default", out=None, gpu="auto", report_dir=None, log=None):
+def run(sweep_ref="default", out=None, gpu="auto", report_dir=None, log=None, shard=None, budget=None, root=None):
+    """`shard`: only its share of the sweep (no report: harness merge joins the shards);
+    `budget` (core.budget.Budget): the sweep's sizes fit its share of the time left, what is
+    left out recorded in ROOT/budget.json and the report."""
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
     sweep = load_sweep(sweep_ref)
     out_dir = output_dir(out if out else RESULTS / sweep.name)
+    root = Path(root) if root else out_dir.parent
     builds, gpu_note = gpu_plan(gpu)
     if gpu_note:
         say(f"harness: GPU rows skipped: {gpu_note}")
     validate(sweep, out_dir, builds, gpu_note, say)
-    _, failed = run_sweep(sweep_ref, out=out_dir, gpu="no" if gpu_note else gpu, log=say, announce_skips=False)
+    gate = TierGate(budget.allowance("paper sweep")) if budget else None
+    if gate:
+        say(f"harness: budget: the paper sweep gets {gate.allowance:.0f} s of the {budget.left():.0f} s left")
+    _, failed = run_sweep(
+        sweep_ref, out=out_dir, gpu="no" if gpu_note else gpu, log=say, announce_skips=False, shard=shard, gate=gate
+    )
     if gpu_note:  # the sweep's record says why, for the report
         _note_gpu_skip(out_dir / "env.json", gpu_note)
+    if gate and gate.summary():
+        budget.leave_out(f"sweep {sweep.name}", gate.summary(), gate.closed)
+    if budget:
+        write_json(root / "budget.json", budget.record())
+    if shard is not None and shard.n > 1:
+        if shard.first:
+            figure_state(out_dir)
+        say(f"harness: shard {shard}: no report (harness merge OUT SHARD... joins the shards, then make report)")
+        return 1 if failed else 0
     figure_state(out_dir)
     path = report_paper.build(out_dir, report_dir)
     say(f"harness: report in {display(path)}")

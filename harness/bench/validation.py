@@ -8,6 +8,7 @@ from pathlib import Path
 from harness import HarnessError
 from harness.core import env
 from harness.core.paths import CUDA_BUILDS, binary_path, display
+from harness.core.progress import Progress
 from harness.io.files import write_json
 
 
@@ -23,9 +24,11 @@ def validate(make_validator, what, out_dir, builds, gpu_note, say, header):
     scratch = tempfile.mkdtemp(prefix=f"bench-{what.replace(' ', '-')}-", dir=scratch_root)
     try:
         v = make_validator(scratch, say)
-        ref = v.cpu_checks()
-        if builds:
-            v.gpu_checks(builds, ref)
+        with Progress(v.planned(builds), what) as progress:
+            v.on_check = progress.update
+            ref = v.cpu_checks()
+            if builds:
+                v.gpu_checks(builds, ref)
     except BaseException:
         _remove(scratch, scratch_root)
         raise

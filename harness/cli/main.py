@@ -1,6 +1,6 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
-Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, accuracy, headline,
+Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, accuracy, headline,
 export, calibrate, featurecost, peer, animate, stability, docs (`--help` on each; docs/harness.md
 lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
@@ -136,9 +136,19 @@ def cmd_stepdiff(args):
 
 
 def cmd_sweep(args):
+    from harness.core import shards
+    from harness.io.sweepfile import load_sweep
     from harness.studies import sweep
 
-    _, failed = sweep.run_sweep(args.sweep, out=args.out, gpu=args.gpu)
+    shard = shards.parse(args.shard) if args.shard else None
+    if shard:
+        from harness.bench import merge
+        from harness.core.paths import RESULTS, output_dir
+
+        spec = load_sweep(args.sweep)
+        out = output_dir(args.out if args.out else RESULTS / spec.name)
+        merge.write_record(out, shard, {"sweep": spec.path}, f"sweep {spec.name}")
+    _, failed = sweep.run_sweep(args.sweep, out=args.out, gpu=args.gpu, shard=shard)
     return 1 if failed else 0
 
 
@@ -171,20 +181,61 @@ def cmd_report_dynamic(args):
 
 def cmd_bench(args):
     from harness.bench import dynamic as bench_dynamic
+    from harness.bench import merge
     from harness.bench import paper as bench_paper
+    from harness.core import budget, shards
+    from harness.core.paths import LOCAL_RUN
+    from harness.io.sweepfile import load_sweep
 
+    # one run folder (docs/decisions/bench-runs.md): the paper sweep in ROOT/sweep, the dynamic
+    # bench's folders beside it, the report in ROOT/report; nothing tracked is written
+    root = Path(args.out) if args.out else LOCAL_RUN
+    report_dir = Path(args.report_dir) if args.report_dir else root / "report"
+    shard = shards.parse(args.shard) if args.shard else None
+    plan = budget.Budget(budget.parse_duration(args.budget)) if args.budget else None
+    sweeps = {}
+    if args.model in ("all", "paper"):
+        sweeps["paper"] = load_sweep(args.sweep).path
+    if args.model in ("all", "dynamic"):
+        sweeps["dynamic"] = load_sweep(bench_dynamic.SWEEP).path
+    if plan:
+        print(
+            f"harness: budget {plan.seconds:.0f} s: the sweeps' largest sizes and the studies are left out "
+            "where they do not fit",
+            flush=True,
+        )
+    if shard:
+        command = f"bench --model {args.model} --sweep {args.sweep}" + (" --full-studies" if args.full_studies else "")
+        merge.write_record(root, shard, sweeps, command)
     code = 0
     if args.model in ("all", "paper"):
-        code = bench_paper.run(args.sweep, out=args.out, gpu=args.gpu, report_dir=args.report_dir)
+        code = bench_paper.run(
+            args.sweep, out=root / "sweep", gpu=args.gpu, report_dir=report_dir, shard=shard, budget=plan, root=root
+        )
     if args.model in ("all", "dynamic"):
-        # with both models the dynamic results sit beside the paper sweep's directory, as the
-        # headline and accuracy results do (results/ by default)
-        root = args.out if args.model == "dynamic" else (str(Path(args.out).parent) if args.out else None)
         code = (
-            bench_dynamic.run(out=root, gpu=args.gpu, report_dir=args.report_dir, quick_studies=not args.full_studies)
+            bench_dynamic.run(
+                out=root,
+                gpu=args.gpu,
+                report_dir=report_dir,
+                quick_studies=not args.full_studies,
+                shard=shard,
+                budget=plan,
+            )
             or code
         )
+    if plan and args.model == "all" and not (shard and shard.n > 1):
+        from harness.render import report_paper
+
+        report_paper.build(root / "sweep", report_dir)  # again: its time-budget section now lists the dynamic part too
     return code
+
+
+def cmd_merge(args):
+    from harness.bench import merge
+
+    merge.merge(args.out, args.shards)
+    return 0
 
 
 PAPER_ACCURACY = dict(
@@ -586,11 +637,16 @@ def parser():
         default="auto",
         help="run cuda cases: auto (if a GPU is usable), yes (fail without), no",
     )
+    s.add_argument(
+        "--shard",
+        default=None,
+        help="K/N: run the K-th of N deterministic shares of the cases (harness merge joins them)",
+    )
     s.set_defaults(func=cmd_sweep)
 
     for name, helptext, fn in (
         ("plot", "draw the PNG plots of a results directory", cmd_plot),
-        ("report", "write report/report.md (and its plots)", cmd_report),
+        ("report", "write results/local/report/report.md (and its plots)", cmd_report),
     ):
         description = (
             helptext[0].upper()
@@ -602,20 +658,21 @@ def parser():
         q.add_argument(
             "results",
             nargs="?",
-            default="results/default",
-            help="results directory with runs.csv and env.json (default results/default)",
+            default="results/local/sweep",
+            help="results directory with runs.csv and env.json (default results/local/sweep, the paper "
+            "sweep of make bench's run)",
         )
-        q.add_argument("--report-dir", default=None, help="where to write (default report/)")
+        q.add_argument("--report-dir", default=None, help="where to write (default results/local/report/)")
         q.set_defaults(func=fn)
 
     rd = sub.add_parser(
         "report-dynamic",
-        help="write report/dynamic.md (and its plots) from a dynamic bench root",
-        description="Write report/dynamic.md and its plots from the results of the dynamic bench "
+        help="write results/local/report/dynamic.md (and its plots) from a dynamic bench root",
+        description="Write results/local/report/dynamic.md and its plots from the results of the dynamic bench "
         "(ROOT/dynamic/, featurecost/, dynamic-accuracy/, stability/, peer/, headline/): rendering only.",
     )
-    rd.add_argument("root", nargs="?", default="results", help="the bench root (default results/)")
-    rd.add_argument("--report-dir", default=None, help="where to write (default report/)")
+    rd.add_argument("root", nargs="?", default="results/local", help="the bench root (default results/local)")
+    rd.add_argument("--report-dir", default=None, help="where to write (default results/local/report/)")
     rd.set_defaults(func=cmd_report_dynamic)
 
     b = sub.add_parser(
@@ -625,16 +682,31 @@ def parser():
         "(fail before timing), run the sweep, then plot and report.",
     )
     b.add_argument("--sweep", default="default", help="sweep name in configs/sweeps/ or a path (default: default)")
-    b.add_argument("--out", help="results directory (default results/<sweep name>)")
+    b.add_argument(
+        "--out",
+        help="the run's folder (default results/local): the paper sweep in OUT/sweep, the dynamic bench's "
+        "folders (dynamic, featurecost, dynamic-accuracy, stability, peer) beside it, the report in OUT/report",
+    )
     b.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto")
-    b.add_argument("--report-dir", default=None, help="where to write the report (default report/)")
+    b.add_argument("--report-dir", default=None, help="where to write the report (default OUT/report)")
     b.add_argument(
         "--model",
         choices=("all", "paper", "dynamic"),
         default="all",
-        help="all (default): the paper model's bench, then the dynamic model's; --out is the paper "
-        "sweep's directory (the dynamic results go beside it) with all, the dynamic bench's root with "
-        "dynamic (default results/)",
+        help="all (default): the paper model's bench, then the dynamic model's; paper or dynamic: one of them",
+    )
+    b.add_argument(
+        "--budget",
+        default=None,
+        help="a time for the whole bench (600, 90s, 10m, 1h30m): the sweeps run smallest size first and "
+        "leave out the sizes whose time, estimated from the sizes measured before, does not fit; the studies "
+        "run while time is left; what was left out is in OUT/budget.json and the report",
+    )
+    b.add_argument(
+        "--shard",
+        default=None,
+        help="K/N: run the K-th of N deterministic shares of the sweeps' cases and the stability map's cells "
+        "(the other studies on shard 1), record OUT/shard.json and write no report; harness merge joins them",
     )
     b.add_argument(
         "--full-studies",
@@ -644,17 +716,29 @@ def parser():
     )
     b.set_defaults(func=cmd_bench)
 
+    mg = sub.add_parser(
+        "merge",
+        help="join shard folders (bench --shard K/N) into one results folder",
+        description="Join the folders of one run's N shards (bench or sweep --shard K/N) into OUT: the rows of "
+        "every CSV, the sweeps' sessions, every shard's validation. Refused in one line (exit 2), writing "
+        "nothing, when the shards differ in revision, machine, sweep files or command, or one is missing "
+        "or given twice. Render the result with make report REPORT_FROM=OUT.",
+    )
+    mg.add_argument("out", help="the merged folder to write (must not exist, or be empty)")
+    mg.add_argument("shards", nargs="+", help="the shard folders")
+    mg.set_defaults(func=cmd_merge)
+
     a = sub.add_parser(
         "accuracy",
         help="speed against accuracy: every mode against a reference (paper or dynamic model)",
         description="Paper model (default): run the scene in every precision/build mode available "
         "here and in several model resolutions, compare with hairsim-cpu --precision fp64, time "
-        "each mode apart, and write results/accuracy/ and report/accuracy.md with a Pareto plot. "
+        "each mode apart, and write results/accuracy/ and results/local/report/accuracy.md with a Pareto plot. "
         "Dynamic model (--model dynamic, or a dynamic --scene): every solver x substeps x "
         "iterations x precision x build against a converged xpbd fp64 reference (substeps doubled "
         "until S and 2S agree to a tenth of the smallest error), time per frame measured apart, "
         "small steps against iterations, the analytic checks and a recommendation; writes "
-        "results/dynamic-accuracy/ and report/dynamic_accuracy.md with its plots "
+        "results/dynamic-accuracy/ and results/local/report/dynamic_accuracy.md with its plots "
         "(docs/harness.md). Exit 0, or 1 when the dynamic reference did not converge.",
     )
     a.add_argument(
@@ -719,7 +803,7 @@ def parser():
     a.add_argument(
         "--out", default=None, help="results directory (default results/accuracy or results/dynamic-accuracy)"
     )
-    a.add_argument("--report-dir", default=None, help="where to write (default report/)")
+    a.add_argument("--report-dir", default=None, help="where to write (default results/local/report/)")
     a.add_argument(
         "--from-csv",
         default=None,
@@ -730,7 +814,7 @@ def parser():
 
     h = sub.add_parser(
         "headline",
-        help="the issues' headline numbers: bandwidth fractions and speedups",
+        help="the headline numbers: bandwidth fractions and speedups (--model dynamic: the dynamic model's targets)",
         description="At one size, measure the copy bandwidths, every CUDA variant's init and "
         "wind+collide time and bandwidth fraction, and three CPU baselines "
         "(ref 1 thread, ref all cores, simd all cores); write "
@@ -817,7 +901,7 @@ def parser():
         help="the same chain scenes in Bender's PositionBasedDynamics (pypbd) beside ours",
         description="Run chains released from rest in hairsim-cpu and in pypbd (XPBD distance constraints, "
         "the parameters mapped as docs/decisions.md says), against our converged fp64 reference: error, "
-        "stretch and time per frame at several strand counts. Writes results/peer/ and report/peer.md. "
+        "stretch and time per frame at several strand counts. Writes results/peer/ and results/local/report/peer.md. "
         "Needs pypbd (optional): without it, one line says so and the exit status is 2.",
     )
     pe.add_argument(
@@ -858,8 +942,8 @@ def parser():
     pe.add_argument("--ref-max", type=whole(2), default=peer_plan.ref_max, help="largest S of the reference (16384)")
     pe.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
     pe.add_argument("--out", default=None, help="results directory (default results/peer)")
-    pe.add_argument("--report-dir", default=None, help="where peer.md goes (default report/)")
-    pe.add_argument("--report-only", action="store_true", help="only re-render report/peer.md from --out")
+    pe.add_argument("--report-dir", default=None, help="where peer.md goes (default results/local/report/)")
+    pe.add_argument("--report-only", action="store_true", help="only re-render results/local/report/peer.md from --out")
     pe.set_defaults(func=cmd_peer)
 
     an = sub.add_parser(
@@ -870,7 +954,7 @@ def parser():
         "is on PATH). Without STATE, runs configs/scenes/dynamic.toml on hairsim-cpu first.",
     )
     an.add_argument("state", nargs="?", default=None, help="a dynamic state file (default: run the dynamic scene)")
-    an.add_argument("--out", default=None, help="the GIF to write (default report/dynamic.gif)")
+    an.add_argument("--out", default=None, help="the GIF to write (default results/local/report/dynamic.gif)")
     an.add_argument("--max-strands", type=whole(1), default=150, help="strands drawn at most (default 150)")
     an.add_argument("--every", type=whole(1), default=None, help="draw every K-th frame (default: about 60 frames)")
     an.add_argument("--fps", type=whole(1), default=None, help="frames per second of the GIF (default: real time)")
@@ -888,8 +972,8 @@ def parser():
         "compliance, points and iterations; head-motion frequency against amplitude) for both solvers and "
         "precisions, on the CPU and every built CUDA build where a GPU answers; judge each cell ok, "
         "over-stretched, penetrating, escaped (a point past 2L) or diverged (NaN/Inf); write "
-        "results/stability/, report/stability_*.png and "
-        "report/dynamic_stability.md.",
+        "results/stability/, results/local/report/stability_*.png and "
+        "results/local/report/dynamic_stability.md.",
     )
     sb.add_argument("--quick", action="store_true", help="a coarser grid (about a quarter of the cells)")
     sb.add_argument("--slice", action="append", choices=SLICE_NAMES, help="run only this slice (repeatable)")
@@ -899,7 +983,7 @@ def parser():
     sb.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto", help="run the CUDA builds too")
     sb.add_argument("--timeout", type=seconds, default=None, help="seconds per cell before giving up")
     sb.add_argument("--out", default=None, help="results directory (default results/stability)")
-    sb.add_argument("--report-dir", default=None, help="where to write (default report/)")
+    sb.add_argument("--report-dir", default=None, help="where to write (default results/local/report/)")
     sb.add_argument("--from-csv", default=None, help="only redraw the report from an existing stability.csv")
     sb.set_defaults(func=cmd_stability)
 

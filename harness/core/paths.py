@@ -1,5 +1,5 @@
 """Where things live: the repository root, the built binaries, configs/scenes/,
-configs/sweeps/, results/, report/.
+configs/sweeps/, results/, the report folders.
 
 HAIRBENCH_BUILD_DIR overrides the build directory (the tests use it to point the harness
 at stand-in binaries)."""
@@ -12,7 +12,9 @@ CONFIGS = ROOT / "configs"
 SCENES = CONFIGS / "scenes"  # scene files (docs/model.md §2.6)
 SWEEPS = CONFIGS / "sweeps"  # sweep files
 RESULTS = ROOT / "results"
-REPORT = ROOT / "report"
+LOCAL_RUN = RESULTS / "local"  # make bench's run folder (untracked; docs/decisions/bench-runs.md)
+REPORT = LOCAL_RUN / "report"  # where reports are rendered unless --report-dir says otherwise
+REFERENCE_REPORT = ROOT / "report"  # the committed report of the reference run (make report REPORT_TO=report)
 
 # cuda builds: the same source compiled three ways (docs/interfaces.md)
 CUDA_BUILDS = {

@@ -1,8 +1,11 @@
 """Progress of a long step: a bar (tqdm) on a terminal; elsewhere (a CI job's log, a file)
-a line at most every `every` seconds and at the end: done/total, time elapsed, an estimate
-of what is left. Without tqdm the lines are printed on a terminal too."""
+a line at least every `every` seconds and at the end: done/total, time elapsed, an estimate
+of what is left. A timer thread prints the line when no case has ended for `every` seconds
+(one case can take minutes), so the log never goes quiet for longer. Without tqdm the lines
+are printed on a terminal too."""
 
 import sys
+import threading
 import time
 
 try:
@@ -14,7 +17,9 @@ LOG_EVERY_S = 30.0  # a log shows a step is alive at least this often
 
 
 class Progress:
-    def __init__(self, total, desc, stream=None, clock=time.monotonic, every=LOG_EVERY_S):
+    def __init__(self, total, desc, stream=None, clock=time.monotonic, every=LOG_EVERY_S, timer=None):
+        """`timer`: run the thread that prints when nothing ends for `every` s (default: with
+        the real clock off a terminal; tests drive tick() with a fake clock instead)."""
         self.total, self.desc, self.clock, self.every = total, desc, clock, every
         self.stream = stream if stream is not None else sys.stderr
         tty = bool(getattr(self.stream, "isatty", lambda: False)())
@@ -24,24 +29,51 @@ class Progress:
         self.lines = bool(total) and self.bar is None
         self.done = 0
         self.start = self.last = clock()
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread = None
+        if timer is None:
+            timer = clock is time.monotonic
+        if self.lines and timer:
+            self._thread = threading.Thread(target=self._beat, name=f"progress {desc}", daemon=True)
+            self._thread.start()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
 
     def update(self, n=1):
         if self.bar is not None:
             self.bar.update(n)
             return
-        self.done += n
-        now = self.clock()
-        if self.lines and (now - self.last >= self.every or self.done >= self.total):
-            self.last = now
-            self._line(now)
+        with self._lock:
+            self.done += n
+            now = self.clock()
+            if self.lines and (now - self.last >= self.every or self.done >= self.total):
+                self._line(now)
+
+    def tick(self):
+        """Print the line if none was printed for `every` seconds (the timer calls this)."""
+        with self._lock:
+            now = self.clock()
+            if self.lines and self.done < self.total and now - self.last >= self.every:
+                self._line(now)
+
+    def _beat(self):
+        while not self._stop.wait(self.every / 6):
+            self.tick()
 
     def _line(self, now):
+        self.last = now
         elapsed = now - self.start
-        left = elapsed / self.done * (self.total - self.done) if self.done else float("nan")
+        if self.done:
+            left = f"about {elapsed / self.done * (self.total - self.done):.0f} s left"
+        else:
+            left = "no estimate before the first is done"
         print(
-            f"{self.desc}: {self.done}/{self.total} done, {elapsed:.0f} s elapsed, about {left:.0f} s left",
-            file=self.stream,
-            flush=True,
+            f"{self.desc}: {self.done}/{self.total} done, {elapsed:.0f} s elapsed, {left}", file=self.stream, flush=True
         )
 
     def write(self, message):
@@ -52,5 +84,9 @@ class Progress:
             print(message, file=self.stream, flush=True)
 
     def close(self):
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
         if self.bar is not None:
             self.bar.close()

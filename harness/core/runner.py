@@ -6,6 +6,7 @@ sweep can skip the case and go on.
 """
 
 import json
+import os
 import signal
 import subprocess
 from collections.abc import Iterable, Sequence
@@ -44,13 +45,19 @@ def last_line(text: str) -> str:
 
 
 def run_binary(
-    binary: str | Path, args: Sequence[Any], timeout: float | None = None, expect_keys: Iterable[str] = RECORD_KEYS
+    binary: str | Path,
+    args: Sequence[Any],
+    timeout: float | None = None,
+    expect_keys: Iterable[str] = RECORD_KEYS,
+    env: dict[str, str] | None = None,
 ) -> dict[str, Any]:
-    """Run `binary args… --json --quiet`; return the JSON object it prints."""
+    """Run `binary args… --json --quiet` (`env`: added to the environment); return the JSON
+    object it prints."""
     binary = require_binary(binary)
     cmd = [str(binary), *map(str, args), "--json", "--quiet"]
+    child_env = dict(os.environ, **env) if env else None
     try:
-        child = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        child = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=child_env)
     except OSError as e:
         raise BackendError(f"cannot run {display(binary)}: {e.strerror}") from None
     try:

@@ -52,6 +52,8 @@ COLUMNS = [
     "iterations",
     "features",
     "point_substeps_per_s",
+    # the GPU (nvidia-smi -L's index) that measured a cuda row
+    "gpu",
 ]
 HEADER = ",".join(COLUMNS) + "\n"
 

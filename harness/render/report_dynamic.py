@@ -16,7 +16,13 @@ import pandas as pd  # noqa: E402
 
 from harness.core.paths import REPORT, display  # noqa: E402
 from harness.io import results_data  # noqa: E402
-from harness.render import accuracy_dynamic_report, featurecost_report, peer_report, stability_report  # noqa: E402
+from harness.render import (  # noqa: E402
+    accuracy_dynamic_report,
+    budget_report,
+    featurecost_report,
+    peer_report,
+    stability_report,
+)
 
 
 def _save(fig, path):
@@ -216,9 +222,9 @@ def build(root, report_dir=None):
         "gravity and a gusting wind on a nodding head (configs/scenes/dynamic.toml). Generated "
         f"by `python -m harness bench` from `{display(root)}`; rendering only.",
         "",
-        "## Validation",
-        "",
     ]
+    lines += budget_report.section(root)
+    lines += ["## Validation", ""]
     lines += validation_lines(sweep_dir) + [""]
     lines += ["## Headline targets", ""] + headline_lines(root / "headline" / "headline_dynamic.json") + [""]
     lines += ["## Throughput over strand counts", ""]

@@ -53,6 +53,7 @@ from harness import HarnessError
 from harness.check import observables
 from harness.core import env, runner, scenes, scenes_dynamic, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
+from harness.core.progress import Progress
 from harness.io.trajectory import open_trajectory
 from harness.studies import observables_long
 from harness.studies.accuracy import (
@@ -355,6 +356,13 @@ class Study:
         S = self.plan.first_rung
         prev_path = first_path or self.rung(build, S)
         then, moved = None, None
+        rungs, top = 1, S  # the most rungs: S doubles until 4·S passes --ref-max
+        while 4 * top <= self.plan.ref_max:
+            top, rungs = 2 * top, rungs + 1
+        with Progress(rungs, "dynamic accuracy: reference ladder (at most)") as bar:
+            return self._climb(build, mode_paths, S, prev_path, then, moved, steps, factor, H, bar)
+
+    def _climb(self, build, mode_paths, S, prev_path, then, moved, steps, factor, H, bar):
         while True:
             cur_path = self.rung(build, 2 * S)
             prev, cur = read_run(prev_path), read_run(cur_path)
@@ -378,6 +386,7 @@ class Study:
                 f"holds until t = {holds_until(ok, cur.times):.3f} s ({len(errs)} modes compared)"
             )
             os.unlink(prev_path)
+            bar.update()
             if converged or 4 * S > self.plan.ref_max:
                 return dict(
                     build=build,
@@ -505,17 +514,15 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                     m.ftl_damping,
                 )
                 futures[f] = m
-            done = 0
-            for f in as_completed(futures):
-                m = futures[f]
-                if m is None:
-                    analytic_lines = f.result()
-                    log("dynamic accuracy: analytic tables done")
-                    continue
-                mode_paths[m.name], records[m.name] = f.result()
-                done += 1
-                if done % 20 == 0 or done == len(modes):
-                    log(f"dynamic accuracy: checked runs {done}/{len(modes)}")
+            with Progress(len(futures), "dynamic accuracy: checked runs") as bar:
+                for f in as_completed(futures):
+                    m = futures[f]
+                    bar.update()
+                    if m is None:
+                        analytic_lines = f.result()
+                        bar.write("dynamic accuracy: analytic tables done")
+                        continue
+                    mode_paths[m.name], records[m.name] = f.result()
 
         # 2. the reference (GPU fp64 where usable and validated against the CPU)
         gpu_ref = _gpu_reference_build(gpu_ok, plan)
@@ -571,10 +578,10 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
 
         # 3. timing, one mode at a time, nothing else running
         timing = {}
-        for k, m in enumerate(modes, 1):
-            timing[m.name] = study.timed(m)
-            if k % 20 == 0 or k == len(modes):
-                log(f"dynamic accuracy: timed {k}/{len(modes)}")
+        with Progress(len(modes), "dynamic accuracy: timed") as bar:
+            for m in modes:
+                timing[m.name] = study.timed(m)
+                bar.update()
 
         rows = _rows(study, modes, mode_paths, ref, timing) + _ladder_rows(study, ref) + check_rows
         rows += _ref_error_rows(study, ref, ref_err)

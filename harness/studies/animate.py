@@ -20,6 +20,7 @@ import numpy as np
 from harness import HarnessError
 from harness.core import runner, scenes
 from harness.core.paths import REPORT, RESULTS, binary_path, display
+from harness.core.progress import Progress
 from harness.io.trajectory import open_trajectory
 
 TARGET_FRAMES = 60  # drawn frames when `every` is not given
@@ -156,12 +157,28 @@ def render(traj, paths, max_strands=150, every=None, fps=None, log=print):
     return written
 
 
-def run(state=None, out=None, max_strands=150, every=None, fps=None, force=False, strands=300, frames=120, log=print):
-    """The `animate` command: the written paths."""
+def run(
+    state=None,
+    out=None,
+    max_strands=150,
+    every=None,
+    fps=None,
+    force=False,
+    strands=300,
+    frames=120,
+    log=print,
+    state_dir=None,
+):
+    """The `animate` command: the written paths (`state_dir`: where the simulated state goes,
+    default results/animation)."""
     paths = _outputs(out, force)
-    if state is None:
-        state = simulate_default(strands, frames, log=log)
-    with open_trajectory(state) as traj:
-        if not traj.is_dynamic:
-            raise HarnessError(f"animate: {display(state)} is a paper-model state (no simulated frames)")
-        return render(traj, paths, max_strands=max_strands, every=every, fps=fps, log=log)
+    with Progress(2 if state is None else 1, "animate: simulate and draw") as bar:
+        if state is None:
+            state = simulate_default(strands, frames, out_dir=state_dir, log=log)
+            bar.update()
+        with open_trajectory(state) as traj:
+            if not traj.is_dynamic:
+                raise HarnessError(f"animate: {display(state)} is a paper-model state (no simulated frames)")
+            written = render(traj, paths, max_strands=max_strands, every=every, fps=fps, log=log)
+        bar.update()
+        return written

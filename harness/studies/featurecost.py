@@ -19,6 +19,7 @@ from pathlib import Path
 from harness import HarnessError
 from harness.core import runner, scenes
 from harness.core.paths import binary_path
+from harness.core.progress import Progress
 from harness.core.scenes_dynamic import DECLARING, FEATURES, NEEDS
 
 FIELDS = (
@@ -101,32 +102,11 @@ def measure(
     base = _set(base, "--frames", str(frames))
     binary = binary_path(backend, build)
     rows = []
-    for name, flags in cases(base):
-        rec = runner.run_binary(binary, flags, timeout=timeout)
-        st = declared(rec)
-        ips = instructions_per_point_substep(binary, flags, rec, st, timeout) if instructions else None
-        row = {
-            "row": name,
-            "features": st["features"],
-            "solver": st["solver"],
-            "substeps": st["substeps"],
-            "iterations": st["iterations"],
-            "strands": rec["strands"],
-            "points": rec["points"],
-            "precision": rec["precision"],
-            "backend": rec["backend"],
-            "variant": rec["variant"],
-            "threads": rec.get("threads"),
-            "block_size": rec.get("block_size"),
-            "median_ms": st["median_ms"],
-            "min_ms": st["min_ms"],
-            "max_ms": st["max_ms"],
-            "point_substeps_per_s": st["point_substeps_per_s"],
-            "device": rec["device"],
-            "instructions_per_point_substep": ips,
-        }
-        progress(f"featurecost: {name:28s} {st['features']:44s} {st['median_ms']:10.3f} ms/frame")
-        rows.append(row)
+    todo = cases(base)
+    with Progress(len(todo), f"featurecost {backend}") as bar:
+        for name, flags in todo:
+            rows.append(_row(binary, name, flags, timeout, instructions, progress))
+            bar.update()
     if out:
         path = Path(out)
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -135,6 +115,35 @@ def measure(
             w.writeheader()
             w.writerows(rows)
     return rows
+
+
+def _row(binary, name, flags, timeout, instructions, progress):
+    """One row of the study: the binary's record of one feature set."""
+    rec = runner.run_binary(binary, flags, timeout=timeout)
+    st = declared(rec)
+    ips = instructions_per_point_substep(binary, flags, rec, st, timeout) if instructions else None
+    row = {
+        "row": name,
+        "features": st["features"],
+        "solver": st["solver"],
+        "substeps": st["substeps"],
+        "iterations": st["iterations"],
+        "strands": rec["strands"],
+        "points": rec["points"],
+        "precision": rec["precision"],
+        "backend": rec["backend"],
+        "variant": rec["variant"],
+        "threads": rec.get("threads"),
+        "block_size": rec.get("block_size"),
+        "median_ms": st["median_ms"],
+        "min_ms": st["min_ms"],
+        "max_ms": st["max_ms"],
+        "point_substeps_per_s": st["point_substeps_per_s"],
+        "device": rec["device"],
+        "instructions_per_point_substep": ips,
+    }
+    progress(f"featurecost: {name:28s} {st['features']:44s} {st['median_ms']:10.3f} ms/frame")
+    return row
 
 
 def instructions_per_point_substep(binary, flags, rec, st, timeout=None):

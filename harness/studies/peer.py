@@ -36,6 +36,7 @@ from harness import HarnessError
 from harness.check import invariants_dynamic
 from harness.core import runner, tolerances, variants
 from harness.core.paths import RESULTS, binary_path, display
+from harness.core.progress import Progress
 from harness.io.trajectory import open_trajectory
 from harness.studies import analytic_runs
 from harness.studies import peer_pypbd as peer
@@ -144,7 +145,7 @@ def reference(binary, inp, workdir, args, smallest_error, log=print):
         s, x_s = 2 * s, x_2s
 
 
-def accuracy(binary, workdir, args, log=print):
+def accuracy(binary, workdir, args, log=print, step=lambda: None):
     """Rows of accuracy.csv, the reference table and whether it converged."""
     pos = chain_positions(len(args.tilts), args.points, args.length, args.tilts)
     inputs = {
@@ -167,6 +168,7 @@ def accuracy(binary, workdir, args, log=print):
             threads=args.threads,
         )[0]
         log(f"peer: accuracy runs S = {s}, I = {i} done")
+        step()
 
     def smallest(x_ref):
         return min(_errors(x, x_ref, args.length)[0] for x in runs.values())
@@ -195,7 +197,7 @@ def accuracy(binary, workdir, args, log=print):
     return rows, s_ref, table, converged
 
 
-def timing(binary, workdir, args, log=print):
+def timing(binary, workdir, args, log=print, step=lambda: None):
     """Rows of timing.csv: per setting and strand count, each variant × precision of ours
     (the binary's declared variants) and the peer."""
     ours_variants = variants.declared("cpu").variants
@@ -291,6 +293,7 @@ def timing(binary, workdir, args, log=print):
                     if r["strands"] == n and r["substeps"] == s and r["iterations"] == i
                 )
             )
+            step()
     return rows
 
 
@@ -360,8 +363,9 @@ def run_study(args, log=print):
     out = Path(args.out) if args.out else RESULTS / "peer"
     out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="hairbench-peer-") as workdir:
-        acc, s_ref, table, converged = accuracy(binary, workdir, args, log)
-        tim = timing(binary, workdir, args, log)
+        with Progress(len(args.settings) * (1 + len(args.strands)), "peer: runs") as bar:
+            acc, s_ref, table, converged = accuracy(binary, workdir, args, log, bar.update)
+            tim = timing(binary, workdir, args, log, bar.update)
     _write_csv(out / "accuracy.csv", ACCURACY_FIELDS, acc)
     _write_csv(out / "timing.csv", TIMING_FIELDS, tim)
     _write_csv(out / "reference.csv", REFERENCE_FIELDS, [dict(substeps=s, change_to_2s=c) for s, c in table])

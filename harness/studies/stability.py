@@ -37,7 +37,7 @@ import numpy as np
 
 from harness import HarnessError
 from harness.check import invariants_dynamic
-from harness.core import env, runner, scenes, tolerances, variants
+from harness.core import env, gpus, runner, scenes, tolerances, variants
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io.files import write_json
@@ -138,8 +138,8 @@ def cell_scene(slc, row, col, solver, precision, strands, frames):
     return replace(base.with_overrides(strands=strands, precision=precision, points=points), dynamic=dyn)
 
 
-def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None):
-    """Run one cell; return its CSV row."""
+def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None, gpu=None):
+    """Run one cell (`gpu`: a core.gpus.Gpu its child alone sees); return its CSV row."""
     scene = cell_scene(slc, row, col, solver, precision, strands, frames)
     out = {
         "slice": slc.name,
@@ -167,7 +167,8 @@ def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None
             scene, be.backend, variant=be.variant, threads=1 if be.backend == "cpu" else None, output=path
         )
         try:
-            runner.run_binary(binary_path(be.backend, be.build), flags, timeout=timeout)
+            pin = {"CUDA_VISIBLE_DEVICES": gpu.select} if gpu is not None else None
+            runner.run_binary(binary_path(be.backend, be.build), flags, timeout=timeout, env=pin)
         except runner.BackendError as e:
             out.update(verdict="refused" if e.code == 2 else "failed", message=str(e), wall_s=time.perf_counter() - t0)
             return out
@@ -211,6 +212,7 @@ def measure(
     gpu="auto",
     timeout=None,
     log=print,
+    shard=None,
 ):
     """Run the map; return (rows, backends run, seconds)."""
     unknown = [s for s in slices if s not in SLICE_NAMES]
@@ -226,15 +228,25 @@ def measure(
         for solver in declared[be].dynamic_solvers
         for precision in declared[be].precisions
     ]
+    if shard is not None:  # a share of the cells (harness merge joins the shards' rows)
+        todo = shard.share(todo)
     jobs = jobs or os.cpu_count() or 1
     log(
         f"stability: {len(todo)} cells ({len(chosen)} slice(s) × solvers × precisions × {len(bes)} backend(s)), "
         f"{strands} strands, {frames} frames, {jobs} jobs"
     )
+    # nothing here is timed: with several GPUs the GPU cells take them in turn
+    spread = gpus.visible() if any(job[-1].backend == "cuda" for job in todo) else []
+
+    def gpu_for(i, job):
+        return spread[i % len(spread)] if len(spread) > 1 and job[-1].backend == "cuda" else None
+
+    if len(spread) > 1:
+        log(f"stability: GPU cells spread over {len(spread)} GPUs")
     t0 = time.perf_counter()
     bar = Progress(len(todo), "stability")
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = [pool.submit(run_cell, *job, strands, frames, timeout) for job in todo]
+        futures = [pool.submit(run_cell, *job, strands, frames, timeout, gpu_for(i, job)) for i, job in enumerate(todo)]
         rows = []
         for f in futures:
             rows.append(f.result())
@@ -267,11 +279,12 @@ def run_study(
     timeout=None,
     out_dir=None,
     log=print,
+    shard=None,
 ):
     """Measure the slices; write stability.csv and env.json into out_dir (the renderer,
     render/stability_report.py, draws them) and return the CSV's path."""
     out_dir = Path(out_dir or RESULTS / "stability")
-    rows, bes, seconds = measure(slices, quick, strands, frames, jobs, gpu, timeout, log)
+    rows, bes, seconds = measure(slices, quick, strands, frames, jobs, gpu, timeout, log, shard)
     csv_path = write_csv(rows, out_dir / "stability.csv")
     info = dict(
         env.collect(),
@@ -283,6 +296,7 @@ def run_study(
         backends=[b.label for b in bes],
         stretch_bound=tolerances.STABILITY_STRETCH_MAX,
         penetration_bound_rel=tolerances.STABILITY_PENETRATION_REL,
+        shard=str(shard) if shard else None,
     )
     env_path = out_dir / "env.json"
     write_json(env_path, info)

@@ -10,12 +10,13 @@ results/<name>/env.json, one entry per session (a resumed run adds one).
 
 import json
 import os
+import time
 from pathlib import Path
 
 import numpy as np
 
 from harness import HarnessError
-from harness.core import env, scenes
+from harness.core import budget, env, gpus, scenes
 from harness.core.paths import RESULTS, binary_path, display, output_dir
 from harness.core.progress import Progress
 from harness.core.runner import BackendError, DoesNotFit, run_binary, run_flags
@@ -181,8 +182,10 @@ def check_same_machine(before, now, out_dir):
         )
 
 
-def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
-    """Run (or resume) a sweep; return (results dir, number of failed cases)."""
+def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, shard=None, gate=None):
+    """Run (or resume) a sweep; return (results dir, number of failed cases). `shard` (a
+    core.shards.Shard): only its share of the cases; `gate` (a core.budget.TierGate): the
+    cases run smallest size first and a tier that does not fit is left out with every larger one."""
     sweep = load_sweep(sweep_ref)
     out_dir = output_dir(out if out else RESULTS / sweep.name)
     csv_path = out_dir / "runs.csv"
@@ -199,6 +202,16 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
     if done and record.get("sessions"):
         check_same_machine(record["sessions"][-1].get("host") or {}, env.collect(), out_dir)
     cases = sweep.cases()
+    if done and record.get("shard") != (str(shard) if shard else None):
+        was = f"shard {record['shard']}" if record.get("shard") else "the whole sweep"
+        raise HarnessError(
+            f"{display(out_dir)} holds rows of {was}; this run is "
+            + (f"shard {shard}" if shard else "the whole sweep")
+            + ": give another --out"
+        )
+    if shard is not None:
+        cases = shard.share(cases)
+        record["shard"] = str(shard)
     reasons = backend_reasons(cases, gpu)
     skipped = []
     for why in sorted(set(reasons.values())):
@@ -239,31 +252,31 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
         say(f"harness: {note}")
     write_json(env_path, record)
 
+    gpu_list = gpus.visible() if any(c.backend == "cuda" for c in todo) else []
+    session["gpus"] = [{"index": g.index, "name": g.name} for g in gpu_list]
+    if len(gpu_list) > 1:
+        say(
+            f"harness: sweep {sweep.name}: GPU cases spread over {len(gpu_list)} GPUs "
+            f"({', '.join(str(g.index) for g in gpu_list)}); the CPU cases run before them, alone"
+        )
+    groups = budget.tiers(todo, case_size) if gate is not None else [(None, todo)]
     progress = Progress(len(todo), f"sweep {sweep.name}")
     failed = 0
     try:
-        for case in todo:
-            key = (case.backend, case.build or "default")
-            binary = binary_path(*key)
-            try:
-                rec = run_binary(binary, case_flags(sweep, case), timeout=sweep.timeout_s)
-            except (DoesNotFit, SceneError) as e:
-                session["skipped"].append({"case": case.case_id, "reason": str(e)})
-                progress.write(f"harness: skipping {case.case_id}: {e}")
-            except BackendError as e:
-                failed += 1
-                session["failed"].append({"case": case.case_id, "error": str(e)})
-                progress.write(f"harness: case {case.case_id} failed: {e}")
-            else:
-                runlog.append_case(csv_path, rows_of_record(case, rec, bandwidth.get(key), session_index, binary))
-                session["cases_run"] += 1
-                session["binaries"].setdefault(
-                    binary.name,
-                    {k: rec.get(k) for k in ("version", "git_revision", "compiler", "flags", "device", "driver")},
-                )
-            progress.update()
-            session["finished_at"] = env.now()
-            write_json(env_path, record)
+        for size, tier in groups:
+            if gate is not None:
+                fits, why = gate.admit(size, len(tier))
+                if not fits:
+                    session["skipped"].append({"cases": len(tier), "size": size, "reason": why, "budget": True})
+                    progress.write(f"harness: sweep {sweep.name}: {len(tier)} case(s) of size {size} {why}")
+                    progress.update(len(tier))
+                    continue
+            t0 = time.monotonic()
+            failed += _run_cases(
+                tier, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list
+            )
+            if gate is not None:
+                gate.measured(size, len(tier), time.monotonic() - t0)
     finally:
         progress.close()
     say(
@@ -271,6 +284,70 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True):
         f"{failed} failed; rows in {display(csv_path)}"
     )
     return out_dir, failed
+
+
+def case_size(case):
+    """A case's rung on the budget's size ladder: strands × points."""
+    return case.strands * case.points
+
+
+def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list):
+    """Run the cases, appending their rows; the number that failed. With several GPUs the
+    CPU cases run first, alone, then the GPU cases on one worker per GPU (core/gpus.py)."""
+    failed = 0
+    pin = len(gpu_list) > 1 or bool(os.environ.get("HB_GPUS"))  # else the one GPU as the binary finds it
+
+    def run_case(case, gpu):
+        binary = binary_path(case.backend, case.build or "default")
+        env_add = {"CUDA_VISIBLE_DEVICES": gpu.select} if gpu is not None and pin else None
+        return run_binary(binary, case_flags(sweep, case), timeout=sweep.timeout_s, env=env_add)
+
+    def done(case, gpu, rec, error):
+        nonlocal failed
+        key = (case.backend, case.build or "default")
+        binary = binary_path(*key)
+        if isinstance(error, (DoesNotFit, SceneError)):
+            session["skipped"].append({"case": case.case_id, "reason": str(error)})
+            progress.write(f"harness: skipping {case.case_id}: {error}")
+        elif isinstance(error, BackendError):
+            failed += 1
+            session["failed"].append({"case": case.case_id, "error": str(error)})
+            progress.write(f"harness: case {case.case_id} failed: {error}")
+        elif error is not None:
+            raise error
+        else:
+            rows = rows_of_record(case, rec, bandwidth.get(key), session_index, binary)
+            for r in rows:
+                r["gpu"] = gpu.index if gpu is not None else ""
+            runlog.append_case(csv_path, rows)
+            session["cases_run"] += 1
+            session["binaries"].setdefault(
+                binary.name,
+                {k: rec.get(k) for k in ("version", "git_revision", "compiler", "flags", "device", "driver")},
+            )
+        progress.update()
+        session["finished_at"] = env.now()
+        write_json(env_path, record)
+
+    one = gpu_list[0] if gpu_list else None
+    on_gpu = [c for c in todo if c.backend == "cuda"]
+    if len(gpu_list) <= 1 or not on_gpu:  # one GPU: the cases in the sweep's order, as always
+        for case in todo:
+            gpu = one if case.backend == "cuda" else None
+            try:
+                rec, error = run_case(case, gpu), None
+            except (DoesNotFit, SceneError, BackendError) as e:
+                rec, error = None, e
+            done(case, gpu, rec, error)
+        return failed
+    for case in (c for c in todo if c.backend != "cuda"):  # the CPU baselines, no GPU worker running
+        try:
+            rec, error = run_case(case, None), None
+        except (DoesNotFit, SceneError, BackendError) as e:
+            rec, error = None, e
+        done(case, None, rec, error)
+    gpus.spread(on_gpu, gpu_list, run_case, done)
+    return failed
 
 
 FIGURE_STRANDS = 400  # strands in the Fig. 1/2 state

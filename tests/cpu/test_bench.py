@@ -29,9 +29,7 @@ def bench(tmp_path, *extra, env=None):
         "--sweep",
         "configs/sweeps/quick.toml",
         "--out",
-        str(tmp_path / "results"),
-        "--report-dir",
-        str(tmp_path / "report"),
+        str(tmp_path / "run"),
         *extra,
     ]
     return subprocess.run(
@@ -39,19 +37,32 @@ def bench(tmp_path, *extra, env=None):
     )
 
 
+def git_status():
+    """The repository's `git status --porcelain` of tracked files (other tests may add files)."""
+    p = subprocess.run(
+        ["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT, capture_output=True, text=True, timeout=60
+    )
+    assert p.returncode == 0, p.stderr
+    return p.stdout
+
+
 @needs_cpu
 def test_bench_end_to_end_on_cpu(tmp_path):
-    before = scratch_listing()
+    before, status = scratch_listing(), git_status()
     p = bench(tmp_path, env={"HAIRBENCH_NO_GPU": "1"})
     assert p.returncode == 0, p.stdout + p.stderr
     assert "Traceback" not in p.stderr
+    # the tree is left as found: no tracked file changed
+    assert git_status() == status
     # the validator's states went to a scratch under --out and are gone
-    assert scratch_listing() == before and not (tmp_path / "results" / "_scratch").exists()
+    assert scratch_listing() == before and not (tmp_path / "run" / "sweep" / "_scratch").exists()
     gpu_lines = [ln for ln in p.stdout.splitlines() if "GPU" in ln]
     assert gpu_lines == ["harness: GPU rows skipped: HAIRBENCH_NO_GPU is set"]
-    results = tmp_path / "results"
+    results = tmp_path / "run" / "sweep"
     validation = json.loads((results / "validation.json").read_text())
     assert validation["checks"] and all(c["equivalent"] for c in validation["checks"])
+    n = len(validation["checks"])  # the progress line counted every comparison it planned
+    assert f"validation: {n}/{n} done" in p.stderr
     whats = " ".join(c["what"] for c in validation["checks"])
     assert "1 thread vs all cores" in whats and "fp32 vs cpu fp64" in whats and "resumed" in whats
     with open(results / "runs.csv", newline="") as f:
@@ -62,12 +73,12 @@ def test_bench_end_to_end_on_cpu(tmp_path):
     assert all(int(r["n_times"]) >= 9 and r["copy_gbps"] for r in rows)
     env = json.loads((results / "env.json").read_text())
     assert env["sessions"][0]["skipped"][0]["reason"] == "HAIRBENCH_NO_GPU is set"
-    md = (tmp_path / "report" / "report.md").read_text()
+    md = (tmp_path / "run" / "report" / "report.md").read_text()  # the report inside the run's folder
     assert "GPU rows are absent**: HAIRBENCH_NO_GPU is set" in md
     n = len(validation["checks"])
     assert f"{n} of {n} comparisons equivalent" in md
     for png in ("speedup_fp32.png", "fig1_initialized.png", "fig2_after_wind.png"):
-        assert (tmp_path / "report" / png).stat().st_size > 5000
+        assert (tmp_path / "run" / "report" / png).stat().st_size > 5000
     # run again: the sweep resumes (nothing to do), the report is rebuilt
     p = bench(tmp_path, env={"HAIRBENCH_NO_GPU": "1"})
     assert p.returncode == 0 and "8 case(s) already complete" in p.stdout
@@ -79,7 +90,7 @@ def test_bench_without_binaries_says_run_make(tmp_path):
     p = bench(tmp_path, env={"HAIRBENCH_BUILD_DIR": str(tmp_path / "empty")})
     assert p.returncode == 2
     assert p.stderr.strip().endswith("hairsim-cpu not found: run make")
-    assert p.stderr.count("\n") == 1 and not (tmp_path / "results").exists()
+    assert p.stderr.count("\n") == 1 and not (tmp_path / "run").exists()
 
 
 def scratch_listing():
@@ -95,7 +106,7 @@ def test_bench_fails_before_timing_when_not_equivalent(tmp_path):
     assert p.returncode == 1, p.stdout + p.stderr
     assert "harness: error: validation failed" in p.stderr and "nothing was timed" in p.stderr
     assert "NOT EQUIVALENT: cpu fp32 vs cpu fp64" in p.stdout
-    results = tmp_path / "results"
+    results = tmp_path / "run" / "sweep"
     assert not (results / "runs.csv").exists()
     checks = json.loads((results / "validation.json").read_text())["checks"]
     assert not next(c for c in checks if c["what"] == "cpu fp32 vs cpu fp64")["equivalent"]
@@ -109,8 +120,22 @@ def test_bench_fails_before_timing_when_not_equivalent(tmp_path):
 def test_bench_validates_every_gpu_variant(tmp_path):
     p = bench(tmp_path, "--gpu", "yes")
     assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
-    checks = json.loads((tmp_path / "results" / "validation.json").read_text())["checks"]
+    checks = json.loads((tmp_path / "run" / "sweep" / "validation.json").read_text())["checks"]
     gpu = [c for c in checks if c["what"].startswith("cuda")]
     assert len(gpu) >= 3 * 6 * 2 and all(c["equivalent"] for c in gpu)
-    with open(tmp_path / "results" / "runs.csv", newline="") as f:
+    with open(tmp_path / "run" / "sweep" / "runs.csv", newline="") as f:
         assert any(r["backend"] == "cuda" for r in csv.DictReader(f))
+
+
+def test_the_default_run_folder_and_report_are_untracked_and_ignored():
+    """make bench's defaults write only where git ignores: results/local/ and its report/,
+    never the committed report/ (so the run's recorded revision stays clean)."""
+    from harness.core.paths import LOCAL_RUN, REFERENCE_REPORT, REPORT
+
+    assert REPORT.is_relative_to(LOCAL_RUN) and REFERENCE_REPORT == ROOT / "report"
+    for path in (LOCAL_RUN / "sweep" / "runs.csv", REPORT / "report.md", REPORT / "dynamic.gif"):
+        rel = str(path.relative_to(ROOT))
+        ignored = subprocess.run(["git", "check-ignore", "-q", rel], cwd=ROOT, timeout=60)
+        assert ignored.returncode == 0, f"{rel} is not ignored by git"
+        tracked = subprocess.run(["git", "ls-files", "--error-unmatch", rel], cwd=ROOT, capture_output=True, timeout=60)
+        assert tracked.returncode != 0, f"{rel} is tracked"

@@ -10,6 +10,7 @@ environment:
   FAKE_TOO_BIG=N          exit 3 (does not fit in memory) for more than N strands
   FAKE_SHIFT_FP32=d       move every fp32 point by d (a planted inequivalence)
   FAKE_BACKEND=name       the backend named in the record (default: from the program name)
+  FAKE_LOG=path           append "start|end backend strands CUDA_VISIBLE_DEVICES" lines per timed run
 """
 
 import json
@@ -84,7 +85,15 @@ def main(argv=None):
             )
         )
         return 0
+    log = os.environ.get("FAKE_LOG") if not o.get("measure-bandwidth") else None
+    seen = os.environ.get("CUDA_VISIBLE_DEVICES", "-")
+    if log:
+        with open(log, "a") as f:
+            f.write(f"start {backend} {o.get('strands', '-')} {seen}\n")
     time.sleep(float(os.environ.get("FAKE_SLEEP", "0")))
+    if log:
+        with open(log, "a") as f:
+            f.write(f"end {backend} {o.get('strands', '-')} {seen}\n")
     if o.get("measure-bandwidth"):
         if os.environ.get("FAKE_NO_BANDWIDTH"):
             print("hairsim-fake: error: unknown flag --measure-bandwidth", file=sys.stderr)

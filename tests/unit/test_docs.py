@@ -31,3 +31,17 @@ def test_check_says_when_the_page_is_stale(tmp_path, monkeypatch, capsys):
     page.write_text("no markers\n")
     assert main(["docs"]) == 2
     assert capsys.readouterr().err.strip().startswith("harness: error: ")
+
+
+def test_every_help_text_stands_alone():
+    """`harness --help` and each command's help name the project's own documents only: no
+    outside brief, no issue tracker."""
+    import re
+
+    p = parser()
+    texts = [p.format_help()]
+    sub = next(a for a in p._actions if a.dest == "command")
+    texts += [c.format_help() for c in sub.choices.values()]
+    for text in texts:
+        flat = " ".join(text.split())
+        assert not re.search(r"\bDESIGN\b|\bissues?\b|\.\./shared", flat), flat[:200]

@@ -2,6 +2,7 @@
 count, the time elapsed and an estimate of what is left (a CI log shows the step is alive)."""
 
 import io
+import time
 
 from harness.core.progress import LOG_EVERY_S, Progress
 
@@ -44,3 +45,33 @@ def test_messages_pass_through_and_an_empty_step_prints_nothing():
     p.write("harness: skipping a case")
     p.close()
     assert out.getvalue() == "harness: skipping a case\n"
+
+
+def test_a_long_case_still_prints_a_line_every_30_s():
+    """One case can take minutes: the timer's tick prints the line while nothing ends."""
+    out, clock = io.StringIO(), Clock()
+    p = Progress(3, "featurecost", stream=out, clock=clock)
+    clock.t += 29.0
+    p.tick()
+    assert out.getvalue() == ""
+    clock.t += 1.0
+    p.tick()
+    clock.t += 10.0
+    p.tick()  # 10 s after the last line: nothing
+    clock.t += 20.0
+    p.tick()
+    p.close()
+    assert out.getvalue().splitlines() == [
+        "featurecost: 0/3 done, 30 s elapsed, no estimate before the first is done",
+        "featurecost: 0/3 done, 60 s elapsed, no estimate before the first is done",
+    ]
+
+
+def test_the_timer_thread_prints_without_an_update():
+    out = io.StringIO()
+    with Progress(2, "peer", stream=out, every=0.05, timer=True) as p:
+        deadline = time.monotonic() + 5.0
+        while not out.getvalue() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert p.done == 0
+    assert out.getvalue().startswith("peer: 0/2 done")

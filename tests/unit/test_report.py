@@ -187,3 +187,22 @@ def test_report_of_the_reference_run_with_its_accuracy_study(tmp_path, capsys):
     assert (rep / "fig1_initialized.png").exists() and (rep / "fig2_after_wind.png").exists()
     assert {p: p.stat().st_mtime_ns for p in results.rglob("*")} == before
     assert capsys.readouterr().out.strip() == f"wrote {rep / 'report.md'}"
+
+
+def test_both_reports_say_what_a_time_budget_left_out(tmp_path):
+    """RUN/budget.json (harness bench --budget) becomes a "Time budget" section in report.md
+    and dynamic.md; a run without one has no such section."""
+    import json
+
+    from harness.render import report_dynamic, report_paper
+
+    run = tmp_path / "run"
+    results = write_results(run / "sweep", False)
+    report_paper.build(results, tmp_path / "plain")
+    assert "## Time budget" not in (tmp_path / "plain" / "report.md").read_text()
+    left = {"step": "sweep default", "what": "8 case(s) at sizes 96000000 (strands × points)", "reason": "over"}
+    (run / "budget.json").write_text(json.dumps({"budget_s": 600.0, "used_s": 590.2, "left_out": [left]}))
+    for path in (report_paper.build(results, tmp_path / "r"), report_dynamic.build(run, tmp_path / "r")):
+        text = path.read_text()
+        assert "## Time budget" in text and "budget of 600 s" in text and "used 590 s" in text
+        assert "- sweep default: 8 case(s) at sizes 96000000 (strands × points) (over)" in text

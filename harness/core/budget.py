@@ -1,0 +1,124 @@
+"""A time budget for `harness bench --budget 10m` (docs/decisions/bench-runs.md).
+
+The size ladder is the sweep's own: its cases grouped into tiers of one size (strands ×
+points), smallest first. The first tier always runs; before each further tier its time is
+estimated from the tier just measured in this run (time per case × the size ratio: the
+per-strand cost only falls as the size grows, so this over-estimates), and the tier and all
+larger ones are left out when the estimate does not fit the time left to the step. The
+bench gives each step a declared share of what is left when it starts (SHARES)."""
+
+import re
+import time
+from dataclasses import dataclass, field
+
+from harness import HarnessError
+
+# of the time left when the step starts: the paper sweep, then the dynamic sweep; the
+# dynamic studies get what is left after that (each runs while any is left)
+SHARES = {"paper sweep": 0.45, "dynamic sweep": 0.5}
+
+_UNIT = {"s": 1, "m": 60, "h": 3600}
+
+
+def parse_duration(text):
+    """'600', '600s', '10m', '1h', '1h30m' → seconds (> 0); anything else refused in one line."""
+    t = str(text).strip()
+    if re.fullmatch(r"[0-9]+", t):
+        value = float(t)
+    else:
+        parts = re.findall(r"([0-9]+)([smh])", t)
+        if not parts or "".join(n + u for n, u in parts) != t:
+            raise HarnessError(f"--budget needs a time like 600, 90s, 10m or 1h30m (got '{text}')", code=2)
+        value = float(sum(int(n) * _UNIT[u] for n, u in parts))
+    if value <= 0:
+        raise HarnessError(f"--budget must be more than 0 s (got '{text}')", code=2)
+    return value
+
+
+@dataclass
+class Budget:
+    """The run's deadline; `allowance(step)` the share of what is left for a step."""
+
+    seconds: float
+    clock: object = time.monotonic
+    start: float = field(default=0.0)
+    left_out: list = field(default_factory=list)  # what was not run, for budget.json and the report
+
+    def __post_init__(self):
+        self.start = self.clock()
+
+    def left(self):
+        return self.seconds - (self.clock() - self.start)
+
+    def allowance(self, step):
+        return max(0.0, self.left() * SHARES.get(step, 1.0))
+
+    def leave_out(self, step, what, reason):
+        self.left_out.append({"step": step, "what": what, "reason": reason})
+
+    def record(self):
+        return {"budget_s": self.seconds, "used_s": round(self.clock() - self.start, 1), "left_out": self.left_out}
+
+
+def tiers(cases, size):
+    """The cases grouped by size(case), smallest first (the sweep's order kept within a tier)."""
+    out = {}
+    for c in cases:
+        out.setdefault(size(c), []).append(c)
+    return [(s, out[s]) for s in sorted(out)]
+
+
+def estimate(last, nxt):
+    """Seconds the tier `nxt` = (size, n_cases) should take, from the measured tier
+    `last` = (size, n_cases, seconds)."""
+    size, n, seconds = last
+    per_case = seconds / max(n, 1)
+    return per_case * (nxt[0] / size) * nxt[1]
+
+
+class TierGate:
+    """Decides, before each tier, whether it fits the allowance: `admit(size, n)` → (True,
+    None) or (False, reason); `measured(size, n, seconds)` after a tier ran."""
+
+    def __init__(self, allowance_s, clock=time.monotonic):
+        self.allowance, self.clock = allowance_s, clock
+        self.start = clock()
+        self.last = None
+        self.closed = None  # the reason, once a tier was refused (all larger ones are too)
+        self.refused = []  # (size, cases) of every tier left out
+
+    def admit(self, size, n):
+        if self.closed:
+            self.refused.append((size, n))
+            return False, self.closed
+        if self.last is None:
+            return True, None  # the first tier is the measurement the rest is judged by
+        need = estimate(self.last, (size, n))
+        left = self.allowance - (self.clock() - self.start)
+        if need > left:
+            self.closed = (
+                f"left out to fit the budget: from size {size} (strands × points) on, the next tier was "
+                f"estimated at {need:.0f} s with {max(left, 0):.0f} s of this step's {self.allowance:.0f} s left"
+            )
+            self.refused.append((size, n))
+            return False, self.closed
+        return True, None
+
+    def summary(self):
+        """What was left out, in words (None when nothing was)."""
+        if not self.refused:
+            return None
+        n = sum(c for _, c in self.refused)
+        sizes = ", ".join(str(sz) for sz, _ in self.refused)
+        return f"{n} case(s) at sizes {sizes} (strands × points)"
+
+    def measured(self, size, n, seconds):
+        if n:
+            self.last = (size, n, seconds)
+
+
+def largest_that_fits(ladder, seconds_at, allowance_s):
+    """The largest size of `ladder` whose estimate seconds_at(size) fits allowance_s; the
+    smallest when none does (a study's smallest size still says something)."""
+    fitting = [n for n in ladder if seconds_at(n) <= allowance_s]
+    return max(fitting) if fitting else min(ladder)

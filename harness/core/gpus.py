@@ -1,0 +1,107 @@
+"""Every GPU of the node: which GPUs the sweep spreads its GPU cases over, and the spreading.
+
+`visible()` lists the GPUs as nvidia-smi -L names them, kept to CUDA_VISIBLE_DEVICES when a
+scheduler set it (indices or UUIDs) and to HB_GPUS when given (indices as nvidia-smi -L
+numbers them, e.g. HB_GPUS=0,1; HB_GPUS=0 keeps one GPU). `spread()` runs cases on one
+worker per GPU, each worker's child seeing only its GPU (CUDA_VISIBLE_DEVICES), a worker
+taking the next case when its last one ends; the caller runs the CPU cases before or after,
+never while GPU workers load the host."""
+
+import os
+import queue
+import re
+import shutil
+import subprocess
+import threading
+from dataclasses import dataclass
+
+from harness import HarnessError
+
+
+@dataclass(frozen=True)
+class Gpu:
+    index: int  # as nvidia-smi -L numbers it
+    name: str
+    uuid: str = ""
+
+    @property
+    def select(self):
+        """The CUDA_VISIBLE_DEVICES value that shows a child this GPU alone."""
+        return self.uuid or str(self.index)
+
+
+_LINE = re.compile(r"GPU (\d+): (.*?) \(UUID: ([^)]+)\)")
+
+
+def parse_smi(text):
+    return [Gpu(int(m[1]), m[2].strip(), m[3].strip()) for m in _LINE.finditer(text or "")]
+
+
+def _smi_list():
+    smi = shutil.which("nvidia-smi")
+    if smi is None:
+        return []
+    try:
+        return parse_smi(subprocess.run([smi, "-L"], capture_output=True, text=True, timeout=30).stdout)
+    except (OSError, subprocess.TimeoutExpired):
+        return []
+
+
+def visible(listed=None, environ=None):
+    """The GPUs to use (see the module's text); `listed` and `environ` replace nvidia-smi -L's
+    GPUs and os.environ (tests)."""
+    environ = os.environ if environ is None else environ
+    gpus = _smi_list() if listed is None else list(listed)
+    cvd = environ.get("CUDA_VISIBLE_DEVICES")
+    if cvd is not None and cvd.strip() != "":
+        keep = [x.strip() for x in cvd.split(",") if x.strip()]
+        gpus = [
+            g for g in gpus if str(g.index) in keep or g.uuid in keep or any(k and g.uuid.startswith(k) for k in keep)
+        ]
+    wanted = environ.get("HB_GPUS", "").strip()
+    if wanted and wanted != "all":
+        try:
+            indices = [int(x, 10) for x in wanted.split(",")]
+        except ValueError:
+            raise HarnessError(f"HB_GPUS needs GPU indices like 0,1 (got '{wanted}')") from None
+        by_index = {g.index: g for g in gpus}
+        missing = [i for i in indices if i not in by_index]
+        if missing:
+            have = ", ".join(str(g.index) for g in gpus) or "none"
+            raise HarnessError(
+                f"HB_GPUS names GPU(s) {', '.join(map(str, missing))} that are not visible (visible: {have})"
+            )
+        gpus = [by_index[i] for i in dict.fromkeys(indices)]
+    return gpus
+
+
+def spread(cases, gpus, run_case, on_done):
+    """run_case(case, gpu) for every case, on one worker thread per GPU; on_done(case, gpu,
+    result, error) is called in the calling thread as each ends (in the order they end)."""
+    todo = queue.Queue()
+    for c in cases:
+        todo.put(c)
+    ended = queue.Queue()
+    stop = threading.Event()
+
+    def worker(gpu):
+        while not stop.is_set():
+            try:
+                case = todo.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                ended.put((case, gpu, run_case(case, gpu), None))
+            except Exception as e:  # reported to the caller, which decides
+                ended.put((case, gpu, None, e))
+
+    threads = [threading.Thread(target=worker, args=(g,), name=f"gpu {g.index}", daemon=True) for g in gpus]
+    for t in threads:
+        t.start()
+    try:
+        for _ in range(len(cases)):
+            on_done(*ended.get())
+    finally:
+        stop.set()
+        for t in threads:
+            t.join()

@@ -1,0 +1,106 @@
+"""The sweep on a node with several GPUs, with stand-ins: the fake backend (support.fakebackend)
+and an nvidia-smi that lists two GPUs. The CPU cases run before any GPU case, the GPU cases
+run on one worker per GPU, each child seeing only its GPU (CUDA_VISIBLE_DEVICES), and each
+row names the GPU that measured it; HB_GPUS keeps one GPU."""
+
+import csv
+import os
+import subprocess
+import sys
+
+import pytest
+
+from conftest import ROOT
+from support.fakebackend import install
+
+SWEEP = """
+name = "two-gpus"
+scene = "paper"
+repeat = 9
+warmup = 0
+[axes]
+strands = [100, 200, 300]
+points = [8]
+precision = ["fp32"]
+[cpu]
+variant = ["ref"]
+threads = [1]
+[cuda]
+build = ["default"]
+variant = ["paper", "fused"]
+block_size = [32, 64]
+"""
+SMI = """#!/bin/sh
+case "$1" in
+  -L) printf 'GPU 0: Fake GPU (UUID: GPU-fake-0)\\nGPU 1: Fake GPU (UUID: GPU-fake-1)\\n' ;;
+  *) printf 'Fake GPU, 0.0, 80 GiB\\nFake GPU, 0.0, 80 GiB\\n' ;;
+esac
+"""
+
+
+@pytest.fixture
+def node(tmp_path):
+    build = install(tmp_path / "build", ["hairsim-cpu", "hairsim-cuda"])
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    (bin_dir / "nvidia-smi").write_text(SMI)
+    (bin_dir / "nvidia-smi").chmod(0o755)
+    sweep = tmp_path / "two-gpus.toml"
+    sweep.write_text(SWEEP)
+    env = {k: v for k, v in os.environ.items() if k not in ("HAIRBENCH_NO_GPU", "CUDA_VISIBLE_DEVICES", "HB_GPUS")}
+    env.update(
+        HAIRBENCH_BUILD_DIR=str(build),
+        PATH=f"{bin_dir}{os.pathsep}{env.get('PATH', '')}",
+        FAKE_LOG=str(tmp_path / "runs.log"),
+        FAKE_SLEEP="0.2",
+    )
+    return tmp_path, sweep, env
+
+
+def sweep(node, **extra):
+    tmp_path, path, env = node
+    out = tmp_path / "out"
+    p = subprocess.run(
+        [sys.executable, "-m", "harness", "sweep", str(path), "--out", str(out), "--gpu", "yes"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=dict(env, **extra),
+    )
+    assert p.returncode == 0, p.stdout + p.stderr
+    with open(out / "runs.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    log = [line.split() for line in (tmp_path / "runs.log").read_text().splitlines()]
+    return p, rows, log
+
+
+def test_gpu_cases_spread_over_both_gpus_after_the_cpu_cases(node):
+    p, rows, log = sweep(node)
+    assert "spread over 2 GPUs" in p.stdout
+    cuda = [e for e in log if e[1] == "cuda"]
+    cpu = [e for e in log if e[1] == "cpu"]
+    assert len(cpu) == 2 * 3 and len(cuda) == 2 * 3 * 4  # start and end of each case
+    first_gpu = next(i for i, e in enumerate(log) if e[1] == "cuda")
+    assert all(i < first_gpu for i, e in enumerate(log) if e[1] == "cpu"), "a CPU case ran beside GPU workers"
+    assert {e[3] for e in cuda} == {"GPU-fake-0", "GPU-fake-1"}  # each child saw one GPU
+    assert {e[3] for e in cpu} == {"-"}
+    in_flight, most = 0, 0
+    for e in log[first_gpu:]:
+        in_flight += 1 if e[0] == "start" else -1
+        most = max(most, in_flight)
+    assert most == 2  # the two workers overlapped, never more than one case a GPU
+    gpu_of = {r["gpu"] for r in rows if r["backend"] == "cuda"}
+    assert gpu_of == {"0", "1"} and {r["gpu"] for r in rows if r["backend"] == "cpu"} == {""}
+    assert len({r["case_id"] for r in rows}) == 3 + 12
+
+
+def test_hb_gpus_keeps_one_gpu_and_the_sweep_order(node):
+    p, rows, log = sweep(node, HB_GPUS="1")
+    assert "spread over" not in p.stdout
+    assert {e[3] for e in log if e[1] == "cuda"} == {"GPU-fake-1"}
+    assert {r["gpu"] for r in rows if r["backend"] == "cuda"} == {"1"}
+    in_flight = 0
+    for e in log:
+        in_flight += 1 if e[0] == "start" else -1
+        assert in_flight <= 1  # one case at a time, as on any one-GPU machine
