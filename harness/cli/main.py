@@ -110,6 +110,7 @@ def cmd_stepdiff(args):
         exact=args.exact,
         keep=args.keep,
         timeout=args.timeout,
+        spread=not args.no_spread,
     )
 
 
@@ -431,6 +432,26 @@ def cmd_stability(args):
     return 0
 
 
+def cmd_judge(args):
+    from harness.studies import judge
+
+    plan = judge.Plan.quick(gpu=args.gpu) if args.quick else judge.Plan(gpu=args.gpu)
+    if args.strands:
+        plan = judge.replace(plan, strands=args.strands)
+    if args.extreme:
+        unknown = [n for n in args.extreme if n not in judge.EXTREME]
+        if unknown:
+            raise HarnessError(
+                f"judge: unknown extreme scene(s) {', '.join(unknown)} (known: {', '.join(judge.EXTREME)})"
+            )
+        plan = judge.replace(plan, extreme=tuple(args.extreme))
+    if args.plant:
+        plan = judge.replace(plan, plants=tuple(args.plant))
+    summary = judge.run(plan, out_dir=args.out)
+    print(judge.format_summary(summary))
+    return 0 if summary["caught"] == summary["planted"] and summary["false_alarms"] == 0 else 1
+
+
 def cmd_calibrate(args):
     from harness.studies import calibrate
 
@@ -513,6 +534,11 @@ def parser():
     sd.add_argument("--exact", action="store_true", help="require bit-identical frames")
     sd.add_argument("--keep", help="keep the binary's outputs in this directory")
     sd.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
+    sd.add_argument(
+        "--no-spread",
+        action="store_true",
+        help="judge by the DYN_STEP_K rule alone, without the scene's spread (measured by build/hairsim-cpu-contract)",
+    )
     sd.add_argument(
         "flags", nargs=argparse.REMAINDER, help="further flags for the binary (after the options, e.g. -- --threads 1)"
     )
@@ -851,6 +877,30 @@ def parser():
     sb.add_argument("--report-dir", default=None, help="where to write (default report/)")
     sb.add_argument("--from-csv", default=None, help="only redraw the report from an existing stability.csv")
     sb.set_defaults(func=cmd_stability)
+
+    from harness.studies.judge import EXTREME, PLANTS
+
+    jg = sub.add_parser(
+        "judge",
+        help="the one-frame judge's power: planted defects caught, false alarms on extreme scenes",
+        description="Step every planted defect (build/planted/, make planted) from the C reference's frames "
+        "on the standard scenes, and every honest build × variant × precision on the extreme scenes, judging "
+        "each frame as stepdiff does (the rule and the scene's spread); print caught / planted and false "
+        "alarms / honest runs, write results/judge/judge.csv and judge.json (docs/judge.md). Exit 0 when "
+        "every defect is caught and no honest run fails, else 1.",
+    )
+    jg.add_argument("--quick", action="store_true", help="fewer strands and frames (the tests' size)")
+    jg.add_argument("--strands", type=whole(1), default=None, help="strands per scene")
+    jg.add_argument(
+        "--extreme",
+        action="append",
+        metavar="NAME",
+        help=f"only this extreme scene (repeatable; {len(EXTREME)} declared)",
+    )
+    jg.add_argument("--plant", action="append", type=int, choices=sorted(PLANTS), help="only this planted defect")
+    jg.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto", help="honest runs of the CUDA builds too")
+    jg.add_argument("--out", default=None, help="results directory (default results/judge)")
+    jg.set_defaults(func=cmd_judge)
 
     dc = sub.add_parser(
         "docs",

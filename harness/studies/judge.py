@@ -1,0 +1,334 @@
+"""`python -m harness judge`: the one-frame judge's power, measured (docs/judge.md).
+
+Two counts, each over one-frame comparisons judged exactly as `harness stepdiff` judges
+(harness.check.diff_dynamic.compare with the scene's spread):
+
+  caught / planted: every planted defect (build/planted/hairsim-cpu-plant<n>, `make planted`:
+      the C reference with `#if HB_PLANT == n` compiled in) stepped from the honest
+      reference's frames on the standard scenes (STANDARD), fp32 and fp64; a defect is caught
+      when any of its comparisons is not equivalent. A defect that no standard scene can show
+      is listed with its reason (PLANTS[n].needs);
+  false alarms / honest runs: every honest build × variant × precision that simulates (the
+      CPU's variants; each CUDA build's where a GPU is usable) stepped from the reference on
+      the extreme scenes (EXTREME); an honest run is a false alarm when any of its frames is
+      not equivalent.
+
+Writes <out>/judge.csv (one row per compared frame) and <out>/judge.json (the counts, what
+each defect is and which scenes caught it); report/dynamic.md renders them.
+"""
+
+import csv
+import os
+import shutil
+import tempfile
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from harness import HarnessError
+from harness.check import diff_dynamic
+from harness.core import env, runner, scenes, tolerances, variants
+from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, build_dir, display, output_dir
+from harness.core.progress import Progress
+from harness.io.files import write_json
+from harness.io.trajectory import open_trajectory
+
+RESULTS_NAME = "judge"
+
+
+@dataclass(frozen=True)
+class Plant:
+    what: str  # the defect, in words
+    needs: str  # what a scene must have for it to show
+
+
+# The planted defects: hunk n of c_ref (`#if HB_PLANT == n`); tests/cpu/test_judge.py checks
+# that this list and the C sources name the same numbers.
+PLANTS = {
+    1: Plant("gravity dropped from the velocity update", "gravity"),
+    2: Plant("the head rotation at t instead of t + h", "a moving head"),
+    3: Plant("the even stretch group before the odd", "xpbd"),
+    4: Plant("the multipliers λ not reset between substeps", "a compliant constraint, S ≥ 2"),
+    5: Plant("a bend rest length from the current shape instead of the rest shape", "bend"),
+    6: Plant("the collider skips point P/2", "the collider, point P/2 in contact"),
+    7: Plant("the gust phase one substep late", "gusts"),
+    8: Plant("the root given weight 1 in its stretch constraint", "xpbd"),
+    9: Plant("the ftl correction from the point's own d_k, not d_{k+1}", "ftl"),
+    10: Plant("the shape range one point too long", "shape, ρ_g < 1"),
+}
+
+# The standard scenes the planted defects are run on: configs/scenes/<name> × solver.
+STANDARD = (("dynamic", "xpbd"), ("dynamic", "ftl"), ("still-dynamic", "xpbd"), ("still-dynamic", "ftl"))
+
+# The extreme scenes honest builds must pass: name → (solver, scene fields, dynamic flags),
+# over configs/scenes/dynamic (every feature) unless the flags say otherwise. OFF drops a flag.
+OFF = None
+GALE = {"--wind-speed": 3000.0, "--gust-amplitude": 1.0, "--gust-wavelength": 15.0, "--gust-frequency": 3.0}
+EXTREME = {
+    "long-strands": ("xpbd", {"points": 96, "hair_length": 60.0}, {}),
+    "long-strands-ftl": ("ftl", {"points": 96, "hair_length": 60.0}, {}),
+    "short-strands": ("xpbd", {"points": 4, "hair_length": 2.0}, {}),
+    "two-points": ("xpbd", {"points": 2, "hair_length": 20.0}, {"--shape-compliance": OFF, "--shape-range": OFF}),
+    "stiff": ("xpbd", {}, {"--bend-compliance": 0.0, "--shape-compliance": 1e-9, "--iterations": 8}),
+    "soft": ("xpbd", {}, {"--stretch-compliance": 1e-4, "--bend-compliance": 1e-3, "--shape-compliance": 1e-2}),
+    "gale": ("xpbd", {}, GALE),
+    "gale-ftl": ("ftl", {}, GALE),
+    "stiff-bend-ftl-gale-200": ("ftl", {"points": 200, "hair_length": 60.0}, {**GALE, "--bend-compliance": 0.0}),
+    "fast-shake": ("xpbd", {}, {"--head-motion": "shake", "--motion-amplitude": 1.0, "--motion-frequency": 4.0}),
+    "fast-nod-ftl": ("ftl", {}, {"--motion-amplitude": 1.0, "--motion-frequency": 4.0}),
+    "fast-tilt": ("xpbd", {}, {"--head-motion": "tilt", "--motion-amplitude": 1.2, "--motion-frequency": 3.0}),
+    "collider-margin": ("xpbd", {}, {"--collision-margin": 0.5, "--iterations": 3}),
+    "collider-larger-than-scalp": ("xpbd", {}, {"--collision-margin": 3.0}),
+    "collider-larger-than-scalp-ftl": ("ftl", {}, {"--collision-margin": 3.0}),
+    "one-strand-tilt-big-collider": (
+        "xpbd",
+        {"strands": 1},
+        {"--collision-margin": 3.0, "--head-motion": "tilt", "--motion-amplitude": 1.0, "--motion-frequency": 2.0},
+    ),
+    "no-collider": ("xpbd", {}, {"--no-collider": ""}),
+    "one-substep": ("xpbd", {}, {"--substeps": 1, "--iterations": 1}),
+    "one-substep-ftl": ("ftl", {}, {"--substeps": 1, "--iterations": 1}),
+    "many-substeps": ("xpbd", {}, {"--substeps": 64, "--iterations": 1}),
+    "many-iterations": ("xpbd", {}, {"--substeps": 4, "--iterations": 16}),
+    "heavy-drag": ("xpbd", {}, {"--drag": 50.0, "--damping": 20.0}),
+    "no-gravity-wind": ("xpbd", {}, {"--gravity": 0.0, "--wind-speed": 800.0}),
+    "long-frame": ("xpbd", {}, {"--frame-dt": 1.0 / 15.0}),
+    "full-shape": ("xpbd", {}, {"--shape-range": 1.0, "--shape-compliance": 1e-7}),
+}
+
+
+@dataclass(frozen=True)
+class Plan:
+    strands: int = 32  # per scene (a scene that sets its own keeps it)
+    frames: int = 3  # simulated frames of each reference
+    stepped: int = 2  # frames stepped from: the last `stepped` candidates of the reference
+    precisions: tuple = ("fp32", "fp64")
+    standard: tuple = STANDARD
+    extreme: tuple = tuple(EXTREME)
+    plants: tuple = tuple(PLANTS)
+    gpu: str = "auto"  # auto | yes | no: the CUDA builds' honest runs
+
+    @classmethod
+    def quick(cls, **kw):
+        return cls(**{"strands": 8, "frames": 2, "stepped": 1, **kw})
+
+
+def planted_binary(n):
+    return build_dir() / "planted" / f"hairsim-cpu-plant{n}"
+
+
+def standard_scene(name, solver, plan):
+    base = scenes.load_scene(name)
+    return replace(base.with_overrides(strands=plan.strands), dynamic={**base.dynamic, "--solver": solver})
+
+
+def extreme_scene(name, plan):
+    solver, fields, flags = EXTREME[name]
+    base = scenes.load_scene("dynamic")
+    dyn = {**base.dynamic, "--solver": solver}
+    for flag, value in flags.items():
+        if value is OFF:
+            dyn.pop(flag, None)
+        else:
+            dyn[flag] = value
+    scene = base.with_overrides(**{"strands": plan.strands, **fields})
+    return replace(scene, name=name, dynamic=dyn)
+
+
+def honest_runners(gpu, log):
+    """(label, binary, flags) of every honest build × variant that simulates."""
+    out = []
+    cpu = variants.declared("cpu")
+    out += [(f"cpu {v}", binary_path("cpu"), ["--variant", v]) for v in cpu.running("simulate")]
+    if gpu == "no":
+        return out, "--gpu no"
+    usable, why = env.gpu_status()
+    if not usable:
+        if gpu == "yes":
+            raise HarnessError(f"judge: --gpu yes but {why}")
+        return out, why
+    for build in CUDA_BUILDS:
+        if not binary_path("cuda", build).exists():
+            log(f"judge: {display(binary_path('cuda', build))} not built: its honest runs are not made")
+            continue
+        d = variants.declared("cuda", build)
+        out += [(f"cuda {build} {v}", binary_path("cuda", build), ["--variant", v]) for v in d.running("simulate")]
+    return out, ""
+
+
+class Judge:
+    def __init__(self, plan, work, log):
+        self.plan, self.work, self.log = plan, Path(work), log
+        self.rows = []
+        self.count = 0
+
+    def reference(self, scene, precision):
+        """The honest reference's file: init,collide,simulate for plan.frames, every velocity."""
+        self.count += 1
+        out = self.work / f"ref{self.count}-{scene.name}-{precision}.h5"
+        s = scenes.with_frames(scene.with_overrides(precision=precision), self.plan.frames)
+        flags = runner.run_flags(s, "cpu", output=out) + ["--velocities", "all"]
+        runner.run_binary(binary_path("cpu"), flags, timeout=600)
+        with open_trajectory(out) as t:
+            cand = diff_dynamic.step_candidates(t)
+        return out, cand[-self.plan.stepped :]
+
+    def step(self, ref, frames, binary, flags, points):
+        """One frame from each of `frames` of `ref` by `binary`; the compared frames' rows.
+        A variant that refuses the scene (exit 2: e.g. over its most points) gives no row."""
+        rows = []
+        for k in frames:
+            self.count += 1
+            out = self.work / f"step{self.count}.h5"
+            cmd = ["--input", ref, "--input-frame", k, "--stages", "simulate", "--frames", 1, *flags, "--output", out]
+            try:
+                runner.run_binary(binary, cmd, timeout=600)
+            except runner.BackendError as e:
+                if e.code == 2:
+                    return rows
+                rows.append({"frame": k, "equivalent": False, "failures": str(e)})
+                continue
+            with open_trajectory(out) as t:
+                step = int(t.step[-1])
+            r = diff_dynamic.compare(ref, out, frames=[step], check_paper=False, spread=True)
+            f = r.frames[0]
+            rows.append(
+                {
+                    "frame": k,
+                    "step": step,
+                    "max_abs": f.max_abs,
+                    "rule": tolerances.DYN_STEP_K[diff_dynamic.diff_key(*r.pair.split("↔"))] * r.unit,
+                    "spread": getattr(f, "spread", float("nan")),
+                    "limit": getattr(f, "limit", float("nan")),
+                    "velocity_max_abs": getattr(f, "velocity_max_abs", float("nan")),
+                    "velocity_limit": getattr(f, "velocity_limit", float("nan")),
+                    "over": f.over,
+                    "equivalent": r.equivalent,
+                    "failures": "; ".join(r.failures()[:2]),
+                }
+            )
+            out.unlink()
+        return rows
+
+    def add(self, kind, who, scene, precision, rows):
+        for r in rows:
+            self.rows.append(
+                {
+                    "kind": kind,
+                    "who": who,
+                    "scene": scene.name,
+                    "solver": scene.dynamic.get("--solver", "xpbd"),
+                    "points": scene.points,
+                    "precision": precision,
+                    **r,
+                }
+            )
+        return any(not r["equivalent"] for r in rows)
+
+
+CSV_FIELDS = (
+    "kind who scene solver points precision frame step max_abs rule spread limit velocity_max_abs "
+    "velocity_limit over equivalent failures"
+).split()
+
+
+def write_csv(rows, path):
+    """The compared frames, one a row, written whole or not at all."""
+    tmp = f"{path}.tmp.{os.getpid()}"
+    with open(tmp, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=CSV_FIELDS, restval="")
+        w.writeheader()
+        w.writerows(rows)
+    os.replace(tmp, path)
+
+
+def run(plan=None, out_dir=None, log=print):
+    """Measure both counts; write judge.csv and judge.json under out_dir; return the summary."""
+    plan = plan or Plan()
+    runner.require_binary(binary_path("cpu"))
+    if not diff_dynamic.spread_binary().exists():
+        raise HarnessError(f"judge: {display(diff_dynamic.spread_binary())} is not built (run make cpu)")
+    missing = [n for n in plan.plants if not planted_binary(n).exists()]
+    if missing:
+        raise HarnessError(
+            f"judge: planted build(s) {', '.join(map(str, missing))} missing under {display(build_dir() / 'planted')} "
+            "(run make planted)"
+        )
+    out_dir = output_dir(out_dir or RESULTS / RESULTS_NAME)
+    honest, gpu_note = honest_runners(plan.gpu, log)
+    if gpu_note:
+        log(f"judge: GPU builds not run: {gpu_note}")
+    oracle = variants.declared("cpu").default_variant
+    t0 = time.perf_counter()
+    work = tempfile.mkdtemp(prefix="hb-judge-")
+    caught_by = {n: [] for n in plan.plants}
+    false_alarms, honest_runs = [], 0
+    jobs = len(plan.standard) * len(plan.precisions) + len(plan.extreme) * len(plan.precisions)
+    bar = Progress(jobs, "judge")
+    try:
+        j = Judge(plan, work, log)
+        for name, solver in plan.standard:
+            scene = standard_scene(name, solver, plan)
+            scene = replace(scene, name=f"{name} {solver}")
+            for precision in plan.precisions:
+                ref, frames = j.reference(scene, precision)
+                for n in plan.plants:
+                    rows = j.step(ref, frames, planted_binary(n), ["--variant", oracle], scene.points)
+                    if j.add("planted", f"plant {n}", scene, precision, rows):
+                        caught_by[n].append(f"{scene.name} {precision}")
+                bar.update()
+        for name in plan.extreme:
+            scene = extreme_scene(name, plan)
+            for precision in plan.precisions:
+                ref, frames = j.reference(scene, precision)
+                for label, binary, flags in honest:
+                    rows = j.step(ref, frames, binary, flags, scene.points)
+                    if not rows:
+                        continue
+                    honest_runs += 1
+                    if j.add("honest", label, scene, precision, rows):
+                        false_alarms.append(f"{label} {name} {precision}")
+                bar.update()
+    finally:
+        bar.close()
+        shutil.rmtree(work, ignore_errors=True)
+    caught = [n for n in plan.plants if caught_by[n]]
+    summary = {
+        "caught": len(caught),
+        "planted": len(plan.plants),
+        "false_alarms": len(false_alarms),
+        "honest_runs": honest_runs,
+        "spread_k": tolerances.DYN_SPREAD_K,
+        "rule_k": tolerances.DYN_STEP_K[("fp64", "fp64")],
+        "plan": {k: list(v) if isinstance(v, tuple) else v for k, v in plan.__dict__.items()},
+        "gpu_note": gpu_note,
+        "plants": {
+            str(n): {"what": PLANTS[n].what, "needs": PLANTS[n].needs, "caught_on": caught_by[n]} for n in plan.plants
+        },
+        "missed": [n for n in plan.plants if not caught_by[n]],
+        "false_alarm_runs": false_alarms,
+        "honest": [label for label, _, _ in honest],
+        "seconds": round(time.perf_counter() - t0, 1),
+    }
+    write_csv(j.rows, out_dir / "judge.csv")
+    write_json(out_dir / "judge.json", summary)
+    return summary
+
+
+def format_summary(s):
+    lines = [
+        f"judge: caught {s['caught']} / {s['planted']} planted defects on the standard scenes",
+        f"judge: false alarms {s['false_alarms']} / {s['honest_runs']} honest runs on the extreme scenes "
+        f"({', '.join(s['honest'])})",
+        f"judge: limit max({s['rule_k']:g}·ε·E·S·I, {s['spread_k']:g} × spread); {s['seconds']} s",
+    ]
+    for n, p in s["plants"].items():
+        seen = (
+            f"caught on {len(p['caught_on'])} scene(s): {', '.join(p['caught_on'])}"
+            if p["caught_on"]
+            else (f"NOT CAUGHT: needs {p['needs']}, which no standard scene run showed")
+        )
+        lines.append(f"  plant {n:>2} ({p['what']}): {seen}")
+    for r in s["false_alarm_runs"]:
+        lines.append(f"  false alarm: {r}")
+    return "\n".join(lines)
