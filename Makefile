@@ -135,6 +135,7 @@ PLANTS := $(shell grep -ho 'HB_PLANT == [0-9]*' c_ref/*.c c_ref/*.h | awk '{prin
 PLANT_SRC := c_ref/dynamics_f32.c c_ref/dynamics_f64.c c_ref/dynamics_host.c
 PLANT_BINS := $(PLANTS:%=$(BUILD)/planted/hairsim-cpu-plant%)
 planted: $(PLANT_BINS)
+.SECONDARY: $(foreach n,$(PLANTS),$(PLANT_SRC:c_ref/%.c=$(BUILD)/planted/obj$(n)/%.o))
 $(BUILD)/planted/obj%/dynamics_f32.o $(BUILD)/planted/obj%/dynamics_f64.o $(BUILD)/planted/obj%/dynamics_host.o: \
   c_ref/dynamics_f32.c c_ref/dynamics_f64.c c_ref/dynamics_host.c $(C_HEADERS) | check-hdf5
 	@mkdir -p $(BUILD)/planted/obj$*

@@ -25,11 +25,13 @@ directory and compare BIN's new frame with A's frame k + 1 by the rule above.
 SPREAD (docs/judge.md): the rule above does not know how sensitive a scene is, so a
 one-frame comparison may also be judged against the scene's own spread: the same frame
 from the same input by the spread build (build/hairsim-cpu-contract, the C reference with
-FMA contraction on), max |x_spread − x_A| over the frame (and h·|Δv| likewise). A point is
+FMA contraction on) and by the C reference, max |x_spread − x_ref| over the frame (and
+h·|Δv| likewise). A point is
 then over when it is farther than max(DYN_STEP_K·u, DYN_SPREAD_K·spread) (positions;
 velocities with their own spread). `stepdiff`, the bench's validation, the GPU tests and
 the stability search judge this way (`spread=True`); each spread is measured once per
-reference file and frame in a process (one extra CPU run).
+reference file and frame in a process (two CPU runs from A's frame: the spread build and
+build/hairsim-cpu, so that a wrong frame in A cannot widen its own spread).
 
 Exit status as for diff: 0 equivalent, 1 not, 2 could not compare.
 """
@@ -151,34 +153,41 @@ def spread_binary():
 _SPREADS = {}
 
 
+def _step_once(binary, reference, k, out, timeout):
+    cmd = [str(binary), "--input", str(reference), "--input-frame", str(k), "--stages", "simulate"]
+    cmd += ["--frames", "1", "--output", str(out), "--force", "--quiet"]
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        raise HarnessError(f"{display(binary)} did not finish within {timeout} s", code=2) from None
+    if p.returncode != 0:
+        msg = (p.stderr.strip().splitlines() or [f"status {p.returncode}"])[-1]
+        raise HarnessError(
+            f"cannot measure the spread: {display(binary)} failed on frame {k} of {reference}: {msg}",
+            code=diff.EXIT_CANNOT_COMPARE,
+        )
+
+
 def measure_spread(reference, k, binary=None, timeout=None):
-    """The Spread of the step after frame k of `reference` (a file written with velocities),
-    or None when the spread build is not built. Cached per file (path, size, mtime), frame and
-    build in this process."""
+    """The Spread of the step after frame k of `reference` (a file written with velocities):
+    the spread build's frame against the C reference's (build/hairsim-cpu), both advanced
+    from frame k, so a wrong frame k + 1 in the file cannot widen it. None when the spread
+    build is not built. Cached per file (path, size, mtime), frame and build in this process."""
     binary = Path(binary) if binary else spread_binary()
-    if not binary.exists():
+    oracle = build_dir() / "hairsim-cpu"
+    if not binary.exists() or not oracle.exists():
         return None
     st, bst = os.stat(reference), os.stat(binary)
     key = (str(Path(reference).resolve()), st.st_size, st.st_mtime_ns, int(k), str(binary.resolve()), bst.st_mtime_ns)
     if key in _SPREADS:
         return _SPREADS[key]
     with tempfile.TemporaryDirectory(prefix="hb-spread-") as tmp:
-        out = Path(tmp) / "spread.h5"
-        cmd = [str(binary), "--input", str(reference), "--input-frame", str(k), "--stages", "simulate"]
-        cmd += ["--frames", "1", "--output", str(out), "--force", "--quiet"]
-        try:
-            p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-        except subprocess.TimeoutExpired:
-            raise HarnessError(f"the spread build did not finish within {timeout} s", code=2) from None
-        if p.returncode != 0:
-            msg = (p.stderr.strip().splitlines() or [f"status {p.returncode}"])[-1]
-            raise HarnessError(
-                f"cannot measure the spread: {display(binary)} failed on frame {k} of {reference}: {msg}",
-                code=diff.EXIT_CANNOT_COMPARE,
-            )
-        with open_trajectory(reference) as a, open_trajectory(out) as b:
-            step = int(a.step[k + 1])
-            fd = compare_sim_frame(a, b, k + 1, b.frame_at_step(step), tolerances.EXACT, 1.0, a.dtype)
+        ref_out, out = Path(tmp) / "oracle.h5", Path(tmp) / "spread.h5"
+        _step_once(oracle, reference, k, ref_out, timeout)
+        _step_once(binary, reference, k, out, timeout)
+        with open_trajectory(ref_out) as a, open_trajectory(out) as b:
+            step = int(a.step[-1])
+            fd = compare_sim_frame(a, b, a.frame_at_step(step), b.frame_at_step(step), tolerances.EXACT, 1.0, a.dtype)
     vel = fd.velocity_max_abs if getattr(fd, "velocity_compared", False) else float("nan")
     sp = _SPREADS[key] = Spread(step, fd.max_abs, vel, display(binary))
     return sp

@@ -447,7 +447,7 @@ def cmd_judge(args):
         plan = judge.replace(plan, extreme=tuple(args.extreme))
     if args.plant:
         plan = judge.replace(plan, plants=tuple(args.plant))
-    summary = judge.run(plan, out_dir=args.out)
+    summary = judge.run(plan, out_dir=args.out, jobs=args.jobs)
     print(judge.format_summary(summary))
     return 0 if summary["caught"] == summary["planted"] and summary["false_alarms"] == 0 else 1
 
@@ -519,7 +519,8 @@ def parser():
         description="For each chosen simulated frame k of a reference written with "
         "--velocities all, run BINARY --input REF --input-frame k --stages "
         "simulate --frames 1 and compare its new frame with the reference's "
-        "frame k+1 by the dynamic per-frame tolerance (harness/check/diff_dynamic.py). "
+        "frame k+1 by the dynamic per-frame tolerance: max(DYN_STEP_K·ε·E·S·I, DYN_SPREAD_K × the scene's spread, "
+        "measured by build/hairsim-cpu-contract from the same input) (harness/check/diff_dynamic.py, docs/judge.md). "
         "Exit 0 = equivalent, 1 = not, 2 = could not compare.",
     )
     sd.add_argument("--reference", required=True, help="dynamic state file (A)")
@@ -899,6 +900,7 @@ def parser():
     )
     jg.add_argument("--plant", action="append", type=int, choices=sorted(PLANTS), help="only this planted defect")
     jg.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto", help="honest runs of the CUDA builds too")
+    jg.add_argument("--jobs", type=whole(1), default=None, help="scenes run at once (default: all cores)")
     jg.add_argument("--out", default=None, help="results directory (default results/judge)")
     jg.set_defaults(func=cmd_judge)
 

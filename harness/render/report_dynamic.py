@@ -115,7 +115,8 @@ def validation_lines(results_dir):
         f"{len(checks)} comparisons, {len(checks) - len(bad)} equivalent"
         + (f" ({len(bad)} NOT)" if bad else "")
         + ". One frame from the same input state, judged by `harness.check.diff_dynamic` (the rule of "
-        "`harness stepdiff` and of the GPU tests); bit-identical where marked. " + (v.get("gpu_note") or ""),
+        "`harness stepdiff` and of the GPU tests: a point is over beyond the larger of DYN_STEP_K·ε·E·S·I and "
+        "DYN_SPREAD_K × the scene's spread, docs/judge.md); bit-identical where marked. " + (v.get("gpu_note") or ""),
         "",
         "| check | pair | max abs (cm) | max / L | ulp max | spread (cm) | limit (cm) | verdict |",
         "| --- | --- | ---: | ---: | ---: | ---: | ---: | --- |",

@@ -22,6 +22,7 @@ import os
 import shutil
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -119,7 +120,8 @@ def planted_binary(n):
 
 def standard_scene(name, solver, plan):
     base = scenes.load_scene(name)
-    return replace(base.with_overrides(strands=plan.strands), dynamic={**base.dynamic, "--solver": solver})
+    scene = base.with_overrides(strands=plan.strands)
+    return replace(scene, name=f"{name} {solver}", dynamic={**base.dynamic, "--solver": solver})
 
 
 def extreme_scene(name, plan):
@@ -165,7 +167,7 @@ class Judge:
     def reference(self, scene, precision):
         """The honest reference's file: init,collide,simulate for plan.frames, every velocity."""
         self.count += 1
-        out = self.work / f"ref{self.count}-{scene.name}-{precision}.h5"
+        out = self.work / f"ref{self.count}-{scene.name.replace(' ', '-')}-{precision}.h5"
         s = scenes.with_frames(scene.with_overrides(precision=precision), self.plan.frames)
         flags = runner.run_flags(s, "cpu", output=out) + ["--velocities", "all"]
         runner.run_binary(binary_path("cpu"), flags, timeout=600)
@@ -242,8 +244,9 @@ def write_csv(rows, path):
     os.replace(tmp, path)
 
 
-def run(plan=None, out_dir=None, log=print):
-    """Measure both counts; write judge.csv and judge.json under out_dir; return the summary."""
+def run(plan=None, out_dir=None, log=print, jobs=None):
+    """Measure both counts; write judge.csv and judge.json under out_dir; return the summary.
+    `jobs` scenes at once (default: every core); each scene's runs are one after another."""
     plan = plan or Plan()
     runner.require_binary(binary_path("cpu"))
     if not diff_dynamic.spread_binary().exists():
@@ -260,34 +263,46 @@ def run(plan=None, out_dir=None, log=print):
         log(f"judge: GPU builds not run: {gpu_note}")
     oracle = variants.declared("cpu").default_variant
     t0 = time.perf_counter()
-    work = tempfile.mkdtemp(prefix="hb-judge-")
+    work = Path(tempfile.mkdtemp(prefix="hb-judge-"))
+    units = [
+        ("planted", standard_scene(name, solver, plan), p) for name, solver in plan.standard for p in plan.precisions
+    ]
+    units += [("honest", extreme_scene(name, plan), p) for name in plan.extreme for p in plan.precisions]
+
+    def one(i, kind, scene, precision):
+        """One scene at one precision: its reference, then every planted or honest run from it."""
+        j = Judge(plan, work / f"u{i}", log)
+        j.work.mkdir()
+        ref, frames = j.reference(scene, precision)
+        flagged: list = []
+        runs = 0
+        if kind == "planted":
+            for n in plan.plants:
+                rows = j.step(ref, frames, planted_binary(n), ["--variant", oracle], scene.points)
+                flagged += [n] if j.add(kind, f"plant {n}", scene, precision, rows) else []
+        else:
+            for label, binary, flags in honest:
+                rows = j.step(ref, frames, binary, flags, scene.points)
+                runs += bool(rows)
+                flagged += [label] if rows and j.add(kind, label, scene, precision, rows) else []
+        shutil.rmtree(j.work, ignore_errors=True)
+        return j.rows, flagged, runs
+
     caught_by = {n: [] for n in plan.plants}
-    false_alarms, honest_runs = [], 0
-    jobs = len(plan.standard) * len(plan.precisions) + len(plan.extreme) * len(plan.precisions)
-    bar = Progress(jobs, "judge")
+    false_alarms, honest_runs, rows = [], 0, []
+    bar = Progress(len(units), "judge")
     try:
-        j = Judge(plan, work, log)
-        for name, solver in plan.standard:
-            scene = standard_scene(name, solver, plan)
-            scene = replace(scene, name=f"{name} {solver}")
-            for precision in plan.precisions:
-                ref, frames = j.reference(scene, precision)
-                for n in plan.plants:
-                    rows = j.step(ref, frames, planted_binary(n), ["--variant", oracle], scene.points)
-                    if j.add("planted", f"plant {n}", scene, precision, rows):
-                        caught_by[n].append(f"{scene.name} {precision}")
-                bar.update()
-        for name in plan.extreme:
-            scene = extreme_scene(name, plan)
-            for precision in plan.precisions:
-                ref, frames = j.reference(scene, precision)
-                for label, binary, flags in honest:
-                    rows = j.step(ref, frames, binary, flags, scene.points)
-                    if not rows:
-                        continue
-                    honest_runs += 1
-                    if j.add("honest", label, scene, precision, rows):
-                        false_alarms.append(f"{label} {name} {precision}")
+        with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
+            futures = [pool.submit(one, i, *u) for i, u in enumerate(units)]
+            for (kind, scene, precision), fut in zip(units, futures):
+                unit_rows, flagged, runs = fut.result()
+                rows += unit_rows
+                honest_runs += runs
+                for who in flagged:
+                    if kind == "planted":
+                        caught_by[who].append(f"{scene.name} {precision}")
+                    else:
+                        false_alarms.append(f"{who} {scene.name} {precision}")
                 bar.update()
     finally:
         bar.close()
@@ -310,7 +325,7 @@ def run(plan=None, out_dir=None, log=print):
         "honest": [label for label, _, _ in honest],
         "seconds": round(time.perf_counter() - t0, 1),
     }
-    write_csv(j.rows, out_dir / "judge.csv")
+    write_csv(rows, out_dir / "judge.csv")
     write_json(out_dir / "judge.json", summary)
     return summary
 
