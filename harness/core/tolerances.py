@@ -292,7 +292,7 @@ DYN_STEP_WHY = (
 # reference on the 25 extreme scenes is ≤ 3.25 × the spread (stiff, fp32; ≤ 2.0 elsewhere),
 # and ≤ 0.30·DYN_STEP_K·u; the spread itself ≤ 0.25·DYN_STEP_K·u there and ≤ 0.05 on the
 # standard scenes. A 1000-strand, 200-point stiff-bend ftl gale at S = I = 1 (fp64, frames
-# 20–30) gave simd ≤ 1.0 × the spread. 16 is a 4.9× margin over the worst ratio; it leaves
+# 20–30) gave simd ≤ 1.2 × the spread. 16 is a 4.9× margin over the worst ratio; it leaves
 # the standard scenes' limit at the rule (16 × 0.05 < 1), so the planted defects keep their
 # margins (each caught at ≥ 225 × its limit in fp32 and ≥ 1.3e8 × in fp64, the gust phase
 # one substep late aside: 0.27 × in fp32, caught in fp64 only).
