@@ -439,12 +439,15 @@ def cmd_judge(args):
     if args.strands:
         plan = judge.replace(plan, strands=args.strands)
     if args.extreme:
-        unknown = [n for n in args.extreme if n not in judge.EXTREME]
+        unknown = [n for n in args.extreme if n not in judge.EXTREME and n not in judge.PAPER_EXTREME]
         if unknown:
-            raise HarnessError(
-                f"judge: unknown extreme scene(s) {', '.join(unknown)} (known: {', '.join(judge.EXTREME)})"
-            )
-        plan = judge.replace(plan, extreme=tuple(args.extreme))
+            known = ", ".join([*judge.EXTREME, *judge.PAPER_EXTREME])
+            raise HarnessError(f"judge: unknown extreme scene(s) {', '.join(unknown)} (known: {known})")
+        plan = judge.replace(
+            plan,
+            extreme=tuple(n for n in args.extreme if n in judge.EXTREME),
+            paper_extreme=tuple(n for n in args.extreme if n in judge.PAPER_EXTREME),
+        )
     if args.plant:
         plan = judge.replace(plan, plants=tuple(args.plant))
     summary = judge.run(plan, out_dir=args.out, jobs=args.jobs)
@@ -879,14 +882,15 @@ def parser():
     sb.add_argument("--from-csv", default=None, help="only redraw the report from an existing stability.csv")
     sb.set_defaults(func=cmd_stability)
 
-    from harness.studies.judge import EXTREME, PLANTS
+    from harness.studies.judge import EXTREME, PAPER_EXTREME, PLANTS
 
     jg = sub.add_parser(
         "judge",
         help="the one-frame judge's power: planted defects caught, false alarms on extreme scenes",
         description="Step every planted defect (build/planted/, make planted) from the C reference's frames "
         "on the standard scenes, and every honest build × variant × precision on the extreme scenes, judging "
-        "each frame as stepdiff does (the rule and the scene's spread); print caught / planted and false "
+        "each frame as stepdiff does (the rule and the scene's spread); the paper model's planted defects and "
+        "variants likewise by whole runs judged as harness diff does; print caught / planted and false "
         "alarms / honest runs, write results/judge/judge.csv and judge.json (docs/judge.md). Exit 0 when "
         "every defect is caught and no honest run fails, else 1.",
     )
@@ -896,7 +900,7 @@ def parser():
         "--extreme",
         action="append",
         metavar="NAME",
-        help=f"only this extreme scene (repeatable; {len(EXTREME)} declared)",
+        help=f"only this extreme scene (repeatable; {len(EXTREME)} dynamic, {len(PAPER_EXTREME)} paper declared)",
     )
     jg.add_argument("--plant", action="append", type=int, choices=sorted(PLANTS), help="only this planted defect")
     jg.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto", help="honest runs of the CUDA builds too")

@@ -18,6 +18,13 @@ def _g(x):
     return f"{x:.3g}" if math.isfinite(x) else ""
 
 
+def _by_model(s, num, den):
+    bm = s.get("by_model")
+    if not bm:
+        return ""
+    return " (" + ", ".join(f"{m} {bm[m][num]} / {bm[m][den]}" for m in ("dynamic", "paper") if m in bm) + ")"
+
+
 def section(results_dir, out_dir=None):
     d = Path(results_dir)
     path = d / "judge.json"
@@ -28,18 +35,22 @@ def section(results_dir, out_dir=None):
     lines = head + [
         f"Each frame of a comparison is judged as `harness stepdiff` judges it: a point is over when farther "
         f"than max({s['rule_k']:g}·ε·E·S·I, {s['spread_k']:g} × the scene's spread), the spread being how far "
-        "the C reference built with FMA contraction lands from the same input (docs/judge.md).",
+        "the C reference built with FMA contraction lands from the same input; the paper model's defects and "
+        "variants are judged by whole runs as `harness diff` judges them (docs/judge.md).",
         "",
-        f"- planted defects caught on the standard scenes: **{s['caught']} / {s['planted']}**",
+        f"- planted defects caught on the standard scenes: **{s['caught']} / {s['planted']}**"
+        + _by_model(s, "caught", "planted"),
         f"- false alarms on the extreme scenes: **{s['false_alarms']} / {s['honest_runs']}** honest runs "
-        f"({', '.join(s.get('honest', []))})" + (f"; GPU builds not run: {s['gpu_note']}" if s.get("gpu_note") else ""),
+        f"({', '.join(s.get('honest', []))})"
+        + _by_model(s, "false_alarms", "honest_runs")
+        + (f"; GPU builds not run: {s['gpu_note']}" if s.get("gpu_note") else ""),
         "",
-        "| plant | defect | caught on |",
-        "| ---: | --- | --- |",
+        "| plant | model | defect | caught on |",
+        "| ---: | --- | --- | --- |",
     ]
     for n, p in s["plants"].items():
         seen = ", ".join(p["caught_on"]) if p["caught_on"] else f"NOT CAUGHT (needs {p['needs']})"
-        lines.append(f"| {n} | {p['what']} | {seen} |")
+        lines.append(f"| {n} | {p.get('model', 'dynamic')} | {p['what']} | {seen} |")
     csv = d / "judge.csv"
     if csv.exists():
         rows = pd.read_csv(csv)

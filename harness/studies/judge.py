@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from harness import HarnessError
-from harness.check import diff_dynamic
+from harness.check import diff, diff_dynamic
 from harness.core import env, runner, scenes, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, build_dir, display, output_dir
 from harness.core.progress import Progress
@@ -41,6 +41,7 @@ RESULTS_NAME = "judge"
 class Plant:
     what: str  # the defect, in words
     needs: str  # what a scene must have for it to show
+    model: str = "dynamic"  # the model whose code it is in: dynamic (stepdiff) or paper (diff)
 
 
 # The planted defects: hunk n of c_ref (`#if HB_PLANT == n`); tests/cpu/test_judge.py checks
@@ -56,10 +57,27 @@ PLANTS = {
     8: Plant("the root given weight 1 in its stretch constraint", "xpbd"),
     9: Plant("the ftl correction from the point's own d_k, not d_{k+1}", "ftl"),
     10: Plant("the shape range one point too long", "shape, ρ_g < 1"),
+    11: Plant("the wind's blend of segment k taken at k − 1", "wind", "paper"),
+    12: Plant("collide without the follow-the-leader pull after a move", "a point collide moves", "paper"),
+    13: Plant("every drape step from the head circle, not the shell", "a draped strand of ≥ 3 points", "paper"),
 }
 
 # The standard scenes the planted defects are run on: configs/scenes/<name> × solver.
 STANDARD = (("dynamic", "xpbd"), ("dynamic", "ftl"), ("still-dynamic", "xpbd"), ("still-dynamic", "ftl"))
+
+# The paper model (`harness diff` of whole runs, the precision pair's rule): its planted defects
+# run on these configs/scenes, and the honest variants on PAPER_EXTREME (changes to paper.toml).
+PAPER_STANDARD = ("paper", "still", "breeze", "gale")
+PAPER_EXTREME = {
+    "paper-two-points": {"points": 2},
+    "paper-long-strands": {"points": 200, "hair_length": 60.0},
+    "paper-short-segments": {"points": 251, "hair_length": 30.0, "hair_offset": 0.01},
+    "paper-full-wind": {"wind_strength": 1.0},
+    "paper-side-wind": {"wind_strength": 1.0, "wind_angle": 1.5707963267948966},
+    "paper-wind-from-behind": {"wind_strength": 0.9, "wind_angle": 0.0},
+    "paper-thick-shell": {"hair_offset": 0.9, "points": 8},
+    "paper-small-head": {"head_radius": 2.0, "face_margin": 0.2, "hair_length": 60.0},
+}
 
 # The extreme scenes honest builds must pass: name → (solver, scene fields, dynamic flags),
 # over configs/scenes/dynamic (every feature) unless the flags say otherwise. OFF drops a flag.
@@ -107,6 +125,8 @@ class Plan:
     standard: tuple = STANDARD
     extreme: tuple = tuple(EXTREME)
     plants: tuple = tuple(PLANTS)
+    paper_standard: tuple = PAPER_STANDARD
+    paper_extreme: tuple = tuple(PAPER_EXTREME)
     gpu: str = "auto"  # auto | yes | no: the CUDA builds' honest runs
 
     @classmethod
@@ -135,6 +155,14 @@ def extreme_scene(name, plan):
             dyn[flag] = value
     scene = base.with_overrides(**{"strands": plan.strands, **fields})
     return replace(scene, name=name, dynamic=dyn)
+
+
+def paper_scene(name, plan):
+    if name in PAPER_EXTREME:
+        return replace(
+            scenes.load_scene("paper").with_overrides(strands=plan.strands, **PAPER_EXTREME[name]), name=name
+        )
+    return scenes.load_scene(name).with_overrides(strands=plan.strands)
 
 
 def honest_runners(gpu, log):
@@ -212,6 +240,38 @@ class Judge:
             out.unlink()
         return rows
 
+    def paper_run(self, scene, precision, binary=None, flags=()):
+        """A whole paper-model run of `scene`; its file."""
+        self.count += 1
+        out = self.work / f"paper{self.count}.h5"
+        s = scene.with_overrides(precision=precision)
+        runner.run_binary(
+            binary or binary_path("cpu"), runner.run_flags(s, "cpu", output=out) + list(flags), timeout=600
+        )
+        return out
+
+    def paper_diff(self, ref, scene, precision, binary, flags):
+        """`harness diff` of `binary`'s run against the reference run: one row (every frame judged)."""
+        try:
+            out = self.paper_run(scene, precision, binary, flags)
+        except runner.BackendError as e:
+            return [] if e.code == 2 else [{"frame": "all", "equivalent": False, "failures": str(e)}]
+        r = diff.compare(ref, out)
+        worst = max(r.frames, key=lambda f: f.max_abs)
+        out.unlink()
+        return [
+            {
+                "frame": "all",
+                "max_abs": worst.max_abs,
+                "rule": r.limit_range[1],
+                "spread": float("nan"),
+                "limit": r.limit_range[1],
+                "over": sum(f.over for f in r.frames),
+                "equivalent": r.equivalent,
+                "failures": "; ".join(r.failures()[:2]),
+            }
+        ]
+
     def add(self, kind, who, scene, precision, rows):
         for r in rows:
             self.rows.append(
@@ -219,7 +279,7 @@ class Judge:
                     "kind": kind,
                     "who": who,
                     "scene": scene.name,
-                    "solver": scene.dynamic.get("--solver", "xpbd"),
+                    "solver": scene.dynamic.get("--solver", "xpbd") if scene.model == "dynamic" else "",
                     "points": scene.points,
                     "precision": precision,
                     **r,
@@ -268,16 +328,34 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
         ("planted", standard_scene(name, solver, plan), p) for name, solver in plan.standard for p in plan.precisions
     ]
     units += [("honest", extreme_scene(name, plan), p) for name in plan.extreme for p in plan.precisions]
+    paper_plants = [n for n in plan.plants if PLANTS[n].model == "paper"]
+    if paper_plants:
+        units += [("planted", paper_scene(n, plan), p) for n in plan.paper_standard for p in plan.precisions]
+    units += [("honest", paper_scene(n, plan), p) for n in plan.paper_extreme for p in plan.precisions]
+    cpu_honest = [(f"cpu {v}", binary_path("cpu"), ["--variant", v]) for v in variants.declared("cpu").running("init")]
 
     def one(i, kind, scene, precision):
         """One scene at one precision: its reference, then every planted or honest run from it."""
         j = Judge(plan, work / f"u{i}", log)
         j.work.mkdir()
-        ref, frames = j.reference(scene, precision)
         flagged: list = []
         runs = 0
+        if scene.model == "paper":
+            ref = j.paper_run(scene, precision)
+            if kind == "planted":
+                for n in paper_plants:
+                    rows = j.paper_diff(ref, scene, precision, planted_binary(n), ["--variant", oracle])
+                    flagged += [n] if j.add(kind, f"plant {n}", scene, precision, rows) else []
+            else:
+                for label, binary, flags in cpu_honest:
+                    rows = j.paper_diff(ref, scene, precision, binary, flags)
+                    runs += bool(rows)
+                    flagged += [label] if rows and j.add(kind, label, scene, precision, rows) else []
+            shutil.rmtree(j.work, ignore_errors=True)
+            return j.rows, flagged, runs
+        ref, frames = j.reference(scene, precision)
         if kind == "planted":
-            for n in plan.plants:
+            for n in (n for n in plan.plants if PLANTS[n].model == "dynamic"):
                 rows = j.step(ref, frames, planted_binary(n), ["--variant", oracle], scene.points)
                 flagged += [n] if j.add(kind, f"plant {n}", scene, precision, rows) else []
         else:
@@ -289,7 +367,7 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
         return j.rows, flagged, runs
 
     caught_by = {n: [] for n in plan.plants}
-    false_alarms, honest_runs, rows = [], 0, []
+    false_alarms, honest_runs, rows = [], {"dynamic": 0, "paper": 0}, []
     bar = Progress(len(units), "judge")
     try:
         with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
@@ -297,7 +375,7 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
             for (kind, scene, precision), fut in zip(units, futures):
                 unit_rows, flagged, runs = fut.result()
                 rows += unit_rows
-                honest_runs += runs
+                honest_runs[scene.model] += runs
                 for who in flagged:
                     if kind == "planted":
                         caught_by[who].append(f"{scene.name} {precision}")
@@ -312,13 +390,30 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
         "caught": len(caught),
         "planted": len(plan.plants),
         "false_alarms": len(false_alarms),
-        "honest_runs": honest_runs,
+        "honest_runs": sum(honest_runs.values()),
+        "by_model": {
+            m: {
+                "caught": sum(1 for n in caught if PLANTS[n].model == m),
+                "planted": sum(1 for n in plan.plants if PLANTS[n].model == m),
+                "false_alarms": sum(
+                    1 for r in false_alarms if r.split(" ", 2)[2].startswith("paper-") == (m == "paper")
+                ),
+                "honest_runs": honest_runs[m],
+            }
+            for m in ("dynamic", "paper")
+        },
         "spread_k": tolerances.DYN_SPREAD_K,
         "rule_k": tolerances.DYN_STEP_K[("fp64", "fp64")],
         "plan": {k: list(v) if isinstance(v, tuple) else v for k, v in plan.__dict__.items()},
         "gpu_note": gpu_note,
         "plants": {
-            str(n): {"what": PLANTS[n].what, "needs": PLANTS[n].needs, "caught_on": caught_by[n]} for n in plan.plants
+            str(n): {
+                "what": PLANTS[n].what,
+                "needs": PLANTS[n].needs,
+                "model": PLANTS[n].model,
+                "caught_on": caught_by[n],
+            }
+            for n in plan.plants
         },
         "missed": [n for n in plan.plants if not caught_by[n]],
         "false_alarm_runs": false_alarms,
@@ -331,10 +426,14 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
 
 
 def format_summary(s):
+    bm = s["by_model"]
     lines = [
-        f"judge: caught {s['caught']} / {s['planted']} planted defects on the standard scenes",
+        f"judge: caught {s['caught']} / {s['planted']} planted defects on the standard scenes "
+        f"(dynamic {bm['dynamic']['caught']} / {bm['dynamic']['planted']} by stepdiff's judge, "
+        f"paper {bm['paper']['caught']} / {bm['paper']['planted']} by diff's)",
         f"judge: false alarms {s['false_alarms']} / {s['honest_runs']} honest runs on the extreme scenes "
-        f"({', '.join(s['honest'])})",
+        f"({', '.join(s['honest'])}; dynamic {bm['dynamic']['false_alarms']} / {bm['dynamic']['honest_runs']}, "
+        f"paper {bm['paper']['false_alarms']} / {bm['paper']['honest_runs']})",
         f"judge: limit max({s['rule_k']:g}·ε·E·S·I, {s['spread_k']:g} × spread); {s['seconds']} s",
     ]
     for n, p in s["plants"].items():
