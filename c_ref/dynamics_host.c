@@ -141,6 +141,7 @@ void hb_dyn_frame_plan(const hb_scene *s, int64_t m0, hb_dyn_frame *f)
         double *q = f->q64 + 9 * j;
 #if HB_PLANT == 2 /* judge test: the head rotation at t, not t + h */
         hb_head_rotation(d, t, q);
+        (void)t1;
 #else
         hb_head_rotation(d, t1, q);
 #endif

@@ -324,9 +324,12 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
     oracle = variants.declared("cpu").default_variant
     t0 = time.perf_counter()
     work = Path(tempfile.mkdtemp(prefix="hb-judge-"))
-    units = [
-        ("planted", standard_scene(name, solver, plan), p) for name, solver in plan.standard for p in plan.precisions
-    ]
+    dynamic_plants = [n for n in plan.plants if PLANTS[n].model == "dynamic"]
+    units = (
+        [("planted", standard_scene(name, solver, plan), p) for name, solver in plan.standard for p in plan.precisions]
+        if dynamic_plants
+        else []
+    )
     units += [("honest", extreme_scene(name, plan), p) for name in plan.extreme for p in plan.precisions]
     paper_plants = [n for n in plan.plants if PLANTS[n].model == "paper"]
     if paper_plants:
@@ -355,7 +358,7 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
             return j.rows, flagged, runs
         ref, frames = j.reference(scene, precision)
         if kind == "planted":
-            for n in (n for n in plan.plants if PLANTS[n].model == "dynamic"):
+            for n in dynamic_plants:
                 rows = j.step(ref, frames, planted_binary(n), ["--variant", oracle], scene.points)
                 flagged += [n] if j.add(kind, f"plant {n}", scene, precision, rows) else []
         else:
