@@ -440,11 +440,10 @@ def format_summary(s):
         f"judge: limit max({s['rule_k']:g}·ε·E·S·I, {s['spread_k']:g} × spread); {s['seconds']} s",
     ]
     for n, p in s["plants"].items():
-        seen = (
-            f"caught on {len(p['caught_on'])} scene(s): {', '.join(p['caught_on'])}"
-            if p["caught_on"]
-            else (f"NOT CAUGHT: needs {p['needs']}, which no standard scene run showed")
-        )
+        if p["caught_on"]:
+            seen = f"caught on {len(p['caught_on'])} scene(s) (it needs {p['needs']}): {', '.join(p['caught_on'])}"
+        else:
+            seen = f"NOT CAUGHT: it needs {p['needs']}, which no standard scene run showed"
         lines.append(f"  plant {n:>2} ({p['what']}): {seen}")
     for r in s["false_alarm_runs"]:
         lines.append(f"  false alarm: {r}")
