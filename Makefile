@@ -1,7 +1,8 @@
 # hairbench — the front door. `make help` lists the targets.
 #
 #   make          build build/hairsim-cpu and, where nvcc is present, the CUDA binaries
-#   make test     build, then run the pytest suite (GPU tests skip with a reason without a GPU)
+#   make test     build (with build/planted/, the judge's planted defects), then run the pytest suite
+#                 (GPU tests skip with a reason without a GPU)
 #   make bench    build, validate the GPU variants against the CPU, sweep, studies, report (results/local/)
 #   make report   re-render a run folder's report (the committed one: REPORT_FROM=results/reference-h200 REPORT_TO=report)
 
@@ -71,7 +72,7 @@ CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim
 HOSTCHECK_BINS := $(BUILD)/hostcheck/model_hostcheck_reference $(BUILD)/hostcheck/model_hostcheck_free \
                   $(BUILD)/hostcheck/dyn_hostcheck
 
-.PHONY: all cpu cuda hostcheck test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt docs
+.PHONY: all cpu planted cuda hostcheck test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt docs
 
 # The Python that runs the tests and the harness: harness/setup.sh picks it (PYTHON when it has
 # the packages, else ./.venv) after installing what is missing, and writes its path here.
@@ -80,7 +81,7 @@ RUN_PY   = "$$(cat $(PY_FILE))"
 
 all: cpu cuda
 
-cpu: $(BUILD)/hairsim-cpu
+cpu: $(BUILD)/hairsim-cpu $(BUILD)/hairsim-cpu-contract
 
 help:
 	@echo "make          build build/hairsim-cpu (and the CUDA binaries where nvcc is present)"
@@ -96,6 +97,7 @@ help:
 	@echo "make docs     remake docs/harness.md's command and module reference (python3 -m harness docs)"
 	@echo "make setup    install what is missing (apt as root/sudo, pip into .venv under PEP 668); nothing when all is there"
 	@echo "make hostcheck  build the CUDA port's host checks (cuda/hostcheck/, run by tests/native)"
+	@echo "make planted  build/planted/: the C reference with each planted defect (python -m harness judge)"
 	@echo "make clean    remove build/"
 
 check-hdf5:
@@ -118,6 +120,37 @@ $(OBJ)/runtime/record.o: $(REV_STAMP)
 
 $(BUILD)/hairsim-cpu: $(SHARED_OBJ) $(CPU_OBJ)
 	$(CC) -fopenmp $^ -o $@ $(HDF5_LIBS) -lm
+
+# The spread build (docs/judge.md): the C reference's model sources with FMA contraction on,
+# a legitimate change of arithmetic whose difference from the reference measures how
+# sensitive a scene is; the rest of its objects are the reference's.
+CONTRACT_FLAGS := $(filter-out -ffp-contract=off,$(CFLAGS_REF)) -ffp-contract=fast -march=x86-64-v3
+CONTRACT_SRC := c_ref/paper/model.c c_ref/dynamic/dynamics_f32.c c_ref/dynamic/dynamics_f64.c c_ref/dynamic/dynamics_host.c \
+                c_ref/runtime/record.c
+CONTRACT_OBJ := $(CONTRACT_SRC:c_ref/%.c=$(OBJ)/contract/%.o)
+$(OBJ)/contract/%.o: c_ref/%.c $(C_HEADERS) | check-hdf5
+	@mkdir -p $(dir $@)
+	$(CC) $(CONTRACT_FLAGS) -fopenmp -Ic_ref $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' \
+	  -DHB_FLAGS='"$(CC) $(CONTRACT_FLAGS) -fopenmp (spread build: $(notdir $(CONTRACT_SRC)); the rest as hairsim-cpu)"' -c $< -o $@
+$(OBJ)/contract/runtime/record.o: $(REV_STAMP)
+$(BUILD)/hairsim-cpu-contract: $(CONTRACT_OBJ) $(filter-out $(CONTRACT_SRC:c_ref/%.c=$(OBJ)/%.o),$(SHARED_OBJ) $(CPU_OBJ))
+	$(CC) -fopenmp $^ -o $@ $(HDF5_LIBS) -lm
+
+# Planted defects (docs/judge.md), test-only: build/planted/hairsim-cpu-plant<n> is the C
+# reference with `#if HB_PLANT == n` hunk n compiled in. Not part of `make`; `make planted`.
+PLANTS := $(shell grep -ho 'HB_PLANT == [0-9]*' c_ref/*/*.c c_ref/*/*.h | awk '{print $$3}' | sort -un)
+PLANT_SRC := c_ref/dynamic/dynamics_f32.c c_ref/dynamic/dynamics_f64.c c_ref/dynamic/dynamics_host.c c_ref/paper/model.c
+PLANT_BINS := $(PLANTS:%=$(BUILD)/planted/hairsim-cpu-plant%)
+planted: $(PLANT_BINS)
+.SECONDARY: $(foreach n,$(PLANTS),$(PLANT_SRC:c_ref/%.c=$(BUILD)/planted/obj$(n)/%.o))
+$(BUILD)/planted/obj%/dynamics_f32.o $(BUILD)/planted/obj%/dynamics_f64.o $(BUILD)/planted/obj%/dynamics_host.o \
+  $(BUILD)/planted/obj%/model.o: $(PLANT_SRC) $(C_HEADERS) | check-hdf5
+	@mkdir -p $(BUILD)/planted/obj$*
+	for f in $(PLANT_SRC); do $(CC) $(CFLAGS_REF) -Ic_ref -O0 -g0 -fopenmp $(HDF5_CFLAGS) -DHB_PLANT=$* -c $$f \
+	  -o $(BUILD)/planted/obj$*/$$(basename $${f%.c}).o || exit 1; done
+$(BUILD)/planted/hairsim-cpu-plant%: $(BUILD)/planted/obj%/dynamics_f32.o \
+  $(filter-out $(PLANT_SRC:c_ref/%.c=$(OBJ)/%.o),$(SHARED_OBJ) $(CPU_OBJ))
+	$(CC) -fopenmp $(BUILD)/planted/obj$*/*.o $(filter-out $(BUILD)/planted/%,$^) -o $@ $(HDF5_LIBS) -lm
 
 ifeq ($(HAVE_NVCC),yes)
 cuda: $(CUDA_BINS)
@@ -159,7 +192,7 @@ endif
 # on every core: the CUDA binaries and the C reference's feature instantiations take minutes
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 test: setup
-	@$(MAKE) --no-print-directory -j$(JOBS) all $(if $(HAVE_NVCC),hostcheck)
+	@$(MAKE) --no-print-directory -j$(JOBS) all planted $(if $(HAVE_NVCC),hostcheck)
 	$(RUN_PY) -m pytest tests -q -ra
 
 # make bench's run folder (untracked): results, then the report in $(OUT)/report

@@ -139,9 +139,18 @@ void hb_dyn_frame_plan(const hb_scene *s, int64_t m0, hb_dyn_frame *f)
         const int64_t m = m0 + j;
         const double t = (double)m * h, t1 = (double)(m + 1) * h;
         double *q = f->q64 + 9 * j;
+#if HB_PLANT == 2 /* judge test: the head rotation at t, not t + h */
+        hb_head_rotation(d, t, q);
+        (void)t1;
+#else
         hb_head_rotation(d, t1, q);
+#endif
         for (int e = 0; e < 9; e++) f->q32[9 * j + e] = (float)q[e];
+#if HB_PLANT == 7 /* judge test: the gust phase one substep late */
+        const double ft = d->gust_frequency * (t - h);
+#else
         const double ft = d->gust_frequency * t;
+#endif
         const double phase = 2.0 * M_PI * (ft - floor(ft));
         f->phase64[j] = phase;
         f->phase32[j] = (float)phase;

@@ -11,6 +11,16 @@
  */
 
 #define HB_ALWAYS_INLINE static inline __attribute__((always_inline))
+#if HB_PLANT == 8 /* judge test: the root given weight 1 in its stretch constraint */
+#define ROOT_MOVES(k) 1
+#else
+#define ROOT_MOVES(k) ((k)-1 != 0)
+#endif
+#if HB_PLANT == 6 /* judge test: the collider skips point P/2 */
+#define PLANT_SKIPPED(k) ((k) == P / 2)
+#else
+#define PLANT_SKIPPED(k) 0
+#endif
 
 /* r = Q·a, row-major Q, each row summed left to right. */
 HB_ALWAYS_INLINE void SFX(rotate)(const REAL *q, const REAL *a, REAL *r)
@@ -73,6 +83,16 @@ HB_ALWAYS_INLINE void SFX(collide_sphere)(REAL *p, REAL rc)
     p[2] = p[2] * sc;
 }
 
+#if HB_PLANT == 5 /* judge test: the bend rest length from the current shape, not the rest shape */
+HB_ALWAYS_INLINE REAL SFX(dist)(const REAL *a, const REAL *b)
+{
+    return SQRT((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) + (b[2] - a[2]) * (b[2] - a[2]));
+}
+#define BEND_REST(p, k) SFX(dist)(p + 3 * ((k)-1), p + 3 * ((k) + 1))
+#else
+#define BEND_REST(p, k) bend_rest[(k)-1]
+#endif
+
 /* §3.6 bend constraints (k−1, k+1), k = 1…P−2, of one parity group: ⌊(k−1)/2⌋ even
  * (parity 0) or odd (parity 1). */
 HB_ALWAYS_INLINE void SFX(bend_group)(const DMODEL *m, REAL *p, const REAL *bend_rest, REAL *lam, int parity)
@@ -80,14 +100,18 @@ HB_ALWAYS_INLINE void SFX(bend_group)(const DMODEL *m, REAL *p, const REAL *bend
     const int64_t P = m->points;
     for (int64_t k = 1; k + 1 < P; k++)
         if ((((k - 1) / 2) & 1) == parity)
-            SFX(distance)(p + 3 * (k - 1), p + 3 * (k + 1), k - 1 != 0, bend_rest[k - 1], m->bend_at, &lam[k - 1]);
+            SFX(distance)(p + 3 * (k - 1), p + 3 * (k + 1), k - 1 != 0, BEND_REST(p, k), m->bend_at, &lam[k - 1]);
 }
 
 /* §3.5 shape targets T_k = Q(t+h)·X̄_k (X̄_k itself when the head does not move). */
 HB_ALWAYS_INLINE void SFX(shape_all)(const DMODEL *m, REAL *p, const REAL *rest, const REAL *q, REAL *lam,
                                      const unsigned F)
 {
+#if HB_PLANT == 10 /* judge test: the shape range one point too long */
+    for (int64_t k = 1; k <= m->shape_count + (m->shape_count + 1 < m->points); k++) {
+#else
     for (int64_t k = 1; k <= m->shape_count; k++) {
+#endif
         REAL t[3];
         if (F & HB_F_MOTION) SFX(rotate)(q, rest + 3 * k, t);
         else {
@@ -156,10 +180,16 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
                 REAL gam = (REAL)1;
                 if (F & HB_F_GUST)
                     gam = (REAL)1 + m->gust * SIN(phase - m->kappa * (m->dir_y * xk[1] + m->dir_z * xk[2]));
+#if HB_PLANT == 1 /* judge test: gravity dropped from the velocity update */
+                vy = vy + h * (m->wind_y * gam);
+#else
                 vy = vy + h * (m->gravity_y + m->wind_y * gam);
+#endif
                 vz = vz + h * (m->wind_z * gam);
             } else {
+#if HB_PLANT != 1
                 vy = vy + h * m->gravity_y;
+#endif
             }
             if (F & HB_F_DRAG) {
                 vx = vx / m->den;
@@ -175,20 +205,30 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
         }
 
         /* 3. constraints; every multiplier starts the substep at 0 */
-        for (int64_t i = 0; i < 3 * P; i++) lam[i] = (REAL)0;
+#if HB_PLANT == 4 /* judge test: the multipliers kept from the last substep */
+        if (j == 0)
+#endif
+            for (int64_t i = 0; i < 3 * P; i++) lam[i] = (REAL)0;
         if (m->solver == HB_SOLVER_XPBD) {
             for (int64_t it = 0; it < m->iterations; it++) {
+#if HB_PLANT == 3 /* judge test: the even stretch group before the odd */
+                for (int64_t k = 2; k < P; k += 2)
+                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, 1, m->seg_len, m->stretch_at, &lam_s[k - 1]);
+#endif
                 for (int64_t k = 1; k < P; k += 2) /* stretch, k odd */
-                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, k - 1 != 0, m->seg_len, m->stretch_at, &lam_s[k - 1]);
+                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, ROOT_MOVES(k), m->seg_len, m->stretch_at, &lam_s[k - 1]);
+#if HB_PLANT != 3
                 for (int64_t k = 2; k < P; k += 2) /* stretch, k even */
                     SFX(distance)(p + 3 * (k - 1), p + 3 * k, 1, m->seg_len, m->stretch_at, &lam_s[k - 1]);
+#endif
                 if (F & HB_F_BEND) {
                     SFX(bend_group)(m, p, bend_rest, lam_b, 0);
                     SFX(bend_group)(m, p, bend_rest, lam_b, 1);
                 }
                 if (F & HB_F_SHAPE) SFX(shape_all)(m, p, rest, q, lam_g, F);
                 if (F & HB_F_COLLIDE)
-                    for (int64_t k = 1; k < P; k++) SFX(collide_sphere)(p + 3 * k, m->collide_r);
+                    for (int64_t k = 1; k < P; k++)
+                        if (!PLANT_SKIPPED(k)) SFX(collide_sphere)(p + 3 * k, m->collide_r);
             }
         } else {
             for (int64_t it = 0; it < m->iterations; it++) {
@@ -215,7 +255,7 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
                     nq[2] = pp[2];
                 }
                 for (int c = 0; c < 3; c++) d[3 * k + c] = nq[c] - pk[c];
-                if (F & HB_F_COLLIDE) SFX(collide_sphere)(nq, m->collide_r);
+                if ((F & HB_F_COLLIDE) && !PLANT_SKIPPED(k)) SFX(collide_sphere)(nq, m->collide_r);
                 for (int c = 0; c < 3; c++) pk[c] = nq[c];
             }
         }
@@ -225,7 +265,11 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
             for (int c = 0; c < 3; c++) v[3 * k + c] = (p[3 * k + c] - x[3 * k + c]) / h;
         if (m->solver == HB_SOLVER_FTL)
             for (int64_t k = 1; k + 1 < P; k++)
+#if HB_PLANT == 9 /* judge test: the ftl correction of the point's own d_k, not d_{k+1} */
+                for (int c = 0; c < 3; c++) v[3 * k + c] = v[3 * k + c] - (m->ftl_s * d[3 * k + c]) / h;
+#else
                 for (int c = 0; c < 3; c++) v[3 * k + c] = v[3 * k + c] - (m->ftl_s * d[3 * (k + 1) + c]) / h;
+#endif
         for (int64_t i = 3; i < 3 * P; i++) x[i] = p[i];
     }
 }
@@ -300,3 +344,6 @@ void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v,
 }
 
 #undef HB_ALWAYS_INLINE
+#undef ROOT_MOVES
+#undef PLANT_SKIPPED
+#undef BEND_REST

@@ -77,7 +77,11 @@ void SFX(hb_drape_strand)(const MODEL *m, REAL *s)
                     theta = next;
                     pz = rc * COS(next);
                     py = rc * SIN(next);
+#if HB_PLANT == 13 /* judge test: every drape step from the head circle, not the shell */
+                    rho = r0;
+#else
                     rho = rc;
+#endif
                     q[0] = x0;
                     q[1] = py;
                     q[2] = pz;
@@ -132,7 +136,11 @@ void SFX(hb_wind_strand)(const MODEL *m, REAL *s)
         /* Exactly opposite: take the arc through +y. Turning by +π passes through the
          * direction φ + π/2, whose y component has the sign of cos φ, i.e. of dz. */
         if (delta == PI_R) delta = dz >= (REAL)0 ? PI_R : -PI_R;
+#if HB_PLANT == 11 /* judge test: the wind's blend of segment k taken at k − 1 */
+        const REAL t = (w * (REAL)(k - 1)) / last;
+#else
         const REAL t = (w * (REAL)k) / last;
+#endif
         const REAL turned = phi + t * delta;
         nz = nz + ell * COS(turned);
         ny = ny + ell * SIN(turned);
@@ -164,7 +172,11 @@ int64_t SFX(hb_collide_strand)(const MODEL *m, REAL *s)
     for (int64_t k = 1; k < P; k++) {
         REAL *q = s + 3 * k;
         REAL cy = q[1], cz = q[2];
+#if HB_PLANT == 12 /* judge test: no follow-the-leader pull after a move */
+        if (0) {
+#else
         if (moved) {
+#endif
             /* Follow the leader: p_k ← p_{k−1} + ℓ·unit(p_k − p_{k−1}). */
             const REAL dy = cy - py, dz = cz - pz;
             const REAL len = SQRT(dy * dy + dz * dz);

@@ -5,7 +5,8 @@
      written with every frame's velocities:
      - always: the CPU oracle on one thread and on all cores bit-identical; a frame resumed
        from the file (--input-frame) bit-identical to the same frame of the run; every
-       other CPU variant one frame from the oracle's state (harness.check.diff_dynamic's rule);
+       other CPU variant one frame from the oracle's state (harness.check.diff_dynamic's rule
+       and the scene's spread, measured once per reference);
      - with a usable GPU: every cuda build × simulate variant × precision × block size
        one frame from the CPU's state, judged by the same rule (the strict build bit for
        bit where the scene has no gusts); and the strict build's variants bit-identical
@@ -94,6 +95,8 @@ class DynValidator:
                 "max_abs": f.max_abs,
                 "max_rel_L": f.max_rel_L,
                 "ulp_max": f.ulp_max,
+                "spread": getattr(f, "spread", float("nan")),
+                "limit": getattr(f, "limit", float("nan")),
                 "failures": r.failures()[:5],
             }
         self.checks.append(entry)
@@ -138,7 +141,7 @@ class DynValidator:
                     other = self.step(ref, binary_path("cpu"), ["--variant", v], f"cpu-{v}-{precision}-{solver}")
                     self.record(
                         f"cpu {v} {precision} {solver}: one frame from the oracle's state",
-                        lambda a=ref, b=other: diff_dynamic.compare(a, b, frames=[self.last_step(b)]),
+                        lambda a=ref, b=other: diff_dynamic.compare(a, b, frames=[self.last_step(b)], spread=True),
                     )
         return refs
 
@@ -152,7 +155,7 @@ class DynValidator:
                     strict[v] = g
                 self.record(
                     f"cuda {build} {v} b{block} {precision} {solver}: one frame from the cpu state",
-                    lambda a=ref, b=g: diff_dynamic.compare(a, b, frames=[self.last_step(b)]),
+                    lambda a=ref, b=g: diff_dynamic.compare(a, b, frames=[self.last_step(b)], spread=True),
                 )
             names = list(strict)
             for other in names[1:]:

@@ -22,10 +22,22 @@ stepdiff: for each chosen simulated frame k of a reference A written with --velo
 all, run BIN --input A --input-frame k --stages simulate --frames 1 into a temporary
 directory and compare BIN's new frame with A's frame k + 1 by the rule above.
 
+SPREAD (docs/judge.md): the rule above does not know how sensitive a scene is, so a
+one-frame comparison may also be judged against the scene's own spread: the same frame
+from the same input by the spread build (build/hairsim-cpu-contract, the C reference with
+FMA contraction on) and by the C reference, max |x_spread − x_ref| over the frame (and
+h·|Δv| likewise). A point is
+then over when it is farther than max(DYN_STEP_K·u, DYN_SPREAD_K·spread) (positions;
+velocities with their own spread). `stepdiff`, the bench's validation, the GPU tests and
+the stability search judge this way (`spread=True`); each spread is measured once per
+reference file and frame in a process (two CPU runs from A's frame: the spread build and
+build/hairsim-cpu, so that a wrong frame in A cannot widen its own spread).
+
 Exit status as for diff: 0 equivalent, 1 not, 2 could not compare.
 """
 
 import math
+import os
 import shutil
 import subprocess
 import tempfile
@@ -37,6 +49,7 @@ import numpy as np
 from harness import HarnessError
 from harness.check import diff, invariants_dynamic
 from harness.core import tolerances
+from harness.core.paths import build_dir, display
 from harness.core.ulp import coarser, ulp_distance
 from harness.io.states import StateError, as_text
 from harness.io.trajectory import open_trajectory
@@ -112,19 +125,102 @@ class DynDiffResult:
     def as_dict(self):
         frames = [dict(f.as_dict(), step=f.step) for f in self.frames]
         limits = {"unit": self.unit, "point_limit": self.tolerance.point_k * self.unit}
+        limits.update(spread_k=tolerances.DYN_SPREAD_K, spread_why=tolerances.DYN_SPREAD_WHY)
         return diff.result_dict(self, limits, frames, observables=self.observables, notes=self.notes)
 
 
-def _over(dist, finite, tol, unit):
-    if tol.point_k == 0.0:
+@dataclass(frozen=True)
+class Spread:
+    """A scene's own sensitivity at one step: how far the spread build's frame, advanced from
+    the same input, lies from the reference's (largest over the frame's points; cm)."""
+
+    step: int
+    position: float  # max |x_spread − x_ref|
+    velocity: float  # max h·|v_spread − v_ref| (nan where velocities were not stored)
+    binary: str
+
+    def limit(self, floor, velocity=False):
+        """max(floor, DYN_SPREAD_K × spread): the judged limit of a point."""
+        s = self.velocity if velocity else self.position
+        return max(floor, tolerances.DYN_SPREAD_K * s) if math.isfinite(s) else floor
+
+
+def spread_binary():
+    """The spread build (`make cpu` builds it beside build/hairsim-cpu)."""
+    return Path(os.environ.get("HAIRBENCH_SPREAD_BIN") or build_dir() / "hairsim-cpu-contract")
+
+
+_SPREADS = {}
+
+
+def _step_once(binary, reference, k, out, timeout):
+    cmd = [str(binary), "--input", str(reference), "--input-frame", str(k), "--stages", "simulate"]
+    cmd += ["--frames", "1", "--output", str(out), "--force", "--quiet"]
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        raise HarnessError(f"{display(binary)} did not finish within {timeout} s", code=2) from None
+    if p.returncode != 0:
+        msg = (p.stderr.strip().splitlines() or [f"status {p.returncode}"])[-1]
+        raise HarnessError(
+            f"cannot measure the spread: {display(binary)} failed on frame {k} of {reference}: {msg}",
+            code=diff.EXIT_CANNOT_COMPARE,
+        )
+
+
+def measure_spread(reference, k, binary=None, timeout=None):
+    """The Spread of the step after frame k of `reference` (a file written with velocities):
+    the spread build's frame against the C reference's (build/hairsim-cpu), both advanced
+    from frame k, so a wrong frame k + 1 in the file cannot widen it. None when the spread
+    build is not built. Cached per file (path, size, mtime), frame and build in this process."""
+    binary = Path(binary) if binary else spread_binary()
+    oracle = build_dir() / "hairsim-cpu"
+    if not binary.exists() or not oracle.exists():
+        return None
+    st, bst = os.stat(reference), os.stat(binary)
+    key = (str(Path(reference).resolve()), st.st_size, st.st_mtime_ns, int(k), str(binary.resolve()), bst.st_mtime_ns)
+    if key in _SPREADS:
+        return _SPREADS[key]
+    with tempfile.TemporaryDirectory(prefix="hb-spread-") as tmp:
+        ref_out, out = Path(tmp) / "oracle.h5", Path(tmp) / "spread.h5"
+        _step_once(oracle, reference, k, ref_out, timeout)
+        _step_once(binary, reference, k, out, timeout)
+        with open_trajectory(ref_out) as a, open_trajectory(out) as b:
+            step = int(a.step[-1])
+            fd = compare_sim_frame(a, b, a.frame_at_step(step), b.frame_at_step(step), tolerances.EXACT, 1.0, a.dtype)
+    vel = fd.velocity_max_abs if getattr(fd, "velocity_compared", False) else float("nan")
+    sp = _SPREADS[key] = Spread(step, fd.max_abs, vel, display(binary))
+    return sp
+
+
+def spreads_for(path_a, a, steps):
+    """{step: Spread} for the simulated steps of A that follow a frame one can step from."""
+    cand = set(step_candidates(a))
+    out = {}
+    for s in steps:
+        k = a.frame_at_step(s) - 1
+        if k in cand:
+            sp = measure_spread(path_a, k)
+            if sp is not None:
+                out[s] = sp
+    return out
+
+
+def _over(dist, finite, limit, exact):
+    if exact:
         return (dist > 0) | ~finite
-    return ~(dist <= tol.point_k * unit) | ~finite
+    return ~(dist <= limit) | ~finite
 
 
-def compare_sim_frame(a, b, fa, fb, tol, unit, ulp_dtype):
+def compare_sim_frame(a, b, fa, fb, tol, unit, ulp_dtype, spread=None):
     """Positions, and the velocities where both files stored them at this step (|Δv|·h, the
-    position change a velocity makes in one substep, on the positions' rule)."""
+    position change a velocity makes in one substep, on the positions' rule); with a Spread,
+    each against max(the rule, DYN_SPREAD_K × the spread)."""
     fd = diff.FrameDiff(fa, fb, "simulate")
+    exact = tol.point_k == 0.0
+    floor = tol.point_k * unit
+    fd.limit = spread.limit(floor) if spread and not exact else floor
+    fd.spread = spread.position if spread else float("nan")
     xa, xb = a.frame(fa), b.frame(fb)
     finite = np.all(np.isfinite(xa), axis=2) & np.all(np.isfinite(xb), axis=2)
     fd.nonfinite = int((~finite).sum())
@@ -137,7 +233,7 @@ def compare_sim_frame(a, b, fa, fb, tol, unit, ulp_dtype):
         fd.max_k = fd.max_abs / unit
     else:
         fd.rms_abs = float("nan")
-    fd.over = int(_over(dist, finite, tol, unit).sum())
+    fd.over = int(_over(dist, finite, fd.limit, exact).sum())
     fd.max_rel_L = fd.max_abs / a.hair_length
     both = np.isfinite(xa) & np.isfinite(xb)
     u = ulp_distance(xa[both], xb[both], ulp_dtype)
@@ -154,7 +250,9 @@ def compare_sim_frame(a, b, fa, fb, tol, unit, ulp_dtype):
             vdist = h * np.sqrt(np.sum((va.astype(np.float64) - vb.astype(np.float64)) ** 2, axis=2))
         fd.nonfinite += int((~vfinite).sum())
         fd.velocity_max_abs = float(vdist[vfinite].max()) if vfinite.any() else float("nan")
-        fd.velocity_over = int(_over(vdist, vfinite, tol, unit).sum())
+        fd.velocity_limit = spread.limit(floor, velocity=True) if spread and not exact else floor
+        fd.velocity_spread = spread.velocity if spread else float("nan")
+        fd.velocity_over = int(_over(vdist, vfinite, fd.velocity_limit, exact).sum())
         fd.over += fd.velocity_over
     return fd
 
@@ -214,8 +312,10 @@ def _pick_steps(a, b, frames):
     return list(frames)
 
 
-def compare(path_a, path_b, frames="all", exact=False, check_paper=True):
-    """Compare two files (either may be dynamic) at their common steps; DynDiffResult."""
+def compare(path_a, path_b, frames="all", exact=False, check_paper=True, spread=False):
+    """Compare two files (either may be dynamic) at their common steps; DynDiffResult.
+    spread=True: B's simulated frames were each advanced by one frame from A's previous
+    frame, and are judged against A's spread there too (module docstring)."""
     with open_trajectory(path_a) as a, open_trajectory(path_b) as b:
         diff.check_comparable(a, b)
         check_same_run(a, b, frames)
@@ -245,6 +345,9 @@ def compare(path_a, path_b, frames="all", exact=False, check_paper=True):
             va, vb = a.dynamic_params.get(key), b.dynamic_params.get(key)
             if as_text(va) != as_text(vb) and key not in ("simulated_frames", "output_every"):
                 res.notes.append(f"{key}: A {va}, B {vb}")
+        spreads = spreads_for(path_a, a, steps) if spread and not exact and a.is_dynamic else {}
+        if spread and not exact and not spreads:
+            res.notes.append(f"spread not measured ({display(spread_binary())} not built or no frame to step from)")
         oa, ob = a.observables.set_index("step"), b.observables.set_index("step")
         used_a, used_b = [], []
         for s in steps:
@@ -253,7 +356,7 @@ def compare(path_a, path_b, frames="all", exact=False, check_paper=True):
             if (sa == "simulate") != (sb == "simulate"):
                 raise StateError(f"step {s} is '{sa}' in A but '{sb}' in B")
             if sa == "simulate":
-                fd = compare_sim_frame(a, b, fa, fb, tol, unit, coarser(a.dtype, b.dtype))
+                fd = compare_sim_frame(a, b, fa, fb, tol, unit, coarser(a.dtype, b.dtype), spreads.get(s))
                 row = {"step": s, "time": float(a.time[fa])}
                 for name in OBS_SHOWN:
                     va = float(oa.loc[s, name]) if s in oa.index else float("nan")
@@ -293,15 +396,23 @@ def format_result(r):
     else:
         lines.append(f"tolerance {r.pair}: {r.tolerance.why}")
     for n in r.notes:
-        lines.append(f"note: parameters differ: {n}")
+        lines.append(f"note: {n}" if n.startswith("spread") else f"note: parameters differ: {n}")
+    if any(math.isfinite(getattr(f, "spread", float("nan"))) for f in r.frames):
+        lines.append(
+            f"spread: a point is over when farther than max(the rule, {tolerances.DYN_SPREAD_K:g} × the scene's "
+            f"spread), the spread measured by {display(spread_binary())} from the same input"
+        )
     lines.append(
         f"{'step':>5} {'stage':8} {'max abs':>10} {'rms':>10} {'max/L':>10} {'max/u':>9} "
-        f"{'ulp p50':>8} {'ulp p99':>8} {'ulp max':>10} {'over':>7} {'nan/inf':>7}  verdict"
+        f"{'ulp p50':>8} {'ulp p99':>8} {'ulp max':>10} {'spread':>10} {'limit':>10} {'over':>7} "
+        f"{'nan/inf':>7}  verdict"
     )
     for f in r.frames:
+        lim = getattr(f, "limit", float("nan"))
         lines.append(
             f"{f.step:>5} {f.stage:8} {f.max_abs:10.3e} {f.rms_abs:10.3e} {f.max_rel_L:10.3e} "
-            f"{f.max_k:9.3g} {f.ulp_p50:8.0f} {f.ulp_p99:8.0f} {f.ulp_max:10.3g} {f.over:7d} "
+            f"{f.max_k:9.3g} {f.ulp_p50:8.0f} {f.ulp_p99:8.0f} {f.ulp_max:10.3g} "
+            f"{getattr(f, 'spread', float('nan')):10.3e} {lim:10.3e} {f.over:7d} "
             f"{f.nonfinite:7d}  {'ok' if f.ok else 'FAIL'}"
         )
     if r.observables:
@@ -380,8 +491,9 @@ def step_candidates(ref):
     return out
 
 
-def stepdiff(reference, binary, flags=(), frames="all", exact=False, keep=None, timeout=None, out=print):
-    """The `harness stepdiff` command; returns the exit status."""
+def stepdiff(reference, binary, flags=(), frames="all", exact=False, keep=None, timeout=None, out=print, spread=True):
+    """The `harness stepdiff` command; returns the exit status. `spread`: judge each frame
+    against the scene's spread too (the module docstring), measured by the spread build."""
     from harness.core.runner import require_binary
 
     binary = require_binary(binary)
@@ -404,7 +516,13 @@ def stepdiff(reference, binary, flags=(), frames="all", exact=False, keep=None, 
     tmp.mkdir(parents=True, exist_ok=True)
     worst = 0
     lines = [f"reference {reference}, binary {binary} {' '.join(flags)}".rstrip()]
-    lines.append(f"{'frame':>5} {'step':>5} {'max abs':>10} {'max/u':>9} {'ulp max':>10} {'over':>6}  verdict")
+    use_spread = spread and not exact and spread_binary().exists()
+    if spread and not exact and not use_spread:
+        lines.append(f"note: spread not measured ({display(spread_binary())} not built: make cpu); the rule alone")
+    lines.append(
+        f"{'frame':>5} {'step':>5} {'max abs':>10} {'max/u':>9} {'ulp max':>10} {'spread':>10} {'limit':>10} "
+        f"{'over':>6}  verdict"
+    )
     try:
         for k in chosen:
             o = tmp / f"step{k}.h5"
@@ -435,14 +553,15 @@ def stepdiff(reference, binary, flags=(), frames="all", exact=False, keep=None, 
                     code=diff.EXIT_CANNOT_COMPARE,
                 )
             try:
-                res = compare(reference, o, [steps[k]], exact, check_paper=False)
+                res = compare(reference, o, [steps[k]], exact, check_paper=False, spread=use_spread)
             except StateError as e:
                 raise HarnessError(f"cannot compare: {e}", code=diff.EXIT_CANNOT_COMPARE) from None
             f = res.frames[0]
             ok = res.equivalent
             worst = max(worst, 0 if ok else 1)
             lines.append(
-                f"{k:>5} {steps[k]:>5} {f.max_abs:10.3e} {f.max_k:9.3g} {f.ulp_max:10.3g} {f.over:6d}  "
+                f"{k:>5} {steps[k]:>5} {f.max_abs:10.3e} {f.max_k:9.3g} {f.ulp_max:10.3g} "
+                f"{getattr(f, 'spread', float('nan')):10.3e} {getattr(f, 'limit', float('nan')):10.3e} {f.over:6d}  "
                 f"{'ok' if ok else 'FAIL: ' + '; '.join(res.failures()[:2])}"
             )
     finally:
@@ -451,7 +570,12 @@ def stepdiff(reference, binary, flags=(), frames="all", exact=False, keep=None, 
     lines.append(
         "verdict: "
         + ("EQUIVALENT" if worst == 0 else "NOT EQUIVALENT")
-        + (" (exact)" if exact else " (one frame from the same input; rule DYN_STEP_K·ε·E·S·I)")
+        + (
+            " (exact)"
+            if exact
+            else " (one frame from the same input; limit max(DYN_STEP_K·ε·E·S·I"
+            + (", DYN_SPREAD_K × spread))" if use_spread else "))")
+        )
     )
     out("\n".join(lines))
     return worst

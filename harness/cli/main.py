@@ -132,6 +132,7 @@ def cmd_stepdiff(args):
         exact=args.exact,
         keep=args.keep,
         timeout=args.timeout,
+        spread=not args.no_spread,
     )
 
 
@@ -511,6 +512,29 @@ def cmd_stability(args):
     return 0
 
 
+def cmd_judge(args):
+    from harness.studies import judge
+
+    plan = judge.Plan.quick(gpu=args.gpu) if args.quick else judge.Plan(gpu=args.gpu)
+    if args.strands:
+        plan = judge.replace(plan, strands=args.strands)
+    if args.extreme:
+        unknown = [n for n in args.extreme if n not in judge.EXTREME and n not in judge.PAPER_EXTREME]
+        if unknown:
+            known = ", ".join([*judge.EXTREME, *judge.PAPER_EXTREME])
+            raise HarnessError(f"judge: unknown extreme scene(s) {', '.join(unknown)} (known: {known})")
+        plan = judge.replace(
+            plan,
+            extreme=tuple(n for n in args.extreme if n in judge.EXTREME),
+            paper_extreme=tuple(n for n in args.extreme if n in judge.PAPER_EXTREME),
+        )
+    if args.plant:
+        plan = judge.replace(plan, plants=tuple(args.plant))
+    summary = judge.run(plan, out_dir=args.out, jobs=args.jobs)
+    print(judge.format_summary(summary))
+    return 0 if summary["caught"] == summary["planted"] and summary["false_alarms"] == 0 else 1
+
+
 def cmd_calibrate(args):
     from harness.studies import calibrate
 
@@ -578,7 +602,8 @@ def parser():
         description="For each chosen simulated frame k of a reference written with "
         "--velocities all, run BINARY --input REF --input-frame k --stages "
         "simulate --frames 1 and compare its new frame with the reference's "
-        "frame k+1 by the dynamic per-frame tolerance (harness/check/diff_dynamic.py). "
+        "frame k+1 by the dynamic per-frame tolerance: max(DYN_STEP_K·ε·E·S·I, DYN_SPREAD_K × the scene's spread, "
+        "measured by build/hairsim-cpu-contract from the same input) (harness/check/diff_dynamic.py, docs/judge.md). "
         "Exit 0 = equivalent, 1 = not, 2 = could not compare.",
     )
     sd.add_argument("--reference", required=True, help="dynamic state file (A)")
@@ -593,6 +618,11 @@ def parser():
     sd.add_argument("--exact", action="store_true", help="require bit-identical frames")
     sd.add_argument("--keep", help="keep the binary's outputs in this directory")
     sd.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
+    sd.add_argument(
+        "--no-spread",
+        action="store_true",
+        help="judge by the DYN_STEP_K rule alone, without the scene's spread (measured by build/hairsim-cpu-contract)",
+    )
     sd.add_argument(
         "flags", nargs=argparse.REMAINDER, help="further flags for the binary (after the options, e.g. -- --threads 1)"
     )
@@ -986,6 +1016,32 @@ def parser():
     sb.add_argument("--report-dir", default=None, help="where to write (default results/local/report/)")
     sb.add_argument("--from-csv", default=None, help="only redraw the report from an existing stability.csv")
     sb.set_defaults(func=cmd_stability)
+
+    from harness.studies.judge import EXTREME, PAPER_EXTREME, PLANTS
+
+    jg = sub.add_parser(
+        "judge",
+        help="the one-frame judge's power: planted defects caught, false alarms on extreme scenes",
+        description="Step every planted defect (build/planted/, make planted) from the C reference's frames "
+        "on the standard scenes, and every honest build × variant × precision on the extreme scenes, judging "
+        "each frame as stepdiff does (the rule and the scene's spread); the paper model's planted defects and "
+        "variants likewise by whole runs judged as harness diff does; print caught / planted and false "
+        "alarms / honest runs, write results/judge/judge.csv and judge.json (docs/judge.md). Exit 0 when "
+        "every defect is caught and no honest run fails, else 1.",
+    )
+    jg.add_argument("--quick", action="store_true", help="fewer strands and frames (the tests' size)")
+    jg.add_argument("--strands", type=whole(1), default=None, help="strands per scene")
+    jg.add_argument(
+        "--extreme",
+        action="append",
+        metavar="NAME",
+        help=f"only this extreme scene (repeatable; {len(EXTREME)} dynamic, {len(PAPER_EXTREME)} paper declared)",
+    )
+    jg.add_argument("--plant", action="append", type=int, choices=sorted(PLANTS), help="only this planted defect")
+    jg.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto", help="honest runs of the CUDA builds too")
+    jg.add_argument("--jobs", type=whole(1), default=None, help="scenes run at once (default: all cores)")
+    jg.add_argument("--out", default=None, help="results directory (default results/judge)")
+    jg.set_defaults(func=cmd_judge)
 
     dc = sub.add_parser(
         "docs",

@@ -1,7 +1,7 @@
 """report/dynamic.md: the dynamic model's report, rendered from a bench root (the results
 of harness/bench/dynamic.py: <root>/dynamic/{runs.csv, env.json, validation.json},
 <root>/featurecost/*.csv, <root>/peer/, <root>/dynamic-accuracy/, <root>/stability/,
-<root>/headline/headline_dynamic.json). Rendering only: every number comes from those
+<root>/headline/headline_dynamic.json, <root>/judge/). Rendering only: every number comes from those
 files, every missing piece is named with the command that makes it."""
 
 import json
@@ -20,6 +20,7 @@ from harness.render import (  # noqa: E402
     accuracy_dynamic_report,
     budget_report,
     featurecost_report,
+    judge_report,
     peer_report,
     stability_report,
 )
@@ -99,6 +100,10 @@ def best_table(rows):
     return lines
 
 
+def _num(x):
+    return f"{x:.3g}" if isinstance(x, (int, float)) and x == x else ""
+
+
 def validation_lines(results_dir):
     path = Path(results_dir) / "validation.json"
     if not path.exists():
@@ -111,17 +116,19 @@ def validation_lines(results_dir):
         f"{len(checks)} comparisons, {len(checks) - len(bad)} equivalent"
         + (f" ({len(bad)} NOT)" if bad else "")
         + ". One frame from the same input state, judged by `harness.check.diff_dynamic` (the rule of "
-        "`harness stepdiff` and of the GPU tests); bit-identical where marked. " + (v.get("gpu_note") or ""),
+        "`harness stepdiff` and of the GPU tests: a point is over beyond the larger of DYN_STEP_K·ε·E·S·I and "
+        "DYN_SPREAD_K × the scene's spread, docs/judge.md); bit-identical where marked. " + (v.get("gpu_note") or ""),
         "",
-        "| check | pair | max abs (cm) | max / L | ulp max | verdict |",
-        "| --- | --- | ---: | ---: | ---: | --- |",
+        "| check | pair | max abs (cm) | max / L | ulp max | spread (cm) | limit (cm) | verdict |",
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | --- |",
     ]
     for c in checks:
         why = c.get("error") or "; ".join(c.get("failures", []))
         verdict = "equivalent" if c.get("equivalent") else "NOT: " + why
         lines.append(
             f"| {c['what']} | {c.get('pair', '')} | {c.get('max_abs', float('nan')):.3g} | "
-            f"{c.get('max_rel_L', float('nan')):.3g} | {c.get('ulp_max', float('nan')):.3g} | {verdict} |"
+            f"{c.get('max_rel_L', float('nan')):.3g} | {c.get('ulp_max', float('nan')):.3g} | "
+            f"{_num(c.get('spread'))} | {_num(c.get('limit'))} | {verdict} |"
         )
     return lines
 
@@ -258,6 +265,7 @@ def build(root, report_dir=None):
         out_dir,
     )
     lines += _study(root, "stability", stability_report, "Stability at the extremes", "harness stability", out_dir)
+    lines += _study(root, "judge", judge_report, "The judge's power", "harness judge", out_dir)
     lines += peer_report.section(root / "peer", out_dir, missing_ok=True) + [""]
     gif = out_dir / "dynamic.gif"
     lines += ["## The default scene in motion", ""]

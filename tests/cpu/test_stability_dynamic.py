@@ -272,7 +272,7 @@ def test_search_gpu_frame_agrees_with_cpu(cpu_bin, tmp_path_factory, s, variant,
     what = f"strict {variant} block {block} {s['solver']} {s['precision']}"
     exact = tolerances.GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS and not gusts
     if exact or blown == 0:  # the rule of tests/gpu/test_gpu_dynamic.py and the bench (harness.check.diff_dynamic)
-        r = diff_dynamic.compare(cpu, gpu, frames=[step], exact=exact, check_paper=False)
+        r = diff_dynamic.compare(cpu, gpu, frames=[step], exact=exact, check_paper=False, spread=not exact)
         assert r.equivalent, f"{what}: " + "; ".join(r.failures()[:5])
     else:
         event("gusts and a blown-up CPU frame: compared for finiteness only")
