@@ -19,6 +19,7 @@
 #include "backend.h"
 #include "checked.h"
 #include "cli.h"
+#include "dyn_followers.h"
 #include "dynamics.h"
 #include "dynamics_simd.h"
 #include "host.h"
@@ -46,6 +47,7 @@ typedef struct {
     hb_dyn_model_f64 d64;
     /* simulate (simd): velocities, saved velocities, rest shape as [P][stride], bend rest [P−2][stride] */
     void *pv[3], *pv_saved[3], *pr[3], *pb;
+    hb_followers fl; /* ref with --guides (docs/model.md §3.13) */
 } cpu_impl;
 
 
@@ -181,6 +183,10 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
         snprintf(err, errlen,
                  "--variant simd needs an x86-64-v3 CPU (AVX2 + FMA) and this CPU lacks it; "
                  "use --variant ref");
+        return HB_EXIT_USAGE;
+    }
+    if (s->dyn.guided || s->dyn.lra) { /* docs/cpu_simd.md: not in the simd variant yet */
+        snprintf(err, errlen, "--variant simd does not run %s; use --variant ref", s->dyn.guided ? "--guides" : "--lra");
         return HB_EXIT_USAGE;
     }
     if (s->points > INT32_MAX) {
@@ -607,6 +613,8 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
             hb_dyn_bend_rest_f64(&c->d64, (const double *)c->rest + (size_t)i * stride,
                                  (double *)c->bend_rest + (size_t)i * bstride);
     }
+    hb_followers_free(&c->fl);
+    if (c->scene.dyn.guided && hb_followers_plan(&c->scene, c->rest, &c->fl, err, errlen) != 0) return -1;
     return 0;
 }
 
@@ -618,23 +626,44 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
         if (!scratch) {                                                                                                \
             _Pragma("omp atomic write") failed = 1;                                                                    \
         } else {                                                                                                       \
-            _Pragma("omp for schedule(static)") for (int64_t i = 0; i < N; i++) hb_dyn_frame_strand_##SFX(             \
-                M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride,                            \
-                (const T *)c->rest + (size_t)i * stride, (const T *)c->bend_rest + (size_t)i * bstride, scratch);      \
+            _Pragma("omp for schedule(static)") for (int64_t j = 0; j < NS; j++)                                       \
+            {                                                                                                          \
+                const int64_t i = c->scene.dyn.guided ? c->fl.guide[j] : j;                                            \
+                hb_dyn_frame_strand_##SFX(M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride, \
+                                          (const T *)c->rest + (size_t)i * stride,                                     \
+                                          (const T *)c->bend_rest + (size_t)i * bstride, scratch);                     \
+            }                                                                                                          \
             free(scratch);                                                                                             \
         }                                                                                                              \
     }
+
+/* §3.13: the followers placed from the guides at the frame's end pose, after every guide. */
+static void cpu_place_followers(cpu_impl *c, const hb_dyn_frame *f)
+{
+    const int still = c->scene.dyn.motion == HB_MOTION_STILL;
+    const int64_t last = 9 * (f->substeps - 1);
+    if (c->scene.precision == HB_FP32) {
+#pragma omp parallel for schedule(static)
+        for (int64_t j = 0; j < c->fl.n_followers; j++)
+            hb_follower_place_f32(&c->d32, &c->fl, j, still ? NULL : f->q32 + last, c->state, c->vel, c->rest);
+    } else {
+#pragma omp parallel for schedule(static)
+        for (int64_t j = 0; j < c->fl.n_followers; j++)
+            hb_follower_place_f64(&c->d64, &c->fl, j, still ? NULL : f->q64 + last, c->state, c->vel, c->rest);
+    }
+}
 
 static int cpu_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen)
 {
     cpu_impl *c = b->impl;
     if (c->simd) return simd_dyn_frame(c, f, r, err, errlen);
-    const int64_t N = c->scene.n_strands, P = c->scene.points;
+    const int64_t NS = c->scene.dyn.guided ? c->fl.n_guides : c->scene.n_strands, P = c->scene.points;
     const size_t stride = (size_t)P * 3u, bstride = (size_t)(P - 2 > 0 ? P - 2 : 0);
     int failed = 0;
     const double t0 = hb_now_ms();
     if (c->scene.precision == HB_FP32) DYN_FRAME(float, f32, &c->d32)
     else DYN_FRAME(double, f64, &c->d64)
+    if (c->scene.dyn.guided && !failed) cpu_place_followers(c, f);
     r->ms = hb_now_ms() - t0;
     r->moved_points = -1;
     r->consumed = 1;
@@ -790,6 +819,7 @@ static void cpu_teardown(hb_backend *b)
     free(c->vel_saved);
     free(c->rest);
     free(c->bend_rest);
+    hb_followers_free(&c->fl);
     for (int d = 0; d < 3; d++) {
         free(c->pm[d]);
         free(c->pm_saved[d]);

@@ -11,6 +11,7 @@
 #include "backend.h"
 #include "checked.h"
 #include "cli.h"
+#include "dyn_followers.h"
 #include "host.h"
 #include "philox.h"
 #include "record.h"
@@ -99,7 +100,7 @@ static int list_variants(const hb_backend *b)
         hb_dyn_feature_names(1u << i, name, sizeof name);
         printf("%s\"%s\"", i ? ", " : "", name);
     }
-    printf("]}\n");
+    printf(", \"guides\", \"lra\"]}\n"); /* §3.13's, declared by their own flags */
     return HB_EXIT_OK;
 }
 
@@ -280,7 +281,7 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
 
     r->sim.dynamic = 1;
     r->sim.paper_frames = paper_frames;
-    hb_dyn_feature_names(hb_dyn_features(s), r->sim.features, sizeof r->sim.features);
+    hb_dyn_scene_feature_names(s, r->sim.features, sizeof r->sim.features);
     snprintf(sr->features, sizeof sr->features, "%s", r->sim.features);
     sr->frames = o->frames;
     sr->times_ms = times;

@@ -82,6 +82,11 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
         snprintf(err, errlen, "internal error: variant without simulate reached the simulate setup");
         return -1;
     }
+    if (o->scene.dyn.guided || o->scene.dyn.lra) { /* docs/cuda.md: §3.13 on the GPU is not built yet */
+        snprintf(err, errlen, "the cuda backend does not run %s yet; use hairsim-cpu --variant ref",
+                 o->scene.dyn.guided ? "--guides" : "--lra");
+        return HB_EXIT_USAGE;
+    }
     DynState *d = (DynState *)calloc(1, sizeof *d);
     if (!d) {
         snprintf(err, errlen, "out of host memory");

@@ -1,0 +1,174 @@
+"""Guides and followers, long-range attachments (docs/model.md §3.13) in the C reference:
+known answers. Followers recomputed from a file's guides by harness/check/followers.py match
+bit for bit; the guides of a guided run are the same strands of a full run, bit for bit
+(strands are independent); a follower whose guides are identical to it equals them; an LRA
+bound is never exceeded and is inactive on a relaxed strand. Tiny scenes (≤ 40 strands,
+≤ 12 points, ≤ 8 frames)."""
+
+import h5py
+import numpy as np
+import pytest
+
+from harness.check import followers, invariants_dynamic
+from harness.core.guides import guide_count, guide_strands
+from harness.io.trajectory import open_trajectory
+from support.statecheck import run
+
+TINY = ["--strands", "40", "--points", "12"]
+SIM = ["--stages", "init,collide,simulate"]
+MOVING = ["--substeps", "2", "--iterations", "2", "--bend-compliance", "1e-6", "--head-motion", "nod"]
+
+
+def simulate(cpu_bin, path, *args, frames=6, stages=SIM, scene=TINY):
+    run(cpu_bin, *stages, *scene, "--frames", frames, *args, "--output", path, "--quiet")
+    return path
+
+
+def bits(a):
+    return np.ascontiguousarray(a).view(np.uint8)
+
+
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("motion", ["still", "nod"])
+@pytest.mark.parametrize("follow", ["one", "blend3"])
+def test_followers_recompute_bit_for_bit_from_the_guides(cpu_bin, tmp_path, follow, motion, precision):
+    path = simulate(
+        cpu_bin,
+        tmp_path / "g.h5",
+        *MOVING[:-2],
+        "--head-motion",
+        motion,
+        "--guides",
+        "0.25",
+        "--follow",
+        follow,
+        "--precision",
+        precision,
+        "--velocities",
+        "all",
+    )
+    with open_trajectory(path) as t:
+        assert t.guided and t.follow == follow and "guides" in t.features.split("+")
+        g = guide_count(t.n_strands, float(t.dynamic_params["guides"]))
+        assert g == 10
+        moved = False
+        for f in t.simulated:
+            v = t.velocity_at_step(int(t.step[f]))
+            x_want, v_want = followers.place_followers(t, f, v)
+            x = t.frame(f).reshape(t.n_strands, t.points, 3)
+            assert np.array_equal(bits(x), bits(x_want)), f"frame {f}: followers differ from their recomputation"
+            assert np.array_equal(bits(v.reshape(x.shape)), bits(v_want)), f"frame {f}: follower velocities differ"
+            moved |= not np.array_equal(x, t.rest)
+        assert moved, "the scene must move for the check to mean anything"
+        rep = invariants_dynamic.check(t)
+        assert rep.ok, "; ".join(v.message for v in rep.all_violations()[:5])
+
+
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+def test_guides_move_as_in_a_fully_simulated_run(cpu_bin, tmp_path, solver):
+    full = simulate(cpu_bin, tmp_path / "full.h5", *MOVING, "--solver", solver)
+    guided = simulate(cpu_bin, tmp_path / "g.h5", *MOVING, "--solver", solver, "--guides", "7")
+    with open_trajectory(full) as a, open_trajectory(guided) as b:
+        gs = guide_strands(a.n_strands, 7)
+        for f in a.simulated:
+            xa = a.frame(f).reshape(a.n_strands, a.points, 3)[gs]
+            xb = b.frame(f).reshape(b.n_strands, b.points, 3)[gs]
+            assert np.array_equal(bits(xa), bits(xb)), f"frame {f}: a guide moved otherwise than when all are simulated"
+        followers_idx = np.setdiff1d(np.arange(a.n_strands), gs)
+        last = a.simulated[-1]
+        assert not np.array_equal(
+            a.frame(last).reshape(a.n_strands, a.points, 3)[followers_idx],
+            b.frame(last).reshape(b.n_strands, b.points, 3)[followers_idx],
+        ), "followers are placed, not simulated: they cannot equal the simulated strands"
+
+
+@pytest.mark.parametrize("collider", [False, True])
+@pytest.mark.parametrize("follow", ["one", "blend3"])
+def test_a_follower_whose_guides_are_identical_to_it_equals_them(cpu_bin, tmp_path, follow, collider):
+    """Every strand a copy of strand 0: each follower's guides sit at distance 0, so it is
+    placed exactly on its nearest guide (weight 1), which moves as strand 0 does. With the
+    collider on, the follower's collision projects again a guide point that the guide's own
+    projection left a rounding inside R_c (the projection is not idempotent in floating
+    point): those points, and only those, may differ."""
+    paper = tmp_path / "paper.h5"
+    run(cpu_bin, "--stages", "init,collide", *TINY, "--output", paper, "--quiet")
+    with h5py.File(paper, "r+") as f:
+        pos = f["particles/hair/position/value"]
+        x = pos[-1].reshape(40, 12, 3)
+        x[:] = x[0]
+        pos[-1] = x.reshape(-1, 3)
+    out = tmp_path / "g.h5"
+    extra = [] if collider else ["--no-collider"]
+    run(cpu_bin, "--input", paper, "--stages", "simulate", "--frames", 5, *MOVING, "--guides", "0.25",
+        "--follow", follow, *extra, "--output", out, "--quiet")  # fmt: skip
+    with open_trajectory(out) as t:
+        rc = np.float32(t.collide_radius)
+        for f in t.simulated:
+            x = t.frame(f).reshape(t.n_strands, t.points, 3)
+            same = np.all(bits(x).reshape(40, 12, 3, 4) == bits(x[:1]).reshape(1, 12, 3, 4), axis=(2, 3))
+            g = x[0]
+            inside = np.sqrt((g[:, 0] * g[:, 0] + g[:, 1] * g[:, 1]) + g[:, 2] * g[:, 2]) < rc
+            allowed = inside[None, :] if collider else np.zeros((1, 12), dtype=bool)
+            assert np.all(same | allowed), f"frame {f}: a follower differs from its identical guide"
+        assert not np.array_equal(t.frame(t.simulated[-1]).reshape(40, 12, 3), t.rest), "the scene must move"
+
+
+def _arc_excess(t, scale):
+    """max over written frames and points k ≥ 1 of |x_k − x_0| / (s_L·k·ℓ) − 1, in double."""
+    ell = t.hair_length / (t.points - 1)
+    k = np.arange(1, t.points, dtype=np.float64)
+    worst = -np.inf
+    for f in t.simulated:
+        x = t.frame(f).reshape(t.n_strands, t.points, 3).astype(np.float64)
+        d = np.sqrt(np.sum((x[:, 1:] - x[:, :1]) ** 2, axis=2))
+        worst = max(worst, float(np.max(d / (scale * ell * k) - 1.0)))
+    return worst
+
+
+STRETCHY = ["--precision", "fp64", "--no-collider", "--stretch-compliance", "1e-3", "--head-motion", "nod",
+            "--motion-frequency", "8", "--motion-amplitude", "0.5"]  # fmt: skip
+
+
+@pytest.mark.parametrize("scale", ["1", "1.05"])
+def test_lra_never_lets_a_point_beyond_its_bound(cpu_bin, tmp_path, scale):
+    free = simulate(cpu_bin, tmp_path / "free.h5", *STRETCHY, frames=8)
+    held = simulate(cpu_bin, tmp_path / "lra.h5", *STRETCHY, "--lra", scale, frames=8)
+    with open_trajectory(free) as a, open_trajectory(held) as b:
+        assert _arc_excess(a, float(scale)) > 1e-3, "without LRA this scene must over-stretch"
+        assert "lra" in b.features.split("+")
+        # the projection puts a point at r·(e/|e|): a few roundings of fp64 beyond r at most
+        assert _arc_excess(b, float(scale)) <= 8 * np.finfo(np.float64).eps
+
+
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+def test_lra_is_inactive_on_a_relaxed_strand(cpu_bin, tmp_path, solver):
+    """No gravity, a still head: the groom stays at rest, where no chord from the root is
+    longer than its arc, so LRA must not move a bit. The bound is 0.1 % above the arc: a
+    straight run of segments from the root lies on the arc itself, up to the roundings of
+    its segment lengths (5e-7 relative in fp32 here), where s_L = 1 leaves rounding to decide."""
+    calm = ["--gravity", "0", "--solver", solver, "--bend-compliance", "1e-6"]
+    a = simulate(cpu_bin, tmp_path / "a.h5", *calm, frames=3)
+    b = simulate(cpu_bin, tmp_path / "b.h5", *calm, "--lra", "1.001", frames=3)
+    with open_trajectory(a) as ta, open_trajectory(b) as tb:
+        for f in ta.simulated:
+            assert np.array_equal(bits(ta.frame(f)), bits(tb.frame(f)))
+
+
+BAD = [
+    (["--follow", "one"], "--follow needs --guides"),
+    (["--guides", "0"], "--guides must be a fraction in (0, 1] or a whole count > 1"),
+    (["--guides", "2.5"], "--guides must be a fraction in (0, 1] or a whole count > 1"),
+    (["--guides", "41"], "--guides 41 is more than the 40 strands"),
+    (["--guides", "0.5", "--follow", "two"], "--follow must be one or blend3"),
+    (["--lra", "0.5"], "--lra scale must be a finite number >= 1"),
+    (["--guides", "0.5", "--variant", "simd"], "--variant simd does not run --guides"),
+    (["--lra", "--variant", "simd"], "--variant simd does not run --lra"),
+]
+
+
+@pytest.mark.parametrize("args, message", BAD)
+def test_bad_feature_flags_are_refused_before_any_work(cpu_bin, tmp_path, args, message):
+    out = tmp_path / "o.h5"
+    p = run(cpu_bin, *SIM, *TINY, *args, "--output", out, "--quiet", check=False)
+    assert p.returncode == 2 and message in p.stderr and "Traceback" not in p.stderr
+    assert not out.exists()
