@@ -186,7 +186,8 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
         return HB_EXIT_USAGE;
     }
     if (s->dyn.guided || s->dyn.lra) { /* docs/cpu_simd.md: not in the simd variant yet */
-        snprintf(err, errlen, "--variant simd does not run %s; use --variant ref", s->dyn.guided ? "--guides" : "--lra");
+        snprintf(err, errlen, "--variant simd does not run %s; use --variant ref",
+                 s->dyn.guided ? "--guides" : "--lra");
         return HB_EXIT_USAGE;
     }
     if (s->points > INT32_MAX) {
@@ -629,7 +630,7 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
             _Pragma("omp for schedule(static)") for (int64_t j = 0; j < NS; j++)                                       \
             {                                                                                                          \
                 const int64_t i = c->scene.dyn.guided ? c->fl.guide[j] : j;                                            \
-                hb_dyn_frame_strand_##SFX(M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride, \
+                hb_dyn_frame_strand_##SFX(M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride,  \
                                           (const T *)c->rest + (size_t)i * stride,                                     \
                                           (const T *)c->bend_rest + (size_t)i * bstride, scratch);                     \
             }                                                                                                          \

@@ -159,7 +159,9 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
     for (size_t i = 0; i < N_DYN_FLAGS; i++) {
         char name[64];
         snprintf(name, sizeof name, "%s%s", dyn_flags[i].flag,
-                 dyn_flags[i].kind == DF_SWITCH ? "" : dyn_flags[i].kind == DF_OPTREAL ? " [S]" : " V");
+                 dyn_flags[i].kind == DF_SWITCH    ? ""
+                 : dyn_flags[i].kind == DF_OPTREAL ? " [S]"
+                                                   : " V");
         fprintf(f, "  %-20s %s\n", name, dyn_flags[i].help);
     }
 }

@@ -49,11 +49,11 @@ typedef struct {
     double motion_amplitude; /* A, radians */
     double motion_frequency; /* f, Hz */
     /* docs/model.md §3.13: guides and followers, long-range attachments */
-    int guided;        /* --guides given: only the guides are simulated */
-    double guides;     /* a fraction in (0, 1] of the strands, or a count > 1 */
-    hb_follow follow;  /* how followers are placed from their guides */
-    int lra;           /* --lra given */
-    double lra_scale;  /* s_L ≥ 1: the bound is s_L times the rest arc length */
+    int guided;       /* --guides given: only the guides are simulated */
+    double guides;    /* a fraction in (0, 1] of the strands, or a count > 1 */
+    hb_follow follow; /* how followers are placed from their guides */
+    int lra;          /* --lra given */
+    double lra_scale; /* s_L ≥ 1: the bound is s_L times the rest arc length */
 } hb_dynamics;
 
 /* The scene: everything that decides the bits of a state. */
