@@ -30,7 +30,7 @@ from harness.core.paths import RESULTS, binary_path, display
 from harness.core.scenes import with_frames
 from harness.io import results_data
 from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
-from harness.studies import accuracy_dynamic, animate, featurecost, peer, stability
+from harness.studies import accuracy_dynamic, animate, featurecost, peer, reduced, stability
 from harness.studies.sweep import run_sweep
 
 VALIDATION_STRANDS = 2000
@@ -179,6 +179,9 @@ def studies(root, builds, say, report_dir=None, quick=False):
         for v in fastest_gpu_variants(root / SWEEP):
             say(f"harness: featurecost --backend cuda --variant {v} --strands 1000000")
             featurecost.measure(backend="cuda", variant=v, strands=1_000_000, out=fc / f"cuda-{v}.csv")
+    say(f"harness: reduced{' --quick' if quick else ''}")
+    plan = reduced.Plan.quick(gpu="auto" if builds else "no") if quick else reduced.Plan(gpu="auto" if builds else "no")
+    reduced.measure(plan, out=root / "reduced" / "reduced.csv", progress=say)
     acc_dir = root / accuracy_dynamic.RESULTS_NAME
     gpu = "auto" if builds else "no"
     plan = accuracy_dynamic.Plan.quick(gpu=gpu) if quick else accuracy_dynamic.Plan(gpu=gpu)

@@ -16,7 +16,13 @@ import pandas as pd  # noqa: E402
 
 from harness.core.paths import REPORT, display  # noqa: E402
 from harness.io import results_data  # noqa: E402
-from harness.render import accuracy_dynamic_report, featurecost_report, peer_report, stability_report  # noqa: E402
+from harness.render import (  # noqa: E402
+    accuracy_dynamic_report,
+    featurecost_report,
+    peer_report,
+    reduced_report,
+    stability_report,
+)
 
 
 def _save(fig, path):
@@ -243,6 +249,7 @@ def build(root, report_dir=None):
         cmd = "python -m harness bench --model dynamic"
         lines += [f"Not measured (no `{display(sweep_dir / 'runs.csv')}`): `{cmd}`.", ""]
     lines += featurecost_report.section(sorted((root / "featurecost").glob("*.csv"))) + [""]
+    lines += reduced_report.section(root / "reduced" / "reduced.csv") + [""]
     lines += _study(
         root,
         "dynamic-accuracy",
