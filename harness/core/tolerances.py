@@ -259,6 +259,12 @@ DYN_PENETRATION_K = 8.0
 # FTL segments the collider did not move: |len − ℓ| ≤ 0.45·ε·E in every run (fp32 0.44,
 # fp64 0.45, with and without the collider, FMA build 0.42); 4 is a 8.9× margin.
 DYN_FTL_SEGMENT_K = 4.0
+# Long-range attachments (docs/model.md §3.13): after a frame no point lies farther from its
+# root than its bound s_L·k·ℓ by more than 2·ε of the precision, relative (the C reference,
+# fp64, 40 strands × 12 points, 8 frames of an 8 Hz nod at A = 0.5 rad with α_s = 1e-3, no
+# collider, I = 1, s_L = 1 and 1.05: 1·ε and 2·ε; without LRA the same scene is 2.4 bounds
+# beyond). The projection's three roundings and the root's own; 8 is a 4× margin.
+DYN_LRA_BOUND_EPS = 8.0
 # Kinetic energy recomputed by the harness (strand by strand in order) against the file's
 # (the binary sums in chunks of 1024 strands): bit-equal up to 1000 strands, ≤ 9.9e-15
 # relative at 5000 strands (1.55e5 terms), ≤ 3.9e-16 for the FMA build. Rounding errors of
