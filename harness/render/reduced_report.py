@@ -108,7 +108,10 @@ def section(path):
     lines = ["## Modelling less: guides and followers, long-range attachments", ""]
     p = Path(path)
     if not p.exists():
-        return lines + [f"Not measured (no `{display(p)}`): `python -m harness reduced --out {display(p)}`."]
+        return lines + [
+            f"Not measured here: this results directory has no `{display(p)}` (the study is newer than the run); "
+            f"`python -m harness reduced --out {display(p)}` or `make bench` measures it."
+        ]
     lines += [
         "docs/model.md §3.13. Simulated-point LOD and sag-free rest are not built yet (no rows).",
         "",

@@ -172,3 +172,23 @@ def test_bad_feature_flags_are_refused_before_any_work(cpu_bin, tmp_path, args, 
     p = run(cpu_bin, *SIM, *TINY, *args, "--output", out, "--quiet", check=False)
     assert p.returncode == 2 and message in p.stderr and "Traceback" not in p.stderr
     assert not out.exists()
+
+
+def test_a_guided_run_resumes_bit_for_bit(cpu_bin, tmp_path):
+    """Followers are placed from the guides again after a resume: 3 + 3 frames equal 6."""
+    args = [*MOVING, "--guides", "0.3", "--lra", "1.01"]
+    whole = simulate(cpu_bin, tmp_path / "whole.h5", *args, frames=6)
+    half = simulate(cpu_bin, tmp_path / "half.h5", *args, frames=3)
+    rest = tmp_path / "rest.h5"
+    run(cpu_bin, "--input", half, "--stages", "simulate", "--frames", 3, "--output", rest, "--quiet")
+    with open_trajectory(whole) as a, open_trajectory(rest) as b:
+        assert b.guided and int(b.dynamic_params["lra"]) == 1
+        assert np.array_equal(bits(a.frame(-1)), bits(b.frame(-1)))
+        assert np.array_equal(bits(a.velocity(-1)), bits(b.velocity(-1)))
+
+
+def test_help_and_list_variants_declare_the_features(cpu_bin):
+    text = run(cpu_bin, "--help").stdout
+    assert all(f in text for f in ("--guides V", "--follow V", "--lra [S]"))
+    listed = run(cpu_bin, "--list-variants").stdout
+    assert '"guides", "lra"' in listed
