@@ -50,7 +50,7 @@ SIMD_CFLAGS := -O3 -march=x86-64-v3 -fopenmp-simd -fno-math-errno -fno-trapping-
 CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (model_simd.c, dynamics_simd.c) adds: $(SIMD_CFLAGS)
 
 SHARED_SRC := c_ref/params.c c_ref/cli.c c_ref/state_io.c c_ref/safe_write.c c_ref/h5md_meta.c c_ref/record.c \
-              c_ref/driver.c c_ref/dynamics_host.c c_ref/host.c c_ref/dyn_followers.c
+              c_ref/driver.c c_ref/dynamics_host.c c_ref/host.c c_ref/dyn_followers.c c_ref/dyn_sagfree.c
 SHARED_OBJ := $(SHARED_SRC:c_ref/%.c=$(OBJ)/%.o)
 CPU_SRC    := c_ref/model.c c_ref/model_simd.c c_ref/dynamics_simd.c c_ref/dynamics_f32.c c_ref/dynamics_f64.c c_ref/backend_cpu.c
 CPU_OBJ    := $(CPU_SRC:c_ref/%.c=$(OBJ)/%.o)

@@ -54,6 +54,7 @@ typedef struct {
     hb_follow follow; /* how followers are placed from their guides */
     int lra;          /* --lra given */
     double lra_scale; /* s_L ≥ 1: the bound is s_L times the rest arc length */
+    int sag_free;     /* --sag-free: shape targets that hold the rest shape against gravity */
 } hb_dynamics;
 
 /* The scene: everything that decides the bits of a state. */

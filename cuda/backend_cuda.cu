@@ -38,6 +38,7 @@
 #include "dyn_followers.h"
 #include "dyn_kernels.cuh"
 #include "dyn_post.cuh"
+#include "dyn_sagfree.h"
 #include "host.h"
 #include "kernels.cuh"
 #include "model.h"

@@ -41,6 +41,7 @@ struct DynState {
     hb_followers fl;
     int64_t *d_guide, *d_follower, *d_src;
     void *d_w;
+    void *shape_rest; /* --sag-free: the rest shape the frame kernels read (root, shape targets) */
 };
 
 int dyn_is_strand_major(const cuda_impl *c)
@@ -121,6 +122,7 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
     d->nchunks = (N + hbd::kObsChunk - 1) / hbd::kObsChunk;
     need = sat_add(need, hb_mul_sat((uint64_t)d->nchunks, sizeof(hbd::ObsPartial)));
     d->guided = s->dyn.guided;
+    if (s->dyn.sag_free) need = sat_add(need, c->bytes); /* the raised shape targets */
     if (d->guided) /* guide and follower numbers, up to 3 guides and weights a follower */
         need = sat_add(need, hb_mul_sat((uint64_t)N, 8u + 3u * (8u + rs)));
     if (c->variant == V_STRAND) {
@@ -198,8 +200,8 @@ void dyn_free(cuda_impl *c)
 {
     DynState *d = c->dyn;
     if (!d) return;
-    void *ptrs[] = {d->vel, d->vel_saved, d->rest,    d->bend_rest,  d->scratch, d->q,
-                    d->ph,  d->d_obs,     d->d_guide, d->d_follower, d->d_src,   d->d_w};
+    void *ptrs[] = {d->vel,   d->vel_saved, d->rest,       d->bend_rest, d->scratch, d->q,         d->ph,
+                    d->d_obs, d->d_guide,   d->d_follower, d->d_src,     d->d_w,     d->shape_rest};
     for (void *p : ptrs)
         if (p) cudaFree(p);
     free(d->h_obs);
@@ -262,6 +264,14 @@ template <typename T> int dyn_load_t(cuda_impl *c, const void *velocity, const v
     HB_CUDA_AS(hbd::launch_bend_rest<T>((const T *)d->rest, dyn_layout(c), (T *)d->bend_rest, dyn_bend_layout(c), c->N,
                                         c->P, 0),
                "the bend-rest-length kernel launch");
+    if (c->scene.dyn.sag_free) { /* §3.13: the raised shape targets, made on the host */
+        std::vector<unsigned char> targets((size_t)c->bytes);
+        hb_sagfree_targets(&c->scene, rest, targets.data());
+        int rc;
+        if (!d->shape_rest && (rc = device_alloc(&d->shape_rest, c->bytes, c, "sag-free targets", err, errlen)))
+            return rc;
+        if (dyn_upload<T>(c, d->shape_rest, targets.data(), "uploading the sag-free targets", err, errlen)) return -1;
+    }
     if (d->guided) { /* §3.13: the plan from the rest shape, once, to the device */
         for (void *p : {(void *)d->d_guide, (void *)d->d_follower, (void *)d->d_src, d->d_w})
             if (p) cudaFree(p);
@@ -313,19 +323,20 @@ cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m, const void *q, con
     DynState *d = c->dyn;
     const int64_t *map = d->guided ? d->d_guide : nullptr;
     const int64_t n_run = d->guided ? d->fl.n_guides : c->N;
+    const T *rest = (const T *)(d->shape_rest ? d->shape_rest : d->rest); /* root and shape targets */
     cudaError_t e;
     if (c->variant == V_STRAND)
-        e = hbd::launch_frame_strand<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, (const T *)d->rest,
+        e = hbd::launch_frame_strand<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, rest,
                                         (const T *)d->bend_rest, (T *)d->scratch, c->N, d->grid, c->block, stream, map,
                                         n_run);
     else if (c->variant == V_LANES)
-        e = hbd::launch_frame_lanes<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, (const T *)d->rest,
+        e = hbd::launch_frame_lanes<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, rest,
                                        (const T *)d->bend_rest, c->N, c->block, stream);
     else if (c->variant == V_WARPREG)
-        e = hbd::launch_frame_warpreg<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, (const T *)d->rest,
+        e = hbd::launch_frame_warpreg<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, rest,
                                          (const T *)d->bend_rest, c->N, d->grid, c->block, stream, map, n_run);
     else
-        e = hbd::launch_frame_warp<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, (const T *)d->rest,
+        e = hbd::launch_frame_warp<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, rest,
                                       (const T *)d->bend_rest, c->N, d->grid, c->block, stream, map, n_run);
     if (e != cudaSuccess || !d->guided) return e;
     const T *qe = c->scene.dyn.motion != HB_MOTION_STILL ? (const T *)q + 9 * (d->S - 1) : nullptr;

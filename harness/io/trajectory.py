@@ -65,6 +65,7 @@ DYNAMIC_ATTRS = (
     "follow",
     "lra",
     "lra_scale",
+    "sag_free",
 )
 REQUIRED_DYNAMIC = (
     "paper_frames",

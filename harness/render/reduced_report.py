@@ -28,7 +28,7 @@ def _times(rows):
         col = f"{r['backend']}/{r['variant']}"
         if col not in cols:
             cols.append(col)
-        key = (r["study"], r["solver"], r["iterations"], r["guides"], r["follow"], r["lra"])
+        key = (r["study"], r["solver"], r["iterations"], r["guides"], r["follow"], r["lra"], str(r.get("sag_free", 0)))
         out.setdefault(key, (r, {}))[1][col] = float(r["median_ms"])
     return cols, out
 
@@ -50,7 +50,7 @@ def markdown(rows):
         "| solver | guides | scheme | rms err / L | max err / L | " + " | ".join(f"{c} ms" for c in cols) + " |",
         "| --- | ---: | --- | ---: | ---: |" + " ---: |" * len(cols),
     ]
-    for (study, solver, _i, guides, follow, _lra), (r, t) in cases.items():
+    for (study, solver, _i, guides, follow, _lra, _sag), (r, t) in cases.items():
         if study != "guides":
             continue
         lines.append(
@@ -64,13 +64,28 @@ def markdown(rows):
         "| I | LRA | rms err / L | max err / L | stretch_max | " + " | ".join(f"{c} ms" for c in cols) + " |",
         "| ---: | --- | ---: | ---: | ---: |" + " ---: |" * len(cols),
     ]
-    for (study, _s, it, _g, _f, lra), (r, t) in cases.items():
+    for (study, _s, it, _g, _f, lra, _sag), (r, t) in cases.items():
         if study != "lra":
             continue
         lines.append(
             f"| {it} | {'on' if int(lra) else 'off'} | {float(r['rms_err_L']):.3g} | {float(r['max_err_L']):.3g} | "
             f"{float(r['stretch_max']):.3g} | " + " | ".join(_fmt_ms(t, c) for c in cols) + " |"
         )
+    sag = [(k, v) for k, v in cases.items() if k[0] == "sagfree"]
+    if sag:
+        lines += [
+            "",
+            "Sag-free rest: the scene held still (no head motion, no wind, every point in shape); how far the "
+            "groom moves from its rest shape:",
+            "",
+            "| solver | sag-free | rest rms / L | rest max / L | " + " | ".join(f"{c} ms" for c in cols) + " |",
+            "| --- | --- | ---: | ---: |" + " ---: |" * len(cols),
+        ]
+        for (_st, solver, _i, _g, _f, _l, on), (r, t) in sag:
+            lines.append(
+                f"| {solver} | {'on' if on == '1' else 'off'} | {float(r['rest_rms_L']):.3g} | "
+                f"{float(r['rest_max_L']):.3g} | " + " | ".join(_fmt_ms(t, c) for c in cols) + " |"
+            )
     lines += ["", *recommend(rows)]
     return "\n".join(lines) + "\n"
 
@@ -100,6 +115,12 @@ def recommend(rows):
     helps = [i for (i, on) in lra if on == "1" and lra[(i, "1")] < lra.get((i, "0"), float("inf"))]
     note = f"LRA lowered the error at I = {', '.join(sorted(helps))}" if helps else "LRA did not lower the error here"
     out.append(f"- For an offline render: every strand simulated, and LRA only where it helps ({note}).")
+    sag = {(r["solver"], str(r.get("sag_free"))): float(r["rest_max_L"]) for r in rows if r["study"] == "sagfree"}
+    if ("xpbd", "0") in sag and ("xpbd", "1") in sag:
+        out.append(
+            f"- Sag-free rest for every scene with shape: the still groom moved at most {sag[('xpbd', '1')]:.3g} L "
+            f"with it and {sag[('xpbd', '0')]:.3g} L without (xpbd)."
+        )
     return out
 
 

@@ -7,6 +7,9 @@ Rows of one dynamic scene (default `dynamic`), each run for `seconds` of simulat
            scene's S and I: followers placed from the guides
   lra      solver xpbd × iterations (1, 2) × LRA off/on, at the scene's S, with the head
            nodding at `lra_frequency` Hz (fast enough to over-stretch at few iterations)
+  sagfree  solver × sag-free off/on: the scene held still (no head motion, no wind, every
+           point in shape) for `sag_seconds`; rest_rms_L and rest_max_L, the largest RMS and
+           max displacement from the rest shape over L, say how far the groom sags
 
 Each row's checked run (`strands` strands, fp32, every frame written) is compared frame by
 frame with a reference of the same scene (the LRA rows: with their fast nod) in which every
@@ -41,11 +44,14 @@ FIELDS = (
     "guides",
     "follow",
     "lra",
+    "sag_free",
     "precision",
     "strands",
     "rms_err_L",
     "max_err_L",
     "stretch_max",
+    "rest_rms_L",
+    "rest_max_L",
     "blown_up",
     "backend",
     "variant",
@@ -65,6 +71,7 @@ class Plan:
     ref_substeps: int = 64
     lra_frequency: float = 6.0
     lra_iterations: tuple = (1, 2)
+    sag_seconds: float = 2.0
     time_strands: int = 10_000
     time_gpu_strands: int = 1_000_000
     repeat: int = 3
@@ -72,7 +79,8 @@ class Plan:
 
     @classmethod
     def quick(cls, **changes):
-        return cls(**{**dict(strands=40, seconds=0.1, ref_substeps=16, time_strands=1000), **changes})
+        base = dict(strands=40, seconds=0.1, ref_substeps=16, time_strands=1000, sag_seconds=0.5)
+        return cls(**{**base, **changes})
 
 
 def cases(plan, scene):
@@ -88,6 +96,10 @@ def cases(plan, scene):
     for i in plan.lra_iterations:
         for lra in (0, 1):
             out.append(("lra", "xpbd", s, i, 1.0, "", lra, fast + (["--lra"] if lra else [])))
+    still = ["--head-motion", "still", "--wind-speed", "0", "--shape-range", "1"]
+    for solver in ("xpbd", "ftl"):
+        for sag in (0, 1):
+            out.append(("sagfree", solver, s, it, 1.0, "", 0, still + (["--sag-free"] if sag else [])))
     return out
 
 
@@ -105,7 +117,8 @@ def _positions(path):
         sim = t.simulated
         pos = np.stack([t.frame(f) for f in sim]).astype(np.float64)
         obs = t.observables.set_index("step").reindex(t.step[sim])
-        return pos, float(np.nanmax(obs["stretch_max"])), int(np.max(obs["blown_up_strands"]))
+        rest = t.rest.astype(np.float64)
+        return pos, float(np.nanmax(obs["stretch_max"])), int(np.max(obs["blown_up_strands"])), rest
 
 
 def timing_binaries(plan):
@@ -143,16 +156,22 @@ def measure(plan=Plan(), out=None, work=None, progress=print):
                 refs[key] = _positions(path)[0]
             return refs[key]
 
+        def reference_for(study, extra):
+            if study == "sagfree":
+                return None
+            return reference([] if study == "guides" else extra[:4])
+
         timers = timing_binaries(plan)
         for study, solver, s, it, frac, follow, lra, extra in cases(plan, scene):
-            fast = [] if study == "guides" else extra[:4]
-            ref = reference(fast)
+            ref = reference_for(study, extra)
             path = Path(tmp) / "row.h5"
+            n_frames = max(1, round(plan.sag_seconds / frame_dt)) if study == "sagfree" else frames
             flags = _flags(scene, solver=solver, substeps=s, iterations=it, precision="fp32", strands=plan.strands,
-                           frames=frames, extra=extra, output=path)  # fmt: skip
+                           frames=n_frames, extra=extra, output=path)  # fmt: skip
             runner.run_binary(cpu, flags)
-            pos, stretch, blown = _positions(path)
-            rms, mx = frame_errors(pos, ref, L)
+            pos, stretch, blown, rest = _positions(path)
+            rms, mx = frame_errors(pos, ref, L) if ref is not None else (np.nan, np.nan)
+            sag_rms, sag_max = frame_errors(pos, np.broadcast_to(rest, pos.shape), L)
             base = {
                 "study": study,
                 "solver": solver,
@@ -161,11 +180,14 @@ def measure(plan=Plan(), out=None, work=None, progress=print):
                 "guides": frac,
                 "follow": follow,
                 "lra": lra,
+                "sag_free": int("--sag-free" in extra),
                 "precision": "fp32",
                 "strands": plan.strands,
-                "rms_err_L": float(np.nanmax(rms)),
-                "max_err_L": float(np.nanmax(mx)),
+                "rms_err_L": float(np.max(rms)),  # NaN where there is no reference (sagfree) or a run blew up
+                "max_err_L": float(np.max(mx)),
                 "stretch_max": stretch,
+                "rest_rms_L": float(np.nanmax(sag_rms)),
+                "rest_max_L": float(np.nanmax(sag_max)),
                 "blown_up": blown,
             }
             for backend, variant in timers:

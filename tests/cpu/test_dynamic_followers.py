@@ -163,6 +163,8 @@ BAD = [
     (["--lra", "0.5"], "--lra scale must be a finite number >= 1"),
     (["--guides", "0.5", "--variant", "simd"], "--variant simd does not run --guides"),
     (["--lra", "--variant", "simd"], "--variant simd does not run --lra"),
+    (["--sag-free"], "--sag-free needs --shape-compliance"),
+    (["--shape-compliance", "1e-4", "--sag-free=1"], "--sag-free takes no value"),
 ]
 
 
@@ -189,6 +191,35 @@ def test_a_guided_run_resumes_bit_for_bit(cpu_bin, tmp_path):
 
 def test_help_and_list_variants_declare_the_features(cpu_bin):
     text = run(cpu_bin, "--help").stdout
-    assert all(f in text for f in ("--guides V", "--follow V", "--lra [S]"))
+    assert all(f in text for f in ("--guides V", "--follow V", "--lra [S]", "--sag-free "))
     listed = run(cpu_bin, "--list-variants").stdout
-    assert '"guides", "lra"' in listed
+    assert '"guides", "lra", "sagfree"' in listed
+
+
+STILL = ["--substeps", "8", "--iterations", "2", "--bend-compliance", "1e-6", "--shape-compliance", "1e-4",
+         "--shape-range", "1"]  # fmt: skip
+
+
+def _sag(t):
+    """The largest displacement of any point from its rest position over the written frames, over L."""
+    rest = t.rest.astype(np.float64)
+    return (
+        max(
+            float(np.max(np.linalg.norm(t.frame(f).reshape(rest.shape).astype(np.float64) - rest, axis=2)))
+            for f in t.simulated
+        )
+        / t.hair_length
+    )
+
+
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+def test_sag_free_still_scene_stays_while_the_plain_one_sags(cpu_bin, tmp_path, solver):
+    """2 s of a still head, no wind, every point in shape: with --sag-free the groom stays within
+    DYN_SAGFREE_STILL_MAX_L of its rest shape; without, the same scene sags by more than
+    DYN_SAG_PLAIN_MIN_L (both measured, harness/core/tolerances.py)."""
+    plain = simulate(cpu_bin, tmp_path / "plain.h5", *STILL, "--solver", solver, frames=120)
+    held = simulate(cpu_bin, tmp_path / "held.h5", *STILL, "--solver", solver, "--sag-free", frames=120)
+    with open_trajectory(plain) as a, open_trajectory(held) as b:
+        assert int(b.dynamic_params["sag_free"]) == 1 and "sagfree" in b.features.split("+")
+        assert _sag(a) > tolerances.DYN_SAG_PLAIN_MIN_L, _sag(a)
+        assert _sag(b) < tolerances.DYN_SAGFREE_STILL_MAX_L, _sag(b)
