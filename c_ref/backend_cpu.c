@@ -19,6 +19,8 @@
 #include "runtime/backend.h"
 #include "runtime/checked.h"
 #include "runtime/cli.h"
+#include "dynamic/dyn_followers.h"
+#include "dynamic/dyn_sagfree.h"
 #include "dynamic/dynamics.h"
 #include "simd/dynamics_simd.h"
 #include "runtime/host.h"
@@ -46,6 +48,8 @@ typedef struct {
     hb_dyn_model_f64 d64;
     /* simulate (simd): velocities, saved velocities, rest shape as [P][stride], bend rest [P−2][stride] */
     void *pv[3], *pv_saved[3], *pr[3], *pb;
+    hb_followers fl;  /* ref with --guides (docs/model.md §3.14) */
+    void *shape_rest; /* ref with --sag-free: the rest shape the frame reads (root, shape targets) */
 } cpu_impl;
 
 
@@ -80,7 +84,8 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     uint64_t bend_bytes; /* saturated sizes: the memory check below refuses them */
     hb_mul3_u64((uint64_t)o->scene.n_strands, (uint64_t)(o->scene.points - 2 > 0 ? o->scene.points - 2 : 1),
                 hb_real_size(o->scene.precision), &bend_bytes);
-    const uint64_t dyn = c->dynamic ? hb_add_sat(hb_mul_sat(c->bytes, need_save ? 3u : 2u), bend_bytes) : 0;
+    const unsigned copies = (need_save ? 3u : 2u) + (o->scene.dyn.sag_free ? 1u : 0u);
+    const uint64_t dyn = c->dynamic ? hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes) : 0;
     const uint64_t need = hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, need_save ? 2u : 1u), dyn), driver_bytes);
     if (need == UINT64_MAX) {
         snprintf(err, errlen, "--strands x --points: the run's memory does not fit in 64 bits");
@@ -99,6 +104,7 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
         c->rest = malloc(c->bytes);
         c->bend_rest = malloc(bend_bytes);
         if (need_save) c->vel_saved = malloc(c->bytes);
+        if (o->scene.dyn.sag_free) bad |= !(c->shape_rest = malloc(c->bytes));
         bad |= !c->vel || !c->rest || !c->bend_rest || (need_save && !c->vel_saved);
         hb_dyn_round(&o->scene, &c->d32, &c->d64);
     }
@@ -181,6 +187,10 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
         snprintf(err, errlen,
                  "--variant simd needs an x86-64-v3 CPU (AVX2 + FMA) and this CPU lacks it; "
                  "use --variant ref");
+        return HB_EXIT_USAGE;
+    }
+    if (s->dyn.guided) { /* docs/cpu_simd.md: not in the simd variant yet */
+        snprintf(err, errlen, "--variant simd does not run --guides; use --variant ref");
         return HB_EXIT_USAGE;
     }
     if (s->points > INT32_MAX) {
@@ -357,6 +367,13 @@ static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
 #pragma omp parallel for schedule(static)
         for (int64_t b = 0; b < nb; b++)
             hb_simd_dyn_bend_rest_block_f64(&c->d64, RX + b * DB, RY + b * DB, RZ + b * DB, BR + b * DB, S);
+    }
+    if (c->scene.dyn.sag_free) { /* §3.14: the frame's rest rows become the raised targets */
+        void *targets = malloc(hb_state_bytes(&c->scene));
+        if (!targets) return -1;
+        hb_sagfree_targets(&c->scene, rest, targets);
+        simd_convert(c, c->pr, targets, 1);
+        free(targets);
     }
     return 0;
 }
@@ -551,7 +568,11 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
     (void)err;
     (void)errlen;
     cpu_impl *c = b->impl;
-    if (c->simd) return simd_dyn_load(c, velocity, rest);
+    if (c->simd && simd_dyn_load(c, velocity, rest) != 0) {
+        snprintf(err, errlen, "out of host memory for the sag-free shape targets");
+        return -1;
+    }
+    if (c->simd) return 0;
     const int64_t N = c->scene.n_strands, P = c->scene.points;
     const size_t stride = (size_t)P * 3u, bstride = (size_t)(P - 2 > 0 ? P - 2 : 0);
     if (velocity) memcpy(c->vel, velocity, c->bytes);
@@ -568,6 +589,9 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
             hb_dyn_bend_rest_f64(&c->d64, (const double *)c->rest + (size_t)i * stride,
                                  (double *)c->bend_rest + (size_t)i * bstride);
     }
+    if (c->shape_rest) hb_sagfree_targets(&c->scene, c->rest, c->shape_rest); /* §3.14 */
+    hb_followers_free(&c->fl);
+    if (c->scene.dyn.guided && hb_followers_plan(&c->scene, c->rest, &c->fl, err, errlen) != 0) return -1;
     return 0;
 }
 
@@ -579,23 +603,44 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
         if (!scratch) {                                                                                                \
             _Pragma("omp atomic write") failed = 1;                                                                    \
         } else {                                                                                                       \
-            _Pragma("omp for schedule(static)") for (int64_t i = 0; i < N; i++) hb_dyn_frame_strand_##SFX(             \
-                M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride,                            \
-                (const T *)c->rest + (size_t)i * stride, (const T *)c->bend_rest + (size_t)i * bstride, scratch);      \
+            _Pragma("omp for schedule(static)") for (int64_t j = 0; j < NS; j++)                                       \
+            {                                                                                                          \
+                const int64_t i = c->scene.dyn.guided ? c->fl.guide[j] : j;                                            \
+                hb_dyn_frame_strand_##SFX(M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride,  \
+                                          (const T *)(c->shape_rest ? c->shape_rest : c->rest) + (size_t)i * stride,   \
+                                          (const T *)c->bend_rest + (size_t)i * bstride, scratch);                     \
+            }                                                                                                          \
             free(scratch);                                                                                             \
         }                                                                                                              \
     }
+
+/* §3.14: the followers placed from the guides at the frame's end pose, after every guide. */
+static void cpu_place_followers(cpu_impl *c, const hb_dyn_frame *f)
+{
+    const int still = c->scene.dyn.motion == HB_MOTION_STILL;
+    const int64_t last = 9 * (f->substeps - 1);
+    if (c->scene.precision == HB_FP32) {
+#pragma omp parallel for schedule(static)
+        for (int64_t j = 0; j < c->fl.n_followers; j++)
+            hb_follower_place_f32(&c->d32, &c->fl, j, still ? NULL : f->q32 + last, c->state, c->vel, c->rest);
+    } else {
+#pragma omp parallel for schedule(static)
+        for (int64_t j = 0; j < c->fl.n_followers; j++)
+            hb_follower_place_f64(&c->d64, &c->fl, j, still ? NULL : f->q64 + last, c->state, c->vel, c->rest);
+    }
+}
 
 static int cpu_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen)
 {
     cpu_impl *c = b->impl;
     if (c->simd) return simd_dyn_frame(c, f, r, err, errlen);
-    const int64_t N = c->scene.n_strands, P = c->scene.points;
+    const int64_t NS = c->scene.dyn.guided ? c->fl.n_guides : c->scene.n_strands, P = c->scene.points;
     const size_t stride = (size_t)P * 3u, bstride = (size_t)(P - 2 > 0 ? P - 2 : 0);
     int failed = 0;
     const double t0 = hb_now_ms();
     if (c->scene.precision == HB_FP32) DYN_FRAME(float, f32, &c->d32)
     else DYN_FRAME(double, f64, &c->d64)
+    if (c->scene.dyn.guided && !failed) cpu_place_followers(c, f);
     r->ms = hb_now_ms() - t0;
     r->moved_points = -1;
     r->consumed = 1;
@@ -751,6 +796,8 @@ static void cpu_teardown(hb_backend *b)
     free(c->vel_saved);
     free(c->rest);
     free(c->bend_rest);
+    free(c->shape_rest);
+    hb_followers_free(&c->fl);
     for (int d = 0; d < 3; d++) {
         free(c->pm[d]);
         free(c->pm_saved[d]);

@@ -49,6 +49,12 @@ struct DynState {
     hbd::DModel<float> m32;
     hbd::DModel<double> m64;
     hbd::ObsScene obs;
+    /* §3.14 guides and followers (cuda/dyn_post.cu): the plan on the host and the device */
+    int guided;
+    hb_followers fl;
+    int64_t *d_guide, *d_follower, *d_src;
+    void *d_w;
+    void *shape_rest; /* --sag-free: the rest shape the frame kernels read (root, shape targets) */
 };
 
 int dyn_is_strand_major(const cuda_impl *c)
@@ -95,6 +101,11 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
         snprintf(err, errlen, "internal error: variant without simulate reached the simulate setup");
         return -1;
     }
+    if (c->variant == V_LANES && (o->scene.dyn.guided || o->scene.dyn.lra)) { /* docs/cuda.md */
+        snprintf(err, errlen, "--variant lanes does not run %s; use strand, warp or warpreg",
+                 o->scene.dyn.guided ? "--guides" : "--lra");
+        return HB_EXIT_USAGE;
+    }
     DynState *d = (DynState *)calloc(1, sizeof *d);
     if (!d) {
         snprintf(err, errlen, "out of host memory");
@@ -123,6 +134,10 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
     need = sat_add(need, hb_mul_sat((uint64_t)d->S, 10u * rs));
     d->nchunks = (N + hbd::kObsChunk - 1) / hbd::kObsChunk;
     need = sat_add(need, hb_mul_sat((uint64_t)d->nchunks, sizeof(hbd::ObsPartial)));
+    d->guided = s->dyn.guided;
+    if (s->dyn.sag_free) need = sat_add(need, c->bytes); /* the raised shape targets */
+    if (d->guided) /* guide and follower numbers, up to 3 guides and weights a follower */
+        need = sat_add(need, hb_mul_sat((uint64_t)N, 8u + 3u * (8u + rs)));
     if (c->variant == V_STRAND) {
         const int64_t resident = (int64_t)prop.multiProcessorCount * prop.maxThreadsPerMultiProcessor;
         d->grid = dyn_strand_grid(N, c->block, resident);
@@ -198,11 +213,13 @@ void dyn_free(cuda_impl *c)
 {
     DynState *d = c->dyn;
     if (!d) return;
-    void *ptrs[] = {d->vel, d->vel_saved, d->rest, d->bend_rest, d->scratch, d->q, d->ph, d->d_obs};
+    void *ptrs[] = {d->vel,   d->vel_saved, d->rest,       d->bend_rest, d->scratch, d->q,         d->ph,
+                    d->d_obs, d->d_guide,   d->d_follower, d->d_src,     d->d_w,     d->shape_rest};
     for (void *p : ptrs)
         if (p) cudaFree(p);
     free(d->h_obs);
     free(d->h_part);
+    hb_followers_free(&d->fl);
     free(d);
     c->dyn = NULL;
 }
@@ -261,6 +278,35 @@ static int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char
     HB_CUDA_AS(hbd::launch_bend_rest<T>((const T *)d->rest, dyn_layout(c), (T *)d->bend_rest, dyn_bend_layout(c), c->N,
                                         c->P, 0),
                "the bend-rest-length kernel launch");
+    if (c->scene.dyn.sag_free) { /* §3.14: the raised shape targets, made on the host */
+        std::vector<unsigned char> targets((size_t)c->bytes);
+        hb_sagfree_targets(&c->scene, rest, targets.data());
+        int rc;
+        if (!d->shape_rest && (rc = device_alloc(&d->shape_rest, c->bytes, c, "sag-free targets", err, errlen)))
+            return rc;
+        if (dyn_upload<T>(c, d->shape_rest, targets.data(), "uploading the sag-free targets", err, errlen)) return -1;
+    }
+    if (d->guided) { /* §3.14: the plan from the rest shape, once, to the device */
+        for (void *p : {(void *)d->d_guide, (void *)d->d_follower, (void *)d->d_src, d->d_w})
+            if (p) cudaFree(p);
+        d->d_guide = d->d_follower = d->d_src = NULL;
+        d->d_w = NULL;
+        hb_followers_free(&d->fl);
+        if (hb_followers_plan(&c->scene, rest, &d->fl, err, errlen)) return HB_EXIT_MEMORY;
+        const hb_followers *fl = &d->fl;
+        const uint64_t nf = (uint64_t)(fl->n_followers > 0 ? fl->n_followers : 1), nw = nf * (uint64_t)fl->width;
+        int rc;
+        if ((rc = device_alloc((void **)&d->d_guide, (uint64_t)fl->n_guides * 8u, c, "guide list", err, errlen)) ||
+            (rc = device_alloc((void **)&d->d_follower, nf * 8u, c, "follower list", err, errlen)) ||
+            (rc = device_alloc((void **)&d->d_src, nw * 8u, c, "followers' guides", err, errlen)) ||
+            (rc = device_alloc(&d->d_w, nw * sizeof(T), c, "followers' weights", err, errlen)))
+            return rc;
+        const void *w = sizeof(T) == sizeof(float) ? (const void *)fl->w32 : (const void *)fl->w64;
+        HB_CUDA(cudaMemcpy(d->d_guide, fl->guide, (size_t)fl->n_guides * 8u, cudaMemcpyHostToDevice));
+        HB_CUDA(cudaMemcpy(d->d_follower, fl->follower, (size_t)nf * 8u, cudaMemcpyHostToDevice));
+        HB_CUDA(cudaMemcpy(d->d_src, fl->src, (size_t)nw * 8u, cudaMemcpyHostToDevice));
+        HB_CUDA(cudaMemcpy(d->d_w, w, (size_t)nw * sizeof(T), cudaMemcpyHostToDevice));
+    }
     if (c->variant == V_WARP) {
         const size_t smem = hbd::warp_smem_bytes<T>(c->P) * (size_t)(c->block / 32);
         HB_CUDA_AS(hbd::prepare_warp<T>(d->m64.features, smem), "raising the warp kernel's shared-memory limit");
@@ -283,24 +329,34 @@ int cuda_dyn_load(hb_backend *b, const void *velocity, const void *rest, char *e
                                          : dyn_load_t<double>(c, velocity, rest, err, errlen);
 }
 
-/* One frame's kernel on `stream`, with the frame's tables q [S][9] and ph [S] on the device. */
+/* One frame's kernel on `stream`, with the frame's tables q [S][9] and ph [S] on the device;
+ * in a guided run (§3.14) only the guides, then the followers' placement kernel. */
 template <typename T>
 static cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m, const void *q, const void *ph, cudaStream_t stream)
 {
     DynState *d = c->dyn;
+    const int64_t *map = d->guided ? d->d_guide : nullptr;
+    const int64_t n_run = d->guided ? d->fl.n_guides : c->N;
+    const T *rest = (const T *)(d->shape_rest ? d->shape_rest : d->rest); /* root and shape targets */
+    cudaError_t e;
     if (c->variant == V_STRAND)
-        return hbd::launch_frame_strand<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel,
-                                           (const T *)d->rest, (const T *)d->bend_rest, (T *)d->scratch, c->N, d->grid,
-                                           c->block, stream);
-    if (c->variant == V_LANES)
-        return hbd::launch_frame_lanes<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel,
-                                          (const T *)d->rest, (const T *)d->bend_rest, c->N, c->block, stream);
-    if (c->variant == V_WARPREG)
-        return hbd::launch_frame_warpreg<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel,
-                                            (const T *)d->rest, (const T *)d->bend_rest, c->N, d->grid, c->block,
-                                            stream);
-    return hbd::launch_frame_warp<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, (const T *)d->rest,
-                                     (const T *)d->bend_rest, c->N, d->grid, c->block, stream);
+        e = hbd::launch_frame_strand<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, rest,
+                                        (const T *)d->bend_rest, (T *)d->scratch, c->N, d->grid, c->block, stream, map,
+                                        n_run);
+    else if (c->variant == V_LANES)
+        e = hbd::launch_frame_lanes<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, rest,
+                                       (const T *)d->bend_rest, c->N, c->block, stream);
+    else if (c->variant == V_WARPREG)
+        e = hbd::launch_frame_warpreg<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, rest,
+                                         (const T *)d->bend_rest, c->N, d->grid, c->block, stream, map, n_run);
+    else
+        e = hbd::launch_frame_warp<T>(m, (const T *)q, (const T *)ph, (T *)c->state, (T *)d->vel, rest,
+                                      (const T *)d->bend_rest, c->N, d->grid, c->block, stream, map, n_run);
+    if (e != cudaSuccess || !d->guided) return e;
+    const T *qe = c->scene.dyn.motion != HB_MOTION_STILL ? (const T *)q + 9 * (d->S - 1) : nullptr;
+    return hbd::launch_place_followers<T>(m, qe, (T *)c->state, (T *)d->vel, (const T *)d->rest, dyn_layout(c),
+                                          d->d_follower, d->d_src, (const T *)d->d_w, d->fl.width, d->fl.n_followers,
+                                          stream);
 }
 
 static const char *dyn_launch_name(const cuda_impl *c)

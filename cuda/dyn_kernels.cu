@@ -44,7 +44,7 @@ struct Lanes {
 template <typename T, class Feat>
 __global__ void __launch_bounds__(kMaxThreads)
     k_strand(DModel<T> m, const T *__restrict__ q, const T *__restrict__ ph, T *x, T *v, const T *rest,
-             const T *bend_rest, T *scratch, int64_t N)
+             const T *bend_rest, T *scratch, int64_t N, const int64_t *map, int64_t n_run)
 {
     const Feat has = MakeFeat<Feat>::make(m.features);
     const int64_t nt = (int64_t)gridDim.x * blockDim.x;
@@ -54,7 +54,8 @@ __global__ void __launch_bounds__(kMaxThreads)
     s.p = Arr<T>{scratch + t, nt, P * nt};
     s.lam = Arr1<T>{scratch + 3 * P * nt + t, nt};
     s.d = Arr<T>{scratch + 6 * P * nt + t, nt, P * nt};
-    for (int64_t i = t; i < N; i += nt) {
+    for (int64_t j = t; j < n_run; j += nt) {
+        const int64_t i = map ? map[j] : j; /* §3.14: only the guides, when guided */
         s.x = Arr<T>{x + i, N, NP};
         s.v = Arr<T>{v + i, N, NP};
         s.rest = Arr<const T>{rest + i, N, NP};
@@ -70,8 +71,9 @@ template <typename T> __host__ __device__ constexpr int64_t warp_reals(int64_t P
 } /* x, v, p, d [3][P]; λ [3P] */
 
 template <typename T, class Feat>
-__global__ void __launch_bounds__(kMaxThreads) k_warp(DModel<T> m, const T *__restrict__ q, const T *__restrict__ ph,
-                                                      T *x, T *v, const T *rest, const T *bend_rest, int64_t N)
+__global__ void __launch_bounds__(kMaxThreads)
+    k_warp(DModel<T> m, const T *__restrict__ q, const T *__restrict__ ph, T *x, T *v, const T *rest,
+           const T *bend_rest, int64_t N, const int64_t *map, int64_t n_run)
 {
     extern __shared__ __align__(16) unsigned char hb_dyn_smem[];
     const Feat has = MakeFeat<Feat>::make(m.features);
@@ -86,7 +88,9 @@ __global__ void __launch_bounds__(kMaxThreads) k_warp(DModel<T> m, const T *__re
     s.lam = Arr1<T>{base + 12 * P, 1};
     const Lanes ex{lane};
     /* the loop bound is the same for every lane of a warp: whole warps take each strand */
-    for (int64_t i = (int64_t)blockIdx.x * wpb + w; i < N; i += (int64_t)gridDim.x * wpb) {
+    (void)N;
+    for (int64_t j = (int64_t)blockIdx.x * wpb + w; j < n_run; j += (int64_t)gridDim.x * wpb) {
+        const int64_t i = map ? map[j] : j; /* §3.14: only the guides, when guided */
         T *gx = x + i * P3, *gv = v + i * P3;
         for (int64_t e = lane; e < P3; e += 32) { /* coalesced: the strand's 3P reals in a row */
             base[(e % 3) * P + e / 3] = gx[e];
@@ -149,7 +153,7 @@ template <typename T> __device__ __forceinline__ void move_plus(const Step<T> &s
 template <typename T, class Feat>
 __global__ void __launch_bounds__(kMaxThreads)
     k_warpreg(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
-              const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N)
+              const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N, const int64_t *map, int64_t n_run)
 {
     const Feat has = MakeFeat<Feat>::make(m.features);
     const int k = (int)(threadIdx.x & 31u), w = (int)(threadIdx.x >> 5), wpb = (int)(blockDim.x >> 5);
@@ -161,7 +165,9 @@ __global__ void __launch_bounds__(kMaxThreads)
     const bool xpbd = m.solver == HB_SOLVER_XPBD;
     const T h = m.h;
     /* the loop bound is the same for every lane of a warp: whole warps take each strand */
-    for (int64_t i = (int64_t)blockIdx.x * wpb + w; i < N; i += (int64_t)gridDim.x * wpb) {
+    (void)N;
+    for (int64_t j = (int64_t)blockIdx.x * wpb + w; j < n_run; j += (int64_t)gridDim.x * wpb) {
+        const int64_t i = map ? map[j] : j; /* §3.14: only the guides, when guided */
         const int64_t at = i * 3 * (int64_t)P + 3 * k;
         T x0 = 0, x1 = 0, x2 = 0, v0 = 0, v1 = 0, v2 = 0, r0 = 0, r1 = 0, r2 = 0, br = 0;
         if (on) {
@@ -230,6 +236,11 @@ __global__ void __launch_bounds__(kMaxThreads)
                 }
                 shape_pull(p0, p1, p2, t, m.shape_at, lg);
             };
+            auto lra = [&]() { /* §3.14: every lane reads the root's p from lane 0 */
+                               const T a0 = __shfl_sync(kFull, p0, 0), a1 = __shfl_sync(kFull, p1, 0),
+                                       a2 = __shfl_sync(kFull, p2, 0);
+                               if (inner) lra_point(a0, a1, a2, p0, p1, p2, m.lra_len, (int64_t)k);
+            };
             if (xpbd) {
                 for (int64_t it = 0; it < m.iterations; it++) {
                     stretch(1);
@@ -239,6 +250,7 @@ __global__ void __launch_bounds__(kMaxThreads)
                         bend(1);
                     }
                     if (has(HB_F_SHAPE)) shape();
+                    if (m.lra) lra();
                     if (has(HB_F_COLLIDE) && inner) collide_sphere(p0, p1, p2, m.collide_r);
                 }
             } else {
@@ -248,6 +260,7 @@ __global__ void __launch_bounds__(kMaxThreads)
                         bend(1);
                     }
                     if (has(HB_F_SHAPE)) shape();
+                    if (m.lra) lra();
                 }
                 /* §3.7 follow the leader, k ascending: lane kk follows lane kk−1's corrected point */
                 for (int kk = 1; kk < P; kk++) {
@@ -286,8 +299,11 @@ __global__ void __launch_bounds__(kMaxThreads)
 
 /* ---- the dispatch tables ---- */
 template <typename T>
-using StrandFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, const T *, T *, int64_t);
-template <typename T> using WarpFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, const T *, int64_t);
+using StrandFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, const T *, T *, int64_t,
+                          const int64_t *, int64_t);
+template <typename T>
+using WarpFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, const T *, int64_t, const int64_t *,
+                        int64_t);
 /* k_warp and k_warpreg share a signature */
 
 template <typename T, unsigned F> constexpr StrandFn<T> strand_entry()
@@ -356,11 +372,12 @@ int grid_for(int64_t items, int per_block)
 
 template <typename T>
 cudaError_t launch_frame_strand(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
-                                const T *bend_rest, T *scratch, int64_t N, int grid, int block, cudaStream_t stream)
+                                const T *bend_rest, T *scratch, int64_t N, int grid, int block, cudaStream_t stream,
+                                const int64_t *map, int64_t n_run)
 {
     if (!valid_mask(m.features)) return cudaErrorInvalidValue;
     const StrandFn<T> fn = TablesT<T>::strand[m.features];
-    fn<<<grid, block, 0, stream>>>(m, q, phase, x, v, rest, bend_rest, scratch, N);
+    fn<<<grid, block, 0, stream>>>(m, q, phase, x, v, rest, bend_rest, scratch, N, map, map ? n_run : N);
     return cudaGetLastError();
 }
 
@@ -377,22 +394,24 @@ template <typename T> cudaError_t prepare_warp(unsigned features, size_t bytes)
 
 template <typename T>
 cudaError_t launch_frame_warp(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
-                              const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream)
+                              const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream,
+                              const int64_t *map, int64_t n_run)
 {
     if (!valid_mask(m.features)) return cudaErrorInvalidValue;
     const WarpFn<T> fn = TablesT<T>::warp[m.features];
     const size_t smem = warp_smem_bytes<T>(m.points) * (size_t)(block / 32);
-    fn<<<grid, block, smem, stream>>>(m, q, phase, x, v, rest, bend_rest, N);
+    fn<<<grid, block, smem, stream>>>(m, q, phase, x, v, rest, bend_rest, N, map, map ? n_run : N);
     return cudaGetLastError();
 }
 
 template <typename T>
 cudaError_t launch_frame_warpreg(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
-                                 const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream)
+                                 const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream,
+                                 const int64_t *map, int64_t n_run)
 {
     if (!valid_mask(m.features) || m.points > kWarpregMaxPoints) return cudaErrorInvalidValue;
     const WarpFn<T> fn = TablesT<T>::warpreg[m.features];
-    fn<<<grid, block, 0, stream>>>(m, q, phase, x, v, rest, bend_rest, N);
+    fn<<<grid, block, 0, stream>>>(m, q, phase, x, v, rest, bend_rest, N, map, map ? n_run : N);
     return cudaGetLastError();
 }
 
@@ -413,11 +432,13 @@ cudaError_t launch_observe(const ObsScene &sc, const T *x, const T *v, Layout la
 
 #define HB_DYN_INSTANTIATE(T)                                                                                          \
     template cudaError_t launch_frame_strand<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,          \
-                                                const T *, T *, int64_t, int, int, cudaStream_t);                      \
+                                                const T *, T *, int64_t, int, int, cudaStream_t, const int64_t *,      \
+                                                int64_t);                                                              \
     template cudaError_t launch_frame_warp<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *, const T *, \
-                                              int64_t, int, int, cudaStream_t);                                        \
+                                              int64_t, int, int, cudaStream_t, const int64_t *, int64_t);              \
     template cudaError_t launch_frame_warpreg<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,         \
-                                                 const T *, int64_t, int, int, cudaStream_t);                          \
+                                                 const T *, int64_t, int, int, cudaStream_t, const int64_t *,          \
+                                                 int64_t);                                                             \
     template size_t warp_smem_bytes<T>(int64_t);                                                                       \
     template cudaError_t prepare_warp<T>(unsigned, size_t);                                                            \
     template cudaError_t launch_bend_rest<T>(const T *, Layout, T *, Layout1, int64_t, int64_t, cudaStream_t);         \

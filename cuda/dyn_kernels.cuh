@@ -92,20 +92,25 @@ constexpr bool specialised_mask(unsigned f)
 }
 
 
+/* map (with n_run entries): the strands to simulate, the guides of docs/model.md §3.14;
+ * nullptr simulates all N. */
+
 /* The strand variant: one thread per strand, all S substeps of the frame in one launch.
  * x, v, rest: point-major X|Y|Z [P][N]; bend_rest [P−2][N]; scratch: 9·P·threads reals
  * (p, λ, d of each thread, interleaved so that a warp's accesses coalesce), threads =
  * grid·block. q, phase: the frame's tables on the device ([S][9], [S]). */
 template <typename T>
 cudaError_t launch_frame_strand(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
-                                const T *bend_rest, T *scratch, int64_t N, int grid, int block, cudaStream_t stream);
+                                const T *bend_rest, T *scratch, int64_t N, int grid, int block, cudaStream_t stream,
+                                const int64_t *map = nullptr, int64_t n_run = 0);
 
 /* The warp variant: one warp per strand (block/32 strands per block), the strand's x, v, p,
  * λ and d in shared memory (warp_smem_bytes per warp). x, v, rest canonical [N][P][3];
  * bend_rest [N][P−2]. */
 template <typename T>
 cudaError_t launch_frame_warp(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
-                              const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream);
+                              const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream,
+                              const int64_t *map = nullptr, int64_t n_run = 0);
 template <typename T> size_t warp_smem_bytes(int64_t P);
 
 /* The warpreg variant: one warp per strand, lane k holds point k in registers and
@@ -114,7 +119,8 @@ template <typename T> size_t warp_smem_bytes(int64_t P);
 constexpr int64_t kWarpregMaxPoints = 32;
 template <typename T>
 cudaError_t launch_frame_warpreg(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
-                                 const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream);
+                                 const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream,
+                                 const int64_t *map = nullptr, int64_t n_run = 0);
 /* The lanes variant (cuda/dyn_lanes.cu): L lanes a strand, G consecutive points a lane in
  * registers (xpbd: L = 16, G = 2, 4, 8; ftl: fewer lanes with more points), P ≤
  * kLanesMaxPoints; x, v, rest canonical [N][P][3], bend_rest [N][P−2]; lanes_smem_bytes of

@@ -56,6 +56,8 @@ template <typename T> struct DModel {
      * computed once in double from the rounded constants and rounded once: 1/h, 1/D,
      * 1/(W + α̃) for W = 1 (root) and 2 of stretch and bend, 1/(1 + α̃_g), R_c² */
     T inv_h, inv_den, inv_s1, inv_s2, inv_b1, inv_b2, inv_g, rc2;
+    int lra; /* §3.14 long-range attachments: a run-time switch */
+    T lra_len;
 };
 
 template <typename T, typename M> inline DModel<T> dmodel_from(const M &m)
@@ -82,6 +84,8 @@ template <typename T, typename M> inline DModel<T> dmodel_from(const M &m)
     r.shape_at = m.shape_at;
     r.collide_r = m.collide_r;
     r.ftl_s = m.ftl_s;
+    r.lra = m.lra;
+    r.lra_len = m.lra_len;
     r.inv_h = (T)(1.0 / (double)r.h);
     r.inv_den = (T)(1.0 / (double)r.den);
     r.inv_s1 = (T)(1.0 / (1.0 + (double)r.stretch_at));
@@ -250,6 +254,20 @@ template <typename T> HB_DHD void collide_sphere(T &p0, T &p1, T &p2, T rc)
     p2 = p2 * sc;
 }
 
+/* §3.14 long-range attachment of point k to its root a: |p − a| ≤ (s_L·ℓ)·k */
+template <typename T> HB_DHD void lra_point(T a0, T a1, T a2, T &p0, T &p1, T &p2, T len, int64_t k)
+{
+    const T ex = p0 - a0, ey = p1 - a1, ez = p2 - a2;
+    const T d = d_sqrt(ex * ex + ey * ey + ez * ez);
+    const T r = len * (T)k;
+    if (d > r) {
+        const T sc = r / d;
+        p0 = a0 + ex * sc;
+        p1 = a1 + ey * sc;
+        p2 = a2 + ez * sc;
+    }
+}
+
 /* §3.4 step 1: the root on the head, x0 ← Q·X̄0, v0 ← (x0_new − x0_old)/h. */
 template <typename T> HB_DHD void root_step(const T *q, T r0, T r1, T r2, T h, T &x0, T &x1, T &x2, T &v0, T &v1, T &v2)
 {
@@ -415,6 +433,10 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
                     bend_group(m, s, ex, 1);
                 }
                 if (has(HB_F_SHAPE)) shape_all(m, s, q, ex, has);
+                if (m.lra)
+                    ex.each(1, P, 1, [&](int64_t k) {
+                        lra_point(p(0, 0), p(0, 1), p(0, 2), p(k, 0), p(k, 1), p(k, 2), m.lra_len, k);
+                    });
                 if (has(HB_F_COLLIDE))
                     ex.each(1, P, 1, [&](int64_t k) { collide_sphere(p(k, 0), p(k, 1), p(k, 2), m.collide_r); });
             }
@@ -425,6 +447,10 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
                     bend_group(m, s, ex, 1);
                 }
                 if (has(HB_F_SHAPE)) shape_all(m, s, q, ex, has);
+                if (m.lra)
+                    ex.each(1, P, 1, [&](int64_t k) {
+                        lra_point(p(0, 0), p(0, 1), p(0, 2), p(k, 0), p(k, 1), p(k, 2), m.lra_len, k);
+                    });
             }
             /* §3.7 follow the leader, k ascending: each point follows its corrected predecessor */
             ex.one([&]() {

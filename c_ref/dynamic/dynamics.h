@@ -44,6 +44,8 @@ enum {
         T stretch_at, bend_at, shape_at; /* α̃ = α/h² */                                                           \
         T collide_r;                     /* R_c = R + c_m */                                                           \
         T ftl_s;                         /* s */                                                                       \
+        int lra;                         /* §3.13: long-range attachments (a run-time switch) */                      \
+        T lra_len;                       /* s_L·ℓ */                                                                \
     }
 typedef HB_DYN_MODEL(float) hb_dyn_model_f32;
 typedef HB_DYN_MODEL(double) hb_dyn_model_f64;

@@ -59,6 +59,8 @@ void hb_dyn_feature_names(unsigned features, char *out, size_t n)
         (M)->shape_at = (T)(d->shape_compliance / (h * h));                                                            \
         (M)->collide_r = (T)(s->head_radius + d->collision_margin);                                                    \
         (M)->ftl_s = (T)d->ftl_damping;                                                                                \
+        (M)->lra = d->lra;                                                                                             \
+        (M)->lra_len = (T)(d->lra_scale * hb_segment_length(s));                                                       \
     } while (0)
 
 void hb_dyn_round(const hb_scene *s, hb_dyn_model_f32 *m32, hb_dyn_model_f64 *m64)

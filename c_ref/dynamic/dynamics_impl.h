@@ -123,6 +123,24 @@ HB_ALWAYS_INLINE void SFX(shape_all)(const DMODEL *m, REAL *p, const REAL *rest,
     }
 }
 
+/* §3.14 long-range attachments: |p_k − p_0| ≤ s_L·ℓ·k, a unilateral projection toward the
+ * root (whose inverse mass is 0); each touches only p_k, so the group's order is free. */
+HB_ALWAYS_INLINE void SFX(lra_all)(const DMODEL *m, REAL *p)
+{
+    for (int64_t k = 1; k < m->points; k++) {
+        REAL *pk = p + 3 * k;
+        const REAL ex = pk[0] - p[0], ey = pk[1] - p[1], ez = pk[2] - p[2];
+        const REAL d = SQRT(ex * ex + ey * ey + ez * ez);
+        const REAL r = m->lra_len * (REAL)k;
+        if (d > r) {
+            const REAL sc = r / d;
+            pk[0] = p[0] + ex * sc;
+            pk[1] = p[1] + ey * sc;
+            pk[2] = p[2] + ez * sc;
+        }
+    }
+}
+
 /* One frame of one strand: S substeps of §3.4, the solver of §3.6, §3.7 or §3.13 (rigid). */
 HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, REAL *x, REAL *v, const REAL *rest,
                                       const REAL *bend_rest, REAL *scratch, const unsigned F)
@@ -226,6 +244,7 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
                     SFX(bend_group)(m, p, bend_rest, lam_b, 1);
                 }
                 if (F & HB_F_SHAPE) SFX(shape_all)(m, p, rest, q, lam_g, F);
+                if (m->lra) SFX(lra_all)(m, p);
                 if (F & HB_F_COLLIDE)
                     for (int64_t k = 1; k < P; k++)
                         if (!PLANT_SKIPPED(k)) SFX(collide_sphere)(p + 3 * k, m->collide_r);
@@ -237,6 +256,7 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
                     SFX(bend_group)(m, p, bend_rest, lam_b, 1);
                 }
                 if (F & HB_F_SHAPE) SFX(shape_all)(m, p, rest, q, lam_g, F);
+                if (m->lra) SFX(lra_all)(m, p);
             }
             /* §3.7 follow the leader: q = p_{k−1} + ℓ·(p_k − p_{k−1})/|p_k − p_{k−1}| */
             for (int64_t k = 1; k < P; k++) {

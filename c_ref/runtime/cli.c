@@ -37,7 +37,7 @@ void hb_default_options(hb_options *o)
 }
 
 /* ---- the dynamic model's flags (docs/model.md §3), one table -------------------------- */
-typedef enum { DF_REAL, DF_COUNT, DF_SOLVER, DF_MOTION, DF_SWITCH } dyn_kind;
+typedef enum { DF_REAL, DF_COUNT, DF_SOLVER, DF_MOTION, DF_SWITCH, DF_FOLLOW, DF_OPTREAL, DF_FLAG } dyn_kind;
 typedef struct {
     const char *flag;
     dyn_kind kind;
@@ -69,6 +69,11 @@ static const dyn_flag dyn_flags[] = {
     {"--head-motion", DF_MOTION, DYN(motion), 0, "still | nod | shake | tilt (default still)"},
     {"--motion-amplitude", DF_REAL, DYN(motion_amplitude), 0, "head motion amplitude A, radians (default 0.25)"},
     {"--motion-frequency", DF_REAL, DYN(motion_frequency), 0, "head motion frequency f, Hz (default 1)"},
+    {"--guides", DF_REAL, DYN(guides), DYN(guided),
+     "simulate only guides, a fraction in (0, 1] or a count > 1; the others follow"},
+    {"--follow", DF_FOLLOW, DYN(follow), 0, "one | blend3: how followers are placed (default blend3)"},
+    {"--sag-free", DF_FLAG, DYN(sag_free), 0, "shape targets that hold the groom's rest shape against gravity"},
+    {"--lra", DF_OPTREAL, DYN(lra_scale), DYN(lra), "long-range attachments |p_k - p_0| <= S k l (S >= 1, default 1)"},
 };
 #undef DYN
 #define N_DYN_FLAGS (sizeof dyn_flags / sizeof dyn_flags[0])
@@ -91,6 +96,9 @@ int hb_dyn_flag_differs(int i, const hb_dynamics *a, const hb_dynamics *b)
     case DF_SOLVER: return *(const hb_solver *)pa != *(const hb_solver *)pb;
     case DF_MOTION: return *(const hb_motion *)pa != *(const hb_motion *)pb;
     case DF_SWITCH: return *(const int *)pa != *(const int *)pb;
+    case DF_FOLLOW: return *(const hb_follow *)pa != *(const hb_follow *)pb;
+    case DF_OPTREAL: return *(const double *)pa != *(const double *)pb;
+    case DF_FLAG: return *(const int *)pa != *(const int *)pb;
     }
     return 0;
 }
@@ -152,7 +160,10 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
                "                       loop would (launches and the frame's tables included; cuda only)\n");
     for (size_t i = 0; i < N_DYN_FLAGS; i++) {
         char name[64];
-        snprintf(name, sizeof name, "%s%s", dyn_flags[i].flag, dyn_flags[i].kind == DF_SWITCH ? "" : " V");
+        snprintf(name, sizeof name, "%s%s", dyn_flags[i].flag,
+                 dyn_flags[i].kind == DF_SWITCH || dyn_flags[i].kind == DF_FLAG ? ""
+                 : dyn_flags[i].kind == DF_OPTREAL                              ? " [S]"
+                                                                                : " V");
         fprintf(f, "  %-20s %s\n", name, dyn_flags[i].help);
     }
 }
@@ -282,6 +293,15 @@ static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err
         else FAIL("--head-motion must be still, nod, shake or tilt (got '%s')", v);
         break;
     case DF_SWITCH: *(int *)(base + df->offset) = 0; break;
+    case DF_FOLLOW:
+        if (strcmp(v, "one") == 0) o->scene.dyn.follow = HB_FOLLOW_ONE;
+        else if (strcmp(v, "blend3") == 0) o->scene.dyn.follow = HB_FOLLOW_BLEND3;
+        else FAIL("--follow must be one or blend3 (got '%s')", v);
+        break;
+    case DF_FLAG: *(int *)(base + df->offset) = 1; break;
+    case DF_OPTREAL: /* no value: the default stays */
+        if (v[0] && parse_f64(df->flag, v, (double *)(base + df->offset), err, errlen)) return -1;
+        break;
     }
     if (df->declares) *(int *)(base + df->declares) = 1;
     return 0;
@@ -355,8 +375,16 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         }
         {
             int di = hb_dyn_flag_index(a);
-            if (di >= 0 && dyn_flags[di].kind == DF_SWITCH) {
-                if (parse_dyn(&dyn_flags[di], "", o, err, errlen)) return -1;
+            if (di >= 0 && (dyn_flags[di].kind == DF_SWITCH || dyn_flags[di].kind == DF_FLAG ||
+                            dyn_flags[di].kind == DF_OPTREAL)) {
+                /* an optional value follows when the next word is a number */
+                const char *v = "";
+                char *end = NULL;
+                if (dyn_flags[di].kind == DF_OPTREAL && i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0) {
+                    (void)strtod(argv[i + 1], &end);
+                    if (end != argv[i + 1] && *end == '\0') v = argv[++i];
+                }
+                if (parse_dyn(&dyn_flags[di], v, o, err, errlen)) return -1;
                 o->dyn_given |= 1ull << di;
                 continue;
             }
@@ -382,7 +410,7 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         hb_scene *s = &o->scene;
         const int di = hb_dyn_flag_index(name);
         if (di >= 0) {
-            if (dyn_flags[di].kind == DF_SWITCH) FAIL("%s takes no value", name);
+            if (dyn_flags[di].kind == DF_SWITCH || dyn_flags[di].kind == DF_FLAG) FAIL("%s takes no value", name);
             if (parse_dyn(&dyn_flags[di], v, o, err, errlen)) return -1;
             o->dyn_given |= 1ull << di;
         } else if (strcmp(name, "--frames") == 0) {
@@ -480,6 +508,10 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
                 FAIL("%s belongs to the simulate stage, which --stages does not list", dyn_flags[i].flag);
         FAIL("--frames, --output-every and --velocities belong to the simulate stage, which --stages does not list");
     }
+    if (!o->scene.dyn.guided && (o->dyn_given & (1ull << hb_dyn_flag_index("--follow"))))
+        FAIL("--follow needs --guides (every strand is simulated unless --guides is given)");
+    if (o->scene.dyn.sag_free && !o->scene.dyn.shape)
+        FAIL("--sag-free needs --shape-compliance (it moves the shape targets)");
     if (o->scene.dyn.shape == 0 && (o->dyn_given & (1ull << hb_dyn_flag_index("--shape-range"))))
         FAIL("--shape-range needs --shape-compliance (shape is off unless its compliance is given)");
     return 0;

@@ -11,6 +11,7 @@
 #include "runtime/backend.h"
 #include "runtime/checked.h"
 #include "runtime/cli.h"
+#include "dynamic/dyn_followers.h"
 #include "runtime/host.h"
 #include "runtime/philox.h"
 #include "runtime/record.h"
@@ -118,7 +119,7 @@ static int list_variants(const hb_backend *b)
         hb_dyn_feature_names(1u << i, name, sizeof name);
         printf("%s\"%s\"", i ? ", " : "", name);
     }
-    printf("]}\n");
+    printf(", \"guides\", \"lra\", \"sagfree\"]}\n"); /* §3.13's, declared by their own flags */
     return HB_EXIT_OK;
 }
 
@@ -299,7 +300,7 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
 
     r->sim.dynamic = 1;
     r->sim.paper_frames = paper_frames;
-    hb_dyn_feature_names(hb_dyn_features(s), r->sim.features, sizeof r->sim.features);
+    hb_dyn_scene_feature_names(s, r->sim.features, sizeof r->sim.features);
     snprintf(sr->features, sizeof sr->features, "%s", r->sim.features);
     sr->frames = o->frames;
     sr->times_ms = times;

@@ -112,6 +112,11 @@ const char *hb_solver_name(hb_solver s)
     return s == HB_SOLVER_FTL ? "ftl" : s == HB_SOLVER_RIGID ? "rigid" : "xpbd";
 }
 
+const char *hb_follow_name(hb_follow f)
+{
+    return f == HB_FOLLOW_ONE ? "one" : "blend3";
+}
+
 const char *hb_motion_name(hb_motion m)
 {
     switch (m) {
@@ -139,6 +144,8 @@ void hb_dynamics_defaults(hb_dynamics *d)
     d->gust_wavelength = 100.0;
     d->motion_amplitude = 0.25;
     d->motion_frequency = 1.0;
+    d->follow = HB_FOLLOW_BLEND3;
+    d->lra_scale = 1.0;
 }
 
 int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
@@ -176,6 +183,10 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
         FAIL("--shape-range must be in (0, 1] (got %g)", d->shape_range);
     if (!(d->ftl_damping >= 0.0 && d->ftl_damping <= 1.0))
         FAIL("--ftl-damping must be in [0, 1] (got %g)", d->ftl_damping);
+    if (d->guided && !(isfinite(d->guides) && d->guides > 0.0 && (d->guides <= 1.0 || d->guides == floor(d->guides))))
+        FAIL("--guides must be a fraction in (0, 1] or a whole count > 1 (got %g)", d->guides);
+    if (d->lra && !(isfinite(d->lra_scale) && d->lra_scale >= 1.0))
+        FAIL("--lra scale must be a finite number >= 1 (got %g)", d->lra_scale);
     /* h = Δt/S and α/h² must stay normal numbers in double */
     const double h = d->frame_dt / (double)d->substeps;
     if (!(h >= 1e-12 && h <= 1e3))
@@ -239,6 +250,8 @@ int hb_dynamics_validate_scene(const hb_scene *s, char *err, size_t errlen)
         if (c[i].used && !fits(c[i].v, p))
             FAIL("%s = %g overflows %s (largest %g)%s", c[i].what, c[i].v, name, p == HB_FP32 ? FLT_MAX : DBL_MAX,
                  hint);
+    if (d->guided && d->guides > 1.0 && d->guides > (double)s->n_strands)
+        FAIL("--guides %g is more than the %lld strands", d->guides, (long long)s->n_strands);
     if (d->collider && !(rc <= hi))
         FAIL("--head-radius + --collision-margin = %g is beyond the lengths %s can square (at most %g)%s", rc, name, hi,
              hint);

@@ -22,6 +22,7 @@ typedef enum { HB_STAGE_INIT = 0, HB_STAGE_WIND = 1, HB_STAGE_COLLIDE = 2, HB_ST
 /* rigid: no dynamics, every point carried with the head (docs/model.md §3.13) */
 typedef enum { HB_SOLVER_XPBD = 0, HB_SOLVER_FTL = 1, HB_SOLVER_RIGID = 2, HB_SOLVER_COUNT = 3 } hb_solver;
 typedef enum { HB_MOTION_STILL = 0, HB_MOTION_NOD = 1, HB_MOTION_SHAKE = 2, HB_MOTION_TILT = 3 } hb_motion;
+typedef enum { HB_FOLLOW_BLEND3 = 0, HB_FOLLOW_ONE = 1 } hb_follow;
 
 /* The dynamic model's physics (docs/model.md §3): everything that decides the bits of a
  * simulated frame. Units: cm, s. Bend and shape exist only when declared (their
@@ -48,6 +49,13 @@ typedef struct {
     hb_motion motion;
     double motion_amplitude; /* A, radians */
     double motion_frequency; /* f, Hz */
+    /* docs/model.md §3.13: guides and followers, long-range attachments */
+    int guided;       /* --guides given: only the guides are simulated */
+    double guides;    /* a fraction in (0, 1] of the strands, or a count > 1 */
+    hb_follow follow; /* how followers are placed from their guides */
+    int lra;          /* --lra given */
+    double lra_scale; /* s_L ≥ 1: the bound is s_L times the rest arc length */
+    int sag_free;     /* --sag-free: shape targets that hold the rest shape against gravity */
 } hb_dynamics;
 
 /* The scene: everything that decides the bits of a state. */
@@ -135,6 +143,7 @@ int hb_dynamics_validate_time(const hb_scene *s, double t_end, char *err, size_t
 void hb_dynamics_defaults(hb_dynamics *d);
 const char *hb_solver_name(hb_solver s);
 const char *hb_motion_name(hb_motion m);
+const char *hb_follow_name(hb_follow f);
 
 /* Bytes of one state [N·P][3] in the scene's precision; 0 on overflow. */
 uint64_t hb_state_bytes(const hb_scene *s);

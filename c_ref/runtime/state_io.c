@@ -439,6 +439,10 @@ static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
     bad |= attr_i64(p, "shape", d->shape) < 0;
     bad |= attr_i64(p, "collider", d->collider) < 0;
     bad |= attr_i64(p, "drag_declared", d->drag_declared) < 0;
+    bad |= attr_i64(p, "guided", d->guided) < 0; /* §3.13 */
+    bad |= attr_i64(p, "lra", d->lra) < 0;
+    bad |= attr_i64(p, "sag_free", d->sag_free) < 0;
+    if (d->guided) bad |= attr_str(p, "follow", hb_follow_name(d->follow)) < 0;
     const struct {
         const char *name;
         double v;
@@ -459,6 +463,8 @@ static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
         {"gust_wavelength", d->gust_wavelength},
         {"motion_amplitude", d->motion_amplitude},
         {"motion_frequency", d->motion_frequency},
+        {"guides", d->guides},
+        {"lra_scale", d->lra_scale},
     };
     for (size_t i = 0; i < sizeof num / sizeof num[0]; i++) bad |= attr_f64(p, num[i].name, num[i].v) < 0;
 
@@ -810,6 +816,27 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
         NEED(read_attr(p, num[i].name, H5T_NATIVE_DOUBLE, num[i].v), num[i].name);
 #undef NEED
     if (missing) return snprintf(err, errlen, "--input %s: /parameters lacks the attribute '%s'", path, missing), -1;
+    /* §3.13's features, absent from files written before them: not declared */
+    int64_t guided = 0, lra = 0;
+    char follow[16] = "blend3";
+    d->follow = HB_FOLLOW_BLEND3;
+    d->lra_scale = 1.0;
+    if (read_attr(p, "guided", H5T_NATIVE_INT64, &guided) == 0 && guided) {
+        if (read_attr(p, "guides", H5T_NATIVE_DOUBLE, &d->guides) < 0 ||
+            read_attr_str(p, "follow", follow, sizeof follow) < 0)
+            return snprintf(err, errlen, "--input %s: /parameters has guided = 1 but lacks guides or follow", path), -1;
+        d->guided = 1;
+        if (strcmp(follow, "one") == 0) d->follow = HB_FOLLOW_ONE;
+        else if (strcmp(follow, "blend3") == 0) d->follow = HB_FOLLOW_BLEND3;
+        else return snprintf(err, errlen, "--input %s: unknown follow scheme '%s'", path, follow), -1;
+    }
+    int64_t sag_free = 0;
+    if (read_attr(p, "sag_free", H5T_NATIVE_INT64, &sag_free) == 0) d->sag_free = sag_free != 0;
+    if (read_attr(p, "lra", H5T_NATIVE_INT64, &lra) == 0 && lra) {
+        if (read_attr(p, "lra_scale", H5T_NATIVE_DOUBLE, &d->lra_scale) < 0)
+            return snprintf(err, errlen, "--input %s: /parameters has lra = 1 but lacks lra_scale", path), -1;
+        d->lra = 1;
+    }
     d->bend = bend != 0;
     d->shape = shape != 0;
     d->collider = collider != 0;

@@ -97,6 +97,25 @@ HB_ALWAYS_INLINE void SFX(distance_lanes)(const DMODEL *m, REAL *scratch, const 
 
 /* §3.5 head collision of row k of p (dynamics_impl.h collide_sphere): inside when
  * |p|² < R_c²; the centre itself (|p|² below TINY) goes to (0, R_c, 0). */
+/* docs/model.md §3.13 long-range attachment of point k to the root (row 0), every lane:
+ * |p_k − p_0| ≤ (s_L·ℓ)·k, the oracle's lra_all for one point. */
+HB_ALWAYS_INLINE void SFX(lra_lanes)(const DMODEL *m, REAL *scratch, const int64_t k)
+{
+    REAL *restrict px = SROW(3 * k), *restrict py = SROW(3 * k + 1), *restrict pz = SROW(3 * k + 2);
+    const REAL *restrict ox = SROW(0), *restrict oy = SROW(1), *restrict oz = SROW(2);
+    const REAL r = m->lra_len * (REAL)k;
+#pragma omp simd
+    for (int j = 0; j < DB; j++) {
+        const REAL ex = px[j] - ox[j], ey = py[j] - oy[j], ez = pz[j] - oz[j];
+        const REAL d = SQRT(ex * ex + ey * ey + ez * ez);
+        const int over = d > r;
+        const REAL sc = r / (over ? d : r + (REAL)1);
+        px[j] = over ? ox[j] + ex * sc : px[j];
+        py[j] = over ? oy[j] + ey * sc : py[j];
+        pz[j] = over ? oz[j] + ez * sc : pz[j];
+    }
+}
+
 HB_ALWAYS_INLINE void SFX(collide_lanes)(const DMODEL *m, REAL *scratch, const int64_t k, const SFX(dyn_consts) * K)
 {
     REAL *restrict px = SROW(3 * k), *restrict py = SROW(3 * k + 1), *restrict pz = SROW(3 * k + 2);
@@ -331,6 +350,8 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
                 SFX(bend_lanes)(m, K, scratch, BR, stride, 1);
             }
             if (F & HB_F_SHAPE) SFX(shape_lanes)(m, K, scratch, q, RX, RY, RZ, stride, F);
+            if (m->lra)
+                for (int64_t k = 1; k < P; k++) SFX(lra_lanes)(m, scratch, k);
             if (F & HB_F_COLLIDE)
                 for (int64_t k = 1; k < P; k++) SFX(collide_lanes)(m, scratch, k, K);
         }
@@ -344,6 +365,8 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
             SFX(bend_lanes)(m, K, scratch, BR, stride, 1);
         }
         if (F & HB_F_SHAPE) SFX(shape_lanes)(m, K, scratch, q, RX, RY, RZ, stride, F);
+        if (m->lra)
+            for (int64_t k = 1; k < P; k++) SFX(lra_lanes)(m, scratch, k);
     }
     /* §3.7 follow the leader, point by point; as soon as d_k is known, point k − 1 is final:
      * v_{k−1} = (p − x)/h − (s/h)·d_k and x_{k−1} = p (the oracle's step 4 for that point) */

@@ -146,6 +146,8 @@ hb_scene make_scene(unsigned F, int solver, int64_t N, int64_t P, int precision,
     d->motion = (F & HB_F_MOTION) ? (hb_motion)(1 + variant % 3) : HB_MOTION_STILL;
     d->motion_amplitude = 0.4;
     d->motion_frequency = 1.3;
+    d->lra = variant % 3 == 1; /* docs/model.md §3.14, a run-time switch: on in a third of the cases */
+    d->lra_scale = 1.0 + 0.01 * (double)(variant % 2);
     return s;
 }
 

@@ -14,7 +14,8 @@
      anything not equivalent stops the bench before timing;
   2. the sweep configs/sweeps/dynamic.toml (results/<out>/dynamic/runs.csv);
   3. the studies, each into results/<out>/<study>/: what each feature costs (featurecost,
-     CPU and every cuda build), speed against accuracy (accuracy --model dynamic), stability at the
+     CPU and every cuda build), modelling less (reduced: guides and followers, LRA; docs/model.md
+     §3.14), speed against accuracy (accuracy --model dynamic), stability at the
      extremes (stability), the peer (pypbd, optional), the animation;
   4. report/dynamic.md with all of it.
 Without a GPU the GPU rows and checks are skipped with one line saying why.
@@ -33,7 +34,7 @@ from harness.core.scenes import with_frames
 from harness.io import results_data
 from harness.io.files import write_json
 from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
-from harness.studies import accuracy_dynamic, animate, featurecost, peer, stability
+from harness.studies import accuracy_dynamic, animate, featurecost, peer, reduced, stability
 from harness.studies.sweep import run_sweep
 
 VALIDATION_STRANDS = 2000
@@ -254,6 +255,10 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
                 say(f"harness: featurecost --backend cuda --variant {v} --strands 1000000")
                 featurecost.measure(backend="cuda", variant=v, strands=1_000_000, out=fc / f"cuda-{v}.csv")
     gpu = "auto" if builds else "no"
+    if first and fits("reduced"):
+        say(f"harness: reduced{' --quick' if quick else ''}")
+        plan = reduced.Plan.quick(gpu=gpu) if quick else reduced.Plan(gpu=gpu)
+        reduced.measure(plan, out=root / "reduced" / "reduced.csv", progress=say)
     if first and fits("accuracy"):
         acc_dir = root / accuracy_dynamic.RESULTS_NAME
         plan = accuracy_dynamic.Plan.quick(gpu=gpu) if quick else accuracy_dynamic.Plan(gpu=gpu)

@@ -1,7 +1,7 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
 Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, accuracy, headline,
-export, calibrate, featurecost, peer, animate, stability, docs (`--help` on each; docs/harness.md
+export, calibrate, featurecost, reduced, peer, animate, stability, judge, docs (`--help` on each; docs/harness.md
 lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
 
@@ -431,6 +431,17 @@ def cmd_featurecost(args):
         instructions=args.instructions,
     )
     print(featurecost_report.markdown(rows), end="")
+    return 0
+
+
+def cmd_reduced(args):
+    from harness.render import reduced_report
+    from harness.studies import reduced
+
+    base = reduced.Plan.quick if args.quick else reduced.Plan
+    changes = {k: v for k, v in (("scene", args.scene), ("strands", args.strands), ("seconds", args.seconds)) if v}
+    rows = reduced.measure(base(gpu=args.gpu, **changes), out=args.out)
+    print(reduced_report.markdown(rows), end="")
     return 0
 
 
@@ -924,6 +935,22 @@ def parser():
         "the frame function (deterministic where times are noisy)",
     )
     fc.set_defaults(func=cmd_featurecost)
+
+    rd = sub.add_parser(
+        "reduced",
+        help="the dynamic model with guides and followers and with long-range attachments: error and time",
+        description="Run a dynamic scene with guide fractions 100/50/25/10/5%% x scheme (one, blend3) and "
+        "LRA off/on at few iterations; compare each with every strand simulated (xpbd, fp64, finer S) and time "
+        "it on the cpu oracle and, with a usable GPU, the cuda variants that run it (docs/model.md §3.14). "
+        "Prints a Markdown table; --out writes the rows as CSV.",
+    )
+    rd.add_argument("--scene", default=None, help="a dynamic scene (default dynamic)")
+    rd.add_argument("--strands", type=whole(1), default=None, help="strands of the checked runs")
+    rd.add_argument("--seconds", type=seconds, default=None, help="simulated time of each run")
+    rd.add_argument("--quick", action="store_true", help="the small version (CI, a first look)")
+    rd.add_argument("--gpu", choices=("auto", "no"), default="auto")
+    rd.add_argument("--out", default=None, help="CSV file to write")
+    rd.set_defaults(func=cmd_reduced)
 
     peer_plan = peer.Plan()
     pe = sub.add_parser(

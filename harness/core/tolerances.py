@@ -259,6 +259,20 @@ DYN_PENETRATION_K = 8.0
 # FTL segments the collider did not move: |len − ℓ| ≤ 0.45·ε·E in every run (fp32 0.44,
 # fp64 0.45, with and without the collider, FMA build 0.42); 4 is a 8.9× margin.
 DYN_FTL_SEGMENT_K = 4.0
+# Long-range attachments (docs/model.md §3.14): after a frame no point lies farther from its
+# root than its bound s_L·k·ℓ by more than 2·ε of the precision, relative (the C reference,
+# fp64, 40 strands × 12 points, 8 frames of an 8 Hz nod at A = 0.5 rad with α_s = 1e-3, no
+# collider, I = 1, s_L = 1 and 1.05: 1·ε and 2·ε; without LRA the same scene is 2.4 bounds
+# beyond). The projection's three roundings and the root's own; 8 is a 4× margin.
+DYN_LRA_BOUND_EPS = 8.0
+# Sag-free rest (docs/model.md §3.14): the still scene of tests/cpu/test_dynamic_followers.py
+# (40 strands × 12 points, L = 30, S = 8, I = 2, α_b = 1e-6, α_g = 1e-4, ρ_g = 1, fp32, 120
+# frames = 2 s, the collider on) moves at most 7.8e-5 L (xpbd) and 4.2e-4 L (ftl) from its
+# rest shape with --sag-free (xpbd at I = 20, fp64: 2.9e-5 L: the rigid stretch against rest
+# segments that are ℓ only to 5e-7), and 6.8e-3 L (xpbd) and 7.7e-3 L (ftl) without it.
+# The bound with it: 1e-3 L (2.4× the worse solver); the sag without it: at least 3e-3 L.
+DYN_SAGFREE_STILL_MAX_L = 1e-3
+DYN_SAG_PLAIN_MIN_L = 3e-3
 # Kinetic energy recomputed by the harness (strand by strand in order) against the file's
 # (the binary sums in chunks of 1024 strands): bit-equal up to 1000 strands, ≤ 9.9e-15
 # relative at 5000 strands (1.55e5 terms), ≤ 3.9e-16 for the FMA build. Rounding errors of

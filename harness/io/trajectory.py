@@ -60,6 +60,12 @@ DYNAMIC_ATTRS = (
     "gust_wavelength",
     "motion_amplitude",
     "motion_frequency",
+    "guided",
+    "guides",
+    "follow",
+    "lra",
+    "lra_scale",
+    "sag_free",
 )
 REQUIRED_DYNAMIC = (
     "paper_frames",
@@ -139,6 +145,15 @@ class Trajectory(State):
     @property
     def features(self):
         return as_text(self.dynamic_params.get("features", ""))
+
+    @property
+    def guided(self):
+        """Whether only guides were simulated and the other strands placed from them (§3.14)."""
+        return bool(int(self.dynamic_params.get("guided", 0)))
+
+    @property
+    def follow(self):
+        return as_text(self.dynamic_params.get("follow", "blend3"))
 
     @property
     def collider(self):

@@ -22,6 +22,7 @@ from harness.render import (  # noqa: E402
     featurecost_report,
     judge_report,
     peer_report,
+    reduced_report,
     stability_report,
 )
 
@@ -256,6 +257,7 @@ def build(root, report_dir=None):
         cmd = "python -m harness bench --model dynamic"
         lines += [f"Not measured (no `{display(sweep_dir / 'runs.csv')}`): `{cmd}`.", ""]
     lines += featurecost_report.section(sorted((root / "featurecost").glob("*.csv"))) + [""]
+    lines += reduced_report.section(root / "reduced" / "reduced.csv") + [""]
     lines += _study(
         root,
         "dynamic-accuracy",

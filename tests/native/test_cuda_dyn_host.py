@@ -6,7 +6,8 @@ feature set (96) x xpbd and ftl x fp32 and fp64 x P = 2, 3, 5, 8, 33, 70, two fr
 in the three ways the kernels run the math (sequential on the canonical layout, the strand
 kernel's point-major layout and interleaved scratch, and an emulation of the warp kernel's
 lanes that runs every parallel group in reverse lane order), with the feature set compiled
-in and as a run-time mask; plus the bend rest lengths and the per-strand observables.
+in and as a run-time mask, long-range attachments (docs/model.md §3.14) on in a third of the
+cases; plus the bend rest lengths and the per-strand observables.
 
 What it cannot show: on the device, CUDA's sinf/sin (gust frames only) may differ from
 glibc's, and the normal build contracts a*b + c into FMAs; tests/gpu/test_gpu_dynamic.py

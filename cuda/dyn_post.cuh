@@ -1,0 +1,102 @@
+/* dyn_post.cuh — what the dynamic model does after a frame's substeps (cuda/dyn_post.cu):
+ * the followers of docs/model.md §3.14, placed from their guides by a kernel of their own.
+ * The per-follower math is `__host__ __device__` (place_follower), so
+ * cuda/hostcheck/post_hostcheck.cu runs it on the host against c_ref/dynamic/dyn_followers_impl.h. */
+#ifndef HB_DYN_POST_CUH
+#define HB_DYN_POST_CUH
+
+#include <cuda_runtime.h>
+#include <stdint.h>
+
+#include "dyn_kernels.cuh"
+#include "dyn_model.cuh"
+
+namespace hb {
+namespace dyn {
+
+/* Element (strand i, point k, coordinate c) of an array in a layout. */
+template <typename T> struct At {
+    T *b;
+    Layout l;
+    HB_DHD T &operator()(int64_t i, int64_t k, int c) const { return b[i * l.is + k * l.ks + (int64_t)c * l.cs]; }
+};
+
+/* y = x_g,k + M(a → b)·o: follower f's point k carried by guide g (fl_carry). */
+template <typename T>
+HB_DHD void carry(const At<T> &x, const At<const T> &rest, int64_t g, int64_t f, int64_t k, const T *q, T *y)
+{
+    T e[3], t[3], d[3], a[3], o[3];
+    for (int c = 0; c < 3; c++) e[c] = rest(g, k, c) - rest(g, k - 1, c);
+    const T len = d_sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    for (int c = 0; c < 3; c++) d[c] = rest(f, k, c) - rest(g, k, c);
+    for (int c = 0; c < 3; c++) t[c] = len > (T)0 ? e[c] / len : (T)0;
+    if (q) {
+        rotate(q, t[0], t[1], t[2], a);
+        rotate(q, d[0], d[1], d[2], o);
+    } else {
+        for (int c = 0; c < 3; c++) {
+            a[c] = t[c];
+            o[c] = d[c];
+        }
+    }
+    for (int c = 0; c < 3; c++) e[c] = x(g, k, c) - x(g, k - 1, c);
+    const T rho = d_sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    T r[3] = {o[0], o[1], o[2]};
+    if (len > (T)0 && rho > (T)0) {
+        T b[3];
+        for (int c = 0; c < 3; c++) b[c] = e[c] / rho;
+        const T cs = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        const T den = (T)1 + cs;
+        if (den > (T)0) {
+            const T u[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+            const T uo = u[0] * o[0] + u[1] * o[1] + u[2] * o[2];
+            const T sc = uo / den;
+            const T uxo[3] = {u[1] * o[2] - u[2] * o[1], u[2] * o[0] - u[0] * o[2], u[0] * o[1] - u[1] * o[0]};
+            for (int c = 0; c < 3; c++) r[c] = cs * o[c] + uxo[c] + sc * u[c];
+        }
+    }
+    for (int c = 0; c < 3; c++) y[c] = x(g, k, c) + r[c];
+}
+
+/* Follower f placed from its W guides g[] with weights w[] (hb_follower_place). */
+template <typename T>
+HB_DHD void place_follower(const DModel<T> &m, const T *q, const At<T> &x, const At<T> &v, const At<const T> &rest,
+                           int64_t f, const int64_t *g, const T *w, int W)
+{
+    const int64_t P = m.points;
+    T root[3];
+    if (q) rotate(q, rest(f, 0, 0), rest(f, 0, 1), rest(f, 0, 2), root);
+    else
+        for (int c = 0; c < 3; c++) root[c] = rest(f, 0, c);
+    for (int c = 0; c < 3; c++) x(f, 0, c) = root[c];
+    for (int64_t k = 0; k < P; k++)
+        for (int c = 0; c < 3; c++) {
+            T acc = w[0] * v(g[0], k, c);
+            for (int i = 1; i < W; i++) acc = acc + w[i] * v(g[i], k, c);
+            v(f, k, c) = acc;
+        }
+    for (int64_t k = 1; k < P; k++) {
+        T acc[3] = {0, 0, 0};
+        for (int i = 0; i < W; i++) {
+            T y[3];
+            carry(x, rest, g[i], f, k, q, y);
+            for (int c = 0; c < 3; c++) acc[c] = i == 0 ? w[0] * y[c] : acc[c] + w[i] * y[c];
+        }
+        if (m.features & HB_F_COLLIDE) collide_sphere(acc[0], acc[1], acc[2], m.collide_r);
+        for (int c = 0; c < 3; c++) x(f, k, c) = acc[c];
+    }
+}
+
+/* One thread per follower j: strand follower[j] placed from the strands src[width·j + i]
+ * with weights w[width·j + i] (c_ref/dynamic/dyn_followers.c's plan, on the device); q the head
+ * rotation at the frame's end ([9] on the device; nullptr: still head); x, v, rest in the
+ * variant's layout `lay`. The same operations in the same order as
+ * c_ref/dynamic/dyn_followers_impl.h. */
+template <typename T>
+cudaError_t launch_place_followers(const DModel<T> &m, const T *q, T *x, T *v, const T *rest, Layout lay,
+                                   const int64_t *follower, const int64_t *src, const T *w, int width,
+                                   int64_t n_followers, cudaStream_t stream);
+
+} /* namespace dyn */
+} /* namespace hb */
+#endif

@@ -1,0 +1,263 @@
+"""Guides and followers, long-range attachments (docs/model.md §3.14) in the C reference:
+known answers. Followers recomputed from a file's guides by harness/check/followers.py match
+bit for bit; the guides of a guided run are the same strands of a full run, bit for bit
+(strands are independent); a follower whose guides are identical to it equals them; an LRA
+bound is never exceeded and is inactive on a relaxed strand. Tiny scenes (≤ 40 strands,
+≤ 12 points, ≤ 8 frames)."""
+
+import h5py
+import numpy as np
+import pytest
+
+from harness.check import followers, invariants_dynamic
+from harness.core import tolerances
+from harness.core.guides import guide_count, guide_strands
+from harness.io.trajectory import open_trajectory
+from support.statecheck import run
+
+TINY = ["--strands", "40", "--points", "12"]
+SIM = ["--stages", "init,collide,simulate"]
+MOVING = ["--substeps", "2", "--iterations", "2", "--bend-compliance", "1e-6", "--head-motion", "nod"]
+
+
+def simulate(cpu_bin, path, *args, frames=6, stages=SIM, scene=TINY):
+    run(cpu_bin, *stages, *scene, "--frames", frames, *args, "--output", path, "--quiet")
+    return path
+
+
+def bits(a):
+    return np.ascontiguousarray(a).view(np.uint8)
+
+
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("motion", ["still", "nod"])
+@pytest.mark.parametrize("follow", ["one", "blend3"])
+def test_followers_recompute_bit_for_bit_from_the_guides(cpu_bin, tmp_path, follow, motion, precision):
+    path = simulate(
+        cpu_bin,
+        tmp_path / "g.h5",
+        *MOVING[:-2],
+        "--head-motion",
+        motion,
+        "--guides",
+        "0.25",
+        "--follow",
+        follow,
+        "--precision",
+        precision,
+        "--velocities",
+        "all",
+    )
+    with open_trajectory(path) as t:
+        assert t.guided and t.follow == follow and "guides" in t.features.split("+")
+        g = guide_count(t.n_strands, float(t.dynamic_params["guides"]))
+        assert g == 10
+        moved = False
+        for f in t.simulated:
+            v = t.velocity_at_step(int(t.step[f]))
+            x_want, v_want = followers.place_followers(t, f, v)
+            x = t.frame(f).reshape(t.n_strands, t.points, 3)
+            assert np.array_equal(bits(x), bits(x_want)), f"frame {f}: followers differ from their recomputation"
+            assert np.array_equal(bits(v.reshape(x.shape)), bits(v_want)), f"frame {f}: follower velocities differ"
+            moved |= not np.array_equal(x, t.rest)
+        assert moved, "the scene must move for the check to mean anything"
+        rep = invariants_dynamic.check(t)
+        assert rep.ok, "; ".join(v.message for v in rep.all_violations()[:5])
+
+
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+def test_guides_move_as_in_a_fully_simulated_run(cpu_bin, tmp_path, solver):
+    full = simulate(cpu_bin, tmp_path / "full.h5", *MOVING, "--solver", solver)
+    guided = simulate(cpu_bin, tmp_path / "g.h5", *MOVING, "--solver", solver, "--guides", "7")
+    with open_trajectory(full) as a, open_trajectory(guided) as b:
+        gs = guide_strands(a.n_strands, 7)
+        for f in a.simulated:
+            xa = a.frame(f).reshape(a.n_strands, a.points, 3)[gs]
+            xb = b.frame(f).reshape(b.n_strands, b.points, 3)[gs]
+            assert np.array_equal(bits(xa), bits(xb)), f"frame {f}: a guide moved otherwise than when all are simulated"
+        followers_idx = np.setdiff1d(np.arange(a.n_strands), gs)
+        last = a.simulated[-1]
+        assert not np.array_equal(
+            a.frame(last).reshape(a.n_strands, a.points, 3)[followers_idx],
+            b.frame(last).reshape(b.n_strands, b.points, 3)[followers_idx],
+        ), "followers are placed, not simulated: they cannot equal the simulated strands"
+
+
+@pytest.mark.parametrize("collider", [False, True])
+@pytest.mark.parametrize("follow", ["one", "blend3"])
+def test_a_follower_whose_guides_are_identical_to_it_equals_them(cpu_bin, tmp_path, follow, collider):
+    """Every strand a copy of strand 0: each follower's guides sit at distance 0, so it is
+    placed exactly on its nearest guide (weight 1), which moves as strand 0 does. With the
+    collider on, the follower's collision projects again a guide point that the guide's own
+    projection left a rounding inside R_c (the projection is not idempotent in floating
+    point): those points, and only those, may differ."""
+    paper = tmp_path / "paper.h5"
+    run(cpu_bin, "--stages", "init,collide", *TINY, "--output", paper, "--quiet")
+    with h5py.File(paper, "r+") as f:
+        pos = f["particles/hair/position/value"]
+        x = pos[-1].reshape(40, 12, 3)
+        x[:] = x[0]
+        pos[-1] = x.reshape(-1, 3)
+    out = tmp_path / "g.h5"
+    extra = [] if collider else ["--no-collider"]
+    run(cpu_bin, "--input", paper, "--stages", "simulate", "--frames", 5, *MOVING, "--guides", "0.25",
+        "--follow", follow, *extra, "--output", out, "--quiet")  # fmt: skip
+    with open_trajectory(out) as t:
+        rc = np.float32(t.collide_radius)
+        for f in t.simulated:
+            x = t.frame(f).reshape(t.n_strands, t.points, 3)
+            same = np.all(bits(x).reshape(40, 12, 3, 4) == bits(x[:1]).reshape(1, 12, 3, 4), axis=(2, 3))
+            g = x[0]
+            inside = np.sqrt((g[:, 0] * g[:, 0] + g[:, 1] * g[:, 1]) + g[:, 2] * g[:, 2]) < rc
+            allowed = inside[None, :] if collider else np.zeros((1, 12), dtype=bool)
+            assert np.all(same | allowed), f"frame {f}: a follower differs from its identical guide"
+        assert not np.array_equal(t.frame(t.simulated[-1]).reshape(40, 12, 3), t.rest), "the scene must move"
+
+
+def _arc_excess(t, scale):
+    """max over written frames and points k ≥ 1 of |x_k − x_0| / (s_L·k·ℓ) − 1, in double."""
+    ell = t.hair_length / (t.points - 1)
+    k = np.arange(1, t.points, dtype=np.float64)
+    worst = -np.inf
+    for f in t.simulated:
+        x = t.frame(f).reshape(t.n_strands, t.points, 3).astype(np.float64)
+        d = np.sqrt(np.sum((x[:, 1:] - x[:, :1]) ** 2, axis=2))
+        worst = max(worst, float(np.max(d / (scale * ell * k) - 1.0)))
+    return worst
+
+
+STRETCHY = ["--precision", "fp64", "--no-collider", "--stretch-compliance", "1e-3", "--head-motion", "nod",
+            "--motion-frequency", "8", "--motion-amplitude", "0.5"]  # fmt: skip
+
+
+@pytest.mark.parametrize("scale", ["1", "1.05"])
+def test_lra_never_lets_a_point_beyond_its_bound(cpu_bin, tmp_path, scale):
+    free = simulate(cpu_bin, tmp_path / "free.h5", *STRETCHY, frames=8)
+    held = simulate(cpu_bin, tmp_path / "lra.h5", *STRETCHY, "--lra", scale, frames=8)
+    with open_trajectory(free) as a, open_trajectory(held) as b:
+        assert _arc_excess(a, float(scale)) > 1.0, "without LRA this scene must over-stretch (2.4 bounds measured)"
+        assert "lra" in b.features.split("+")
+        assert _arc_excess(b, float(scale)) <= tolerances.DYN_LRA_BOUND_EPS * tolerances.EPS["fp64"]
+
+
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+def test_lra_is_inactive_on_a_relaxed_strand(cpu_bin, tmp_path, solver):
+    """No gravity, a still head: the groom stays at rest, where no chord from the root is
+    longer than its arc, so LRA must not move a bit. The bound is 0.1 % above the arc: a
+    straight run of segments from the root lies on the arc itself, up to the roundings of
+    its segment lengths (5e-7 relative in fp32 here), where s_L = 1 leaves rounding to decide."""
+    calm = ["--gravity", "0", "--solver", solver, "--bend-compliance", "1e-6"]
+    a = simulate(cpu_bin, tmp_path / "a.h5", *calm, frames=3)
+    b = simulate(cpu_bin, tmp_path / "b.h5", *calm, "--lra", "1.001", frames=3)
+    with open_trajectory(a) as ta, open_trajectory(b) as tb:
+        for f in ta.simulated:
+            assert np.array_equal(bits(ta.frame(f)), bits(tb.frame(f)))
+
+
+BAD = [
+    (["--follow", "one"], "--follow needs --guides"),
+    (["--guides", "0"], "--guides must be a fraction in (0, 1] or a whole count > 1"),
+    (["--guides", "2.5"], "--guides must be a fraction in (0, 1] or a whole count > 1"),
+    (["--guides", "41"], "--guides 41 is more than the 40 strands"),
+    (["--guides", "0.5", "--follow", "two"], "--follow must be one or blend3"),
+    (["--lra", "0.5"], "--lra scale must be a finite number >= 1"),
+    (["--guides", "0.5", "--variant", "simd"], "--variant simd does not run --guides"),
+    (["--sag-free"], "--sag-free needs --shape-compliance"),
+    (["--shape-compliance", "1e-4", "--sag-free=1"], "--sag-free takes no value"),
+]
+
+
+@pytest.mark.parametrize("args, message", BAD)
+def test_bad_feature_flags_are_refused_before_any_work(cpu_bin, tmp_path, args, message):
+    out = tmp_path / "o.h5"
+    p = run(cpu_bin, *SIM, *TINY, *args, "--output", out, "--quiet", check=False)
+    assert p.returncode == 2 and message in p.stderr and "Traceback" not in p.stderr
+    assert not out.exists()
+
+
+def test_a_guided_run_resumes_bit_for_bit(cpu_bin, tmp_path):
+    """Followers are placed from the guides again after a resume: 3 + 3 frames equal 6."""
+    args = [*MOVING, "--guides", "0.3", "--lra", "1.01"]
+    whole = simulate(cpu_bin, tmp_path / "whole.h5", *args, frames=6)
+    half = simulate(cpu_bin, tmp_path / "half.h5", *args, frames=3)
+    rest = tmp_path / "rest.h5"
+    run(cpu_bin, "--input", half, "--stages", "simulate", "--frames", 3, "--output", rest, "--quiet")
+    with open_trajectory(whole) as a, open_trajectory(rest) as b:
+        assert b.guided and int(b.dynamic_params["lra"]) == 1
+        assert np.array_equal(bits(a.frame(-1)), bits(b.frame(-1)))
+        assert np.array_equal(bits(a.velocity(-1)), bits(b.velocity(-1)))
+
+
+def test_help_and_list_variants_declare_the_features(cpu_bin):
+    text = run(cpu_bin, "--help").stdout
+    assert all(f in text for f in ("--guides V", "--follow V", "--lra [S]", "--sag-free "))
+    listed = run(cpu_bin, "--list-variants").stdout
+    assert '"guides", "lra", "sagfree"' in listed
+
+
+STILL = ["--substeps", "8", "--iterations", "2", "--bend-compliance", "1e-6", "--shape-compliance", "1e-4",
+         "--shape-range", "1"]  # fmt: skip
+
+
+def _sag(t):
+    """The largest displacement of any point from its rest position over the written frames, over L."""
+    rest = t.rest.astype(np.float64)
+    return (
+        max(
+            float(np.max(np.linalg.norm(t.frame(f).reshape(rest.shape).astype(np.float64) - rest, axis=2)))
+            for f in t.simulated
+        )
+        / t.hair_length
+    )
+
+
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+def test_sag_free_still_scene_stays_while_the_plain_one_sags(cpu_bin, tmp_path, solver):
+    """2 s of a still head, no wind, every point in shape: with --sag-free the groom stays within
+    DYN_SAGFREE_STILL_MAX_L of its rest shape; without, the same scene sags by more than
+    DYN_SAG_PLAIN_MIN_L (both measured, harness/core/tolerances.py)."""
+    plain = simulate(cpu_bin, tmp_path / "plain.h5", *STILL, "--solver", solver, frames=120)
+    held = simulate(cpu_bin, tmp_path / "held.h5", *STILL, "--solver", solver, "--sag-free", frames=120)
+    with open_trajectory(plain) as a, open_trajectory(held) as b:
+        assert int(b.dynamic_params["sag_free"]) == 1 and "sagfree" in b.features.split("+")
+        assert _sag(a) > tolerances.DYN_SAG_PLAIN_MIN_L, _sag(a)
+        assert _sag(b) < tolerances.DYN_SAGFREE_STILL_MAX_L, _sag(b)
+
+
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("feature", ["sag-free", "lra"])
+def test_simd_runs_the_features_as_ref_does(cpu_bin, tmp_path, feature, precision):
+    """One frame of --variant simd from the oracle's state, judged by harness stepdiff's rule
+    (harness.check.diff_dynamic.compare): a sag-free scene with a tilting head, and LRA under
+    a fast nod with soft stretch at one iteration (both solvers' LRA groups run in xpbd here)."""
+    from harness.check import diff_dynamic
+
+    scene = (
+        [*STILL, "--sag-free", "--head-motion", "tilt"]
+        if feature == "sag-free"
+        else [
+            "--iterations",
+            "1",
+            "--substeps",
+            "2",
+            "--stretch-compliance",
+            "1e-3",
+            "--head-motion",
+            "nod",
+            "--motion-frequency",
+            "8",
+            "--motion-amplitude",
+            "0.5",
+            "--lra",
+            "1.01",
+        ]  # fmt: skip
+    )
+    args = [*scene, "--precision", precision, "--velocities", "all"]
+    ref = simulate(cpu_bin, tmp_path / "ref.h5", *args, frames=3)
+    out = tmp_path / "simd.h5"
+    with open_trajectory(ref) as t:
+        k, step = t.n_frames - 2, int(t.step[-1])
+    run(cpu_bin, "--input", ref, "--input-frame", k, "--stages", "simulate", "--frames", 1, "--variant", "simd",
+        "--output", out, "--quiet")  # fmt: skip
+    r = diff_dynamic.compare(ref, out, frames=[step], check_paper=False)
+    assert r.equivalent, "; ".join(r.failures()[:5])
