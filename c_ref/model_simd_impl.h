@@ -22,8 +22,9 @@
  * radius ℓ about the root only touches the shell, ℓ = h, √h² turns an ulp into √ε). With FAST_TRIG (fp32) the drape's step angles are computed once per
  * strand (every step after the first goes from the shell to the shell), θ advances by
  * additions as in model_impl.h, and a point's sin and cos are fast_trig.h's inline
- * polynomials (one loop per point). The wind keeps libmvec's atan2, sin and cos: measured,
- * fast_trig.h's polynomials there were no faster (docs/cpu_simd.md).
+ * polynomials (one loop per point); the wind keeps libmvec's atan2 and takes the turned
+ * direction's sin and cos from fast_trig.h in one loop (docs/cpu_simd.md). A wind followed
+ * by collide runs as one pass (hb_simd_wind_collide_block).
  */
 
 #define PI_R ((REAL)3.14159265358979323846)
@@ -214,6 +215,30 @@ static inline __attribute__((always_inline)) void SFX(hb_wind_point)(SFX(hb_wind
     inZ = HB_ASSUME_ALIGNED(inZ);
     outY = HB_ASSUME_ALIGNED(outY);
     outZ = HB_ASSUME_ALIGNED(outZ);
+#if FAST_TRIG
+    /* one loop: fast_trig.h's inline sincos of the turned direction */
+#pragma omp simd
+    for (int j = 0; j < BLOCK; j++) {
+        const REAL cy = inY[j], cz = inZ[j];
+        const REAL dy = cy - ws->oy[j], dz = cz - ws->oz[j];
+        const REAL phi = ATAN2(dy, dz);
+        REAL delta = psi - phi;
+        const REAL dm = delta - TWO_PI_R, dp = delta + TWO_PI_R;
+        const ITYPE above = delta > PI_R, below = delta <= -PI_R;
+        delta = above ? dm : (below ? dp : delta);
+        const ITYPE opposite = delta == PI_R, up = dz >= (REAL)0;
+        delta = opposite ? (up ? PI_R : -PI_R) : delta;
+        REAL sn, cs;
+        hb_sincos_fast(phi + t * delta, &sn, &cs);
+        const REAL z = ws->nz[j] + ell * cs, y = ws->ny[j] + ell * sn;
+        ws->nz[j] = z;
+        ws->ny[j] = y;
+        outZ[j] = z;
+        outY[j] = y;
+        ws->oy[j] = cy;
+        ws->oz[j] = cz;
+    }
+#else
     /* Two loops per point, the cos in the first and the sin in the second (see init). */
 #pragma omp simd
     for (int j = 0; j < BLOCK; j++) {
@@ -241,6 +266,7 @@ static inline __attribute__((always_inline)) void SFX(hb_wind_point)(SFX(hb_wind
         ws->ny[j] = y;
         outY[j] = y;
     }
+#endif
 }
 
 void SFX(hb_simd_wind_block)(const MODEL *m, REAL *Y, REAL *Z, int64_t stride)
