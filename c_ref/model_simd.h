@@ -63,8 +63,8 @@ int64_t hb_simd_collide_block_f64(const hb_model_f64 *m, int real, double *Y, do
  * the two is stored there too. Returns collide's count. */
 int64_t hb_simd_wind_collide_block_f32(const hb_model_f32 *m, int real, float *Y, float *Z, float *WY, float *WZ,
                                        int64_t stride);
-int64_t hb_simd_wind_collide_block_f64(const hb_model_f64 *m, int real, double *Y, double *Z, double *WY,
-                                       double *WZ, int64_t stride);
+int64_t hb_simd_wind_collide_block_f64(const hb_model_f64 *m, int real, double *Y, double *Z, double *WY, double *WZ,
+                                       int64_t stride);
 
 /* The ISA model_simd.c is compiled for, as the compiler saw it (for messages). */
 extern const char hb_simd_isa[];

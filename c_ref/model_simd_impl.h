@@ -206,8 +206,8 @@ static inline void SFX(hb_wind_start)(SFX(hb_wind_lanes) * ws, const REAL *Y, co
 /* Point k read from (inY, inZ), its wound value left in ws->ny, ws->nz and stored to
  * (outY, outZ) (which may be the input row, or ws->ny, ws->nz themselves). */
 static inline __attribute__((always_inline)) void SFX(hb_wind_point)(SFX(hb_wind_lanes) * ws, const MODEL *m, REAL t,
-                                                                      const REAL *inY, const REAL *inZ, REAL *outY,
-                                                                      REAL *outZ)
+                                                                     const REAL *inY, const REAL *inZ, REAL *outY,
+                                                                     REAL *outZ)
 {
     const REAL ell = m->seg_len;
     const REAL psi = m->wind_angle; /* already reduced to (−π, π] */
@@ -314,8 +314,8 @@ static inline void SFX(hb_collide_start)(SFX(hb_collide_lanes) * cs, const MODEL
  * stored (the fused pass, whose input is not the output row), otherwise only the points
  * collide changes (a masked store: untouched points are not written). */
 static inline __attribute__((always_inline)) void SFX(hb_collide_point)(SFX(hb_collide_lanes) * cs, const MODEL *m,
-                                                                         const REAL *inY, const REAL *inZ, REAL *outY,
-                                                                         REAL *outZ, const int store_all)
+                                                                        const REAL *inY, const REAL *inZ, REAL *outY,
+                                                                        REAL *outZ, const int store_all)
 {
     const REAL ell = m->seg_len;
     inY = HB_ASSUME_ALIGNED(inY);
