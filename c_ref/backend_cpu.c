@@ -39,6 +39,10 @@ typedef struct {
     int simd;
     int64_t block, nblocks, stride;
     void *pm[3], *pm_saved[3];
+    /* simd: a wind followed by collide runs as one pass (consumed 2); with `keep` (a file
+     * is written) the wind frame's Y, Z go to pm_wind, allocated on first use */
+    int keep;
+    void *pm_wind[2];
     size_t pm_bytes; /* bytes of one of X, Y, Z (allocation size) */
     /* simulate (ref): velocities [N·P][3], rest shape [N·P][3], bend rest lengths [N][P−2],
      * a copy of the velocities for repeats; the run's constants */
@@ -314,6 +318,37 @@ static int64_t simd_run_stage(cpu_impl *c, hb_stage st)
     return moved;
 }
 
+/* wind then collide, one pass over the points (model_simd.h), the same bits as the two
+ * stages; the wind frame is stored to pm_wind when the driver keeps it. Returns −1 when
+ * pm_wind cannot be allocated. */
+static int64_t simd_run_wind_collide(cpu_impl *c)
+{
+    const int64_t N = c->scene.n_strands, B = c->block, NB = c->nblocks, S = c->stride;
+    if (c->keep && !c->pm_wind[0]) {
+        for (int d = 0; d < 2; d++) c->pm_wind[d] = pm_alloc(c->pm_bytes);
+        if (!c->pm_wind[0] || !c->pm_wind[1]) return -1;
+    }
+    int64_t moved = 0;
+    if (c->scene.precision == HB_FP32) {
+        float *Y = c->pm[1], *Z = c->pm[2], *WY = c->keep ? c->pm_wind[0] : NULL, *WZ = c->keep ? c->pm_wind[1] : NULL;
+#pragma omp parallel for schedule(static) reduction(+ : moved)
+        for (int64_t b = 0; b < NB; b++) {
+            const int real = (int)(N - b * B < B ? N - b * B : B);
+            moved += hb_simd_wind_collide_block_f32(&c->m32, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,
+                                                    WZ ? WZ + b * B : NULL, S);
+        }
+    } else {
+        double *Y = c->pm[1], *Z = c->pm[2], *WY = c->keep ? c->pm_wind[0] : NULL, *WZ = c->keep ? c->pm_wind[1] : NULL;
+#pragma omp parallel for schedule(static) reduction(+ : moved)
+        for (int64_t b = 0; b < NB; b++) {
+            const int real = (int)(N - b * B < B ? N - b * B : B);
+            moved += hb_simd_wind_collide_block_f64(&c->m64, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,
+                                                    WZ ? WZ + b * B : NULL, S);
+        }
+    }
+    return moved;
+}
+
 /* ---- the simd variant: the dynamic model (docs/cpu_simd.md, "The dynamic model") ------ */
 
 /* Bytes simulate adds: velocities (and their saved copy), the rest shape, bend rest lengths. */
@@ -489,6 +524,25 @@ static int cpu_fetch(hb_backend *b, void *canonical, double *ms, char *err, size
     return 0;
 }
 
+/* After a fused wind+collide (simd): the wind frame, canonical. */
+static int cpu_fetch_intermediate(hb_backend *b, void *canonical, char *err, size_t errlen)
+{
+    cpu_impl *c = b->impl;
+    if (!c->simd || !c->pm_wind[0]) {
+        snprintf(err, errlen, "internal: no wind frame was kept");
+        return HB_EXIT_RUNTIME;
+    }
+    void *const a[3] = {c->pm[0], c->pm_wind[0], c->pm_wind[1]};
+    simd_dyn_convert(c, a, canonical, 0);
+    return 0;
+}
+
+static void cpu_keep_intermediate(hb_backend *b, int keep)
+{
+    cpu_impl *c = b->impl;
+    c->keep = keep;
+}
+
 static int cpu_save(hb_backend *b, char *err, size_t errlen)
 {
     (void)err;
@@ -517,14 +571,24 @@ static int cpu_restore(hb_backend *b, char *err, size_t errlen)
 static int cpu_run_stage(hb_backend *b, const hb_stage *stages, int i, int n, hb_stage_result *r, char *err,
                          size_t errlen)
 {
-    (void)n;
-    (void)err;
-    (void)errlen;
     cpu_impl *c = b->impl;
     const int64_t N = c->scene.n_strands;
     const size_t stride = (size_t)c->scene.points * 3u;
     const hb_stage st = stages[i];
     int64_t moved = 0;
+    if (c->simd && st == HB_STAGE_WIND && i + 1 < n && stages[i + 1] == HB_STAGE_COLLIDE) {
+        double t0 = hb_now_ms();
+        moved = simd_run_wind_collide(c);
+        r->ms = hb_now_ms() - t0;
+        if (moved < 0) {
+            snprintf(err, errlen, "cannot allocate %.2f GB of host memory for the wind frame",
+                     2e-9 * (double)c->pm_bytes);
+            return HB_EXIT_RUNTIME;
+        }
+        r->moved_points = moved;
+        r->consumed = 2;
+        return 0;
+    }
     double t0 = hb_now_ms();
     if (c->simd) {
         moved = simd_run_stage(c, st);
@@ -805,6 +869,8 @@ static void cpu_teardown(hb_backend *b)
         free(c->pv_saved[d]);
         free(c->pr[d]);
     }
+    free(c->pm_wind[0]);
+    free(c->pm_wind[1]);
     free(c->pb);
     free(c);
     b->impl = NULL;
@@ -838,6 +904,8 @@ int main(int argc, char **argv)
     b.save = cpu_save;
     b.restore = cpu_restore;
     b.fetch = cpu_fetch;
+    b.fetch_intermediate = cpu_fetch_intermediate;
+    b.keep_intermediate = cpu_keep_intermediate;
     b.measure_bandwidth = cpu_measure_bandwidth;
     b.describe = cpu_describe;
     b.teardown = cpu_teardown;

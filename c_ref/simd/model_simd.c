@@ -9,7 +9,8 @@
  *    `simd("notinbranch")` attribute, bits/math-vector.h) only when __FAST_MATH__ is
  *    defined, and GCC defines that only with all of -ffast-math's value-changing flags
  *    (-funsafe-math-optimizations, -ffinite-math-only, -fno-signed-zeros, …). We declare
- *    the same attribute on the eight functions we call, below: the declarations glibc
+ *    the same attribute on the eight functions (fp32's sin and cos are now fast_trig.h's),
+ *    below: the declarations glibc
  *    makes, without those flags. The vector functions are libmvec's, accurate to 4 ulp
  *    (glibc manual, "Errors in Math Functions").
  *  - -fno-math-errno: sqrt becomes the vector sqrt instruction, and the math builtins

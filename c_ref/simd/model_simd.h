@@ -58,6 +58,14 @@ void hb_simd_wind_block_f64(const hb_model_f64 *m, double *Y, double *Z, int64_t
 int64_t hb_simd_collide_block_f32(const hb_model_f32 *m, int real, float *Y, float *Z, int64_t stride);
 int64_t hb_simd_collide_block_f64(const hb_model_f64 *m, int real, double *Y, double *Z, int64_t stride);
 
+/* wind then collide in one pass over the points (each point read and written once), the
+ * same bits as the two calls above; with WY, WZ (same layout, or NULL) the state between
+ * the two is stored there too. Returns collide's count. */
+int64_t hb_simd_wind_collide_block_f32(const hb_model_f32 *m, int real, float *Y, float *Z, float *WY, float *WZ,
+                                       int64_t stride);
+int64_t hb_simd_wind_collide_block_f64(const hb_model_f64 *m, int real, double *Y, double *Z, double *WY, double *WZ,
+                                       int64_t stride);
+
 /* The ISA model_simd.c is compiled for, as the compiler saw it (for messages). */
 extern const char hb_simd_isa[];
 

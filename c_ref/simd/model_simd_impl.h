@@ -22,8 +22,9 @@
  * radius ℓ about the root only touches the shell, ℓ = h, √h² turns an ulp into √ε). With FAST_TRIG (fp32) the drape's step angles are computed once per
  * strand (every step after the first goes from the shell to the shell), θ advances by
  * additions as in model_impl.h, and a point's sin and cos are fast_trig.h's inline
- * polynomials (one loop per point). The wind keeps libmvec's atan2, sin and cos: measured,
- * fast_trig.h's polynomials there were no faster (docs/cpu_simd.md).
+ * polynomials (one loop per point); the wind keeps libmvec's atan2 and takes the turned
+ * direction's sin and cos from fast_trig.h in one loop (docs/cpu_simd.md). A wind followed
+ * by collide runs as one pass (hb_simd_wind_collide_block).
  */
 
 #define PI_R ((REAL)3.14159265358979323846)
@@ -185,182 +186,279 @@ void SFX(hb_simd_init_block)(const MODEL *m, uint64_t first, REAL *X, REAL *Y, R
 }
 
 /* ---- wind (model_impl.h hb_wind_strand) ----------------------------------------------- */
+/* a block's running wind state: the predecessor before (oy, oz) and after (ny, nz) the
+ * wind (the root never moves), and within one point the turned direction */
+typedef struct {
+    REAL oy[BLOCK] HB_ALIGNED, oz[BLOCK] HB_ALIGNED, ny[BLOCK] HB_ALIGNED, nz[BLOCK] HB_ALIGNED;
+    REAL angle[BLOCK] HB_ALIGNED;
+} SFX(hb_wind_lanes);
+
+static inline void SFX(hb_wind_start)(SFX(hb_wind_lanes) * ws, const REAL *Y, const REAL *Z)
+{
+    const REAL *restrict Y0 = HB_ASSUME_ALIGNED(Y), *restrict Z0 = HB_ASSUME_ALIGNED(Z);
+#pragma omp simd
+    for (int j = 0; j < BLOCK; j++) {
+        ws->oy[j] = ws->ny[j] = Y0[j];
+        ws->oz[j] = ws->nz[j] = Z0[j];
+    }
+}
+
+/* Point k read from (inY, inZ), its wound value left in ws->ny, ws->nz and stored to
+ * (outY, outZ) (which may be the input row, or ws->ny, ws->nz themselves). */
+static inline __attribute__((always_inline)) void SFX(hb_wind_point)(SFX(hb_wind_lanes) * ws, const MODEL *m, REAL t,
+                                                                     const REAL *inY, const REAL *inZ, REAL *outY,
+                                                                     REAL *outZ)
+{
+    const REAL ell = m->seg_len;
+    const REAL psi = m->wind_angle; /* already reduced to (−π, π] */
+    inY = HB_ASSUME_ALIGNED(inY);
+    inZ = HB_ASSUME_ALIGNED(inZ);
+    outY = HB_ASSUME_ALIGNED(outY);
+    outZ = HB_ASSUME_ALIGNED(outZ);
+#if FAST_TRIG
+    /* one loop: fast_trig.h's inline sincos of the turned direction */
+#pragma omp simd
+    for (int j = 0; j < BLOCK; j++) {
+        const REAL cy = inY[j], cz = inZ[j];
+        const REAL dy = cy - ws->oy[j], dz = cz - ws->oz[j];
+        const REAL phi = ATAN2(dy, dz);
+        REAL delta = psi - phi;
+        const REAL dm = delta - TWO_PI_R, dp = delta + TWO_PI_R;
+        const ITYPE above = delta > PI_R, below = delta <= -PI_R;
+        delta = above ? dm : (below ? dp : delta);
+        const ITYPE opposite = delta == PI_R, up = dz >= (REAL)0;
+        delta = opposite ? (up ? PI_R : -PI_R) : delta;
+        REAL sn, cs;
+        hb_sincos_fast(phi + t * delta, &sn, &cs);
+        const REAL z = ws->nz[j] + ell * cs, y = ws->ny[j] + ell * sn;
+        ws->nz[j] = z;
+        ws->ny[j] = y;
+        outZ[j] = z;
+        outY[j] = y;
+        ws->oy[j] = cy;
+        ws->oz[j] = cz;
+    }
+#else
+    /* Two loops per point, the cos in the first and the sin in the second (see init). */
+#pragma omp simd
+    for (int j = 0; j < BLOCK; j++) {
+        const REAL cy = inY[j], cz = inZ[j];
+        const REAL dy = cy - ws->oy[j], dz = cz - ws->oz[j];
+        const REAL phi = ATAN2(dy, dz);
+        REAL delta = psi - phi; /* in [−2π, 2π]: wrap to (−π, π] */
+        const REAL dm = delta - TWO_PI_R, dp = delta + TWO_PI_R;
+        const ITYPE above = delta > PI_R, below = delta <= -PI_R;
+        delta = above ? dm : (below ? dp : delta);
+        /* exactly opposite: the arc through +y (the sign of dz, model_impl.h) */
+        const ITYPE opposite = delta == PI_R, up = dz >= (REAL)0;
+        delta = opposite ? (up ? PI_R : -PI_R) : delta;
+        const REAL turned = phi + t * delta;
+        const REAL z = ws->nz[j] + ell * COS(turned);
+        ws->angle[j] = turned;
+        ws->nz[j] = z;
+        outZ[j] = z;
+        ws->oy[j] = cy;
+        ws->oz[j] = cz;
+    }
+#pragma omp simd
+    for (int j = 0; j < BLOCK; j++) {
+        const REAL y = ws->ny[j] + ell * SIN(ws->angle[j]);
+        ws->ny[j] = y;
+        outY[j] = y;
+    }
+#endif
+}
+
 void SFX(hb_simd_wind_block)(const MODEL *m, REAL *Y, REAL *Z, int64_t stride)
 {
     const int64_t P = m->points;
-    const REAL ell = m->seg_len;
-    const REAL w = m->wind_strength;
-    const REAL psi = m->wind_angle; /* already reduced to (−π, π] */
-    const REAL last = (REAL)(P - 1);
-    /* the predecessor before (oy, oz) and after (ny, nz) the wind; the root never moves */
-    REAL oy[BLOCK] HB_ALIGNED, oz[BLOCK] HB_ALIGNED, ny[BLOCK] HB_ALIGNED, nz[BLOCK] HB_ALIGNED;
-    REAL angle[BLOCK] HB_ALIGNED; /* within one point: the turned direction */
-    {
-        const REAL *restrict Y0 = HB_ASSUME_ALIGNED(Y), *restrict Z0 = HB_ASSUME_ALIGNED(Z);
+    SFX(hb_wind_lanes) ws;
+    SFX(hb_wind_start)(&ws, Y, Z);
+    const REAL w_per_point = m->wind_strength / (REAL)(P - 1);
+    for (int64_t k = 1; k < P; k++)
+        SFX(hb_wind_point)(&ws, m, (REAL)k * w_per_point, ROW(Y, k), ROW(Z, k), ROW(Y, k), ROW(Z, k));
+}
+
+/* ---- collide (model_impl.h hb_collide_strand) ----------------------------------------- */
+/* a block's running collide state: the predecessor (after this pass), the shell, whether
+ * the strand has moved, the count of points changed; within one point the point after the
+ * pull and the projection, and whether it is inside the shell (then: whether it was
+ * projected) */
+typedef struct {
+    REAL py[BLOCK] HB_ALIGNED, pz[BLOCK] HB_ALIGNED, rc[BLOCK] HB_ALIGNED, inner2[BLOCK] HB_ALIGNED;
+    ITYPE moved[BLOCK] HB_ALIGNED, changed[BLOCK] HB_ALIGNED;
+    REAL ny[BLOCK] HB_ALIGNED, nz[BLOCK] HB_ALIGNED;
+    ITYPE inside[BLOCK] HB_ALIGNED;
+} SFX(hb_collide_lanes);
+
+static inline void SFX(hb_collide_start)(SFX(hb_collide_lanes) * cs, const MODEL *m, const REAL *Y, const REAL *Z)
+{
+    const REAL h = m->hair_offset;
+    const REAL *restrict Y0 = HB_ASSUME_ALIGNED(Y), *restrict Z0 = HB_ASSUME_ALIGNED(Z);
 #pragma omp simd
-        for (int j = 0; j < BLOCK; j++) {
-            oy[j] = ny[j] = Y0[j];
-            oz[j] = nz[j] = Z0[j];
-        }
+    for (int j = 0; j < BLOCK; j++) {
+        const REAL y = Y0[j], z = Z0[j];
+        const REAL r0 = SQRT(y * y + z * z);
+        const REAL c = r0 + h;
+        const REAL inner = c - c * ((REAL)HB_SHELL_ULPS * EPS); /* rounding allowance */
+        cs->rc[j] = c;
+        cs->inner2[j] = inner * inner;
+        cs->py[j] = y;
+        cs->pz[j] = z;
+        cs->moved[j] = 0;
+        cs->changed[j] = 0;
     }
-    const REAL w_per_point = w / last;
-    for (int64_t k = 1; k < P; k++) {
-        REAL *restrict Yk = HB_ASSUME_ALIGNED(ROW(Y, k)), *restrict Zk = HB_ASSUME_ALIGNED(ROW(Z, k));
-        const REAL t = (REAL)k * w_per_point;
-        /* Two loops per point, the cos in the first and the sin in the second (see init). */
+}
+
+/* Point k read from (inY, inZ) and stored to (outY, outZ): with store_all every lane is
+ * stored (the fused pass, whose input is not the output row), otherwise only the points
+ * collide changes (a masked store: untouched points are not written). */
+static inline __attribute__((always_inline)) void SFX(hb_collide_point)(SFX(hb_collide_lanes) * cs, const MODEL *m,
+                                                                        const REAL *inY, const REAL *inZ, REAL *outY,
+                                                                        REAL *outZ, const int store_all)
+{
+    const REAL ell = m->seg_len;
+    inY = HB_ASSUME_ALIGNED(inY);
+    inZ = HB_ASSUME_ALIGNED(inZ);
+    outY = HB_ASSUME_ALIGNED(outY);
+    outZ = HB_ASSUME_ALIGNED(outZ);
+    /* model_impl.h's two branches, the pull of a moved strand and the projection of a
+     * point inside the shell, cost divisions and square roots that selects would compute
+     * on every lane; most lanes take neither. So each chunk of HB_SIMD_CHUNK lanes runs a
+     * branch's loop only when one of its lanes takes it; every lane of the chunk then
+     * computes it and the select keeps it where model_impl.h would. */
+    for (int j0 = 0; j0 < BLOCK; j0 += HB_SIMD_CHUNK) {
+        const int j1 = j0 + HB_SIMD_CHUNK;
+        ITYPE any_moved = 0, any_inside = 0;
+#pragma omp simd reduction(| : any_moved)
+        for (int j = j0; j < j1; j++) any_moved |= cs->moved[j];
+        if (any_moved) {
+            /* follow the leader once the strand has moved:
+             * p_k ← p_{k−1} + ℓ·unit(p_k − p_{k−1}), or ℓ straight down when there is no
+             * direction left */
+#pragma omp simd reduction(| : any_inside)
+            for (int j = j0; j < j1; j++) {
+                const REAL y = cs->py[j], z = cs->pz[j], qy = inY[j], qz = inZ[j];
+                const REAL dy = qy - y, dz = qz - z;
+                const REAL len = SQRT(dy * dy + dz * dz);
+                const ITYPE dir = len > (REAL)0;
+                const REAL scale = ell / len; /* one division (model_impl.h: two) */
+                const REAL fy = y + dy * scale, fz = z + dz * scale, down = y - ell;
+                const REAL cy = cs->moved[j] ? (dir ? fy : down) : qy;
+                const REAL cz = cs->moved[j] ? (dir ? fz : z) : qz;
+                const ITYPE in = cy * cy + cz * cz < cs->inner2[j];
+                cs->ny[j] = cy;
+                cs->nz[j] = cz;
+                cs->inside[j] = in;
+                any_inside |= in;
+            }
+        } else {
+#pragma omp simd reduction(| : any_inside)
+            for (int j = j0; j < j1; j++) {
+                const REAL cy = inY[j], cz = inZ[j];
+                const ITYPE in = cy * cy + cz * cz < cs->inner2[j];
+                cs->ny[j] = cy;
+                cs->nz[j] = cz;
+                cs->inside[j] = in;
+                any_inside |= in;
+            }
+        }
+        if (any_inside) {
+            /* inside the shell: the intersection of the shell with the circle of radius ℓ
+             * around the predecessor closest to the point (ties: the upper one), through
+             * t = d − a and hh² = (rc − d + t)(rc + a) as in model_impl.h */
 #pragma omp simd
-        for (int j = 0; j < BLOCK; j++) {
-            const REAL cy = Yk[j], cz = Zk[j];
-            const REAL dy = cy - oy[j], dz = cz - oz[j];
-            const REAL phi = ATAN2(dy, dz);
-            REAL delta = psi - phi; /* in [−2π, 2π]: wrap to (−π, π] */
-            const REAL dm = delta - TWO_PI_R, dp = delta + TWO_PI_R;
-            const ITYPE above = delta > PI_R, below = delta <= -PI_R;
-            delta = above ? dm : (below ? dp : delta);
-            /* exactly opposite: the arc through +y (the sign of dz, model_impl.h) */
-            const ITYPE opposite = delta == PI_R, up = dz >= (REAL)0;
-            delta = opposite ? (up ? PI_R : -PI_R) : delta;
-            const REAL turned = phi + t * delta;
-            const REAL z = nz[j] + ell * COS(turned);
-            angle[j] = turned;
-            nz[j] = z;
-            Zk[j] = z;
-            oy[j] = cy;
-            oz[j] = cz;
+            for (int j = j0; j < j1; j++) {
+                const REAL y = cs->py[j], z = cs->pz[j], c = cs->rc[j], cy = cs->ny[j], cz = cs->nz[j];
+                const REAL d2 = y * y + z * z;
+                const REAL d = SQRT(d2);
+                const ITYPE proj = cs->inside[j] & (d > (REAL)0);
+                const REAL t = ((d - c) * (d + c) + ell * ell) / ((REAL)2 * d);
+                const REAL a = d - t;
+                const REAL h2 = ((c - d) + t) * (c + a);
+                const REAL hh = SQRT(h2 > (REAL)0 ? h2 : (REAL)0);
+                const REAL uy = y / d, uz = z / d;
+                const REAL fy = a * uy, fz = a * uz;
+                const REAL y1 = fy + hh * uz, z1 = fz - hh * uy;
+                const REAL y2 = fy - hh * uz, z2 = fz + hh * uy;
+                const REAL e1 = (y1 - cy) * (y1 - cy) + (z1 - cz) * (z1 - cz);
+                const REAL e2 = (y2 - cy) * (y2 - cy) + (z2 - cz) * (z2 - cz);
+                const ITYPE upper = (e1 < e2) | ((e1 == e2) & (y1 >= y2));
+                cs->ny[j] = proj ? (upper ? y1 : y2) : cy;
+                cs->nz[j] = proj ? (upper ? z1 : z2) : cz;
+                cs->inside[j] = proj;
+            }
+        }
+        if (!any_moved && !any_inside) {
+#pragma omp simd
+            for (int j = j0; j < j1; j++) {
+                const REAL cy = cs->ny[j], cz = cs->nz[j];
+                if (store_all) {
+                    outY[j] = cy;
+                    outZ[j] = cz;
+                }
+                cs->py[j] = cy;
+                cs->pz[j] = cz;
+            }
+            continue;
         }
 #pragma omp simd
-        for (int j = 0; j < BLOCK; j++) {
-            const REAL y = ny[j] + ell * SIN(angle[j]);
-            ny[j] = y;
-            Yk[j] = y;
+        for (int j = j0; j < j1; j++) {
+            const REAL cy = cs->ny[j], cz = cs->nz[j];
+            const ITYPE now = cs->moved[j] | cs->inside[j]; /* inside[] is now "projected" */
+            if (store_all || now) {
+                outY[j] = cy;
+                outZ[j] = cz;
+            }
+            cs->moved[j] = now;
+            cs->changed[j] += now;
+            cs->py[j] = cy;
+            cs->pz[j] = cz;
         }
     }
 }
 
-/* ---- collide (model_impl.h hb_collide_strand) ----------------------------------------- */
+static inline int64_t SFX(hb_collide_total)(const SFX(hb_collide_lanes) * cs, int real)
+{
+    int64_t total = 0;
+    for (int j = 0; j < real && j < BLOCK; j++) total += (int64_t)cs->changed[j];
+    return total;
+}
+
 int64_t SFX(hb_simd_collide_block)(const MODEL *m, int real, REAL *Y, REAL *Z, int64_t stride)
 {
     const int64_t P = m->points;
-    const REAL ell = m->seg_len, h = m->hair_offset;
-    /* the predecessor (after this pass), the shell, whether the strand has moved, and the
-     * count of points changed */
-    REAL py[BLOCK] HB_ALIGNED, pz[BLOCK] HB_ALIGNED, rc[BLOCK] HB_ALIGNED, inner2[BLOCK] HB_ALIGNED;
-    ITYPE moved[BLOCK] HB_ALIGNED, changed[BLOCK] HB_ALIGNED;
-    /* within one point: the point after the pull and the projection, and whether it is
-     * inside the shell (then: whether it was projected) */
-    REAL ny[BLOCK] HB_ALIGNED, nz[BLOCK] HB_ALIGNED;
-    ITYPE inside[BLOCK] HB_ALIGNED;
-    {
-        const REAL *restrict Y0 = HB_ASSUME_ALIGNED(Y), *restrict Z0 = HB_ASSUME_ALIGNED(Z);
-#pragma omp simd
-        for (int j = 0; j < BLOCK; j++) {
-            const REAL y = Y0[j], z = Z0[j];
-            const REAL r0 = SQRT(y * y + z * z);
-            const REAL c = r0 + h;
-            const REAL inner = c - c * ((REAL)HB_SHELL_ULPS * EPS); /* rounding allowance */
-            rc[j] = c;
-            inner2[j] = inner * inner;
-            py[j] = y;
-            pz[j] = z;
-            moved[j] = 0;
-            changed[j] = 0;
+    SFX(hb_collide_lanes) cs;
+    SFX(hb_collide_start)(&cs, m, Y, Z);
+    for (int64_t k = 1; k < P; k++) SFX(hb_collide_point)(&cs, m, ROW(Y, k), ROW(Z, k), ROW(Y, k), ROW(Z, k), 0);
+    return SFX(hb_collide_total)(&cs, real);
+}
+
+/* ---- wind then collide in one pass (the CUDA fused variant's pair) -------------------- */
+/* Each point is read once and written once: wound into the lanes' wind state, then
+ * collided from there with exactly the operations of the two passes above, so the result
+ * is theirs bit for bit. With WY, WZ (not NULL) the wound state is stored there too. */
+int64_t SFX(hb_simd_wind_collide_block)(const MODEL *m, int real, REAL *Y, REAL *Z, REAL *WY, REAL *WZ, int64_t stride)
+{
+    const int64_t P = m->points;
+    SFX(hb_wind_lanes) ws;
+    SFX(hb_collide_lanes) cs;
+    SFX(hb_wind_start)(&ws, Y, Z);
+    SFX(hb_collide_start)(&cs, m, Y, Z);
+    const REAL w_per_point = m->wind_strength / (REAL)(P - 1);
+    if (WY) {
+        for (int64_t j = 0; j < BLOCK; j++) {
+            WY[j] = Y[j];
+            WZ[j] = Z[j];
         }
     }
     for (int64_t k = 1; k < P; k++) {
-        REAL *restrict Yk = HB_ASSUME_ALIGNED(ROW(Y, k)), *restrict Zk = HB_ASSUME_ALIGNED(ROW(Z, k));
-        /* model_impl.h's two branches, the pull of a moved strand and the projection of a
-         * point inside the shell, cost divisions and square roots that selects would
-         * compute on every lane; most lanes take neither. So each chunk of HB_SIMD_CHUNK
-         * lanes runs a branch's loop only when one of its lanes takes it; every lane of
-         * the chunk then computes it and the select keeps it where model_impl.h would. */
-        for (int j0 = 0; j0 < BLOCK; j0 += HB_SIMD_CHUNK) {
-            const int j1 = j0 + HB_SIMD_CHUNK;
-            ITYPE any_moved = 0, any_inside = 0;
-#pragma omp simd reduction(| : any_moved)
-            for (int j = j0; j < j1; j++) any_moved |= moved[j];
-            if (any_moved) {
-                /* follow the leader once the strand has moved:
-                 * p_k ← p_{k−1} + ℓ·unit(p_k − p_{k−1}), or ℓ straight down when there is
-                 * no direction left */
-#pragma omp simd reduction(| : any_inside)
-                for (int j = j0; j < j1; j++) {
-                    const REAL y = py[j], z = pz[j], qy = Yk[j], qz = Zk[j];
-                    const REAL dy = qy - y, dz = qz - z;
-                    const REAL len = SQRT(dy * dy + dz * dz);
-                    const ITYPE dir = len > (REAL)0;
-                    const REAL scale = ell / len; /* one division (model_impl.h: two) */
-                    const REAL fy = y + dy * scale, fz = z + dz * scale, down = y - ell;
-                    const REAL cy = moved[j] ? (dir ? fy : down) : qy;
-                    const REAL cz = moved[j] ? (dir ? fz : z) : qz;
-                    const ITYPE in = cy * cy + cz * cz < inner2[j];
-                    ny[j] = cy;
-                    nz[j] = cz;
-                    inside[j] = in;
-                    any_inside |= in;
-                }
-            } else {
-#pragma omp simd reduction(| : any_inside)
-                for (int j = j0; j < j1; j++) {
-                    const REAL cy = Yk[j], cz = Zk[j];
-                    const ITYPE in = cy * cy + cz * cz < inner2[j];
-                    ny[j] = cy;
-                    nz[j] = cz;
-                    inside[j] = in;
-                    any_inside |= in;
-                }
-            }
-            if (any_inside) {
-                /* inside the shell: the intersection of the shell with the circle of radius
-                 * ℓ around the predecessor closest to the point (ties: the upper one),
-                 * through t = d − a and hh² = (rc − d + t)(rc + a) as in model_impl.h */
-#pragma omp simd
-                for (int j = j0; j < j1; j++) {
-                    const REAL y = py[j], z = pz[j], c = rc[j], cy = ny[j], cz = nz[j];
-                    const REAL d2 = y * y + z * z;
-                    const REAL d = SQRT(d2);
-                    const ITYPE proj = inside[j] & (d > (REAL)0);
-                    const REAL t = ((d - c) * (d + c) + ell * ell) / ((REAL)2 * d);
-                    const REAL a = d - t;
-                    const REAL h2 = ((c - d) + t) * (c + a);
-                    const REAL hh = SQRT(h2 > (REAL)0 ? h2 : (REAL)0);
-                    const REAL uy = y / d, uz = z / d;
-                    const REAL fy = a * uy, fz = a * uz;
-                    const REAL y1 = fy + hh * uz, z1 = fz - hh * uy;
-                    const REAL y2 = fy - hh * uz, z2 = fz + hh * uy;
-                    const REAL e1 = (y1 - cy) * (y1 - cy) + (z1 - cz) * (z1 - cz);
-                    const REAL e2 = (y2 - cy) * (y2 - cy) + (z2 - cz) * (z2 - cz);
-                    const ITYPE upper = (e1 < e2) | ((e1 == e2) & (y1 >= y2));
-                    ny[j] = proj ? (upper ? y1 : y2) : cy;
-                    nz[j] = proj ? (upper ? z1 : z2) : cz;
-                    inside[j] = proj;
-                }
-            }
-            if (!any_moved && !any_inside) {
-#pragma omp simd
-                for (int j = j0; j < j1; j++) {
-                    py[j] = ny[j];
-                    pz[j] = nz[j];
-                }
-                continue;
-            }
-#pragma omp simd
-            for (int j = j0; j < j1; j++) {
-                const REAL cy = ny[j], cz = nz[j];
-                const ITYPE now = moved[j] | inside[j]; /* inside[] is now "projected" */
-                if (now) {                              /* a masked store: untouched points are not written */
-                    Yk[j] = cy;
-                    Zk[j] = cz;
-                }
-                moved[j] = now;
-                changed[j] += now;
-                py[j] = cy;
-                pz[j] = cz;
-            }
-        }
+        const REAL t = (REAL)k * w_per_point;
+        if (WY) SFX(hb_wind_point)(&ws, m, t, ROW(Y, k), ROW(Z, k), ROW(WY, k), ROW(WZ, k));
+        else SFX(hb_wind_point)(&ws, m, t, ROW(Y, k), ROW(Z, k), ws.ny, ws.nz);
+        SFX(hb_collide_point)(&cs, m, ws.ny, ws.nz, ROW(Y, k), ROW(Z, k), 1);
     }
-    int64_t total = 0;
-    for (int j = 0; j < real && j < BLOCK; j++) total += (int64_t)changed[j];
-    return total;
+    return SFX(hb_collide_total)(&cs, real);
 }
 
 #undef ROW
