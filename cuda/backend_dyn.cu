@@ -28,9 +28,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <vector>
+
 #include "backend_cuda.cuh"
 #include "check.cuh"
 #include "dyn_kernels.cuh"
+#include "dyn_post.cuh"
+#include "dynamic/dyn_followers.h"
+#include "dynamic/dyn_sagfree.h"
 #include "runtime/checked.h"
 #include "runtime/host.h"
 
