@@ -533,7 +533,7 @@ static int cpu_fetch_intermediate(hb_backend *b, void *canonical, char *err, siz
         return HB_EXIT_RUNTIME;
     }
     void *const a[3] = {c->pm[0], c->pm_wind[0], c->pm_wind[1]};
-    simd_dyn_convert(c, a, canonical, 0);
+    simd_convert(c, a, canonical, 0);
     return 0;
 }
 
