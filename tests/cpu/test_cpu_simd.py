@@ -433,7 +433,7 @@ def test_simd_object_calls_libmvec_and_no_scalar_math(cpu_bin):
         pytest.skip("a sanitizer build (make sanitize): its instrumentation keeps the loops scalar")
     scalar = {"sinf", "cosf", "asinf", "atan2f", "sin", "cos", "asin", "atan2", "sincosf", "sincos"} & called
     assert not scalar, f"scalar math calls left in model_simd.o: {sorted(scalar)}"
-    # fp32's sin and cos are c_ref/fast_trig.h's inline polynomials (docs/cpu_simd.md)
+    # fp32's sin and cos are c_ref/paper/fast_trig.h's inline polynomials (docs/cpu_simd.md)
     for f in ("asinf", "atan2f", "sin", "cos", "asin", "atan2"):
         assert any(c.startswith("_ZGV") and c.endswith("_" + f) for c in called), f"no vector call to {f}"
 
