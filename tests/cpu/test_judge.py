@@ -35,7 +35,7 @@ def _reference(cpu_bin, tmp_path_factory, name, precision="fp64", strands=8):
 def test_planted_defects_declared_once():
     """The harness's list of planted defects and the C sources' `#if HB_PLANT == n` hunks name
     the same numbers (the Makefile builds one binary per number found in c_ref)."""
-    text = "".join(p.read_text() for p in sorted((ROOT / "c_ref").glob("*.[ch]")))
+    text = "".join(p.read_text() for p in sorted((ROOT / "c_ref").rglob("*.[ch]")))
     in_c = {int(n) for n in re.findall(r"HB_PLANT == (\d+)", text)}
     assert in_c == set(judge.PLANTS)
     assert sum(p.model == "dynamic" for p in judge.PLANTS.values()) >= 10 and len(judge.EXTREME) >= 20
