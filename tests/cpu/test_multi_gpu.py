@@ -12,24 +12,15 @@ import pytest
 
 from conftest import ROOT
 from support.fakebackend import install
+from support.sweeps import sweep_toml
 
-SWEEP = """
-name = "two-gpus"
-scene = "paper"
-repeat = 9
-warmup = 0
-[axes]
-strands = [100, 200, 300]
-points = [8]
-precision = ["fp32"]
-[cpu]
-variant = ["ref"]
-threads = [1]
-[cuda]
-build = ["default"]
-variant = ["paper", "fused"]
-block_size = [32, 64]
-"""
+SWEEP = sweep_toml(
+    "two-gpus",
+    strands=[100, 200, 300],
+    points=[8],
+    precision=["fp32"],
+    cuda={"build": ["default"], "variant": ["paper", "fused"], "block_size": [32, 64]},
+)
 SMI = """#!/bin/sh
 case "$1" in
   -L) printf 'GPU 0: Fake GPU (UUID: GPU-fake-0)\\nGPU 1: Fake GPU (UUID: GPU-fake-1)\\n' ;;

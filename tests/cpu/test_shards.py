@@ -13,22 +13,11 @@ import pytest
 
 from conftest import CPU_BIN, ROOT
 from harness.core import shards
+from support.sweeps import sweep_toml
 
 needs_cpu = pytest.mark.skipif(not CPU_BIN.exists(), reason=f"{CPU_BIN} is not built (run make)")
 
-SWEEP = """
-name = "shard-t"
-scene = "paper"
-repeat = 9
-warmup = 0
-[axes]
-strands = [40, 80, 120]
-points = [8]
-precision = ["fp32", "fp64"]
-[cpu]
-variant = ["ref"]
-threads = [1]
-"""
+SWEEP = sweep_toml("shard-t", strands=[40, 80, 120], points=[8], precision=["fp32", "fp64"])
 # what a case measures that does not depend on the run (times, dates and sessions do)
 DETERMINISTIC = (
     "case_id",

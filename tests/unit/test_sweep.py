@@ -19,23 +19,17 @@ from harness.io.sweepfile import load_sweep
 from harness.studies import roofline
 from harness.studies.sweep import quartiles, run_sweep
 from support.fakebackend import install
+from support.sweeps import sweep_toml
 
-SWEEP = """
-name = "t"
-scene = "paper"
-repeat = 9
-warmup = 1
-[axes]
-strands = [10, 20, 30]
-points = [4]
-precision = ["fp32", "fp64"]
-[cpu]
-variant = ["ref"]
-threads = [1, "all"]
-[cuda]
-variant = ["paper"]
-block_size = [32, 64]
-"""
+SWEEP = sweep_toml(
+    "t",
+    strands=[10, 20, 30],
+    points=[4],
+    precision=["fp32", "fp64"],
+    warmup=1,
+    threads=[1, "all"],
+    cuda={"variant": ["paper"], "block_size": [32, 64]},
+)
 N_CPU_CASES = 3 * 2 * 2
 STAGES = 4
 
