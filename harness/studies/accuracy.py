@@ -47,6 +47,20 @@ class Mode:
     def tag(self):
         return self.name.replace(" ", "_")
 
+    def columns(self):
+        """The mode's columns in a study's rows: its name and what picks its runs."""
+        return dict(
+            mode=self.name,
+            backend=self.runner.backend,
+            build=self.runner.build,
+            variant=self.runner.variant,
+            solver=self.solver,
+            ftl_damping=self.ftl_damping,
+            substeps=self.substeps,
+            iterations=self.iterations,
+            precision=self.precision,
+        )
+
 
 # the paper study's modes: the cpu ones run the cpu's default variant (the oracle), the gpu
 # ones each build's default variant; accuracy_paper.modes() adds one fp32 mode for each

@@ -548,15 +548,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                 frame_metrics(gpu_run, cpu_run, study.L, study.gravity),
                 study="gpu_check",
                 mode=f"{gpu_ref.label} vs {cpu_oracle.label} S{S0}",
-                backend="cuda",
-                build=gpu_ref.build,
-                variant=gpu_ref.variant,
-                solver=REF_SOLVER,
-                substeps=S0,
-                iterations=REF_ITERATIONS,
-                precision=REF_PRECISION,
-                strands=plan.strands,
-                points=study.scene.points,
+                **_ref_columns(study, gpu_ref, S0),
                 ref_substeps=S0,
             )
             if valid:
@@ -675,16 +667,8 @@ def _rows(study, modes, mode_paths, ref, timing):
             rms,
             mx,
             frame_metrics(r, ref["final"], study.L, study.gravity),
-            ftl_damping=m.ftl_damping,
+            **m.columns(),
             study="mode",
-            mode=m.name,
-            backend=m.runner.backend,
-            build=m.runner.build,
-            variant=m.runner.variant,
-            solver=m.solver,
-            substeps=m.substeps,
-            iterations=m.iterations,
-            precision=m.precision,
             strands=study.plan.strands,
             points=study.scene.points,
             time_per_frame_ms=ms,
@@ -705,22 +689,16 @@ def _ladder_rows(study, ref):
         run = st["run"]
         for f in range(len(st["rms"])):
             rows.append(
-                _row(
-                    study="reference",
-                    mode=f"{b.label} {REF_SOLVER} S{st['S']} I{REF_ITERATIONS} {REF_PRECISION}",
-                    backend=b.backend,
-                    build=b.build,
-                    variant=b.variant,
-                    solver=REF_SOLVER,
-                    substeps=st["S"],
-                    iterations=REF_ITERATIONS,
-                    precision=REF_PRECISION,
-                    strands=study.plan.strands,
-                    points=study.scene.points,
-                    frame=f + 1,
-                    time_s=run.times[f],
-                    rms_err_L=st["rms"][f],
-                    max_err_L=st["max"][f],
+                _ref_row(
+                    study,
+                    b,
+                    "reference",
+                    f"{b.label} {REF_SOLVER} S{st['S']} I{REF_ITERATIONS} {REF_PRECISION}",
+                    st["S"],
+                    f,
+                    run.times[f],
+                    st["rms"][f],
+                    st["max"][f],
                     stretch_max=run.stretch[f],
                     penetration_max=run.penetration[f],
                     blown_up_strands=run.blown[f],
@@ -729,6 +707,36 @@ def _ladder_rows(study, ref):
                 )
             )
     return rows
+
+
+def _ref_columns(study, b, substeps):
+    """The columns a run of the reference solver (REF_SOLVER, REF_ITERATIONS, REF_PRECISION) on
+    build b at `substeps` shares with every row it gives."""
+    return dict(
+        backend=b.backend,
+        build=b.build,
+        variant=b.variant,
+        solver=REF_SOLVER,
+        substeps=substeps,
+        iterations=REF_ITERATIONS,
+        precision=REF_PRECISION,
+        strands=study.plan.strands,
+        points=study.scene.points,
+    )
+
+
+def _ref_row(study, b, name, mode, substeps, f, time_s, rms, mx, **extra):
+    """One frame's row of the reference solver on build b."""
+    return _row(
+        **_ref_columns(study, b, substeps),
+        study=name,
+        mode=mode,
+        frame=f + 1,
+        time_s=time_s,
+        rms_err_L=rms,
+        max_err_L=mx,
+        **extra,
+    )
 
 
 def _ref_error_rows(study, ref, err):
@@ -741,25 +749,10 @@ def _ref_error_rows(study, ref, err):
     rows = []
     for name, rms, mx in (("ref_error", err["rms"], err["max"]), ("ref_error_est", err["est_rms"], err["est_max"])):
         for f in range(len(rms)):
+            mode = f"{b.label} {REF_SOLVER} S{err['S']} against S{err['finest']}"
+            if name == "ref_error_est":
+                mode += " + tail"
             rows.append(
-                _row(
-                    study=name,
-                    mode=f"{b.label} {REF_SOLVER} S{err['S']} against S{err['finest']}"
-                    + (" + tail" if name == "ref_error_est" else ""),
-                    backend=b.backend,
-                    build=b.build,
-                    variant=b.variant,
-                    solver=REF_SOLVER,
-                    substeps=err["S"],
-                    iterations=REF_ITERATIONS,
-                    precision=REF_PRECISION,
-                    strands=study.plan.strands,
-                    points=study.scene.points,
-                    frame=f + 1,
-                    time_s=run.times[f],
-                    rms_err_L=rms[f],
-                    max_err_L=mx[f],
-                    ref_substeps=err["finest"],
-                )
+                _ref_row(study, b, name, mode, err["S"], f, run.times[f], rms[f], mx[f], ref_substeps=err["finest"])
             )
     return rows

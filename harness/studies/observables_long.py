@@ -213,17 +213,7 @@ class LongRuns:
                 rows += self._rows(
                     "mode",
                     scene,
-                    dict(
-                        mode=m.name,
-                        backend=m.runner.backend,
-                        build=m.runner.build,
-                        variant=m.runner.variant,
-                        solver=m.solver,
-                        ftl_damping=m.ftl_damping,
-                        substeps=m.substeps,
-                        iterations=m.iterations,
-                        precision=m.precision,
-                    ),
+                    m.columns(),
                     got,
                     ref_vals,
                     unc,
