@@ -228,26 +228,13 @@ def test_each_stage_matches_ref_across_the_scene_space(cpu_bin, tmp_path_factory
 # ---- edge states made by hand (the stability suite's), through --input -------------------
 
 
-def _crafted(tmp_path, strands, precision, L):
-    pos = np.asarray([strands], dtype=np.float64 if precision == "fp64" else np.float32)
-    path = tmp_path / "crafted.h5"
-    synthetic.write_state(
-        path,
-        pos,
-        ["init"],
-        precision=precision,
-        params={"hair_length": L, "head_radius": 10.0, "hair_offset": 0.1, "face_margin": 1.0},
-    )
-    return path
-
-
 @needs_simd
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_exactly_opposite_segments_turn_through_plus_y(cpu_bin, tmp_path, precision):
     P, ell = 4, 1.0
     toward_face = [(0.0, 0.0, 10.0 + k * ell) for k in range(P)]  # φ = 0, wind ψ = π
     toward_back = [(1.0, 0.0, -math.sqrt(99.0) - k * ell) for k in range(P)]  # φ = π, wind ψ = 0
-    src = _crafted(tmp_path, [toward_face, toward_back], precision, L=(P - 1) * ell)
+    src = synthetic.crafted_state(tmp_path / "crafted.h5", [toward_face, toward_back], precision, L=(P - 1) * ell)
     for strand, angle in ((0, math.pi), (1, 0.0)):
         ref, simd = tmp_path / f"r{strand}.h5", tmp_path / f"s{strand}.h5"
         common = ["--input", src, "--stages", "wind", "--wind-strength", 1, "--wind-angle", angle, "--quiet"]
@@ -268,7 +255,9 @@ def test_collide_at_the_slice_poles_matches_ref(cpu_bin, tmp_path, precision):
     back = [(6.0, 0.0, -8.0)] + [(6.0, -0.5 * k, -8.0 + 0.8660254037844386 * k) for k in range(1, P)]
     below = [(6.0, -8.0, 0.0)] + [(6.0, -8.0 + 0.8 * k, 0.6 * k) for k in range(1, P)]
     coincident = [(6.0, -8.0, 0.0), (6.0, -8.0, 0.0)] + [(6.0, -8.0 - k, 0.0) for k in range(1, P - 1)]
-    src = _crafted(tmp_path, [r0_zero, back, below, coincident], precision, L=(P - 1) * ell)
+    src = synthetic.crafted_state(
+        tmp_path / "crafted.h5", [r0_zero, back, below, coincident], precision, L=(P - 1) * ell
+    )
     ref, simd = tmp_path / "r.h5", tmp_path / "s.h5"
     run(cpu_bin, "--input", src, "--stages", "collide", "--output", ref, "--quiet")
     run(cpu_bin, "--input", src, "--stages", "collide", "--variant", "simd", "--output", simd, "--quiet")

@@ -129,6 +129,19 @@ H5MD_BREAKS = {
 }
 
 
+def crafted_state(path, strands, precision="fp64", L=3.0):
+    """A one-frame state of hand-placed strands (each a list of (x, y, z) points), written at path."""
+    pos = np.asarray([strands], dtype=np.float64 if precision == "fp64" else np.float32)
+    write_state(
+        path,
+        pos,
+        ["init"],
+        precision=precision,
+        params={"hair_length": L, "head_radius": 10.0, "hair_offset": 0.1, "face_margin": 1.0},
+    )
+    return path
+
+
 def break_h5md(path, how):
     """Change one thing of a state at `path`, in place, so that it departs from H5MD (or
     from the documented strand ids) in the way H5MD_BREAKS[how] names."""
