@@ -15,6 +15,7 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from harness.core import tolerances, variants
+from support import synthetic
 from support.invariants_check import assert_frames_invariants, assert_invariants
 from support.statecheck import State, run
 
@@ -44,29 +45,22 @@ def scenes(draw):
     return dict(precision=precision, R=R, P=P, h=h, L=L, m=m, w=w, psi=psi, n=n, seed=seed)
 
 
+# the scene's real-valued flags and their keys in scenes()
+REAL_FLAGS = (
+    ("--head-radius", "R"),
+    ("--hair-offset", "h"),
+    ("--hair-length", "L"),
+    ("--face-margin", "m"),
+    ("--wind-strength", "w"),
+    ("--wind-angle", "psi"),
+)
+
+
 def scene_args(s):
-    return [
-        "--strands",
-        s["n"],
-        "--points",
-        s["P"],
-        "--seed",
-        s["seed"],
-        "--head-radius",
-        repr(s["R"]),
-        "--hair-offset",
-        repr(s["h"]),
-        "--hair-length",
-        repr(s["L"]),
-        "--face-margin",
-        repr(s["m"]),
-        "--wind-strength",
-        repr(s["w"]),
-        "--wind-angle",
-        repr(s["psi"]),
-        "--precision",
-        s["precision"],
-    ]
+    args = ["--strands", s["n"], "--points", s["P"], "--seed", s["seed"], "--precision", s["precision"]]
+    for flag, key in REAL_FLAGS:
+        args += [flag, repr(s[key])]
+    return args
 
 
 @SETTINGS
@@ -164,48 +158,25 @@ def test_regression_fp32_near_denormal_range_is_refused(cpu_bin, tmp_path, R):
     assert_invariants(State(out))
 
 
+def _short_segments(cpu_bin, tmp_path, precision, *args):
+    """The short-segment regressions' scene (P = 251, ℓ ≪ rc) run with args; its state."""
+    out = tmp_path / "s.h5"
+    run(cpu_bin, "--strands", 3000, "--points", 251, "--precision", precision, *args, "--output", out, "--quiet")
+    return State(out)
+
+
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_regression_drape_short_segment(cpu_bin, tmp_path, precision):
     """acos near 1 lost the drape's accuracy when ℓ ≪ rc; the half-angle form keeps every
     segment within ε·(R + L) (worst measured 0.54 ε·(R + L))."""
-    out = tmp_path / "s.h5"
-    run(
-        cpu_bin,
-        "--strands",
-        3000,
-        "--points",
-        251,
-        "--precision",
-        precision,
-        "--stages",
-        "init",
-        "--output",
-        out,
-        "--quiet",
-    )
-    assert_invariants(State(out), tolerances.SHORT_SEGMENTS)
+    assert_invariants(_short_segments(cpu_bin, tmp_path, precision, "--stages", "init"), tolerances.SHORT_SEGMENTS)
 
 
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_regression_collide_short_segment(cpu_bin, tmp_path, precision):
     """rc² − a² cancelled when ℓ ≪ rc, so projected points sat off the ℓ-circle (24 ε·(R+L)
     in fp32 at P = 251); the (rc − a)(rc + a) form keeps them within 2 ε·(R + L)."""
-    out = tmp_path / "s.h5"
-    run(
-        cpu_bin,
-        "--strands",
-        3000,
-        "--points",
-        251,
-        "--precision",
-        precision,
-        "--wind-strength",
-        1,
-        "--output",
-        out,
-        "--quiet",
-    )
-    s = State(out)
+    s = _short_segments(cpu_bin, tmp_path, precision, "--wind-strength", 1)
     assert s.moved[3] > 0  # the wind really pushed points into the shell
     assert_invariants(s, tolerances.SHORT_SEGMENTS)
 
@@ -213,56 +184,15 @@ def test_regression_collide_short_segment(cpu_bin, tmp_path, precision):
 def test_regression_segment_exactly_h_is_accepted(cpu_bin, tmp_path):
     """L = 43·h with P = 44 gives ℓ = L/43 one rounding below h in double; it was refused as
     "ℓ < h". The check now allows a relative 1e-12."""
+    scene = ("--strands", 200, "--points", 44, "--hair-offset", 0.1)
     out = tmp_path / "s.h5"
-    run(
-        cpu_bin,
-        "--strands",
-        200,
-        "--points",
-        44,
-        "--hair-offset",
-        0.1,
-        "--hair-length",
-        repr(43 * 0.1),
-        "--output",
-        out,
-        "--quiet",
-    )
+    run(cpu_bin, *scene, "--hair-length", repr(43 * 0.1), "--output", out, "--quiet")
     assert_invariants(State(out))
-    p = run(
-        cpu_bin,
-        "--strands",
-        200,
-        "--points",
-        44,
-        "--hair-offset",
-        0.1,
-        "--hair-length",
-        4.29,
-        "--output",
-        tmp_path / "t.h5",
-        check=False,
-    )
+    p = run(cpu_bin, *scene, "--hair-length", 4.29, "--output", tmp_path / "t.h5", check=False)
     assert p.returncode == 2 and "is shorter than --hair-offset" in p.stderr
 
 
 # ---- hand-made states at the edges (fed through --input) ---------------------------------
-
-
-def _crafted(tmp_path, strands, precision="fp64", L=3.0):
-    """A one-frame state of hand-placed strands (each a list of (x, y, z) points)."""
-    from support.synthetic import write_state
-
-    pos = np.asarray([strands], dtype=np.float64 if precision == "fp64" else np.float32)
-    path = tmp_path / "crafted.h5"
-    write_state(
-        path,
-        pos,
-        ["init"],
-        precision=precision,
-        params={"hair_length": L, "head_radius": 10.0, "hair_offset": 0.1, "face_margin": 1.0},
-    )
-    return path
 
 
 # Each hand-made state runs on the CPU and on every variant of the strict CUDA build; a GPU
@@ -294,7 +224,7 @@ def test_segment_exactly_opposite_to_the_wind_turns_through_plus_y(cpu_bin, tmp_
     P, ell = 4, 1.0
     toward_face = [(0.0, 0.0, 10.0 + k * ell) for k in range(P)]  # φ = 0, wind ψ = π
     toward_back = [(1.0, 0.0, -math.sqrt(99.0) - k * ell) for k in range(P)]  # φ = π, wind ψ = 0
-    src = _crafted(tmp_path, [toward_face, toward_back], precision, L=(P - 1) * ell)
+    src = synthetic.crafted_state(tmp_path / "crafted.h5", [toward_face, toward_back], precision, L=(P - 1) * ell)
     for strand, angle in ((0, math.pi), (1, 0.0)):
         s = _run_backend(
             cpu_bin,
@@ -316,7 +246,7 @@ def test_collide_at_the_slice_poles(cpu_bin, tmp_path, precision, backend):
     r0_zero = [(10.0, -k * 0.6, -k * 0.8) for k in range(P)]  # slice centre root
     back = [(6.0, 0.0, -8.0)] + [(6.0, -0.5 * k, -8.0 + 0.8660254037844386 * k) for k in range(1, P)]
     below = [(6.0, -8.0, 0.0)] + [(6.0, -8.0 + 0.8 * k, 0.6 * k) for k in range(1, P)]
-    src = _crafted(tmp_path, [r0_zero, back, below], precision, L=(P - 1) * ell)
+    src = synthetic.crafted_state(tmp_path / "crafted.h5", [r0_zero, back, below], precision, L=(P - 1) * ell)
     s = _run_backend(cpu_bin, backend, ["--input", src, "--stages", "collide"], tmp_path / "c.h5")
     assert s.moved[-1] > 0
     assert np.isfinite(s.frames).all()
