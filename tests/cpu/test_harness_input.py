@@ -12,14 +12,9 @@ import pytest
 from harness.core import scenes
 from harness.core.scenes import SceneError
 from harness.io import sweepfile
+from support.statecheck import run
 
 ROOT_DIR = Path(__file__).resolve().parents[2]
-
-
-def run(binary, *args, check=True):
-    p = subprocess.run([str(binary), *map(str, args)], capture_output=True, text=True, timeout=600)
-    assert not check or p.returncode == 0, p.stderr
-    return p
 
 
 def tmp_leftovers(directory):
@@ -127,16 +122,15 @@ STAGE_LISTS = [
 ]
 
 
+# a scene small enough that only the arguments under test matter
+TINY = ("--strands", "2", "--points", "4", "--hair-length", "3")
+
+
 @pytest.mark.parametrize("stages", STAGE_LISTS)
 def test_binary_and_harness_agree_on_stage_lists(cpu_bin, stages):
     p = run(
         cpu_bin,
-        "--strands",
-        "2",
-        "--points",
-        "4",
-        "--hair-length",
-        "3",
+        *TINY,
         "--stages",
         stages,
         "--wind-strength",
@@ -155,12 +149,7 @@ def test_binary_and_harness_agree_on_stage_lists(cpu_bin, stages):
 def test_seed_is_base_ten(cpu_bin):
     p = run(
         cpu_bin,
-        "--strands",
-        "2",
-        "--points",
-        "4",
-        "--hair-length",
-        "3",
+        *TINY,
         "--stages",
         "init",
         "--seed",

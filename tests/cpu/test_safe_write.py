@@ -12,14 +12,9 @@ from pathlib import Path
 import pytest
 
 from harness.core import tempfiles
+from support.statecheck import run
 
 ROOT_DIR = Path(__file__).resolve().parents[2]
-
-
-def run(binary, *args, check=True):
-    p = subprocess.run([str(binary), *map(str, args)], capture_output=True, text=True, timeout=600)
-    assert not check or p.returncode == 0, p.stderr
-    return p
 
 
 def tmp_leftovers(directory):
