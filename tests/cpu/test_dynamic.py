@@ -427,6 +427,11 @@ def test_diff_refuses_other_solvers_and_other_frame_counts(cpu_bin, reference, t
     assert harness_main(["diff", fp64, str(shorter), "--frame", "3"]) == 0
 
 
+def _stepdiff(reference, cpu_bin, *args):
+    """`harness stepdiff` of reference against cpu_bin with args; its exit status."""
+    return harness_main(["stepdiff", "--reference", str(reference), "--binary", str(cpu_bin), *args])
+
+
 def test_stepdiff_frame_ranges_refuse_what_cannot_be_stepped(cpu_bin, reference, capsys):
     """A frame that cannot be stepped from is an error whether named alone or in a range."""
     with open_trajectory(reference["fp64"]) as t:
@@ -434,8 +439,7 @@ def test_stepdiff_frame_ranges_refuse_what_cannot_be_stepped(cpu_bin, reference,
         n = t.n_frames
     assert 0 not in cand and cand
     for frames in ("0", "0..2", f"{n}", f"{cand[0]}..{n + 3}", f"..{n}"):
-        args = ["--reference", str(reference["fp64"]), "--binary", str(cpu_bin), "--frames", frames]
-        assert harness_main(["stepdiff", *args]) == 2, frames
+        assert _stepdiff(reference["fp64"], cpu_bin, "--frames", frames) == 2, frames
         err = capsys.readouterr().err
         assert "cannot be stepped from" in err and err.count("\n") == 1, frames
     assert diff_dynamic.parse_frame_range(f"{cand[0]}..{cand[1]}", cand) == cand[:2]
@@ -443,49 +447,20 @@ def test_stepdiff_frame_ranges_refuse_what_cannot_be_stepped(cpu_bin, reference,
 
 
 def test_stepdiff_thread_counts(cpu_bin, reference, capsys):
-    code = harness_main(
-        ["stepdiff", "--reference", str(reference["fp64"]), "--binary", str(cpu_bin), "--exact", "--", "--threads", "1"]
-    )
+    code = _stepdiff(reference["fp64"], cpu_bin, "--exact", "--", "--threads", "1")
     assert code == 0, capsys.readouterr().out
     assert "EQUIVALENT" in capsys.readouterr().out
 
 
 def test_stepdiff_fp32_with_a_tighter_rule(cpu_bin, reference, capsys):
     """fp32 against itself passes even the exact rule, one frame at a time, from frame 2 on."""
-    code = harness_main(
-        [
-            "stepdiff",
-            "--reference",
-            str(reference["fp32"]),
-            "--binary",
-            str(cpu_bin),
-            "--frames",
-            "3..",
-            "--exact",
-            "--",
-            "--threads",
-            "2",
-        ]
-    )
+    code = _stepdiff(reference["fp32"], cpu_bin, "--frames", "3..", "--exact", "--", "--threads", "2")
     assert code == 0, capsys.readouterr().out
 
 
 def test_stepdiff_different_physics_fails(cpu_bin, reference, capsys):
     """A resumed run keeps its physics: the binary refuses the other flag (exit 2)."""
-    code = harness_main(
-        [
-            "stepdiff",
-            "--reference",
-            str(reference["fp64"]),
-            "--binary",
-            str(cpu_bin),
-            "--frames",
-            "2",
-            "--",
-            "--gravity",
-            "500",
-        ]
-    )
+    code = _stepdiff(reference["fp64"], cpu_bin, "--frames", "2", "--", "--gravity", "500")
     assert code == 2
     assert "--gravity does not match" in capsys.readouterr().err
 
@@ -505,9 +480,9 @@ def test_stepdiff_catches_a_wrong_frame(cpu_bin, reference, tmp_path, capsys):
         a = v[4]
         a[37, 1] += 100 * limit
         v[4] = a
-    code = harness_main(["stepdiff", "--reference", str(bad), "--binary", str(cpu_bin), "--frames", "3"])
+    code = _stepdiff(bad, cpu_bin, "--frames", "3")
     assert code == 1, capsys.readouterr().out
-    assert harness_main(["stepdiff", "--reference", str(bad), "--binary", str(cpu_bin), "--frames", "2"]) == 0
+    assert _stepdiff(bad, cpu_bin, "--frames", "2") == 0
 
 
 # ---- dynamic scenes and `harness run` ----------------------------------------------------------
@@ -575,9 +550,9 @@ def test_stepdiff_judges_velocities(cpu_bin, reference, tmp_path, capsys):
         a = v[i]
         a[37, 1] += 100 * limit / h
         v[i] = a
-    assert harness_main(["stepdiff", "--reference", str(bad), "--binary", str(cpu_bin), "--frames", "3"]) == 1
+    assert _stepdiff(bad, cpu_bin, "--frames", "3") == 1
     capsys.readouterr()
-    assert harness_main(["stepdiff", "--reference", str(bad), "--binary", str(cpu_bin), "--frames", "2"]) == 0
+    assert _stepdiff(bad, cpu_bin, "--frames", "2") == 0
 
 
 def test_diff_judges_observables(reference, tmp_path):
