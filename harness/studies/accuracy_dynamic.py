@@ -37,7 +37,6 @@ reference ladder and the GPU check), analytic.md (harness/studies/analytic_table
 env.json; then accuracy_dynamic_report.py writes report/dynamic_accuracy.md and its PNGs.
 """
 
-import csv
 import itertools
 import json
 import os
@@ -54,6 +53,7 @@ from harness.check import observables
 from harness.core import env, runner, scenes, scenes_dynamic, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
+from harness.io import files
 from harness.io.trajectory import open_trajectory
 from harness.studies import observables_long
 from harness.studies.accuracy import (
@@ -581,20 +581,10 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         shutil.rmtree(study.scratch, ignore_errors=True)
 
     out_dir.mkdir(parents=True, exist_ok=True)
-    tmp = csv_path.with_suffix(".csv.tmp")
-    with open(tmp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=COLUMNS)
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(tmp, csv_path)
+    files.write_csv(csv_path, COLUMNS, rows)
     long_path = out_dir / observables_long.CSV_NAME
     if long_rows:
-        tmp = long_path.with_suffix(".csv.tmp")
-        with open(tmp, "w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=observables_long.COLUMNS)
-            w.writeheader()
-            w.writerows(long_rows)
-        os.replace(tmp, long_path)
+        files.write_csv(long_path, observables_long.COLUMNS, long_rows)
     elif long_path.exists():
         long_path.unlink()  # stale long runs must not be rendered with these rows
     if analytic_lines:

@@ -20,9 +20,7 @@ Writes results/accuracy/accuracy.csv and env.json (render/accuracy_paper_report.
 report/accuracy_pareto.png and writes report/accuracy.md from them).
 """
 
-import csv
 import json
-import os
 
 import numpy as np
 
@@ -30,6 +28,7 @@ from harness.check import invariants
 from harness.core import env, runner, scenes, variants
 from harness.core.paths import RESULTS, binary_path, display, output_dir
 from harness.core.variants import Runner
+from harness.io import files
 from harness.io.states import open_state
 from harness.studies.accuracy import PAPER_MODES, PAPER_OTHER_CPU_USE, Mode, frame_errors
 
@@ -227,13 +226,7 @@ def run_study(
                         )
 
     csv_path = out_dir / "accuracy.csv"
-    tmp = csv_path.with_suffix(".csv.tmp")
-    with open(tmp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=COLUMNS)
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: row.get(k) for k in COLUMNS})
-    os.replace(tmp, csv_path)
+    files.write_csv(csv_path, COLUMNS, rows, extrasaction="ignore")
     meta = dict(env.collect(), resolution_strands=res_strands, gpu_absent=None if gpu_ok else why)
     (out_dir / "env.json").write_text(json.dumps(meta, indent=1) + "\n")
     for p in scratch.glob("*.h5"):

@@ -12,15 +12,14 @@ compiles it out), never by setting it to zero:
     collide  --no-collider added          drag    --drag, --damping (the wind's drag too)
 """
 
-import csv
 import shutil
-from pathlib import Path
 
 from harness import HarnessError
 from harness.core import runner, scenes
 from harness.core.paths import binary_path
 from harness.core.progress import Progress
 from harness.core.scenes_dynamic import DECLARING, FEATURES, NEEDS
+from harness.io.files import write_csv
 
 FIELDS = (
     "row",
@@ -108,12 +107,7 @@ def measure(
             rows.append(_row(binary, name, flags, timeout, instructions, progress))
             bar.update()
     if out:
-        path = Path(out)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=FIELDS)
-            w.writeheader()
-            w.writerows(rows)
+        write_csv(out, FIELDS, rows)
     return rows
 
 

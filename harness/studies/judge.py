@@ -17,7 +17,6 @@ Writes <out>/judge.csv (one row per compared frame) and <out>/judge.json (the co
 each defect is and which scenes caught it); report/dynamic.md renders them.
 """
 
-import csv
 import os
 import shutil
 import tempfile
@@ -31,6 +30,7 @@ from harness.check import diff, diff_dynamic
 from harness.core import env, runner, scenes, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, build_dir, display, output_dir
 from harness.core.progress import Progress
+from harness.io import files
 from harness.io.files import write_json
 from harness.io.trajectory import open_trajectory
 
@@ -296,12 +296,7 @@ CSV_FIELDS = (
 
 def write_csv(rows, path):
     """The compared frames, one a row, written whole or not at all."""
-    tmp = f"{path}.tmp.{os.getpid()}"
-    with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=CSV_FIELDS, restval="")
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(tmp, path)
+    files.write_csv(path, CSV_FIELDS, rows)
 
 
 def run(plan=None, out_dir=None, log=print, jobs=None):

@@ -19,7 +19,6 @@ Files: results/peer/accuracy.csv, timing.csv, reference.csv and peer.json (the r
 settings, machine, versions).
 """
 
-import csv
 import datetime
 import json
 import math
@@ -37,6 +36,7 @@ from harness.check import invariants_dynamic
 from harness.core import runner, tolerances, variants
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
+from harness.io import files
 from harness.io.trajectory import open_trajectory
 from harness.studies import analytic_runs
 from harness.studies import peer_pypbd as peer
@@ -297,15 +297,6 @@ def timing(binary, workdir, args, log=print, step=lambda: None):
     return rows
 
 
-def _write_csv(path, fields, rows):
-    tmp = path.with_name(f"{path.name}.tmp.{os.getpid()}")
-    with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(tmp, path)
-
-
 class PeerUnavailable(HarnessError):
     """pypbd cannot be imported here: the comparison is skipped, with this reason."""
 
@@ -366,9 +357,9 @@ def run_study(args, log=print):
         with Progress(len(args.settings) * (1 + len(args.strands)), "peer: runs") as bar:
             acc, s_ref, table, converged = accuracy(binary, workdir, args, log, bar.update)
             tim = timing(binary, workdir, args, log, bar.update)
-    _write_csv(out / "accuracy.csv", ACCURACY_FIELDS, acc)
-    _write_csv(out / "timing.csv", TIMING_FIELDS, tim)
-    _write_csv(out / "reference.csv", REFERENCE_FIELDS, [dict(substeps=s, change_to_2s=c) for s, c in table])
+    files.write_csv(out / "accuracy.csv", ACCURACY_FIELDS, acc)
+    files.write_csv(out / "timing.csv", TIMING_FIELDS, tim)
+    files.write_csv(out / "reference.csv", REFERENCE_FIELDS, [dict(substeps=s, change_to_2s=c) for s, c in table])
     rec = runner.run_binary(binary, ["--strands", 1, "--points", 2, "--stages", "init"])
     meta = {
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),

@@ -24,7 +24,6 @@ oracle and, with a usable GPU, on each cuda variant that runs the features (`lan
 them, docs/cuda.md). Writes CSV (one row per case and timing binary).
 """
 
-import csv
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -33,6 +32,7 @@ import numpy as np
 from harness import HarnessError
 from harness.core import env, runner, scenes, variants
 from harness.core.paths import binary_path
+from harness.io.files import write_csv
 from harness.io.trajectory import open_trajectory
 from harness.studies.accuracy import frame_errors
 
@@ -204,10 +204,5 @@ def measure(plan=Plan(), out=None, work=None, progress=print):
                     f"{backend}/{variant}: rms {base['rms_err_L']:.3g} L, {st['median_ms']:.3f} ms/frame"
                 )
     if out:
-        path = Path(out)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=FIELDS)
-            w.writeheader()
-            w.writerows(rows)
+        write_csv(out, FIELDS, rows)
     return rows

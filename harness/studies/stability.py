@@ -25,7 +25,6 @@ Writes results/stability/stability.csv and env.json, and render/stability_report
 report/stability_<slice>.png and writes report/dynamic_stability.md.
 """
 
-import csv
 import os
 import tempfile
 import time
@@ -40,6 +39,7 @@ from harness.check import invariants_dynamic
 from harness.core import env, gpus, runner, scenes, tolerances, variants
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
+from harness.io import files
 from harness.io.files import write_json
 from harness.io.trajectory import open_trajectory
 from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES
@@ -257,16 +257,7 @@ def measure(
 
 def write_csv(rows, path):
     """rows → CSV, written beside and renamed, so no partial file is left."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f"{path.name}.tmp.{os.getpid()}")
-    with open(tmp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=COLUMNS)
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: r.get(k, "") for k in COLUMNS})
-    os.replace(tmp, path)
-    return path
+    return files.write_csv(path, COLUMNS, rows, extrasaction="ignore")
 
 
 def run_study(
