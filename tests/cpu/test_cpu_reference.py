@@ -2,7 +2,6 @@
 independence, resume equivalence, fp32 against fp64, the HDF5 layout of §4, the JSON
 record, repeats and nil stages."""
 
-import json
 import shutil
 import subprocess
 
@@ -214,22 +213,8 @@ def test_repeats_do_not_change_the_result(cpu_bin, tmp_path):
 
 def test_wind_zero_is_not_run_and_changes_nothing(cpu_bin, tmp_path):
     out = tmp_path / "s.h5"
-    rec = json.loads(
-        run(
-            cpu_bin,
-            "--strands",
-            300,
-            "--points",
-            16,
-            "--hair-length",
-            10,
-            "--wind-strength",
-            0,
-            "--output",
-            out,
-            "--json",
-            "--quiet",
-        ).stdout
+    rec = run_json(
+        cpu_bin, "--strands", 300, "--points", 16, "--hair-length", 10, "--wind-strength", 0, "--output", out
     )
     wind = rec["stages"][2]
     assert wind["stage"] == "wind" and wind["skipped"] is True and wind["times_ms"] == []
@@ -241,23 +226,7 @@ def test_wind_zero_is_not_run_and_changes_nothing(cpu_bin, tmp_path):
 
 def test_only_listed_stages_run(cpu_bin, tmp_path):
     out = tmp_path / "still.h5"
-    rec = json.loads(
-        run(
-            cpu_bin,
-            "--strands",
-            200,
-            "--points",
-            8,
-            "--hair-length",
-            5,
-            "--stages",
-            "init",
-            "--output",
-            out,
-            "--json",
-            "--quiet",
-        ).stdout
-    )
+    rec = run_json(cpu_bin, "--strands", 200, "--points", 8, "--hair-length", 5, "--stages", "init", "--output", out)
     assert [s["stage"] for s in rec["stages"]] == ["init"]
     assert State(out).frames.shape[0] == 1
 
