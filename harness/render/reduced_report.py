@@ -37,6 +37,25 @@ def _fmt_ms(d, col):
     return f"{d[col]:.3f}" if col in d else "—"
 
 
+def _errs(r):
+    return f"{float(r['rms_err_L']):.3g}", f"{float(r['max_err_L']):.3g}"
+
+
+def _table(cases, cols, study, head, align, cells):
+    """A Markdown table of one study's cases: `head` and `cells(key, row)` first, then a time
+    column per backend."""
+    lines = [
+        "| " + " | ".join(head) + " | " + " | ".join(f"{c} ms" for c in cols) + " |",
+        align + " ---: |" * len(cols),
+    ]
+    for key, (r, t) in cases.items():
+        if key[0] == study:
+            lines.append(
+                "| " + " | ".join(map(str, cells(key, r))) + " | " + " | ".join(_fmt_ms(t, c) for c in cols) + " |"
+            )
+    return lines
+
+
 def markdown(rows):
     if not rows:
         return "No rows.\n"
@@ -47,30 +66,26 @@ def markdown(rows):
         f"Checked runs: {int(first['strands']):,} strands, fp32, S = {first['substeps']}; errors against every "
         f"strand simulated (xpbd, fp64, finer S). Times per frame ({sizes}, median):",
         "",
-        "| solver | guides | scheme | rms err / L | max err / L | " + " | ".join(f"{c} ms" for c in cols) + " |",
-        "| --- | ---: | --- | ---: | ---: |" + " ---: |" * len(cols),
-    ]
-    for (study, solver, _i, guides, follow, _lra, _sag), (r, t) in cases.items():
-        if study != "guides":
-            continue
-        lines.append(
-            f"| {solver} | {float(guides):.0%} | {follow or 'all simulated'} | {float(r['rms_err_L']):.3g} | "
-            f"{float(r['max_err_L']):.3g} | " + " | ".join(_fmt_ms(t, c) for c in cols) + " |"
-        )
-    lines += [
+        *_table(
+            cases,
+            cols,
+            "guides",
+            ("solver", "guides", "scheme", "rms err / L", "max err / L"),
+            "| --- | ---: | --- | ---: | ---: |",
+            lambda k, r: (k[1], f"{float(k[3]):.0%}", k[4] or "all simulated", *_errs(r)),
+        ),
         "",
         "Long-range attachments under a fast nod, few iterations (xpbd):",
         "",
-        "| I | LRA | rms err / L | max err / L | stretch_max | " + " | ".join(f"{c} ms" for c in cols) + " |",
-        "| ---: | --- | ---: | ---: | ---: |" + " ---: |" * len(cols),
+        *_table(
+            cases,
+            cols,
+            "lra",
+            ("I", "LRA", "rms err / L", "max err / L", "stretch_max"),
+            "| ---: | --- | ---: | ---: | ---: |",
+            lambda k, r: (k[2], "on" if int(k[5]) else "off", *_errs(r), f"{float(r['stretch_max']):.3g}"),
+        ),
     ]
-    for (study, _s, it, _g, _f, lra, _sag), (r, t) in cases.items():
-        if study != "lra":
-            continue
-        lines.append(
-            f"| {it} | {'on' if int(lra) else 'off'} | {float(r['rms_err_L']):.3g} | {float(r['max_err_L']):.3g} | "
-            f"{float(r['stretch_max']):.3g} | " + " | ".join(_fmt_ms(t, c) for c in cols) + " |"
-        )
     sag = [(k, v) for k, v in cases.items() if k[0] == "sagfree"]
     if sag:
         lines += [
