@@ -16,7 +16,8 @@
  * build at block 1024); docs/cuda.md.
  *
  * Point-major kernels take X, Y, Z as separate __restrict__ pointers; wind, collide and the
- * fused kernel without the intermediate never touch X.
+ * fused kernel without the intermediate never touch X. That kernel runs HB_WC_TILE strands a
+ * thread in fp32 (k_wind_collide_tile; docs/cuda.md, "Two strands a thread").
  *
  * Prefetch depth (model.cuh, walk_points): the paper variant's strand-major kernels load
  * each point when its turn comes (D = 0, as the C code and the paper do: that variant is
@@ -40,6 +41,7 @@ constexpr int kMaxThreads = 1024;
 #define HB_STAGE_BOUNDS __launch_bounds__(kMaxThreads)
 #define HB_POINT_BOUNDS(T) __maxnreg__(PointRegs<T>::value)
 #endif
+#define HB_TILE_BOUNDS(T) __maxnreg__(TileRegs<T>::value)
 
 /* The fused wind+collide and the init kernels' register cap: fp32 HB_POINT_REGS_F32 (more warps a
  * SM hide the walks' latencies better than the registers saved cost; measured, docs/cuda.md),
@@ -49,6 +51,13 @@ constexpr int kMaxThreads = 1024;
 #endif
 template <typename T> struct PointRegs {
     static constexpr int value = sizeof(T) == 4 ? HB_POINT_REGS_F32 : 64;
+};
+/* The tile kernel's cap: HB_TILE_REGS_F32 for fp32, 64 for fp64 */
+#ifndef HB_TILE_REGS_F32
+#define HB_TILE_REGS_F32 64
+#endif
+template <typename T> struct TileRegs {
+    static constexpr int value = sizeof(T) == 4 ? HB_TILE_REGS_F32 : 64;
 };
 
 /* Prefetch depth of the point-major kernels, per precision: D points of y and z in flight
@@ -160,6 +169,77 @@ __global__ void HB_POINT_BOUNDS(T)
     block_add(changed, count);
 }
 
+/* The fused kernel without the intermediate: K strands a thread. A warp takes a tile of 32·K
+ * consecutive strands, lane l the strands l, l + 32, …, l + 32·(K − 1) of it, so each of
+ * the K loads and stores of a point is one coalesced access of the warp, and the K walks
+ * share the offsets, the loop and the prefetch (point k + 1 of every strand is loaded before
+ * point k is computed). A strand past N (the last tile) computes on zeros and stores
+ * nothing. Offsets in int: the launcher checks that N·P + 32·K fits. */
+#ifndef HB_WC_TILE
+#define HB_WC_TILE 2
+#endif
+template <typename T, int K>
+__global__ void HB_TILE_BOUNDS(T) k_wind_collide_tile(const Model<T> m, T *__restrict__ Y, T *__restrict__ Z,
+                                                      const int64_t N, unsigned long long *__restrict__ count)
+{
+    const int lane = threadIdx.x & 31;
+    const int64_t tile = ((int64_t)blockIdx.x * blockDim.x + threadIdx.x) >> 5;
+    const int64_t tiles = ((int64_t)gridDim.x * blockDim.x) >> 5;
+    const int P = (int)m.points;
+    const int stride = (int)N;
+    unsigned long long changed = 0;
+    for (int64_t base = tile * 32 * K; base < N; base += tiles * 32 * K) {
+        const int first = (int)base + lane; /* point 0 of slot 0 */
+        bool ok[K];
+        T qy[K], qz[K];
+        HB_UNROLL
+        for (int j = 0; j < K; j++) {
+            ok[j] = base + lane + 32 * j < N;
+            qy[j] = ok[j] ? Y[first + 32 * j] : (T)0;
+            qz[j] = ok[j] ? Z[first + 32 * j] : (T)0;
+        }
+        WindWalk<T> wind[K];
+        CollideWalk<T, int> col[K];
+        HB_UNROLL
+        for (int j = 0; j < K; j++) {
+            wind[j] = WindWalk<T>(m, qy[j], qz[j]);
+            col[j] = CollideWalk<T, int>(m, qy[j], qz[j]);
+        }
+        int at = first + stride; /* point k of slot 0 */
+        HB_UNROLL
+        for (int j = 0; j < K; j++) {
+            qy[j] = ok[j] && P > 1 ? Y[at + 32 * j] : (T)0;
+            qz[j] = ok[j] && P > 1 ? Z[at + 32 * j] : (T)0;
+        }
+        HB_NO_UNROLL
+        for (int k = 1; k < P; k++) {
+            T cy[K], cz[K];
+            HB_UNROLL
+            for (int j = 0; j < K; j++) {
+                cy[j] = qy[j];
+                cz[j] = qz[j];
+                qy[j] = ok[j] && k + 1 < P ? Y[at + stride + 32 * j] : (T)0;
+                qz[j] = ok[j] && k + 1 < P ? Z[at + stride + 32 * j] : (T)0;
+            }
+            HB_UNROLL
+            for (int j = 0; j < K; j++) {
+                wind[j].step(k, cy[j], cz[j]);
+                T wy = wind[j].ny, wz = wind[j].nz;
+                col[j].step(wy, wz);
+                if (ok[j]) {
+                    Y[at + 32 * j] = wy;
+                    Z[at + 32 * j] = wz;
+                }
+            }
+            at += stride;
+        }
+        HB_UNROLL
+        for (int j = 0; j < K; j++)
+            if (ok[j]) changed += (unsigned long long)col[j].changed;
+    }
+    block_add(changed, count);
+}
+
 /* ---- the launchers ---------------------------------------------------------------------- */
 /* The three arrays a stage kernel takes: strand-major passes its one array first. */
 template <typename T> struct Arrays {
@@ -195,8 +275,12 @@ cudaError_t launch_wind_collide(const Model<T> &m, const PointMajor<T> &lay, int
 {
     const bool narrow = N * m.points < (int64_t)INT32_MAX; /* every offset of a point fits an int */
     const unsigned grid = grid_for(N, block);
+    constexpr int K = sizeof(T) == 4 ? HB_WC_TILE : 1; /* fp64 spills at K = 2 */
+    const bool tile_fits = N * m.points + 32 * K < (int64_t)INT32_MAX;
     if (inter) {
         k_wind_collide<T, true, int64_t><<<grid, block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, inter, count);
+    } else if (K > 1 && tile_fits) {
+        k_wind_collide_tile<T, K><<<grid_for((N + K - 1) / K, block), block, 0, stream>>>(m, lay.Y, lay.Z, N, count);
     } else if (narrow) {
         k_wind_collide<T, false, int><<<grid, block, 0, stream>>>(m, lay.X, lay.Y, lay.Z, N, nullptr, count);
     } else {

@@ -408,6 +408,7 @@ template <typename T> struct WindWalk {
     T oy, oz;          /* the predecessor before the wind */
     T ny, nz;          /* the predecessor after the wind (the root never moves) */
 
+    WindWalk() = default;
     HB_HD WindWalk(const Model<T> &m, T y0, T z0)
     {
         ell = m.seg_len;
@@ -431,7 +432,10 @@ template <typename T> struct WindWalk {
             const T dy = cy - oy, dz = cz - oz;
             const T phi = m_atan2_free(dy, dz);
             const T d0 = psi - phi;
-            T delta = d0 > pi_r<T>() ? d0 - two_pi_r<T>() : d0 <= -pi_r<T>() ? d0 + two_pi_r<T>() : d0;
+            /* the wrap as two selects and one add (d0 + 0 is d0): no branch in the walk */
+            const T up = d0 <= -pi_r<T>() ? two_pi_r<T>() : (T)0;
+            const T wrap = d0 > pi_r<T>() ? -two_pi_r<T>() : up;
+            T delta = d0 + wrap;
             delta = delta == pi_r<T>() && dz < (T)0 ? -pi_r<T>() : delta;
             kf += (T)1;
             const T turned = phi + (kf * w_per_point) * delta;
@@ -470,6 +474,7 @@ template <typename T, class Count = int64_t> struct CollideWalk {
     int moved;
     Count changed;
 
+    CollideWalk() = default;
     HB_HD CollideWalk(const Model<T> &m, T y0, T z0)
     {
         ell = m.seg_len;
@@ -543,13 +548,16 @@ template <typename T, class Count = int64_t> struct CollideWalk {
      * roots and divisions; the pull is written as selects (no branch inside it). */
     HB_HD int step_free(T &cy, T &cz)
     {
-        if (moved) {
+        {
+            /* the pull, evaluated by every thread and kept where the strand has moved */
             const T dy = cy - py, dz = cz - pz;
             const T len2 = dy * dy + dz * dz;
             const int dir = len2 > rsqrt_floor<T>();
-            const T scale = dir ? ell * m_rsqrt(len2) : (T)0;
-            cy = dir ? py + dy * scale : py - ell;
-            cz = dir ? pz + dz * scale : pz;
+            const T scale = ell * m_rsqrt(dir ? len2 : (T)1);
+            const T fy = dir ? py + dy * scale : py - ell;
+            const T fz = dir ? pz + dz * scale : pz;
+            cy = moved ? fy : cy;
+            cz = moved ? fz : cz;
         }
         if (cy * cy + cz * cz < inner2) {
             const T d2 = py * py + pz * pz;

@@ -41,15 +41,15 @@ GPU_SETTINGS = settings(
 
 
 def _gpu_variants():
-    """The strict build's variants that simulate, and their point limits."""
+    """The strict build's variants that simulate, their point limits and their block limits."""
     try:
         d = variants.declared("cuda", "strict")
     except HarnessError:
-        return ("not-built",), {}  # the GPU tests skip without it
-    return d.running("simulate"), d.max_points
+        return ("not-built",), {}, {}  # the GPU tests skip without it
+    return d.running("simulate"), d.max_points, d.max_block
 
 
-GPU_VARIANTS, GPU_MAX_POINTS = _gpu_variants()
+GPU_VARIANTS, GPU_MAX_POINTS, GPU_MAX_BLOCK = _gpu_variants()
 
 HAIR_LENGTH = 30.0
 HUGE = (1e10, 1e30, 1e38, 1e300)  # compliances, drag and damping far past any physical value
@@ -267,6 +267,11 @@ def test_search_gpu_frame_agrees_with_cpu(cpu_bin, tmp_path_factory, s, variant,
     if limit and s["points"] > limit:  # a variant's declared point limit: refused, naming --points
         assert g.returncode == 2 and "--points" in g.stderr, (g.returncode, g.stderr)
         event(f"{variant}: more than {limit} points, refused")
+        return
+    most = GPU_MAX_BLOCK.get(variant)
+    if most and block > most:  # a variant's declared block limit: refused, naming --block-size
+        assert g.returncode == 2 and "--block-size" in g.stderr, (g.returncode, g.stderr)
+        event(f"{variant}: a block of more than {most} threads, refused")
         return
     assert g.returncode == 0, g.stderr
     what = f"strict {variant} block {block} {s['solver']} {s['precision']}"
