@@ -526,8 +526,10 @@ def long_lines(long, study):
         "",
         f"Long runs ({first['seconds']:g} s, {int(first['strands'])} strands × {int(first['points'])} points, "
         "harness/studies/observables_long.py): **motion** is the study's scene; **release** the still-dynamic "
-        "scene without its collider let go from its rest shape (each strand's swing frequency and damping ratio "
-        "over the first half, the median over strands); **rest** the still-dynamic scene with a strong damping "
+        "scene without its collider let go from its rest shape (the median over the strands that swing of each "
+        "strand's swing frequency over the first half and of its damping ratio over the whole run, from the decay "
+        "of the swing's envelope; ζ's noise is the larger of the strand halves' difference and the fit's "
+        "standard error); **rest** the still-dynamic scene with a strong damping "
         "over half the time (RMS frame-to-frame velocity and the largest move over its last fifth, settled: what "
         "flickers). Distances (W1 of the tip's distribution, total variation of its "
         "spectrum, IoU of the silhouettes) compare statistics, not phases: pointwise error means little after "
