@@ -797,7 +797,11 @@ def parser():
         help="paper: points per strand of the resolution study (the largest is the reference; default 4 … 256)",
     )
     a.add_argument("--resolution-strands", type=whole(1), default=None, help="paper: default 20000")
-    a.add_argument("--quick", action="store_true", help="dynamic: a small study (32 strands, 0.25 s, S 1 4 16, I 1 2)")
+    a.add_argument(
+        "--quick",
+        action="store_true",
+        help="dynamic: a small study (32 strands, 0.25 s, S 1 4 16, I 1, s 0.9 1, 5 s long runs)",
+    )
     a.add_argument("--seconds", type=seconds, default=None, help="dynamic: simulated time (default 1; --quick 0.25)")
     a.add_argument(
         "--horizon", type=seconds, default=None, help="dynamic: time over which errors are compared (default 0.5)"
@@ -805,7 +809,9 @@ def parser():
     a.add_argument(
         "--substeps", type=whole(1), nargs="+", default=None, help="dynamic: S values (default 1 2 4 8 16 32)"
     )
-    a.add_argument("--iterations", type=whole(1), nargs="+", default=None, help="dynamic: I values (default 1 2 4)")
+    a.add_argument(
+        "--iterations", type=whole(1), nargs="+", default=None, help="dynamic: I values (default 1 2 4; --quick 1)"
+    )
     a.add_argument(
         "--time-strands", type=whole(1), default=None, help="dynamic: strands of the timing runs (default 10000)"
     )
@@ -824,7 +830,7 @@ def parser():
         type=unit_interval,
         nargs="+",
         default=None,
-        help="dynamic: ftl's s values, an axis of the study (default 0 0.5 0.9 1)",
+        help="dynamic: ftl's s values, an axis of the study (default 0 0.5 0.9 1; --quick 0.9 1)",
     )
     a.add_argument(
         "--ref-extra",
@@ -837,7 +843,7 @@ def parser():
         type=nonneg_seconds,
         default=None,
         help="dynamic: simulated time of the long runs (energy, tip motion, jitter, distributions; "
-        "default 10; 0: none)",
+        "default 10; --quick 5; 0: none)",
     )
     a.add_argument("--long-strands", type=whole(2), default=None, help="dynamic: strands of the long runs (default 8)")
     a.add_argument("--force", action="store_true", help="dynamic: replace an existing results CSV")

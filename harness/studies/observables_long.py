@@ -3,7 +3,7 @@ seconds rather than how far each point is from the reference's after a fraction 
 (docs/harness.md, "The dynamic accuracy study"). Measured with harness/check/observables.py.
 
 Three scenes, `long_strands` strands (the study's points), `long_seconds` of simulated time
-(rest: half of it):
+(rest: REST_SECONDS at most):
 
   motion   the study's own scene (a nodding head in gusty wind): energy per particle
            (kinetic mean, drift of kinetic + potential), stretch max and p99, pointwise error
@@ -40,6 +40,7 @@ CSV_NAME = "observables.csv"
 RELEASE_SCENE = "still-dynamic"
 SCENES = ("motion", "release", "rest")
 REST_DAMPING = 5.0  # 1/s: motion decays as e^(−β·t/2), to e^(−10) of its start in 4 s
+REST_SECONDS = 5.0  # the rest scene's time (at most the long time): what the hair takes to settle on the head
 COLUMNS = (
     "study",  # mode | reference
     "scene",  # motion | release | rest
@@ -148,7 +149,9 @@ class LongRuns:
         self.ref_S = min(ref_S, self.plan.long_ref_max)
 
     def frames_of(self, scene):
-        return max(4, self.frames // 2) if scene == "rest" else self.frames
+        if scene == "rest":
+            return max(4, min(self.frames, round(REST_SECONDS / self.study.frame_dt)))
+        return self.frames
 
     def run(self, scene, build, solver, substeps, iterations, precision, ftl_damping, tag, threads):
         sc = self.configure(
