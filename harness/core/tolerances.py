@@ -384,6 +384,7 @@ def jitter_budget_cm(use):
     lb = DYN_ACC_USES_LONG[use]
     return lb["jitter_px"] * DYN_ACC_VIEW_CM / lb["lines"]
 
+
 # ---------------------------------------------------------------------------------------
 # ANALYTIC CHECKS of the dynamic model (docs/model.md §4; tests/cpu/test_analytic.py; the full
 # S sweeps in docs/analytic.md, made by `python -m harness.studies.analytic_table`). Measured on the
