@@ -379,7 +379,7 @@ DYN_ACC_USES_LONG = {
 DYN_ACC_VIEW_CM = 40.0  # scene height across the picture (L = 30 cm of hair below a head)
 
 
-def jitter_budget_cm(use):
+def jitter_budget_cm(use: str) -> float:
     """The use's rest-jitter budget (largest frame-to-frame move) in cm."""
     lb = DYN_ACC_USES_LONG[use]
     return lb["jitter_px"] * DYN_ACC_VIEW_CM / lb["lines"]
