@@ -810,7 +810,7 @@ def parser():
         "--model", choices=("paper", "dynamic"), default=None, help="default: the --scene's model, else paper"
     )
     a.add_argument("--scene", default=None, help="scene name or .toml path (default paper, or dynamic)")
-    a.add_argument("--strands", type=whole(1), default=None, help="paper 100000; dynamic 256 (--quick 32)")
+    a.add_argument("--strands", type=whole(1), default=None, help="paper 100000; dynamic 256 (--quick 16)")
     a.add_argument("--points", type=whole(2), default=None, help="default: paper 32; dynamic the scene's")
     a.add_argument("--repeat", type=whole(1), default=None, help="timed repetitions (default: paper 9, dynamic 3)")
     a.add_argument(
@@ -824,7 +824,7 @@ def parser():
     a.add_argument(
         "--quick",
         action="store_true",
-        help="dynamic: a small study (32 strands, 0.25 s, S 1 4 16, I 1, s 0.9 1, 5 s long runs)",
+        help="dynamic: a small study (16 strands, 0.25 s, S 1 4 16, I 1, 5 s long runs on 6 strands)",
     )
     a.add_argument("--seconds", type=seconds, default=None, help="dynamic: simulated time (default 1; --quick 0.25)")
     a.add_argument(
@@ -859,7 +859,7 @@ def parser():
         type=unit_interval,
         nargs="+",
         default=None,
-        help="dynamic: ftl's s values, an axis of the study (default 0 0.5 0.9 1; --quick 0.9 1)",
+        help="dynamic: ftl's s values, an axis of the study (default 0 0.5 0.9 1)",
     )
     a.add_argument(
         "--ref-extra",
@@ -874,7 +874,9 @@ def parser():
         help="dynamic: simulated time of the long runs (energy, tip motion, jitter, distributions; "
         "default 10; --quick 5; 0: none)",
     )
-    a.add_argument("--long-strands", type=whole(2), default=None, help="dynamic: strands of the long runs (default 8)")
+    a.add_argument(
+        "--long-strands", type=whole(2), default=None, help="dynamic: strands of the long runs (default 8; --quick 6)"
+    )
     a.add_argument("--force", action="store_true", help="dynamic: replace an existing results CSV")
     output_options(
         a,
