@@ -198,3 +198,31 @@ def test_swing_of_strands_in_opposite_phase_and_other_planes():
     still = pos.copy()
     still[:, 1] = still[0, 1]  # a strand at rest adds no frequency 0 and no ζ to the medians
     assert ob.swing(still, dt)[:2] == (pytest.approx(f0, rel=2e-3), pytest.approx(zeta, rel=0.02))
+
+
+def test_release_damping_noise_is_the_larger_of_halves_and_fit():
+    """observables_long.metrics on four strands swinging with ζ = 0.02, 0.02, 0.04, 0.04
+    (even strands 0.02 and 0.04, odd the same): the strand halves agree, so ζ's noise is
+    the envelope fit's standard error; with 0.02, 0.04 on the even and 0.03, 0.05 on the odd
+    strands it is half the halves' difference."""
+    from harness.studies import observables_long
+
+    dt, f0 = 1 / 60, 1.1
+    t = np.arange(600) * dt
+
+    def strands(zetas):
+        pos = np.zeros((len(t), len(zetas), 3, 3))
+        pos[:, :, :, 1] = -np.array([0.0, 15.0, 30.0])
+        for n, z in enumerate(zetas):
+            w = 2 * math.pi * f0
+            pos[:, n, -1, 0] = 2.0 * np.exp(-z * w * t) * np.cos(w * math.sqrt(1 - z * z) * t)
+        return pos
+
+    pos = strands([0.02, 0.02, 0.04, 0.04])
+    values, noise, verdict = observables_long.metrics("release", pos, np.zeros_like(pos), None, L, 981.0, dt)
+    assert verdict == ob.OK and set(values) == {"tip_frequency_hz", "tip_damping_ratio"}
+    assert values["tip_damping_ratio"] == pytest.approx(0.03, rel=0.03)  # the median of two 0.02s and two 0.04s
+    assert noise["tip_damping_ratio"] == ob.swing(pos, dt)[2] > 0
+    pos = strands([0.02, 0.03, 0.04, 0.05])
+    _, noise, _ = observables_long.metrics("release", pos, np.zeros_like(pos), None, L, 981.0, dt)
+    assert noise["tip_damping_ratio"] == pytest.approx(0.005, rel=0.05)
