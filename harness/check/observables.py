@@ -111,18 +111,20 @@ def dominant_frequency(signal, dt, pad=16):
 
 def damping_fit(signal, dt):
     """(ζ, its standard error) of a decaying swing from its envelope: the signal from its first
-    extremum is cut into windows one period of its dominant frequency long, half a period
-    apart; each window's
-    height (max − min, so an offset does not matter, and an extremum of a faster, smaller
-    mode only adds its own amplitude) falls as e^(−σt); σ is the least-squares slope of their
-    logarithms against time and ζ = σ/√(ω_d² + σ²), ω_d = 2π·f. The standard error is the
-    slope's, from the fit's residuals (0 for an exact exponential). (NaN, NaN) with fewer than
-    4 windows or a flat signal. A swing damped so fast (ζ ≳ 0.15 over many periods) that its
-    spectrum has no peak at its frequency has no fit either."""
+    extremum is cut into windows one period of its dominant frequency f long, half a period
+    apart; each window's height (max − min, so an offset does not matter, and an extremum of
+    a faster, smaller mode only adds its own amplitude) falls as e^(−σt); σ is the
+    least-squares slope of their logarithms against time and ζ = σ/√(ω_d² + σ²), ω_d = 2π·f.
+    The standard error is the slope's, from the fit's residuals (0 for an exact exponential).
+    (NaN, NaN) for a signal that is flat, not finite, or shorter than 4 windows; a swing
+    damped so fast (ζ ≳ 0.15 over many periods) that its spectrum has no peak at its
+    frequency has no fit either."""
     y = _f64(signal)
-    f = dominant_frequency(y, dt)
     nan = (float("nan"), float("nan"))
-    if not f > 0 or not np.isfinite(y).all():
+    if not np.isfinite(y).all():
+        return nan
+    f = dominant_frequency(y, dt)
+    if not f > 0:
         return nan
     period = 1.0 / (f * dt)  # samples
     first = int(np.argmax(np.abs(y - y.mean())[: int(period) + 1]))  # the first swing's extremum
