@@ -75,47 +75,79 @@ def tip_swing(pos):
 
 def swing(pos, dt):
     """The median over strands of the dominant frequency (Hz) and of the damping ratio of each
-    strand's tip swing (tip_swing): the strands' own motion, not their average (strands that
-    swing in opposite phase would cancel in a mean). NaN where no strand gives a value."""
+    strand's tip swing (tip_swing) that moves, and the median of the damping fits' standard
+    errors: the strands' own motion, not their average (strands that swing in opposite phase
+    would cancel in a mean). NaN where no strand gives a value."""
     s = tip_swing(pos)
-    f = [dominant_frequency(s[:, n], dt) for n in range(s.shape[1])]
-    z = [damping_ratio(s[:, n], dt) for n in range(s.shape[1])]
-    z = [v for v in z if np.isfinite(v)]
-    return float(np.median(f)) if f else float("nan"), float(np.median(z)) if z else float("nan")
+    moving = [s[:, n] for n in range(s.shape[1]) if np.ptp(s[:, n]) > 0]  # a strand at rest has no swing
+    f = [dominant_frequency(y, dt) for y in moving]
+    fits = [damping_fit(y, dt) for y in moving]
+    fits = [v for v in fits if np.isfinite(v[0])]
+
+    def median(v):
+        return float(np.median(v)) if len(v) else float("nan")
+
+    return median(f), median([z for z, _ in fits]), median([e for _, e in fits])
 
 
-def dominant_frequency(signal, dt):
+def dominant_frequency(signal, dt, pad=16):
     """The frequency (Hz) of the largest peak of the signal's spectrum (mean removed, Hann
-    window), refined by a parabola through the peak's log magnitudes; 0 for a flat signal."""
+    window, zero-padded `pad`× for a finer grid), refined by a parabola through the log
+    magnitudes of the peak's three bins; 0 for a flat signal. Needs uniform samples."""
     y = _f64(signal)
     y = y - y.mean()
     n = len(y)
     if n < 4 or not np.any(y):
         return 0.0
-    pad = 8 * n  # zero padding: a finer grid for the parabola to refine
-    mag = np.abs(np.fft.rfft(y * np.hanning(n), pad))
+    mag = np.abs(np.fft.rfft(y * np.hanning(n), pad * n))
     k = int(np.argmax(mag[1:])) + 1
     shift = 0.0
-    if 1 <= k < len(mag) - 1 and mag[k - 1] > 0 and mag[k + 1] > 0:
-        a, b, c = np.log(mag[k - 1]), np.log(mag[k]), np.log(mag[k + 1])
+    if k < len(mag) - 1 and mag[k - 1] > 0 and mag[k + 1] > 0:
+        a, b, c = np.log(mag[k - 1 : k + 2])
         den = a - 2 * b + c
         shift = 0.5 * (a - c) / den if den != 0 else 0.0
-    return float((k + shift) / (pad * dt))
+    return float((k + shift) / (pad * n * dt))
+
+
+def damping_fit(signal, dt):
+    """(ζ, its standard error) of a decaying swing from its envelope: the signal from its first
+    extremum is cut into windows one period of its dominant frequency f long, half a period
+    apart; each window's height (max − min, so an offset does not matter, and an extremum of
+    a faster, smaller mode only adds its own amplitude) falls as e^(−σt); σ is the
+    least-squares slope of their logarithms against time and ζ = σ/√(ω_d² + σ²), ω_d = 2π·f.
+    The standard error is the slope's, from the fit's residuals (0 for an exact exponential).
+    (NaN, NaN) for a signal that is flat, not finite, or shorter than 4 windows; a swing
+    damped so fast (ζ ≳ 0.15 over many periods) that its spectrum has no peak at its
+    frequency has no fit either."""
+    y = _f64(signal)
+    nan = (float("nan"), float("nan"))
+    if not np.isfinite(y).all():
+        return nan
+    f = dominant_frequency(y, dt)
+    if not f > 0:
+        return nan
+    period = 1.0 / (f * dt)  # samples
+    first = int(np.argmax(np.abs(y - y.mean())[: int(period) + 1]))  # the first swing's extremum
+    starts = np.arange(float(first), len(y) - period + 1e-9, period / 2)
+    if len(starts) < 4:
+        return nan
+    heights = np.array([np.ptp(y[int(round(a)) : int(round(a + period)) + 1]) for a in starts])
+    if not (heights > 0).all():
+        return nan
+    t = (starts + period / 2) * dt
+    (slope, _), res, *_ = np.polyfit(t, np.log(heights), 1, full=True)
+    dof = len(t) - 2
+    var = float(res[0]) / dof if len(res) and dof > 0 else 0.0
+    se_slope = np.sqrt(var / np.sum((t - t.mean()) ** 2))
+    wd, sigma = 2 * np.pi * f, -float(slope)
+    norm = np.hypot(wd, sigma)
+    # dζ/dσ = ω_d²/(ω_d² + σ²)^(3/2)
+    return float(sigma / norm), float(se_slope * wd * wd / norm**3)
 
 
 def damping_ratio(signal, dt):
-    """ζ from the logarithmic decrement of the swing: the heights between successive extrema
-    of the signal (so its offset does not matter) fall by e^(−δ) per half period, δ fitted by
-    least squares on their logarithms; ζ = δ/√(π² + δ²). NaN with fewer than 3 heights."""
-    y = _f64(signal)
-    dy = np.diff(y)
-    ext = [i for i in range(1, len(y) - 1) if dy[i - 1] * dy[i] < 0 or (dy[i - 1] != 0 and dy[i] == 0)]
-    heights = np.abs(np.diff(y[ext]))
-    heights = heights[heights > 0]
-    if len(heights) < 3:
-        return float("nan")
-    delta = -float(np.polyfit(np.arange(len(heights)), np.log(heights), 1)[0])
-    return float(delta / np.sqrt(np.pi**2 + delta**2))
+    """ζ of a decaying swing (damping_fit)."""
+    return damping_fit(signal, dt)[0]
 
 
 # ---- jitter, stretch, errors ------------------------------------------------------------

@@ -39,37 +39,29 @@ def whole(low):
     return parse
 
 
-def seconds(text):
-    """An argparse type: a finite number of seconds > 0."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"needs a number of seconds (got '{text}')") from None
-    if not 0 < value < float("inf"):
-        raise argparse.ArgumentTypeError(f"must be a finite number of seconds > 0 (got '{text}')")
-    return value
+def real(name, needs, accept, must):
+    """An argparse type named `name`: a float that `accept` takes; otherwise one line, "needs
+    NEEDS" for what is not a number and "MUST" for one outside the range."""
+
+    def parse(text):
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"needs {needs} (got '{text}')") from None
+        if not accept(value):
+            raise argparse.ArgumentTypeError(f"{must} (got '{text}')")
+        return value
+
+    parse.__name__ = name
+    return parse
 
 
-def unit_interval(text):
-    """An argparse type: a number in [0, 1]."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"needs a number in [0, 1] (got '{text}')") from None
-    if not 0.0 <= value <= 1.0:
-        raise argparse.ArgumentTypeError(f"must lie in [0, 1] (got '{text}')")
-    return value
-
-
-def nonneg_seconds(text):
-    """An argparse type: a finite number of seconds ≥ 0."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"needs a number of seconds (got '{text}')") from None
-    if not 0 <= value < float("inf"):
-        raise argparse.ArgumentTypeError(f"must be a finite number of seconds ≥ 0 (got '{text}')")
-    return value
+seconds = real("seconds", "a number of seconds", lambda v: 0 < v < math.inf, "must be a finite number of seconds > 0")
+nonneg_seconds = real(
+    "nonneg_seconds", "a number of seconds", lambda v: 0 <= v < math.inf, "must be a finite number of seconds ≥ 0"
+)
+unit_interval = real("unit_interval", "a number in [0, 1]", lambda v: 0.0 <= v <= 1.0, "must lie in [0, 1]")
+number = real("number", "a number", math.isfinite, "needs a finite number")
 
 
 def cmd_run(args):
@@ -457,17 +449,6 @@ def setting(text):
     return (s, i)
 
 
-def number(text):
-    """An argparse type: a finite number."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"needs a number (got '{text}')") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"needs a finite number (got '{text}')")
-    return value
-
-
 def cmd_peer(args):
     from harness.render import peer_report
 
@@ -560,6 +541,58 @@ def cmd_docs(args):
     return docs.run(parser(), check=args.check)
 
 
+REPORT_DIR_HELP = "where to write (default results/local/report/)"
+GPU_CHOICES = ("auto", "yes", "no")
+GPU_HELP = "run cuda cases: auto (if a GPU is usable), yes (fail without), no"
+
+
+def output_options(p, results=None, report=None, from_csv=None):
+    """The output options the commands share, each where its text is given: --out (a results
+    directory, `results` its default), --report-dir (`report`: its help) and --from-csv (its help)."""
+    if results:
+        p.add_argument("--out", default=None, help=f"results directory (default {results})")
+    if report:
+        p.add_argument("--report-dir", default=None, help=report)
+    if from_csv:
+        p.add_argument("--from-csv", default=None, help=from_csv)
+
+
+def case_options(p, jobs=None, gpu=None, timeout=None, gpu_choices=GPU_CHOICES, gpu_default="auto"):
+    """How a command runs its cases, each option where its help is given: --jobs (at once),
+    --gpu (whether GPU cases run) and --timeout (seconds per binary run)."""
+    if jobs:
+        p.add_argument("--jobs", type=whole(1), default=None, help=jobs)
+    if gpu:
+        p.add_argument("--gpu", choices=gpu_choices, default=gpu_default, help=gpu)
+    if timeout:
+        p.add_argument("--timeout", type=seconds, default=None, help=timeout)
+
+
+def binary_options(p):
+    """Which binary runs and how: --backend, --build, --variant, --threads (cpu) and
+    --block-size (cuda), as `run` and `featurecost` take them."""
+    p.add_argument("--backend", choices=("cpu", "cuda"), default="cpu")
+    p.add_argument(
+        "--build",
+        choices=("default", "strict", "fastmath"),
+        default="default",
+        help="cuda build: hairsim-cuda, -strict or -fastmath (default: default)",
+    )
+    p.add_argument(
+        "--variant",
+        help="a variant the binary declares (`hairsim-* --list-variants`; default: the binary's default variant)",
+    )
+    p.add_argument("--threads", type=whole(1), help="cpu OpenMP threads (default: all cores)")
+    p.add_argument("--block-size", type=whole(32), help="cuda threads per block (32…1024)")
+
+
+def command(sub, name, func, help, description=None):  # noqa: A002 (argparse's own name)
+    """A subcommand's parser that runs func(args)."""
+    p = sub.add_parser(name, help=help, description=description)
+    p.set_defaults(func=func)
+    return p
+
+
 def parser():
     p = OneLineParser(
         prog="python -m harness",
@@ -568,35 +601,25 @@ def parser():
     p.add_argument("--version", action="version", version=f"hairbench harness {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
-    r = sub.add_parser(
+    r = command(
+        sub,
         "run",
+        cmd_run,
         help="run one scene on a backend and print its record",
         description="Run a scene (configs/scenes/NAME.toml or a path) on a backend binary "
         "with --json; print a summary, or the JSON record with --json.",
     )
     r.add_argument("scene", help="scene name in configs/scenes/ (e.g. paper) or a .toml path")
-    r.add_argument("--backend", choices=("cpu", "cuda"), default="cpu")
-    r.add_argument(
-        "--build",
-        choices=("default", "strict", "fastmath"),
-        default="default",
-        help="cuda build: hairsim-cuda, -strict or -fastmath (default: default)",
-    )
-    r.add_argument(
-        "--variant",
-        help="a variant the binary declares (`hairsim-* --list-variants`; default: the binary's default variant)",
-    )
+    binary_options(r)
     r.add_argument("--precision", choices=("fp32", "fp64"), help="override the scene's precision")
-    r.add_argument("--block-size", type=whole(32), help="cuda threads per block (32…1024)")
     r.add_argument("--strands", type=whole(1), help="override the scene's strand count")
     r.add_argument("--points", type=whole(2), help="override the scene's points per strand")
     r.add_argument("--stages", help="override the scene's stages (comma-separated)")
-    r.add_argument("--threads", type=whole(1), help="cpu OpenMP threads (default: all cores)")
     r.add_argument("--repeat", type=whole(1), help="timed repetitions per stage")
     r.add_argument("--warmup", type=whole(0), help="untimed runs per stage before the timed ones")
     r.add_argument("--output", help="write the HDF5 state here (refused if it exists, unless --force)")
     r.add_argument("--force", action="store_true", help="allow replacing --output")
-    r.add_argument("--timeout", type=seconds, default=None, help="seconds before giving up")
+    case_options(r, timeout="seconds before giving up")
     r.add_argument("--json", action="store_true", help="print the binary's JSON record")
     r.add_argument("--frames", type=whole(1), default=None, help="dynamic scenes: override dynamics.frames")
     r.add_argument(
@@ -605,10 +628,11 @@ def parser():
         default=None,
         help="dynamic scenes: print every K-th frame's observables (default: about 30 lines)",
     )
-    r.set_defaults(func=cmd_run)
 
-    sd = sub.add_parser(
+    sd = command(
+        sub,
         "stepdiff",
+        cmd_stepdiff,
         help="validate a dynamic backend one frame at a time (exit 0/1/2)",
         description="For each chosen simulated frame k of a reference written with "
         "--velocities all, run BINARY --input REF --input-frame k --stages "
@@ -628,7 +652,7 @@ def parser():
     )
     sd.add_argument("--exact", action="store_true", help="require bit-identical frames")
     sd.add_argument("--keep", help="keep the binary's outputs in this directory")
-    sd.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
+    case_options(sd, timeout="seconds per binary run")
     sd.add_argument(
         "--no-spread",
         action="store_true",
@@ -637,10 +661,11 @@ def parser():
     sd.add_argument(
         "flags", nargs=argparse.REMAINDER, help="further flags for the binary (after the options, e.g. -- --threads 1)"
     )
-    sd.set_defaults(func=cmd_stepdiff)
 
-    d = sub.add_parser(
+    d = command(
+        sub,
         "diff",
+        cmd_diff,
         help="compare two state files frame by frame (exit 0/1/2)",
         description="Compare two HDF5 states frame by frame (docs/harness.md, Equivalence). Exit 0 = "
         "equivalent, 1 = not equivalent, 2 = could not compare.",
@@ -662,28 +687,23 @@ def parser():
     )
     d.add_argument("--exact", action="store_true", help="require bit-identical positions")
     d.add_argument("--json", action="store_true", help="print the comparison as JSON")
-    d.set_defaults(func=cmd_diff)
 
-    s = sub.add_parser(
+    s = command(
+        sub,
         "sweep",
+        cmd_sweep,
         help="run a sweep file, appending rows to results/NAME/runs.csv",
         description="Run every case of a sweep (configs/sweeps/NAME.toml), one row per "
         "(case, stage) in results/NAME/runs.csv; a killed sweep resumes.",
     )
     s.add_argument("sweep", help="sweep name in configs/sweeps/ (e.g. quick) or a .toml path")
-    s.add_argument("--out", help="results directory (default results/<sweep name>)")
-    s.add_argument(
-        "--gpu",
-        choices=("auto", "yes", "no"),
-        default="auto",
-        help="run cuda cases: auto (if a GPU is usable), yes (fail without), no",
-    )
+    output_options(s, results="results/<sweep name>")
+    case_options(s, gpu=GPU_HELP)
     s.add_argument(
         "--shard",
         default=None,
         help="K/N: run the K-th of N deterministic shares of the cases (harness merge joins them)",
     )
-    s.set_defaults(func=cmd_sweep)
 
     for name, helptext, fn in (
         ("plot", "draw the PNG plots of a results directory", cmd_plot),
@@ -695,7 +715,7 @@ def parser():
             + " (rendering only: Fig. 1/2 come from the hair "
             + ("state the bench leaves in RESULTS/states/, when it is there).")
         )
-        q = sub.add_parser(name, help=helptext, description=description)
+        q = command(sub, name, fn, help=helptext, description=description)
         q.add_argument(
             "results",
             nargs="?",
@@ -703,21 +723,23 @@ def parser():
             help="results directory with runs.csv and env.json (default results/local/sweep, the paper "
             "sweep of make bench's run)",
         )
-        q.add_argument("--report-dir", default=None, help="where to write (default results/local/report/)")
-        q.set_defaults(func=fn)
+        output_options(q, report=REPORT_DIR_HELP)
 
-    rd = sub.add_parser(
+    rd = command(
+        sub,
         "report-dynamic",
+        cmd_report_dynamic,
         help="write results/local/report/dynamic.md (and its plots) from a dynamic bench root",
         description="Write results/local/report/dynamic.md and its plots from the results of the dynamic bench "
         "(ROOT/dynamic/, featurecost/, dynamic-accuracy/, stability/, peer/, headline/): rendering only.",
     )
     rd.add_argument("root", nargs="?", default="results/local", help="the bench root (default results/local)")
-    rd.add_argument("--report-dir", default=None, help="where to write (default results/local/report/)")
-    rd.set_defaults(func=cmd_report_dynamic)
+    output_options(rd, report=REPORT_DIR_HELP)
 
-    b = sub.add_parser(
+    b = command(
+        sub,
         "bench",
+        cmd_bench,
         help="the make bench pipeline: check, validate, sweep, report",
         description="Check the binaries, validate every GPU variant against the CPU "
         "(fail before timing), run the sweep, then plot and report.",
@@ -728,8 +750,8 @@ def parser():
         help="the run's folder (default results/local): the paper sweep in OUT/sweep, the dynamic bench's "
         "folders (dynamic, featurecost, dynamic-accuracy, stability, peer) beside it, the report in OUT/report",
     )
-    b.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto")
-    b.add_argument("--report-dir", default=None, help="where to write the report (default OUT/report)")
+    case_options(b, gpu=GPU_HELP)
+    output_options(b, report="where to write the report (default OUT/report)")
     b.add_argument(
         "--model",
         choices=("all", "paper", "dynamic"),
@@ -755,10 +777,11 @@ def parser():
         help="dynamic: the full accuracy study and stability map (tens of minutes) instead of the "
         "bench's size (accuracy --quick, stability --quick: minutes on a 16-core + H200 node)",
     )
-    b.set_defaults(func=cmd_bench)
 
-    mg = sub.add_parser(
+    mg = command(
+        sub,
         "merge",
+        cmd_merge,
         help="join shard folders (bench --shard K/N) into one results folder",
         description="Join the folders of one run's N shards (bench or sweep --shard K/N) into OUT: the rows of "
         "every CSV, the sweeps' sessions, every shard's validation. Refused in one line (exit 2), writing "
@@ -767,10 +790,11 @@ def parser():
     )
     mg.add_argument("out", help="the merged folder to write (must not exist, or be empty)")
     mg.add_argument("shards", nargs="+", help="the shard folders")
-    mg.set_defaults(func=cmd_merge)
 
-    a = sub.add_parser(
+    a = command(
+        sub,
         "accuracy",
+        cmd_accuracy,
         help="speed against accuracy: every mode against a reference (paper or dynamic model)",
         description="Paper model (default): run the scene in every precision/build mode available "
         "here and in several model resolutions, compare with hairsim-cpu --precision fp64, time "
@@ -786,7 +810,7 @@ def parser():
         "--model", choices=("paper", "dynamic"), default=None, help="default: the --scene's model, else paper"
     )
     a.add_argument("--scene", default=None, help="scene name or .toml path (default paper, or dynamic)")
-    a.add_argument("--strands", type=whole(1), default=None, help="paper 100000; dynamic 256 (--quick 32)")
+    a.add_argument("--strands", type=whole(1), default=None, help="paper 100000; dynamic 256 (--quick 16)")
     a.add_argument("--points", type=whole(2), default=None, help="default: paper 32; dynamic the scene's")
     a.add_argument("--repeat", type=whole(1), default=None, help="timed repetitions (default: paper 9, dynamic 3)")
     a.add_argument(
@@ -797,7 +821,11 @@ def parser():
         help="paper: points per strand of the resolution study (the largest is the reference; default 4 … 256)",
     )
     a.add_argument("--resolution-strands", type=whole(1), default=None, help="paper: default 20000")
-    a.add_argument("--quick", action="store_true", help="dynamic: a small study (32 strands, 0.25 s, S 1 4 16, I 1 2)")
+    a.add_argument(
+        "--quick",
+        action="store_true",
+        help="dynamic: a small study (16 strands, 0.25 s, S 1 4 16, I 1, 5 s long runs on 6 strands)",
+    )
     a.add_argument("--seconds", type=seconds, default=None, help="dynamic: simulated time (default 1; --quick 0.25)")
     a.add_argument(
         "--horizon", type=seconds, default=None, help="dynamic: time over which errors are compared (default 0.5)"
@@ -805,7 +833,9 @@ def parser():
     a.add_argument(
         "--substeps", type=whole(1), nargs="+", default=None, help="dynamic: S values (default 1 2 4 8 16 32)"
     )
-    a.add_argument("--iterations", type=whole(1), nargs="+", default=None, help="dynamic: I values (default 1 2 4)")
+    a.add_argument(
+        "--iterations", type=whole(1), nargs="+", default=None, help="dynamic: I values (default 1 2 4; --quick 1)"
+    )
     a.add_argument(
         "--time-strands", type=whole(1), default=None, help="dynamic: strands of the timing runs (default 10000)"
     )
@@ -814,11 +844,16 @@ def parser():
         "--ref-start", type=whole(2), default=None, help="dynamic: first S of the reference (default 2 x max S)"
     )
     a.add_argument("--ref-max", type=whole(2), default=None, help="dynamic: largest S of the reference (default 16384)")
-    a.add_argument("--jobs", type=whole(1), default=None, help="dynamic: parallel checked runs (default: cores)")
     a.add_argument(
         "--analytic", choices=("full", "quick", "none"), default=None, help="dynamic: the analytic tables to run"
     )
-    a.add_argument("--gpu", choices=("auto", "no"), default=None, help="dynamic: GPU modes and reference if usable")
+    case_options(
+        a,
+        jobs="dynamic: parallel checked runs (default: cores)",
+        gpu="dynamic: GPU modes and reference if usable",
+        gpu_choices=("auto", "no"),
+        gpu_default=None,
+    )
     a.add_argument(
         "--ftl-damping",
         type=unit_interval,
@@ -837,24 +872,24 @@ def parser():
         type=nonneg_seconds,
         default=None,
         help="dynamic: simulated time of the long runs (energy, tip motion, jitter, distributions; "
-        "default 10; 0: none)",
+        "default 10; --quick 5; 0: none)",
     )
-    a.add_argument("--long-strands", type=whole(2), default=None, help="dynamic: strands of the long runs (default 8)")
+    a.add_argument(
+        "--long-strands", type=whole(2), default=None, help="dynamic: strands of the long runs (default 8; --quick 6)"
+    )
     a.add_argument("--force", action="store_true", help="dynamic: replace an existing results CSV")
-    a.add_argument(
-        "--out", default=None, help="results directory (default results/accuracy or results/dynamic-accuracy)"
-    )
-    a.add_argument("--report-dir", default=None, help="where to write (default results/local/report/)")
-    a.add_argument(
-        "--from-csv",
-        default=None,
-        help="only rewrite the report from an existing CSV (results/accuracy/accuracy.csv, or with "
+    output_options(
+        a,
+        results="results/accuracy or results/dynamic-accuracy",
+        report=REPORT_DIR_HELP,
+        from_csv="only rewrite the report from an existing CSV (results/accuracy/accuracy.csv, or with "
         "--model dynamic results/dynamic-accuracy/dynamic_accuracy.csv)",
     )
-    a.set_defaults(func=cmd_accuracy)
 
-    h = sub.add_parser(
+    h = command(
+        sub,
         "headline",
+        cmd_headline,
         help="the headline numbers: bandwidth fractions and speedups (--model dynamic: the dynamic model's targets)",
         description="At one size, measure the copy bandwidths, every CUDA variant's init and "
         "wind+collide time and bandwidth fraction, and three CPU baselines "
@@ -874,11 +909,12 @@ def parser():
         "(memory-bound case, default scene, real-time regime, CPU), results/headline/headline_dynamic.json",
     )
     h.add_argument("--ncu", action="store_true", help="dynamic: also profile the best kernel with Nsight Compute")
-    h.add_argument("--out", default=None, help="results directory (default results/headline)")
-    h.set_defaults(func=cmd_headline)
+    output_options(h, results="results/headline")
 
-    e = sub.add_parser(
+    e = command(
+        sub,
         "export",
+        cmd_export,
         help="sidecars that ParaView/VisIt (XDMF) and Blender/Houdini/usdview (USD) open",
         description="Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions "
         "referenced in STATE) and, with --usd, STATE.usdc (BasisCurves, one "
@@ -890,10 +926,11 @@ def parser():
     e.add_argument("--usd-only", action="store_true", help="write only the USD file")
     e.add_argument("--out", help="output prefix (default: the state's path)")
     e.add_argument("--force", action="store_true", help="replace sidecars that exist (else refused, nothing written)")
-    e.set_defaults(func=cmd_export)
 
-    c = sub.add_parser(
+    c = command(
+        sub,
         "calibrate",
+        cmd_calibrate,
         help="measure fp32-vs-fp64 errors behind tolerances.py",
         description="Run the cpu binary at fp32 and fp64 on the paper scene and print "
         "the errors and invariant residuals that tolerances.py is set from.",
@@ -907,26 +944,23 @@ def parser():
         "precision (e.g. build/hairsim-cuda on a GPU node)",
     )
     c.add_argument("--json", action="store_true")
-    c.set_defaults(func=cmd_calibrate)
 
-    fc = sub.add_parser(
+    fc = command(
+        sub,
         "featurecost",
+        cmd_featurecost,
         help="the dynamic model's time per frame with each feature undeclared, alone, and the full scene",
         description="Run a dynamic scene with every feature undeclared, each alone, the full scene "
         "less each, and the full scene (features are removed by their flags, so the binary compiles "
         "them out); print a Markdown table and, with --out, write the rows as CSV.",
     )
     fc.add_argument("--scene", default="dynamic", help="a dynamic scene (default dynamic)")
-    fc.add_argument("--backend", choices=("cpu", "cuda"), default="cpu")
-    fc.add_argument("--build", default="default", help="cuda build: default | strict | fastmath")
-    fc.add_argument("--variant", default=None)
+    binary_options(fc)
     fc.add_argument("--strands", type=whole(1), default=100_000)
     fc.add_argument("--points", type=whole(2), default=None)
     fc.add_argument("--frames", type=whole(1), default=3, help="frames per case (default 3)")
     fc.add_argument("--repeat", type=whole(1), default=3, help="timed repeats of each frame (default 3)")
-    fc.add_argument("--threads", type=whole(1), default=None, help="cpu threads (default: all cores)")
-    fc.add_argument("--block-size", type=whole(32), default=None)
-    fc.add_argument("--timeout", type=seconds, default=None)
+    case_options(fc, timeout="seconds per case before giving up")
     fc.add_argument("--out", default=None, help="CSV file to write")
     fc.add_argument(
         "--instructions",
@@ -934,10 +968,11 @@ def parser():
         help="cpu oracle: also count, under valgrind's callgrind, the instructions per point-substep of "
         "the frame function (deterministic where times are noisy)",
     )
-    fc.set_defaults(func=cmd_featurecost)
 
-    rd = sub.add_parser(
+    rd = command(
+        sub,
         "reduced",
+        cmd_reduced,
         help="the dynamic model with guides and followers and with long-range attachments: error and time",
         description="Run a dynamic scene with guide fractions 100/50/25/10/5%% x scheme (one, blend3) and "
         "LRA off/on at few iterations; compare each with every strand simulated (xpbd, fp64, finer S) and time "
@@ -948,13 +983,14 @@ def parser():
     rd.add_argument("--strands", type=whole(1), default=None, help="strands of the checked runs")
     rd.add_argument("--seconds", type=seconds, default=None, help="simulated time of each run")
     rd.add_argument("--quick", action="store_true", help="the small version (CI, a first look)")
-    rd.add_argument("--gpu", choices=("auto", "no"), default="auto")
+    case_options(rd, gpu="the cuda variants too, where a GPU is usable", gpu_choices=("auto", "no"))
     rd.add_argument("--out", default=None, help="CSV file to write")
-    rd.set_defaults(func=cmd_reduced)
 
     peer_plan = peer.Plan()
-    pe = sub.add_parser(
+    pe = command(
+        sub,
         "peer",
+        cmd_peer,
         help="the same chain scenes in Bender's PositionBasedDynamics (pypbd) beside ours",
         description="Run chains released from rest in hairsim-cpu and in pypbd (XPBD distance constraints, "
         "the parameters mapped as docs/decisions.md says), against our converged fp64 reference: error, "
@@ -997,14 +1033,14 @@ def parser():
         "--ref-start", type=whole(1), default=peer_plan.ref_start, help="first S of the reference doubling (64)"
     )
     pe.add_argument("--ref-max", type=whole(2), default=peer_plan.ref_max, help="largest S of the reference (16384)")
-    pe.add_argument("--timeout", type=seconds, default=None, help="seconds per binary run")
-    pe.add_argument("--out", default=None, help="results directory (default results/peer)")
-    pe.add_argument("--report-dir", default=None, help="where peer.md goes (default results/local/report/)")
+    case_options(pe, timeout="seconds per binary run")
+    output_options(pe, results="results/peer", report="where peer.md goes (default results/local/report/)")
     pe.add_argument("--report-only", action="store_true", help="only re-render results/local/report/peer.md from --out")
-    pe.set_defaults(func=cmd_peer)
 
-    an = sub.add_parser(
+    an = command(
+        sub,
         "animate",
+        cmd_animate,
         help="an animation of a dynamic state from the side and from the front",
         description="Draw the frames of a dynamic HDF5 state (read through harness.io.trajectory) seen from "
         "the side and from the front, the head sphere drawn, as a GIF (and an MP4 beside it where ffmpeg "
@@ -1018,12 +1054,13 @@ def parser():
     an.add_argument("--strands", type=whole(1), default=300, help="without STATE: strands simulated (default 300)")
     an.add_argument("--frames", type=whole(1), default=120, help="without STATE: frames simulated (default 120)")
     an.add_argument("--force", action="store_true", help="replace existing output files")
-    an.set_defaults(func=cmd_animate)
 
     from harness.studies.stability import FRAMES, SLICE_NAMES, STRANDS
 
-    sb = sub.add_parser(
+    sb = command(
+        sub,
         "stability",
+        cmd_stability,
         help="the dynamic model's stability map: verdicts over 2-D slices of the scene space",
         description="Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend "
         "compliance, points and iterations; head-motion frequency against amplitude) for both solvers and "
@@ -1036,18 +1073,25 @@ def parser():
     sb.add_argument("--slice", action="append", choices=SLICE_NAMES, help="run only this slice (repeatable)")
     sb.add_argument("--strands", type=whole(1), default=STRANDS, help=f"strands per cell (default {STRANDS})")
     sb.add_argument("--frames", type=whole(1), default=FRAMES, help=f"frames per cell (default {FRAMES}: 1 s)")
-    sb.add_argument("--jobs", type=whole(1), default=None, help="cells run at once (default: all cores)")
-    sb.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto", help="run the CUDA builds too")
-    sb.add_argument("--timeout", type=seconds, default=None, help="seconds per cell before giving up")
-    sb.add_argument("--out", default=None, help="results directory (default results/stability)")
-    sb.add_argument("--report-dir", default=None, help="where to write (default results/local/report/)")
-    sb.add_argument("--from-csv", default=None, help="only redraw the report from an existing stability.csv")
-    sb.set_defaults(func=cmd_stability)
+    case_options(
+        sb,
+        jobs="cells run at once (default: all cores)",
+        gpu="run the CUDA builds too",
+        timeout="seconds per cell before giving up",
+    )
+    output_options(
+        sb,
+        results="results/stability",
+        report=REPORT_DIR_HELP,
+        from_csv="only redraw the report from an existing stability.csv",
+    )
 
     from harness.studies.judge import EXTREME, PAPER_EXTREME, PLANTS
 
-    jg = sub.add_parser(
+    jg = command(
+        sub,
         "judge",
+        cmd_judge,
         help="the one-frame judge's power: planted defects caught, false alarms on extreme scenes",
         description="Step every planted defect (build/planted/, make planted) from the C reference's frames "
         "on the standard scenes, and every honest build × variant × precision on the extreme scenes, judging "
@@ -1065,19 +1109,18 @@ def parser():
         help=f"only this extreme scene (repeatable; {len(EXTREME)} dynamic, {len(PAPER_EXTREME)} paper declared)",
     )
     jg.add_argument("--plant", action="append", type=int, choices=sorted(PLANTS), help="only this planted defect")
-    jg.add_argument("--gpu", choices=("auto", "yes", "no"), default="auto", help="honest runs of the CUDA builds too")
-    jg.add_argument("--jobs", type=whole(1), default=None, help="scenes run at once (default: all cores)")
-    jg.add_argument("--out", default=None, help="results directory (default results/judge)")
-    jg.set_defaults(func=cmd_judge)
+    case_options(jg, jobs="scenes run at once (default: all cores)", gpu="honest runs of the CUDA builds too")
+    output_options(jg, results="results/judge")
 
-    dc = sub.add_parser(
+    dc = command(
+        sub,
         "docs",
+        cmd_docs,
         help="remake docs/harness.md's command and module reference",
         description="Remake the command and module reference of docs/harness.md from this parser and the "
         "modules' docstrings (what `make docs` runs); --check only says whether it is current (exit 1 if not).",
     )
     dc.add_argument("--check", action="store_true", help="write nothing; exit 1 when the page is out of date")
-    dc.set_defaults(func=cmd_docs)
     return p
 
 

@@ -371,11 +371,11 @@ def checks(r, use, longm):
     if lb and m is not None:
         out["tip frequency"] = _within(m.get("tip_frequency_hz"), lb["freq_rel"])
         out["kinetic energy"] = _within_factor(m.get("kinetic_mean"), lb["kinetic_factor"])
-        j = m.get("jitter_rms_velocity")
+        j = m.get("jitter_max_move")
         if j is not None:
-            v, noise, ref, unc = j
-            lim = lb["jitter_factor"] * ref + tolerances.DYN_ACC_JITTER_FLOOR
-            out["rest jitter"] = bool(np.isfinite(v) and v <= lim + (noise if np.isfinite(noise) else 0))
+            v, noise, _, _ = j
+            lim = tolerances.jitter_budget_cm(use) + (noise if np.isfinite(noise) else 0)
+            out["rest jitter"] = bool(np.isfinite(v) and v <= lim)
     return out
 
 
@@ -446,16 +446,53 @@ def recommend(summ, long=None):
         lb = tolerances.DYN_ACC_USES_LONG.get(use)
         long_txt = (
             f", tip frequency within {100 * lb['freq_rel']:g} %, mean kinetic energy within ×{lb['kinetic_factor']:g}"
-            f" and rest jitter at most ×{lb['jitter_factor']:g} + {tolerances.DYN_ACC_JITTER_FLOOR:g} cm/s of the "
-            "reference's (long runs, noise allowed)"
+            " of the reference's, and no point of a still head moving more than "
+            f"{lb['jitter_px']:g} px from frame to frame at {lb['lines']} lines ({_jit(use)}; long runs, noise allowed)"
+            if lb and longm
+            else ""
+        )
+        jit = [c for c in verdicts.values() if c.get("rest jitter") is False]
+        alone = [c for c in jit if all(v is not False for k, v in c.items() if k != "rest jitter")]
+        jit_note = (
+            f" Rest jitter rejects {len(jit)} of the {len(verdicts)} modes, {len(alone)} of them on that alone."
             if lb and longm
             else ""
         )
         lines.append(
             f"- **{use}** (RMS error ≤ {rms_budget:g}·L and stretch ≤ {_pct(stretch_budget)} over the horizon"
-            f"{long_txt}, never blown up; {why}{base_note}): " + "; ".join(picks) + "."
+            f"{long_txt}, never blown up; {why}{base_note}): " + "; ".join(picks) + "." + jit_note
         )
     return lines
+
+
+def _jit(use):
+    return f"{tolerances.jitter_budget_cm(use):.2g} cm"
+
+
+def jitter_budget_lines(long):
+    """Each use's rest-jitter budget in pixels and cm, against the reference's own largest
+    move and the no-simulation mode's (nothing moves)."""
+    if long is None or long.empty:
+        return []
+    _, ref = long_metrics(long)
+    ref_move = ref.get("jitter_max_move", (np.nan,) * 4)[0]
+    out = [
+        "Rest jitter budgets: the largest frame-to-frame move of any point of the settled **rest** scene, in "
+        f"pixels of a picture {tolerances.DYN_ACC_VIEW_CM:g} cm high (a head-and-shoulders shot; "
+        "harness/core/tolerances.py, DYN_ACC_USES_LONG). Not simulating moves nothing (0 px), so every move is "
+        "flicker the simulation adds; the reference's own largest move is its settling, and each budget must be "
+        "looser than it.",
+        "",
+        "| use | lines | budget (px) | budget (cm) | reference's largest move (px) | looser than the reference |",
+        "| --- | ---: | ---: | ---: | ---: | --- |",
+    ]
+    for use, lb in tolerances.DYN_ACC_USES_LONG.items():
+        cm = tolerances.jitter_budget_cm(use)
+        px = ref_move * lb["lines"] / tolerances.DYN_ACC_VIEW_CM
+        looser = "yes" if np.isfinite(ref_move) and cm > ref_move else "**no**"
+        out.append(f"| {use} | {lb['lines']} | {lb['jitter_px']:g} | {cm:.3g} | {px:.2g} | {looser} |")
+    out.append("")
+    return out
 
 
 def baseline_lines(summ, study):
@@ -520,15 +557,19 @@ def long_lines(long, study):
         ]
     longm, ref = long_metrics(long)
     first = long.iloc[0]
+    rest = long[long["scene"] == "rest"]
+    rest_s = f"{rest['seconds'].iloc[0]:g} s" if len(rest) else "its time"
     head = "| mode | " + " | ".join(c[1] for c in LONG_COLUMNS) + " | verdict |"
     out = [
         "### What a user sees over seconds",
         "",
         f"Long runs ({first['seconds']:g} s, {int(first['strands'])} strands × {int(first['points'])} points, "
         "harness/studies/observables_long.py): **motion** is the study's scene; **release** the still-dynamic "
-        "scene without its collider let go from its rest shape (each strand's swing frequency and damping ratio "
-        "over the first half, the median over strands); **rest** the still-dynamic scene with a strong damping "
-        "over half the time (RMS frame-to-frame velocity and the largest move over its last fifth, settled: what "
+        "scene without its collider let go from its rest shape (the median over the strands that swing of each "
+        "strand's swing frequency over the first half and of its damping ratio over the whole run, from the decay "
+        "of the swing's envelope; ζ's noise is the larger of the strand halves' difference and the fit's "
+        "standard error); **rest** the still-dynamic scene with a strong damping "
+        f"for {rest_s} (RMS frame-to-frame velocity and the largest move over its last fifth, settled: what "
         "flickers). Distances (W1 of the tip's distribution, total variation of its "
         "spectrum, IoU of the silhouettes) compare statistics, not phases: pointwise error means little after "
         "about half a second (the horizon's table). Each value ± its noise (half the difference between the "
@@ -903,11 +944,12 @@ def markdown(rows, study, env, analytic, long=None):
         "",
         "Rule: for each use, the mode with the least time per frame among those never blown up whose RMS error "
         "and stretch_max over the horizon are within the use's budget (harness/core/tolerances.py, DYN_ACC_USES) "
-        "and, where the long runs measured its settings, whose tip frequency, mean kinetic energy and rest "
-        "jitter are within the use's allowance of the reference's (DYN_ACC_USES_LONG, each widened by the "
-        "measured noise), on the CPU and on the GPU apart. ftl's s is part of the setting: s < 1 converges to "
-        "another motion and adds energy (docs/model.md §3.7).",
+        "and, where the long runs measured its settings, whose tip frequency and mean kinetic energy are within "
+        "the use's allowance of the reference's and whose rest jitter is within the use's pixel budget "
+        "(DYN_ACC_USES_LONG, each widened by the measured noise), on the CPU and on the GPU apart. ftl's s is "
+        "part of the setting: s < 1 converges to another motion and adds energy (docs/model.md §3.7).",
         "",
+        *jitter_budget_lines(long),
         *recommend(summ, long),
         "",
     ]

@@ -4,8 +4,8 @@ Pure functions on numpy arrays (no scipy): the pendulum period (small amplitude 
 amplitude, K(m) by the arithmetic–geometric mean), the hanging chain's first mode (continuum
 ω1 and shape J0, and the linearised discrete chain of P−1 unit masses), the steady wind
 angle; and from a time series: zero crossings with linear interpolation, the period they
-give, the dominant frequency of a signal (FFT with zero padding and parabolic peak
-interpolation), the steady angle of a segment.
+give, the steady angle of a segment (a signal's dominant frequency is
+harness.check.observables.dominant_frequency).
 
 `read_series(path)` gives (time, positions [F][N][P][3]) of a state file (harness.io.trajectory).
 """
@@ -140,24 +140,6 @@ def period_from_crossings(t, y, periods=None):
     if len(c) < 3:
         return float("nan")
     return 2.0 * (c[-1] - c[0]) / (len(c) - 1)
-
-
-def dominant_frequency(t, y, pad=16):
-    """Angular frequency of the largest spectral peak of y (mean removed, Hann window, FFT
-    zero-padded `pad`×, the peak refined by a parabola through the log magnitudes of its
-    three bins). Needs uniform samples."""
-    t = np.asarray(t, dtype=np.float64)
-    y = np.asarray(y, dtype=np.float64)
-    dt = float(np.mean(np.diff(t)))
-    y = (y - y.mean()) * np.hanning(len(y))
-    n = pad * len(y)
-    mag = np.abs(np.fft.rfft(y, n))
-    k = int(np.argmax(mag[1:])) + 1
-    if 0 < k < len(mag) - 1:
-        a, b, c = np.log(mag[k - 1 : k + 2] + 1e-300)
-        den = a - 2 * b + c
-        k = k + (0.5 * (a - c) / den if den != 0 else 0.0)
-    return 2.0 * math.pi * k / (n * dt)
 
 
 def segment_angle(root, tip):

@@ -81,3 +81,40 @@ def test_a_budget_not_tighter_than_no_simulation_is_flagged():
 
 def games_line_of(summ):
     return next(ln for ln in rep.recommend(summ) if ln.startswith("- **games**"))
+
+
+def jitter_table(move_s09):
+    """observables.csv rows: the largest rest move (cm) of the reference and the two ftl settings."""
+    rows = [dict(study="reference", solver="xpbd", ftl_damping=math.nan, substeps=1024, iterations=1)]
+    rows += [dict(study="mode", solver="ftl", ftl_damping=s, substeps=4, iterations=1) for s in (0.9, 1.0)]
+    return pd.DataFrame(
+        [
+            dict(r, precision="fp32", metric="jitter_max_move", value=v, noise=0.0, reference=1e-4, ref_uncertainty=0)
+            for r, v in zip(rows, (1e-4, move_s09, 1e-4))
+        ]
+    )
+
+
+def test_the_rest_jitter_budget_is_a_fraction_of_a_pixel():
+    """games: 0.25 px at 1080 lines of a 40 cm picture is 0.0093 cm. A mode whose points jump
+    just over it is rejected on that alone and the next mode is picked; just under, it passes."""
+    budget = tolerances.jitter_budget_cm("games")
+    lb = tolerances.DYN_ACC_USES_LONG["games"]
+    assert budget == lb["jitter_px"] * tolerances.DYN_ACC_VIEW_CM / lb["lines"]
+    over = games_line(jitter_table(move_s09=1.1 * budget))
+    assert "**cpu ref ftl s=1 S4 I1 fp32**" in over
+    assert "decided by rest jitter" not in over  # RMS error rejects the two faster modes the pick beat
+    assert "Rest jitter rejects 1 of the 4 modes, 1 of them on that alone." in over
+    under = games_line(jitter_table(move_s09=0.9 * budget))
+    assert "**cpu ref ftl s=0.9 S4 I1 fp32**" in under
+    assert "Rest jitter rejects 0 of the 4 modes" in under
+
+
+def test_each_jitter_budget_is_checked_against_the_reference():
+    table = rep.jitter_budget_lines(jitter_table(move_s09=0.0))
+    rows = [ln for ln in table if ln.startswith("| previews") or ln.startswith("| offline")]
+    assert len(rows) == 2 and all(ln.endswith("| yes |") for ln in rows)
+    shaky = jitter_table(move_s09=0.0)
+    shaky.loc[0, "value"] = 2 * tolerances.jitter_budget_cm("offline")  # the reference itself moves more
+    offline = next(ln for ln in rep.jitter_budget_lines(shaky) if ln.startswith("| offline"))
+    assert offline.endswith("| **no** |")
