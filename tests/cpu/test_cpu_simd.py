@@ -402,11 +402,12 @@ def test_records_say_simd_and_its_flags(cpu_bin, tmp_path):
     assert s.params["variant"] == "simd" and s.params["flags"] == rec["flags"]
 
 
-def test_simd_object_calls_libmvec_and_no_scalar_math(cpu_bin):
-    """Every sin/cos/asin/atan2 of the simd file is a vector call (_ZGV…); a scalar call (or a
-    sincos, which GCC makes of a sin and a cos of one angle) would mean a loop was not
-    vectorised."""
-    obj = Path(cpu_bin).parent / "obj" / "model_simd.o"
+@pytest.mark.parametrize("name, isa", [("model_simd.o", "_ZGVd"), ("model_simd_v4.o", "_ZGVe")])
+def test_simd_object_calls_libmvec_and_no_scalar_math(cpu_bin, name, isa):
+    """Every sin/cos/asin/atan2 of the simd file is a vector call of its build's width
+    (_ZGVd…: AVX2, _ZGVe…: AVX-512); a scalar call (or a sincos, which GCC makes of a sin and
+    a cos of one angle) would mean a loop was not vectorised."""
+    obj = Path(cpu_bin).parent / "obj" / "simd" / name
     if platform.machine() != "x86_64":
         pytest.skip(f"simd test skipped: {NO_SIMD}")
     if not obj.exists():
@@ -421,10 +422,10 @@ def test_simd_object_calls_libmvec_and_no_scalar_math(cpu_bin):
     if "__asan_init" in called or any(c.startswith("__ubsan_") for c in called):
         pytest.skip("a sanitizer build (make sanitize): its instrumentation keeps the loops scalar")
     scalar = {"sinf", "cosf", "asinf", "atan2f", "sin", "cos", "asin", "atan2", "sincosf", "sincos"} & called
-    assert not scalar, f"scalar math calls left in model_simd.o: {sorted(scalar)}"
+    assert not scalar, f"scalar math calls left in {name}: {sorted(scalar)}"
     # fp32's sin and cos are c_ref/paper/fast_trig.h's inline polynomials (docs/cpu_simd.md)
     for f in ("asinf", "atan2f", "sin", "cos", "asin", "atan2"):
-        assert any(c.startswith("_ZGV") and c.endswith("_" + f) for c in called), f"no vector call to {f}"
+        assert any(c.startswith(isa) and c.endswith("_" + f) for c in called), f"no {isa} vector call to {f}"
 
 
 def test_refused_with_one_clear_line_without_avx2(cpu_bin, tmp_path):
