@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_cpu_simd import NO_SIMD, needs_simd
+from test_cpu_simd import ISAS, NO_SIMD, needs_simd
 
 from harness.check import diff_dynamic as dyndiff
 from harness.io.trajectory import open_trajectory
@@ -189,6 +189,18 @@ def test_one_frame_within_the_rule(cpu_bin, inputs, tmp_path, precision, solver,
     assert_one_frame_rule(
         cpu_bin, inp, tmp_path, f"{precision} {solver} {features}", ["--solver", solver, *FEATURES[features]]
     )
+
+
+@needs_simd
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+def test_each_build_within_the_rule(cpu_bin, inputs, tmp_path, monkeypatch, isa, precision, solver):
+    """Both builds (x86-64-v3 and -v4, forced), every feature: the suite's other tests run the
+    one this CPU picks."""
+    monkeypatch.setenv("HAIRBENCH_SIMD_ISA", isa)
+    inp = inputs(precision, 33)
+    assert_one_frame_rule(cpu_bin, inp, tmp_path, f"{isa} {precision} {solver}", ["--solver", solver, *ALL])
 
 
 @needs_simd
