@@ -160,7 +160,8 @@ static int simd_pick_isa(cpu_impl *c, char *err, size_t errlen)
         if (strcmp(want, "avx2") == 0) use_v4 = 0;
         else if (strcmp(want, "avx512") == 0) {
             if (!v4) {
-                snprintf(err, errlen, "HAIRBENCH_SIMD_ISA=avx512 needs an x86-64-v4 CPU (AVX-512) and this CPU lacks it");
+                snprintf(err, errlen,
+                         "HAIRBENCH_SIMD_ISA=avx512 needs an x86-64-v4 CPU (AVX-512) and this CPU lacks it");
                 return HB_EXIT_USAGE;
             }
             use_v4 = 1;
@@ -322,8 +323,7 @@ static int64_t simd_run_stage(cpu_impl *c, hb_stage st)
         const hb_model_f32 *m = &c->m32;
         if (st == HB_STAGE_INIT) {
 #pragma omp parallel for schedule(static)
-            for (int64_t b = 0; b < NB; b++)
-                c->sm->init_f32(m, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);
+            for (int64_t b = 0; b < NB; b++) c->sm->init_f32(m, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);
         } else if (st == HB_STAGE_WIND) {
 #pragma omp parallel for schedule(static)
             for (int64_t b = 0; b < NB; b++) c->sm->wind_f32(m, Y + b * B, Z + b * B, S);
@@ -339,8 +339,7 @@ static int64_t simd_run_stage(cpu_impl *c, hb_stage st)
         const hb_model_f64 *m = &c->m64;
         if (st == HB_STAGE_INIT) {
 #pragma omp parallel for schedule(static)
-            for (int64_t b = 0; b < NB; b++)
-                c->sm->init_f64(m, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);
+            for (int64_t b = 0; b < NB; b++) c->sm->init_f64(m, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);
         } else if (st == HB_STAGE_WIND) {
 #pragma omp parallel for schedule(static)
             for (int64_t b = 0; b < NB; b++) c->sm->wind_f64(m, Y + b * B, Z + b * B, S);
@@ -372,7 +371,7 @@ static int64_t simd_run_wind_collide(cpu_impl *c)
         for (int64_t b = 0; b < NB; b++) {
             const int real = (int)(N - b * B < B ? N - b * B : B);
             moved += c->sm->wind_collide_f32(&c->m32, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,
-                                                    WZ ? WZ + b * B : NULL, S);
+                                             WZ ? WZ + b * B : NULL, S);
         }
     } else {
         double *Y = c->pm[1], *Z = c->pm[2], *WY = c->keep ? c->pm_wind[0] : NULL, *WZ = c->keep ? c->pm_wind[1] : NULL;
@@ -380,7 +379,7 @@ static int64_t simd_run_wind_collide(cpu_impl *c)
         for (int64_t b = 0; b < NB; b++) {
             const int real = (int)(N - b * B < B ? N - b * B : B);
             moved += c->sm->wind_collide_f64(&c->m64, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,
-                                                    WZ ? WZ + b * B : NULL, S);
+                                             WZ ? WZ + b * B : NULL, S);
         }
     }
     return moved;
@@ -458,15 +457,15 @@ static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
         const T *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2], *BR = c->pb;                                           \
         _Pragma("omp parallel")                                                                                        \
         {                                                                                                              \
-            T *scratch = aligned_alloc(64, ((size_t)c->sd->scratch_reals(P) * sizeof(T) + 63) / 64 * 64);         \
+            T *scratch = aligned_alloc(64, ((size_t)c->sd->scratch_reals(P) * sizeof(T) + 63) / 64 * 64);              \
             if (!scratch) {                                                                                            \
                 _Pragma("omp atomic write") failed = 1;                                                                \
             } else {                                                                                                   \
                 _Pragma("omp for schedule(static)") for (int64_t b = 0; b < nb; b++)                                   \
                 {                                                                                                      \
                     const int64_t o = b * DB;                                                                          \
-                    c->sd->frame_##SFX(M, f, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, RY + o,   \
-                                                  RZ + o, BR + o, S, scratch);                                         \
+                    c->sd->frame_##SFX(M, f, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, RY + o, RZ + o,      \
+                                       BR + o, S, scratch);                                                            \
                 }                                                                                                      \
                 free(scratch);                                                                                         \
             }                                                                                                          \
@@ -511,11 +510,11 @@ static int simd_dyn_observe(cpu_impl *c, hb_observables *obs, char *err, size_t 
     for (int64_t ch = 0; ch < nchunks; ch++) {
         const int64_t i0 = ch * SIMD_OBS_CHUNK, i1 = i0 + SIMD_OBS_CHUNK < N ? i0 + SIMD_OBS_CHUNK : N;
         if (c->scene.precision == HB_FP32)
-            c->sd->observe_f32(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0,
-                                    i1 - i0, strand + i0);
+            c->sd->observe_f32(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0, i1 - i0,
+                               strand + i0);
         else
-            c->sd->observe_f64(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0,
-                                    i1 - i0, strand + i0);
+            c->sd->observe_f64(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0, i1 - i0,
+                               strand + i0);
         hb_obs_partial acc = {0, 0, 0, 0};
         for (int64_t i = i0; i < i1; i++) hb_dyn_reduce_into(&acc, &strand[i]);
         part[ch] = acc;

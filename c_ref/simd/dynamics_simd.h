@@ -73,13 +73,11 @@ void hb_simd_dyn_observe_f64(const hb_scene *s, const double *X, const double *Y
 typedef struct {
     int64_t (*scratch_reals)(int64_t);
     void (*bend_rest_f32)(const hb_dyn_model_f32 *, const float *, const float *, const float *, float *, int64_t);
-    void (*bend_rest_f64)(const hb_dyn_model_f64 *, const double *, const double *, const double *, double *,
-                          int64_t);
+    void (*bend_rest_f64)(const hb_dyn_model_f64 *, const double *, const double *, const double *, double *, int64_t);
     void (*frame_f32)(const hb_dyn_model_f32 *, const hb_dyn_frame *, float *, float *, float *, float *, float *,
                       float *, const float *, const float *, const float *, const float *, int64_t, float *);
-    void (*frame_f64)(const hb_dyn_model_f64 *, const hb_dyn_frame *, double *, double *, double *, double *,
-                      double *, double *, const double *, const double *, const double *, const double *, int64_t,
-                      double *);
+    void (*frame_f64)(const hb_dyn_model_f64 *, const hb_dyn_frame *, double *, double *, double *, double *, double *,
+                      double *, const double *, const double *, const double *, const double *, int64_t, double *);
     void (*observe_f32)(const hb_scene *, const float *, const float *, const float *, const float *, const float *,
                         const float *, int64_t, int64_t, int64_t, hb_obs_partial *);
     void (*observe_f64)(const hb_scene *, const double *, const double *, const double *, const double *,
