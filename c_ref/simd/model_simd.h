@@ -46,6 +46,12 @@ extern "C" {
 #define HB_SIMD_CHUNK 64
 #endif
 
+/* The fused wind+collide pass requests the block's rows this many points ahead into the
+ * cache (0: none; docs/cpu_simd.md). Overridable with -D; it changes no bit. */
+#ifndef HB_SIMD_PREFETCH_ROWS
+#define HB_SIMD_PREFETCH_ROWS 2
+#endif
+
 /* init: roots (strands first … first + block − 1) and drape; writes X, Y, Z. */
 void hb_simd_init_block_f32(const hb_model_f32 *m, uint64_t first, float *X, float *Y, float *Z, int64_t stride);
 void hb_simd_init_block_f64(const hb_model_f64 *m, uint64_t first, double *X, double *Y, double *Z, int64_t stride);
