@@ -10,7 +10,7 @@
  * vector sine (≤ 4 ulp), declared here with the attribute glibc's <math.h> gives it only
  * under -ffast-math (model_simd.c explains why).
  *
- * Check: objdump -dr build/obj/dynamics_simd.o | grep _ZGV lists the vector sines.
+ * Check: objdump -dr build/obj/simd/dynamics_simd.o | grep _ZGV lists the vector sines.
  */
 #include "simd/dynamics_simd.h"
 

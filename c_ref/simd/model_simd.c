@@ -26,7 +26,7 @@
  *    which has no vector variant it can use, and the loop is then not vectorised at all
  *    (with or without -ffast-math): model_simd_impl.h puts them in two loops.
  *
- * Check that the calls are vectorised: objdump -dr build/obj/model_simd.o | grep _ZGV
+ * Check that the calls are vectorised: objdump -dr build/obj/simd/model_simd.o | grep _ZGV
  * (tests/cpu/test_cpu_simd.py fails on any scalar call to these functions).
  */
 #include "simd/model_simd.h"
