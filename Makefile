@@ -48,7 +48,11 @@ CFLAGS_REF := $(CSTD) $(COPT) -ffp-contract=off -fno-fast-math $(CWARN)
 # The simd variant's file only (docs/cpu_simd.md): AVX2 code checked for at run time, glibc's
 # vector math, and of -ffast-math's flags only the two that change no value.
 SIMD_CFLAGS := -O3 -march=x86-64-v3 -fopenmp-simd -fno-math-errno -fno-trapping-math
+# ... and built a second time (c_ref/simd/*_v4.c) for x86-64-v4 with 512-bit vectors, picked at
+# run time on a CPU with AVX-512; the record's flags name the build that ran.
+SIMD_V4_CFLAGS := -O3 -march=x86-64-v4 -mprefer-vector-width=512 -fopenmp-simd -fno-math-errno -fno-trapping-math
 CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (c_ref/simd/) adds: $(SIMD_CFLAGS)
+CPU_FLAGS_STR_V4 := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (c_ref/simd/, x86-64-v4 build) adds: $(SIMD_V4_CFLAGS)
 
 # c_ref/: runtime/ (the host runtime both binaries link: command line, driver, HDF5 and JSON
 # output), paper/ and dynamic/ (the two models' reference), simd/ (the CPU simd variant), and
@@ -114,9 +118,14 @@ check-python: setup
 
 $(OBJ)/%.o: c_ref/%.c $(C_HEADERS) | check-hdf5
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_REF) -fopenmp -Ic_ref $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' -DHB_FLAGS='"$(CPU_FLAGS_STR)"' -c $< -o $@
+	$(CC) $(CFLAGS_REF) -fopenmp -Ic_ref $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' -DHB_FLAGS='"$(CPU_FLAGS_STR)"' \
+	  -DHB_FLAGS_SIMD_V4='"$(CPU_FLAGS_STR_V4)"' -c $< -o $@
 
 $(OBJ)/simd/%.o: CFLAGS_REF += $(SIMD_CFLAGS)
+# the x86-64-v4 build: the v3 file's source under other flags (the later -march wins)
+$(OBJ)/simd/%_v4.o: CFLAGS_REF += $(SIMD_V4_CFLAGS)
+$(OBJ)/simd/model_simd_v4.o: c_ref/simd/model_simd.c
+$(OBJ)/simd/dynamics_simd_v4.o: c_ref/simd/dynamics_simd.c
 $(OBJ)/runtime/record.o: $(REV_STAMP)
 
 $(BUILD)/hairsim-cpu: $(SHARED_OBJ) $(CPU_OBJ)

@@ -37,6 +37,8 @@ typedef struct {
     /* simd: X, Y, Z as [P][stride] each (point k of strand i at k·stride + i), the strands
      * in blocks of `block`, the last block padded; `pm_saved` for repeats */
     int simd;
+    const hb_simd_model_fns *sm; /* the build of model_simd.c and dynamics_simd.c picked at setup */
+    const hb_simd_dyn_fns *sd;
     int64_t block, nblocks, stride;
     void *pm[3], *pm_saved[3];
     /* simd: a wind followed by collide runs as one pass (consumed 2); with `keep` (a file
@@ -81,7 +83,11 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     hb_model_round(&o->scene, &c->m32, &c->m64);
     if (o->threads > 0) omp_set_num_threads(o->threads);
     b->threads = omp_get_max_threads();
-    if (o->variant && strcmp(o->variant, "simd") == 0) return simd_setup(c, o, need_save, driver_bytes, err, errlen);
+    if (o->variant && strcmp(o->variant, "simd") == 0) {
+        const int status = simd_setup(c, o, need_save, driver_bytes, err, errlen);
+        if (c->sm == &hb_simd_model_v4) b->flags = HB_FLAGS_SIMD_V4; /* the record names the build that runs */
+        return status;
+    }
 
     for (int i = 0; i < o->n_stages; i++) c->dynamic |= o->stages[i] == HB_STAGE_SIMULATE;
     /* simulate adds velocities, the rest shape, bend rest lengths and a saved velocity copy */
@@ -139,6 +145,36 @@ static int simd_cpu_ok(void)
     return __builtin_cpu_supports("x86-64-v3") && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 }
 
+/* Which build of the simd files runs (docs/cpu_simd.md, "Two builds"): the x86-64-v4 one
+ * where the CPU has it (AVX-512 F, VL, BW, DQ, CD), else the x86-64-v3 one.
+ * HAIRBENCH_SIMD_ISA=avx2 or =avx512 asks for one (avx512 is refused on a CPU without it);
+ * any other value is refused. Returns 0, or an exit status with err set. */
+static int simd_pick_isa(cpu_impl *c, char *err, size_t errlen)
+{
+    const char *want = getenv("HAIRBENCH_SIMD_ISA");
+    const int v4 = __builtin_cpu_supports("x86-64-v4") && __builtin_cpu_supports("avx512f") &&
+                   __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") &&
+                   __builtin_cpu_supports("avx512dq");
+    int use_v4 = v4;
+    if (want && *want) {
+        if (strcmp(want, "avx2") == 0) use_v4 = 0;
+        else if (strcmp(want, "avx512") == 0) {
+            if (!v4) {
+                snprintf(err, errlen,
+                         "HAIRBENCH_SIMD_ISA=avx512 needs an x86-64-v4 CPU (AVX-512) and this CPU lacks it");
+                return HB_EXIT_USAGE;
+            }
+            use_v4 = 1;
+        } else {
+            snprintf(err, errlen, "HAIRBENCH_SIMD_ISA must be avx2 or avx512 (got '%s')", want);
+            return HB_EXIT_USAGE;
+        }
+    }
+    c->sm = use_v4 ? &hb_simd_model_v4 : &hb_simd_model_v3;
+    c->sd = use_v4 ? &hb_simd_dyn_v4 : &hb_simd_dyn_v3;
+    return HB_EXIT_OK;
+}
+
 /* An array for the point-major state: 2 MiB aligned and advised as huge pages where it is
  * that large (each block touches P rows, i.e. P pages, per stage), not yet touched. */
 static void *pm_alloc(size_t bytes)
@@ -193,6 +229,8 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
                  "use --variant ref");
         return HB_EXIT_USAGE;
     }
+    const int isa_status = simd_pick_isa(c, err, errlen);
+    if (isa_status != HB_EXIT_OK) return isa_status;
     if (s->dyn.guided) { /* docs/cpu_simd.md: not in the simd variant yet */
         snprintf(err, errlen, "--variant simd does not run --guides; use --variant ref");
         return HB_EXIT_USAGE;
@@ -285,16 +323,15 @@ static int64_t simd_run_stage(cpu_impl *c, hb_stage st)
         const hb_model_f32 *m = &c->m32;
         if (st == HB_STAGE_INIT) {
 #pragma omp parallel for schedule(static)
-            for (int64_t b = 0; b < NB; b++)
-                hb_simd_init_block_f32(m, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);
+            for (int64_t b = 0; b < NB; b++) c->sm->init_f32(m, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);
         } else if (st == HB_STAGE_WIND) {
 #pragma omp parallel for schedule(static)
-            for (int64_t b = 0; b < NB; b++) hb_simd_wind_block_f32(m, Y + b * B, Z + b * B, S);
+            for (int64_t b = 0; b < NB; b++) c->sm->wind_f32(m, Y + b * B, Z + b * B, S);
         } else {
 #pragma omp parallel for schedule(static) reduction(+ : moved)
             for (int64_t b = 0; b < NB; b++) {
                 const int real = (int)(N - b * B < B ? N - b * B : B); /* strands of the block */
-                moved += hb_simd_collide_block_f32(m, real, Y + b * B, Z + b * B, S);
+                moved += c->sm->collide_f32(m, real, Y + b * B, Z + b * B, S);
             }
         }
     } else {
@@ -302,16 +339,15 @@ static int64_t simd_run_stage(cpu_impl *c, hb_stage st)
         const hb_model_f64 *m = &c->m64;
         if (st == HB_STAGE_INIT) {
 #pragma omp parallel for schedule(static)
-            for (int64_t b = 0; b < NB; b++)
-                hb_simd_init_block_f64(m, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);
+            for (int64_t b = 0; b < NB; b++) c->sm->init_f64(m, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);
         } else if (st == HB_STAGE_WIND) {
 #pragma omp parallel for schedule(static)
-            for (int64_t b = 0; b < NB; b++) hb_simd_wind_block_f64(m, Y + b * B, Z + b * B, S);
+            for (int64_t b = 0; b < NB; b++) c->sm->wind_f64(m, Y + b * B, Z + b * B, S);
         } else {
 #pragma omp parallel for schedule(static) reduction(+ : moved)
             for (int64_t b = 0; b < NB; b++) {
                 const int real = (int)(N - b * B < B ? N - b * B : B); /* strands of the block */
-                moved += hb_simd_collide_block_f64(m, real, Y + b * B, Z + b * B, S);
+                moved += c->sm->collide_f64(m, real, Y + b * B, Z + b * B, S);
             }
         }
     }
@@ -334,16 +370,16 @@ static int64_t simd_run_wind_collide(cpu_impl *c)
 #pragma omp parallel for schedule(static) reduction(+ : moved)
         for (int64_t b = 0; b < NB; b++) {
             const int real = (int)(N - b * B < B ? N - b * B : B);
-            moved += hb_simd_wind_collide_block_f32(&c->m32, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,
-                                                    WZ ? WZ + b * B : NULL, S);
+            moved += c->sm->wind_collide_f32(&c->m32, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,
+                                             WZ ? WZ + b * B : NULL, S);
         }
     } else {
         double *Y = c->pm[1], *Z = c->pm[2], *WY = c->keep ? c->pm_wind[0] : NULL, *WZ = c->keep ? c->pm_wind[1] : NULL;
 #pragma omp parallel for schedule(static) reduction(+ : moved)
         for (int64_t b = 0; b < NB; b++) {
             const int real = (int)(N - b * B < B ? N - b * B : B);
-            moved += hb_simd_wind_collide_block_f64(&c->m64, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,
-                                                    WZ ? WZ + b * B : NULL, S);
+            moved += c->sm->wind_collide_f64(&c->m64, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,
+                                             WZ ? WZ + b * B : NULL, S);
         }
     }
     return moved;
@@ -395,13 +431,13 @@ static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
         float *BR = c->pb;
 #pragma omp parallel for schedule(static)
         for (int64_t b = 0; b < nb; b++)
-            hb_simd_dyn_bend_rest_block_f32(&c->d32, RX + b * DB, RY + b * DB, RZ + b * DB, BR + b * DB, S);
+            c->sd->bend_rest_f32(&c->d32, RX + b * DB, RY + b * DB, RZ + b * DB, BR + b * DB, S);
     } else {
         const double *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2];
         double *BR = c->pb;
 #pragma omp parallel for schedule(static)
         for (int64_t b = 0; b < nb; b++)
-            hb_simd_dyn_bend_rest_block_f64(&c->d64, RX + b * DB, RY + b * DB, RZ + b * DB, BR + b * DB, S);
+            c->sd->bend_rest_f64(&c->d64, RX + b * DB, RY + b * DB, RZ + b * DB, BR + b * DB, S);
     }
     if (c->scene.dyn.sag_free) { /* §3.14: the frame's rest rows become the raised targets */
         void *targets = malloc(hb_state_bytes(&c->scene));
@@ -421,15 +457,15 @@ static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
         const T *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2], *BR = c->pb;                                           \
         _Pragma("omp parallel")                                                                                        \
         {                                                                                                              \
-            T *scratch = aligned_alloc(64, ((size_t)hb_simd_dyn_scratch_reals(P) * sizeof(T) + 63) / 64 * 64);         \
+            T *scratch = aligned_alloc(64, ((size_t)c->sd->scratch_reals(P) * sizeof(T) + 63) / 64 * 64);              \
             if (!scratch) {                                                                                            \
                 _Pragma("omp atomic write") failed = 1;                                                                \
             } else {                                                                                                   \
                 _Pragma("omp for schedule(static)") for (int64_t b = 0; b < nb; b++)                                   \
                 {                                                                                                      \
                     const int64_t o = b * DB;                                                                          \
-                    hb_simd_dyn_frame_block_##SFX(M, f, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, RY + o,   \
-                                                  RZ + o, BR + o, S, scratch);                                         \
+                    c->sd->frame_##SFX(M, f, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, RY + o, RZ + o,      \
+                                       BR + o, S, scratch);                                                            \
                 }                                                                                                      \
                 free(scratch);                                                                                         \
             }                                                                                                          \
@@ -474,11 +510,11 @@ static int simd_dyn_observe(cpu_impl *c, hb_observables *obs, char *err, size_t 
     for (int64_t ch = 0; ch < nchunks; ch++) {
         const int64_t i0 = ch * SIMD_OBS_CHUNK, i1 = i0 + SIMD_OBS_CHUNK < N ? i0 + SIMD_OBS_CHUNK : N;
         if (c->scene.precision == HB_FP32)
-            hb_simd_dyn_observe_f32(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0,
-                                    i1 - i0, strand + i0);
+            c->sd->observe_f32(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0, i1 - i0,
+                               strand + i0);
         else
-            hb_simd_dyn_observe_f64(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0,
-                                    i1 - i0, strand + i0);
+            c->sd->observe_f64(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0, i1 - i0,
+                               strand + i0);
         hb_obs_partial acc = {0, 0, 0, 0};
         for (int64_t i = i0; i < i1; i++) hb_dyn_reduce_into(&acc, &strand[i]);
         part[ch] = acc;
@@ -882,12 +918,17 @@ static const hb_variant cpu_variants[] = {
      "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands", 0, 0,
      (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL) | (1u << HB_SOLVER_RIGID)},
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
-     "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks", 0, 0, 0},
+     "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks; built for x86-64-v3 and "
+     "x86-64-v4, the CPU's widest runs (the record's flags say which)",
+     0, 0, 0},
     {NULL, 0, NULL, 0, 0, 0},
 };
 
 #ifndef HB_FLAGS
 #define HB_FLAGS "unknown"
+#endif
+#ifndef HB_FLAGS_SIMD_V4
+#define HB_FLAGS_SIMD_V4 HB_FLAGS
 #endif
 
 int main(int argc, char **argv)

@@ -532,6 +532,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
         return die(status, err);
     }
     b->describe(b, rec.device, sizeof rec.device, rec.driver, sizeof rec.driver);
+    rec.flags = b->flags; /* setup may name the build that runs (cpu simd: x86-64-v3 or -v4) */
     rec.threads = b->threads;
     rec.block_size = b->block_size;
     if (need_host && !(run.host = malloc(bytes))) {

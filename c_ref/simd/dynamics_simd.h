@@ -12,8 +12,8 @@
  * The model is dynamics_impl.h's, its branches turned into selects; the arithmetic is free
  * (reciprocal square roots, reciprocals of the constant denominators; docs/cpu_simd.md), so
  * the result is judged against the `ref` variant by the one-frame rule, not bit for bit.
- * dynamics_simd.c is compiled for x86-64-v3: call these only after the CPU check of
- * backend_cpu.c.
+ * dynamics_simd.c is compiled for x86-64-v3 and dynamics_simd_v4.c for x86-64-v4: call
+ * them only after the CPU check of backend_cpu.c.
  */
 #ifndef HB_DYNAMICS_SIMD_H
 #define HB_DYNAMICS_SIMD_H
@@ -67,6 +67,23 @@ void hb_simd_dyn_observe_f32(const hb_scene *s, const float *X, const float *Y, 
 void hb_simd_dyn_observe_f64(const hb_scene *s, const double *X, const double *Y, const double *Z, const double *VX,
                              const double *VY, const double *VZ, int64_t stride, int64_t first, int64_t count,
                              hb_obs_partial *out);
+
+/* The functions above as one table, built twice as model_simd.h's (hb_simd_dyn_v3 from
+ * dynamics_simd.c, hb_simd_dyn_v4 from dynamics_simd_v4.c). */
+typedef struct {
+    int64_t (*scratch_reals)(int64_t);
+    void (*bend_rest_f32)(const hb_dyn_model_f32 *, const float *, const float *, const float *, float *, int64_t);
+    void (*bend_rest_f64)(const hb_dyn_model_f64 *, const double *, const double *, const double *, double *, int64_t);
+    void (*frame_f32)(const hb_dyn_model_f32 *, const hb_dyn_frame *, float *, float *, float *, float *, float *,
+                      float *, const float *, const float *, const float *, const float *, int64_t, float *);
+    void (*frame_f64)(const hb_dyn_model_f64 *, const hb_dyn_frame *, double *, double *, double *, double *, double *,
+                      double *, const double *, const double *, const double *, const double *, int64_t, double *);
+    void (*observe_f32)(const hb_scene *, const float *, const float *, const float *, const float *, const float *,
+                        const float *, int64_t, int64_t, int64_t, hb_obs_partial *);
+    void (*observe_f64)(const hb_scene *, const double *, const double *, const double *, const double *,
+                        const double *, const double *, int64_t, int64_t, int64_t, hb_obs_partial *);
+} hb_simd_dyn_fns;
+extern const hb_simd_dyn_fns hb_simd_dyn_v3, hb_simd_dyn_v4;
 
 #ifdef __cplusplus
 }

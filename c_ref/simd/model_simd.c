@@ -26,7 +26,7 @@
  *    which has no vector variant it can use, and the loop is then not vectorised at all
  *    (with or without -ffast-math): model_simd_impl.h puts them in two loops.
  *
- * Check that the calls are vectorised: objdump -dr build/obj/model_simd.o | grep _ZGV
+ * Check that the calls are vectorised: objdump -dr build/obj/simd/model_simd.o | grep _ZGV
  * (tests/cpu/test_cpu_simd.py fails on any scalar call to these functions).
  */
 #include "simd/model_simd.h"
@@ -79,3 +79,22 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #define BLOCK HB_SIMD_BLOCK_F64
 #define FAST_TRIG 0
 #include "simd/model_simd_impl.h"
+#include "paper/precision_end.h"
+#undef ITYPE
+#undef BLOCK
+#undef FAST_TRIG
+
+#ifndef HB_SIMD_MODEL_FNS
+#define HB_SIMD_MODEL_FNS hb_simd_model_v3
+#endif
+const hb_simd_model_fns HB_SIMD_MODEL_FNS = {
+    hb_simd_isa,
+    hb_simd_init_block_f32,
+    hb_simd_init_block_f64,
+    hb_simd_wind_block_f32,
+    hb_simd_wind_block_f64,
+    hb_simd_collide_block_f32,
+    hb_simd_collide_block_f64,
+    hb_simd_wind_collide_block_f32,
+    hb_simd_wind_collide_block_f64,
+};

@@ -13,8 +13,9 @@
  * better-conditioned evaluations of docs/model.md §2.3, §2.5), with its branches turned into
  * selects, in the free arithmetic of model_simd_impl.h (fewer operations, judged by
  * tolerance); sin/cos/asin/atan2 are glibc's libmvec vector functions or, for the fp32
- * drape, c_ref/paper/fast_trig.h's. model_simd.c is compiled for x86-64-v3 (AVX2 + FMA): call these only after
- * hb_simd_cpu_ok() in a file compiled for the baseline ISA (backend_cpu.c does).
+ * drape, c_ref/paper/fast_trig.h's. model_simd.c is compiled for x86-64-v3 (AVX2 + FMA) and
+ * model_simd_v4.c for x86-64-v4: call them only after backend_cpu.c's CPU check (a file
+ * compiled for the baseline ISA).
  */
 #ifndef HB_MODEL_SIMD_H
 #define HB_MODEL_SIMD_H
@@ -45,6 +46,12 @@ extern "C" {
 #define HB_SIMD_CHUNK 64
 #endif
 
+/* The fused wind+collide pass requests the block's rows this many points ahead into the
+ * cache (0: none; docs/cpu_simd.md). Overridable with -D; it changes no bit. */
+#ifndef HB_SIMD_PREFETCH_ROWS
+#define HB_SIMD_PREFETCH_ROWS 2
+#endif
+
 /* init: roots (strands first … first + block − 1) and drape; writes X, Y, Z. */
 void hb_simd_init_block_f32(const hb_model_f32 *m, uint64_t first, float *X, float *Y, float *Z, int64_t stride);
 void hb_simd_init_block_f64(const hb_model_f64 *m, uint64_t first, double *X, double *Y, double *Z, int64_t stride);
@@ -68,6 +75,23 @@ int64_t hb_simd_wind_collide_block_f64(const hb_model_f64 *m, int real, double *
 
 /* The ISA model_simd.c is compiled for, as the compiler saw it (for messages). */
 extern const char hb_simd_isa[];
+
+/* The functions above as one table. model_simd.c is built twice (docs/cpu_simd.md, "Two
+ * builds"): for x86-64-v3 (hb_simd_model_v3) and, as model_simd_v4.c, for x86-64-v4 with
+ * 512-bit vectors (hb_simd_model_v4, its exported names ending in _v4). backend_cpu.c picks
+ * one at setup from what the CPU supports and calls it through the table. */
+typedef struct {
+    const char *isa;
+    void (*init_f32)(const hb_model_f32 *, uint64_t, float *, float *, float *, int64_t);
+    void (*init_f64)(const hb_model_f64 *, uint64_t, double *, double *, double *, int64_t);
+    void (*wind_f32)(const hb_model_f32 *, float *, float *, int64_t);
+    void (*wind_f64)(const hb_model_f64 *, double *, double *, int64_t);
+    int64_t (*collide_f32)(const hb_model_f32 *, int, float *, float *, int64_t);
+    int64_t (*collide_f64)(const hb_model_f64 *, int, double *, double *, int64_t);
+    int64_t (*wind_collide_f32)(const hb_model_f32 *, int, float *, float *, float *, float *, int64_t);
+    int64_t (*wind_collide_f64)(const hb_model_f64 *, int, double *, double *, double *, double *, int64_t);
+} hb_simd_model_fns;
+extern const hb_simd_model_fns hb_simd_model_v3, hb_simd_model_v4;
 
 #ifdef __cplusplus
 }

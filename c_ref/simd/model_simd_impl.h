@@ -434,6 +434,17 @@ int64_t SFX(hb_simd_collide_block)(const MODEL *m, int real, REAL *Y, REAL *Z, i
     return SFX(hb_collide_total)(&cs, real);
 }
 
+/* The block's row k of Y and Z requested into the cache, for writing: a block reads 2·P
+ * rows `stride` reals apart, more separate streams than a hardware prefetcher tracks. */
+static inline void SFX(hb_prefetch_row)(const REAL *Y, const REAL *Z, int64_t k, int64_t stride)
+{
+    const REAL *y = ROW(Y, k), *z = ROW(Z, k);
+    for (int j = 0; j < BLOCK; j += 64 / (int)sizeof(REAL)) {
+        __builtin_prefetch(y + j, 1, 3);
+        __builtin_prefetch(z + j, 1, 3);
+    }
+}
+
 /* ---- wind then collide in one pass (the CUDA fused variant's pair) -------------------- */
 /* Each point is read once and written once: wound into the lanes' wind state, then
  * collided from there with exactly the operations of the two passes above, so the result
@@ -452,8 +463,10 @@ int64_t SFX(hb_simd_wind_collide_block)(const MODEL *m, int real, REAL *Y, REAL 
             WZ[j] = Z[j];
         }
     }
+    for (int64_t k = 1; k < P && k <= HB_SIMD_PREFETCH_ROWS; k++) SFX(hb_prefetch_row)(Y, Z, k, stride);
     for (int64_t k = 1; k < P; k++) {
         const REAL t = (REAL)k * w_per_point;
+        if (k + HB_SIMD_PREFETCH_ROWS < P) SFX(hb_prefetch_row)(Y, Z, k + HB_SIMD_PREFETCH_ROWS, stride);
         if (WY) SFX(hb_wind_point)(&ws, m, t, ROW(Y, k), ROW(Z, k), ROW(WY, k), ROW(WZ, k));
         else SFX(hb_wind_point)(&ws, m, t, ROW(Y, k), ROW(Z, k), ws.ny, ws.nz);
         SFX(hb_collide_point)(&cs, m, ws.ny, ws.nz, ROW(Y, k), ROW(Z, k), 1);

@@ -174,14 +174,15 @@ NAMED_PAIRS = {
         point_k=4.0,
         max_over_fraction=0.0,
         name="simd",
-        why="measured ≤ 1.69·u (simd vs ref, free arithmetic, P = 2, wind; P ≥ 16 ≤ 0.18·u; docs/cpu_simd.md); "
+        why="measured ≤ 1.69·u (simd vs ref, free arithmetic, P = 2, wind; P ≥ 16 ≤ 0.18·u; the same in the "
+        "x86-64-v3 and -v4 builds; docs/cpu_simd.md); "
         "4 = margin 2.4×; same roots and decisions, so no point may be over",
     ),
     ("simd", "fp64"): PairTolerance(
         point_k=4.0,
         max_over_fraction=0.0,
         name="simd",
-        why="measured ≤ 1.16·u (simd vs ref, free arithmetic, P = 2; docs/cpu_simd.md); 4 = margin 3.4×",
+        why="measured ≤ 1.16·u (simd vs ref, free arithmetic, P = 2; both builds; docs/cpu_simd.md); 4 = margin 3.4×",
     ),
     # cuda-strict vs c_ref, same precision: differs only where CUDA's sinf/cosf/asinf/atan2f
     # differ from glibc's; the precision pair's rule (docs/cuda.md, docs/harness.md).

@@ -40,27 +40,43 @@ PAPER = ["init", "collide", "wind", "collide"]
 V3_FLAGS = ("avx", "avx2", "fma", "bmi1", "bmi2", "f16c", "movbe", "abm")
 
 
-def _no_simd_reason():
-    """None where this machine can run the simd variant, else why not."""
-    if platform.machine() not in ("x86_64", "AMD64"):
-        return f"the simd variant is built for x86_64 only (this is {platform.machine()})"
+# x86-64-v4 adds these (the simd variant's second build, docs/cpu_simd.md "Two builds")
+V4_FLAGS = ("avx512f", "avx512vl", "avx512bw", "avx512dq", "avx512cd")
+
+
+def _cpu_flags():
+    """The CPU's flags as /proc/cpuinfo names them, or the reason they cannot be read."""
     try:
         text = Path("/proc/cpuinfo").read_text()
     except OSError as e:
         return f"cannot read /proc/cpuinfo ({e})"
-    flags = set()
     for line in text.splitlines():
         if line.startswith("flags"):
-            flags = set(line.split(":", 1)[1].split())
-            break
-    missing = [f for f in V3_FLAGS if f not in flags]
+            return set(line.split(":", 1)[1].split())
+    return set()
+
+
+def _no_simd_reason(wanted=V3_FLAGS, level="x86-64-v3", what="hairsim-cpu refuses --variant simd"):
+    """None where this machine can run the simd variant (its `level` build), else why not."""
+    if platform.machine() not in ("x86_64", "AMD64"):
+        return f"the simd variant is built for x86_64 only (this is {platform.machine()})"
+    flags = _cpu_flags()
+    if isinstance(flags, str):
+        return flags
+    missing = [f for f in wanted if f not in flags]
     if missing:
-        return f"this CPU lacks {', '.join(missing)} (x86-64-v3), so hairsim-cpu refuses --variant simd"
+        return f"this CPU lacks {', '.join(missing)} ({level}), so {what}"
     return None
 
 
 NO_SIMD = _no_simd_reason()
 needs_simd = pytest.mark.skipif(NO_SIMD is not None, reason=f"simd test skipped: {NO_SIMD}")
+NO_V4 = NO_SIMD or _no_simd_reason(V3_FLAGS + V4_FLAGS, "x86-64-v4", "the simd variant's AVX-512 build cannot run")
+# the two builds, forced through HAIRBENCH_SIMD_ISA (without it the CPU's widest runs)
+ISAS = [
+    pytest.param("avx2", id="avx2"),
+    pytest.param("avx512", id="avx512", marks=pytest.mark.skipif(NO_V4 is not None, reason=f"{NO_V4}")),
+]
 
 
 def assert_close(ref_path, simd_path, precision, frames, what):
@@ -110,6 +126,47 @@ def test_whole_run_matches_ref_and_keeps_the_invariants(cpu_bin, tmp_path, preci
     for f in range(len(PAPER)):
         if PAPER[f] == "collide":  # the count covers the real strands only, not the padding
             assert b.moved[f] == moved_from_frames(b.frames[f - 1], b.frames[f])
+
+
+@needs_simd
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("points", [3, 33])
+def test_each_build_matches_ref(cpu_bin, tmp_path, monkeypatch, isa, precision, points):
+    """Both builds (x86-64-v3 and -v4, forced) pass the same rule against ref; the suite's other
+    tests run the one this CPU picks."""
+    monkeypatch.setenv("HAIRBENCH_SIMD_ISA", isa)
+    ref, simd = tmp_path / "ref.h5", tmp_path / "simd.h5"
+    args = scene(points, 7, precision, strands=1100)
+    run(cpu_bin, *args, "--variant", "ref", "--output", ref, "--quiet")
+    rec = run_json(cpu_bin, *args, "--variant", "simd", "--output", simd)
+    assert ("-march=x86-64-v4" in rec["flags"]) == (isa == "avx512"), rec["flags"]
+    b = State(simd)
+    assert_invariants(b)
+    assert np.array_equal(b.frames[..., 0], State(ref).frames[..., 0])
+    assert_close(ref, simd, precision, "all", f"{isa} P={points}")
+    for f in range(len(PAPER)):
+        if PAPER[f] == "collide":
+            assert b.moved[f] == moved_from_frames(b.frames[f - 1], b.frames[f])
+
+
+@needs_simd
+@pytest.mark.parametrize("value", ["sse2", "AVX2", "avx512 "])
+def test_an_unknown_isa_request_is_refused(cpu_bin, tmp_path, monkeypatch, value):
+    monkeypatch.setenv("HAIRBENCH_SIMD_ISA", value)
+    out = tmp_path / "s.h5"
+    p = run(cpu_bin, "--strands", 10, "--points", 8, "--variant", "simd", "--output", out, check=False)
+    lines = p.stderr.strip().splitlines()
+    assert p.returncode == 2 and len(lines) == 1 and "HAIRBENCH_SIMD_ISA must be avx2 or avx512" in lines[0]
+    assert not out.exists() and tmp_leftovers(tmp_path) == []
+
+
+@needs_simd
+@pytest.mark.skipif(NO_V4 is None, reason="this CPU has AVX-512: the refusal of avx512 cannot happen here")
+def test_avx512_request_refused_without_it(cpu_bin, monkeypatch):
+    monkeypatch.setenv("HAIRBENCH_SIMD_ISA", "avx512")
+    p = run(cpu_bin, "--strands", 10, "--points", 8, "--variant", "simd", check=False)
+    assert p.returncode == 2 and "needs an x86-64-v4 CPU (AVX-512)" in p.stderr
 
 
 @needs_simd
@@ -325,10 +382,13 @@ def test_resume_gives_the_same_bits_as_one_run(cpu_bin, tmp_path):
 
 
 @needs_simd
+@pytest.mark.parametrize("isa", ISAS)
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
-def test_fused_wind_collide_is_the_two_stages_bit_for_bit(cpu_bin, tmp_path, precision):
+def test_fused_wind_collide_is_the_two_stages_bit_for_bit(cpu_bin, tmp_path, monkeypatch, isa, precision):
     """A wind followed by collide runs as one pass (the record says so); its two frames and
-    moved count are those of the stages run apart (a wind that ends the run is not fused)."""
+    moved count are those of the stages run apart (a wind that ends the run is not fused),
+    in either build."""
+    monkeypatch.setenv("HAIRBENCH_SIMD_ISA", isa)
     args = ["--strands", 1100, "--points", 24, "--hair-length", 10, "--precision", precision, "--variant", "simd"]
     fused, apart, rest = tmp_path / "fused.h5", tmp_path / "apart.h5", tmp_path / "rest.h5"
     rec = run_json(cpu_bin, *args, "--output", fused)
@@ -376,7 +436,10 @@ def test_wind_zero_is_not_run_and_changes_nothing(cpu_bin, tmp_path):
 
 
 @needs_simd
-def test_records_say_simd_and_its_flags(cpu_bin, tmp_path):
+@pytest.mark.parametrize("isa", ISAS)
+def test_records_say_simd_and_its_flags(cpu_bin, tmp_path, monkeypatch, isa):
+    """The flags of the record and of the file name the build that ran."""
+    monkeypatch.setenv("HAIRBENCH_SIMD_ISA", isa)
     out = tmp_path / "s.h5"
     rec = run_json(
         cpu_bin,
@@ -394,19 +457,23 @@ def test_records_say_simd_and_its_flags(cpu_bin, tmp_path):
         out,
     )
     assert rec["backend"] == "cpu" and rec["variant"] == "simd"
-    for flag in ("-ffp-contract=off", "-march=x86-64-v3", "-fno-math-errno", "-fno-trapping-math"):
+    march = {"avx2": "-march=x86-64-v3", "avx512": "-march=x86-64-v4 -mprefer-vector-width=512"}[isa]
+    for flag in ("-ffp-contract=off", march, "-fno-math-errno", "-fno-trapping-math"):
         assert flag in rec["flags"], flag
+    other = {"avx2": "-march=x86-64-v4", "avx512": "-march=x86-64-v3"}[isa]
+    assert other not in rec["flags"]
     assert "-ffast-math" not in rec["flags"]
     assert all(len(s["times_ms"]) == 2 for s in rec["stages"] if s["fused"] != "into-previous")
     s = State(out)
     assert s.params["variant"] == "simd" and s.params["flags"] == rec["flags"]
 
 
-def test_simd_object_calls_libmvec_and_no_scalar_math(cpu_bin):
-    """Every sin/cos/asin/atan2 of the simd file is a vector call (_ZGV…); a scalar call (or a
-    sincos, which GCC makes of a sin and a cos of one angle) would mean a loop was not
-    vectorised."""
-    obj = Path(cpu_bin).parent / "obj" / "model_simd.o"
+@pytest.mark.parametrize("name, isa", [("model_simd.o", "_ZGVd"), ("model_simd_v4.o", "_ZGVe")])
+def test_simd_object_calls_libmvec_and_no_scalar_math(cpu_bin, name, isa):
+    """Every sin/cos/asin/atan2 of the simd file is a vector call of its build's width
+    (_ZGVd…: AVX2, _ZGVe…: AVX-512); a scalar call (or a sincos, which GCC makes of a sin and
+    a cos of one angle) would mean a loop was not vectorised."""
+    obj = Path(cpu_bin).parent / "obj" / "simd" / name
     if platform.machine() != "x86_64":
         pytest.skip(f"simd test skipped: {NO_SIMD}")
     if not obj.exists():
@@ -421,10 +488,10 @@ def test_simd_object_calls_libmvec_and_no_scalar_math(cpu_bin):
     if "__asan_init" in called or any(c.startswith("__ubsan_") for c in called):
         pytest.skip("a sanitizer build (make sanitize): its instrumentation keeps the loops scalar")
     scalar = {"sinf", "cosf", "asinf", "atan2f", "sin", "cos", "asin", "atan2", "sincosf", "sincos"} & called
-    assert not scalar, f"scalar math calls left in model_simd.o: {sorted(scalar)}"
+    assert not scalar, f"scalar math calls left in {name}: {sorted(scalar)}"
     # fp32's sin and cos are c_ref/paper/fast_trig.h's inline polynomials (docs/cpu_simd.md)
     for f in ("asinf", "atan2f", "sin", "cos", "asin", "atan2"):
-        assert any(c.startswith("_ZGV") and c.endswith("_" + f) for c in called), f"no vector call to {f}"
+        assert any(c.startswith(isa) and c.endswith("_" + f) for c in called), f"no {isa} vector call to {f}"
 
 
 def test_refused_with_one_clear_line_without_avx2(cpu_bin, tmp_path):

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_cpu_simd import NO_SIMD, needs_simd
+from test_cpu_simd import ISAS, NO_SIMD, needs_simd
 
 from harness.check import diff_dynamic as dyndiff
 from harness.io.trajectory import open_trajectory
@@ -192,6 +192,18 @@ def test_one_frame_within_the_rule(cpu_bin, inputs, tmp_path, precision, solver,
 
 
 @needs_simd
+@pytest.mark.parametrize("isa", ISAS)
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+def test_each_build_within_the_rule(cpu_bin, inputs, tmp_path, monkeypatch, isa, precision, solver):
+    """Both builds (x86-64-v3 and -v4, forced), every feature: the suite's other tests run the
+    one this CPU picks."""
+    monkeypatch.setenv("HAIRBENCH_SIMD_ISA", isa)
+    inp = inputs(precision, 33)
+    assert_one_frame_rule(cpu_bin, inp, tmp_path, f"{isa} {precision} {solver}", ["--solver", solver, *ALL])
+
+
+@needs_simd
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 @pytest.mark.parametrize("points", [2, 3, 16])
 def test_short_strands_within_the_rule(cpu_bin, inputs, tmp_path, precision, points):
@@ -275,10 +287,11 @@ def test_resume_gives_the_same_bits(cpu_bin, inputs, tmp_path, solver):
     assert np.array_equal(pw[-1], pm[-1]) and np.array_equal(vw[-1], vm[-1])
 
 
-def test_dynamics_simd_object_calls_only_the_vector_sine(cpu_bin):
-    """The gust sine of dynamics_simd.o is libmvec's (_ZGV…sin/sinf); a scalar sin would mean
-    the velocity loop was not vectorised."""
-    obj = Path(cpu_bin).parent / "obj" / "dynamics_simd.o"
+@pytest.mark.parametrize("name, isa", [("dynamics_simd.o", "_ZGVd"), ("dynamics_simd_v4.o", "_ZGVe")])
+def test_dynamics_simd_object_calls_only_the_vector_sine(cpu_bin, name, isa):
+    """The gust sine of each build of dynamics_simd.c is libmvec's at its width (_ZGVd…: AVX2,
+    _ZGVe…: AVX-512); a scalar sin would mean the velocity loop was not vectorised."""
+    obj = Path(cpu_bin).parent / "obj" / "simd" / name
     if platform.machine() != "x86_64":
         pytest.skip(f"simd test skipped: {NO_SIMD}")
     if not obj.exists():
@@ -295,7 +308,7 @@ def test_dynamics_simd_object_calls_only_the_vector_sine(cpu_bin):
         pytest.skip("a sanitizer build (make sanitize): its instrumentation keeps the loops scalar")
     assert not {"sinf", "sin", "sqrtf", "sqrt", "sincosf", "sincos"} & called, sorted(called)
     for f in ("sinf", "sin"):
-        assert any(c.startswith("_ZGV") and c.endswith("_" + f) for c in called), f"no vector call to {f}"
+        assert any(c.startswith(isa) and c.endswith("_" + f) for c in called), f"no {isa} vector call to {f}"
 
 
 @needs_simd
