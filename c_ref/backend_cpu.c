@@ -48,6 +48,8 @@ typedef struct {
      * a copy of the velocities for repeats; the run's constants */
     int dynamic;
     void *vel, *vel_saved, *rest, *bend_rest;
+    void *seg_rest; /* a groom's ℓ_k [N][P−1] (docs/model.md §3.15), and in double for the observables */
+    double *seg64;
     hb_dyn_model_f32 d32;
     hb_dyn_model_f64 d64;
     /* simulate (simd): velocities, saved velocities, rest shape as [P][stride], bend rest [P−2][stride] */
@@ -89,7 +91,12 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     hb_mul3_u64((uint64_t)o->scene.n_strands, (uint64_t)(o->scene.points - 2 > 0 ? o->scene.points - 2 : 1),
                 hb_real_size(o->scene.precision), &bend_bytes);
     const unsigned copies = (need_save ? 3u : 2u) + (o->scene.dyn.sag_free ? 1u : 0u);
-    const uint64_t dyn = c->dynamic ? hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes) : 0;
+    uint64_t seg_bytes = 0; /* a groom's ℓ_k in the working precision and in double */
+    if (o->scene.dyn.per_segment)
+        hb_mul3_u64((uint64_t)o->scene.n_strands, (uint64_t)(o->scene.points - 1),
+                    hb_real_size(o->scene.precision) + sizeof(double), &seg_bytes);
+    const uint64_t dyn =
+        c->dynamic ? hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes), seg_bytes) : 0;
     const uint64_t need = hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, need_save ? 2u : 1u), dyn), driver_bytes);
     if (need == UINT64_MAX) {
         snprintf(err, errlen, "--strands x --points: the run's memory does not fit in 64 bits");
@@ -110,6 +117,12 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
         if (need_save) c->vel_saved = malloc(c->bytes);
         if (o->scene.dyn.sag_free) bad |= !(c->shape_rest = malloc(c->bytes));
         bad |= !c->vel || !c->rest || !c->bend_rest || (need_save && !c->vel_saved);
+        if (o->scene.dyn.per_segment) {
+            const size_t nseg = (size_t)o->scene.n_strands * (size_t)(o->scene.points - 1);
+            c->seg_rest = malloc(nseg * hb_real_size(o->scene.precision));
+            c->seg64 = malloc(nseg * sizeof *c->seg64);
+            bad |= !c->seg_rest || !c->seg64;
+        }
         hb_dyn_round(&o->scene, &c->d32, &c->d64);
     }
     if (bad) {
@@ -653,6 +666,7 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
             hb_dyn_bend_rest_f64(&c->d64, (const double *)c->rest + (size_t)i * stride,
                                  (double *)c->bend_rest + (size_t)i * bstride);
     }
+    if (c->seg_rest) hb_dyn_seg_rest(&c->scene, c->rest, c->seg64, c->seg_rest); /* §3.15 */
     if (c->shape_rest) hb_sagfree_targets(&c->scene, c->rest, c->shape_rest); /* §3.14 */
     hb_followers_free(&c->fl);
     if (c->scene.dyn.guided && hb_followers_plan(&c->scene, c->rest, &c->fl, err, errlen) != 0) return -1;
@@ -672,7 +686,8 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
                 const int64_t i = c->scene.dyn.guided ? c->fl.guide[j] : j;                                            \
                 hb_dyn_frame_strand_##SFX(M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride,  \
                                           (const T *)(c->shape_rest ? c->shape_rest : c->rest) + (size_t)i * stride,   \
-                                          (const T *)c->bend_rest + (size_t)i * bstride, scratch);                     \
+                                          (const T *)c->bend_rest + (size_t)i * bstride,                               \
+                                          c->seg_rest ? (const T *)c->seg_rest + (size_t)i * (P - 1) : NULL, scratch); \
             }                                                                                                          \
             free(scratch);                                                                                             \
         }                                                                                                              \
@@ -740,10 +755,12 @@ static int cpu_dyn_observe(hb_backend *b, hb_observables *obs, char *err, size_t
             hb_obs_partial o;
             if (c->scene.precision == HB_FP32)
                 hb_dyn_observe_strand_f32(&c->scene, (const float *)c->state + (size_t)i * stride,
-                                          (const float *)c->vel + (size_t)i * stride, &o);
+                                          (const float *)c->vel + (size_t)i * stride,
+                                          c->seg64 ? c->seg64 + (size_t)i * (P - 1) : NULL, &o);
             else
                 hb_dyn_observe_strand_f64(&c->scene, (const double *)c->state + (size_t)i * stride,
-                                          (const double *)c->vel + (size_t)i * stride, &o);
+                                          (const double *)c->vel + (size_t)i * stride,
+                                          c->seg64 ? c->seg64 + (size_t)i * (P - 1) : NULL, &o);
             hb_dyn_reduce_into(&acc, &o);
         }
         part[ch] = acc;
@@ -860,6 +877,8 @@ static void cpu_teardown(hb_backend *b)
     free(c->vel_saved);
     free(c->rest);
     free(c->bend_rest);
+    free(c->seg_rest);
+    free(c->seg64);
     free(c->shape_rest);
     hb_followers_free(&c->fl);
     for (int d = 0; d < 3; d++) {
@@ -880,10 +899,10 @@ static void cpu_teardown(hb_backend *b)
 static const hb_variant cpu_variants[] = {
     {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands", 0, 0,
-     (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL) | (1u << HB_SOLVER_RIGID)},
+     (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL) | (1u << HB_SOLVER_RIGID), 1},
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
-     "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks", 0, 0, 0},
-    {NULL, 0, NULL, 0, 0, 0},
+     "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks", 0, 0, 0, 0},
+    {NULL, 0, NULL, 0, 0, 0, 0},
 };
 
 #ifndef HB_FLAGS
