@@ -130,16 +130,10 @@ static int read_hair(const char *path, hb_options *o, hb_groom *g, char *err, si
     const double want = HAIR_HEADER + ((flags & HAIR_SEGMENTS) ? 2.0 * nh : 0.0) + 12.0 * np +
                         ((flags & HAIR_THICKNESS) ? 4.0 * np : 0.0) + ((flags & HAIR_TRANSPARENCY) ? 4.0 * np : 0.0) +
                         ((flags & HAIR_COLOR) ? 12.0 * np : 0.0);
-    if (fseek(f, 0, SEEK_END) != 0) FAIL("--groom %s: cannot seek in the file", path);
-    const long size = ftell(f);
-    if (size < 0 || (double)size < want)
-        FAIL("--groom %s: truncated (%ld bytes; its header's %u strands and %u points need %.0f)", path, size, nh, np,
-             want);
-    if (fseek(f, HAIR_HEADER, SEEK_SET) != 0) FAIL("--groom %s: cannot seek in the file", path);
     uint64_t total = 0;
     if (flags & HAIR_SEGMENTS) {
         seg_raw = malloc(2u * (size_t)nh);
-        if (!seg_raw || fread(seg_raw, 2, nh, f) != nh) FAIL("--groom %s: cannot read the segments array", path);
+        if (!seg_raw || fread(seg_raw, 2, nh, f) != nh) FAIL("--groom %s: truncated in its segments array", path);
         for (uint32_t i = 0; i < nh; i++) total += (uint64_t)seg_raw[2 * i] + ((uint64_t)seg_raw[2 * i + 1] << 8) + 1;
     } else {
         total = (uint64_t)nh * ((uint64_t)dseg + 1);
@@ -147,6 +141,12 @@ static int read_hair(const char *path, hb_options *o, hb_groom *g, char *err, si
     if (total != np)
         FAIL("--groom %s: wrong counts: the strands' segments need %llu points, the header says %u", path,
              (unsigned long long)total, np);
+    if (fseek(f, 0, SEEK_END) != 0) FAIL("--groom %s: cannot seek in the file", path);
+    const long size = ftell(f);
+    if (size < 0 || (double)size < want)
+        FAIL("--groom %s: truncated (%ld bytes; its header's %u strands and %u points need %.0f)", path, size, nh, np,
+             want);
+    if (fseek(f, (long)(HAIR_HEADER + ((flags & HAIR_SEGMENTS) ? 2u * (size_t)nh : 0u)), SEEK_SET) != 0) FAIL("--groom %s: cannot seek in the file", path);
     pts_raw = malloc(12u * (size_t)np);
     if (!pts_raw || fread(pts_raw, 12, np, f) != np) FAIL("--groom %s: cannot read the points array", path);
     fclose(f);
