@@ -379,7 +379,7 @@ out:
 
 /* --groom (docs/model.md §3.15): init places the groom; the paper stages, which keep each
  * strand in its slice plane, and what is not yet defined for a groom are refused. */
-static int check_groom(hb_options *o, const hb_variant *var, hb_groom *g, char *err, size_t errlen)
+static int check_groom(hb_options *o, hb_groom *g, char *err, size_t errlen)
 {
     if (o->input) return snprintf(err, errlen, "--groom with --input: the input file holds the state"), -1;
     for (int i = 0; i < o->n_stages; i++)
@@ -392,12 +392,6 @@ static int check_groom(hb_options *o, const hb_variant *var, hb_groom *g, char *
     if (o->end_to_end) return snprintf(err, errlen, "--end-to-end is not measured with --groom"), -1;
     if (o->scene.dyn.lra || o->scene.dyn.sag_free)
         return snprintf(err, errlen, "--lra and --sag-free are not defined for a groom yet (docs/model.md §3.15)"), -1;
-    if (o->stages[o->n_stages - 1] == HB_STAGE_SIMULATE && !var->per_segment)
-        return snprintf(err, errlen,
-                        "--groom: the %s variant does not simulate per-segment rest lengths yet (see "
-                        "docs/model.md §3.15)",
-                        var->name),
-               -1;
     return hb_groom_prepare(o, g, err, errlen);
 }
 
@@ -513,7 +507,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
                 CHECK(1, HB_EXIT_USAGE);
             }
     }
-    if (o.groom) CHECK(check_groom(&o, var, &run.groom, err, sizeof err), HB_EXIT_USAGE);
+    if (o.groom) CHECK(check_groom(&o, &run.groom, err, sizeof err), HB_EXIT_USAGE);
     if (!o.input && o.stages[0] != HB_STAGE_INIT) {
         snprintf(err, sizeof err, "--stages: '%s' needs a state: list init first or give --input",
                  hb_stage_name(o.stages[0]));
@@ -537,6 +531,13 @@ int hb_main(int argc, char **argv, hb_backend *b)
         if (!(hb_variant_solvers(var) & (1u << o.scene.dyn.solver))) {
             snprintf(err, sizeof err, "--solver %s: the %s variant %s does not run it (see --list-variants)",
                      hb_solver_name(o.scene.dyn.solver), b->name, var->name);
+            CHECK(1, HB_EXIT_USAGE);
+        }
+        if (o.scene.dyn.per_segment && !var->per_segment) {
+            snprintf(err, sizeof err,
+                     "%s: the %s variant %s does not simulate a groom's per-segment rest lengths yet (docs/model.md "
+                     "§3.15)",
+                     o.groom ? "--groom" : "--input", b->name, var->name);
             CHECK(1, HB_EXIT_USAGE);
         }
         if (var->max_block > 0 && o.block_size > var->max_block) {

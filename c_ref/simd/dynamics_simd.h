@@ -49,24 +49,25 @@ void hb_simd_dyn_bend_rest_block_f32(const hb_dyn_model_f32 *m, const float *RX,
 void hb_simd_dyn_bend_rest_block_f64(const hb_dyn_model_f64 *m, const double *RX, const double *RY, const double *RZ,
                                      double *BR, int64_t stride);
 
-/* One frame (S substeps) of one block. All pointers point at the block's first strand in
+/* One frame (S substeps) of one block; SR: a groom's stretch rest lengths ℓ_k as rows
+ * [P−1][stride] (docs/model.md §3.15), NULL for ℓ = L/(P−1). All pointers point at the block's first strand in
  * row 0 and are 64-byte aligned; scratch holds hb_simd_dyn_scratch_reals(P) reals. */
 void hb_simd_dyn_frame_block_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *X, float *Y, float *Z,
                                  float *VX, float *VY, float *VZ, const float *RX, const float *RY, const float *RZ,
-                                 const float *BR, int64_t stride, float *scratch);
+                                 const float *BR, const float *SR, int64_t stride, float *scratch);
 void hb_simd_dyn_frame_block_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *X, double *Y, double *Z,
                                  double *VX, double *VY, double *VZ, const double *RX, const double *RY,
-                                 const double *RZ, const double *BR, int64_t stride, double *scratch);
+                                 const double *RZ, const double *BR, const double *SR, int64_t stride, double *scratch);
 
 /* The per-strand observables (docs/model.md §3.8) of `count` consecutive strands starting
  * at lane `first` (any alignment), into out[0 … count−1]: each strand's partial is the
  * same bits as hb_dyn_observe_strand's, so a reduction in strand order gives ref's. */
 void hb_simd_dyn_observe_f32(const hb_scene *s, const float *X, const float *Y, const float *Z, const float *VX,
                              const float *VY, const float *VZ, int64_t stride, int64_t first, int64_t count,
-                             hb_obs_partial *out);
+                             const double *seg64, hb_obs_partial *out);
 void hb_simd_dyn_observe_f64(const hb_scene *s, const double *X, const double *Y, const double *Z, const double *VX,
                              const double *VY, const double *VZ, int64_t stride, int64_t first, int64_t count,
-                             hb_obs_partial *out);
+                             const double *seg64, hb_obs_partial *out);
 
 #ifdef __cplusplus
 }

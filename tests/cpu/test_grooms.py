@@ -15,9 +15,12 @@ import struct
 import numpy as np
 import pytest
 
+from harness.check import diff_dynamic as dyndiff
 from harness.core import scenes
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run, tmp_leftovers
+from test_cpu_simd import needs_simd
+from test_cpu_simd_dynamic import ALL, SOLVE
 
 SEGMENTS, POINTS, THICKNESS = 1, 2, 4
 
@@ -164,7 +167,6 @@ def test_bad_hair_files_refused(cpu_bin, tmp_path, name):
     "args, words",
     [
         (["--groom", "curly", "--stages", "init,collide,simulate"], "a groom runs init then simulate"),
-        (["--groom", "curly", "--stages", "init,simulate", "--variant", "simd"], "per-segment rest lengths"),
         (["--groom", "curly", "--stages", "init,simulate", "--lra"], "not defined for a groom"),
         (["--curl-radius", "2"], "need --groom curly"),
         (["--groom", "curly", "--curl-radius", "0", "--curl-pitch", "0", "--stages", "init"], "both 0"),
@@ -253,3 +255,24 @@ def test_curly_scene_flags():
         )
     with pytest.raises(scenes.SceneError, match='need groom = "curly"'):
         scenes.scene_from_dict({"model": "dynamic", "hair": {"curl_radius": 2.0}}, "x", "scene x")
+
+
+@needs_simd
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+def test_simd_curly_within_the_rule(cpu_bin, tmp_path, precision, solver):
+    """The simd variant on a curly groom (its ℓ_k as rows beside the bend rest lengths): one
+    frame from ref's within the one-frame rule, as for the procedural scenes."""
+    physics = ["--solver", solver, *ALL, *SOLVE]
+    ref = tmp_path / "curly.h5"
+    run(cpu_bin, "--groom", "curly", "--strands", 300, "--points", 33, "--stages", "init,simulate", "--frames", 3,
+        "--precision", precision, *physics, "--velocities", "all", "--output", ref, "--quiet")  # fmt: skip
+    with open_trajectory(ref) as t:
+        cand = dyndiff.step_candidates(t)
+        steps = {k: int(t.step[k + 1]) for k in cand}
+    for k in (cand[0], cand[-2]):  # from the groom itself, and from a moving state
+        out = tmp_path / f"simd_{k}.h5"
+        run(cpu_bin, "--input", ref, "--input-frame", k, "--stages", "simulate", "--frames", 1, "--variant", "simd",
+            *physics, "--velocities", "all", "--output", out, "--quiet")  # fmt: skip
+        r = dyndiff.compare(ref, out, frames=[steps[k]], check_paper=False)
+        assert r.frames[0].velocity_compared and r.equivalent, f"from frame {k}: " + "; ".join(r.failures()[:5])
