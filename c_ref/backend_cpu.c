@@ -54,7 +54,7 @@ typedef struct {
     hb_dyn_model_f64 d64;
     /* simulate (simd): velocities, saved velocities, rest shape as [P][stride], bend rest [P−2][stride] */
     void *pv[3], *pv_saved[3], *pr[3], *pb;
-    void *ps; /* a groom's ℓ_k as rows [P−1][stride] (seg_rest and seg64 canonical beside it) */
+    void *ps;         /* a groom's ℓ_k as rows [P−1][stride] (seg_rest and seg64 canonical beside it) */
     hb_followers fl;  /* ref with --guides (docs/model.md §3.14) */
     void *shape_rest; /* ref with --sag-free: the rest shape the frame reads (root, shape targets) */
 } cpu_impl;
@@ -96,8 +96,7 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     if (o->scene.dyn.per_segment)
         hb_mul3_u64((uint64_t)o->scene.n_strands, (uint64_t)(o->scene.points - 1),
                     hb_real_size(o->scene.precision) + sizeof(double), &seg_bytes);
-    const uint64_t dyn =
-        c->dynamic ? hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes), seg_bytes) : 0;
+    const uint64_t dyn = c->dynamic ? hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes), seg_bytes) : 0;
     const uint64_t need = hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, need_save ? 2u : 1u), dyn), driver_bytes);
     if (need == UINT64_MAX) {
         snprintf(err, errlen, "--strands x --points: the run's memory does not fit in 64 bits");
@@ -390,7 +389,8 @@ static int simd_dyn_setup(cpu_impl *c, int need_save, uint64_t need, char *err, 
     }
     c->pb = pm_alloc((size_t)rows * (size_t)c->stride * hb_real_size(c->scene.precision));
     if (c->scene.dyn.per_segment) {
-        const size_t nseg = (size_t)c->scene.n_strands * (size_t)(c->scene.points - 1), rs = hb_real_size(c->scene.precision);
+        const size_t nseg = (size_t)c->scene.n_strands * (size_t)(c->scene.points - 1),
+                     rs = hb_real_size(c->scene.precision);
         const size_t rows = (size_t)(c->scene.points - 1) * (size_t)c->stride * rs;
         c->seg_rest = malloc(nseg * rs);
         c->seg64 = malloc(nseg * sizeof *c->seg64);
@@ -690,7 +690,7 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
                                  (double *)c->bend_rest + (size_t)i * bstride);
     }
     if (c->seg_rest) hb_dyn_seg_rest(&c->scene, c->rest, c->seg64, c->seg_rest); /* §3.15 */
-    if (c->shape_rest) hb_sagfree_targets(&c->scene, c->rest, c->shape_rest); /* §3.14 */
+    if (c->shape_rest) hb_sagfree_targets(&c->scene, c->rest, c->shape_rest);    /* §3.14 */
     hb_followers_free(&c->fl);
     if (c->scene.dyn.guided && hb_followers_plan(&c->scene, c->rest, &c->fl, err, errlen) != 0) return -1;
     return 0;

@@ -191,9 +191,9 @@ void hb_dyn_seg_rest(const hb_scene *s, const void *rest, double *seg64, void *s
             const int64_t a = 3 * (i * P + k - 1), b = a + 3, j = i * (P - 1) + k - 1;
             double e2 = 0.0;
             for (int c = 0; c < 3; c++) {
-                const double e = s->precision == HB_FP32 ? (double)((const float *)rest)[b + c] -
-                                                               (double)((const float *)rest)[a + c]
-                                                         : ((const double *)rest)[b + c] - ((const double *)rest)[a + c];
+                const double e = s->precision == HB_FP32
+                                     ? (double)((const float *)rest)[b + c] - (double)((const float *)rest)[a + c]
+                                     : ((const double *)rest)[b + c] - ((const double *)rest)[a + c];
                 e2 += e * e;
             }
             seg64[j] = sqrt(e2);

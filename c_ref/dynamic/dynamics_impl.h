@@ -333,8 +333,7 @@ void SFX(hb_dyn_bend_rest)(const DMODEL *m, const REAL *rest, REAL *bend_rest)
 }
 
 /* §3.8 observables of one strand, in double. */
-void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v, const double *seg64,
-                                 hb_obs_partial *o)
+void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v, const double *seg64, hb_obs_partial *o)
 {
     const int64_t P = s->points;
     const double ell = hb_segment_length(s), far2 = 4.0 * s->hair_length * s->hair_length;

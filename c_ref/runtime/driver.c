@@ -107,6 +107,7 @@ static int list_variants(const hb_backend *b)
         if (v->max_points > 0) printf(", \"max_points\": %lld", (long long)v->max_points);
         if (v->max_block > 0) printf(", \"max_block\": %d", v->max_block);
         if (v->stages & (1u << HB_STAGE_SIMULATE)) print_solvers(", \"solvers\": ", hb_variant_solvers(v));
+        if (v->per_segment) printf(", \"per_segment\": true"); /* simulates a groom (docs/model.md §3.15) */
         printf("}");
     }
     unsigned any = 0;
@@ -198,8 +199,8 @@ typedef struct {
     hb_input in;
     int have_input;
     hb_groom groom; /* --groom: what init places (docs/model.md §3.15) */
-    double *times; /* all stages' timed runs */
-    struct {       /* the simulation, for the file's /parameters */
+    double *times;  /* all stages' timed runs */
+    struct {        /* the simulation, for the file's /parameters */
         int dynamic;
         int64_t paper_frames, last_frame;
         char features[96];

@@ -146,7 +146,8 @@ static int read_hair(const char *path, hb_options *o, hb_groom *g, char *err, si
     if (size < 0 || (double)size < want)
         FAIL("--groom %s: truncated (%ld bytes; its header's %u strands and %u points need %.0f)", path, size, nh, np,
              want);
-    if (fseek(f, (long)(HAIR_HEADER + ((flags & HAIR_SEGMENTS) ? 2u * (size_t)nh : 0u)), SEEK_SET) != 0) FAIL("--groom %s: cannot seek in the file", path);
+    if (fseek(f, (long)(HAIR_HEADER + ((flags & HAIR_SEGMENTS) ? 2u * (size_t)nh : 0u)), SEEK_SET) != 0)
+        FAIL("--groom %s: cannot seek in the file", path);
     pts_raw = malloc(12u * (size_t)np);
     if (!pts_raw || fread(pts_raw, 12, np, f) != np) FAIL("--groom %s: cannot read the points array", path);
     fclose(f);
@@ -199,7 +200,8 @@ static int read_hair(const char *path, hb_options *o, hb_groom *g, char *err, si
         arc[first] = 0.0;
         for (uint64_t j = 1; j < n; j++) {
             double e2 = 0.0;
-            for (int c = 0; c < 3; c++) e2 += (in[3 * j + c] - in[3 * (j - 1) + c]) * (in[3 * j + c] - in[3 * (j - 1) + c]);
+            for (int c = 0; c < 3; c++)
+                e2 += (in[3 * j + c] - in[3 * (j - 1) + c]) * (in[3 * j + c] - in[3 * (j - 1) + c]);
             arc[first + j] = arc[first + j - 1] + sqrt(e2);
         }
         const double len = arc[first + n - 1];
