@@ -258,17 +258,18 @@ fail:
 
 /* §3.15 the curly groom: strand i's root on the head at the i-th point of a golden-angle
  * spiral over the cap cos θ ≥ HB_CURLY_COS_MIN (θ from +y), a helix of radius r and pitch q
- * about the outward normal n through the root, sampled at equal arc lengths. */
+ * about an axis down the scalp's slope t = (−ŷ + c·n)/s, raised r off the head through the
+ * root, so that the curl lies outside it and hangs rather than stands. */
 static void curly_point(const hb_scene *s, int64_t i, int64_t k, double p[3])
 {
     const double N = (double)s->n_strands, R = s->head_radius, r = s->curl_radius, c = s->curl_pitch / (2.0 * M_PI);
     const double ct = 1.0 - (1.0 - HB_CURLY_COS_MIN) * ((double)i + 0.5) / N, st = sqrt(fmax(1.0 - ct * ct, 0.0));
     const double phi = (double)i * M_PI * (3.0 - sqrt(5.0));
     const double n[3] = {st * cos(phi), ct, st * sin(phi)};
-    const double u[3] = {sin(phi), 0.0, -cos(phi)}; /* ŷ × n / |ŷ × n| */
-    const double w[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
+    const double t[3] = {ct * cos(phi), -st, ct * sin(phi)}; /* (−ŷ + c·n)/s: down the slope */
+    const double b[3] = {n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]};
     const double tau = (double)k * s->hair_length / (double)(s->points - 1) / sqrt(r * r + c * c);
-    for (int d = 0; d < 3; d++) p[d] = R * n[d] + r * (cos(tau) - 1.0) * u[d] + r * sin(tau) * w[d] + c * tau * n[d];
+    for (int d = 0; d < 3; d++) p[d] = (R + r * (1.0 - cos(tau))) * n[d] + r * sin(tau) * b[d] + c * tau * t[d];
 }
 
 void hb_groom_state(const hb_scene *s, const hb_groom *g, void *out)
