@@ -330,3 +330,22 @@ def test_usd_refused_without_usd_core(tmp_path):
     (tmp_path / "g.usda").write_text("#usda 1.0\n")
     assert harness_main(["groom", "convert", str(tmp_path / "g.usda"), str(tmp_path / "g.hair")]) != 0
     assert not (tmp_path / "g.hair").exists()
+
+
+def test_harness_runs_a_groom_file_scene(tmp_path):
+    """A scene whose groom names a HAIR file beside it: `harness run` passes the file, not the head
+    flags the file decides, and the run's invariants hold."""
+    from harness.cli.main import main as harness_main
+
+    (tmp_path / "g.hair").write_bytes(hair_bytes(radial_strands((0, 0, 0), 10.0, [6.0] * 6, [7] * 6)))
+    scene = tmp_path / "mine.toml"
+    scene.write_text(
+        'model = "dynamic"\nstages = ["init", "simulate"]\ngroom = "g.hair"\n[hair]\npoints = 8\n'
+        "[dynamics]\nframes = 2\n[constraints]\nbend_compliance = 1e-6\n"
+    )
+    flags = scenes.load_scene(str(scene)).flags()
+    assert "--head-radius" not in flags and flags[flags.index("--groom") + 1] == str(tmp_path / "g.hair")
+    out = tmp_path / "mine.h5"
+    assert harness_main(["run", str(scene), "--output", str(out)]) == 0
+    with open_trajectory(out) as t:
+        assert t.per_segment and t.n_strands == 6 and len(t.simulated) == 2
