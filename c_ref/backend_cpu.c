@@ -50,10 +50,13 @@ typedef struct {
      * a copy of the velocities for repeats; the run's constants */
     int dynamic;
     void *vel, *vel_saved, *rest, *bend_rest;
+    void *seg_rest; /* a groom's ℓ_k [N][P−1] (docs/model.md §3.15), and in double for the observables */
+    double *seg64;
     hb_dyn_model_f32 d32;
     hb_dyn_model_f64 d64;
     /* simulate (simd): velocities, saved velocities, rest shape as [P][stride], bend rest [P−2][stride] */
     void *pv[3], *pv_saved[3], *pr[3], *pb;
+    void *ps;         /* a groom's ℓ_k as rows [P−1][stride] (seg_rest and seg64 canonical beside it) */
     hb_followers fl;  /* ref with --guides (docs/model.md §3.14) */
     void *shape_rest; /* ref with --sag-free: the rest shape the frame reads (root, shape targets) */
 } cpu_impl;
@@ -95,7 +98,11 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     hb_mul3_u64((uint64_t)o->scene.n_strands, (uint64_t)(o->scene.points - 2 > 0 ? o->scene.points - 2 : 1),
                 hb_real_size(o->scene.precision), &bend_bytes);
     const unsigned copies = (need_save ? 3u : 2u) + (o->scene.dyn.sag_free ? 1u : 0u);
-    const uint64_t dyn = c->dynamic ? hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes) : 0;
+    uint64_t seg_bytes = 0; /* a groom's ℓ_k in the working precision and in double */
+    if (o->scene.dyn.per_segment)
+        hb_mul3_u64((uint64_t)o->scene.n_strands, (uint64_t)(o->scene.points - 1),
+                    hb_real_size(o->scene.precision) + sizeof(double), &seg_bytes);
+    const uint64_t dyn = c->dynamic ? hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes), seg_bytes) : 0;
     const uint64_t need = hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, need_save ? 2u : 1u), dyn), driver_bytes);
     if (need == UINT64_MAX) {
         snprintf(err, errlen, "--strands x --points: the run's memory does not fit in 64 bits");
@@ -116,6 +123,12 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
         if (need_save) c->vel_saved = malloc(c->bytes);
         if (o->scene.dyn.sag_free) bad |= !(c->shape_rest = malloc(c->bytes));
         bad |= !c->vel || !c->rest || !c->bend_rest || (need_save && !c->vel_saved);
+        if (o->scene.dyn.per_segment) {
+            const size_t nseg = (size_t)o->scene.n_strands * (size_t)(o->scene.points - 1);
+            c->seg_rest = malloc(nseg * hb_real_size(o->scene.precision));
+            c->seg64 = malloc(nseg * sizeof *c->seg64);
+            bad |= !c->seg_rest || !c->seg64;
+        }
         hb_dyn_round(&o->scene, &c->d32, &c->d64);
     }
     if (bad) {
@@ -393,7 +406,11 @@ static uint64_t simd_dyn_bytes(const cpu_impl *c, uint64_t one, int need_save)
     const int64_t rows = c->scene.points - 2 > 0 ? c->scene.points - 2 : 1;
     uint64_t bend;
     hb_mul3_u64((uint64_t)rows, (uint64_t)c->stride, hb_real_size(c->scene.precision), &bend);
-    return hb_add_sat(hb_mul_sat(hb_mul_sat(one, 3u), need_save ? 3u : 2u), bend);
+    uint64_t seg = 0; /* a groom's ℓ_k: rows, canonical, canonical in double */
+    if (c->scene.dyn.per_segment)
+        hb_mul3_u64((uint64_t)c->stride, (uint64_t)(c->scene.points - 1), 2u * hb_real_size(c->scene.precision) + 8u,
+                    &seg);
+    return hb_add_sat(hb_add_sat(hb_mul_sat(hb_mul_sat(one, 3u), need_save ? 3u : 2u), bend), seg);
 }
 
 static int simd_dyn_setup(cpu_impl *c, int need_save, uint64_t need, char *err, size_t errlen)
@@ -407,6 +424,16 @@ static int simd_dyn_setup(cpu_impl *c, int need_save, uint64_t need, char *err, 
         bad |= !c->pv[d] || !c->pr[d] || (need_save && !c->pv_saved[d]);
     }
     c->pb = pm_alloc((size_t)rows * (size_t)c->stride * hb_real_size(c->scene.precision));
+    if (c->scene.dyn.per_segment) {
+        const size_t nseg = (size_t)c->scene.n_strands * (size_t)(c->scene.points - 1),
+                     rs = hb_real_size(c->scene.precision);
+        const size_t rows = (size_t)(c->scene.points - 1) * (size_t)c->stride * rs;
+        c->seg_rest = malloc(nseg * rs);
+        c->seg64 = malloc(nseg * sizeof *c->seg64);
+        c->ps = pm_alloc(rows);
+        bad |= !c->seg_rest || !c->seg64 || !c->ps;
+        if (c->ps) memset(c->ps, 0, rows); /* padding lanes: 0 */
+    }
     if (bad || !c->pb) {
         snprintf(err, errlen, "cannot allocate %.2f GB of host memory for the state", 1e-9 * (double)need);
         return HB_EXIT_MEMORY;
@@ -439,6 +466,15 @@ static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
         for (int64_t b = 0; b < nb; b++)
             c->sd->bend_rest_f64(&c->d64, RX + b * DB, RY + b * DB, RZ + b * DB, BR + b * DB, S);
     }
+    if (c->ps) { /* §3.15: a groom's ℓ_k, canonical then as rows */
+        const int64_t N = c->scene.n_strands, P = c->scene.points;
+        hb_dyn_seg_rest(&c->scene, rest, c->seg64, c->seg_rest);
+        const size_t rs = hb_real_size(c->scene.precision);
+        for (int64_t i = 0; i < N; i++)
+            for (int64_t k = 1; k < P; k++)
+                memcpy((char *)c->ps + ((size_t)(k - 1) * (size_t)S + (size_t)i) * rs,
+                       (const char *)c->seg_rest + ((size_t)i * (size_t)(P - 1) + (size_t)(k - 1)) * rs, rs);
+    }
     if (c->scene.dyn.sag_free) { /* §3.14: the frame's rest rows become the raised targets */
         void *targets = malloc(hb_state_bytes(&c->scene));
         if (!targets) return -1;
@@ -454,7 +490,7 @@ static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
 #define SIMD_DYN_FRAME(T, SFX, M)                                                                                      \
     do {                                                                                                               \
         T *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2], *VX = c->pv[0], *VY = c->pv[1], *VZ = c->pv[2];                 \
-        const T *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2], *BR = c->pb;                                           \
+        const T *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2], *BR = c->pb, *SR = c->ps;                              \
         _Pragma("omp parallel")                                                                                        \
         {                                                                                                              \
             T *scratch = aligned_alloc(64, ((size_t)c->sd->scratch_reals(P) * sizeof(T) + 63) / 64 * 64);              \
@@ -465,7 +501,7 @@ static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
                 {                                                                                                      \
                     const int64_t o = b * DB;                                                                          \
                     c->sd->frame_##SFX(M, f, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, RY + o, RZ + o,      \
-                                       BR + o, S, scratch);                                                            \
+                                       BR + o, SR ? SR + o : NULL, S, scratch);                                        \
                 }                                                                                                      \
                 free(scratch);                                                                                         \
             }                                                                                                          \
@@ -511,10 +547,10 @@ static int simd_dyn_observe(cpu_impl *c, hb_observables *obs, char *err, size_t 
         const int64_t i0 = ch * SIMD_OBS_CHUNK, i1 = i0 + SIMD_OBS_CHUNK < N ? i0 + SIMD_OBS_CHUNK : N;
         if (c->scene.precision == HB_FP32)
             c->sd->observe_f32(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0, i1 - i0,
-                               strand + i0);
+                               c->seg64, strand + i0);
         else
             c->sd->observe_f64(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0, i1 - i0,
-                               strand + i0);
+                               c->seg64, strand + i0);
         hb_obs_partial acc = {0, 0, 0, 0};
         for (int64_t i = i0; i < i1; i++) hb_dyn_reduce_into(&acc, &strand[i]);
         part[ch] = acc;
@@ -689,7 +725,8 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
             hb_dyn_bend_rest_f64(&c->d64, (const double *)c->rest + (size_t)i * stride,
                                  (double *)c->bend_rest + (size_t)i * bstride);
     }
-    if (c->shape_rest) hb_sagfree_targets(&c->scene, c->rest, c->shape_rest); /* §3.14 */
+    if (c->seg_rest) hb_dyn_seg_rest(&c->scene, c->rest, c->seg64, c->seg_rest); /* §3.15 */
+    if (c->shape_rest) hb_sagfree_targets(&c->scene, c->rest, c->shape_rest);    /* §3.14 */
     hb_followers_free(&c->fl);
     if (c->scene.dyn.guided && hb_followers_plan(&c->scene, c->rest, &c->fl, err, errlen) != 0) return -1;
     return 0;
@@ -708,7 +745,8 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
                 const int64_t i = c->scene.dyn.guided ? c->fl.guide[j] : j;                                            \
                 hb_dyn_frame_strand_##SFX(M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride,  \
                                           (const T *)(c->shape_rest ? c->shape_rest : c->rest) + (size_t)i * stride,   \
-                                          (const T *)c->bend_rest + (size_t)i * bstride, scratch);                     \
+                                          (const T *)c->bend_rest + (size_t)i * bstride,                               \
+                                          c->seg_rest ? (const T *)c->seg_rest + (size_t)i * (P - 1) : NULL, scratch); \
             }                                                                                                          \
             free(scratch);                                                                                             \
         }                                                                                                              \
@@ -776,10 +814,12 @@ static int cpu_dyn_observe(hb_backend *b, hb_observables *obs, char *err, size_t
             hb_obs_partial o;
             if (c->scene.precision == HB_FP32)
                 hb_dyn_observe_strand_f32(&c->scene, (const float *)c->state + (size_t)i * stride,
-                                          (const float *)c->vel + (size_t)i * stride, &o);
+                                          (const float *)c->vel + (size_t)i * stride,
+                                          c->seg64 ? c->seg64 + (size_t)i * (P - 1) : NULL, &o);
             else
                 hb_dyn_observe_strand_f64(&c->scene, (const double *)c->state + (size_t)i * stride,
-                                          (const double *)c->vel + (size_t)i * stride, &o);
+                                          (const double *)c->vel + (size_t)i * stride,
+                                          c->seg64 ? c->seg64 + (size_t)i * (P - 1) : NULL, &o);
             hb_dyn_reduce_into(&acc, &o);
         }
         part[ch] = acc;
@@ -896,6 +936,8 @@ static void cpu_teardown(hb_backend *b)
     free(c->vel_saved);
     free(c->rest);
     free(c->bend_rest);
+    free(c->seg_rest);
+    free(c->seg64);
     free(c->shape_rest);
     hb_followers_free(&c->fl);
     for (int d = 0; d < 3; d++) {
@@ -908,6 +950,7 @@ static void cpu_teardown(hb_backend *b)
     free(c->pm_wind[0]);
     free(c->pm_wind[1]);
     free(c->pb);
+    free(c->ps);
     free(c);
     b->impl = NULL;
 }
@@ -916,12 +959,12 @@ static void cpu_teardown(hb_backend *b)
 static const hb_variant cpu_variants[] = {
     {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands", 0, 0,
-     (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL) | (1u << HB_SOLVER_RIGID)},
+     (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL) | (1u << HB_SOLVER_RIGID), 1},
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks; built for x86-64-v3 and "
      "x86-64-v4, the CPU's widest runs (the record's flags say which)",
-     0, 0, 0},
-    {NULL, 0, NULL, 0, 0, 0},
+     0, 0, 0, 1},
+    {NULL, 0, NULL, 0, 0, 0, 0},
 };
 
 #ifndef HB_FLAGS

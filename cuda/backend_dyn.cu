@@ -60,6 +60,8 @@ struct DynState {
     int64_t *d_guide, *d_follower, *d_src;
     void *d_w;
     void *shape_rest; /* --sag-free: the rest shape the frame kernels read (root, shape targets) */
+    void *seg_rest;   /* §3.15 a groom's ℓ_k in the variant's layout ([P−1][N] strand, [N][P−1] warp) */
+    double *seg64;    /* and in double [N][P−1], for the observables */
 };
 
 int dyn_is_strand_major(const cuda_impl *c)
@@ -141,6 +143,8 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
     need = sat_add(need, hb_mul_sat((uint64_t)d->nchunks, sizeof(hbd::ObsPartial)));
     d->guided = s->dyn.guided;
     if (s->dyn.sag_free) need = sat_add(need, c->bytes); /* the raised shape targets */
+    if (s->dyn.per_segment)                              /* §3.15 a groom's ℓ_k, working precision and double */
+        need = sat_add(need, hb_mul_sat(hb_mul_sat((uint64_t)N, (uint64_t)(P - 1)), rs + 8u));
     if (d->guided) /* guide and follower numbers, up to 3 guides and weights a follower */
         need = sat_add(need, hb_mul_sat((uint64_t)N, 8u + 3u * (8u + rs)));
     if (c->variant == V_STRAND) {
@@ -195,6 +199,12 @@ int dyn_alloc(cuda_impl *c, int need_save, char *err, size_t errlen)
     if ((rc = device_alloc(&d->bend_rest, hb_mul_sat(hb_mul_sat((uint64_t)c->N, (uint64_t)(P - 2 > 0 ? P - 2 : 1)), rs),
                            c, "bend rest lengths", err, errlen)))
         return rc;
+    if (c->scene.dyn.per_segment) { /* §3.15 */
+        const uint64_t nseg = hb_mul_sat((uint64_t)c->N, (uint64_t)(P - 1));
+        if ((rc = device_alloc(&d->seg_rest, hb_mul_sat(nseg, rs), c, "stretch rest lengths", err, errlen))) return rc;
+        if ((rc = device_alloc((void **)&d->seg64, hb_mul_sat(nseg, 8u), c, "stretch rest lengths", err, errlen)))
+            return rc;
+    }
     if ((rc = device_alloc(&d->q, hb_mul_sat((uint64_t)d->S, 9u * rs), c, "rotation table", err, errlen))) return rc;
     if ((rc = device_alloc(&d->ph, hb_mul_sat((uint64_t)d->S, rs), c, "phase table", err, errlen))) return rc;
     if ((rc = device_alloc((void **)&d->d_obs, hb_mul_sat((uint64_t)d->nchunks, sizeof(hbd::ObsPartial)), c,
@@ -218,8 +228,8 @@ void dyn_free(cuda_impl *c)
 {
     DynState *d = c->dyn;
     if (!d) return;
-    void *ptrs[] = {d->vel,   d->vel_saved, d->rest,       d->bend_rest, d->scratch, d->q,         d->ph,
-                    d->d_obs, d->d_guide,   d->d_follower, d->d_src,     d->d_w,     d->shape_rest};
+    void *ptrs[] = {d->vel,     d->vel_saved,  d->rest,  d->bend_rest, d->scratch,    d->q,        d->ph,   d->d_obs,
+                    d->d_guide, d->d_follower, d->d_src, d->d_w,       d->shape_rest, d->seg_rest, d->seg64};
     for (void *p : ptrs)
         if (p) cudaFree(p);
     free(d->h_obs);
@@ -270,6 +280,16 @@ static int dyn_upload(cuda_impl *c, void *dst, const void *canonical, const char
     return 0;
 }
 
+template <typename T> static hbd::DModel<T> &dyn_model(DynState *d);
+template <> hbd::DModel<float> &dyn_model<float>(DynState *d)
+{
+    return d->m32;
+}
+template <> hbd::DModel<double> &dyn_model<double>(DynState *d)
+{
+    return d->m64;
+}
+
 template <typename T>
 static int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char *err, size_t errlen)
 {
@@ -283,6 +303,29 @@ static int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char
     HB_CUDA_AS(hbd::launch_bend_rest<T>((const T *)d->rest, dyn_layout(c), (T *)d->bend_rest, dyn_bend_layout(c), c->N,
                                         c->P, 0),
                "the bend-rest-length kernel launch");
+    if (d->seg_rest) { /* §3.15: a groom's ℓ_k, computed on the host as for every backend */
+        const int64_t N = c->N, P = c->P, ns = N * (P - 1);
+        std::vector<double> s64((size_t)ns);
+        std::vector<T> sw((size_t)ns), rows;
+        hb_dyn_seg_rest(&c->scene, rest, s64.data(), sw.data());
+        const T *src = sw.data();
+        hbd::DModel<T> &m = dyn_model<T>(d);
+        m.seg_rest = (const T *)d->seg_rest;
+        if (c->variant == V_STRAND) { /* point-major [P−1][N] */
+            rows.resize((size_t)ns);
+            for (int64_t i = 0; i < N; i++)
+                for (int64_t k = 0; k < P - 1; k++) rows[(size_t)(k * N + i)] = sw[(size_t)(i * (P - 1) + k)];
+            src = rows.data();
+            m.seg_is = 1;
+            m.seg_s = N;
+        } else { /* warp: canonical [N][P−1] */
+            m.seg_is = P - 1;
+            m.seg_s = 1;
+        }
+        HB_CUDA(cudaMemcpy(d->seg_rest, src, (size_t)ns * sizeof(T), cudaMemcpyHostToDevice));
+        HB_CUDA(cudaMemcpy(d->seg64, s64.data(), (size_t)ns * sizeof(double), cudaMemcpyHostToDevice));
+        d->obs.seg64 = d->seg64;
+    }
     if (c->scene.dyn.sag_free) { /* §3.14: the raised shape targets, made on the host */
         std::vector<unsigned char> targets((size_t)c->bytes);
         hb_sagfree_targets(&c->scene, rest, targets.data());

@@ -60,6 +60,7 @@ __global__ void __launch_bounds__(kMaxThreads)
         s.v = Arr<T>{v + i, N, NP};
         s.rest = Arr<const T>{rest + i, N, NP};
         s.bend_rest = Arr1<const T>{bend_rest + i, N};
+        if (m.seg_rest) s.seg_rest = Arr1<const T>{m.seg_rest + i * m.seg_is, m.seg_s}; /* §3.15 */
         frame_body(m, q, ph, s, Seq(), has);
     }
 }
@@ -99,6 +100,7 @@ __global__ void __launch_bounds__(kMaxThreads)
         __syncwarp();
         s.rest = Arr<const T>{rest + i * P3, 3, 1};
         s.bend_rest = Arr1<const T>{bend_rest + i * (P - 2), 1};
+        if (m.seg_rest) s.seg_rest = Arr1<const T>{m.seg_rest + i * m.seg_is, m.seg_s}; /* §3.15 */
         frame_body(m, q, ph, s, ex, has);
         for (int64_t e = lane; e < P3; e += 32) {
             gx[e] = base[(e % 3) * P + e / 3];
@@ -351,7 +353,9 @@ __global__ void __launch_bounds__(kObsThreads)
     const int64_t n = N - i0 < kObsChunk ? N - i0 : kObsChunk;
     for (int64_t j = threadIdx.x; j < n; j += blockDim.x) {
         const int64_t i = i0 + j;
-        observe_strand(sc, Arr<const T>{x + i * lay.is, lay.ks, lay.cs}, Arr<const T>{v + i * lay.is, lay.ks, lay.cs},
+        ObsScene si = sc;
+        if (sc.seg64) si.seg64 = sc.seg64 + i * (sc.points - 1); /* §3.15: strand i's ℓ_k */
+        observe_strand(si, Arr<const T>{x + i * lay.is, lay.ks, lay.cs}, Arr<const T>{v + i * lay.is, lay.ks, lay.cs},
                        &part[j]);
     }
     __syncthreads();

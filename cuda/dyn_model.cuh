@@ -58,6 +58,10 @@ template <typename T> struct DModel {
     T inv_h, inv_den, inv_s1, inv_s2, inv_b1, inv_b2, inv_g, rc2;
     int lra; /* §3.14 long-range attachments: a run-time switch */
     T lra_len;
+    /* §3.15 a groom's stretch rest lengths ℓ_k on the device (nullptr: ℓ = seg_len); strand i's
+     * ℓ_k at seg_rest[i·seg_is + (k − 1)·seg_s] (strand and warp variants only) */
+    const T *seg_rest = nullptr;
+    int64_t seg_is = 0, seg_s = 0;
 };
 
 template <typename T, typename M> inline DModel<T> dmodel_from(const M &m)
@@ -102,6 +106,7 @@ struct ObsScene {
     int64_t points;
     double ell, far2, rc;
     int collider;
+    const double *seg64 = nullptr; /* §3.15 a groom's ℓ_k in double, [N][P−1] on the device; nullptr: ell */
 };
 
 inline ObsScene obs_scene(const hb_scene *s)
@@ -162,6 +167,7 @@ template <typename T> struct Strand {
     Arr1<const T> bend_rest;
     Arr<T> p, d;
     Arr1<T> lam;
+    Arr1<const T> seg_rest = {nullptr, 0}; /* §3.15 a groom's ℓ_k (b = nullptr: m.seg_len) */
 };
 
 struct Seq {
@@ -396,6 +402,8 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
     const Arr<T> x = s.x, v = s.v, p = s.p, d = s.d;
     const Arr<const T> rest = s.rest;
     const Arr1<T> lam = s.lam;
+    const Arr1<const T> sr = s.seg_rest;
+    auto seg = [&](int64_t k) { return sr.b ? sr(k - 1) : m.seg_len; }; /* §3.15 */
 
     for (int64_t j = 0; j < m.substeps; j++) {
         const T *q = qtab + 9 * j;
@@ -422,11 +430,10 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
         if (m.solver == HB_SOLVER_XPBD) {
             for (int64_t it = 0; it < m.iterations; it++) {
                 ex.each(1, P, 2, [&](int64_t k) { /* stretch, k odd */
-                                                  distance(p, k - 1, k, k - 1 != 0, m.seg_len, m.stretch_at,
-                                                           lam(k - 1));
+                                                  distance(p, k - 1, k, k - 1 != 0, seg(k), m.stretch_at, lam(k - 1));
                 });
                 ex.each(2, P, 2, [&](int64_t k) { /* stretch, k even */
-                                                  distance(p, k - 1, k, 1, m.seg_len, m.stretch_at, lam(k - 1));
+                                                  distance(p, k - 1, k, 1, seg(k), m.stretch_at, lam(k - 1));
                 });
                 if (has(HB_F_BEND)) {
                     bend_group(m, s, ex, 0);
@@ -455,8 +462,8 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
             /* §3.7 follow the leader, k ascending: each point follows its corrected predecessor */
             ex.one([&]() {
                 for (int64_t k = 1; k < P; k++)
-                    follow(p(k - 1, 0), p(k - 1, 1), p(k - 1, 2), p(k, 0), p(k, 1), p(k, 2), m.seg_len,
-                           has(HB_F_COLLIDE), m.collide_r, d(k, 0), d(k, 1), d(k, 2));
+                    follow(p(k - 1, 0), p(k - 1, 1), p(k - 1, 2), p(k, 0), p(k, 1), p(k, 2), seg(k), has(HB_F_COLLIDE),
+                           m.collide_r, d(k, 0), d(k, 1), d(k, 2));
             });
         }
 
@@ -513,7 +520,7 @@ HB_DHD void observe_strand(const ObsScene &sc, const Arr<const T> &x, const Arr<
             n2 += (double)x(k, c) * (double)x(k, c);
             w2 += (double)v(k, c) * (double)v(k, c);
         }
-        const double st = fabs(sqrt(l2) / ell - 1.0);
+        const double st = fabs(sqrt(l2) / (sc.seg64 ? sc.seg64[k - 1] : ell) - 1.0);
         if (st > smax) smax = st;
         if (sc.collider) {
             const double pen = rc - sqrt(n2);

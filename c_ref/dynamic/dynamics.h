@@ -93,12 +93,19 @@ void hb_dyn_reduce_into(hb_obs_partial *acc, const hb_obs_partial *o);
  * `scratch` holds 9·P reals. `bend_rest` holds P − 2 rest lengths (hb_dyn_bend_rest). */
 void hb_dyn_bend_rest_f32(const hb_dyn_model_f32 *m, const float *rest, float *bend_rest);
 void hb_dyn_bend_rest_f64(const hb_dyn_model_f64 *m, const double *rest, double *bend_rest);
+/* `seg_rest` holds the P − 1 stretch rest lengths ℓ_k of a groom (§3.15), NULL for ℓ = L/(P−1). */
 void hb_dyn_frame_strand_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *x, float *v, const float *rest,
-                             const float *bend_rest, float *scratch);
+                             const float *bend_rest, const float *seg_rest, float *scratch);
 void hb_dyn_frame_strand_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *x, double *v, const double *rest,
-                             const double *bend_rest, double *scratch);
-void hb_dyn_observe_strand_f32(const hb_scene *s, const float *x, const float *v, hb_obs_partial *o);
-void hb_dyn_observe_strand_f64(const hb_scene *s, const double *x, const double *v, hb_obs_partial *o);
+                             const double *bend_rest, const double *seg_rest, double *scratch);
+/* `seg64`: the strand's ℓ_k in double (§3.15), NULL for ℓ = L/(P−1). */
+void hb_dyn_observe_strand_f32(const hb_scene *s, const float *x, const float *v, const double *seg64,
+                               hb_obs_partial *o);
+void hb_dyn_observe_strand_f64(const hb_scene *s, const double *x, const double *v, const double *seg64,
+                               hb_obs_partial *o);
+/* §3.15: the N·(P − 1) rest lengths |X̄_k − X̄_{k−1}| of a rest shape in the run's precision,
+ * computed in double (seg64) and rounded once (seg, float or double as the precision). */
+void hb_dyn_seg_rest(const hb_scene *s, const void *rest, double *seg64, void *seg);
 
 #ifdef __cplusplus
 }

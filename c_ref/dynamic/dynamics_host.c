@@ -181,3 +181,23 @@ int hb_obs_blown_up(const hb_observables *o)
 {
     return o->blown_up_strands > 0;
 }
+
+/* §3.15: each segment's length in double from the rest shape as stored, rounded once. */
+void hb_dyn_seg_rest(const hb_scene *s, const void *rest, double *seg64, void *seg)
+{
+    const int64_t N = s->n_strands, P = s->points;
+    for (int64_t i = 0; i < N; i++)
+        for (int64_t k = 1; k < P; k++) {
+            const int64_t a = 3 * (i * P + k - 1), b = a + 3, j = i * (P - 1) + k - 1;
+            double e2 = 0.0;
+            for (int c = 0; c < 3; c++) {
+                const double e = s->precision == HB_FP32
+                                     ? (double)((const float *)rest)[b + c] - (double)((const float *)rest)[a + c]
+                                     : ((const double *)rest)[b + c] - ((const double *)rest)[a + c];
+                e2 += e * e;
+            }
+            seg64[j] = sqrt(e2);
+            if (s->precision == HB_FP32) ((float *)seg)[j] = (float)seg64[j];
+            else ((double *)seg)[j] = seg64[j];
+        }
+}

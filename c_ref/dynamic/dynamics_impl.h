@@ -93,6 +93,9 @@ HB_ALWAYS_INLINE REAL SFX(dist)(const REAL *a, const REAL *b)
 #define BEND_REST(p, k) bend_rest[(k)-1]
 #endif
 
+/* §3.15 the stretch rest length of segment k: the groom's ℓ_k, else the scene's ℓ */
+#define SEG_REST(k) (seg_rest ? seg_rest[(k)-1] : m->seg_len)
+
 /* §3.6 bend constraints (k−1, k+1), k = 1…P−2, of one parity group: ⌊(k−1)/2⌋ even
  * (parity 0) or odd (parity 1). */
 HB_ALWAYS_INLINE void SFX(bend_group)(const DMODEL *m, REAL *p, const REAL *bend_rest, REAL *lam, int parity)
@@ -143,7 +146,7 @@ HB_ALWAYS_INLINE void SFX(lra_all)(const DMODEL *m, REAL *p)
 
 /* One frame of one strand: S substeps of §3.4, the solver of §3.6, §3.7 or §3.13 (rigid). */
 HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, REAL *x, REAL *v, const REAL *rest,
-                                      const REAL *bend_rest, REAL *scratch, const unsigned F)
+                                      const REAL *bend_rest, const REAL *seg_rest, REAL *scratch, const unsigned F)
 {
     const int64_t P = m->points;
     const REAL h = m->h;
@@ -231,13 +234,13 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
             for (int64_t it = 0; it < m->iterations; it++) {
 #if HB_PLANT == 3 /* judge test: the even stretch group before the odd */
                 for (int64_t k = 2; k < P; k += 2)
-                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, 1, m->seg_len, m->stretch_at, &lam_s[k - 1]);
+                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, 1, SEG_REST(k), m->stretch_at, &lam_s[k - 1]);
 #endif
                 for (int64_t k = 1; k < P; k += 2) /* stretch, k odd */
-                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, ROOT_MOVES(k), m->seg_len, m->stretch_at, &lam_s[k - 1]);
+                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, ROOT_MOVES(k), SEG_REST(k), m->stretch_at, &lam_s[k - 1]);
 #if HB_PLANT != 3
                 for (int64_t k = 2; k < P; k += 2) /* stretch, k even */
-                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, 1, m->seg_len, m->stretch_at, &lam_s[k - 1]);
+                    SFX(distance)(p + 3 * (k - 1), p + 3 * k, 1, SEG_REST(k), m->stretch_at, &lam_s[k - 1]);
 #endif
                 if (F & HB_F_BEND) {
                     SFX(bend_group)(m, p, bend_rest, lam_b, 0);
@@ -264,14 +267,15 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
                 const REAL *pp = p + 3 * (k - 1);
                 const REAL ex = pk[0] - pp[0], ey = pk[1] - pp[1], ez = pk[2] - pp[2];
                 const REAL len = SQRT(ex * ex + ey * ey + ez * ez);
+                const REAL ell = SEG_REST(k);
                 REAL nq[3];
                 if (len > (REAL)0) {
-                    nq[0] = pp[0] + m->seg_len * (ex / len);
-                    nq[1] = pp[1] + m->seg_len * (ey / len);
-                    nq[2] = pp[2] + m->seg_len * (ez / len);
+                    nq[0] = pp[0] + ell * (ex / len);
+                    nq[1] = pp[1] + ell * (ey / len);
+                    nq[2] = pp[2] + ell * (ez / len);
                 } else {
                     nq[0] = pp[0];
-                    nq[1] = pp[1] - m->seg_len;
+                    nq[1] = pp[1] - ell;
                     nq[2] = pp[2];
                 }
                 for (int c = 0; c < 3; c++) d[3 * k + c] = nq[c] - pk[c];
@@ -296,13 +300,13 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
 
 /* One function per feature set: the switch's constant F specialises frame_body. */
 void SFX(hb_dyn_frame_strand)(const DMODEL *m, const hb_dyn_frame *fr, REAL *x, REAL *v, const REAL *rest,
-                              const REAL *bend_rest, REAL *scratch)
+                              const REAL *bend_rest, const REAL *seg_rest, REAL *scratch)
 {
 // clang-format off
 #define HB_F_CASE(n)                                                                         \
     case (n):                                                                                \
         if (((n) & HB_F_GUST) && !((n) & HB_F_WIND)) break; /* no gusts without wind */     \
-        SFX(frame_body)(m, fr, x, v, rest, bend_rest, scratch, (n));                         \
+        SFX(frame_body)(m, fr, x, v, rest, bend_rest, seg_rest, scratch, (n));               \
         break;
 #define HB_F_CASE8(n) HB_F_CASE(n) HB_F_CASE(n + 1) HB_F_CASE(n + 2) HB_F_CASE(n + 3)      \
     HB_F_CASE(n + 4) HB_F_CASE(n + 5) HB_F_CASE(n + 6) HB_F_CASE(n + 7)
@@ -329,7 +333,7 @@ void SFX(hb_dyn_bend_rest)(const DMODEL *m, const REAL *rest, REAL *bend_rest)
 }
 
 /* §3.8 observables of one strand, in double. */
-void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v, hb_obs_partial *o)
+void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v, const double *seg64, hb_obs_partial *o)
 {
     const int64_t P = s->points;
     const double ell = hb_segment_length(s), far2 = 4.0 * s->hair_length * s->hair_length;
@@ -348,7 +352,7 @@ void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v,
             n2 += (double)x[3 * k + c] * (double)x[3 * k + c];
             w2 += (double)v[3 * k + c] * (double)v[3 * k + c];
         }
-        const double st = fabs(sqrt(l2) / ell - 1.0);
+        const double st = fabs(sqrt(l2) / (seg64 ? seg64[k - 1] : ell) - 1.0);
         if (st > smax) smax = st;
         if (s->dyn.collider) {
             const double pen = rc - sqrt(n2);
@@ -367,3 +371,4 @@ void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v,
 #undef ROOT_MOVES
 #undef PLANT_SKIPPED
 #undef BEND_REST
+#undef SEG_REST

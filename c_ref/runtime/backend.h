@@ -32,6 +32,7 @@ typedef struct {
     int64_t max_points;
     int max_block;
     unsigned solvers; /* the dynamic solvers it runs, bit 1 << hb_solver (0: xpbd and ftl) */
+    int per_segment;  /* simulates a groom's per-segment rest lengths (docs/model.md §3.15) */
 } hb_variant;
 
 /* The solvers a variant runs (its `solvers`, or xpbd and ftl where it declares none). */

@@ -19,6 +19,8 @@ void hb_default_options(hb_options *o)
     o->scene.hair_offset = 0.1;
     o->scene.hair_length = 30.0;
     o->scene.face_margin = 1.0;
+    o->scene.curl_radius = 1.0;
+    o->scene.curl_pitch = 2.0;
     o->scene.wind_strength = 0.5;
     o->scene.wind_angle = M_PI;
     o->scene.precision = HB_FP32;
@@ -132,6 +134,10 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
             "                       allowed, init first), then simulate of the dynamic model, once and last\n"
             "                       (default init,collide,wind,collide)\n"
             "  --precision P        fp32 or fp64 (default fp32)\n"
+            "  --groom G            init places a groom, not the drape: 'curly' (helices) or a HAIR file\n"
+            "                       (docs/model.md §3.15; per-segment rest lengths, stages init,simulate)\n"
+            "  --curl-radius C      with --groom curly: helix radius, cm (default 1)\n"
+            "  --curl-pitch Q       with --groom curly: advance per turn along the root normal, cm (default 2)\n"
             "\nrun:\n"
             "  --variant NAME       %s\n"
             "%s"
@@ -476,6 +482,18 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
             o->block_size = (int)iv;
         } else if (strcmp(name, "--input") == 0) {
             o->input = v;
+        } else if (strcmp(name, "--groom") == 0) {
+            if (v[0] == '\0') FAIL("--groom needs 'curly' or a HAIR file name");
+            o->groom = v;
+            s->groom = strcmp(v, "curly") == 0 ? HB_GROOM_CURLY : HB_GROOM_FILE;
+        } else if (strcmp(name, "--curl-radius") == 0) {
+            if (parse_f64(name, v, &s->curl_radius, err, errlen)) return -1;
+            if (!(s->curl_radius >= 0.0)) FAIL("--curl-radius must be >= 0 (got %s)", v);
+            o->given |= HB_GIVEN_CURL;
+        } else if (strcmp(name, "--curl-pitch") == 0) {
+            if (parse_f64(name, v, &s->curl_pitch, err, errlen)) return -1;
+            if (!(s->curl_pitch >= 0.0)) FAIL("--curl-pitch must be >= 0 (got %s)", v);
+            o->given |= HB_GIVEN_CURL;
         } else if (strcmp(name, "--output") == 0) {
             if (v[0] == '\0') FAIL("--output needs a file name");
             o->output = v;
@@ -510,6 +528,9 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
     }
     if (!o->scene.dyn.guided && (o->dyn_given & (1ull << hb_dyn_flag_index("--follow"))))
         FAIL("--follow needs --guides (every strand is simulated unless --guides is given)");
+    if ((o->given & HB_GIVEN_CURL) && o->scene.groom != HB_GROOM_CURLY)
+        FAIL("--curl-radius and --curl-pitch need --groom curly");
+    o->scene.dyn.per_segment = o->groom != NULL;
     if (o->scene.dyn.sag_free && !o->scene.dyn.shape)
         FAIL("--sag-free needs --shape-compliance (it moves the shape targets)");
     if (o->scene.dyn.shape == 0 && (o->dyn_given & (1ull << hb_dyn_flag_index("--shape-range"))))

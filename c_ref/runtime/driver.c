@@ -11,6 +11,7 @@
 #include "runtime/backend.h"
 #include "runtime/checked.h"
 #include "runtime/cli.h"
+#include "runtime/groom.h"
 #include "dynamic/dyn_followers.h"
 #include "runtime/host.h"
 #include "runtime/philox.h"
@@ -106,6 +107,7 @@ static int list_variants(const hb_backend *b)
         if (v->max_points > 0) printf(", \"max_points\": %lld", (long long)v->max_points);
         if (v->max_block > 0) printf(", \"max_block\": %d", v->max_block);
         if (v->stages & (1u << HB_STAGE_SIMULATE)) print_solvers(", \"solvers\": ", hb_variant_solvers(v));
+        if (v->per_segment) printf(", \"per_segment\": true"); /* simulates a groom (docs/model.md §3.15) */
         printf("}");
     }
     unsigned any = 0;
@@ -196,8 +198,9 @@ typedef struct {
     void *input; /* the input's last frame */
     hb_input in;
     int have_input;
-    double *times; /* all stages' timed runs */
-    struct {       /* the simulation, for the file's /parameters */
+    hb_groom groom; /* --groom: what init places (docs/model.md §3.15) */
+    double *times;  /* all stages' timed runs */
+    struct {        /* the simulation, for the file's /parameters */
         int dynamic;
         int64_t paper_frames, last_frame;
         char features[96];
@@ -208,6 +211,7 @@ static void run_free(hb_run *r)
 {
     if (r->w) hb_writer_abort(r->w);
     if (r->have_input) hb_input_close(&r->in);
+    hb_groom_free(&r->groom);
     if (r->b->teardown) r->b->teardown(r->b);
     free(r->host);
     free(r->input);
@@ -374,6 +378,49 @@ out:
     return status;
 }
 
+/* --groom (docs/model.md §3.15): init places the groom; the paper stages, which keep each
+ * strand in its slice plane, and what is not yet defined for a groom are refused. */
+static int check_groom(hb_options *o, hb_groom *g, char *err, size_t errlen)
+{
+    if (o->input) return snprintf(err, errlen, "--groom with --input: the input file holds the state"), -1;
+    for (int i = 0; i < o->n_stages; i++)
+        if (o->stages[i] == HB_STAGE_COLLIDE || o->stages[i] == HB_STAGE_WIND)
+            return snprintf(err, errlen,
+                            "--stages: a groom runs init then simulate; '%s' moves strands in their slice planes, "
+                            "which a groom's strands are not",
+                            hb_stage_name(o->stages[i])),
+                   -1;
+    if (o->end_to_end) return snprintf(err, errlen, "--end-to-end is not measured with --groom"), -1;
+    if (o->scene.dyn.lra || o->scene.dyn.sag_free)
+        return snprintf(err, errlen, "--lra and --sag-free are not defined for a groom yet (docs/model.md §3.15)"), -1;
+    return hb_groom_prepare(o, g, err, errlen);
+}
+
+/* init with a groom: the state computed on the host, loaded as the stage's work. */
+static int place_groom(hb_run *r, hb_stage_record *sr, double *times, char *err, size_t errlen)
+{
+    const hb_options *o = r->o;
+    const uint64_t bytes = hb_state_bytes(&o->scene);
+    void *buf = r->host ? r->host : malloc(bytes);
+    if (!buf) return snprintf(err, errlen, "out of host memory for the groom"), -1;
+    hb_groom_state(&o->scene, &r->groom, buf);
+    int rc = 0;
+    for (int j = 0; j < o->warmup + o->repeat && rc == 0; j++) {
+        const double t0 = hb_now_ms();
+        double ms;
+        rc = r->b->load(r->b, buf, &ms, err, errlen);
+        if (j >= o->warmup) times[j - o->warmup] = hb_now_ms() - t0;
+    }
+    if (rc == 0) {
+        sr->times_ms = times;
+        sr->n_times = o->repeat;
+        hb_time_stats(times, o->repeat, &sr->meta.median_ms, &sr->meta.min_ms, &sr->meta.max_ms);
+        if (r->w) rc = hb_writer_append(r->w, buf, &sr->meta, err, errlen);
+    }
+    if (buf != r->host) free(buf);
+    return rc;
+}
+
 #define CHECK(call, status)                                                                                            \
     do {                                                                                                               \
         if ((call) != 0) {                                                                                             \
@@ -429,6 +476,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
     run.b = b;
     run.o = &o;
     run.rec = &rec;
+    rec.groom = &run.groom;
 
     if (o.measure_bandwidth) {
         double gbps = 0, bytes = 0, triad = NAN, triad_bytes = NAN;
@@ -459,7 +507,9 @@ int hb_main(int argc, char **argv, hb_backend *b)
                 snprintf(err, sizeof err, "--stages: init cannot run on an --input state (it would replace it)");
                 CHECK(1, HB_EXIT_USAGE);
             }
-    } else if (o.stages[0] != HB_STAGE_INIT) {
+    }
+    if (o.groom) CHECK(check_groom(&o, &run.groom, err, sizeof err), HB_EXIT_USAGE);
+    if (!o.input && o.stages[0] != HB_STAGE_INIT) {
         snprintf(err, sizeof err, "--stages: '%s' needs a state: list init first or give --input",
                  hb_stage_name(o.stages[0]));
         CHECK(1, HB_EXIT_USAGE);
@@ -482,6 +532,13 @@ int hb_main(int argc, char **argv, hb_backend *b)
         if (!(hb_variant_solvers(var) & (1u << o.scene.dyn.solver))) {
             snprintf(err, sizeof err, "--solver %s: the %s variant %s does not run it (see --list-variants)",
                      hb_solver_name(o.scene.dyn.solver), b->name, var->name);
+            CHECK(1, HB_EXIT_USAGE);
+        }
+        if (o.scene.dyn.per_segment && !var->per_segment) {
+            snprintf(err, sizeof err,
+                     "%s: the %s variant %s does not simulate a groom's per-segment rest lengths yet (docs/model.md "
+                     "§3.15)",
+                     o.groom ? "--groom" : "--input", b->name, var->name);
             CHECK(1, HB_EXIT_USAGE);
         }
         if (var->max_block > 0 && o.block_size > var->max_block) {
@@ -592,6 +649,13 @@ int hb_main(int argc, char **argv, hb_backend *b)
         sr->stage = st;
         frame_meta(&sr->meta, st, &o.scene, b->name, o.variant);
         sr->meta.step = frame;
+        if (st == HB_STAGE_INIT && o.groom) {
+            CHECK(place_groom(&run, sr, times, err, sizeof err), HB_EXIT_RUNTIME);
+            times += o.repeat;
+            frame++;
+            i++;
+            continue;
+        }
         if (st == HB_STAGE_SIMULATE) {
             status = run_simulate(&run, sr, frame, times, err, sizeof err);
             if (status != HB_EXIT_OK) {

@@ -56,6 +56,7 @@ typedef struct {
     int lra;          /* --lra given */
     double lra_scale; /* s_L ≥ 1: the bound is s_L times the rest arc length */
     int sag_free;     /* --sag-free: shape targets that hold the rest shape against gravity */
+    int per_segment;  /* §3.15: stretch rest lengths per segment from X̄ (a groom), not ℓ = L/(P−1) */
 } hb_dynamics;
 
 /* The scene: everything that decides the bits of a state. */
@@ -71,7 +72,12 @@ typedef struct {
     double wind_angle;    /* psi, radians from +z toward +y */
     hb_precision precision;
     hb_dynamics dyn; /* used by the simulate stage only */
+    /* §3.15: the init stage's strands from a groom instead of the drape (HB_GROOM_DRAPE) */
+    int groom;                      /* hb_groom_kind */
+    double curl_radius, curl_pitch; /* HB_GROOM_CURLY: helix radius and advance per turn, cm */
 } hb_scene;
+
+typedef enum { HB_GROOM_DRAPE = 0, HB_GROOM_CURLY = 1, HB_GROOM_FILE = 2 } hb_groom_kind;
 
 /* How a run is carried out: which stages, how timed, where written. */
 typedef struct {
@@ -82,6 +88,7 @@ typedef struct {
     int threads;         /* cpu: 0 = all cores */
     int block_size;      /* cuda */
     const char *input;   /* NULL: start with init */
+    const char *groom;   /* --groom: "curly" or a HAIR file; NULL: the drape */
     const char *output;  /* NULL: no file */
     int force;
     int repeat;
@@ -113,6 +120,7 @@ enum {
     HB_GIVEN_MARGIN = 1u << 6,
     HB_GIVEN_PRECISION = 1u << 7,
     HB_GIVEN_ANGLE = 1u << 8,
+    HB_GIVEN_CURL = 1u << 9,
 };
 
 /* Derived values, computed once in double on the host and rounded once to the working

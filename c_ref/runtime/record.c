@@ -127,6 +127,21 @@ void hb_record_json(FILE *f, const hb_record *r)
     fprintf(f, ", \"repeat\": %d, \"warmup\": %d", r->opt->repeat, r->opt->warmup);
     json_key_str(f, "input", r->opt->input);
     json_key_str(f, "output", r->opt->output);
+    if (r->opt->groom && r->groom) {
+        fputs(", \"groom\": {\"source\": ", f);
+        json_str(f, r->opt->groom);
+        json_key_num(f, "length_min", r->groom->length_min);
+        json_key_num(f, "length_max", r->groom->length_max);
+        if (r->opt->scene.groom == HB_GROOM_CURLY) {
+            json_key_num(f, "curl_radius", r->opt->scene.curl_radius);
+            json_key_num(f, "curl_pitch", r->opt->scene.curl_pitch);
+        } else {
+            fprintf(f, ", \"file_strands\": %lld", (long long)r->groom->file_strands);
+            json_key_num(f, "resample_error", r->groom->resample_error);
+            json_key_num(f, "fit_offset", r->groom->fit_offset);
+        }
+        fputs("}", f);
+    }
     fputs(", \"stages\": [", f);
     for (int i = 0; i < r->n_stages; i++) {
         const hb_stage_record *st = &r->stages[i];

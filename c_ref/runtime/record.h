@@ -5,6 +5,7 @@
 
 #include <stdio.h>
 
+#include "runtime/groom.h"
 #include "runtime/params.h"
 #include "runtime/state_io.h"
 
@@ -36,6 +37,7 @@ typedef struct {
     hb_stage_record stages[HB_MAX_STAGES];
     int n_stages;
     double end_to_end_ms, h2d_ms, d2h_ms, hdf5_write_ms; /* NaN: not measured */
+    const hb_groom *groom;                               /* with --groom: its numbers */
 } hb_record;
 
 void hb_record_json(FILE *f, const hb_record *r);

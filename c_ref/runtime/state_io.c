@@ -442,6 +442,7 @@ static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
     bad |= attr_i64(p, "guided", d->guided) < 0; /* §3.13 */
     bad |= attr_i64(p, "lra", d->lra) < 0;
     bad |= attr_i64(p, "sag_free", d->sag_free) < 0;
+    bad |= attr_i64(p, "per_segment", d->per_segment) < 0; /* §3.15 */
     if (d->guided) bad |= attr_str(p, "follow", hb_follow_name(d->follow)) < 0;
     const struct {
         const char *name;
@@ -832,6 +833,8 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
     }
     int64_t sag_free = 0;
     if (read_attr(p, "sag_free", H5T_NATIVE_INT64, &sag_free) == 0) d->sag_free = sag_free != 0;
+    int64_t per_segment = 0;
+    if (read_attr(p, "per_segment", H5T_NATIVE_INT64, &per_segment) == 0) d->per_segment = per_segment != 0;
     if (read_attr(p, "lra", H5T_NATIVE_INT64, &lra) == 0 && lra) {
         if (read_attr(p, "lra_scale", H5T_NATIVE_DOUBLE, &d->lra_scale) < 0)
             return snprintf(err, errlen, "--input %s: /parameters has lra = 1 but lacks lra_scale", path), -1;

@@ -49,24 +49,25 @@ void hb_simd_dyn_bend_rest_block_f32(const hb_dyn_model_f32 *m, const float *RX,
 void hb_simd_dyn_bend_rest_block_f64(const hb_dyn_model_f64 *m, const double *RX, const double *RY, const double *RZ,
                                      double *BR, int64_t stride);
 
-/* One frame (S substeps) of one block. All pointers point at the block's first strand in
+/* One frame (S substeps) of one block; SR: a groom's stretch rest lengths ℓ_k as rows
+ * [P−1][stride] (docs/model.md §3.15), NULL for ℓ = L/(P−1). All pointers point at the block's first strand in
  * row 0 and are 64-byte aligned; scratch holds hb_simd_dyn_scratch_reals(P) reals. */
 void hb_simd_dyn_frame_block_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *X, float *Y, float *Z,
                                  float *VX, float *VY, float *VZ, const float *RX, const float *RY, const float *RZ,
-                                 const float *BR, int64_t stride, float *scratch);
+                                 const float *BR, const float *SR, int64_t stride, float *scratch);
 void hb_simd_dyn_frame_block_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *X, double *Y, double *Z,
                                  double *VX, double *VY, double *VZ, const double *RX, const double *RY,
-                                 const double *RZ, const double *BR, int64_t stride, double *scratch);
+                                 const double *RZ, const double *BR, const double *SR, int64_t stride, double *scratch);
 
 /* The per-strand observables (docs/model.md §3.8) of `count` consecutive strands starting
  * at lane `first` (any alignment), into out[0 … count−1]: each strand's partial is the
  * same bits as hb_dyn_observe_strand's, so a reduction in strand order gives ref's. */
 void hb_simd_dyn_observe_f32(const hb_scene *s, const float *X, const float *Y, const float *Z, const float *VX,
                              const float *VY, const float *VZ, int64_t stride, int64_t first, int64_t count,
-                             hb_obs_partial *out);
+                             const double *seg64, hb_obs_partial *out);
 void hb_simd_dyn_observe_f64(const hb_scene *s, const double *X, const double *Y, const double *Z, const double *VX,
                              const double *VY, const double *VZ, int64_t stride, int64_t first, int64_t count,
-                             hb_obs_partial *out);
+                             const double *seg64, hb_obs_partial *out);
 
 /* The functions above as one table, built twice as model_simd.h's (hb_simd_dyn_v3 from
  * dynamics_simd.c, hb_simd_dyn_v4 from dynamics_simd_v4.c). */
@@ -75,13 +76,15 @@ typedef struct {
     void (*bend_rest_f32)(const hb_dyn_model_f32 *, const float *, const float *, const float *, float *, int64_t);
     void (*bend_rest_f64)(const hb_dyn_model_f64 *, const double *, const double *, const double *, double *, int64_t);
     void (*frame_f32)(const hb_dyn_model_f32 *, const hb_dyn_frame *, float *, float *, float *, float *, float *,
-                      float *, const float *, const float *, const float *, const float *, int64_t, float *);
+                      float *, const float *, const float *, const float *, const float *, const float *, int64_t,
+                      float *);
     void (*frame_f64)(const hb_dyn_model_f64 *, const hb_dyn_frame *, double *, double *, double *, double *, double *,
-                      double *, const double *, const double *, const double *, const double *, int64_t, double *);
+                      double *, const double *, const double *, const double *, const double *, const double *,
+                      int64_t, double *);
     void (*observe_f32)(const hb_scene *, const float *, const float *, const float *, const float *, const float *,
-                        const float *, int64_t, int64_t, int64_t, hb_obs_partial *);
+                        const float *, int64_t, int64_t, int64_t, const double *, hb_obs_partial *);
     void (*observe_f64)(const hb_scene *, const double *, const double *, const double *, const double *,
-                        const double *, const double *, int64_t, int64_t, int64_t, hb_obs_partial *);
+                        const double *, const double *, int64_t, int64_t, int64_t, const double *, hb_obs_partial *);
 } hb_simd_dyn_fns;
 extern const hb_simd_dyn_fns hb_simd_dyn_v3, hb_simd_dyn_v4;
 

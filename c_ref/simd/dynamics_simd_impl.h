@@ -322,11 +322,12 @@ HB_ALWAYS_INLINE void SFX(update_row)(const SFX(dyn_consts) * K, REAL *scratch, 
  * from the motion and the positions. Features: BEND, SHAPE, COLLIDE, MOTION (for shape). */
 HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, REAL *X, REAL *Y,
                                      REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY,
-                                     const REAL *RZ, const REAL *BR, const int64_t stride, REAL *scratch,
-                                     const unsigned F)
+                                     const REAL *RZ, const REAL *BR, const REAL *SR, const int64_t stride,
+                                     REAL *scratch, const unsigned F)
 {
     const int64_t P = m->points;
     const REAL ell = K->ell;
+    const int per_seg = SR != NULL; /* §3.15: a groom's ℓ_k, row k − 1 of SR */
     /* every multiplier in use starts the substep at 0 (stretch rows P…, bend 2P…, shape 3P…) */
     {
         const int64_t from = K->st_at != (REAL)0 ? 0 : (F & HB_F_BEND) && K->bd_at != (REAL)0 ? P : 2 * P;
@@ -339,11 +340,11 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
         for (int64_t it = 0; it < m->iterations; it++) {
             // clang-format off
             for (int64_t k = 1; k < P; k += 2) /* stretch, k odd */
-                SFX(distance_lanes)(m, scratch, k - 1, k, 0, NULL, ell, K->st_at, k - 1 != 0 ? K->st_w2 : K->st_w1,
-                                    lam_s ? lam_s + (k - 1) * DB : NULL);
+                SFX(distance_lanes)(m, scratch, k - 1, k, per_seg, per_seg ? AL(ROWP(SR, k - 1)) : NULL, ell, K->st_at,
+                                    k - 1 != 0 ? K->st_w2 : K->st_w1, lam_s ? lam_s + (k - 1) * DB : NULL);
             for (int64_t k = 2; k < P; k += 2) /* stretch, k even */
-                SFX(distance_lanes)(m, scratch, k - 1, k, 0, NULL, ell, K->st_at, K->st_w2,
-                                    lam_s ? lam_s + (k - 1) * DB : NULL);
+                SFX(distance_lanes)(m, scratch, k - 1, k, per_seg, per_seg ? AL(ROWP(SR, k - 1)) : NULL, ell, K->st_at,
+                                    K->st_w2, lam_s ? lam_s + (k - 1) * DB : NULL);
             // clang-format on
             if (F & HB_F_BEND) {
                 SFX(bend_lanes)(m, K, scratch, BR, stride, 0);
@@ -382,13 +383,15 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
             l2r[j] = ex * ex + ey * ey + ez * ez;
         }
         INV_SQRT_ROW(l2r, inv);
+        const REAL *restrict sr = per_seg ? AL(ROWP(SR, k - 1)) : NULL;
 #pragma omp simd
         for (int j = 0; j < DB; j++) {
             const REAL ax = ppx[j], ay = ppy[j], az = ppz[j], bx = px[j], by = py[j], bz = pz[j];
             const REAL ex = bx - ax, ey = by - ay, ez = bz - az;
             const int pos = l2r[j] >= TINY; /* the oracle's |e| > 0 */
-            const REAL g = ell * inv[j];
-            const REAL qx = pos ? ax + g * ex : ax, qy = pos ? ay + g * ey : ay - ell, qz = pos ? az + g * ez : az;
+            const REAL lk = per_seg ? sr[j] : ell;
+            const REAL g = lk * inv[j];
+            const REAL qx = pos ? ax + g * ex : ax, qy = pos ? ay + g * ey : ay - lk, qz = pos ? az + g * ez : az;
             dx[j] = qx - bx;
             dy[j] = qy - by;
             dz[j] = qz - bz;
@@ -431,12 +434,12 @@ static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_const
 
 static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, REAL *X, REAL *Y,
                               REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ,
-                              const REAL *BR, const int64_t stride, REAL *scratch)
+                              const REAL *BR, const REAL *SR, const int64_t stride, REAL *scratch)
 {
 #define CCASE(i)                                                                                                       \
     case (i):                                                                                                          \
         if (((i)&8) && !((i)&2)) break; /* motion matters here only through shape */                                   \
-        SFX(con_phase)(m, K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, stride, scratch, CON_F(i));                       \
+        SFX(con_phase)(m, K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch, CON_F(i));                   \
         break;
     switch (idx) {
         CASE16(CCASE)
@@ -447,7 +450,7 @@ static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_const
 
 void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, REAL *X, REAL *Y, REAL *Z, REAL *VX,
                                   REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ, const REAL *BR,
-                                  int64_t stride, REAL *scratch)
+                                  const REAL *SR, int64_t stride, REAL *scratch)
 {
     const unsigned F = m->features;
     const unsigned vi = ((F & HB_F_WIND) ? 1u : 0u) | ((F & HB_F_WIND) && (F & HB_F_GUST) ? 2u : 0u) |
@@ -476,7 +479,7 @@ void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, REAL 
         const REAL phase = PHASE(fr)[j];                               /* φ(t) */
         const int last = HB_SIMD_DYN_PREFETCH && j + 1 == m->substeps; /* the next block's rows arrive meanwhile */
         SFX(vel_dispatch)(vi, m, &K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, last);
-        SFX(con_dispatch)(ci, m, &K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, stride, scratch);
+        SFX(con_dispatch)(ci, m, &K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch);
     }
 }
 
@@ -503,7 +506,7 @@ void SFX(hb_simd_dyn_bend_rest_block)(const DMODEL *m, const REAL *RX, const REA
 #define OBS_LANES 256
 void SFX(hb_simd_dyn_observe)(const hb_scene *s, const REAL *X, const REAL *Y, const REAL *Z, const REAL *VX,
                               const REAL *VY, const REAL *VZ, int64_t stride, int64_t first, int64_t count,
-                              hb_obs_partial *out)
+                              const double *seg64, hb_obs_partial *out)
 {
     const int64_t P = s->points;
     const double ell = hb_segment_length(s), far2 = 4.0 * s->hair_length * s->hair_length;
@@ -554,7 +557,7 @@ void SFX(hb_simd_dyn_observe)(const hb_scene *s, const REAL *X, const REAL *Y, c
                 w2 += w2v * w2v;
                 const int fin = (fabs(a0) <= big) & (fabs(a1) <= big) & (fabs(a2) <= big) & (fabs(w0) <= big) &
                                 (fabs(w1) <= big) & (fabs(w2v) <= big);
-                const double st = fabs(sqrt(l2) / ell - 1.0);
+                const double st = fabs(sqrt(l2) / (seg64 ? seg64[(base + j) * (P - 1) + k - 1] : ell) - 1.0);
                 smax[j] = st > smax[j] ? st : smax[j];
                 const double pen = rc - sqrt(n2);
                 if (collider) pmax[j] = pen > pmax[j] ? pen : pmax[j];

@@ -15,7 +15,7 @@ frame f (at step s, simulated frame number g = s − paper_frames + 1) is checke
                DYN_PENETRATION_K·ε·R_c
   ftl_segments (solver ftl) every segment (k−1, k) whose end k the collider did not move
                (|x_k| above R_c by more than that tolerance, or the collider off) has length
-               ℓ within DYN_FTL_SEGMENT_K·ε·E, E = R + h + L; in a guided file (§3.14) the
+               ℓ (a groom: its ℓ_k, §3.15) within DYN_FTL_SEGMENT_K·ε·E, E = R + h + L; in a guided file (§3.14) the
                guides' segments only (followers are placed from them, not followed)
   observables  the frame's observables (§3.8) agree with its positions: stretch_max and
                penetration_max recomputed in double from the stored positions (bit for bit
@@ -122,7 +122,7 @@ def observe(traj, x, v=None):
     """§3.8 recomputed in double from stored positions x [N][P][3] (and velocities v):
     (stretch_max, penetration_max, kinetic_energy or None, blown-up count)."""
     N, P = traj.n_strands, traj.points
-    ell = traj.hair_length / (P - 1)
+    ell = traj.segment_rest()
     xd = x.astype(np.float64)
     with np.errstate(invalid="ignore", over="ignore"):
         e = xd[:, 1:, :] - xd[:, :-1, :]
@@ -169,7 +169,8 @@ def check(traj, exact=True, frames=None, paper=True):
     `paper` its paper frames with invariants.check. Returns a DynamicReport."""
     kind = tolerances.kind_of(traj.precision, traj.fast_math)
     rep = DynamicReport(path=traj.path, kind=kind, exact_roots=exact)
-    if paper and traj.paper_frames:
+    # a groom's init frame (§3.15) is no paper state: its strands leave their slice planes
+    if paper and traj.paper_frames and not traj.per_segment:
         rep.paper = invariants.check(_paper_view(traj))
     if not traj.is_dynamic:
         return rep
@@ -177,7 +178,7 @@ def check(traj, exact=True, frames=None, paper=True):
     R, h, L = float(traj.params["head_radius"]), float(traj.params["hair_offset"]), traj.hair_length
     E = tolerances.extent(R, h, L)
     rc = traj.collide_radius
-    ell = L / (traj.points - 1)
+    ell = traj.segment_rest()
     pen_allow = tolerances.DYN_PENETRATION_K * eps * rc
     rest_roots = np.ascontiguousarray(traj.rest[:, 0, :])
     obs = traj.observables.set_index("step")

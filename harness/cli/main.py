@@ -1,7 +1,7 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
 Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, accuracy, headline,
-export, calibrate, featurecost, reduced, peer, animate, stability, judge, docs (`--help` on each; docs/harness.md
+export, groom, calibrate, featurecost, reduced, peer, animate, stability, judge, docs (`--help` on each; docs/harness.md
 lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
 
@@ -81,6 +81,17 @@ def cmd_run(args):
     )
     if scene.model == "dynamic" and args.frames:
         scene = scenes.with_frames(scene, args.frames)
+    if scene.groom_file:
+        from harness.io import grooms
+
+        if grooms.is_usd(scene.groom_file):  # the binaries read HAIR: a USD groom passes through one
+            import dataclasses
+            import tempfile
+
+            tmpdir = tempfile.TemporaryDirectory(prefix="hairbench-groom-")
+            hair = os.path.join(tmpdir.name, "groom.hair")
+            grooms.convert(scene.groom_file, hair)
+            scene = dataclasses.replace(scene, groom=hair)
     binary = binary_path(args.backend, args.build)
     flags = runner.run_flags(
         scene,
@@ -400,6 +411,14 @@ def cmd_export(args):
     usd = args.usd or args.usd_only
     for path in export.run(args.state, xdmf=not args.usd_only, usd=usd, out=args.out, force=args.force):
         print(f"wrote {path}")
+    return 0
+
+
+def cmd_groom(args):
+    from harness.io import grooms
+
+    n = grooms.convert(args.src, args.dst, force=args.force)
+    print(f"wrote {args.dst}: {n} strands")
     return 0
 
 
@@ -927,6 +946,19 @@ def parser():
     e.add_argument("--out", help="output prefix (default: the state's path)")
     e.add_argument("--force", action="store_true", help="replace sidecars that exist (else refused, nothing written)")
 
+    gr = sub.add_parser(
+        "groom",
+        help="convert a USD groom (BasisCurves) to the HAIR file the binaries read",
+        description="groom convert IN.usd OUT.hair: every BasisCurves prim of IN in world space, scaled by its "
+        "metersPerUnit to cm and turned Y-up, written as a HAIR file for --groom (docs/model.md §3.15). "
+        'Needs usd-core; refused in one line without it. A scene\'s groom = "x.usd" is converted the same way '
+        "by `run`.",
+    )
+    gsub = gr.add_subparsers(dest="groom_command", required=True)
+    gc = command(gsub, "convert", cmd_groom, help="USD BasisCurves → HAIR")
+    gc.add_argument("src", help="a USD file (.usd, .usda, .usdc, .usdz)")
+    gc.add_argument("dst", help="the HAIR file to write")
+    gc.add_argument("--force", action="store_true", help="replace dst if it exists")
     c = command(
         sub,
         "calibrate",
@@ -1063,7 +1095,8 @@ def parser():
         cmd_stability,
         help="the dynamic model's stability map: verdicts over 2-D slices of the scene space",
         description="Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend "
-        "compliance, points and iterations; head-motion frequency against amplitude) for both solvers and "
+        "compliance, points and iterations, iterations on curly hair; head-motion frequency against amplitude) for "
+        "both solvers and "
         "precisions, on the CPU and every built CUDA build where a GPU answers; judge each cell ok, "
         "over-stretched, penetrating, escaped (a point past 2L) or diverged (NaN/Inf); write "
         "results/stability/, results/local/report/stability_*.png and "

@@ -47,6 +47,7 @@ SCHEMA = {
         "stages": ("stages", "stages"),
         "precision": ("precision", "precision"),
         "seed": ("seed", "seed"),
+        "groom": ("groom", "text"),
         "head": None,
         "hair": None,
         "wind": None,
@@ -57,6 +58,8 @@ SCHEMA = {
         "points": ("points", "count2"),
         "length": ("hair_length", "pos"),
         "offset": ("hair_offset", "pos"),
+        "curl_radius": ("curl_radius", "nonneg"),
+        "curl_pitch": ("curl_pitch", "nonneg"),
     },
     "wind": {"strength": ("wind_strength", "unit"), "angle": ("wind_angle", "real")},
 }
@@ -90,6 +93,10 @@ class Scene:
     hair_offset: float = 0.1
     wind_strength: float = 0.5
     wind_angle: float = math.pi
+    # init places a groom instead of the drape (docs/model.md §3.15): "curly" or a HAIR file
+    groom: str = ""
+    curl_radius: float = 1.0
+    curl_pitch: float = 2.0
     # model = "dynamic": the binary flags of [dynamics], [constraints], [wind] and [head]
     # (harness/core/scenes_dynamic.py), flag → value text, in the order they were declared
     dynamic: dict = field(default_factory=dict)
@@ -122,9 +129,35 @@ class Scene:
         _check_values(scene, f"scene {self.name}")
         return scene
 
+    @property
+    def groom_file(self):
+        """The groom file's path (relative to the scene file's folder), or None."""
+        if self.groom in ("", "curly"):
+            return None
+        src = self.source.removeprefix("scene ")
+        return str(os.path.join(os.path.dirname(src), self.groom)) if src else self.groom
+
     def flags(self):
         """The backend flags that run this scene (docs/interfaces.md)."""
+        if self.groom_file:  # the file decides the head and the strands (docs/model.md §3.15)
+            return [
+                "--points",
+                str(self.points),
+                "--groom",
+                self.groom_file,
+                "--wind-strength",
+                repr(self.wind_strength),
+                "--wind-angle",
+                repr(self.wind_angle),
+                "--stages",
+                ",".join(self.stages),
+                "--precision",
+                self.precision,
+                *scenes_dynamic.flags(self),
+            ]
+        curl = ["--groom", "curly", "--curl-radius", repr(self.curl_radius), "--curl-pitch", repr(self.curl_pitch)]
         return [
+            *(curl if self.groom == "curly" else []),
             "--strands",
             str(self.strands),
             "--points",
@@ -231,6 +264,19 @@ def memory_bytes():
 
 def _check_values(scene, where):
     scenes_dynamic.check(scene, where, SceneError)
+    if scene.groom:
+        if scene.model != "dynamic":
+            raise SceneError(f'{where}: groom needs model = "dynamic"')
+        bad = [s for s in scene.stages if s in ("collide", "wind")]
+        if bad:
+            raise SceneError(
+                f"{where}: a groom runs init then simulate; stage '{bad[0]}' keeps strands in slice planes, which a "
+                "groom's strands are not"
+            )
+        if scene.groom == "curly" and scene.curl_radius == 0 and scene.curl_pitch == 0:
+            raise SceneError(f"{where}: hair.curl_radius and hair.curl_pitch are both 0 (no helix)")
+    elif (scene.curl_radius, scene.curl_pitch) != (1.0, 2.0):
+        raise SceneError(f'{where}: hair.curl_radius and hair.curl_pitch need groom = "curly"')
     if scene.stages[0] != "init":
         raise SceneError(f"{where}: stages must start with init (got '{scene.stages[0]}')")
     if "init" in scene.stages[1:]:

@@ -36,6 +36,7 @@ class Declared:
     solvers: tuple = ()  # the dynamic model's solvers, in the binary's order (none declared: ())
     max_block: dict = field(default_factory=dict)  # variant -> most threads a block of its simulate (absent: 1024)
     variant_solvers: dict = field(default_factory=dict)  # variant -> its solvers (absent: all of `solvers`)
+    per_segment: tuple = ()  # variants that simulate a groom's per-segment rest lengths (docs/model.md §3.15)
 
     def solvers_of(self, variant):
         """The solvers `variant` runs, in the binary's order."""
@@ -117,6 +118,7 @@ def _read(path):
             solvers=tuple(str(x) for x in d.get("solvers", ())),
             max_block={str(v["name"]): int(v["max_block"]) for v in variants if v.get("max_block")},
             variant_solvers={str(v["name"]): tuple(str(x) for x in v["solvers"]) for v in variants if "solvers" in v},
+            per_segment=tuple(str(v["name"]) for v in variants if v.get("per_segment") is True),
         )
     except (ValueError, KeyError, TypeError, AttributeError):
         raise HarnessError(f"{path} --list-variants did not print the documented JSON object") from None

@@ -66,6 +66,7 @@ DYNAMIC_ATTRS = (
     "lra",
     "lra_scale",
     "sag_free",
+    "per_segment",
 )
 REQUIRED_DYNAMIC = (
     "paper_frames",
@@ -158,6 +159,19 @@ class Trajectory(State):
     @property
     def collider(self):
         return bool(int(self.dynamic_params.get("collider", 1)))
+
+    @property
+    def per_segment(self):
+        """Whether the stretch rest lengths are the rest shape's own segments (a groom, §3.15)."""
+        return bool(int(self.dynamic_params.get("per_segment", 0)))
+
+    def segment_rest(self):
+        """The stretch rest lengths in double: ℓ = L/(P−1), or [N][P−1] from the rest shape
+        for a groom (§3.15, summed as c_ref/dynamic/dynamics_host.c hb_dyn_seg_rest does)."""
+        if not self.per_segment:
+            return self.hair_length / (self.points - 1)
+        e = np.diff(self.rest.astype(np.float64), axis=1)
+        return np.sqrt((e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1]) + e[..., 2] * e[..., 2])
 
     @property
     def collide_radius(self):

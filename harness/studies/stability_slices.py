@@ -77,6 +77,14 @@ SLICES = (
         Axis("--iterations", "I", (1, 2, 4, 8, 16, 32, 64, 128), (1, 8, 128)),
     ),
     Slice(
+        "curly-substeps-iterations",
+        "curly hair: substeps against iterations (curly.toml: the default scene's physics on helices)",
+        "curly",
+        (),
+        SUBSTEPS,
+        Axis("--iterations", "I", (1, 2, 4, 8, 16, 32, 64, 128), (1, 8, 128)),
+    ),
+    Slice(
         "motion",
         "nodding head: frequency against amplitude (S = 32)",
         "still-dynamic",

@@ -1,0 +1,102 @@
+"""Grooms from other tools (docs/model.md §3.15): USD BasisCurves converted to the HAIR file the
+binaries read (`python -m harness groom convert IN.usda OUT.hair`).
+
+The binaries are C and cannot link usd-core (Python); so a USD groom passes through here: every
+BasisCurves prim of the stage's default time, its points taken to world space, scaled by the
+stage's metersPerUnit to cm, turned Y-up when the stage is Z-up, and written as a HAIR file
+(segments and points arrays). usd-core is optional: without it a USD groom is refused in one line.
+"""
+
+import os
+import struct
+from pathlib import Path
+
+import numpy as np
+
+from harness import HarnessError
+
+USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
+HAIR_SEGMENTS, HAIR_POINTS = 1, 2
+
+
+def is_usd(path):
+    return Path(path).suffix.lower() in USD_SUFFIXES
+
+
+def _pxr():
+    try:
+        from pxr import Usd, UsdGeom
+    except ImportError:
+        raise HarnessError("a USD groom needs the USD Python bindings: python3 -m pip install usd-core") from None
+    return Usd, UsdGeom
+
+
+def read_usd_curves(path):
+    """The strands of every BasisCurves prim in a USD file, as float64 [n][3] arrays in cm, Y up."""
+    Usd, UsdGeom = _pxr()
+    if not Path(path).is_file():
+        raise HarnessError(f"groom {path}: no such file")
+    stage = Usd.Stage.Open(str(path))
+    if stage is None:
+        raise HarnessError(f"groom {path}: USD could not open it")
+    to_cm = UsdGeom.GetStageMetersPerUnit(stage) / 0.01
+    z_up = UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.z
+    cache = UsdGeom.XformCache()
+    strands = []
+    for prim in stage.Traverse():
+        if not prim.IsA(UsdGeom.BasisCurves):
+            continue
+        curves = UsdGeom.BasisCurves(prim)
+        pts = np.asarray(curves.GetPointsAttr().Get() or [], dtype=np.float64).reshape(-1, 3)
+        counts = list(curves.GetCurveVertexCountsAttr().Get() or [])
+        if sum(counts) != len(pts):
+            raise HarnessError(
+                f"groom {path}: {prim.GetPath()} has {len(pts)} points but its counts sum to {sum(counts)}"
+            )
+        m = np.asarray(cache.GetLocalToWorldTransform(prim), dtype=np.float64)  # row vectors: p·M
+        world = np.hstack([pts, np.ones((len(pts), 1))]) @ m
+        world = world[:, :3] * to_cm
+        if z_up:
+            world = np.stack([world[:, 0], world[:, 2], -world[:, 1]], axis=1)
+        start = 0
+        for n in counts:
+            strands.append(world[start : start + n])
+            start += n
+    if not strands:
+        raise HarnessError(f"groom {path}: no BasisCurves with points")
+    return strands
+
+
+def hair_bytes(strands):
+    """A HAIR file (docs/model.md §3.15's layout) holding the strands: segments and points arrays."""
+    counts = [len(s) for s in strands]
+    if any(n < 1 or n > 65536 for n in counts):
+        raise HarnessError("groom: a HAIR strand holds 1 to 65536 points")
+    head = struct.pack("<4sIIII", b"HAIR", len(strands), sum(counts), HAIR_SEGMENTS | HAIR_POINTS, 0)
+    head += struct.pack("<ff3f", 0.0, 0.0, 0.0, 0.0, 0.0) + b"hairbench groom".ljust(88, b"\0")
+    segments = struct.pack(f"<{len(strands)}H", *[n - 1 for n in counts])
+    return head + segments + np.concatenate(strands).astype("<f4").tobytes()
+
+
+def write_hair(path, strands, force=False):
+    """Write the strands as a HAIR file at path, whole or not at all (an existing file only with force)."""
+    path = Path(path)
+    if path.is_symlink() or (path.exists() and not path.is_file()):
+        raise HarnessError(f"groom: {path} is a symbolic link or not a regular file; refusing to replace it")
+    if path.exists() and not force:
+        raise HarnessError(f"groom: {path} exists (give --force to replace it)")
+    data = hair_bytes(strands)
+    tmp = path.with_name(f"{path.name}.tmp.{os.getpid()}")
+    try:
+        tmp.write_bytes(data)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return path
+
+
+def convert(src, dst, force=False):
+    """A USD groom as a HAIR file; returns the number of strands written."""
+    strands = read_usd_curves(src)
+    write_hair(dst, strands, force=force)
+    return len(strands)
