@@ -89,6 +89,11 @@ struct hb_backend {
     /* The observables of the current state (docs/model.md §3.8). */
     int (*dyn_observe)(hb_backend *b, hb_observables *obs, char *err, size_t errlen);
     int (*dyn_fetch_velocity)(hb_backend *b, void *canonical, char *err, size_t errlen);
+    /* Optional (NULL: the driver fetches the state and renders it on the host): the current
+     * state's rendered points (docs/model.md §3.14, --render-points) into a canonical host
+     * buffer [N·P_r][3], and its velocities when `velocity` is not NULL; *ms the rendering's
+     * own time (kernel time, transfers not counted). */
+    int (*dyn_render)(hb_backend *b, void *position, void *velocity, double *ms, char *err, size_t errlen);
     /* Optional (NULL: not measured): advance the current state by n frames back to back, as
      * an application's frame loop would (each frame's tables uploaded and its kernel
      * launched, no observables, no fetch); *ms = host wall time per frame after one

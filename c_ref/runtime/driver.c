@@ -12,6 +12,7 @@
 #include "runtime/checked.h"
 #include "runtime/cli.h"
 #include "dynamic/dyn_followers.h"
+#include "dynamic/dyn_lod.h"
 #include "runtime/host.h"
 #include "runtime/philox.h"
 #include "runtime/record.h"
@@ -194,6 +195,7 @@ typedef struct {
     hb_writer *w;
     void *host;  /* canonical host frame (output, end-to-end) */
     void *input; /* the input's last frame */
+    void *render, *vrender, *vhost; /* --render-points: a rendered frame and its velocities; simulated velocities */
     hb_input in;
     int have_input;
     double *times; /* all stages' timed runs */
@@ -211,9 +213,40 @@ static void run_free(hb_run *r)
     if (r->b->teardown) r->b->teardown(r->b);
     free(r->host);
     free(r->input);
+    free(r->render);
+    free(r->vrender);
+    free(r->vhost);
     free(r->times);
 }
 
+
+/* The frame as the file holds it: the state itself, or with --render-points its rendered
+ * points (docs/model.md §3.14, the C reference's spline on the host). */
+static const void *as_written(hb_run *r, const void *state)
+{
+    const hb_scene *s = &r->o->scene;
+    if (!s->dyn.render_points) return state;
+    hb_lod_render(s->precision, state, NULL, s->n_strands, s->points, s->dyn.render_points, r->render, NULL);
+    return r->render;
+}
+
+/* A simulated frame's rendered points (and velocities when `vel`) into r->render (r->vrender):
+ * by the backend's own kernel where it has one, else fetched and rendered on the host; *ms
+ * the rendering's time (the kernel, or the host spline; transfers not counted). */
+static int render_frame(hb_run *r, int vel, double *ms, char *err, size_t errlen)
+{
+    hb_backend *b = r->b;
+    const hb_scene *s = &r->o->scene;
+    if (b->dyn_render) return b->dyn_render(b, r->render, vel ? r->vrender : NULL, ms, err, errlen);
+    double fetch_ms;
+    if (b->fetch(b, r->host, &fetch_ms, err, errlen)) return -1;
+    if (vel && b->dyn_fetch_velocity(b, r->vhost, err, errlen)) return -1;
+    const double t0 = hb_now_ms();
+    hb_lod_render(s->precision, r->host, vel ? r->vhost : NULL, s->n_strands, s->points, s->dyn.render_points,
+                  r->render, r->vrender);
+    *ms = hb_now_ms() - t0;
+    return 0;
+}
 
 /* ---- the simulate stage (docs/model.md §3) ---------------------------------------------
  * Starts from the current state: a new simulation takes it as the rest shape with zero
@@ -233,6 +266,8 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
     void *rest = malloc(bytes), *vel = NULL;
     hb_dyn_frame plan, *plans = NULL;
     int64_t n_plans = 0;
+    double *rt = NULL; /* --render-points: each written frame's rendering time */
+    int64_t n_rt = 0;
     memset(&plan, 0, sizeof plan);
     int status = HB_EXIT_OK;
 #define FAIL_IF(cond, st)                                                                                              \
@@ -242,6 +277,10 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
             goto out;                                                                                                  \
         }                                                                                                              \
     } while (0)
+    if (d->render_points && r->w && !(rt = malloc((size_t)o->frames * sizeof *rt))) {
+        snprintf(err, errlen, "out of host memory for the rendering times");
+        FAIL_IF(1, HB_EXIT_MEMORY);
+    }
     if (!rest || hb_dyn_frame_alloc(&plan, d->substeps) != 0) {
         snprintf(err, errlen, "out of host memory for the simulation's rest shape and substep tables");
         FAIL_IF(1, HB_EXIT_MEMORY);
@@ -296,7 +335,7 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
     const double t_end = (double)(gf0 + (o->frame_loop ? 2 : 1) * o->frames) * d->frame_dt;
     FAIL_IF(hb_dynamics_validate_time(s, t_end, err, errlen), HB_EXIT_USAGE);
     FAIL_IF(b->dyn_load(b, vel, rest, err, errlen), HB_EXIT_RUNTIME);
-    if (r->w) FAIL_IF(hb_writer_rest(r->w, rest, err, errlen), HB_EXIT_RUNTIME);
+    if (r->w) FAIL_IF(hb_writer_rest(r->w, as_written(r, rest), err, errlen), HB_EXIT_RUNTIME);
 
     r->sim.dynamic = 1;
     r->sim.paper_frames = paper_frames;
@@ -335,6 +374,14 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         m.step = step;
         m.time = time;
         double ms;
+        if (d->render_points) { /* §3.14: the rendered points, and their velocities */
+            const int vel = o->all_velocities || j == o->frames;
+            FAIL_IF(render_frame(r, vel, &ms, err, errlen), HB_EXIT_RUNTIME);
+            rt[n_rt++] = ms;
+            FAIL_IF(hb_writer_append(r->w, r->render, &m, err, errlen), HB_EXIT_RUNTIME);
+            if (vel) FAIL_IF(hb_writer_velocity(r->w, r->vrender, step, time, err, errlen), HB_EXIT_RUNTIME);
+            continue;
+        }
         FAIL_IF(b->fetch(b, r->host, &ms, err, errlen), HB_EXIT_RUNTIME);
         FAIL_IF(hb_writer_append(r->w, r->host, &m, err, errlen), HB_EXIT_RUNTIME);
         if (o->all_velocities || j == o->frames) {
@@ -343,6 +390,11 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         }
     }
     sr->observe_ms = observe_ms;
+    sr->render_ms = NAN;
+    if (n_rt > 0) {
+        double lo, hi;
+        hb_time_stats(rt, (int)n_rt, &sr->render_ms, &lo, &hi);
+    }
     hb_time_stats(sr->times_ms, sr->n_times, &sr->meta.median_ms, &sr->meta.min_ms, &sr->meta.max_ms);
     sr->loop_ms = sr->loop_graph_ms = NAN;
     if (o->frame_loop) {
@@ -371,6 +423,7 @@ out:
     hb_dyn_frame_free(&plan);
     free(rest);
     free(vel);
+    free(rt);
     return status;
 }
 
@@ -523,8 +576,13 @@ int hb_main(int argc, char **argv, hb_backend *b)
     const uint64_t bytes = hb_state_bytes(&o.scene);
     const int need_host = o.output != NULL || o.end_to_end || simulate;
     /* simulate: the rest shape and the velocities pass through the host once */
+    /* --render-points with --output: a rendered frame, its velocities and the simulated velocities */
+    const int64_t pr = simulate ? o.scene.dyn.render_points : 0;
+    const uint64_t render_bytes =
+        pr && o.output ? hb_mul_sat(hb_mul_sat((uint64_t)o.scene.n_strands, (uint64_t)pr), 3u * hb_real_size(o.scene.precision)) : 0;
     const uint64_t driver_bytes =
-        hb_add_sat(hb_add_sat(need_host ? bytes : 0, o.input ? bytes : 0), simulate ? hb_mul_sat(bytes, 2u) : 0);
+        hb_add_sat(hb_add_sat(hb_add_sat(need_host ? bytes : 0, o.input ? bytes : 0), simulate ? hb_mul_sat(bytes, 2u) : 0),
+                   hb_add_sat(hb_mul_sat(render_bytes, 2u), render_bytes ? bytes : 0));
     const int need_save = o.repeat > 1 || o.warmup > 0;
     int status = b->setup(b, &o, need_save, driver_bytes, err, sizeof err);
     if (status != HB_EXIT_OK) {
@@ -536,6 +594,12 @@ int hb_main(int argc, char **argv, hb_backend *b)
     rec.block_size = b->block_size;
     if (need_host && !(run.host = malloc(bytes))) {
         snprintf(err, sizeof err, "cannot allocate the %llu-byte host frame", (unsigned long long)bytes);
+        CHECK(1, HB_EXIT_MEMORY);
+    }
+    if (render_bytes && (!(run.render = malloc(render_bytes)) || !(run.vrender = malloc(render_bytes)) ||
+                         !(run.vhost = malloc(bytes)))) {
+        snprintf(err, sizeof err, "cannot allocate the %llu-byte rendered frames (--render-points)",
+                 (unsigned long long)render_bytes);
         CHECK(1, HB_EXIT_MEMORY);
     }
     if (o.input && !(run.input = malloc(bytes))) {
@@ -573,7 +637,8 @@ int hb_main(int argc, char **argv, hb_backend *b)
                     CHECK(hb_input_read_frame(&run.in, f, run.host, err, sizeof err), HB_EXIT_USAGE);
                     src = run.host;
                 }
-                CHECK(hb_writer_append(run.w, src, &run.in.frames[f], err, sizeof err), HB_EXIT_RUNTIME);
+                CHECK(hb_writer_append(run.w, as_written(&run, src), &run.in.frames[f], err, sizeof err),
+                      HB_EXIT_RUNTIME);
             }
         }
         frame = last + 1;
@@ -605,7 +670,8 @@ int hb_main(int argc, char **argv, hb_backend *b)
             if (run.w) {
                 double ms;
                 CHECK(b->fetch(b, run.host, &ms, err, sizeof err), HB_EXIT_RUNTIME);
-                CHECK(hb_writer_append(run.w, run.host, &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
+                CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err),
+                      HB_EXIT_RUNTIME);
             }
             frame++;
             i++;
@@ -634,7 +700,8 @@ int hb_main(int argc, char **argv, hb_backend *b)
             sc->meta.moved_points = r.moved_points;
             if (run.w) {
                 CHECK(b->fetch_intermediate(b, run.host, err, sizeof err), HB_EXIT_RUNTIME);
-                CHECK(hb_writer_append(run.w, run.host, &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
+                CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err),
+                      HB_EXIT_RUNTIME);
             }
             sr = sc;
         } else {
@@ -643,7 +710,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
         if (run.w) {
             double ms;
             CHECK(b->fetch(b, run.host, &ms, err, sizeof err), HB_EXIT_RUNTIME);
-            CHECK(hb_writer_append(run.w, run.host, &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
+            CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
         }
         frame += r.consumed;
         i += r.consumed;

@@ -56,6 +56,7 @@ typedef struct {
     int lra;          /* --lra given */
     double lra_scale; /* s_L ≥ 1: the bound is s_L times the rest arc length */
     int sag_free;     /* --sag-free: shape targets that hold the rest shape against gravity */
+    int64_t render_points; /* --render-points P_r: strands written with P_r points (§3.14); 0: as simulated */
 } hb_dynamics;
 
 /* The scene: everything that decides the bits of a state. */
