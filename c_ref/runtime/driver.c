@@ -120,7 +120,7 @@ static int list_variants(const hb_backend *b)
         hb_dyn_feature_names(1u << i, name, sizeof name);
         printf("%s\"%s\"", i ? ", " : "", name);
     }
-    printf(", \"guides\", \"lra\", \"sagfree\"]}\n"); /* §3.13's, declared by their own flags */
+    printf(", \"guides\", \"lra\", \"sagfree\", \"lod\"]}\n"); /* §3.14's, declared by their own flags */
     return HB_EXIT_OK;
 }
 
