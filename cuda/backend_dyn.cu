@@ -61,7 +61,7 @@ struct DynState {
     int64_t *d_guide, *d_follower, *d_src;
     void *d_w;
     void *shape_rest; /* --sag-free: the rest shape the frame kernels read (root, shape targets) */
-    /* §3.14 --render-points with --output: a rendered frame and its velocities, canonical [N·P_r][3] */
+    /* §3.14 --render-points: a rendered frame and its velocities, canonical [N·P_r][3] */
     uint64_t render_bytes;
     void *d_render, *d_vrender;
 };
@@ -145,7 +145,7 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
     need = sat_add(need, hb_mul_sat((uint64_t)d->nchunks, sizeof(hbd::ObsPartial)));
     d->guided = s->dyn.guided;
     if (s->dyn.sag_free) need = sat_add(need, c->bytes); /* the raised shape targets */
-    if (s->dyn.render_points && o->output) {
+    if (s->dyn.render_points) {
         d->render_bytes = hb_mul_sat(hb_mul_sat((uint64_t)N, (uint64_t)s->dyn.render_points), 3u * rs);
         need = sat_add(need, hb_mul_sat(d->render_bytes, 2u));
     }

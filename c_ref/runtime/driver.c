@@ -277,7 +277,7 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
             goto out;                                                                                                  \
         }                                                                                                              \
     } while (0)
-    if (d->render_points && r->w && !(rt = malloc((size_t)o->frames * sizeof *rt))) {
+    if (d->render_points && !(rt = malloc((size_t)o->frames * sizeof *rt))) {
         snprintf(err, errlen, "out of host memory for the rendering times");
         FAIL_IF(1, HB_EXIT_MEMORY);
     }
@@ -365,7 +365,14 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         sr->last = obs;
         sr->blown_frames += hb_obs_blown_up(&obs);
         r->sim.last_frame = gf;
-        if (!r->w) continue;
+        if (!r->w) {
+            if (d->render_points) { /* §3.14: no file: every frame is rendered (and dropped), so its cost shows */
+                double ms;
+                FAIL_IF(render_frame(r, 0, &ms, err, errlen), HB_EXIT_RUNTIME);
+                rt[n_rt++] = ms;
+            }
+            continue;
+        }
         FAIL_IF(hb_writer_observables(r->w, &obs, step, time, err, errlen), HB_EXIT_RUNTIME);
         if (j % o->output_every != 0 && j != o->frames) continue;
         hb_frame_meta m;
@@ -576,10 +583,10 @@ int hb_main(int argc, char **argv, hb_backend *b)
     const uint64_t bytes = hb_state_bytes(&o.scene);
     const int need_host = o.output != NULL || o.end_to_end || simulate;
     /* simulate: the rest shape and the velocities pass through the host once */
-    /* --render-points with --output: a rendered frame, its velocities and the simulated velocities */
+    /* --render-points: a rendered frame, its velocities and the simulated velocities */
     const int64_t pr = simulate ? o.scene.dyn.render_points : 0;
     const uint64_t render_bytes =
-        pr && o.output ? hb_mul_sat(hb_mul_sat((uint64_t)o.scene.n_strands, (uint64_t)pr), 3u * hb_real_size(o.scene.precision)) : 0;
+        pr ? hb_mul_sat(hb_mul_sat((uint64_t)o.scene.n_strands, (uint64_t)pr), 3u * hb_real_size(o.scene.precision)) : 0;
     const uint64_t driver_bytes =
         hb_add_sat(hb_add_sat(hb_add_sat(need_host ? bytes : 0, o.input ? bytes : 0), simulate ? hb_mul_sat(bytes, 2u) : 0),
                    hb_add_sat(hb_mul_sat(render_bytes, 2u), render_bytes ? bytes : 0));
