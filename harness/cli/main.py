@@ -1026,7 +1026,8 @@ def parser():
         "stability",
         help="the dynamic model's stability map: verdicts over 2-D slices of the scene space",
         description="Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend "
-        "compliance, points and iterations; head-motion frequency against amplitude) for both solvers and "
+        "compliance, points and iterations; head-motion frequency against amplitude; long-range attachments "
+        "on and off under fast nods and gales) for both solvers and "
         "precisions, on the CPU and every built CUDA build where a GPU answers; judge each cell ok, "
         "over-stretched, penetrating, escaped (a point past 2L) or diverged (NaN/Inf); write "
         "results/stability/, results/local/report/stability_*.png and "
