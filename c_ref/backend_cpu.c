@@ -194,10 +194,6 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
                  "use --variant ref");
         return HB_EXIT_USAGE;
     }
-    if (s->dyn.guided) { /* docs/cpu_simd.md: not in the simd variant yet */
-        snprintf(err, errlen, "--variant simd does not run --guides; use --variant ref");
-        return HB_EXIT_USAGE;
-    }
     if (s->points > INT32_MAX) {
         snprintf(err, errlen, "--variant simd takes at most %d points per strand (got %lld)", INT32_MAX,
                  (long long)s->points);
@@ -927,10 +923,10 @@ static void cpu_teardown(hb_backend *b)
 static const hb_variant cpu_variants[] = {
     {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands", 0, 0,
-     (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL) | (1u << HB_SOLVER_RIGID)},
+     (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL) | (1u << HB_SOLVER_RIGID), 0},
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
-     "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks", 0, 0, 0},
-    {NULL, 0, NULL, 0, 0, 0},
+     "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks", 0, 0, 0, HB_X_GUIDES},
+    {NULL, 0, NULL, 0, 0, 0, 0},
 };
 
 #ifndef HB_FLAGS

@@ -110,11 +110,6 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
         snprintf(err, errlen, "internal error: variant without simulate reached the simulate setup");
         return -1;
     }
-    if (c->variant == V_LANES && (o->scene.dyn.guided || o->scene.dyn.lra)) { /* docs/cuda.md */
-        snprintf(err, errlen, "--variant lanes does not run %s; use strand, warp or warpreg",
-                 o->scene.dyn.guided ? "--guides" : "--lra");
-        return HB_EXIT_USAGE;
-    }
     DynState *d = (DynState *)calloc(1, sizeof *d);
     if (!d) {
         snprintf(err, errlen, "out of host memory");

@@ -74,6 +74,18 @@ static int self_test_rng(void)
     return failed ? 1 : 0;
 }
 
+/* The §3.14 features by HB_X_* bit: the name --list-variants gives, the flag that declares it. */
+static const struct {
+    const char *name, *flag;
+} x_features[HB_X_COUNT] = {{"guides", "--guides"}, {"lra", "--lra"}, {"sagfree", "--sag-free"}, {"lod", "--render-points"}};
+
+/* The §3.14 features a scene declares, HB_X_* bits. */
+static unsigned x_declared(const hb_dynamics *d)
+{
+    return (d->guided ? HB_X_GUIDES : 0u) | (d->lra ? HB_X_LRA : 0u) | (d->sag_free ? HB_X_SAGFREE : 0u) |
+           (d->render_points ? HB_X_LOD : 0u);
+}
+
 /* A JSON list of the solvers in the bit set `set` (bit 1 << hb_solver), after `key`. */
 static void print_solvers(const char *key, unsigned set)
 {
@@ -106,7 +118,16 @@ static int list_variants(const hb_backend *b)
         printf("], \"summary\": \"%s\"", v->summary);
         if (v->max_points > 0) printf(", \"max_points\": %lld", (long long)v->max_points);
         if (v->max_block > 0) printf(", \"max_block\": %d", v->max_block);
-        if (v->stages & (1u << HB_STAGE_SIMULATE)) print_solvers(", \"solvers\": ", hb_variant_solvers(v));
+        if (v->stages & (1u << HB_STAGE_SIMULATE)) {
+            print_solvers(", \"solvers\": ", hb_variant_solvers(v));
+            printf(", \"features\": [");
+            for (int x = 0, first = 1; x < HB_X_COUNT; x++)
+                if (!(v->lacks & (1u << x))) {
+                    printf("%s\"%s\"", first ? "" : ", ", x_features[x].name);
+                    first = 0;
+                }
+            printf("]");
+        }
         printf("}");
     }
     unsigned any = 0;
@@ -544,6 +565,13 @@ int hb_main(int argc, char **argv, hb_backend *b)
                      hb_solver_name(o.scene.dyn.solver), b->name, var->name);
             CHECK(1, HB_EXIT_USAGE);
         }
+        const unsigned lacking = x_declared(&o.scene.dyn) & var->lacks;
+        for (int x = 0; x < HB_X_COUNT; x++)
+            if (lacking & (1u << x)) {
+                snprintf(err, sizeof err, "--variant %s does not run %s (see --list-variants)", var->name,
+                         x_features[x].flag);
+                CHECK(1, HB_EXIT_USAGE);
+            }
         if (var->max_block > 0 && o.block_size > var->max_block) {
             snprintf(err, sizeof err,
                      "--block-size %d: the %s variant %s simulates with at most %d threads a block (see "

@@ -28,8 +28,8 @@ the accuracy study's converged ladder: a row's error includes its S and I's own 
 the "all simulated" rows (fraction 1, LRA off) show beside it.
 
 Time per frame: the same settings at `time_strands` strands (no file, --repeat), on the cpu
-oracle and, with a usable GPU, on each cuda variant that runs the features (`lanes` refuses
-them, docs/cuda.md). Writes CSV (one row per case and timing binary).
+oracle and, with a usable GPU, on each cuda variant that runs all the features (its
+`--list-variants` entry lists them; `lanes` lacks guides and LRA, docs/cuda.md). Writes CSV (one row per case and timing binary).
 """
 
 from dataclasses import dataclass, replace
@@ -74,6 +74,7 @@ FIELDS = (
     "device",
 )
 FRACTIONS = (1.0, 0.5, 0.25, 0.1, 0.05)
+STUDIED = ("guides", "lra", "sagfree", "lod")  # the §3.14 features the rows declare: a timed variant runs them all
 SCHEMES = ("one", "blend3")
 
 
@@ -154,7 +155,7 @@ def timing_binaries(plan):
     ok, _ = env.gpu_status()
     if plan.gpu != "no" and ok and binary_path("cuda", "default").exists():
         d = variants.declared("cuda")
-        out += [("cuda", v) for v in d.running("simulate") if v != "lanes"]
+        out += [("cuda", v) for v in d.running("simulate") if d.runs_features(v, STUDIED)]
     return out
 
 
