@@ -799,8 +799,7 @@ static int cpu_dyn_render(hb_backend *b, void *position, void *velocity, double 
             const double *xi = (const double *)x + (size_t)i * ss;
             hb_lod_strand_f64(xi, xi, ps, pr, (double *)position + (size_t)i * sr);
             if (velocity)
-                hb_lod_strand_f64(xi, (const double *)v + (size_t)i * ss, ps, pr,
-                                  (double *)velocity + (size_t)i * sr);
+                hb_lod_strand_f64(xi, (const double *)v + (size_t)i * ss, ps, pr, (double *)velocity + (size_t)i * sr);
         }
     }
     *ms = hb_now_ms() - t0;

@@ -208,9 +208,8 @@ int dyn_alloc(cuda_impl *c, int need_save, char *err, size_t errlen)
                            hb_mul_sat(hb_mul_sat((uint64_t)d->grid * (uint64_t)c->block * 9u, (uint64_t)P), rs), c,
                            "per-thread scratch", err, errlen)))
         return rc;
-    if (d->render_bytes &&
-        ((rc = device_alloc(&d->d_render, d->render_bytes, c, "rendered points", err, errlen)) ||
-         (rc = device_alloc(&d->d_vrender, d->render_bytes, c, "rendered velocities", err, errlen))))
+    if (d->render_bytes && ((rc = device_alloc(&d->d_render, d->render_bytes, c, "rendered points", err, errlen)) ||
+                            (rc = device_alloc(&d->d_vrender, d->render_bytes, c, "rendered velocities", err, errlen))))
         return rc;
     d->h_obs = (hbd::ObsPartial *)malloc((size_t)hb_mul_sat((uint64_t)d->nchunks, sizeof *d->h_obs));
     d->h_part = (hb_obs_partial *)malloc((size_t)hb_mul_sat((uint64_t)d->nchunks, sizeof *d->h_part));
@@ -225,9 +224,9 @@ void dyn_free(cuda_impl *c)
 {
     DynState *d = c->dyn;
     if (!d) return;
-    void *ptrs[] = {d->vel,   d->vel_saved, d->rest,       d->bend_rest, d->scratch, d->q,         d->ph,
-                    d->d_obs, d->d_guide,   d->d_follower, d->d_src,     d->d_w,     d->shape_rest,
-                    d->d_render, d->d_vrender};
+    void *ptrs[] = {d->vel,   d->vel_saved, d->rest,       d->bend_rest, d->scratch,
+                    d->q,     d->ph,        d->d_obs,      d->d_guide,   d->d_follower,
+                    d->d_src, d->d_w,       d->shape_rest, d->d_render,  d->d_vrender};
     for (void *p : ptrs)
         if (p) cudaFree(p);
     free(d->h_obs);
@@ -468,11 +467,12 @@ int cuda_dyn_render(hb_backend *b, void *position, void *velocity, double *ms, c
     HB_CUDA(cudaEventRecord(c->ev0, 0));
     if (c->scene.precision == HB_FP32)
         e = hbd::launch_lod_render<float>((const float *)c->state, velocity ? (const float *)d->vel : nullptr,
-                                          dyn_layout(c), c->N, c->P, pr, (float *)d->d_render, (float *)d->d_vrender, 0);
+                                          dyn_layout(c), c->N, c->P, pr, (float *)d->d_render, (float *)d->d_vrender,
+                                          0);
     else
         e = hbd::launch_lod_render<double>((const double *)c->state, velocity ? (const double *)d->vel : nullptr,
-                                           dyn_layout(c), c->N, c->P, pr, (double *)d->d_render,
-                                           (double *)d->d_vrender, 0);
+                                           dyn_layout(c), c->N, c->P, pr, (double *)d->d_render, (double *)d->d_vrender,
+                                           0);
     HB_CUDA_AS(e, "the rendering kernel launch (--render-points)");
     HB_CUDA(cudaEventRecord(c->ev1, 0));
     HB_CUDA_AS(cudaEventSynchronize(c->ev1), "the rendering kernel (cudaEventSynchronize)");

@@ -23,8 +23,7 @@ void hb_lod_strand_f64(const double *x, const double *y, int64_t ps, int64_t pr,
 void hb_lod_render_f32(const float *x, const float *v, int64_t n, int64_t ps, int64_t pr, float *xr, float *vr);
 void hb_lod_render_f64(const double *x, const double *v, int64_t n, int64_t ps, int64_t pr, double *xr, double *vr);
 /* Either, by the precision. */
-void hb_lod_render(hb_precision p, const void *x, const void *v, int64_t n, int64_t ps, int64_t pr, void *xr,
-                   void *vr);
+void hb_lod_render(hb_precision p, const void *x, const void *v, int64_t n, int64_t ps, int64_t pr, void *xr, void *vr);
 
 #ifdef __cplusplus
 }

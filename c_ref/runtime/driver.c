@@ -77,7 +77,8 @@ static int self_test_rng(void)
 /* The §3.14 features by HB_X_* bit: the name --list-variants gives, the flag that declares it. */
 static const struct {
     const char *name, *flag;
-} x_features[HB_X_COUNT] = {{"guides", "--guides"}, {"lra", "--lra"}, {"sagfree", "--sag-free"}, {"lod", "--render-points"}};
+} x_features[HB_X_COUNT] = {
+    {"guides", "--guides"}, {"lra", "--lra"}, {"sagfree", "--sag-free"}, {"lod", "--render-points"}};
 
 /* The §3.14 features a scene declares, HB_X_* bits. */
 static unsigned x_declared(const hb_dynamics *d)
@@ -214,8 +215,8 @@ typedef struct {
     hb_options *o;
     hb_record *rec;
     hb_writer *w;
-    void *host;  /* canonical host frame (output, end-to-end) */
-    void *input; /* the input's last frame */
+    void *host;                     /* canonical host frame (output, end-to-end) */
+    void *input;                    /* the input's last frame */
     void *render, *vrender, *vhost; /* --render-points: a rendered frame and its velocities; simulated velocities */
     hb_input in;
     int have_input;
@@ -614,10 +615,11 @@ int hb_main(int argc, char **argv, hb_backend *b)
     /* --render-points: a rendered frame, its velocities and the simulated velocities */
     const int64_t pr = simulate ? o.scene.dyn.render_points : 0;
     const uint64_t render_bytes =
-        pr ? hb_mul_sat(hb_mul_sat((uint64_t)o.scene.n_strands, (uint64_t)pr), 3u * hb_real_size(o.scene.precision)) : 0;
-    const uint64_t driver_bytes =
-        hb_add_sat(hb_add_sat(hb_add_sat(need_host ? bytes : 0, o.input ? bytes : 0), simulate ? hb_mul_sat(bytes, 2u) : 0),
-                   hb_add_sat(hb_mul_sat(render_bytes, 2u), render_bytes ? bytes : 0));
+        pr ? hb_mul_sat(hb_mul_sat((uint64_t)o.scene.n_strands, (uint64_t)pr), 3u * hb_real_size(o.scene.precision))
+           : 0;
+    const uint64_t driver_bytes = hb_add_sat(
+        hb_add_sat(hb_add_sat(need_host ? bytes : 0, o.input ? bytes : 0), simulate ? hb_mul_sat(bytes, 2u) : 0),
+        hb_add_sat(hb_mul_sat(render_bytes, 2u), render_bytes ? bytes : 0));
     const int need_save = o.repeat > 1 || o.warmup > 0;
     int status = b->setup(b, &o, need_save, driver_bytes, err, sizeof err);
     if (status != HB_EXIT_OK) {
@@ -705,8 +707,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
             if (run.w) {
                 double ms;
                 CHECK(b->fetch(b, run.host, &ms, err, sizeof err), HB_EXIT_RUNTIME);
-                CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err),
-                      HB_EXIT_RUNTIME);
+                CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
             }
             frame++;
             i++;
@@ -735,8 +736,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
             sc->meta.moved_points = r.moved_points;
             if (run.w) {
                 CHECK(b->fetch_intermediate(b, run.host, err, sizeof err), HB_EXIT_RUNTIME);
-                CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err),
-                      HB_EXIT_RUNTIME);
+                CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
             }
             sr = sc;
         } else {

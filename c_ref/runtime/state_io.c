@@ -102,7 +102,7 @@ struct hb_writer {
     char *path, *tmp;
     int force; /* --force: the rename may replace a file that appeared during the run */
     hid_t file, value;
-    hb_scene scene;          /* points: the written ones (P_r with --render-points) */
+    hb_scene scene;           /* points: the written ones (P_r with --render-points) */
     int64_t simulated_points; /* P_s */
     uint64_t rows;            /* N·P */
     int n_frames, cap;

@@ -938,10 +938,13 @@ def parser():
 
     rd = sub.add_parser(
         "reduced",
-        help="the dynamic model with guides and followers and with long-range attachments: error and time",
-        description="Run a dynamic scene with guide fractions 100/50/25/10/5%% x scheme (one, blend3) and "
-        "LRA off/on at few iterations; compare each with every strand simulated (xpbd, fp64, finer S) and time "
-        "it on the cpu oracle and, with a usable GPU, the cuda variants that run it (docs/model.md §3.14). "
+        help="the dynamic model with guides and followers, long-range attachments, sag-free rest and "
+        "simulated-point LOD: error and time",
+        description="Run a dynamic scene with guide fractions 100/50/25/10/5%% x scheme (one, blend3), "
+        "LRA off/on at few iterations, and P_s simulated points written as P_r = 33 (--render-points); compare "
+        "each with every strand and point simulated (xpbd, fp64, finer S) and time it on the cpu oracle and, "
+        "with a usable GPU, the cuda variants that run it (docs/model.md §3.14); and the still scene with and "
+        "without sag-free rest: how far it sags, and the tip's swing frequency under a wind step. "
         "Prints a Markdown table; --out writes the rows as CSV.",
     )
     rd.add_argument("--scene", default=None, help="a dynamic scene (default dynamic)")

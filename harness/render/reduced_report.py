@@ -44,6 +44,11 @@ def _fmt_ms(d, col):
     return f"{d[col]:.3f}" if col in d else "—"
 
 
+def _points(r):
+    """P_s as the LOD table writes it: "9", or "33 (all)" where every written point is simulated."""
+    return f"{r['points']}" + (" (all)" if int(r["points"]) == int(r["render_points"]) else "")
+
+
 def _errs(r):
     return f"{float(r['rms_err_L']):.3g}", f"{float(r['max_err_L']):.3g}"
 
@@ -120,7 +125,8 @@ def markdown(rows):
         ]
         for (_st, solver, *_rest, on, _p), (r, _t) in freq:
             lines.append(
-                f"| {solver} | {'on' if on == '1' else 'off'} | {float(r['tip_hz']):.4g} | {float(r['tip_damping']):.3g} |"
+                f"| {solver} | {'on' if on == '1' else 'off'} | {float(r['tip_hz']):.4g} | "
+                f"{float(r['tip_damping']):.3g} |"
             )
     if any(k[0] == "lod" for k in cases):
         pr = next(r["render_points"] for k, (r, _t) in cases.items() if k[0] == "lod")
@@ -136,7 +142,7 @@ def markdown(rows):
                 "lod",
                 ("solver", "P_s", "rms err / L", "max err / L"),
                 "| --- | ---: | ---: | ---: |",
-                lambda k, r: (k[1], f"{r['points']}" + (" (all)" if int(r["points"]) == int(r["render_points"]) else ""), *_errs(r)),
+                lambda k, r: (k[1], _points(r), *_errs(r)),
             ),
         ]
     lines += ["", *recommend(rows)]

@@ -29,7 +29,8 @@ the "all simulated" rows (fraction 1, LRA off) show beside it.
 
 Time per frame: the same settings at `time_strands` strands (no file, --repeat), on the cpu
 oracle and, with a usable GPU, on each cuda variant that runs all the features (its
-`--list-variants` entry lists them; `lanes` lacks guides and LRA, docs/cuda.md). Writes CSV (one row per case and timing binary).
+`--list-variants` entry lists them; `lanes` lacks guides and LRA, docs/cuda.md). Writes CSV
+(one row per case and timing binary).
 """
 
 from dataclasses import dataclass, replace
@@ -116,7 +117,8 @@ def cases(plan, scene):
         for lra in (0, 1):
             out.append(("lra", "xpbd", s, i, 1.0, "", lra, fast + (["--lra"] if lra else []), None))
     still = ["--head-motion", "still", "--wind-speed", "0", "--shape-range", "1"]
-    wind = ["--head-motion", "still", "--wind-speed", repr(plan.sag_wind), "--gust-amplitude", "0", "--shape-range", "1"]
+    wind = ["--head-motion", "still", "--wind-speed", repr(plan.sag_wind), "--gust-amplitude", "0"]
+    wind += ["--shape-range", "1"]
     for study, flags in (("sagfree", still), ("sagfreq", wind)):
         for solver in ("xpbd", "ftl"):
             for sag in (0, 1):

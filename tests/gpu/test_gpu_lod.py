@@ -70,8 +70,21 @@ def test_gpu_rendering_matches_the_reference(cpu_files, build, variant, precisio
     out = work / f"gpu_{build}_{variant}_{precision}.h5"
     binary = CUDA_STRICT_BIN if build == "strict" else CUDA_BIN
     rec = json.loads(
-        run(binary, "--input", paper, "--stages", "simulate", *PHYSICS, "--variant", variant, "--output", out,
-            "--force", "--json", "--quiet").stdout  # fmt: skip
+        run(
+            binary,
+            "--input",
+            paper,
+            "--stages",
+            "simulate",
+            *PHYSICS,
+            "--variant",
+            variant,
+            "--output",
+            out,
+            "--force",
+            "--json",
+            "--quiet",
+        ).stdout  # fmt: skip
     )
     sim = rec["stages"][-1]
     assert sim["render_points"] == PR and np.isfinite(sim["render_ms"]) and sim["render_ms"] >= 0
