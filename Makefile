@@ -71,7 +71,7 @@ NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DH
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
 HOSTCHECK_BINS := $(BUILD)/hostcheck/model_hostcheck_reference $(BUILD)/hostcheck/model_hostcheck_free \
-                  $(BUILD)/hostcheck/dyn_hostcheck $(BUILD)/hostcheck/post_hostcheck
+                  $(BUILD)/hostcheck/dyn_hostcheck $(BUILD)/hostcheck/post_hostcheck $(BUILD)/hostcheck/lod_hostcheck
 
 .PHONY: all cpu planted cuda hostcheck test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt docs
 
@@ -183,6 +183,10 @@ $(BUILD)/hostcheck/dyn_hostcheck: cuda/hostcheck/dyn_hostcheck.cu cuda/dyn_model
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
 $(BUILD)/hostcheck/post_hostcheck: cuda/hostcheck/post_hostcheck.cu cuda/dyn_post.cuh cuda/dyn_model.cuh $(C_HEADERS) \
   $(OBJ)/dynamic/dyn_followers.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o
+	@mkdir -p $(@D)
+	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
+$(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/dyn_lod.cuh cuda/dyn_model.cuh $(C_HEADERS) \
+  $(OBJ)/dynamic/dyn_lod.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
 else
