@@ -229,6 +229,8 @@ def measure(plan=Plan(), out=None, work=None, progress=print):
                 "blown_up": blown,
             }
             for backend, variant in timers:
+                if backend == "cuda" and not variants.declared("cuda").runs(variant, points=p_sim):
+                    continue  # more points than the variant simulates (warpreg: 32)
                 n = plan.time_gpu_strands if backend == "cuda" else plan.time_strands
                 tf = _flags(scene, solver=solver, substeps=s, iterations=it, precision="fp32", strands=n, frames=2,
                             extra=extra, variant=(backend, variant), points=points)  # fmt: skip
