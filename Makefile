@@ -58,7 +58,7 @@ CPU_FLAGS_STR_V4 := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (c_ref/simd/, x86
 # output), paper/ and dynamic/ (the two models' reference), simd/ (the CPU simd variant), and
 # backend_cpu.c (the CPU backend that puts them together). Included as "runtime/params.h".
 SHARED_SRC := $(wildcard c_ref/runtime/*.c) c_ref/paper/model_host.c c_ref/dynamic/dynamics_host.c \
-              c_ref/dynamic/dyn_followers.c c_ref/dynamic/dyn_sagfree.c
+              c_ref/dynamic/dyn_followers.c c_ref/dynamic/dyn_sagfree.c c_ref/dynamic/dyn_lod.c
 SHARED_OBJ := $(SHARED_SRC:c_ref/%.c=$(OBJ)/%.o)
 CPU_SRC    := c_ref/paper/model.c c_ref/dynamic/dynamics_f32.c c_ref/dynamic/dynamics_f64.c $(wildcard c_ref/simd/*.c) \
               c_ref/backend_cpu.c
@@ -75,7 +75,7 @@ NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DH
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
 HOSTCHECK_BINS := $(BUILD)/hostcheck/model_hostcheck_reference $(BUILD)/hostcheck/model_hostcheck_free \
-                  $(BUILD)/hostcheck/dyn_hostcheck $(BUILD)/hostcheck/post_hostcheck
+                  $(BUILD)/hostcheck/dyn_hostcheck $(BUILD)/hostcheck/post_hostcheck $(BUILD)/hostcheck/lod_hostcheck
 
 .PHONY: all cpu planted cuda hostcheck test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt docs
 
@@ -192,6 +192,10 @@ $(BUILD)/hostcheck/dyn_hostcheck: cuda/hostcheck/dyn_hostcheck.cu cuda/dyn_model
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
 $(BUILD)/hostcheck/post_hostcheck: cuda/hostcheck/post_hostcheck.cu cuda/dyn_post.cuh cuda/dyn_model.cuh $(C_HEADERS) \
   $(OBJ)/dynamic/dyn_followers.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o
+	@mkdir -p $(@D)
+	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
+$(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/dyn_lod.cuh cuda/dyn_model.cuh $(C_HEADERS) \
+  $(OBJ)/dynamic/dyn_lod.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
 else

@@ -24,6 +24,7 @@
 #include "dynamic/dynamics.h"
 #include "simd/dynamics_simd.h"
 #include "runtime/host.h"
+#include "dynamic/dyn_lod.h"
 #include "paper/model.h"
 #include "simd/model_simd.h"
 #include "runtime/record.h"
@@ -244,10 +245,6 @@ static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t 
     }
     const int isa_status = simd_pick_isa(c, err, errlen);
     if (isa_status != HB_EXIT_OK) return isa_status;
-    if (s->dyn.guided) { /* docs/cpu_simd.md: not in the simd variant yet */
-        snprintf(err, errlen, "--variant simd does not run --guides; use --variant ref");
-        return HB_EXIT_USAGE;
-    }
     if (s->points > INT32_MAX) {
         snprintf(err, errlen, "--variant simd takes at most %d points per strand (got %lld)", INT32_MAX,
                  (long long)s->points);
@@ -842,6 +839,51 @@ static int cpu_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, siz
     return 0;
 }
 
+/* --render-points (docs/model.md §3.14): the rendered points of the current state, strands
+ * in parallel; the simd variant's state is made canonical first (not timed). */
+static int cpu_dyn_render(hb_backend *b, void *position, void *velocity, double *ms, char *err, size_t errlen)
+{
+    cpu_impl *c = b->impl;
+    const hb_scene *s = &c->scene;
+    const int64_t N = s->n_strands, ps = s->points, pr = s->dyn.render_points;
+    const void *x = c->state, *v = c->vel;
+    void *xs = NULL, *vs = NULL;
+    if (c->simd) {
+        xs = malloc(c->bytes);
+        vs = velocity ? malloc(c->bytes) : NULL;
+        if (!xs || (velocity && !vs)) {
+            free(xs);
+            free(vs);
+            snprintf(err, errlen, "out of host memory for the state to render (--render-points)");
+            return -1;
+        }
+        simd_convert(c, c->pm, xs, 0);
+        if (vs) simd_convert(c, c->pv, vs, 0);
+        x = xs;
+        v = vs;
+    }
+    const size_t ss = (size_t)ps * 3u, sr = (size_t)pr * 3u;
+    const double t0 = hb_now_ms();
+#pragma omp parallel for schedule(static)
+    for (int64_t i = 0; i < N; i++) {
+        if (s->precision == HB_FP32) {
+            const float *xi = (const float *)x + (size_t)i * ss;
+            hb_lod_strand_f32(xi, xi, ps, pr, (float *)position + (size_t)i * sr);
+            if (velocity)
+                hb_lod_strand_f32(xi, (const float *)v + (size_t)i * ss, ps, pr, (float *)velocity + (size_t)i * sr);
+        } else {
+            const double *xi = (const double *)x + (size_t)i * ss;
+            hb_lod_strand_f64(xi, xi, ps, pr, (double *)position + (size_t)i * sr);
+            if (velocity)
+                hb_lod_strand_f64(xi, (const double *)v + (size_t)i * ss, ps, pr, (double *)velocity + (size_t)i * sr);
+        }
+    }
+    *ms = hb_now_ms() - t0;
+    free(xs);
+    free(vs);
+    return 0;
+}
+
 /* STREAM-style kernels over all cores (after McCalpin's STREAM definitions, written here):
  * copy c = a, counted as 16 bytes per element (read + write), and triad a = b + q·c,
  * counted as 24 bytes per element (two reads + one write; as in STREAM, the write-allocate
@@ -959,12 +1001,12 @@ static void cpu_teardown(hb_backend *b)
 static const hb_variant cpu_variants[] = {
     {"ref", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "the oracle: model_impl.h and dynamics_impl.h one strand at a time, OpenMP over strands", 0, 0,
-     (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL) | (1u << HB_SOLVER_RIGID), 1},
+     (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL) | (1u << HB_SOLVER_RIGID), 1, 0},
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks; built for x86-64-v3 and "
      "x86-64-v4, the CPU's widest runs (the record's flags say which)",
-     0, 0, 0, 1},
-    {NULL, 0, NULL, 0, 0, 0, 0},
+     0, 0, 0, 1, HB_X_GUIDES},
+    {NULL, 0, NULL, 0, 0, 0, 0, 0},
 };
 
 #ifndef HB_FLAGS
@@ -998,5 +1040,6 @@ int main(int argc, char **argv)
     b.dyn_frame = cpu_dyn_frame;
     b.dyn_observe = cpu_dyn_observe;
     b.dyn_fetch_velocity = cpu_dyn_fetch_velocity;
+    b.dyn_render = cpu_dyn_render;
     return hb_main(argc, argv, &b);
 }

@@ -472,7 +472,7 @@ const hb_variant cuda_variants[] = {
      "strand-major like paper; simulate: L lanes a strand (16 for xpbd, 8 for ftl), 2 to 8 points a lane in "
      "registers (at most 128 points), nearly every lane busy in every constraint group; free arithmetic outside "
      "the strict build",
-     hb::dyn::kLanesMaxPoints, hb::dyn::kLanesMaxBlock},
+     hb::dyn::kLanesMaxPoints, hb::dyn::kLanesMaxBlock, 0, 0, HB_X_GUIDES | HB_X_LRA},
     {NULL, 0, NULL, 0, 0},
 };
 
@@ -520,5 +520,6 @@ int main(int argc, char **argv)
     b.dyn_observe = cuda_dyn_observe;
     b.dyn_fetch_velocity = cuda_dyn_fetch_velocity;
     b.dyn_loop = cuda_dyn_loop;
+    b.dyn_render = cuda_dyn_render;
     return hb_main(argc, argv, &b);
 }

@@ -82,6 +82,7 @@ int cuda_dyn_load(hb_backend *b, const void *velocity, const void *rest, char *e
 int cuda_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen);
 int cuda_dyn_observe(hb_backend *b, hb_observables *obs, char *err, size_t errlen);
 int cuda_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, size_t errlen);
+int cuda_dyn_render(hb_backend *b, void *position, void *velocity, double *ms, char *err, size_t errlen);
 int cuda_dyn_loop(hb_backend *b, const hb_dyn_frame *plans, int n, double *ms, double *graph_ms, char *err,
                   size_t errlen);
 

@@ -33,6 +33,7 @@
 #include "backend_cuda.cuh"
 #include "check.cuh"
 #include "dyn_kernels.cuh"
+#include "dyn_lod.cuh"
 #include "dyn_post.cuh"
 #include "dynamic/dyn_followers.h"
 #include "dynamic/dyn_sagfree.h"
@@ -62,6 +63,9 @@ struct DynState {
     void *shape_rest; /* --sag-free: the rest shape the frame kernels read (root, shape targets) */
     void *seg_rest;   /* §3.15 a groom's ℓ_k in the variant's layout ([P−1][N] strand, [N][P−1] warp) */
     double *seg64;    /* and in double [N][P−1], for the observables */
+    /* §3.14 --render-points: a rendered frame and its velocities, canonical [N·P_r][3] */
+    uint64_t render_bytes;
+    void *d_render, *d_vrender;
 };
 
 int dyn_is_strand_major(const cuda_impl *c)
@@ -108,11 +112,6 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
         snprintf(err, errlen, "internal error: variant without simulate reached the simulate setup");
         return -1;
     }
-    if (c->variant == V_LANES && (o->scene.dyn.guided || o->scene.dyn.lra)) { /* docs/cuda.md */
-        snprintf(err, errlen, "--variant lanes does not run %s; use strand, warp or warpreg",
-                 o->scene.dyn.guided ? "--guides" : "--lra");
-        return HB_EXIT_USAGE;
-    }
     DynState *d = (DynState *)calloc(1, sizeof *d);
     if (!d) {
         snprintf(err, errlen, "out of host memory");
@@ -145,6 +144,10 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
     if (s->dyn.sag_free) need = sat_add(need, c->bytes); /* the raised shape targets */
     if (s->dyn.per_segment)                              /* §3.15 a groom's ℓ_k, working precision and double */
         need = sat_add(need, hb_mul_sat(hb_mul_sat((uint64_t)N, (uint64_t)(P - 1)), rs + 8u));
+    if (s->dyn.render_points) {
+        d->render_bytes = hb_mul_sat(hb_mul_sat((uint64_t)N, (uint64_t)s->dyn.render_points), 3u * rs);
+        need = sat_add(need, hb_mul_sat(d->render_bytes, 2u));
+    }
     if (d->guided) /* guide and follower numbers, up to 3 guides and weights a follower */
         need = sat_add(need, hb_mul_sat((uint64_t)N, 8u + 3u * (8u + rs)));
     if (c->variant == V_STRAND) {
@@ -215,6 +218,9 @@ int dyn_alloc(cuda_impl *c, int need_save, char *err, size_t errlen)
                            hb_mul_sat(hb_mul_sat((uint64_t)d->grid * (uint64_t)c->block * 9u, (uint64_t)P), rs), c,
                            "per-thread scratch", err, errlen)))
         return rc;
+    if (d->render_bytes && ((rc = device_alloc(&d->d_render, d->render_bytes, c, "rendered points", err, errlen)) ||
+                            (rc = device_alloc(&d->d_vrender, d->render_bytes, c, "rendered velocities", err, errlen))))
+        return rc;
     d->h_obs = (hbd::ObsPartial *)malloc((size_t)hb_mul_sat((uint64_t)d->nchunks, sizeof *d->h_obs));
     d->h_part = (hb_obs_partial *)malloc((size_t)hb_mul_sat((uint64_t)d->nchunks, sizeof *d->h_part));
     if (!d->h_obs || !d->h_part) {
@@ -228,8 +234,9 @@ void dyn_free(cuda_impl *c)
 {
     DynState *d = c->dyn;
     if (!d) return;
-    void *ptrs[] = {d->vel,     d->vel_saved,  d->rest,  d->bend_rest, d->scratch,    d->q,        d->ph,   d->d_obs,
-                    d->d_guide, d->d_follower, d->d_src, d->d_w,       d->shape_rest, d->seg_rest, d->seg64};
+    void *ptrs[] = {d->vel,     d->vel_saved,  d->rest,  d->bend_rest, d->scratch,    d->q,        d->ph,
+                    d->d_obs,   d->d_guide,    d->d_follower, d->d_src, d->d_w,   d->shape_rest, d->seg_rest,
+                    d->seg64,   d->d_render,   d->d_vrender};
     for (void *p : ptrs)
         if (p) cudaFree(p);
     free(d->h_obs);
@@ -485,6 +492,38 @@ int cuda_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, size_t er
         HB_CUDA_AS(hb::launch_to_canonical<double>(point_major<double>(c, d->vel), (double *)c->staging, c->N, c->P, 0),
                    "the point-major-to-canonical kernel launch (velocities)");
     HB_CUDA(cudaMemcpy(canonical, c->staging, (size_t)c->bytes, cudaMemcpyDeviceToHost));
+    return 0;
+}
+
+/* --render-points (docs/model.md §3.14): the rendered points of the current state by
+ * cuda/dyn_lod.cu's kernel, timed by events around its launch; then copied to the host. */
+int cuda_dyn_render(hb_backend *b, void *position, void *velocity, double *ms, char *err, size_t errlen)
+{
+    cuda_impl *c = (cuda_impl *)b->impl;
+    DynState *d = c->dyn;
+    if (!d || !d->d_render) {
+        snprintf(err, errlen, "internal error: --render-points without its device buffers");
+        return -1;
+    }
+    const int64_t pr = c->scene.dyn.render_points;
+    cudaError_t e;
+    HB_CUDA(cudaEventRecord(c->ev0, 0));
+    if (c->scene.precision == HB_FP32)
+        e = hbd::launch_lod_render<float>((const float *)c->state, velocity ? (const float *)d->vel : nullptr,
+                                          dyn_layout(c), c->N, c->P, pr, (float *)d->d_render, (float *)d->d_vrender,
+                                          0);
+    else
+        e = hbd::launch_lod_render<double>((const double *)c->state, velocity ? (const double *)d->vel : nullptr,
+                                           dyn_layout(c), c->N, c->P, pr, (double *)d->d_render, (double *)d->d_vrender,
+                                           0);
+    HB_CUDA_AS(e, "the rendering kernel launch (--render-points)");
+    HB_CUDA(cudaEventRecord(c->ev1, 0));
+    HB_CUDA_AS(cudaEventSynchronize(c->ev1), "the rendering kernel (cudaEventSynchronize)");
+    float f = 0.0f;
+    HB_CUDA(cudaEventElapsedTime(&f, c->ev0, c->ev1));
+    *ms = f;
+    HB_CUDA(cudaMemcpy(position, d->d_render, (size_t)d->render_bytes, cudaMemcpyDeviceToHost));
+    if (velocity) HB_CUDA(cudaMemcpy(velocity, d->d_vrender, (size_t)d->render_bytes, cudaMemcpyDeviceToHost));
     return 0;
 }
 

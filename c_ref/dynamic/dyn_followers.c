@@ -25,6 +25,7 @@ void hb_dyn_scene_feature_names(const hb_scene *s, char *out, size_t n)
     if (s->dyn.guided) snprintf(out + strlen(out), n - strlen(out), "%sguides", out[0] ? "+" : "");
     if (s->dyn.lra) snprintf(out + strlen(out), n - strlen(out), "%slra", out[0] ? "+" : "");
     if (s->dyn.sag_free) snprintf(out + strlen(out), n - strlen(out), "%ssagfree", out[0] ? "+" : "");
+    if (s->dyn.render_points) snprintf(out + strlen(out), n - strlen(out), "%slod", out[0] ? "+" : "");
     if (!out[0]) snprintf(out, n, "none");
 }
 

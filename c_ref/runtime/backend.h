@@ -20,11 +20,15 @@ extern "C" {
 
 typedef struct hb_backend hb_backend;
 
+/* The declared features of docs/model.md §3.14, as a variant's `lacks` names them. */
+enum { HB_X_GUIDES = 1u << 0, HB_X_LRA = 1u << 1, HB_X_SAGFREE = 1u << 2, HB_X_LOD = 1u << 3, HB_X_COUNT = 4 };
+
 /* One kernel variant of a backend: its name, the stages it runs (bit 1 << hb_stage), a
- * one-line summary, the most points per strand it can simulate (0: no limit) and the most
- * threads a block its simulate kernel launches with (0: the backend's limit). Declared
- * once, in the backend; `--list-variants` prints the table as JSON and the harness reads it
- * from there. */
+ * one-line summary, the most points per strand it can simulate (0: no limit), the most
+ * threads a block its simulate kernel launches with (0: the backend's limit), its solvers
+ * and the §3.14 features it does not run. Declared once, in the backend; `--list-variants`
+ * prints the table as JSON, the driver refuses what a variant lacks, and the harness reads
+ * the table from there. */
 typedef struct {
     const char *name;
     unsigned stages;
@@ -33,6 +37,7 @@ typedef struct {
     int max_block;
     unsigned solvers; /* the dynamic solvers it runs, bit 1 << hb_solver (0: xpbd and ftl) */
     int per_segment;  /* simulates a groom's per-segment rest lengths (docs/model.md §3.15) */
+    unsigned lacks;   /* the §3.14 features it does not run, HB_X_* bits (0: all of them) */
 } hb_variant;
 
 /* The solvers a variant runs (its `solvers`, or xpbd and ftl where it declares none). */
@@ -90,6 +95,11 @@ struct hb_backend {
     /* The observables of the current state (docs/model.md §3.8). */
     int (*dyn_observe)(hb_backend *b, hb_observables *obs, char *err, size_t errlen);
     int (*dyn_fetch_velocity)(hb_backend *b, void *canonical, char *err, size_t errlen);
+    /* Optional (NULL: the driver fetches the state and renders it on the host): the current
+     * state's rendered points (docs/model.md §3.14, --render-points) into a canonical host
+     * buffer [N·P_r][3], and its velocities when `velocity` is not NULL; *ms the rendering's
+     * own time (kernel time, transfers not counted). */
+    int (*dyn_render)(hb_backend *b, void *position, void *velocity, double *ms, char *err, size_t errlen);
     /* Optional (NULL: not measured): advance the current state by n frames back to back, as
      * an application's frame loop would (each frame's tables uploaded and its kernel
      * launched, no observables, no fetch); *ms = host wall time per frame after one

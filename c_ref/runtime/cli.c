@@ -76,6 +76,8 @@ static const dyn_flag dyn_flags[] = {
     {"--follow", DF_FOLLOW, DYN(follow), 0, "one | blend3: how followers are placed (default blend3)"},
     {"--sag-free", DF_FLAG, DYN(sag_free), 0, "shape targets that hold the groom's rest shape against gravity"},
     {"--lra", DF_OPTREAL, DYN(lra_scale), DYN(lra), "long-range attachments |p_k - p_0| <= S k l (S >= 1, default 1)"},
+    {"--render-points", DF_COUNT, DYN(render_points), 0,
+     "write P_r > P points a strand, a Catmull-Rom spline through the simulated ones; P_r - 1 a multiple of P - 1"},
 };
 #undef DYN
 #define N_DYN_FLAGS (sizeof dyn_flags / sizeof dyn_flags[0])

@@ -13,6 +13,7 @@
 #include "runtime/cli.h"
 #include "runtime/groom.h"
 #include "dynamic/dyn_followers.h"
+#include "dynamic/dyn_lod.h"
 #include "runtime/host.h"
 #include "runtime/philox.h"
 #include "runtime/record.h"
@@ -74,6 +75,19 @@ static int self_test_rng(void)
     return failed ? 1 : 0;
 }
 
+/* The §3.14 features by HB_X_* bit: the name --list-variants gives, the flag that declares it. */
+static const struct {
+    const char *name, *flag;
+} x_features[HB_X_COUNT] = {
+    {"guides", "--guides"}, {"lra", "--lra"}, {"sagfree", "--sag-free"}, {"lod", "--render-points"}};
+
+/* The §3.14 features a scene declares, HB_X_* bits. */
+static unsigned x_declared(const hb_dynamics *d)
+{
+    return (d->guided ? HB_X_GUIDES : 0u) | (d->lra ? HB_X_LRA : 0u) | (d->sag_free ? HB_X_SAGFREE : 0u) |
+           (d->render_points ? HB_X_LOD : 0u);
+}
+
 /* A JSON list of the solvers in the bit set `set` (bit 1 << hb_solver), after `key`. */
 static void print_solvers(const char *key, unsigned set)
 {
@@ -106,8 +120,17 @@ static int list_variants(const hb_backend *b)
         printf("], \"summary\": \"%s\"", v->summary);
         if (v->max_points > 0) printf(", \"max_points\": %lld", (long long)v->max_points);
         if (v->max_block > 0) printf(", \"max_block\": %d", v->max_block);
-        if (v->stages & (1u << HB_STAGE_SIMULATE)) print_solvers(", \"solvers\": ", hb_variant_solvers(v));
-        if (v->per_segment) printf(", \"per_segment\": true"); /* simulates a groom (docs/model.md §3.15) */
+        if (v->stages & (1u << HB_STAGE_SIMULATE)) {
+            print_solvers(", \"solvers\": ", hb_variant_solvers(v));
+            printf(", \"features\": [");
+            for (int x = 0, first = 1; x < HB_X_COUNT; x++)
+                if (!(v->lacks & (1u << x))) {
+                    printf("%s\"%s\"", first ? "" : ", ", x_features[x].name);
+                    first = 0;
+                }
+            printf("]");
+            if (v->per_segment) printf(", \"per_segment\": true"); /* simulates a groom (docs/model.md §3.15) */
+        }
         printf("}");
     }
     unsigned any = 0;
@@ -121,7 +144,7 @@ static int list_variants(const hb_backend *b)
         hb_dyn_feature_names(1u << i, name, sizeof name);
         printf("%s\"%s\"", i ? ", " : "", name);
     }
-    printf(", \"guides\", \"lra\", \"sagfree\"]}\n"); /* §3.13's, declared by their own flags */
+    printf(", \"guides\", \"lra\", \"sagfree\", \"lod\"]}\n"); /* §3.14's, declared by their own flags */
     return HB_EXIT_OK;
 }
 
@@ -194,8 +217,9 @@ typedef struct {
     hb_options *o;
     hb_record *rec;
     hb_writer *w;
-    void *host;  /* canonical host frame (output, end-to-end) */
-    void *input; /* the input's last frame */
+    void *host;                     /* canonical host frame (output, end-to-end) */
+    void *input;                    /* the input's last frame */
+    void *render, *vrender, *vhost; /* --render-points: a rendered frame and its velocities; simulated velocities */
     hb_input in;
     int have_input;
     hb_groom groom; /* --groom: what init places (docs/model.md §3.15) */
@@ -215,9 +239,40 @@ static void run_free(hb_run *r)
     if (r->b->teardown) r->b->teardown(r->b);
     free(r->host);
     free(r->input);
+    free(r->render);
+    free(r->vrender);
+    free(r->vhost);
     free(r->times);
 }
 
+
+/* The frame as the file holds it: the state itself, or with --render-points its rendered
+ * points (docs/model.md §3.14, the C reference's spline on the host). */
+static const void *as_written(hb_run *r, const void *state)
+{
+    const hb_scene *s = &r->o->scene;
+    if (!s->dyn.render_points) return state;
+    hb_lod_render(s->precision, state, NULL, s->n_strands, s->points, s->dyn.render_points, r->render, NULL);
+    return r->render;
+}
+
+/* A simulated frame's rendered points (and velocities when `vel`) into r->render (r->vrender):
+ * by the backend's own kernel where it has one, else fetched and rendered on the host; *ms
+ * the rendering's time (the kernel, or the host spline; transfers not counted). */
+static int render_frame(hb_run *r, int vel, double *ms, char *err, size_t errlen)
+{
+    hb_backend *b = r->b;
+    const hb_scene *s = &r->o->scene;
+    if (b->dyn_render) return b->dyn_render(b, r->render, vel ? r->vrender : NULL, ms, err, errlen);
+    double fetch_ms;
+    if (b->fetch(b, r->host, &fetch_ms, err, errlen)) return -1;
+    if (vel && b->dyn_fetch_velocity(b, r->vhost, err, errlen)) return -1;
+    const double t0 = hb_now_ms();
+    hb_lod_render(s->precision, r->host, vel ? r->vhost : NULL, s->n_strands, s->points, s->dyn.render_points,
+                  r->render, r->vrender);
+    *ms = hb_now_ms() - t0;
+    return 0;
+}
 
 /* ---- the simulate stage (docs/model.md §3) ---------------------------------------------
  * Starts from the current state: a new simulation takes it as the rest shape with zero
@@ -237,6 +292,8 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
     void *rest = malloc(bytes), *vel = NULL;
     hb_dyn_frame plan, *plans = NULL;
     int64_t n_plans = 0;
+    double *rt = NULL; /* --render-points: each written frame's rendering time */
+    int64_t n_rt = 0;
     memset(&plan, 0, sizeof plan);
     int status = HB_EXIT_OK;
 #define FAIL_IF(cond, st)                                                                                              \
@@ -246,6 +303,10 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
             goto out;                                                                                                  \
         }                                                                                                              \
     } while (0)
+    if (d->render_points && !(rt = malloc((size_t)o->frames * sizeof *rt))) {
+        snprintf(err, errlen, "out of host memory for the rendering times");
+        FAIL_IF(1, HB_EXIT_MEMORY);
+    }
     if (!rest || hb_dyn_frame_alloc(&plan, d->substeps) != 0) {
         snprintf(err, errlen, "out of host memory for the simulation's rest shape and substep tables");
         FAIL_IF(1, HB_EXIT_MEMORY);
@@ -300,7 +361,7 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
     const double t_end = (double)(gf0 + (o->frame_loop ? 2 : 1) * o->frames) * d->frame_dt;
     FAIL_IF(hb_dynamics_validate_time(s, t_end, err, errlen), HB_EXIT_USAGE);
     FAIL_IF(b->dyn_load(b, vel, rest, err, errlen), HB_EXIT_RUNTIME);
-    if (r->w) FAIL_IF(hb_writer_rest(r->w, rest, err, errlen), HB_EXIT_RUNTIME);
+    if (r->w) FAIL_IF(hb_writer_rest(r->w, as_written(r, rest), err, errlen), HB_EXIT_RUNTIME);
 
     r->sim.dynamic = 1;
     r->sim.paper_frames = paper_frames;
@@ -330,7 +391,14 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         sr->last = obs;
         sr->blown_frames += hb_obs_blown_up(&obs);
         r->sim.last_frame = gf;
-        if (!r->w) continue;
+        if (!r->w) {
+            if (d->render_points) { /* §3.14: no file: every frame is rendered (and dropped), so its cost shows */
+                double ms;
+                FAIL_IF(render_frame(r, 0, &ms, err, errlen), HB_EXIT_RUNTIME);
+                rt[n_rt++] = ms;
+            }
+            continue;
+        }
         FAIL_IF(hb_writer_observables(r->w, &obs, step, time, err, errlen), HB_EXIT_RUNTIME);
         if (j % o->output_every != 0 && j != o->frames) continue;
         hb_frame_meta m;
@@ -339,6 +407,14 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         m.step = step;
         m.time = time;
         double ms;
+        if (d->render_points) { /* §3.14: the rendered points, and their velocities */
+            const int vel = o->all_velocities || j == o->frames;
+            FAIL_IF(render_frame(r, vel, &ms, err, errlen), HB_EXIT_RUNTIME);
+            rt[n_rt++] = ms;
+            FAIL_IF(hb_writer_append(r->w, r->render, &m, err, errlen), HB_EXIT_RUNTIME);
+            if (vel) FAIL_IF(hb_writer_velocity(r->w, r->vrender, step, time, err, errlen), HB_EXIT_RUNTIME);
+            continue;
+        }
         FAIL_IF(b->fetch(b, r->host, &ms, err, errlen), HB_EXIT_RUNTIME);
         FAIL_IF(hb_writer_append(r->w, r->host, &m, err, errlen), HB_EXIT_RUNTIME);
         if (o->all_velocities || j == o->frames) {
@@ -347,6 +423,11 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         }
     }
     sr->observe_ms = observe_ms;
+    sr->render_ms = NAN;
+    if (n_rt > 0) {
+        double lo, hi;
+        hb_time_stats(rt, (int)n_rt, &sr->render_ms, &lo, &hi);
+    }
     hb_time_stats(sr->times_ms, sr->n_times, &sr->meta.median_ms, &sr->meta.min_ms, &sr->meta.max_ms);
     sr->loop_ms = sr->loop_graph_ms = NAN;
     if (o->frame_loop) {
@@ -375,6 +456,7 @@ out:
     hb_dyn_frame_free(&plan);
     free(rest);
     free(vel);
+    free(rt);
     return status;
 }
 
@@ -541,6 +623,13 @@ int hb_main(int argc, char **argv, hb_backend *b)
                      o.groom ? "--groom" : "--input", b->name, var->name);
             CHECK(1, HB_EXIT_USAGE);
         }
+        const unsigned lacking = x_declared(&o.scene.dyn) & var->lacks;
+        for (int x = 0; x < HB_X_COUNT; x++)
+            if (lacking & (1u << x)) {
+                snprintf(err, sizeof err, "--variant %s does not run %s (see --list-variants)", var->name,
+                         x_features[x].flag);
+                CHECK(1, HB_EXIT_USAGE);
+            }
         if (var->max_block > 0 && o.block_size > var->max_block) {
             snprintf(err, sizeof err,
                      "--block-size %d: the %s variant %s simulates with at most %d threads a block (see "
@@ -580,8 +669,14 @@ int hb_main(int argc, char **argv, hb_backend *b)
     const uint64_t bytes = hb_state_bytes(&o.scene);
     const int need_host = o.output != NULL || o.end_to_end || simulate;
     /* simulate: the rest shape and the velocities pass through the host once */
-    const uint64_t driver_bytes =
-        hb_add_sat(hb_add_sat(need_host ? bytes : 0, o.input ? bytes : 0), simulate ? hb_mul_sat(bytes, 2u) : 0);
+    /* --render-points: a rendered frame, its velocities and the simulated velocities */
+    const int64_t pr = simulate ? o.scene.dyn.render_points : 0;
+    const uint64_t render_bytes =
+        pr ? hb_mul_sat(hb_mul_sat((uint64_t)o.scene.n_strands, (uint64_t)pr), 3u * hb_real_size(o.scene.precision))
+           : 0;
+    const uint64_t driver_bytes = hb_add_sat(
+        hb_add_sat(hb_add_sat(need_host ? bytes : 0, o.input ? bytes : 0), simulate ? hb_mul_sat(bytes, 2u) : 0),
+        hb_add_sat(hb_mul_sat(render_bytes, 2u), render_bytes ? bytes : 0));
     const int need_save = o.repeat > 1 || o.warmup > 0;
     int status = b->setup(b, &o, need_save, driver_bytes, err, sizeof err);
     if (status != HB_EXIT_OK) {
@@ -594,6 +689,12 @@ int hb_main(int argc, char **argv, hb_backend *b)
     rec.block_size = b->block_size;
     if (need_host && !(run.host = malloc(bytes))) {
         snprintf(err, sizeof err, "cannot allocate the %llu-byte host frame", (unsigned long long)bytes);
+        CHECK(1, HB_EXIT_MEMORY);
+    }
+    if (render_bytes && (!(run.render = malloc(render_bytes)) || !(run.vrender = malloc(render_bytes)) ||
+                         !(run.vhost = malloc(bytes)))) {
+        snprintf(err, sizeof err, "cannot allocate the %llu-byte rendered frames (--render-points)",
+                 (unsigned long long)render_bytes);
         CHECK(1, HB_EXIT_MEMORY);
     }
     if (o.input && !(run.input = malloc(bytes))) {
@@ -631,7 +732,8 @@ int hb_main(int argc, char **argv, hb_backend *b)
                     CHECK(hb_input_read_frame(&run.in, f, run.host, err, sizeof err), HB_EXIT_USAGE);
                     src = run.host;
                 }
-                CHECK(hb_writer_append(run.w, src, &run.in.frames[f], err, sizeof err), HB_EXIT_RUNTIME);
+                CHECK(hb_writer_append(run.w, as_written(&run, src), &run.in.frames[f], err, sizeof err),
+                      HB_EXIT_RUNTIME);
             }
         }
         frame = last + 1;
@@ -670,7 +772,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
             if (run.w) {
                 double ms;
                 CHECK(b->fetch(b, run.host, &ms, err, sizeof err), HB_EXIT_RUNTIME);
-                CHECK(hb_writer_append(run.w, run.host, &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
+                CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
             }
             frame++;
             i++;
@@ -699,7 +801,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
             sc->meta.moved_points = r.moved_points;
             if (run.w) {
                 CHECK(b->fetch_intermediate(b, run.host, err, sizeof err), HB_EXIT_RUNTIME);
-                CHECK(hb_writer_append(run.w, run.host, &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
+                CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
             }
             sr = sc;
         } else {
@@ -708,7 +810,7 @@ int hb_main(int argc, char **argv, hb_backend *b)
         if (run.w) {
             double ms;
             CHECK(b->fetch(b, run.host, &ms, err, sizeof err), HB_EXIT_RUNTIME);
-            CHECK(hb_writer_append(run.w, run.host, &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
+            CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
         }
         frame += r.consumed;
         i += r.consumed;

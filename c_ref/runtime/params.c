@@ -250,6 +250,15 @@ int hb_dynamics_validate_scene(const hb_scene *s, char *err, size_t errlen)
         if (c[i].used && !fits(c[i].v, p))
             FAIL("%s = %g overflows %s (largest %g)%s", c[i].what, c[i].v, name, p == HB_FP32 ? FLT_MAX : DBL_MAX,
                  hint);
+    if (d->render_points) { /* §3.14: simulated-point LOD */
+        const int64_t ps = s->points, pr = d->render_points;
+        uint64_t rows;
+        if (pr <= ps || (pr - 1) % (ps - 1) != 0)
+            FAIL("--render-points %lld must exceed --points %lld with %lld - 1 a multiple of %lld - 1 (e.g. %lld)",
+                 (long long)pr, (long long)ps, (long long)pr, (long long)ps, (long long)(2 * ps - 1));
+        if (hb_mul_u64((uint64_t)s->n_strands, (uint64_t)pr, &rows) || hb_mul_u64(rows, 3u * 8u, &rows))
+            FAIL("--strands x --render-points is too large to address");
+    }
     if (d->guided && d->guides > 1.0 && d->guides > (double)s->n_strands)
         FAIL("--guides %g is more than the %lld strands", d->guides, (long long)s->n_strands);
     if (d->collider && !(rc <= hi))

@@ -50,13 +50,14 @@ typedef struct {
     double motion_amplitude; /* A, radians */
     double motion_frequency; /* f, Hz */
     /* docs/model.md §3.13: guides and followers, long-range attachments */
-    int guided;       /* --guides given: only the guides are simulated */
-    double guides;    /* a fraction in (0, 1] of the strands, or a count > 1 */
-    hb_follow follow; /* how followers are placed from their guides */
-    int lra;          /* --lra given */
-    double lra_scale; /* s_L ≥ 1: the bound is s_L times the rest arc length */
-    int sag_free;     /* --sag-free: shape targets that hold the rest shape against gravity */
-    int per_segment;  /* §3.15: stretch rest lengths per segment from X̄ (a groom), not ℓ = L/(P−1) */
+    int guided;            /* --guides given: only the guides are simulated */
+    double guides;         /* a fraction in (0, 1] of the strands, or a count > 1 */
+    hb_follow follow;      /* how followers are placed from their guides */
+    int lra;               /* --lra given */
+    double lra_scale;      /* s_L ≥ 1: the bound is s_L times the rest arc length */
+    int sag_free;          /* --sag-free: shape targets that hold the rest shape against gravity */
+    int64_t render_points; /* --render-points P_r: strands written with P_r points (§3.14); 0: as simulated */
+    int per_segment;       /* §3.15: stretch rest lengths per segment from X̄ (a groom), not ℓ = L/(P−1) */
 } hb_dynamics;
 
 /* The scene: everything that decides the bits of a state. */

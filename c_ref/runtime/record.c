@@ -172,6 +172,10 @@ void hb_record_json(FILE *f, const hb_record *r)
             json_key_num(f, "observe_ms", st->observe_ms);
             json_key_num(f, "frame_loop_ms", st->loop_ms);
             json_key_num(f, "frame_loop_graph_ms", st->loop_graph_ms);
+            /* §3.14: the written points a strand (null: as simulated) and one frame's rendering */
+            if (d->render_points) fprintf(f, ", \"render_points\": %lld", (long long)d->render_points);
+            else fputs(", \"render_points\": null", f);
+            json_key_num(f, "render_ms", st->render_ms);
             fputs(", \"last_observables\": {\"stretch_max\": ", f);
             json_num(f, st->last.stretch_max);
             json_key_num(f, "penetration_max", st->last.penetration_max);

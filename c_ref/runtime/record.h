@@ -27,6 +27,7 @@ typedef struct {
     int64_t blown_frames;
     double observe_ms;             /* computing the observables, all frames, apart from the frame times */
     double loop_ms, loop_graph_ms; /* --frame-loop: per frame, back to back / as a graph (NaN: not run) */
+    double render_ms;              /* --render-points: median time to render a written frame (NaN: none) */
 } hb_stage_record;
 
 typedef struct {

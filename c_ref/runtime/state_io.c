@@ -102,8 +102,9 @@ struct hb_writer {
     char *path, *tmp;
     int force; /* --force: the rename may replace a file that appeared during the run */
     hid_t file, value;
-    hb_scene scene;
-    uint64_t rows; /* N·P */
+    hb_scene scene;           /* points: the written ones (P_r with --render-points) */
+    int64_t simulated_points; /* P_s */
+    uint64_t rows;            /* N·P */
     int n_frames, cap;
     hb_frame_meta *frames;
     double seconds;
@@ -159,7 +160,9 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     }
     w->file = w->value = w->velocity = -1;
     w->scene = *scene;
-    if (hb_mul_u64((uint64_t)scene->n_strands, (uint64_t)scene->points, &w->rows)) {
+    w->simulated_points = scene->points;
+    if (scene->dyn.render_points) w->scene.points = scene->dyn.render_points; /* §3.14: the rendered points */
+    if (hb_mul_u64((uint64_t)scene->n_strands, (uint64_t)w->scene.points, &w->rows)) {
         snprintf(err, errlen, "--strands x --points is too large to address");
         free(w);
         return NULL;
@@ -421,6 +424,23 @@ static int write_series(hid_t obs, const char *name, hid_t ftype, hid_t mtype, c
     return bad ? -1 : 0;
 }
 
+/* Simulated-point LOD (docs/model.md §3.14): the point counts, and which rows are simulated
+ * points (row i·P_r + k·m is simulated point k of strand i, m = (P_r − 1)/(P_s − 1)). */
+static int write_lod(hb_writer *w, hid_t p)
+{
+    const int64_t pr = w->scene.dyn.render_points, ps = w->simulated_points, m = (pr - 1) / (ps - 1);
+    int bad = attr_i64(p, "render_points", pr) < 0;
+    bad |= attr_i64(p, "simulated_points", ps) < 0;
+    int8_t *mark = malloc((size_t)w->rows);
+    if (!mark) return -1;
+    for (uint64_t r = 0; r < w->rows; r++) mark[r] = (int8_t)((int64_t)(r % (uint64_t)pr) % m == 0);
+    hid_t hair = H5Gopen2(w->file, "particles/hair", H5P_DEFAULT);
+    bad |= hair < 0 || ds_1d(hair, "simulated", H5T_STD_I8LE, H5T_NATIVE_INT8, (hsize_t)w->rows, mark) < 0;
+    if (hair >= 0) H5Gclose(hair);
+    free(mark);
+    return bad ? -1 : 0;
+}
+
 /* The dynamic model's datasets and parameters (docs/interfaces.md, "dynamic files"). */
 static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
 {
@@ -443,6 +463,7 @@ static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
     bad |= attr_i64(p, "lra", d->lra) < 0;
     bad |= attr_i64(p, "sag_free", d->sag_free) < 0;
     bad |= attr_i64(p, "per_segment", d->per_segment) < 0; /* §3.15 */
+    if (d->render_points) bad |= write_lod(w, p) < 0;
     if (d->guided) bad |= attr_str(p, "follow", hb_follow_name(d->follow)) < 0;
     const struct {
         const char *name;
@@ -1018,6 +1039,13 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
     if (missing) {
         H5Gclose(p);
         FAIL("--input %s: /parameters lacks the attribute '%s'", path, missing);
+    }
+    int64_t rendered = 0; /* §3.14: its points are a spline's, not a state */
+    if (read_attr(p, "render_points", H5T_NATIVE_INT64, &rendered) == 0 && rendered > 0) {
+        H5Gclose(p);
+        FAIL("--input %s was written with --render-points: its points are rendered, not simulated, so it cannot be "
+             "resumed or simulated from (use a file written without it)",
+             path);
     }
     if (strcmp(prec, "fp32") == 0) s->precision = HB_FP32;
     else if (strcmp(prec, "fp64") == 0) s->precision = HB_FP64;

@@ -14,8 +14,8 @@
      anything not equivalent stops the bench before timing;
   2. the sweep configs/sweeps/dynamic.toml (results/<out>/dynamic/runs.csv);
   3. the studies, each into results/<out>/<study>/: what each feature costs (featurecost,
-     CPU and every cuda build), modelling less (reduced: guides and followers, LRA; docs/model.md
-     §3.14), speed against accuracy (accuracy --model dynamic), stability at the
+     CPU and every cuda build), modelling less (reduced: guides and followers, LRA, sag-free,
+     LOD; docs/model.md §3.14), speed against accuracy (accuracy --model dynamic), stability at the
      extremes (stability), the peer (pypbd, optional), the animation;
   4. report/dynamic.md with all of it.
 Without a GPU the GPU rows and checks are skipped with one line saying why.

@@ -1005,10 +1005,13 @@ def parser():
         sub,
         "reduced",
         cmd_reduced,
-        help="the dynamic model with guides and followers and with long-range attachments: error and time",
-        description="Run a dynamic scene with guide fractions 100/50/25/10/5%% x scheme (one, blend3) and "
-        "LRA off/on at few iterations; compare each with every strand simulated (xpbd, fp64, finer S) and time "
-        "it on the cpu oracle and, with a usable GPU, the cuda variants that run it (docs/model.md §3.14). "
+        help="the dynamic model with guides and followers, long-range attachments, sag-free rest and "
+        "simulated-point LOD: error and time",
+        description="Run a dynamic scene with guide fractions 100/50/25/10/5%% x scheme (one, blend3), "
+        "LRA off/on at few iterations, and P_s simulated points written as P_r = 33 (--render-points); compare "
+        "each with every strand and point simulated (xpbd, fp64, finer S) and time it on the cpu oracle and, "
+        "with a usable GPU, the cuda variants that run it (docs/model.md §3.14); and the still scene with and "
+        "without sag-free rest: how far it sags, and the tip's swing frequency under a wind step. "
         "Prints a Markdown table; --out writes the rows as CSV.",
     )
     rd.add_argument("--scene", default=None, help="a dynamic scene (default dynamic)")
@@ -1095,8 +1098,8 @@ def parser():
         cmd_stability,
         help="the dynamic model's stability map: verdicts over 2-D slices of the scene space",
         description="Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend "
-        "compliance, points and iterations, iterations on curly hair; head-motion frequency against amplitude) for "
-        "both solvers and "
+        "compliance, points and iterations, iterations on curly hair; head-motion frequency against amplitude; "
+        "long-range attachments on and off under fast nods and gales) for both solvers and "
         "precisions, on the CPU and every built CUDA build where a GPU answers; judge each cell ok, "
         "over-stretched, penetrating, escaped (a point past 2L) or diverged (NaN/Inf); write "
         "results/stability/, results/local/report/stability_*.png and "

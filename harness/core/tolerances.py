@@ -274,6 +274,27 @@ DYN_LRA_BOUND_EPS = 8.0
 # The bound with it: 1e-3 L (2.4× the worse solver); the sag without it: at least 3e-3 L.
 DYN_SAGFREE_STILL_MAX_L = 1e-3
 DYN_SAG_PLAIN_MIN_L = 3e-3
+# Simulated-point LOD (docs/model.md §3.14): the spline through simulated points on a straight
+# line stays on it to rounding: over 200 random lines per precision (50 strands each, 2–32
+# points unevenly spaced, m = 2–5 rendered points a segment; harness/check/lod.py, the same
+# operations as the binaries) the farthest rendered point lies 17.7·ε (fp32) and 15.2·ε (fp64)
+# of the strand's length off the line through its ends, the rounding of the simulated points
+# themselves included; 64 is a 3.6× margin.
+# Sag-free rest adds no stiffness (docs/model.md §3.14): the still scene of
+# tests/cpu/test_dynamic_sagfree_swing.py (40 strands × 12 points, S = 8, I = 2, α_b = 1e-6,
+# α_g = 1e-4, ρ_g = 1, fp32) hit by a steady wind (U = 600 cm/s, c_d = 0.5/s) swings at a median
+# tip frequency of 15.70 / 15.70 Hz (xpbd, without / with) and 15.67 / 15.69 Hz (ftl) over 1 s:
+# 2.5e-4 and 1.2e-3 relative apart; damping ratios 0.1038 / 0.1042 and 0.1038 / 0.1042 (4e-3).
+# Bounds 5e-3 (4× the worse frequency) and 2e-2 (5× the worse damping ratio).
+DYN_SAGFREE_TIP_HZ_REL = 5e-3
+DYN_SAGFREE_TIP_DAMPING_REL = 2e-2
+DYN_LOD_STRAIGHT_EPS = 64.0
+# The CUDA default build's rendering kernel (FMA contraction allowed) against the same
+# operations without contraction, from the same simulated points: each rendered coordinate is
+# at most 15 operations (knots, 5 weights, 6 lerps) on values bounded by the extent E = R + c_m
+# + 2L; 32·ε·E allows each of them two contracted roundings. Derived, not yet measured on a
+# GPU (tests/gpu/test_gpu_lod.py measures it).
+DYN_LOD_KERNEL_K = 32.0
 # Kinetic energy recomputed by the harness (strand by strand in order) against the file's
 # (the binary sums in chunks of 1024 strands): bit-equal up to 1000 strands, ≤ 9.9e-15
 # relative at 5000 strands (1.55e5 terms), ≤ 3.9e-16 for the FMA build. Rounding errors of

@@ -37,6 +37,13 @@ class Declared:
     max_block: dict = field(default_factory=dict)  # variant -> most threads a block of its simulate (absent: 1024)
     variant_solvers: dict = field(default_factory=dict)  # variant -> its solvers (absent: all of `solvers`)
     per_segment: tuple = ()  # variants that simulate a groom's per-segment rest lengths (docs/model.md §3.15)
+    variant_features: dict = field(default_factory=dict)  # variant -> its §3.14 features (absent: all of them)
+
+    def runs_features(self, variant, features):
+        """Whether a simulating `variant` runs every one of `features` (docs/model.md §3.14:
+        "guides", "lra", "sagfree", "lod"); a binary that declares no features per variant runs them all."""
+        have = self.variant_features.get(variant)
+        return have is None or set(features) <= set(have)
 
     def solvers_of(self, variant):
         """The solvers `variant` runs, in the binary's order."""
@@ -119,6 +126,9 @@ def _read(path):
             max_block={str(v["name"]): int(v["max_block"]) for v in variants if v.get("max_block")},
             variant_solvers={str(v["name"]): tuple(str(x) for x in v["solvers"]) for v in variants if "solvers" in v},
             per_segment=tuple(str(v["name"]) for v in variants if v.get("per_segment") is True),
+            variant_features={
+                str(v["name"]): tuple(str(x) for x in v["features"]) for v in variants if "features" in v
+            },
         )
     except (ValueError, KeyError, TypeError, AttributeError):
         raise HarnessError(f"{path} --list-variants did not print the documented JSON object") from None

@@ -67,6 +67,8 @@ DYNAMIC_ATTRS = (
     "lra_scale",
     "sag_free",
     "per_segment",
+    "render_points",
+    "simulated_points",
 )
 REQUIRED_DYNAMIC = (
     "paper_frames",
@@ -95,6 +97,7 @@ class Trajectory(State):
     dynamic_params: dict = field(default_factory=dict)
     _rest: object = field(repr=False, default=None)
     _vel: object = field(repr=False, default=None)
+    simulated_rows: np.ndarray = None  # --render-points: which rows of a strand are simulated points (§3.14)
 
     @property
     def rest(self):
@@ -155,6 +158,16 @@ class Trajectory(State):
     @property
     def follow(self):
         return as_text(self.dynamic_params.get("follow", "blend3"))
+
+    @property
+    def render_points(self):
+        """P_r of a file written with --render-points (its `points`), else 0 (§3.14)."""
+        return int(self.dynamic_params.get("render_points", 0))
+
+    @property
+    def simulated_points(self):
+        """P_s: the points a strand simulated (= `points` without --render-points)."""
+        return int(self.dynamic_params.get("simulated_points", self.points))
 
     @property
     def collider(self):
@@ -265,6 +278,25 @@ def _check_dynamic(t, f):
     if stray:
         raise StateError(f"{path}: velocities stored for step(s) {stray[:3]} that have no position frame")
     t.observables = _observables(f, path)
+    if t.render_points:
+        _check_lod(t, f)
+
+
+def _check_lod(t, f):
+    """--render-points: P_r = points, (P_r − 1) a multiple of (P_s − 1), and the marks of the
+    simulated rows (row k·m of every strand) as docs/interfaces.md states them."""
+    path, pr, ps = t.path, t.render_points, t.simulated_points
+    if pr != t.points or not 2 <= ps < pr or (pr - 1) % (ps - 1):
+        raise StateError(f"{path}: render_points = {pr}, simulated_points = {ps} do not fit {t.points} points a strand")
+    name = f"{HAIR}/simulated"
+    marks = f[name][()] if name in f else None
+    if marks is None or marks.shape != (t.n_strands * pr,):
+        raise StateError(f"{path}: a --render-points file needs /{name} [{t.n_strands * pr}]")
+    rows = np.flatnonzero(marks.reshape(t.n_strands, pr)[0])
+    want = np.arange(ps) * ((pr - 1) // (ps - 1))
+    if not np.array_equal(rows, want) or not np.all(marks.reshape(t.n_strands, pr) == marks[:pr]):
+        raise StateError(f"{path}: /{name} does not mark rows k·(P_r − 1)/(P_s − 1) of every strand")
+    t.simulated_rows = want
 
 
 def open_trajectory(path):

@@ -10,6 +10,14 @@ Rows of one dynamic scene (default `dynamic`), each run for `seconds` of simulat
   sagfree  solver × sag-free off/on: the scene held still (no head motion, no wind, every
            point in shape) for `sag_seconds`; rest_rms_L and rest_max_L, the largest RMS and
            max displacement from the rest shape over L, say how far the groom sags
+  sagfreq  solver × sag-free off/on: the same still scene hit at t = 0 by a steady wind of
+           `sag_wind` cm/s (no gusts), a step load that sets every strand swinging about its
+           new equilibrium for `sag_seconds`; tip_hz and tip_damping are the median over strands
+           of the tip's swing frequency and damping ratio (harness/check/observables.py swing):
+           sag-free must leave them as they were (it adds no stiffness)
+  lod      solver × simulated points P_s (`lod_points`) written with `lod_render_points`
+           points (--render-points, a spline through the simulated ones; P_s = P_r simulates
+           every point), at the scene's S and I; the reference simulates P_r points
 
 Each row's checked run (`strands` strands, fp32, every frame written) is compared frame by
 frame with a reference of the same scene (the LRA rows: with their fast nod) in which every
@@ -20,8 +28,9 @@ the accuracy study's converged ladder: a row's error includes its S and I's own 
 the "all simulated" rows (fraction 1, LRA off) show beside it.
 
 Time per frame: the same settings at `time_strands` strands (no file, --repeat), on the cpu
-oracle and, with a usable GPU, on each cuda variant that runs the features (`lanes` refuses
-them, docs/cuda.md). Writes CSV (one row per case and timing binary).
+oracle and, with a usable GPU, on each cuda variant that runs all the features (its
+`--list-variants` entry lists them; `lanes` lacks guides and LRA, docs/cuda.md). Writes CSV
+(one row per case and timing binary).
 """
 
 from dataclasses import dataclass, replace
@@ -30,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
+from harness.check import observables as ob
 from harness.core import env, runner, scenes, variants
 from harness.core.paths import binary_path
 from harness.io.files import write_csv
@@ -45,6 +55,8 @@ FIELDS = (
     "follow",
     "lra",
     "sag_free",
+    "points",
+    "render_points",
     "precision",
     "strands",
     "rms_err_L",
@@ -52,14 +64,18 @@ FIELDS = (
     "stretch_max",
     "rest_rms_L",
     "rest_max_L",
+    "tip_hz",
+    "tip_damping",
     "blown_up",
     "backend",
     "variant",
     "time_strands",
     "median_ms",
+    "render_ms",
     "device",
 )
 FRACTIONS = (1.0, 0.5, 0.25, 0.1, 0.05)
+STUDIED = ("guides", "lra", "sagfree", "lod")  # the §3.14 features the rows declare: a timed variant runs them all
 SCHEMES = ("one", "blend3")
 
 
@@ -72,6 +88,9 @@ class Plan:
     lra_frequency: float = 6.0
     lra_iterations: tuple = (1, 2)
     sag_seconds: float = 2.0
+    sag_wind: float = 600.0
+    lod_render_points: int = 33
+    lod_points: tuple = (33, 17, 9, 5)
     time_strands: int = 10_000
     time_gpu_strands: int = 1_000_000
     repeat: int = 3
@@ -79,34 +98,44 @@ class Plan:
 
     @classmethod
     def quick(cls, **changes):
-        base = dict(strands=40, seconds=0.1, ref_substeps=16, time_strands=1000, sag_seconds=0.5)
+        base = dict(strands=40, seconds=0.1, ref_substeps=16, time_strands=1000, sag_seconds=0.5, lod_points=(33, 9))
         return cls(**{**base, **changes})
 
 
 def cases(plan, scene):
-    """(study, solver, S, I, guides, follow, lra, extra flags) for every row."""
+    """(study, solver, S, I, guides, follow, lra, extra flags, points) for every row (points:
+    the simulated points a strand, None for the scene's)."""
     s, it = int(scene.dynamic["--substeps"]), int(scene.dynamic["--iterations"])
     out = []
     for solver in ("xpbd", "ftl"):
         for frac in FRACTIONS:
             for follow in SCHEMES if frac < 1.0 else ("",):
                 extra = ["--guides", repr(frac), "--follow", follow] if frac < 1.0 else []
-                out.append(("guides", solver, s, it, frac, follow, 0, extra))
+                out.append(("guides", solver, s, it, frac, follow, 0, extra, None))
     fast = ["--head-motion", "nod", "--motion-frequency", repr(plan.lra_frequency)]
     for i in plan.lra_iterations:
         for lra in (0, 1):
-            out.append(("lra", "xpbd", s, i, 1.0, "", lra, fast + (["--lra"] if lra else [])))
+            out.append(("lra", "xpbd", s, i, 1.0, "", lra, fast + (["--lra"] if lra else []), None))
     still = ["--head-motion", "still", "--wind-speed", "0", "--shape-range", "1"]
+    wind = ["--head-motion", "still", "--wind-speed", repr(plan.sag_wind), "--gust-amplitude", "0"]
+    wind += ["--shape-range", "1"]
+    for study, flags in (("sagfree", still), ("sagfreq", wind)):
+        for solver in ("xpbd", "ftl"):
+            for sag in (0, 1):
+                out.append((study, solver, s, it, 1.0, "", 0, flags + (["--sag-free"] if sag else []), None))
+    pr = plan.lod_render_points
     for solver in ("xpbd", "ftl"):
-        for sag in (0, 1):
-            out.append(("sagfree", solver, s, it, 1.0, "", 0, still + (["--sag-free"] if sag else [])))
+        for ps in plan.lod_points:
+            out.append(("lod", solver, s, it, 1.0, "", 0, ["--render-points", str(pr)] if ps < pr else [], ps))
     return out
 
 
-def _flags(scene, *, solver, substeps, iterations, precision, strands, frames, extra, output=None, variant=None):
+def _flags(
+    scene, *, solver, substeps, iterations, precision, strands, frames, extra, output=None, variant=None, points=None
+):
     dyn = {**scene.dynamic, "--solver": solver, "--substeps": substeps, "--iterations": iterations}
     dyn.update({"--frames": frames, "--output-every": 1})
-    sc = replace(scene.with_overrides(strands=strands, precision=precision), dynamic=dyn)
+    sc = replace(scene.with_overrides(strands=strands, precision=precision, points=points), dynamic=dyn)
     backend = "cuda" if variant and variant[0] == "cuda" else "cpu"
     flags = runner.run_flags(sc, backend, variant=variant[1] if variant else None, output=output, force=True)
     return flags + list(extra)
@@ -115,7 +144,7 @@ def _flags(scene, *, solver, substeps, iterations, precision, strands, frames, e
 def _positions(path):
     with open_trajectory(path) as t:
         sim = t.simulated
-        pos = np.stack([t.frame(f) for f in sim]).astype(np.float64)
+        pos = np.stack([t.frame(f).reshape(t.n_strands, t.points, 3) for f in sim]).astype(np.float64)
         obs = t.observables.set_index("step").reindex(t.step[sim])
         rest = t.rest.astype(np.float64)
         return pos, float(np.nanmax(obs["stretch_max"])), int(np.max(obs["blown_up_strands"])), rest
@@ -128,7 +157,7 @@ def timing_binaries(plan):
     ok, _ = env.gpu_status()
     if plan.gpu != "no" and ok and binary_path("cuda", "default").exists():
         d = variants.declared("cuda")
-        out += [("cuda", v) for v in d.running("simulate") if v != "lanes"]
+        out += [("cuda", v) for v in d.running("simulate") if d.runs_features(v, STUDIED)]
     return out
 
 
@@ -146,32 +175,37 @@ def measure(plan=Plan(), out=None, work=None, progress=print):
     with tempfile.TemporaryDirectory(dir=work) as tmp:
         refs = {}
 
-        def reference(fast):
-            key = tuple(fast)
+        def reference(fast, points=None):
+            key = (tuple(fast), points)
             if key not in refs:
                 path = Path(tmp) / f"ref{len(refs)}.h5"
                 flags = _flags(scene, solver="xpbd", substeps=plan.ref_substeps, iterations=1, precision="fp64",
-                               strands=plan.strands, frames=frames, extra=fast, output=path)  # fmt: skip
+                               strands=plan.strands, frames=frames, extra=fast, output=path,
+                               points=points)  # fmt: skip
                 runner.run_binary(cpu, flags)
                 refs[key] = _positions(path)[0]
             return refs[key]
 
         def reference_for(study, extra):
-            if study == "sagfree":
+            if study in ("sagfree", "sagfreq"):
                 return None
+            if study == "lod":
+                return reference([], plan.lod_render_points)
             return reference([] if study == "guides" else extra[:4])
 
         timers = timing_binaries(plan)
-        for study, solver, s, it, frac, follow, lra, extra in cases(plan, scene):
+        for study, solver, s, it, frac, follow, lra, extra, points in cases(plan, scene):
             ref = reference_for(study, extra)
             path = Path(tmp) / "row.h5"
-            n_frames = max(1, round(plan.sag_seconds / frame_dt)) if study == "sagfree" else frames
+            n_frames = max(1, round(plan.sag_seconds / frame_dt)) if study.startswith("sag") else frames
             flags = _flags(scene, solver=solver, substeps=s, iterations=it, precision="fp32", strands=plan.strands,
-                           frames=n_frames, extra=extra, output=path)  # fmt: skip
+                           frames=n_frames, extra=extra, output=path, points=points)  # fmt: skip
             runner.run_binary(cpu, flags)
             pos, stretch, blown, rest = _positions(path)
             rms, mx = frame_errors(pos, ref, L) if ref is not None else (np.nan, np.nan)
             sag_rms, sag_max = frame_errors(pos, np.broadcast_to(rest, pos.shape), L)
+            tip_hz, tip_zeta = ob.swing(pos, frame_dt) if study == "sagfreq" else (np.nan, np.nan)
+            p_sim = int(points or scene.points)
             base = {
                 "study": study,
                 "solver": solver,
@@ -181,6 +215,8 @@ def measure(plan=Plan(), out=None, work=None, progress=print):
                 "follow": follow,
                 "lra": lra,
                 "sag_free": int("--sag-free" in extra),
+                "points": p_sim,
+                "render_points": plan.lod_render_points if "--render-points" in extra else p_sim,
                 "precision": "fp32",
                 "strands": plan.strands,
                 "rms_err_L": float(np.max(rms)),  # NaN where there is no reference (sagfree) or a run blew up
@@ -188,16 +224,20 @@ def measure(plan=Plan(), out=None, work=None, progress=print):
                 "stretch_max": stretch,
                 "rest_rms_L": float(np.nanmax(sag_rms)),
                 "rest_max_L": float(np.nanmax(sag_max)),
+                "tip_hz": tip_hz,
+                "tip_damping": tip_zeta,
                 "blown_up": blown,
             }
             for backend, variant in timers:
+                if backend == "cuda" and not variants.declared("cuda").runs(variant, points=p_sim):
+                    continue  # more points than the variant simulates (warpreg: 32)
                 n = plan.time_gpu_strands if backend == "cuda" else plan.time_strands
                 tf = _flags(scene, solver=solver, substeps=s, iterations=it, precision="fp32", strands=n, frames=2,
-                            extra=extra, variant=(backend, variant))  # fmt: skip
+                            extra=extra, variant=(backend, variant), points=points)  # fmt: skip
                 rec = runner.run_binary(binary_path(backend, "default"), tf + ["--repeat", str(plan.repeat)])
                 st = next(x for x in rec["stages"] if x["stage"] == "simulate")
                 row = {**base, "backend": backend, "variant": variant, "time_strands": n}
-                row.update(median_ms=st["median_ms"], device=rec["device"])
+                row.update(median_ms=st["median_ms"], render_ms=st.get("render_ms"), device=rec["device"])
                 rows.append(row)
                 progress(
                     f"reduced: {study:6s} {solver:4s} I={it} guides={frac:<4g} {follow:6s} lra={lra} "

@@ -3,7 +3,8 @@
 
 A map, not anecdotes: 2-D slices through the dynamic scene space (substeps against wind
 speed, stretch compliance, bend compliance and points per strand; head-motion frequency
-against amplitude), each run for both solvers and both precisions, on the CPU and, where a
+against amplitude; long-range attachments on and off against a fast nod's frequency and
+against wind speed, at one iteration), each run for both solvers and both precisions, on the CPU and, where a
 GPU answers, on every CUDA build that is built (each build's default variant, as its
 `--list-variants` declares). Every cell is one run of a few strands over a horizon of
 about one second (strands are independent, so a few show what many would); its verdict,

@@ -93,4 +93,25 @@ SLICES = (
         Axis("--motion-amplitude", "A", (0.1, 0.25, 0.5, 1, 2, 3), (0.25, 1, 3), "rad"),
     ),
 )
+# Long-range attachments (docs/model.md §3.14) on and off, at one iteration where stretch is
+# weakest: under fast nods and under gales (the still scene with the default scene's drag and gusts).
+LRA = Axis("--lra", "LRA s_L", (OFF, 1), (OFF, 1))
+SLICES += (
+    Slice(
+        "lra-nod",
+        "long-range attachments against a fast nod (A = 0.5 rad, I = 1; off = LRA undeclared)",
+        "still-dynamic",
+        (("--head-motion", "nod"), ("--motion-amplitude", 0.5), ("--iterations", 1)),
+        LRA,
+        Axis("--motion-frequency", "f", (1, 2, 4, 8, 12, 16), (4, 16), "Hz"),
+    ),
+    Slice(
+        "lra-wind",
+        "long-range attachments against wind speed (drag 0.5/s, gusts 0.5, I = 1; off = LRA undeclared)",
+        "still-dynamic",
+        (("--drag", 0.5), ("--gust-amplitude", 0.5), ("--gust-wavelength", 60.0), ("--iterations", 1)),
+        LRA,
+        Axis("--wind-speed", "U", (0, 1000, 2000, 4000, 8000, 16000), (2000, 16000), "cm/s"),
+    ),
+)
 SLICE_NAMES = tuple(s.name for s in SLICES)

@@ -161,7 +161,7 @@ BAD = [
     (["--guides", "41"], "--guides 41 is more than the 40 strands"),
     (["--guides", "0.5", "--follow", "two"], "--follow must be one or blend3"),
     (["--lra", "0.5"], "--lra scale must be a finite number >= 1"),
-    (["--guides", "0.5", "--variant", "simd"], "--variant simd does not run --guides"),
+    (["--guides", "0.5", "--variant", "simd"], "--variant simd does not run --guides (see --list-variants)"),
     (["--sag-free"], "--sag-free needs --shape-compliance"),
     (["--shape-compliance", "1e-4", "--sag-free=1"], "--sag-free takes no value"),
 ]

@@ -301,6 +301,10 @@ KNOWN_CELLS = [
     ("substeps-iterations", 1, 128, "xpbd", "fp64", "ok"),  # 0.021, 4.7× under
     ("substeps-wind", 1, 0, "ftl", "fp32", "ok"),  # a stiff chain at S = 1: 0.051, 2× under
     ("substeps-wind", 1, 8000, "ftl", "fp64", "over-stretched"),  # a gale at S = 1: 0.20, 2× over
+    # a 16000 cm/s gale at I = 1: a point escapes past 2L without long-range attachments (stretch 4.2, blown
+    # up in 5 frames), and LRA holds every point within its arc (stretch 0.70; the segments still stretch)
+    ("lra-wind", "off", 16000, "xpbd", "fp32", "escaped"),
+    ("lra-wind", 1, 16000, "xpbd", "fp32", "over-stretched"),
 ]
 
 

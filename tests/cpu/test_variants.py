@@ -99,3 +99,20 @@ def test_a_study_that_draws_the_point_count_runs_a_variant_without_a_point_limit
     variants.clear_cache()
     with pytest.raises(HarnessError, match="declares no variant that simulates any point count"):
         variants.simulating("cuda")
+
+
+def test_the_features_a_variant_runs_come_from_its_declaration(build_dir):
+    """A variant that lists §3.14 features runs only those; one that lists none runs them all."""
+    listed = {
+        "backend": "cpu",
+        "default_variant": "ref",
+        "variants": [
+            {"name": "ref", "stages": ["simulate"], "features": ["guides", "lra", "sagfree", "lod"]},
+            {"name": "simd", "stages": ["simulate"], "features": ["lra", "sagfree", "lod"]},
+            {"name": "old", "stages": ["simulate"]},
+        ],
+    }
+    script(build_dir / "hairsim-cpu", json.dumps(listed))
+    d = variants.declared("cpu")
+    assert d.runs_features("ref", ("guides", "lod")) and d.runs_features("old", ("guides",))
+    assert not d.runs_features("simd", ("guides",)) and d.runs_features("simd", ("lra", "lod"))
