@@ -28,7 +28,8 @@ HB_HD void SFX(hb_sin_cos)(const REAL x, REAL *s, REAL *c)
 }
 
 /* ---- docs/model.md §2.2 roots (SetStartPoint): p = the root (x, y, z) of `strand` ------ */
-HB_HD void SFX(hb_root_place)(const uint64_t seed, const uint64_t strand, const REAL R, const REAL face_margin, REAL p[3])
+HB_HD void SFX(hb_root_place)(const uint64_t seed, const uint64_t strand, const REAL R, const REAL face_margin,
+                              REAL p[3])
 {
     uint32_t r[4];
     hb_draw_block(seed, strand, 0u, r); /* draws 0, 1, 2 of this strand */
@@ -57,9 +58,9 @@ HB_HD void SFX(hb_root_place)(const uint64_t seed, const uint64_t strand, const 
  * angle θ; returns whether the strand hangs from the root. */
 HB_HD int SFX(hb_drape_begin)(const REAL py, const REAL pz, const REAL hair_offset, REAL *r0, REAL *rc, REAL *theta)
 {
-    *r0 = SQRT(py * py + pz * pz);       /* head circle of the slice */
-    *rc = *r0 + hair_offset;             /* shell circle */
-    REAL th = ATAN2(py, pz);             /* (−π, π] … */
+    *r0 = SQRT(py * py + pz * pz);        /* head circle of the slice */
+    *rc = *r0 + hair_offset;              /* shell circle */
+    REAL th = ATAN2(py, pz);              /* (−π, π] … */
     if (th <= -HALF_PI_R) th += TWO_PI_R; /* … taken in (−π/2, 3π/2] */
     *theta = th;
     /* A root on the lower back (θ0 > π) hangs straight down from the root. */
