@@ -2,12 +2,13 @@
  * `__host__ __device__` templates over the floating type T and the memory layout.
  *
  * Two arithmetics, chosen when the file is compiled (the builds of docs/cuda.md):
- *   - the reference arithmetic (HB_REFERENCE_ARITHMETIC=1, the strict build): this file
- *     follows c_ref/paper/model_impl.h operation by operation: the same expressions in the same
- *     order, the same constants, the same branches. Without FMA contraction and with IEEE
- *     division and square root it therefore differs from the C reference only where CUDA's
- *     sinf/cosf/asinf/atan2f (sin/cos/asin/atan2) differ from glibc's; compiled for the
- *     host (cuda/hostcheck/model_hostcheck.cu) it must reproduce c_ref/paper/model.c bit for bit;
+ *   - the reference arithmetic (HB_REFERENCE_ARITHMETIC=1, the strict build): every point is
+ *     computed by the C reference's own per-point steps (c_ref/paper/points_impl.h, included
+ *     below as float and double overloads), and the walks around them follow
+ *     c_ref/paper/model_impl.h. Without FMA contraction and with IEEE division and square root
+ *     it therefore differs from the C reference only where CUDA's sinf/cosf/asinf/atan2f
+ *     (sin/cos/asin/atan2) differ from glibc's; compiled for the host
+ *     (cuda/hostcheck/model_hostcheck.cu) it must reproduce c_ref/paper/model.c bit for bit;
  *   - the free arithmetic (the default: normal and fast-math builds): the same model and
  *     the same decisions (hanging, the wind's wrap and exactly-opposite rule, collide's
  *     threshold and tie), computed more cheaply, judged by the paper model's tolerances
@@ -41,6 +42,20 @@
 #include "paper/fast_trig.h" /* hb_atan2_fast, hb_sincos_fast (the free arithmetic, fp32) */
 #include "paper/model.h"     /* HB_SHELL_ULPS, hb_model_f32/f64 */
 #include "runtime/philox.h"  /* hb_draw_block, hb_u01, HB_HD = __host__ __device__ __forceinline__ */
+
+/* The reference arithmetic's per-point steps, written once with the C reference: instantiated
+ * here as float and double overloads of one name (SFX(name) = name) at global scope,
+ * with the same math functions as model.c (SQRT = sqrtf/sqrt, …; SINCOS on the device). */
+#include "paper/precision_f32.h"
+#undef SFX
+#define SFX(name) name
+#include "paper/points_impl.h"
+#include "paper/precision_end.h"
+#include "paper/precision_f64.h"
+#undef SFX
+#define SFX(name) name
+#include "paper/points_impl.h"
+#include "paper/precision_end.h"
 
 /* #pragma unroll for the device pass only (the host compiler does not know it) */
 #if defined(__CUDA_ARCH__)
@@ -106,28 +121,6 @@ HB_HD double m_atan2(double y, double x)
 {
     return atan2(y, x);
 }
-/* sin and cos of one argument. On the device one call, sincosf/sincos, shares the range
- * reduction; on an H200 it gave exactly sinf(x) and cosf(x) for every float |x| <= 16, and
- * sin/cos for 2e8 sampled doubles, in all three builds (docs/cuda.md). On the host sinf
- * and cosf, as model.c calls them. */
-HB_HD void m_sincos(float x, float *s, float *c)
-{
-#if defined(__CUDA_ARCH__)
-    sincosf(x, s, c);
-#else
-    *s = sinf(x);
-    *c = cosf(x);
-#endif
-}
-HB_HD void m_sincos(double x, double *s, double *c)
-{
-#if defined(__CUDA_ARCH__)
-    sincos(x, s, c);
-#else
-    *s = sin(x);
-    *c = cos(x);
-#endif
-}
 /* ---- the free arithmetic's functions: fp32 fast_trig.h, fp64 the library's ---------- */
 #ifndef HB_PAPER_MUFU
 #define HB_PAPER_MUFU 1
@@ -150,7 +143,7 @@ HB_HD void m_sincos_free(float x, float *s, float *c)
 }
 HB_HD void m_sincos_free(double x, double *s, double *c)
 {
-    m_sincos(x, s, c);
+    hb_sin_cos(x, s, c); /* the reference's (points_impl.h) */
 }
 /* 1/√x: the device's approximate rsqrt (fast_trig.h; fp64: rsqrt, 1 ulp); 1/sqrt on the host */
 HB_HD float m_rsqrt(float x)
@@ -169,15 +162,6 @@ HB_HD double m_rsqrt(double x)
 template <typename T> HB_HD constexpr T rsqrt_floor()
 {
     return sizeof(T) == 4 ? (T)HB_FAST_FLOOR : (T)0;
-}
-/* the machine epsilon EPS of model.c: 2^-23 / 2^-52 */
-HB_HD float m_eps(float)
-{
-    return 0x1p-23f;
-}
-HB_HD double m_eps(double)
-{
-    return 0x1p-52;
 }
 
 /* PI_R, HALF_PI_R, TWO_PI_R of model_impl.h: the double literals rounded to T */
@@ -233,68 +217,16 @@ template <typename T> struct PointMajor {
 };
 
 /* ---- docs/model.md §2.3 drape (model_impl.h: hb_drape_strand) ------------------------------------ */
-/* A point the shell step does not reach: the first hanging point goes onto the vertical
- * tangent line z = −rc, at distance ℓ below its predecessor; every later point hangs
- * straight down, p_k = p_{k−1} − ℓŷ. */
-template <typename T> HB_HD void hang_step(const T ell, const T rc, int &hanging, T &py, T &pz)
-{
-    if (!hanging) {
-        const T dz = pz + rc;
-        const T dy2 = ell * ell - dz * dz;
-        py = py - m_sqrt(dy2 > (T)0 ? dy2 : (T)0);
-        pz = -rc;
-        hanging = 1;
-    } else {
-        py = py - ell;
-    }
-}
-
-/* The root (x0, py, pz) is already stored; writes points 1 … P−1. */
+/* The root (x0, py, pz) is already stored; writes points 1 … P−1 by points_impl.h's step. */
 template <typename T, class V> HB_HD void drape_reference(const Model<T> &m, const V &s, const T x0, T py, T pz)
 {
     const int64_t P = m.points;
     const T ell = m.seg_len;
-    const T r0 = m_sqrt(py * py + pz * pz);               /* head circle of the slice */
-    const T rc = r0 + m.hair_offset;                      /* shell circle */
-    T theta = m_atan2(py, pz);                            /* (−π, π] … */
-    if (theta <= -half_pi_r<T>()) theta += two_pi_r<T>(); /* … taken in (−π/2, 3π/2] */
-    /* A root on the lower back (θ0 > π) hangs straight down from the root. */
-    int hanging = theta > pi_r<T>();
+    T r0, rc, theta;
+    int hanging = hb_drape_begin(py, pz, m.hair_offset, &r0, &rc, &theta);
     T rho = r0; /* slice radius of the predecessor: r0 for the first step, rc after */
-
     for (int64_t k = 1; k < P; k++) {
-        if (!hanging) {
-            /* Step onto the shell circle: the angle α of the triangle (origin,
-             * predecessor, new point) has cos α = (ρ² + rc² − ℓ²) / (2ρ rc). Evaluated in
-             * the equivalent half-angle form sin²(α/2) = (ℓ − g)(ℓ + g) / (4ρ rc), g = rc − ρ,
-             * which keeps its accuracy for short segments where cos α is near 1
-             * (docs/decisions/paper-model.md, "drape_short_segment"). cos α < −1 is s² > 1, cos α > 1
-             * is s² < 0. */
-            int fits = 0;
-            T s2 = 0;
-            if (rho > (T)0) {
-                const T g = rc - rho;
-                s2 = ((ell - g) * (ell + g)) / ((T)4 * rho * rc);
-                fits = s2 <= (T)1; /* cos α < −1: the step does not fit the circle */
-            }
-            if (fits) {
-                if (s2 < (T)0) s2 = (T)0; /* the shell is out of reach only by rounding */
-                const T next = theta + (T)2 * m_asin(m_sqrt(s2));
-                if (next <= pi_r<T>()) {
-                    theta = next;
-                    T sin_n, cos_n;
-                    m_sincos(next, &sin_n, &cos_n);
-                    pz = rc * cos_n;
-                    py = rc * sin_n;
-                    rho = rc;
-                    s.x(k) = x0;
-                    s.y(k) = py;
-                    s.z(k) = pz;
-                    continue;
-                }
-            }
-        }
-        hang_step(ell, rc, hanging, py, pz);
+        hb_drape_step(ell, r0, rc, &theta, &rho, &hanging, &py, &pz);
         s.x(k) = x0;
         s.y(k) = py;
         s.z(k) = pz;
@@ -365,32 +297,17 @@ template <typename T, class V> HB_HD void drape(const Model<T> &m, const V &s, c
     else drape_reference(m, s, x0, py, pz);
 }
 
-/* ---- docs/model.md §2.2, §2.3 init: roots (model_impl.h: place_root) then the drape -------- */
+/* ---- docs/model.md §2.2, §2.3 init: roots (points_impl.h: hb_root_place) then the drape --- */
+/* The root is IEEE arithmetic on integer draws, the reference's in every build. */
 template <typename T, class Layout> HB_HD void init_strand(const Model<T> &m, const Layout &lay, int64_t i)
 {
     const typename Layout::View s = lay.strand(i);
-    uint32_t r[4];
-    hb_draw_block(m.seed, (uint64_t)i, 0u, r); /* draws 0, 1, 2 of this strand */
-    const T u1 = (T)hb_u01(r[0]);
-    const T u2 = (T)hb_u01(r[1]);
-    const T u3 = (T)hb_u01(r[2]);
-    const T R = m.head_radius;
-
-    /* z = clamp((2u1 − 1)R − m, −R, R): the clamp keeps the square roots real. */
-    T z = ((T)2 * u1 - (T)1) * R - m.face_margin;
-    if (z < -R) z = -R;
-    if (z > R) z = R;
-    T dd = R * R - z * z;
-    const T d = m_sqrt(dd > (T)0 ? dd : (T)0);
-    /* Face side (z > 0): y in [0.3d, d), so no root sits on the lower face. */
-    const T y = z > (T)0 ? d * ((T)0.3 + (T)0.7 * u2) : ((T)2 * u2 - (T)1) * d;
-    T xx = R * R - z * z - y * y;
-    T x = m_sqrt(xx > (T)0 ? xx : (T)0);
-    if (u3 >= (T)0.5) x = -x;
-    s.x(0) = x;
-    s.y(0) = y;
-    s.z(0) = z;
-    drape(m, s, x, y, z);
+    T p[3];
+    hb_root_place(m.seed, (uint64_t)i, m.head_radius, m.face_margin, p);
+    s.x(0) = p[0];
+    s.y(0) = p[1];
+    s.z(0) = p[2];
+    drape(m, s, p[0], p[1], p[2]);
 }
 
 /* Re-drapes strand i from its stored root (model.h: hb_drape_strand). */
@@ -447,22 +364,7 @@ template <typename T> struct WindWalk {
             oz = cz;
             return;
         }
-        const T dy = cy - oy, dz = cz - oz;
-        const T phi = m_atan2(dy, dz);
-        T delta = psi - phi; /* in [−2π, 2π]: wrap to (−π, π] */
-        if (delta > pi_r<T>()) delta -= two_pi_r<T>();
-        else if (delta <= -pi_r<T>()) delta += two_pi_r<T>();
-        /* Exactly opposite: take the arc through +y. Turning by +π passes through the
-         * direction φ + π/2, whose y component has the sign of cos φ, i.e. of dz. */
-        if (delta == pi_r<T>()) delta = dz >= (T)0 ? pi_r<T>() : -pi_r<T>();
-        const T t = (w * (T)k) / last;
-        const T turned = phi + t * delta;
-        T sin_t, cos_t;
-        m_sincos(turned, &sin_t, &cos_t);
-        nz = nz + ell * cos_t;
-        ny = ny + ell * sin_t;
-        oy = cy;
-        oz = cz;
+        hb_wind_step(ell, w, psi, last, k, cy, cz, &oy, &oz, &ny, &nz); /* the reference's */
     }
 };
 
@@ -479,10 +381,7 @@ template <typename T, class Count = int64_t> struct CollideWalk {
     {
         ell = m.seg_len;
         ell2 = ell * ell;
-        const T r0 = m_sqrt(y0 * y0 + z0 * z0);
-        rc = r0 + m.hair_offset;
-        const T inner = rc - rc * ((T)HB_SHELL_ULPS * m_eps(T())); /* rounding allowance */
-        inner2 = inner * inner;
+        hb_collide_begin(y0, z0, m.hair_offset, &rc, &inner2); /* the shell and its rounding allowance */
         moved = 0;
         changed = 0;
         py = y0;
@@ -494,53 +393,8 @@ template <typename T, class Count = int64_t> struct CollideWalk {
     HB_HD int step(T &cy, T &cz)
     {
         if constexpr (kFree) return step_free(cy, cz);
-        if (moved) {
-            /* Follow the leader: p_k ← p_{k−1} + ℓ·unit(p_k − p_{k−1}). */
-            const T dy = cy - py, dz = cz - pz;
-            const T len = m_sqrt(dy * dy + dz * dz);
-            if (len > (T)0) {
-                cy = py + ell * (dy / len);
-                cz = pz + ell * (dz / len);
-            } else { /* no direction left: hang down */
-                cy = py - ell;
-                cz = pz;
-            }
-        }
-        if (cy * cy + cz * cz < inner2) {
-            /* Intersect the shell (radius rc, centre 0) with the circle of radius ℓ around
-             * the predecessor at distance d from the centre: the chord's foot lies at
-             * a = (d² + rc² − ℓ²) / 2d along the unit u towards the predecessor, the
-             * candidates at a·u ± hh·u⊥ with hh = √(rc² − a²). Evaluated through
-             * t = d − a = ((d − rc)(d + rc) + ℓ²) / 2d and hh² = (rc − a)(rc + a), which
-             * avoid the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions/paper-model.md,
-             * "collide_short_segment"). */
-            const T d2 = py * py + pz * pz;
-            const T d = m_sqrt(d2);
-            if (d > (T)0) {
-                const T t = ((d - rc) * (d + rc) + ell * ell) / ((T)2 * d);
-                const T a = d - t;
-                const T h2 = ((rc - d) + t) * (rc + a);
-                const T hh = m_sqrt(h2 > (T)0 ? h2 : (T)0);
-                const T uy = py / d, uz = pz / d;
-                const T fy = a * uy, fz = a * uz;
-                const T y1 = fy + hh * uz, z1 = fz - hh * uy;
-                const T y2 = fy - hh * uz, z2 = fz + hh * uy;
-                const T e1 = (y1 - cy) * (y1 - cy) + (z1 - cz) * (z1 - cz);
-                const T e2 = (y2 - cy) * (y2 - cy) + (z2 - cz) * (z2 - cz);
-                if (e1 < e2 || (e1 == e2 && y1 >= y2)) {
-                    cy = y1;
-                    cz = z1;
-                } else {
-                    cy = y2;
-                    cz = z2;
-                }
-                moved = 1;
-            }
-        }
-        const int write = moved;
-        if (moved) changed++;
-        py = cy;
-        pz = cz;
+        const int write = hb_collide_step(ell, rc, inner2, &moved, &py, &pz, &cy, &cz); /* the reference's */
+        if (write) changed++;
         return write;
     }
 

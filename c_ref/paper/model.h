@@ -3,7 +3,8 @@
  * A strand is P points of (x, y, z) at `s[3k + c]` (the canonical strand-major layout:
  * strand i starts at state + 3·P·i). Every function here is pure and touches one strand,
  * so the results cannot depend on thread count or strand order; backend_cpu.c loops over
- * strands. The math is written once, in model_impl.h, and instantiated for float and
+ * strands. The math is written once, in model_impl.h (the stages) and points_impl.h (one
+ * point's step, shared with the CUDA port's strict build), and instantiated for float and
  * double by model.c.
  */
 #ifndef HB_MODEL_H

@@ -5,6 +5,7 @@
 #undef SQRT
 #undef SIN
 #undef COS
+#undef SINCOS
 #undef ASIN
 #undef ATAN2
 #undef EPS

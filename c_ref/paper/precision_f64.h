@@ -5,6 +5,7 @@
 #define SQRT sqrt
 #define SIN sin
 #define COS cos
+#define SINCOS sincos
 #define ASIN asin
 #define ATAN2 atan2
 #define EPS 0x1p-52

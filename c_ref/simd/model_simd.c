@@ -65,6 +65,7 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #endif
 
 #include "paper/precision_f32.h"
+#include "paper/points_impl.h" /* the roots: the reference's own hb_root_place */
 #define ITYPE int32_t
 #define BLOCK HB_SIMD_BLOCK_F32
 #define FAST_TRIG 1
@@ -75,6 +76,7 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 #undef FAST_TRIG
 
 #include "paper/precision_f64.h"
+#include "paper/points_impl.h" /* the roots: the reference's own hb_root_place */
 #define ITYPE int64_t
 #define BLOCK HB_SIMD_BLOCK_F64
 #define FAST_TRIG 0

@@ -1,9 +1,9 @@
 /* model_simd_impl.h — the stages of model_impl.h on a block of strands in the point-major
  * layout, one strand per SIMD lane (model_simd.h says the layout and the contract).
  *
- * Included twice by model_simd.c with REAL (float, double), ITYPE (an integer as wide as
- * REAL, for per-lane flags and counts), BLOCK (lanes per block), SFX, MODEL, SQRT, SIN,
- * COS, ASIN, ATAN2 and EPS. Every `#pragma omp simd` loop below runs over the BLOCK lanes
+ * Included twice by model_simd.c, after paper/points_impl.h, with REAL (float, double),
+ * ITYPE (an integer as wide as REAL, for per-lane flags and counts), BLOCK (lanes per
+ * block), SFX, MODEL, SQRT, SIN, COS, ASIN, ATAN2 and EPS. Every `#pragma omp simd` loop below runs over the BLOCK lanes
  * of one point k (collide: over a chunk of HB_SIMD_CHUNK of them): its body is the body of
  * the matching loop of model_impl.h for one strand, with each `if` turned into values
  * computed on every lane and a select. Nothing in a lane depends on another lane, and
@@ -33,7 +33,7 @@
 
 #define ROW(A, k) ((A) + (size_t)(k) * (size_t)stride)
 
-/* ---- init: roots (model_impl.h place_root) and drape (model_impl.h drape) ------------- */
+/* ---- init: roots (points_impl.h hb_root_place) and drape (model_impl.h drape) -------- */
 void SFX(hb_simd_init_block)(const MODEL *m, uint64_t first, REAL *X, REAL *Y, REAL *Z, int64_t stride)
 {
     const int64_t P = m->points;
@@ -52,26 +52,14 @@ void SFX(hb_simd_init_block)(const MODEL *m, uint64_t first, REAL *X, REAL *Y, R
     ITYPE fits0[BLOCK] HB_ALIGNED, fits1[BLOCK] HB_ALIGNED;
 #endif
 
-    /* Roots: integer Philox draws and IEEE arithmetic only, so they are the bits of
-     * place_root whether this loop is vectorised or not. */
+    /* Roots: the reference's own function (points_impl.h), integer Philox draws and IEEE
+     * arithmetic only, so they are its bits whether this loop is vectorised or not. */
     for (int j = 0; j < BLOCK; j++) {
-        uint32_t r[4];
-        hb_draw_block(m->seed, first + (uint64_t)j, 0u, r);
-        const REAL u1 = (REAL)hb_u01(r[0]);
-        const REAL u2 = (REAL)hb_u01(r[1]);
-        const REAL u3 = (REAL)hb_u01(r[2]);
-        REAL z = ((REAL)2 * u1 - (REAL)1) * R - m->face_margin;
-        if (z < -R) z = -R;
-        if (z > R) z = R;
-        REAL dd = R * R - z * z;
-        const REAL d = SQRT(dd > (REAL)0 ? dd : (REAL)0);
-        const REAL y = z > (REAL)0 ? d * ((REAL)0.3 + (REAL)0.7 * u2) : ((REAL)2 * u2 - (REAL)1) * d;
-        REAL xx = R * R - z * z - y * y;
-        REAL x = SQRT(xx > (REAL)0 ? xx : (REAL)0);
-        if (u3 >= (REAL)0.5) x = -x;
-        x0[j] = x;
-        py[j] = y;
-        pz[j] = z;
+        REAL p[3];
+        SFX(hb_root_place)(m->seed, first + (uint64_t)j, R, m->face_margin, p);
+        x0[j] = p[0];
+        py[j] = p[1];
+        pz[j] = p[2];
     }
 
     {
