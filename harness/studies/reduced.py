@@ -204,7 +204,7 @@ def measure(plan=Plan(), out=None, work=None, progress=print):
             pos, stretch, blown, rest = _positions(path)
             rms, mx = frame_errors(pos, ref, L) if ref is not None else (np.nan, np.nan)
             sag_rms, sag_max = frame_errors(pos, np.broadcast_to(rest, pos.shape), L)
-            tip_hz, tip_zeta = ob.swing(pos, frame_dt) if study == "sagfreq" else (np.nan, np.nan)
+            tip_hz, tip_zeta = ob.swing(pos, frame_dt)[:2] if study == "sagfreq" else (np.nan, np.nan)
             p_sim = int(points or scene.points)
             base = {
                 "study": study,
