@@ -234,9 +234,9 @@ void dyn_free(cuda_impl *c)
 {
     DynState *d = c->dyn;
     if (!d) return;
-    void *ptrs[] = {d->vel,     d->vel_saved,  d->rest,  d->bend_rest, d->scratch,    d->q,        d->ph,
-                    d->d_obs,   d->d_guide,    d->d_follower, d->d_src, d->d_w,   d->shape_rest, d->seg_rest,
-                    d->seg64,   d->d_render,   d->d_vrender};
+    void *ptrs[] = {d->vel,        d->vel_saved, d->rest,    d->bend_rest,  d->scratch,  d->q,
+                    d->ph,         d->d_obs,     d->d_guide, d->d_follower, d->d_src,    d->d_w,
+                    d->shape_rest, d->seg_rest,  d->seg64,   d->d_render,   d->d_vrender};
     for (void *p : ptrs)
         if (p) cudaFree(p);
     free(d->h_obs);

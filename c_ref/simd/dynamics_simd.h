@@ -79,8 +79,8 @@ typedef struct {
                       float *, const float *, const float *, const float *, const float *, const float *, int64_t,
                       float *);
     void (*frame_f64)(const hb_dyn_model_f64 *, const hb_dyn_frame *, double *, double *, double *, double *, double *,
-                      double *, const double *, const double *, const double *, const double *, const double *,
-                      int64_t, double *);
+                      double *, const double *, const double *, const double *, const double *, const double *, int64_t,
+                      double *);
     void (*observe_f32)(const hb_scene *, const float *, const float *, const float *, const float *, const float *,
                         const float *, int64_t, int64_t, int64_t, const double *, hb_obs_partial *);
     void (*observe_f64)(const hb_scene *, const double *, const double *, const double *, const double *,

@@ -284,8 +284,12 @@ DYN_SAG_PLAIN_MIN_L = 3e-3
 # tests/cpu/test_dynamic_sagfree_swing.py (40 strands × 12 points, S = 8, I = 2, α_b = 1e-6,
 # α_g = 1e-4, ρ_g = 1, fp32) hit by a steady wind (U = 600 cm/s, c_d = 0.5/s) swings at a median
 # tip frequency of 15.70 / 15.70 Hz (xpbd, without / with) and 15.67 / 15.69 Hz (ftl) over 1 s:
-# 2.5e-4 and 1.2e-3 relative apart; damping ratios 0.1038 / 0.1042 and 0.1038 / 0.1042 (4e-3).
-# Bounds 5e-3 (4× the worse frequency) and 2e-2 (5× the worse damping ratio).
+# 2.5e-4 and 1.2e-3 relative apart. Damping ratios by observables.damping_fit (the envelope's
+# decay): xpbd 0.1050 ± 0.0015 / 0.1053 ± 0.0010 (2.5e-3 apart); ftl 0.1074 ± 0.0026 /
+# 0.0712 ± 0.0037, 34% apart, far past the fits' errors: with ftl, sag-free rest changes the
+# swing's decay (an open finding; the earlier log-decrement estimator saw 0.1038 / 0.1042), so
+# the damping bound holds for xpbd only. Bounds 5e-3 (4× the worse frequency) and 2e-2 (8× the
+# xpbd damping ratios' difference).
 DYN_SAGFREE_TIP_HZ_REL = 5e-3
 DYN_SAGFREE_TIP_DAMPING_REL = 2e-2
 DYN_LOD_STRAIGHT_EPS = 64.0
