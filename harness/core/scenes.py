@@ -139,22 +139,19 @@ class Scene:
 
     def flags(self):
         """The backend flags that run this scene (docs/interfaces.md)."""
+        tail = [
+            "--wind-strength",
+            repr(self.wind_strength),
+            "--wind-angle",
+            repr(self.wind_angle),
+            "--stages",
+            ",".join(self.stages),
+            "--precision",
+            self.precision,
+            *scenes_dynamic.flags(self),
+        ]
         if self.groom_file:  # the file decides the head and the strands (docs/model.md §3.15)
-            return [
-                "--points",
-                str(self.points),
-                "--groom",
-                self.groom_file,
-                "--wind-strength",
-                repr(self.wind_strength),
-                "--wind-angle",
-                repr(self.wind_angle),
-                "--stages",
-                ",".join(self.stages),
-                "--precision",
-                self.precision,
-                *scenes_dynamic.flags(self),
-            ]
+            return ["--points", str(self.points), "--groom", self.groom_file, *tail]
         curl = ["--groom", "curly", "--curl-radius", repr(self.curl_radius), "--curl-pitch", repr(self.curl_pitch)]
         return [
             *(curl if self.groom == "curly" else []),
@@ -172,15 +169,7 @@ class Scene:
             repr(self.hair_length),
             "--face-margin",
             repr(self.face_margin),
-            "--wind-strength",
-            repr(self.wind_strength),
-            "--wind-angle",
-            repr(self.wind_angle),
-            "--stages",
-            ",".join(self.stages),
-            "--precision",
-            self.precision,
-            *scenes_dynamic.flags(self),
+            *tail,
         ]
 
 

@@ -4,10 +4,8 @@ and velocities, in the canonical and the point-major layout: cuda/hostcheck/lod_
 GPU needed; on the device the normal build contracts FMAs (tests/gpu/test_gpu_lod.py covers that).
 Built by the Makefile (`make hostcheck`). Skipped, with the reason, where nvcc is missing."""
 
-import subprocess
-
 import pytest
-from test_cuda_port_host import build_hostcheck
+from test_cuda_port_host import build_hostcheck, check_hostcheck
 
 
 @pytest.fixture(scope="module")
@@ -16,8 +14,5 @@ def lod_hostcheck():
 
 
 def test_cuda_lod_rendering_matches_c_reference_bit_for_bit(lod_hostcheck):
-    p = subprocess.run([str(lod_hostcheck)], capture_output=True, text=True, timeout=300)
-    lines = p.stdout.strip().splitlines()
-    summary = lines[-1] if lines else "(no output)"
-    assert p.returncode == 0, f"host check failed: {summary}\n" + "\n".join(lines[:20]) + p.stderr
+    summary = check_hostcheck(lod_hostcheck).strip().splitlines()[-1]
     assert summary == "lod host check: 48 cases, 0 mismatches (all identical)", summary

@@ -61,7 +61,7 @@ def hostcheck():
     return {"reference": ref, "free": free}
 
 
-def _check(exe, *args):
+def check_hostcheck(exe, *args):
     p = subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=600)
     summary = p.stdout.strip().splitlines()[-1] if p.stdout.strip() else "(no output)"
     assert p.returncode == 0, (
@@ -76,7 +76,7 @@ def _check(exe, *args):
 
 def test_cuda_model_matches_c_reference_bit_for_bit(hostcheck):
     """The reference arithmetic (the strict build's): every case bit-identical."""
-    out = _check(hostcheck["reference"])
+    out = check_hostcheck(hostcheck["reference"])
     assert "host check (reference arithmetic)" in out and out.count(" identical ") == 32, out
 
 
@@ -86,7 +86,7 @@ def test_cuda_free_arithmetic_within_paper_tolerance(hostcheck):
     f32 = tolerances.pair_tolerance("fp32", "fp32")
     f64 = tolerances.pair_tolerance("fp64", "fp64")
     args = (f32.point_k, f32.max_over_fraction, f64.point_k, f64.max_over_fraction, tolerances.MOVED_COUNT_FRACTION)
-    out = _check(hostcheck["free"], 2000, *args)
+    out = check_hostcheck(hostcheck["free"], 2000, *args)
     assert "host check (free arithmetic)" in out and out.count(" within tolerance ") == 32, out
 
 
