@@ -19,6 +19,11 @@ PREVIEW_BUDGET = 0.05
 GAME_BUDGET = 0.02
 
 
+def _table_head(intro, header, rule):
+    """A paragraph, then a Markdown table's header and rule."""
+    return ["", intro, "", header, rule]
+
+
 def read(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
@@ -100,14 +105,12 @@ def markdown(rows):
     ]
     sag = [(k, v) for k, v in cases.items() if k[0] == "sagfree"]
     if sag:
-        lines += [
-            "",
+        lines += _table_head(
             "Sag-free rest: the scene held still (no head motion, no wind, every point in shape); how far the "
             "groom moves from its rest shape:",
-            "",
             "| solver | sag-free | rest rms / L | rest max / L | " + " | ".join(f"{c} ms" for c in cols) + " |",
             "| --- | --- | ---: | ---: |" + " ---: |" * len(cols),
-        ]
+        )
         for (_st, solver, _i, _g, _f, _l, on, _p), (r, t) in sag:
             lines.append(
                 f"| {solver} | {'on' if on == '1' else 'off'} | {float(r['rest_rms_L']):.3g} | "
@@ -115,14 +118,12 @@ def markdown(rows):
             )
     freq = [(k, v) for k, v in cases.items() if k[0] == "sagfreq"]
     if freq:
-        lines += [
-            "",
+        lines += _table_head(
             "Sag-free rest leaves the dynamics alone: the same still scene hit at t = 0 by a steady wind (a step "
             "load); the median over strands of the tip's swing frequency and damping ratio:",
-            "",
             "| solver | sag-free | tip Hz | tip damping ratio |",
             "| --- | --- | ---: | ---: |",
-        ]
+        )
         for (_st, solver, *_rest, on, _p), (r, _t) in freq:
             lines.append(
                 f"| {solver} | {'on' if on == '1' else 'off'} | {float(r['tip_hz']):.4g} | "
