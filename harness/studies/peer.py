@@ -119,7 +119,14 @@ def _errors(x, ref, length):
 def _observed(x, length):
     """(stretch_max over the frames, most strands blown up in a frame) by harness.check.invariants_dynamic."""
     n, p = x.shape[1], x.shape[2]
-    view = SimpleNamespace(n_strands=n, points=p, hair_length=length, collider=False, collide_radius=0.0)
+    view = SimpleNamespace(
+        n_strands=n,
+        points=p,
+        hair_length=length,
+        collider=False,
+        collide_radius=0.0,
+        segment_rest=lambda: length / (p - 1),  # a chain's links are equal (no groom)
+    )
     obs = [invariants_dynamic.observe(view, xf) for xf in x[1:]]
     return max(o[0] for o in obs), max(o[3] for o in obs)
 
