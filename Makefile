@@ -190,11 +190,11 @@ $(BUILD)/hostcheck/dyn_hostcheck: cuda/hostcheck/dyn_hostcheck.cu cuda/dyn_model
   $(OBJ)/dynamic/dynamics_f32.o $(OBJ)/dynamic/dynamics_f64.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
-$(BUILD)/hostcheck/post_hostcheck: cuda/hostcheck/post_hostcheck.cu cuda/dyn_post.cuh cuda/dyn_model.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/post_hostcheck: cuda/hostcheck/post_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/dyn_post.cuh cuda/dyn_model.cuh $(C_HEADERS) \
   $(OBJ)/dynamic/dyn_followers.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
-$(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/dyn_lod.cuh cuda/dyn_model.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/dyn_lod.cuh cuda/dyn_model.cuh $(C_HEADERS) \
   $(OBJ)/dynamic/dyn_lod.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm

@@ -19,24 +19,13 @@
 
 #include "dyn_lod.cuh"
 #include "dynamic/dyn_lod.h"
+#include "hostcheck/hostcheck_rng.h"
 
 using namespace hb::dyn;
 
 namespace {
 
 long g_cases = 0, g_mismatch = 0;
-
-struct Rng {
-    uint64_t s;
-    double u()
-    {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        return (double)(s >> 11) * (1.0 / 9007199254740992.0);
-    }
-    double sym() { return 2.0 * u() - 1.0; }
-};
 
 void strand_c(const float *x, const float *y, int64_t ps, int64_t pr, float *out)
 {

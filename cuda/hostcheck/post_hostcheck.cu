@@ -21,24 +21,13 @@
 
 #include "dynamic/dyn_followers.h"
 #include "dyn_post.cuh"
+#include "hostcheck/hostcheck_rng.h"
 
 using namespace hb::dyn;
 
 namespace {
 
 long g_cases = 0, g_mismatch = 0;
-
-struct Rng {
-    uint64_t s;
-    double u()
-    {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        return (double)(s >> 11) * (1.0 / 9007199254740992.0);
-    }
-    double sym() { return 2.0 * u() - 1.0; }
-};
 
 template <typename T> const T *weights(const hb_followers &fl);
 template <> const float *weights<float>(const hb_followers &fl)
