@@ -28,6 +28,14 @@ class DoesNotFit(BackendError):
     """The binary refused the state as too large for memory (its exit status 3)."""
 
 
+class TimedOut(BackendError):
+    """The binary did not finish within the caller's timeout (it was killed); exit status 124,
+    as timeout(1) gives, not the 2 of a refusal."""
+
+    def __init__(self, message):
+        super().__init__(message, code=124)
+
+
 class MissingBinary(HarnessError):
     pass
 
@@ -67,7 +75,7 @@ def run_binary(
         child.wait()
         tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(args))
         if isinstance(e, subprocess.TimeoutExpired):
-            raise BackendError(f"{binary.name} did not finish within {timeout} s: {' '.join(cmd[1:])}") from None
+            raise TimedOut(f"{binary.name} did not finish within {timeout} s: {' '.join(cmd[1:])}") from None
         raise
     proc = subprocess.CompletedProcess(cmd, child.returncode, stdout, stderr)
     if proc.returncode < 0:  # killed by a signal: the binary removes its own on these, SIGKILL aside

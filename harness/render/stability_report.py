@@ -21,6 +21,7 @@ COLOURS = {
     "escaped": "#e8896a",
     "diverged": "#b52b27",
     "refused": "#bbbbbb",
+    "timed out": "#8c8c8c",
     "blown up": "#d9534f",
     "failed": "#555555",
 }
@@ -31,6 +32,7 @@ VERBS = {
     "penetrating": "penetrates the head",
     "over-stretched": "over-stretches",
     "refused": "is refused",
+    "timed out": "did not finish within the map's per-cell timeout",
     "blown up": "blows up (a map measured before the split by cause)",
     "failed": "fails",
 }

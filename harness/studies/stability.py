@@ -17,7 +17,8 @@ harness/core/tolerances.py:
   penetrating     penetration_max > STABILITY_PENETRATION_REL · R_c in some frame
   over-stretched  stretch_max > STABILITY_STRETCH_MAX in some frame
   ok              none of these
-  refused         the binary refused the scene (exit 2); failed: any other failure
+  refused         the binary refused the scene (exit 2); timed out: it did not finish
+                  within --timeout; failed: any other failure
 
 (the first that applies). Each cell's last frame also goes through
 harness.check.invariants_dynamic; its violations are recorded beside the verdict.
@@ -29,7 +30,7 @@ report/stability_<slice>.png and writes report/dynamic_stability.md.
 import os
 import tempfile
 import time
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import replace
 from pathlib import Path
 
@@ -171,7 +172,8 @@ def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None
             pin = {"CUDA_VISIBLE_DEVICES": gpu.select} if gpu is not None else None
             runner.run_binary(binary_path(be.backend, be.build), flags, timeout=timeout, env=pin)
         except runner.BackendError as e:
-            out.update(verdict="refused" if e.code == 2 else "failed", message=str(e), wall_s=time.perf_counter() - t0)
+            why = "timed out" if isinstance(e, runner.TimedOut) else "refused" if e.code == 2 else "failed"
+            out.update(verdict=why, message=str(e), wall_s=time.perf_counter() - t0)
             return out
         with open_trajectory(path) as t:
             obs = t.observables
@@ -246,14 +248,32 @@ def measure(
         log(f"stability: GPU cells spread over {len(spread)} GPUs")
     t0 = time.perf_counter()
     bar = Progress(len(todo), "stability")
+    # the heaviest cells (most substep iterations a frame, GPU before CPU) start first, so that
+    # none is left running alone at the end; the rows keep the order of `todo`
+    order = sorted(range(len(todo)), key=lambda i: -cell_weight(todo[i], strands, frames))
+    rows = [None] * len(todo)
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = [pool.submit(run_cell, *job, strands, frames, timeout, gpu_for(i, job)) for i, job in enumerate(todo)]
-        rows = []
-        for f in futures:
-            rows.append(f.result())
+        futures = {pool.submit(run_cell, *todo[i], strands, frames, timeout, gpu_for(i, todo[i])): i for i in order}
+        for f in as_completed(futures):
+            rows[futures[f]] = f.result()
             bar.update()
     bar.close()
     return rows, bes, time.perf_counter() - t0
+
+
+def cell_weight(job, strands, frames):
+    """A cell's expected cost, for the order the map starts its cells in: substeps ×
+    iterations × points (GPU cells count double: they share one device)."""
+    slc, r, c, solver, precision, be = job
+    scene = cell_scene(slc, r, c, solver, precision, strands, frames)
+
+    def number(flag):
+        try:
+            return float(scene.dynamic.get(flag, 1))
+        except (TypeError, ValueError):
+            return 1.0
+
+    return number("--substeps") * number("--iterations") * scene.points * (2.0 if be.backend == "cuda" else 1.0)
 
 
 def write_csv(rows, path):

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 # farther than 2L from its root, every number finite) or diverged (a NaN or Inf)
 VERDICTS = ("ok", "over-stretched", "penetrating", "escaped", "diverged")
 BLOWN_UP = ("escaped", "diverged")
-OTHER = ("refused", "failed")
+OTHER = ("refused", "timed out", "failed")
 LEGACY = ("blown up",)  # a map measured before the split by cause still reads
 OFF = "off"  # an axis value that leaves its feature undeclared
 

@@ -315,6 +315,32 @@ def test_map_cells_with_known_verdicts(cpu_bin, name, row, col, solver, precisio
     assert cell["violations"] == "", cell
 
 
+def test_a_cell_past_its_timeout_is_timed_out_not_refused(cpu_bin):
+    """A cell killed by --timeout is "timed out" (exit 124 of runner.TimedOut), never "refused"
+    (exit 2: the binary declined the scene): a map once showed slow GPU cells as refused."""
+    cell = stability.run_cell(
+        slice_named("substeps-iterations"), 64, 128, "xpbd", "fp64", CPU, 64, stability.FRAMES, timeout=0.05
+    )
+    assert cell["verdict"] == "timed out", cell
+    assert "did not finish within 0.05 s" in cell["message"]
+
+
+def test_the_map_starts_its_heaviest_cells_first_and_keeps_its_row_order(cpu_bin, monkeypatch):
+    started = []
+
+    def fake_cell(slc, row, col, solver, precision, be, *rest):
+        started.append((row, col))
+        return {"slice": slc.name, "row": row, "col": col, "solver": solver, "precision": precision}
+
+    monkeypatch.setattr(stability, "run_cell", fake_cell)
+    rows, _, _ = stability.measure(["substeps-iterations"], quick=True, gpu="no", jobs=1, log=lambda *_: None)
+    slc = slice_named("substeps-iterations")
+    cells = [(r, c) for r, c in ((r["row"], r["col"]) for r in rows)]
+    assert cells[:: 2 * 2] == [(r, c) for r in slc.rows.quick for c in slc.cols.quick]  # × solvers × precisions
+    work = [float(r) * float(c) for r, c in started]
+    assert work == sorted(work, reverse=True) and work[0] > work[-1]
+
+
 def test_verdict_takes_the_worst_that_applies():
     s_max, p_rel = tolerances.STABILITY_STRETCH_MAX, tolerances.STABILITY_PENETRATION_REL
     assert stability.verdict(0.0, 0.0, 0) == "ok"
