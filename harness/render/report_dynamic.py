@@ -194,7 +194,9 @@ def headline_lines(path):
     m = h.get("ncu")
     if m and "skipped" not in m:
         out.append(
-            f"\nNsight Compute on the {m['variant']} kernel of the default scene ({m['strands']:,} strands): "
+            f"\nNsight Compute on the {m['variant']} kernel of the default scene ({m['strands']:,} strands"
+            + (f"; revision {m['revision']}" if m.get("revision") else "")
+            + "): "
             f"SM throughput {m.get('sm__throughput.avg.pct_of_peak_sustained_elapsed')}% of peak, DRAM "
             f"{m.get('dram__throughput.avg.pct_of_peak_sustained_elapsed')}%, "
             f"{m.get('launch__registers_per_thread'):.0f} registers, "
