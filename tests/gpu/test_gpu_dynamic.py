@@ -31,6 +31,7 @@ from harness.core import variants
 from harness.core.tolerances import GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS
 from harness.io.trajectory import open_trajectory
 from support.measured import write_worst
+from support.statecheck import run
 
 pytestmark = pytest.mark.gpu
 
@@ -117,16 +118,13 @@ def record(key, value):
     ERRORS[key] = max(float(value), ERRORS.get(key, 0.0))
 
 
-def run(binary, *args, check=True, timeout=300):
-    cmd = [str(binary), *[str(a) for a in args]]
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    if check and p.returncode != 0:
-        raise AssertionError(f"{' '.join(cmd)} exited {p.returncode}: {p.stderr.strip()}")
-    return p
-
-
 def dyn_args(scene, solver):
     return ["--substeps", SUBSTEPS, "--iterations", ITERATIONS, "--solver", solver, *SCENES[scene]]
+
+
+def simulate(binary, out, scene, solver, *flags):
+    """`binary FLAGS` with the scene's and solver's dynamic flags, quiet, into out (replaced)."""
+    return run(binary, *flags, "--quiet", *dyn_args(scene, solver), "--output", out, "--force")
 
 
 def last_step(path):
@@ -150,28 +148,9 @@ def cpu_run(work):
         key = ("cpu", scene, solver, precision)
         if key not in _CACHE:
             out = work / f"cpu_{scene}_{solver}_{precision}.h5"
-            run(
-                CPU_BIN,
-                "--strands",
-                N,
-                "--seed",
-                SEED,
-                "--hair-length",
-                L,
-                "--precision",
-                precision,
-                "--stages",
-                "init,simulate",
-                "--frames",
-                FRAME_IN + 1,
-                "--velocities",
-                "all",
-                "--quiet",
-                *dyn_args(scene, solver),
-                "--output",
-                out,
-                "--force",
-            )
+            scene_flags = ("--strands", N, "--seed", SEED, "--hair-length", L, "--precision", precision)
+            flags = ("--stages", "init,simulate", "--frames", FRAME_IN + 1, "--velocities", "all")
+            simulate(CPU_BIN, out, scene, solver, *scene_flags, *flags)
             _CACHE[key] = out
         return _CACHE[key]
 
@@ -187,27 +166,8 @@ def gpu_frame(work, cpu_run):
         if key not in _CACHE:
             src = cpu_run(scene, solver, precision)
             out = work / f"gpu_{build}_{variant}_{scene}_{solver}_{precision}_{block}{tag}.h5"
-            run(
-                BUILDS[build],
-                "--input",
-                src,
-                "--input-frame",
-                FRAME_IN,
-                "--stages",
-                "simulate",
-                "--frames",
-                1,
-                "--variant",
-                variant,
-                "--block-size",
-                block,
-                "--quiet",
-                *dyn_args(scene, solver),
-                *extra,
-                "--output",
-                out,
-                "--force",
-            )
+            flags = ("--input", src, "--input-frame", FRAME_IN, "--stages", "simulate", "--frames", 1)
+            simulate(BUILDS[build], out, scene, solver, *flags, "--variant", variant, "--block-size", block, *extra)
             _CACHE[key] = out
         return _CACHE[key]
 
