@@ -64,6 +64,11 @@ unit_interval = real("unit_interval", "a number in [0, 1]", lambda v: 0.0 <= v <
 number = real("number", "a number", math.isfinite, "needs a finite number")
 
 
+def options(args, names):
+    """The parsed options `names` (space-separated attribute names) as keywords of the same names."""
+    return {name: getattr(args, name) for name in names.split()}
+
+
 def cmd_run(args):
     from harness.core import runner, scenes
     from harness.core.paths import binary_path
@@ -94,15 +99,7 @@ def cmd_run(args):
             scene = dataclasses.replace(scene, groom=hair)
     binary = binary_path(args.backend, args.build)
     flags = runner.run_flags(
-        scene,
-        args.backend,
-        variant=args.variant,
-        block_size=args.block_size,
-        threads=args.threads,
-        repeat=args.repeat,
-        warmup=args.warmup,
-        output=args.output,
-        force=args.force,
+        scene, args.backend, **options(args, "variant block_size threads repeat warmup output force")
     )
     if scene.model == "dynamic":  # per-frame observables (harness/check/run_dynamic.py)
         from harness.check import run_dynamic
@@ -127,16 +124,8 @@ def cmd_stepdiff(args):
     from harness.check import diff_dynamic
 
     flags = args.flags[1:] if args.flags[:1] == ["--"] else args.flags
-    return diff_dynamic.stepdiff(
-        args.reference,
-        args.binary,
-        flags=flags,
-        frames=args.frames,
-        exact=args.exact,
-        keep=args.keep,
-        timeout=args.timeout,
-        spread=not args.no_spread,
-    )
+    given = options(args, "frames exact keep timeout")
+    return diff_dynamic.stepdiff(args.reference, args.binary, flags=flags, spread=not args.no_spread, **given)
 
 
 def cmd_sweep(args):
@@ -272,6 +261,13 @@ DYNAMIC_ONLY = (
 )
 
 
+# the options accuracy_dynamic.Plan takes as given (substeps, iterations and ftl_damping as sets)
+DYNAMIC_SETS = ("substeps", "iterations", "ftl_damping")
+DYNAMIC_PLAN = " ".join(
+    ["scene", "strands", "points", "repeat", *(k for k in DYNAMIC_ONLY if k not in ("quick", "force", *DYNAMIC_SETS))]
+)
+
+
 def _flag(name):
     return "--" + name.replace("_", "-")
 
@@ -343,29 +339,8 @@ def accuracy_dynamic(args):
         for path in accuracy_dynamic_report.write(csv_path.parent, args.report_dir, csv_path=csv_path):
             print(f"wrote {display(path)}")
         return 0
-    given = {
-        k: getattr(args, k)
-        for k in (
-            "scene",
-            "strands",
-            "points",
-            "repeat",
-            "seconds",
-            "horizon",
-            "time_strands",
-            "time_frames",
-            "ref_start",
-            "ref_max",
-            "jobs",
-            "analytic",
-            "gpu",
-            "ref_extra",
-            "long_seconds",
-            "long_strands",
-        )
-        if getattr(args, k) is not None
-    }
-    for k in ("substeps", "iterations", "ftl_damping"):
+    given = {k: v for k, v in options(args, DYNAMIC_PLAN).items() if v is not None}
+    for k in DYNAMIC_SETS:
         if getattr(args, k) is not None:
             given[k] = tuple(sorted(set(getattr(args, k))))
     plan = accuracy_dynamic.Plan.quick(**given) if args.quick else accuracy_dynamic.Plan(**given)
@@ -393,14 +368,7 @@ def cmd_headline(args):
     from harness.render import headline_report
     from harness.studies import headline_paper
 
-    result = headline_paper.run(
-        strands=args.strands,
-        points=args.points,
-        repeat=args.repeat,
-        cpu_repeat=args.cpu_repeat,
-        block_size=args.block_size,
-        out_dir=args.out,
-    )
+    result = headline_paper.run(out_dir=args.out, **options(args, "strands points repeat cpu_repeat block_size"))
     print(headline_report.table(result))
     return 0
 
@@ -426,21 +394,10 @@ def cmd_featurecost(args):
     from harness.render import featurecost_report
     from harness.studies import featurecost
 
-    rows = featurecost.measure(
-        scene_ref=args.scene,
-        backend=args.backend,
-        build=args.build,
-        variant=args.variant,
-        strands=args.strands,
-        points=args.points,
-        frames=args.frames,
-        repeat=args.repeat,
-        threads=args.threads,
-        block_size=args.block_size,
-        out=args.out,
-        timeout=args.timeout,
-        instructions=args.instructions,
+    given = options(
+        args, "backend build variant strands points frames repeat threads block_size out timeout instructions"
     )
+    rows = featurecost.measure(scene_ref=args.scene, **given)
     print(featurecost_report.markdown(rows), end="")
     return 0
 
@@ -488,16 +445,7 @@ def cmd_peer(args):
 def cmd_animate(args):
     from harness.studies import animate
 
-    for path in animate.run(
-        args.state,
-        out=args.out,
-        max_strands=args.max_strands,
-        every=args.every,
-        fps=args.fps,
-        force=args.force,
-        strands=args.strands,
-        frames=args.frames,
-    ):
+    for path in animate.run(args.state, **options(args, "out max_strands every fps force strands frames")):
         print(f"wrote {path}")
     return 0
 
@@ -511,13 +459,8 @@ def cmd_stability(args):
         return 0
     csv_path = stability.run_study(
         slices=tuple(args.slice or stability.SLICE_NAMES),
-        quick=args.quick,
-        strands=args.strands,
-        frames=args.frames,
-        jobs=args.jobs,
-        gpu=args.gpu,
-        timeout=args.timeout,
         out_dir=args.out,
+        **options(args, "quick strands frames jobs gpu timeout"),
     )
     stability_report.report_from_csv(csv_path, report_dir=args.report_dir)
     return 0
