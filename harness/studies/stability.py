@@ -40,7 +40,7 @@ import numpy as np
 from harness import HarnessError
 from harness.check import invariants_dynamic
 from harness.core import env, gpus, runner, scenes, tolerances, variants
-from harness.core.paths import RESULTS, binary_path, display
+from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
 from harness.io.files import write_json
@@ -114,7 +114,7 @@ def backends(gpu="auto", log=print):
             raise HarnessError(f"stability: --gpu yes but {why}")
         log(f"stability: GPU builds not run: {why}")
         return out
-    for build in ("default", "strict", "fastmath"):
+    for build in CUDA_BUILDS:
         if binary_path("cuda", build).exists():
             out.append(Backend("cuda", build, variants.simulating("cuda", build)))
         else:
