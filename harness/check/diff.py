@@ -339,17 +339,15 @@ def run(
     path_a: str | Path,
     path_b: str | Path,
     frames: Frames = "all",
-    align_last: bool = False,
-    exact: bool = False,
     as_json: bool = False,
     out: Callable[[str], Any] = print,
+    **options: Any,
 ) -> int:
-    """`harness diff` on two paper-model files; returns the exit status (dynamic files:
-    harness/check/diff_dynamic.py, picked by the command line)."""
+    """`harness diff` on two paper-model files (`options`: compare()'s align_last, exact and
+    tolerance); returns the exit status (dynamic files: harness/check/diff_dynamic.py, picked by
+    the command line)."""
     chosen = parse_frames(frames) if isinstance(frames, str) else frames
-    return report(
-        lambda: compare(path_a, path_b, chosen, align_last, exact), format_result, path_a, path_b, as_json, out
-    )
+    return report(lambda: compare(path_a, path_b, chosen, **options), format_result, path_a, path_b, as_json, out)
 
 
 def report(

@@ -210,6 +210,14 @@ def check(traj, exact=True, frames=None, paper=True):
                 )
             )
 
+    def bound(f, name, values, k, worst_field, message, nan_over=True):
+        """Values (in units of ε·scale) over k, NaN included with nan_over: `name`'s violation,
+        `message` formatted with n (how many), k and worst; rep.<worst_field> the largest seen."""
+        worst = float(np.nanmax(values)) if values.size else 0.0
+        setattr(rep, worst_field, max(getattr(rep, worst_field), worst))
+        over = ~(values <= k) if nan_over else values > k
+        add(f, name, over.sum(), worst, message.format(n=int(over.sum()), k=k, worst=worst))
+
     for f in sim:
         x = traj.frame(f)
         step = int(traj.step[f])
@@ -237,33 +245,28 @@ def check(traj, exact=True, frames=None, paper=True):
             R = float(traj.params["head_radius"])
             with np.errstate(invalid="ignore"):
                 d = np.max(np.abs(got.astype(np.float64) - want.astype(np.float64)), axis=1) / (eps * R)
-            worst = float(np.nanmax(d)) if d.size else 0.0
-            rep.worst_root = max(rep.worst_root, worst)
-            off = ~(d <= tolerances.DYN_ROOT_K)
-            add(
+            bound(
                 f,
                 "roots",
-                off.sum(),
-                worst,
-                f"{int(off.sum())} root(s) farther than "
-                f"{tolerances.DYN_ROOT_K:g}·ε·R from Q(t)·X̄0 (worst {worst:.3g}·ε·R)",
+                d,
+                tolerances.DYN_ROOT_K,
+                "worst_root",
+                "{n} root(s) farther than {k:g}·ε·R from Q(t)·X̄0 (worst {worst:.3g}·ε·R)",
             )
 
         xd = x.astype(np.float64)
         with np.errstate(invalid="ignore", over="ignore"):
             r = np.sqrt((xd[:, :, 0] * xd[:, :, 0] + xd[:, :, 1] * xd[:, :, 1]) + xd[:, :, 2] * xd[:, :, 2])
             if traj.collider:
-                depth = (rc - r[:, 1:]) / (eps * rc)
-                if depth.size:
-                    rep.worst_penetration_k = max(rep.worst_penetration_k, float(np.nanmax(depth)))
-                inside = depth > tolerances.DYN_PENETRATION_K
-                add(
+                bound(
                     f,
                     "collider",
-                    inside.sum(),
-                    np.nanmax(depth),
-                    f"{int(inside.sum())} point(s) inside the collider R_c = {rc:g} by more than "
-                    f"{tolerances.DYN_PENETRATION_K:g}·ε·R_c (worst {np.nanmax(depth):.3g}·ε·R_c)",
+                    (rc - r[:, 1:]) / (eps * rc),
+                    tolerances.DYN_PENETRATION_K,
+                    "worst_penetration_k",
+                    f"{{n}} point(s) inside the collider R_c = {rc:g} by more than {{k:g}}·ε·R_c "
+                    "(worst {worst:.3g}·ε·R_c)",
+                    nan_over=False,
                 )
             if traj.solver == "ftl":
                 seg = np.sqrt(np.sum(np.diff(xd, axis=1) ** 2, axis=2))
@@ -275,16 +278,14 @@ def check(traj, exact=True, frames=None, paper=True):
                 if traj.guided:  # §3.14: followers are placed, not followed; only guides hold ℓ
                     g = guide_count(traj.n_strands, float(traj.dynamic_params["guides"]))
                     err = err[guide_strands(traj.n_strands, g)]
-                worst = float(np.nanmax(err)) if err.size else 0.0
-                rep.worst_ftl_segment_k = max(rep.worst_ftl_segment_k, worst)
-                over = ~(err <= tolerances.DYN_FTL_SEGMENT_K)
-                add(
+                bound(
                     f,
                     "ftl_segments",
-                    over.sum(),
-                    worst,
-                    f"{int(over.sum())} segment(s) not moved by the collider differ from ℓ by more than "
-                    f"{tolerances.DYN_FTL_SEGMENT_K:g}·ε·E (worst {worst:.3g}·ε·E)",
+                    err,
+                    tolerances.DYN_FTL_SEGMENT_K,
+                    "worst_ftl_segment_k",
+                    "{n} segment(s) not moved by the collider differ from ℓ by more than {k:g}·ε·E "
+                    "(worst {worst:.3g}·ε·E)",
                 )
 
         if step not in obs.index:

@@ -6,6 +6,7 @@ lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
 
 import argparse
+import inspect
 import json
 import math
 import os
@@ -13,6 +14,7 @@ import sys
 from pathlib import Path
 
 from harness import HarnessError, __version__
+from harness.core.paths import CUDA_BUILDS
 from harness.studies import peer
 
 
@@ -64,7 +66,14 @@ unit_interval = real("unit_interval", "a number in [0, 1]", lambda v: 0.0 <= v <
 number = real("number", "a number", math.isfinite, "needs a finite number")
 
 
+def options(args, names):
+    """The parsed options `names` (space-separated attribute names) as keywords of the same names."""
+    return {name: getattr(args, name) for name in names.split()}
+
+
 def cmd_run(args):
+    """Run a scene (configs/scenes/NAME.toml or a path) on a backend binary with --json; print a summary, or the
+    JSON record with --json."""
     from harness.core import runner, scenes
     from harness.core.paths import binary_path
 
@@ -94,15 +103,7 @@ def cmd_run(args):
             scene = dataclasses.replace(scene, groom=hair)
     binary = binary_path(args.backend, args.build)
     flags = runner.run_flags(
-        scene,
-        args.backend,
-        variant=args.variant,
-        block_size=args.block_size,
-        threads=args.threads,
-        repeat=args.repeat,
-        warmup=args.warmup,
-        output=args.output,
-        force=args.force,
+        scene, args.backend, **options(args, "variant block_size threads repeat warmup output force")
     )
     if scene.model == "dynamic":  # per-frame observables (harness/check/run_dynamic.py)
         from harness.check import run_dynamic
@@ -114,6 +115,8 @@ def cmd_run(args):
 
 
 def cmd_diff(args):
+    """Compare two HDF5 states frame by frame (docs/harness.md, Equivalence). Exit 0 = equivalent, 1 = not
+    equivalent, 2 = could not compare."""
     from harness.check import diff, diff_dynamic
 
     frames = ",".join(str(k) for k in args.frame) if args.frame else args.frames
@@ -124,22 +127,21 @@ def cmd_diff(args):
 
 
 def cmd_stepdiff(args):
+    """For each chosen simulated frame k of a reference written with --velocities all, run BINARY --input REF
+    --input-frame k --stages simulate --frames 1 and compare its new frame with the reference's frame k+1 by the
+    dynamic per-frame tolerance: max(DYN_STEP_K·ε·E·S·I, DYN_SPREAD_K × the scene's spread, measured by
+    build/hairsim-cpu-contract from the same input) (harness/check/diff_dynamic.py, docs/judge.md). Exit 0 =
+    equivalent, 1 = not, 2 = could not compare."""
     from harness.check import diff_dynamic
 
     flags = args.flags[1:] if args.flags[:1] == ["--"] else args.flags
-    return diff_dynamic.stepdiff(
-        args.reference,
-        args.binary,
-        flags=flags,
-        frames=args.frames,
-        exact=args.exact,
-        keep=args.keep,
-        timeout=args.timeout,
-        spread=not args.no_spread,
-    )
+    given = options(args, "frames exact keep timeout")
+    return diff_dynamic.stepdiff(args.reference, args.binary, flags=flags, spread=not args.no_spread, **given)
 
 
 def cmd_sweep(args):
+    """Run every case of a sweep (configs/sweeps/NAME.toml), one row per (case, stage) in results/NAME/runs.csv;
+    a killed sweep resumes."""
     from harness.core import shards
     from harness.io.sweepfile import load_sweep
     from harness.studies import sweep
@@ -173,6 +175,8 @@ def cmd_report(args):
 
 
 def cmd_report_dynamic(args):
+    """Write results/local/report/dynamic.md and its plots from the results of the dynamic bench (ROOT/dynamic/,
+    featurecost/, dynamic-accuracy/, stability/, peer/, headline/): rendering only."""
     from harness.core.paths import display
     from harness.render import report_dynamic
 
@@ -184,6 +188,8 @@ def cmd_report_dynamic(args):
 
 
 def cmd_bench(args):
+    """Check the binaries, validate every GPU variant against the CPU (fail before timing), run the sweep, then
+    plot and report."""
     from harness.bench import dynamic as bench_dynamic
     from harness.bench import merge
     from harness.bench import paper as bench_paper
@@ -236,6 +242,10 @@ def cmd_bench(args):
 
 
 def cmd_merge(args):
+    """Join the folders of one run's N shards (bench or sweep --shard K/N) into OUT: the rows of every CSV, the
+    sweeps' sessions, every shard's validation. Refused in one line (exit 2), writing nothing, when the shards
+    differ in revision, machine, sweep files or command, or one is missing or given twice. Render the result
+    with make report REPORT_FROM=OUT."""
     from harness.bench import merge
 
     merge.merge(args.out, args.shards)
@@ -269,6 +279,13 @@ DYNAMIC_ONLY = (
     "ref_extra",
     "long_seconds",
     "long_strands",
+)
+
+
+# the options accuracy_dynamic.Plan takes as given (substeps, iterations and ftl_damping as sets)
+DYNAMIC_SETS = ("substeps", "iterations", "ftl_damping")
+DYNAMIC_PLAN = " ".join(
+    ["scene", "strands", "points", "repeat", *(k for k in DYNAMIC_ONLY if k not in ("quick", "force", *DYNAMIC_SETS))]
 )
 
 
@@ -307,6 +324,14 @@ def accuracy_model(args):
 
 
 def cmd_accuracy(args):
+    """Paper model (default): run the scene in every precision/build mode available here and in several model
+    resolutions, compare with hairsim-cpu --precision fp64, time each mode apart, and write results/accuracy/
+    and results/local/report/accuracy.md with a Pareto plot. Dynamic model (--model dynamic, or a dynamic
+    --scene): every solver x substeps x iterations x precision x build against a converged xpbd fp64 reference
+    (substeps doubled until S and 2S agree to a tenth of the smallest error), time per frame measured apart,
+    small steps against iterations, the analytic checks and a recommendation; writes results/dynamic-accuracy/
+    and results/local/report/dynamic_accuracy.md with its plots (docs/harness.md). Exit 0, or 1 when the dynamic
+    reference did not converge."""
     if accuracy_model(args) == "dynamic":
         return accuracy_dynamic(args)
     from harness.core.paths import RESULTS
@@ -343,29 +368,8 @@ def accuracy_dynamic(args):
         for path in accuracy_dynamic_report.write(csv_path.parent, args.report_dir, csv_path=csv_path):
             print(f"wrote {display(path)}")
         return 0
-    given = {
-        k: getattr(args, k)
-        for k in (
-            "scene",
-            "strands",
-            "points",
-            "repeat",
-            "seconds",
-            "horizon",
-            "time_strands",
-            "time_frames",
-            "ref_start",
-            "ref_max",
-            "jobs",
-            "analytic",
-            "gpu",
-            "ref_extra",
-            "long_seconds",
-            "long_strands",
-        )
-        if getattr(args, k) is not None
-    }
-    for k in ("substeps", "iterations", "ftl_damping"):
+    given = {k: v for k, v in options(args, DYNAMIC_PLAN).items() if v is not None}
+    for k in DYNAMIC_SETS:
         if getattr(args, k) is not None:
             given[k] = tuple(sorted(set(getattr(args, k))))
     plan = accuracy_dynamic.Plan.quick(**given) if args.quick else accuracy_dynamic.Plan(**given)
@@ -379,6 +383,9 @@ def accuracy_dynamic(args):
 
 
 def cmd_headline(args):
+    """At one size, measure the copy bandwidths, every CUDA variant's init and wind+collide time and bandwidth
+    fraction, and three CPU baselines (ref 1 thread, ref all cores, simd all cores); write
+    results/headline/headline.json."""
     if args.model == "dynamic":
         from harness.studies import headline_dynamic
 
@@ -393,19 +400,15 @@ def cmd_headline(args):
     from harness.render import headline_report
     from harness.studies import headline_paper
 
-    result = headline_paper.run(
-        strands=args.strands,
-        points=args.points,
-        repeat=args.repeat,
-        cpu_repeat=args.cpu_repeat,
-        block_size=args.block_size,
-        out_dir=args.out,
-    )
+    result = headline_paper.run(out_dir=args.out, **options(args, "strands points repeat cpu_repeat block_size"))
     print(headline_report.table(result))
     return 0
 
 
 def cmd_export(args):
+    """Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions referenced in STATE) and, with --usd,
+    STATE.usdc (BasisCurves, one time sample per frame; needs usd-core). A dynamic state's times are in seconds.
+    Existing sidecars are replaced only with --force; every refusal comes before anything is written."""
     from harness.io import export
 
     usd = args.usd or args.usd_only
@@ -423,29 +426,27 @@ def cmd_groom(args):
 
 
 def cmd_featurecost(args):
+    """Run a dynamic scene with every feature undeclared, each alone, the full scene less each, and the full
+    scene (features are removed by their flags, so the binary compiles them out); print a Markdown table and,
+    with --out, write the rows as CSV."""
     from harness.render import featurecost_report
     from harness.studies import featurecost
 
-    rows = featurecost.measure(
-        scene_ref=args.scene,
-        backend=args.backend,
-        build=args.build,
-        variant=args.variant,
-        strands=args.strands,
-        points=args.points,
-        frames=args.frames,
-        repeat=args.repeat,
-        threads=args.threads,
-        block_size=args.block_size,
-        out=args.out,
-        timeout=args.timeout,
-        instructions=args.instructions,
+    given = options(
+        args, "backend build variant strands points frames repeat threads block_size out timeout instructions"
     )
+    rows = featurecost.measure(scene_ref=args.scene, **given)
     print(featurecost_report.markdown(rows), end="")
     return 0
 
 
 def cmd_reduced(args):
+    """Run a dynamic scene with guide fractions 100/50/25/10/5% x scheme (one, blend3), LRA off/on at few
+    iterations, and P_s simulated points written as P_r = 33 (--render-points); compare each with every strand
+    and point simulated (xpbd, fp64, finer S) and time it on the cpu oracle and, with a usable GPU, the cuda
+    variants that run it (docs/model.md §3.14); and the still scene with and without sag-free rest: how far it
+    sags, and the tip's swing frequency under a wind step. Prints a Markdown table; --out writes the rows as
+    CSV."""
     from harness.render import reduced_report
     from harness.studies import reduced
 
@@ -469,6 +470,10 @@ def setting(text):
 
 
 def cmd_peer(args):
+    """Run chains released from rest in hairsim-cpu and in pypbd (XPBD distance constraints, the parameters
+    mapped as docs/decisions.md says), against our converged fp64 reference: error, stretch and time per frame
+    at several strand counts. Writes results/peer/ and results/local/report/peer.md. Needs pypbd (optional):
+    without it, one line says so and the exit status is 2."""
     from harness.render import peer_report
 
     if not args.report_only:
@@ -486,23 +491,23 @@ def cmd_peer(args):
 
 
 def cmd_animate(args):
+    """Draw the frames of a dynamic HDF5 state (read through harness.io.trajectory) seen from the side and from
+    the front, the head sphere drawn, as a GIF (and an MP4 beside it where ffmpeg is on PATH). Without STATE,
+    runs configs/scenes/dynamic.toml on hairsim-cpu first."""
     from harness.studies import animate
 
-    for path in animate.run(
-        args.state,
-        out=args.out,
-        max_strands=args.max_strands,
-        every=args.every,
-        fps=args.fps,
-        force=args.force,
-        strands=args.strands,
-        frames=args.frames,
-    ):
+    for path in animate.run(args.state, **options(args, "out max_strands every fps force strands frames")):
         print(f"wrote {path}")
     return 0
 
 
 def cmd_stability(args):
+    """Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend compliance, points and
+    iterations, iterations on curly hair; head-motion frequency against amplitude; long-range attachments on and
+    off under fast nods and gales) for both solvers and precisions, on the CPU and every built CUDA build where
+    a GPU answers; judge each cell ok, over-stretched, penetrating, escaped (a point past 2L) or diverged
+    (NaN/Inf); write results/stability/, results/local/report/stability_*.png and
+    results/local/report/dynamic_stability.md."""
     from harness.render import stability_report
     from harness.studies import stability
 
@@ -511,19 +516,20 @@ def cmd_stability(args):
         return 0
     csv_path = stability.run_study(
         slices=tuple(args.slice or stability.SLICE_NAMES),
-        quick=args.quick,
-        strands=args.strands,
-        frames=args.frames,
-        jobs=args.jobs,
-        gpu=args.gpu,
-        timeout=args.timeout,
         out_dir=args.out,
+        **options(args, "quick strands frames jobs gpu timeout"),
     )
     stability_report.report_from_csv(csv_path, report_dir=args.report_dir)
     return 0
 
 
 def cmd_judge(args):
+    """Step every planted defect (build/planted/, make planted) from the C reference's frames on the standard
+    scenes, and every honest build × variant × precision on the extreme scenes, judging each frame as stepdiff
+    does (the rule and the scene's spread); the paper model's planted defects and variants likewise by whole
+    runs judged as harness diff does; print caught / planted and false alarms / honest runs, write
+    results/judge/judge.csv and judge.json (docs/judge.md). Exit 0 when every defect is caught and no honest run
+    fails, else 1."""
     from harness.studies import judge
 
     plan = judge.Plan.quick(gpu=args.gpu) if args.quick else judge.Plan(gpu=args.gpu)
@@ -547,6 +553,8 @@ def cmd_judge(args):
 
 
 def cmd_calibrate(args):
+    """Run the cpu binary at fp32 and fp64 on the paper scene and print the errors and invariant residuals that
+    tolerances.py is set from."""
     from harness.studies import calibrate
 
     return calibrate.run(
@@ -555,6 +563,8 @@ def cmd_calibrate(args):
 
 
 def cmd_docs(args):
+    """Remake the command and module reference of docs/harness.md from this parser and the modules' docstrings
+    (what `make docs` runs); --check only says whether it is current (exit 1 if not)."""
     from harness.cli import docs
 
     return docs.run(parser(), check=args.check)
@@ -593,7 +603,7 @@ def binary_options(p):
     p.add_argument("--backend", choices=("cpu", "cuda"), default="cpu")
     p.add_argument(
         "--build",
-        choices=("default", "strict", "fastmath"),
+        choices=tuple(CUDA_BUILDS),
         default="default",
         help="cuda build: hairsim-cuda, -strict or -fastmath (default: default)",
     )
@@ -605,9 +615,11 @@ def binary_options(p):
     p.add_argument("--block-size", type=whole(32), help="cuda threads per block (32…1024)")
 
 
-def command(sub, name, func, help, description=None):  # noqa: A002 (argparse's own name)
-    """A subcommand's parser that runs func(args)."""
-    p = sub.add_parser(name, help=help, description=description)
+def command(sub, func, help, description=None, name=None):  # noqa: A002 (argparse's own name)
+    """A subcommand's parser that runs func(args): named `name`, else as func (cmd_report_dynamic:
+    report-dynamic), and described by `description`, else by func's docstring."""
+    name = name or func.__name__.removeprefix("cmd_").replace("_", "-")
+    p = sub.add_parser(name, help=help, description=description or inspect.cleandoc(func.__doc__ or "") or None)
     p.set_defaults(func=func)
     return p
 
@@ -620,14 +632,7 @@ def parser():
     p.add_argument("--version", action="version", version=f"hairbench harness {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
-    r = command(
-        sub,
-        "run",
-        cmd_run,
-        help="run one scene on a backend and print its record",
-        description="Run a scene (configs/scenes/NAME.toml or a path) on a backend binary "
-        "with --json; print a summary, or the JSON record with --json.",
-    )
+    r = command(sub, cmd_run, help="run one scene on a backend and print its record")
     r.add_argument("scene", help="scene name in configs/scenes/ (e.g. paper) or a .toml path")
     binary_options(r)
     r.add_argument("--precision", choices=("fp32", "fp64"), help="override the scene's precision")
@@ -648,18 +653,7 @@ def parser():
         help="dynamic scenes: print every K-th frame's observables (default: about 30 lines)",
     )
 
-    sd = command(
-        sub,
-        "stepdiff",
-        cmd_stepdiff,
-        help="validate a dynamic backend one frame at a time (exit 0/1/2)",
-        description="For each chosen simulated frame k of a reference written with "
-        "--velocities all, run BINARY --input REF --input-frame k --stages "
-        "simulate --frames 1 and compare its new frame with the reference's "
-        "frame k+1 by the dynamic per-frame tolerance: max(DYN_STEP_K·ε·E·S·I, DYN_SPREAD_K × the scene's spread, "
-        "measured by build/hairsim-cpu-contract from the same input) (harness/check/diff_dynamic.py, docs/judge.md). "
-        "Exit 0 = equivalent, 1 = not, 2 = could not compare.",
-    )
+    sd = command(sub, cmd_stepdiff, help="validate a dynamic backend one frame at a time (exit 0/1/2)")
     sd.add_argument("--reference", required=True, help="dynamic state file (A)")
     sd.add_argument("--binary", required=True, help="the binary to validate (e.g. build/hairsim-cuda)")
     sd.add_argument(
@@ -681,14 +675,7 @@ def parser():
         "flags", nargs=argparse.REMAINDER, help="further flags for the binary (after the options, e.g. -- --threads 1)"
     )
 
-    d = command(
-        sub,
-        "diff",
-        cmd_diff,
-        help="compare two state files frame by frame (exit 0/1/2)",
-        description="Compare two HDF5 states frame by frame (docs/harness.md, Equivalence). Exit 0 = "
-        "equivalent, 1 = not equivalent, 2 = could not compare.",
-    )
+    d = command(sub, cmd_diff, help="compare two state files frame by frame (exit 0/1/2)")
     d.add_argument("a", help="first state file (e.g. the CPU reference)")
     d.add_argument("b", help="second state file")
     d.add_argument(
@@ -707,14 +694,7 @@ def parser():
     d.add_argument("--exact", action="store_true", help="require bit-identical positions")
     d.add_argument("--json", action="store_true", help="print the comparison as JSON")
 
-    s = command(
-        sub,
-        "sweep",
-        cmd_sweep,
-        help="run a sweep file, appending rows to results/NAME/runs.csv",
-        description="Run every case of a sweep (configs/sweeps/NAME.toml), one row per "
-        "(case, stage) in results/NAME/runs.csv; a killed sweep resumes.",
-    )
+    s = command(sub, cmd_sweep, help="run a sweep file, appending rows to results/NAME/runs.csv")
     s.add_argument("sweep", help="sweep name in configs/sweeps/ (e.g. quick) or a .toml path")
     output_options(s, results="results/<sweep name>")
     case_options(s, gpu=GPU_HELP)
@@ -734,7 +714,7 @@ def parser():
             + " (rendering only: Fig. 1/2 come from the hair "
             + ("state the bench leaves in RESULTS/states/, when it is there).")
         )
-        q = command(sub, name, fn, help=helptext, description=description)
+        q = command(sub, fn, help=helptext, description=description)
         q.add_argument(
             "results",
             nargs="?",
@@ -746,23 +726,13 @@ def parser():
 
     rd = command(
         sub,
-        "report-dynamic",
         cmd_report_dynamic,
         help="write results/local/report/dynamic.md (and its plots) from a dynamic bench root",
-        description="Write results/local/report/dynamic.md and its plots from the results of the dynamic bench "
-        "(ROOT/dynamic/, featurecost/, dynamic-accuracy/, stability/, peer/, headline/): rendering only.",
     )
     rd.add_argument("root", nargs="?", default="results/local", help="the bench root (default results/local)")
     output_options(rd, report=REPORT_DIR_HELP)
 
-    b = command(
-        sub,
-        "bench",
-        cmd_bench,
-        help="the make bench pipeline: check, validate, sweep, report",
-        description="Check the binaries, validate every GPU variant against the CPU "
-        "(fail before timing), run the sweep, then plot and report.",
-    )
+    b = command(sub, cmd_bench, help="the make bench pipeline: check, validate, sweep, report")
     b.add_argument("--sweep", default="default", help="sweep name in configs/sweeps/ or a path (default: default)")
     b.add_argument(
         "--out",
@@ -797,33 +767,14 @@ def parser():
         "bench's size (accuracy --quick, stability --quick: minutes on a 16-core + H200 node)",
     )
 
-    mg = command(
-        sub,
-        "merge",
-        cmd_merge,
-        help="join shard folders (bench --shard K/N) into one results folder",
-        description="Join the folders of one run's N shards (bench or sweep --shard K/N) into OUT: the rows of "
-        "every CSV, the sweeps' sessions, every shard's validation. Refused in one line (exit 2), writing "
-        "nothing, when the shards differ in revision, machine, sweep files or command, or one is missing "
-        "or given twice. Render the result with make report REPORT_FROM=OUT.",
-    )
+    mg = command(sub, cmd_merge, help="join shard folders (bench --shard K/N) into one results folder")
     mg.add_argument("out", help="the merged folder to write (must not exist, or be empty)")
     mg.add_argument("shards", nargs="+", help="the shard folders")
 
     a = command(
         sub,
-        "accuracy",
         cmd_accuracy,
         help="speed against accuracy: every mode against a reference (paper or dynamic model)",
-        description="Paper model (default): run the scene in every precision/build mode available "
-        "here and in several model resolutions, compare with hairsim-cpu --precision fp64, time "
-        "each mode apart, and write results/accuracy/ and results/local/report/accuracy.md with a Pareto plot. "
-        "Dynamic model (--model dynamic, or a dynamic --scene): every solver x substeps x "
-        "iterations x precision x build against a converged xpbd fp64 reference (substeps doubled "
-        "until S and 2S agree to a tenth of the smallest error), time per frame measured apart, "
-        "small steps against iterations, the analytic checks and a recommendation; writes "
-        "results/dynamic-accuracy/ and results/local/report/dynamic_accuracy.md with its plots "
-        "(docs/harness.md). Exit 0, or 1 when the dynamic reference did not converge.",
     )
     a.add_argument(
         "--model", choices=("paper", "dynamic"), default=None, help="default: the --scene's model, else paper"
@@ -907,13 +858,8 @@ def parser():
 
     h = command(
         sub,
-        "headline",
         cmd_headline,
         help="the headline numbers: bandwidth fractions and speedups (--model dynamic: the dynamic model's targets)",
-        description="At one size, measure the copy bandwidths, every CUDA variant's init and "
-        "wind+collide time and bandwidth fraction, and three CPU baselines "
-        "(ref 1 thread, ref all cores, simd all cores); write "
-        "results/headline/headline.json.",
     )
     h.add_argument("--strands", type=whole(1), default=4 * 1024 * 1024)
     h.add_argument("--points", type=whole(2), default=32)
@@ -930,16 +876,7 @@ def parser():
     h.add_argument("--ncu", action="store_true", help="dynamic: also profile the best kernel with Nsight Compute")
     output_options(h, results="results/headline")
 
-    e = command(
-        sub,
-        "export",
-        cmd_export,
-        help="sidecars that ParaView/VisIt (XDMF) and Blender/Houdini/usdview (USD) open",
-        description="Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions "
-        "referenced in STATE) and, with --usd, STATE.usdc (BasisCurves, one "
-        "time sample per frame; needs usd-core). A dynamic state's times are in seconds. "
-        "Existing sidecars are replaced only with --force; every refusal comes before anything is written.",
-    )
+    e = command(sub, cmd_export, help="sidecars that ParaView/VisIt (XDMF) and Blender/Houdini/usdview (USD) open")
     e.add_argument("state", help="an HDF5 state written by a hairsim binary")
     e.add_argument("--usd", action="store_true", help="also write the USD file")
     e.add_argument("--usd-only", action="store_true", help="write only the USD file")
@@ -955,18 +892,11 @@ def parser():
         "by `run`.",
     )
     gsub = gr.add_subparsers(dest="groom_command", required=True)
-    gc = command(gsub, "convert", cmd_groom, help="USD BasisCurves → HAIR")
+    gc = command(gsub, cmd_groom, help="USD BasisCurves → HAIR", name="convert")
     gc.add_argument("src", help="a USD file (.usd, .usda, .usdc, .usdz)")
     gc.add_argument("dst", help="the HAIR file to write")
     gc.add_argument("--force", action="store_true", help="replace dst if it exists")
-    c = command(
-        sub,
-        "calibrate",
-        cmd_calibrate,
-        help="measure fp32-vs-fp64 errors behind tolerances.py",
-        description="Run the cpu binary at fp32 and fp64 on the paper scene and print "
-        "the errors and invariant residuals that tolerances.py is set from.",
-    )
+    c = command(sub, cmd_calibrate, help="measure fp32-vs-fp64 errors behind tolerances.py")
     c.add_argument("--strands", type=whole(1), default=20000)
     c.add_argument("--points", type=whole(2), nargs="+", default=[8, 32, 128])
     c.add_argument("--seeds", type=whole(0), nargs="+", default=[1, 2, 3])
@@ -979,12 +909,8 @@ def parser():
 
     fc = command(
         sub,
-        "featurecost",
         cmd_featurecost,
         help="the dynamic model's time per frame with each feature undeclared, alone, and the full scene",
-        description="Run a dynamic scene with every feature undeclared, each alone, the full scene "
-        "less each, and the full scene (features are removed by their flags, so the binary compiles "
-        "them out); print a Markdown table and, with --out, write the rows as CSV.",
     )
     fc.add_argument("--scene", default="dynamic", help="a dynamic scene (default dynamic)")
     binary_options(fc)
@@ -1003,16 +929,9 @@ def parser():
 
     rd = command(
         sub,
-        "reduced",
         cmd_reduced,
         help="the dynamic model with guides and followers, long-range attachments, sag-free rest and "
         "simulated-point LOD: error and time",
-        description="Run a dynamic scene with guide fractions 100/50/25/10/5%% x scheme (one, blend3), "
-        "LRA off/on at few iterations, and P_s simulated points written as P_r = 33 (--render-points); compare "
-        "each with every strand and point simulated (xpbd, fp64, finer S) and time it on the cpu oracle and, "
-        "with a usable GPU, the cuda variants that run it (docs/model.md §3.14); and the still scene with and "
-        "without sag-free rest: how far it sags, and the tip's swing frequency under a wind step. "
-        "Prints a Markdown table; --out writes the rows as CSV.",
     )
     rd.add_argument("--scene", default=None, help="a dynamic scene (default dynamic)")
     rd.add_argument("--strands", type=whole(1), default=None, help="strands of the checked runs")
@@ -1022,16 +941,7 @@ def parser():
     rd.add_argument("--out", default=None, help="CSV file to write")
 
     peer_plan = peer.Plan()
-    pe = command(
-        sub,
-        "peer",
-        cmd_peer,
-        help="the same chain scenes in Bender's PositionBasedDynamics (pypbd) beside ours",
-        description="Run chains released from rest in hairsim-cpu and in pypbd (XPBD distance constraints, "
-        "the parameters mapped as docs/decisions.md says), against our converged fp64 reference: error, "
-        "stretch and time per frame at several strand counts. Writes results/peer/ and results/local/report/peer.md. "
-        "Needs pypbd (optional): without it, one line says so and the exit status is 2.",
-    )
+    pe = command(sub, cmd_peer, help="the same chain scenes in Bender's PositionBasedDynamics (pypbd) beside ours")
     pe.add_argument(
         "--points", type=whole(2), default=peer_plan.points, help="points per chain, root included (default 32)"
     )
@@ -1072,15 +982,7 @@ def parser():
     output_options(pe, results="results/peer", report="where peer.md goes (default results/local/report/)")
     pe.add_argument("--report-only", action="store_true", help="only re-render results/local/report/peer.md from --out")
 
-    an = command(
-        sub,
-        "animate",
-        cmd_animate,
-        help="an animation of a dynamic state from the side and from the front",
-        description="Draw the frames of a dynamic HDF5 state (read through harness.io.trajectory) seen from "
-        "the side and from the front, the head sphere drawn, as a GIF (and an MP4 beside it where ffmpeg "
-        "is on PATH). Without STATE, runs configs/scenes/dynamic.toml on hairsim-cpu first.",
-    )
+    an = command(sub, cmd_animate, help="an animation of a dynamic state from the side and from the front")
     an.add_argument("state", nargs="?", default=None, help="a dynamic state file (default: run the dynamic scene)")
     an.add_argument("--out", default=None, help="the GIF to write (default results/local/report/dynamic.gif)")
     an.add_argument("--max-strands", type=whole(1), default=150, help="strands drawn at most (default 150)")
@@ -1094,16 +996,8 @@ def parser():
 
     sb = command(
         sub,
-        "stability",
         cmd_stability,
         help="the dynamic model's stability map: verdicts over 2-D slices of the scene space",
-        description="Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend "
-        "compliance, points and iterations, iterations on curly hair; head-motion frequency against amplitude; "
-        "long-range attachments on and off under fast nods and gales) for both solvers and "
-        "precisions, on the CPU and every built CUDA build where a GPU answers; judge each cell ok, "
-        "over-stretched, penetrating, escaped (a point past 2L) or diverged (NaN/Inf); write "
-        "results/stability/, results/local/report/stability_*.png and "
-        "results/local/report/dynamic_stability.md.",
     )
     sb.add_argument("--quick", action="store_true", help="a coarser grid (about a quarter of the cells)")
     sb.add_argument("--slice", action="append", choices=SLICE_NAMES, help="run only this slice (repeatable)")
@@ -1126,15 +1020,8 @@ def parser():
 
     jg = command(
         sub,
-        "judge",
         cmd_judge,
         help="the one-frame judge's power: planted defects caught, false alarms on extreme scenes",
-        description="Step every planted defect (build/planted/, make planted) from the C reference's frames "
-        "on the standard scenes, and every honest build × variant × precision on the extreme scenes, judging "
-        "each frame as stepdiff does (the rule and the scene's spread); the paper model's planted defects and "
-        "variants likewise by whole runs judged as harness diff does; print caught / planted and false "
-        "alarms / honest runs, write results/judge/judge.csv and judge.json (docs/judge.md). Exit 0 when "
-        "every defect is caught and no honest run fails, else 1.",
     )
     jg.add_argument("--quick", action="store_true", help="fewer strands and frames (the tests' size)")
     jg.add_argument("--strands", type=whole(1), default=None, help="strands per scene")
@@ -1148,14 +1035,7 @@ def parser():
     case_options(jg, jobs="scenes run at once (default: all cores)", gpu="honest runs of the CUDA builds too")
     output_options(jg, results="results/judge")
 
-    dc = command(
-        sub,
-        "docs",
-        cmd_docs,
-        help="remake docs/harness.md's command and module reference",
-        description="Remake the command and module reference of docs/harness.md from this parser and the "
-        "modules' docstrings (what `make docs` runs); --check only says whether it is current (exit 1 if not).",
-    )
+    dc = command(sub, cmd_docs, help="remake docs/harness.md's command and module reference")
     dc.add_argument("--check", action="store_true", help="write nothing; exit 1 when the page is out of date")
     return p
 

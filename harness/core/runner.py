@@ -32,7 +32,7 @@ class TimedOut(BackendError):
     """The binary did not finish within the caller's timeout (it was killed); exit status 124,
     as timeout(1) gives, not the 2 of a refusal."""
 
-    def __init__(self, message):
+    def __init__(self, message: str) -> None:
         super().__init__(message, code=124)
 
 

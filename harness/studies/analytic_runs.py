@@ -164,6 +164,16 @@ def _analytic():
     return analytic
 
 
+def run_series(binary, workdir, tag, positions, length, frames, substeps, solver, precision="fp64", **options):
+    """Write `positions` as WORKDIR/TAG_in.h5, simulate it into WORKDIR/TAG.h5 (`options`: those of
+    simulate()) and return the output's (times, positions [F][N][P][3])."""
+    inp = write_paper_state(os.path.join(workdir, f"{tag}_in.h5"), positions, length, precision=precision)
+    out = simulate(
+        binary, inp, os.path.join(workdir, f"{tag}.h5"), frames, substeps, solver, precision=precision, **options
+    )
+    return _analytic().read_series(out)
+
+
 def run_pendulum(binary, workdir, solver, substeps, theta0, length=30.0, periods=3, precision="fp64"):
     """§4.1: P = 2, rigid, released from rest at θ0; the period from the zero crossings of z
     over the first `periods` full periods (frames enough for periods + 1)."""
@@ -171,11 +181,8 @@ def run_pendulum(binary, workdir, solver, substeps, theta0, length=30.0, periods
     expected = an.pendulum_period(length, G0, theta0)
     frames = int(math.ceil((periods + 1) * expected / FRAME_DT))
     tag = f"pend_{solver}_{substeps}_{theta0:g}_{precision}"
-    inp = write_paper_state(
-        os.path.join(workdir, f"{tag}_in.h5"), pendulum_positions(length, theta0), length, precision=precision
-    )
-    out = simulate(binary, inp, os.path.join(workdir, f"{tag}.h5"), frames, substeps, solver, precision=precision)
-    t, x = an.read_series(out)
+    positions = pendulum_positions(length, theta0)
+    t, x = run_series(binary, workdir, tag, positions, length, frames, substeps, solver, precision)
     z = x[:, 0, 1, 2]
     measured = an.period_from_crossings(t, z, periods=periods)
     # amplitude decay: the largest |θ| in the last full period against θ0 (energy loss)
@@ -209,17 +216,16 @@ def run_wind(
     an = _analytic()
     frames = int(math.ceil(seconds / FRAME_DT))
     tag = f"wind_{solver}_{substeps}_{speed:g}_{wind_angle:g}_{precision}"
-    inp = write_paper_state(
-        os.path.join(workdir, f"{tag}_in.h5"), pendulum_positions(length, 0.0), length, precision=precision
-    )
-    out = simulate(
+    t, x = run_series(
         binary,
-        inp,
-        os.path.join(workdir, f"{tag}.h5"),
+        workdir,
+        tag,
+        pendulum_positions(length, 0.0),
+        length,
         frames,
         substeps,
         solver,
-        precision=precision,
+        precision,
         extra=(
             "--wind-speed",
             repr(float(speed)),
@@ -233,7 +239,6 @@ def run_wind(
             "0",
         ),
     )
-    t, x = an.read_series(out)
     theta = an.segment_angle(x[:, 0, 0], x[:, 0, 1])
     return {
         "measured": float(theta[-1]),
@@ -273,22 +278,11 @@ def run_chain(
     w_disc = float(omegas[0])
     frames = int(math.ceil((periods + 1) * 2 * math.pi / w_disc / FRAME_DT))
     tag = f"chain_{solver}_{substeps}_{points}_{iterations}_{ftl_damping}_{precision}"
-    inp = write_paper_state(
-        os.path.join(workdir, f"{tag}_in.h5"), chain_positions(points, length, amplitude), length, precision=precision
-    )
+    positions = chain_positions(points, length, amplitude)
     extra = ("--ftl-damping", repr(float(ftl_damping))) if ftl_damping is not None else ()
-    out = simulate(
-        binary,
-        inp,
-        os.path.join(workdir, f"{tag}.h5"),
-        frames,
-        substeps,
-        solver,
-        iterations=iterations,
-        precision=precision,
-        extra=extra,
+    t, x = run_series(
+        binary, workdir, tag, positions, length, frames, substeps, solver, precision, iterations=iterations, extra=extra
     )
-    t, x = an.read_series(out)
     q1 = x[:, 0, :, 2] @ shapes[:, 0]
     period = an.period_from_crossings(t, q1, periods=periods)
     tip = x[:, 0, -1, 2]

@@ -135,35 +135,47 @@ def fp32_tables(binary, work, sa, pend_s, wind_s, chain_s):
         "| check | S | measured | expected | rel. / abs. error | fp64 error at this S | u·ℓ/(h²·\\|a\\|) |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
-    for s in pend_s:
-        r = sa.run_pendulum(binary, work, "xpbd", s, 0.1, precision="fp32")
-        r64 = sa.run_pendulum(binary, work, "xpbd", s, 0.1)
-        h = sa.FRAME_DT / s
-        out.append(
-            f"| pendulum θ0 = 0.1, T (s) | {s} | {_fmt(r['measured'], 8)} | {_fmt(r['expected'], 8)} "
-            f"| {an.relative_error(r['measured'], r['expected']):.2e} "
-            f"| {an.relative_error(r64['measured'], r64['expected']):.2e} "
-            f"| {eps * 30.0 / (h * h * sa.G0):.1e} |"
-        )
-    for s in wind_s:
-        r = sa.run_wind(binary, work, "xpbd", s, 981.0, precision="fp32")
-        r64 = sa.run_wind(binary, work, "xpbd", s, 981.0)
-        h = sa.FRAME_DT / s
-        out.append(
-            f"| wind U = 981, ψ = 0, θ (rad) | {s} | {r['measured']:.7f} | {r['expected']:.7f} "
-            f"| {abs(r['measured'] - r['expected']):.1e} | {abs(r64['measured'] - r64['expected']):.1e} "
-            f"| {eps * 30.0 / (h * h * math.hypot(sa.G0, 981.0)):.1e} |"
-        )
-    for s in chain_s:
-        r = sa.run_chain(binary, work, "xpbd", s, 32, precision="fp32")
-        r64 = sa.run_chain(binary, work, "xpbd", s, 32)
-        h = sa.FRAME_DT / s
-        out.append(
-            f"| chain P = 32, ω (rad/s) | {s} | {_fmt(r['measured'], 8)} | {_fmt(r['expected'], 8)} "
-            f"| {an.relative_error(r['measured'], r['expected']):.2e} "
-            f"| {an.relative_error(r64['measured'], r64['expected']):.2e} "
-            f"| {eps * 30.0 / (h * h * sa.G0):.1e} |"
-        )
+
+    def rel(r):
+        return f"{an.relative_error(r['measured'], r['expected']):.2e}"
+
+    def absolute(r):
+        return f"{abs(r['measured'] - r['expected']):.1e}"
+
+    checks = (  # (label, S values, run, value format, error, |a|)
+        (
+            "pendulum θ0 = 0.1, T (s)",
+            pend_s,
+            lambda s, **kw: sa.run_pendulum(binary, work, "xpbd", s, 0.1, **kw),
+            lambda x: _fmt(x, 8),
+            rel,
+            sa.G0,
+        ),
+        (
+            "wind U = 981, ψ = 0, θ (rad)",
+            wind_s,
+            lambda s, **kw: sa.run_wind(binary, work, "xpbd", s, 981.0, **kw),
+            lambda x: f"{x:.7f}",
+            absolute,
+            math.hypot(sa.G0, 981.0),
+        ),
+        (
+            "chain P = 32, ω (rad/s)",
+            chain_s,
+            lambda s, **kw: sa.run_chain(binary, work, "xpbd", s, 32, **kw),
+            lambda x: _fmt(x, 8),
+            rel,
+            sa.G0,
+        ),
+    )
+    for label, s_values, run, value, error, accel in checks:
+        for s in s_values:
+            r, r64 = run(s, precision="fp32"), run(s)
+            h = sa.FRAME_DT / s
+            out.append(
+                f"| {label} | {s} | {value(r['measured'])} | {value(r['expected'])} | {error(r)} | {error(r64)} "
+                f"| {eps * 30.0 / (h * h * accel):.1e} |"
+            )
     out.append("")
     return out
 

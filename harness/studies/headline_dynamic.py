@@ -385,31 +385,31 @@ def table(result):
             )
     s = result.get("summary", {})
     t = result["targets"]
+
+    def target(name, what, measured, m):
+        lines.append(f"target {name} ({what}): {measured} {m['row']}: {yes(m['met'])}")
+
     if "memory" in s:
         m = s["memory"]
-        goal = f"{100 * t['memory_fraction']:.0f}% of copy"
-        lines.append(f"target 1 (memory-bound >= {goal}): {pct(m['fraction'])} {m['row']}: {yes(m['met'])}")
+        target(1, f"memory-bound >= {100 * t['memory_fraction']:.0f}% of copy", pct(m["fraction"]), m)
     if "default" in s:
         d = s["default"]
         goal = f"{t['point_substeps_per_s']:.2g} pt-substeps/s"
-        lines.append(f"target 2 (default scene >= {goal}): {d['point_substeps_per_s']:.3e} {d['row']}: {yes(d['met'])}")
+        target(2, f"default scene >= {goal}", f"{d['point_substeps_per_s']:.3e}", d)
         stretch = t.get("stretch_point_substeps_per_s")
         if stretch:
             lines.append(f"  stretch goal {stretch:.2g} pt-substeps/s: {yes(d.get('stretch_met'))}")
     if "ftl" in s:
         f = s["ftl"]
         goal = f"{t['ftl_point_substeps_per_s']:.2g} pt-substeps/s"
-        got = f"{f['point_substeps_per_s']:.3e} {f['row']}"
-        lines.append(f"target ftl (default scene, ftl >= {goal}): {got}: {yes(f['met'])}")
+        target("ftl", f"default scene, ftl >= {goal}", f"{f['point_substeps_per_s']:.3e}", f)
     if "realtime" in s:
         r = s["realtime"]
-        goal = f"10k strands <= {t['realtime_ms']} ms/frame GPU"
-        lines.append(f"target 3 ({goal}): {r['kernel_ms']:.4f} ms {r['row']}: {yes(r['met'])}")
+        target(3, f"10k strands <= {t['realtime_ms']} ms/frame GPU", f"{r['kernel_ms']:.4f} ms", r)
         lines.append(f"  frame loop {r['frame_loop_ms']:.4f} ms a frame, as a graph {r['frame_loop_graph_ms']:.4f} ms")
     if "cpu" in s:
         c = s["cpu"]
-        goal = f"{100 * t['cpu_fraction']:.0f}% of CPU copy"
-        lines.append(f"target 4 (CPU fast variant >= {goal}): {pct(c['fraction'])} {c['row']}: {yes(c['met'])}")
+        target(4, f"CPU fast variant >= {100 * t['cpu_fraction']:.0f}% of CPU copy", pct(c["fraction"]), c)
     for case, d in s.get("speedups", {}).items():
         h = d.get("headline")
         if h:

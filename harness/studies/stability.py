@@ -27,6 +27,7 @@ Writes results/stability/stability.csv and env.json, and render/stability_report
 report/stability_<slice>.png and writes report/dynamic_stability.md.
 """
 
+import inspect
 import os
 import tempfile
 import time
@@ -39,7 +40,7 @@ import numpy as np
 from harness import HarnessError
 from harness.check import invariants_dynamic
 from harness.core import env, gpus, runner, scenes, tolerances, variants
-from harness.core.paths import RESULTS, binary_path, display
+from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
 from harness.io.files import write_json
@@ -113,7 +114,7 @@ def backends(gpu="auto", log=print):
             raise HarnessError(f"stability: --gpu yes but {why}")
         log(f"stability: GPU builds not run: {why}")
         return out
-    for build in ("default", "strict", "fastmath"):
+    for build in CUDA_BUILDS:
         if binary_path("cuda", build).exists():
             out.append(Backend("cuda", build, variants.simulating("cuda", build)))
         else:
@@ -281,36 +282,28 @@ def write_csv(rows, path):
     return files.write_csv(path, COLUMNS, rows, extrasaction="ignore")
 
 
-def run_study(
-    slices=SLICE_NAMES,
-    quick=False,
-    strands=STRANDS,
-    frames=FRAMES,
-    jobs=None,
-    gpu="auto",
-    timeout=None,
-    out_dir=None,
-    log=print,
-    shard=None,
-):
-    """Measure the slices; write stability.csv and env.json into out_dir (the renderer,
-    render/stability_report.py, draws them) and return the CSV's path."""
+def run_study(out_dir=None, **options):
+    """Measure the slices (`options`: those of measure()); write stability.csv and env.json into
+    out_dir (the renderer, render/stability_report.py, draws them) and return the CSV's path."""
     out_dir = Path(out_dir or RESULTS / "stability")
-    rows, bes, seconds = measure(slices, quick, strands, frames, jobs, gpu, timeout, log, shard)
+    bound = inspect.signature(measure).bind(**options)
+    bound.apply_defaults()
+    opt = bound.arguments
+    rows, bes, seconds = measure(**opt)
     csv_path = write_csv(rows, out_dir / "stability.csv")
     info = dict(
         env.collect(),
-        quick=quick,
-        strands=strands,
-        frames=frames,
-        jobs=jobs or os.cpu_count(),
+        quick=opt["quick"],
+        strands=opt["strands"],
+        frames=opt["frames"],
+        jobs=opt["jobs"] or os.cpu_count(),
         seconds=round(seconds, 1),
         backends=[b.label for b in bes],
         stretch_bound=tolerances.STABILITY_STRETCH_MAX,
         penetration_bound_rel=tolerances.STABILITY_PENETRATION_REL,
-        shard=str(shard) if shard else None,
+        shard=str(opt["shard"]) if opt["shard"] else None,
     )
     env_path = out_dir / "env.json"
     write_json(env_path, info)
-    log(f"stability: {len(rows)} cells in {seconds:.1f} s; wrote {display(csv_path)} and {display(env_path)}")
+    opt["log"](f"stability: {len(rows)} cells in {seconds:.1f} s; wrote {display(csv_path)} and {display(env_path)}")
     return csv_path

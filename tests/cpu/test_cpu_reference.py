@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from harness.io.states import h5md_layout
-from support.invariants_check import assert_invariants
-from support.statecheck import State, assert_equivalent, run, run_json
+from support.invariants_check import assert_invariants, assert_windy_runs_keep_invariants
+from support.statecheck import State, assert_equivalent, assert_threads_change_no_bit, run, run_json
 
 SEEDS = [1, 7, 123456789]
 
@@ -42,52 +42,13 @@ def test_invariants_hold_on_every_frame(cpu_bin, tmp_path, precision, points, se
 
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_strong_wind_and_other_angles_keep_invariants(cpu_bin, tmp_path, precision):
-    for angle in (0.0, 1.0, -2.5, 7.0):
-        out = tmp_path / f"w{angle}.h5"
-        run(
-            cpu_bin,
-            "--strands",
-            300,
-            "--points",
-            24,
-            "--wind-strength",
-            1,
-            "--wind-angle",
-            angle,
-            "--precision",
-            precision,
-            "--stages",
-            "init,collide,wind,collide,wind,collide",
-            "--output",
-            out,
-            "--quiet",
-        )
-        assert_invariants(State(out))
+    flags = ("--strands", 300, "--points", 24, "--precision", precision)
+    assert_windy_runs_keep_invariants(cpu_bin, tmp_path, (0.0, 1.0, -2.5, 7.0), *flags)
 
 
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_thread_count_does_not_change_a_bit(cpu_bin, tmp_path, precision):
-    paths = []
-    for threads in (1, 2, 3):
-        out = tmp_path / f"t{threads}.h5"
-        run(
-            cpu_bin,
-            "--strands",
-            3001,
-            "--points",
-            20,
-            "--threads",
-            threads,
-            "--precision",
-            precision,
-            "--output",
-            out,
-            "--quiet",
-        )
-        paths.append(out)
-    base = State(paths[0]).frames
-    for p in paths[1:]:
-        assert np.array_equal(State(p).frames, base)
+    assert_threads_change_no_bit(cpu_bin, tmp_path, "--strands", 3001, "--points", 20, "--precision", precision)
 
 
 def test_resume_from_a_file_gives_the_same_bits_as_one_run(cpu_bin, tmp_path):

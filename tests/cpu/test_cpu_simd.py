@@ -32,7 +32,7 @@ from test_stability import scene_args, scenes
 from harness.core import tolerances
 from support import synthetic
 from support.invariants_check import assert_invariants
-from support.statecheck import State, assert_equivalent, run, run_json, tmp_leftovers
+from support.statecheck import State, assert_equivalent, assert_threads_change_no_bit, run, run_json, tmp_leftovers
 
 SEEDS = [1, 7, 123456789]
 PAPER = ["init", "collide", "wind", "collide"]
@@ -334,29 +334,8 @@ def test_collide_at_the_slice_poles_matches_ref(cpu_bin, tmp_path, precision):
 @needs_simd
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_thread_count_does_not_change_a_bit(cpu_bin, tmp_path, precision):
-    states = []
-    for threads in (1, 2, 3):
-        out = tmp_path / f"t{threads}.h5"
-        run(
-            cpu_bin,
-            "--strands",
-            3001,
-            "--points",
-            20,
-            "--threads",
-            threads,
-            "--precision",
-            precision,
-            "--variant",
-            "simd",
-            "--output",
-            out,
-            "--quiet",
-        )
-        states.append(State(out))
-    for s in states[1:]:
-        assert np.array_equal(s.frames, states[0].frames)
-        assert list(s.moved) == list(states[0].moved)
+    flags = ("--strands", 3001, "--points", 20, "--precision", precision, "--variant", "simd")
+    assert_threads_change_no_bit(cpu_bin, tmp_path, *flags)
 
 
 @needs_simd
@@ -468,11 +447,9 @@ def test_records_say_simd_and_its_flags(cpu_bin, tmp_path, monkeypatch, isa):
     assert s.params["variant"] == "simd" and s.params["flags"] == rec["flags"]
 
 
-@pytest.mark.parametrize("name, isa", [("model_simd.o", "_ZGVd"), ("model_simd_v4.o", "_ZGVe")])
-def test_simd_object_calls_libmvec_and_no_scalar_math(cpu_bin, name, isa):
-    """Every sin/cos/asin/atan2 of the simd file is a vector call of its build's width
-    (_ZGVd…: AVX2, _ZGVe…: AVX-512); a scalar call (or a sincos, which GCC makes of a sin and
-    a cos of one angle) would mean a loop was not vectorised."""
+def object_calls(cpu_bin, name):
+    """The functions that build/obj/simd/NAME calls (objdump's relocations); skips where there is
+    no such x86-64 object or no objdump, and for a sanitizer build (its loops stay scalar)."""
     obj = Path(cpu_bin).parent / "obj" / "simd" / name
     if platform.machine() != "x86_64":
         pytest.skip(f"simd test skipped: {NO_SIMD}")
@@ -481,12 +458,22 @@ def test_simd_object_calls_libmvec_and_no_scalar_math(cpu_bin, name, isa):
     if shutil.which("objdump") is None:
         pytest.skip("objdump not found (binutils)")
     text = subprocess.run(["objdump", "-dr", str(obj)], capture_output=True, text=True, check=True).stdout
-    called = set()
-    for line in text.splitlines():
-        if "R_X86_64_PLT32" in line or "R_X86_64_PC32" in line:
-            called.add(line.split()[-1].split("-")[0].split("+")[0])
+    called = {
+        line.split()[-1].split("-")[0].split("+")[0]
+        for line in text.splitlines()
+        if "R_X86_64_PLT32" in line or "R_X86_64_PC32" in line
+    }
     if "__asan_init" in called or any(c.startswith("__ubsan_") for c in called):
         pytest.skip("a sanitizer build (make sanitize): its instrumentation keeps the loops scalar")
+    return called
+
+
+@pytest.mark.parametrize("name, isa", [("model_simd.o", "_ZGVd"), ("model_simd_v4.o", "_ZGVe")])
+def test_simd_object_calls_libmvec_and_no_scalar_math(cpu_bin, name, isa):
+    """Every sin/cos/asin/atan2 of the simd file is a vector call of its build's width
+    (_ZGVd…: AVX2, _ZGVe…: AVX-512); a scalar call (or a sincos, which GCC makes of a sin and
+    a cos of one angle) would mean a loop was not vectorised."""
+    called = object_calls(cpu_bin, name)
     scalar = {"sinf", "cosf", "asinf", "atan2f", "sin", "cos", "asin", "atan2", "sincosf", "sincos"} & called
     assert not scalar, f"scalar math calls left in {name}: {sorted(scalar)}"
     # fp32's sin and cos are c_ref/paper/fast_trig.h's inline polynomials (docs/cpu_simd.md)

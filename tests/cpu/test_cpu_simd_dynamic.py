@@ -14,14 +14,9 @@ stages differ from ref's by their libmvec rounding (tests/cpu/test_cpu_simd.py c
 N = 300 and 1000 are not multiples of the blocks (512/256 strands, 256 per dynamic block).
 """
 
-import platform
-import shutil
-import subprocess
-from pathlib import Path
-
 import numpy as np
 import pytest
-from test_cpu_simd import ISAS, NO_SIMD, needs_simd
+from test_cpu_simd import ISAS, needs_simd, object_calls
 
 from harness.check import diff_dynamic as dyndiff
 from harness.io.trajectory import open_trajectory
@@ -95,11 +90,13 @@ def inputs(cpu_bin, tmp_path_factory):
     return get
 
 
-def simulate(cpu_bin, inp, out, variant, *args, frames=FRAMES):
+def simulate(cpu_bin, inp, out, variant, *args, frames=FRAMES, input_frame=None):
+    """`frames` frames of `variant` from the last frame of inp (or its frame input_frame); out."""
     run(
         cpu_bin,
         "--input",
         inp,
+        *(("--input-frame", input_frame) if input_frame is not None else ()),
         "--stages",
         "simulate",
         "--frames",
@@ -150,27 +147,7 @@ def assert_one_frame_rule(cpu_bin, inp, tmp_path, what, args, frames=REF_FRAMES)
     worst = 0.0
     for k in (cand[0], cand[-2]):
         out = tmp_path / f"simd_{k}.h5"
-        run(
-            cpu_bin,
-            "--input",
-            ref,
-            "--input-frame",
-            k,
-            "--stages",
-            "simulate",
-            "--frames",
-            1,
-            "--variant",
-            "simd",
-            *SOLVE,
-            *args,
-            "--velocities",
-            "all",
-            "--output",
-            out,
-            "--force",
-            "--quiet",
-        )
+        simulate(cpu_bin, ref, out, "simd", *args, "--velocities", "all", frames=1, input_frame=k)
         r = dyndiff.compare(ref, out, frames=[steps[k]], check_paper=False)
         f = r.frames[0]
         assert getattr(f, "velocity_compared", False), f"{what}: velocities of step {steps[k]} not compared"
@@ -263,26 +240,7 @@ def test_resume_gives_the_same_bits(cpu_bin, inputs, tmp_path, solver):
     assert np.array_equal(pw[-1], pr[-1]) and np.array_equal(vw[-1], vr[-1])
     assert np.array_equal(ow["kinetic_energy"][-5:], orr["kinetic_energy"][-5:])
     # from simulated frame 3 of the whole run (file frame paper_frames − 1 + 3 = 4)
-    mid = tmp_path / "mid.h5"
-    run(
-        cpu_bin,
-        "--input",
-        whole,
-        "--input-frame",
-        4,
-        "--stages",
-        "simulate",
-        "--frames",
-        7,
-        "--variant",
-        "simd",
-        *SOLVE,
-        *args,
-        "--output",
-        mid,
-        "--force",
-        "--quiet",
-    )
+    mid = simulate(cpu_bin, whole, tmp_path / "mid.h5", "simd", *args, frames=7, input_frame=4)
     pm, vm = read(mid)[:2]
     assert np.array_equal(pw[-1], pm[-1]) and np.array_equal(vw[-1], vm[-1])
 
@@ -291,21 +249,7 @@ def test_resume_gives_the_same_bits(cpu_bin, inputs, tmp_path, solver):
 def test_dynamics_simd_object_calls_only_the_vector_sine(cpu_bin, name, isa):
     """The gust sine of each build of dynamics_simd.c is libmvec's at its width (_ZGVd…: AVX2,
     _ZGVe…: AVX-512); a scalar sin would mean the velocity loop was not vectorised."""
-    obj = Path(cpu_bin).parent / "obj" / "simd" / name
-    if platform.machine() != "x86_64":
-        pytest.skip(f"simd test skipped: {NO_SIMD}")
-    if not obj.exists():
-        pytest.skip(f"{obj} not found (the binary was not built by this Makefile)")
-    if shutil.which("objdump") is None:
-        pytest.skip("objdump not found (binutils)")
-    text = subprocess.run(["objdump", "-dr", str(obj)], capture_output=True, text=True, check=True).stdout
-    called = {
-        line.split()[-1].split("-")[0].split("+")[0]
-        for line in text.splitlines()
-        if "R_X86_64_PLT32" in line or "R_X86_64_PC32" in line
-    }
-    if "__asan_init" in called or any(c.startswith("__ubsan_") for c in called):
-        pytest.skip("a sanitizer build (make sanitize): its instrumentation keeps the loops scalar")
+    called = object_calls(cpu_bin, name)
     assert not {"sinf", "sin", "sqrtf", "sqrt", "sincosf", "sincos"} & called, sorted(called)
     for f in ("sinf", "sin"):
         assert any(c.startswith(isa) and c.endswith("_" + f) for c in called), f"no {isa} vector call to {f}"

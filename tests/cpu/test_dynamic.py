@@ -174,21 +174,8 @@ def test_blown_up_run_is_detected_and_matches_the_observables(cpu_bin, tmp_path)
     """xpbd with S = I = 1 and no damping at 32 points blows up (measured: every strand by
     frame 60); the harness's own count from positions and velocities equals the file's."""
     out = tmp_path / "b.h5"
-    run(
-        cpu_bin,
-        *SIM,
-        "--strands",
-        "64",
-        "--points",
-        "32",
-        "--frames",
-        "30",
-        "--velocities",
-        "all",
-        "--output",
-        out,
-        "--quiet",
-    )
+    size = ("--strands", 64, "--points", 32, "--frames", 30)
+    run(cpu_bin, *SIM, *size, "--velocities", "all", "--output", out, "--quiet")
     with open_trajectory(out) as t:
         assert t.observables["blown_up"].any()
         rep = invariants_dynamic.check(t)

@@ -107,33 +107,16 @@ def scene_args(s):
     return [*geometry, "--precision", s["precision"], *dynamic_args(s)]
 
 
+# the drawn keys that are not a `--key value` flag of the simulate stage
+APART = ("precision", "solver", "strands", "points", "seed", "motion", "collider")
+
+
 def dynamic_args(s):
     """The simulate stage's flags of a drawn scene (None: the flag is left out)."""
     args = ["--solver", s["solver"], "--head-motion", s["motion"]]
-    for key in (
-        "frames",
-        "substeps",
-        "iterations",
-        "frame_dt",
-        "gravity",
-        "stretch_compliance",
-        "bend_compliance",
-        "shape_compliance",
-        "shape_range",
-        "drag",
-        "damping",
-        "wind_speed",
-        "wind_angle",
-        "gust_amplitude",
-        "gust_frequency",
-        "gust_wavelength",
-        "motion_amplitude",
-        "motion_frequency",
-        "collision_margin",
-        "ftl_damping",
-    ):
-        if s[key] is not None:
-            args += ["--" + key.replace("_", "-"), repr(s[key]) if isinstance(s[key], float) else s[key]]
+    for key, value in s.items():
+        if key not in APART and value is not None:
+            args += ["--" + key.replace("_", "-"), repr(value) if isinstance(value, float) else value]
     if not s["collider"]:
         args.append("--no-collider")
     return args

@@ -33,7 +33,7 @@ import pytest
 
 from conftest import BUILD, CPU_BIN, CUDA_BIN, CUDA_FASTMATH_BIN, CUDA_STRICT_BIN
 from harness.core import tolerances, variants
-from support.invariants_check import assert_invariants
+from support.invariants_check import assert_invariants, assert_windy_runs_keep_invariants
 from support.measured import write_worst
 from support.statecheck import State, assert_equivalent, run
 
@@ -64,6 +64,11 @@ def _write_measurements():
 # ---- helpers ---------------------------------------------------------------------------------
 def scene_args(precision, strands=N, points=P):
     return ["--strands", strands, "--points", points, "--seed", SEED, "--precision", precision, *WIND, "--quiet"]
+
+
+def run_scene(binary, precision, stages, out, *flags):
+    """The test scene at `precision` through `stages` (comma-separated) on binary, into out."""
+    return run(binary, *scene_args(precision), "--stages", stages, *flags, "--output", out)
 
 
 def record(key, value):
@@ -102,11 +107,11 @@ def cpu_ref(work):
         key = ("cpu", precision)
         if key not in _CACHE:
             full = work / f"cpu_{precision}.h5"
-            run(CPU_BIN, *scene_args(precision), "--stages", ",".join(STAGES), "--output", full)
+            run_scene(CPU_BIN, precision, ",".join(STAGES), full)
             prefix = {}
             for n in range(1, len(STAGES)):
                 prefix[n] = work / f"cpu_{precision}_{n}.h5"
-                run(CPU_BIN, *scene_args(precision), "--stages", ",".join(STAGES[:n]), "--output", prefix[n])
+                run_scene(CPU_BIN, precision, ",".join(STAGES[:n]), prefix[n])
             _CACHE[key] = (full, prefix)
         return _CACHE[key]
 
@@ -121,18 +126,7 @@ def gpu_run(work):
         key = ("gpu", build, variant, block, precision, tag)
         if key not in _CACHE:
             out = work / f"gpu_{build}_{variant}_{block}_{precision}{tag}.h5"
-            run(
-                BUILDS[build],
-                *scene_args(precision),
-                "--stages",
-                ",".join(STAGES),
-                "--variant",
-                variant,
-                "--block-size",
-                block,
-                "--output",
-                out,
-            )
+            run_scene(BUILDS[build], precision, ",".join(STAGES), out, "--variant", variant, "--block-size", block)
             _CACHE[key] = State(out)
         return _CACHE[key]
 
@@ -161,18 +155,7 @@ def test_stage_by_stage_matches_cpu(tmp_path, cpu_ref, gpu_run, variant, block, 
 
     # init from nothing
     out = tmp_path / "init.h5"
-    run(
-        CUDA_STRICT_BIN,
-        *scene_args(precision),
-        "--stages",
-        "init",
-        "--variant",
-        variant,
-        "--block-size",
-        block,
-        "--output",
-        out,
-    )
+    run_scene(CUDA_STRICT_BIN, precision, "init", out, "--variant", variant, "--block-size", block)
     compare(full, out, [0], f"init [{tag}]", f"strict-vs-cpu init {precision}", tol)
     # roots use only +, -, *, sqrt: bit-identical to the CPU without contraction
     g = State(out)
@@ -216,30 +199,10 @@ def test_invariants_on_gpu_output(gpu_run, variant, build, precision):
 
 @pytest.mark.parametrize("precision", PRECISIONS)
 def test_invariants_strong_wind_other_angles(tmp_path, precision):
+    flags = ("--strands", 3000, "--points", 24, "--seed", 5, "--precision", precision)
     for build in ("normal", "fastmath"):
-        for angle in (0.0, 1.0, -2.5, 7.0, 1.5707963267948966):
-            out = tmp_path / f"w_{build}_{angle}.h5"
-            run(
-                BUILDS[build],
-                "--strands",
-                3000,
-                "--points",
-                24,
-                "--seed",
-                5,
-                "--precision",
-                precision,
-                "--wind-strength",
-                1,
-                "--wind-angle",
-                angle,
-                "--stages",
-                "init,collide,wind,collide,wind,collide",
-                "--output",
-                out,
-                "--quiet",
-            )
-            assert_invariants(State(out))
+        angles = (0.0, 1.0, -2.5, 7.0, 1.5707963267948966)
+        assert_windy_runs_keep_invariants(BUILDS[build], tmp_path, angles, *flags, tag=f"_{build}")
 
 
 # ---- (c) determinism ------------------------------------------------------------------------

@@ -31,6 +31,7 @@ from harness.core import variants
 from harness.core.tolerances import GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS
 from harness.io.trajectory import open_trajectory
 from support.measured import write_worst
+from support.statecheck import run
 
 pytestmark = pytest.mark.gpu
 
@@ -117,16 +118,13 @@ def record(key, value):
     ERRORS[key] = max(float(value), ERRORS.get(key, 0.0))
 
 
-def run(binary, *args, check=True, timeout=300):
-    cmd = [str(binary), *[str(a) for a in args]]
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    if check and p.returncode != 0:
-        raise AssertionError(f"{' '.join(cmd)} exited {p.returncode}: {p.stderr.strip()}")
-    return p
-
-
 def dyn_args(scene, solver):
     return ["--substeps", SUBSTEPS, "--iterations", ITERATIONS, "--solver", solver, *SCENES[scene]]
+
+
+def simulate(binary, out, scene, solver, *flags):
+    """`binary FLAGS` with the scene's and solver's dynamic flags, quiet, into out (replaced)."""
+    return run(binary, *flags, "--quiet", *dyn_args(scene, solver), "--output", out, "--force")
 
 
 def last_step(path):
@@ -150,28 +148,9 @@ def cpu_run(work):
         key = ("cpu", scene, solver, precision)
         if key not in _CACHE:
             out = work / f"cpu_{scene}_{solver}_{precision}.h5"
-            run(
-                CPU_BIN,
-                "--strands",
-                N,
-                "--seed",
-                SEED,
-                "--hair-length",
-                L,
-                "--precision",
-                precision,
-                "--stages",
-                "init,simulate",
-                "--frames",
-                FRAME_IN + 1,
-                "--velocities",
-                "all",
-                "--quiet",
-                *dyn_args(scene, solver),
-                "--output",
-                out,
-                "--force",
-            )
+            scene_flags = ("--strands", N, "--seed", SEED, "--hair-length", L, "--precision", precision)
+            flags = ("--stages", "init,simulate", "--frames", FRAME_IN + 1, "--velocities", "all")
+            simulate(CPU_BIN, out, scene, solver, *scene_flags, *flags)
             _CACHE[key] = out
         return _CACHE[key]
 
@@ -187,27 +166,8 @@ def gpu_frame(work, cpu_run):
         if key not in _CACHE:
             src = cpu_run(scene, solver, precision)
             out = work / f"gpu_{build}_{variant}_{scene}_{solver}_{precision}_{block}{tag}.h5"
-            run(
-                BUILDS[build],
-                "--input",
-                src,
-                "--input-frame",
-                FRAME_IN,
-                "--stages",
-                "simulate",
-                "--frames",
-                1,
-                "--variant",
-                variant,
-                "--block-size",
-                block,
-                "--quiet",
-                *dyn_args(scene, solver),
-                *extra,
-                "--output",
-                out,
-                "--force",
-            )
+            flags = ("--input", src, "--input-frame", FRAME_IN, "--stages", "simulate", "--frames", 1)
+            simulate(BUILDS[build], out, scene, solver, *flags, "--variant", variant, "--block-size", block, *extra)
             _CACHE[key] = out
         return _CACHE[key]
 
@@ -279,28 +239,18 @@ def test_strict_variants_identical(gpu_frame, scene, solver, precision):
         assert same_bits(a, b), f"strict {scene} {solver} {precision}: {names[0]} and {other} differ"
 
 
+def one_frame_on_cuda(out, *flags):
+    """build/hairsim-cuda FLAGS through init and one simulated frame into out; the
+    CompletedProcess, whatever its exit status (the refusal tests)."""
+    return run(CUDA_BIN, *flags, "--stages", "init,simulate", "--frames", 1, "--quiet", "--output", out, check=False)
+
+
 def test_variant_over_its_point_limit_is_refused(tmp_path):
     limited = [(v, DECLARED.max_points[v]) for v in VARIANTS if DECLARED.max_points.get(v)]
     assert limited, "no simulate variant declares a most-points limit"
     for v, most in limited:
         out = tmp_path / f"{v}.h5"
-        p = run(
-            CUDA_BIN,
-            "--strands",
-            10,
-            "--points",
-            most + 1,
-            "--stages",
-            "init,simulate",
-            "--frames",
-            1,
-            "--variant",
-            v,
-            "--quiet",
-            "--output",
-            out,
-            check=False,
-        )
+        p = one_frame_on_cuda(out, "--strands", 10, "--points", most + 1, "--variant", v)
         assert p.returncode == 2, (v, p.returncode, p.stderr)
         assert "--points" in p.stderr and v in p.stderr and "\n" not in p.stderr.strip(), p.stderr
         assert not out.exists()
@@ -309,29 +259,8 @@ def test_variant_over_its_point_limit_is_refused(tmp_path):
 # ---- refusals ---------------------------------------------------------------------------------
 def test_warp_block_too_large_for_shared_memory_is_refused(tmp_path):
     # 512 points x 32 strands a block x 15 reals x 8 bytes = 1.9 MB: more than any GPU gives a block
-    p = run(
-        CUDA_BIN,
-        "--strands",
-        100,
-        "--points",
-        512,
-        "--hair-length",
-        60,
-        "--precision",
-        "fp64",
-        "--stages",
-        "init,simulate",
-        "--frames",
-        1,
-        "--variant",
-        "warp",
-        "--block-size",
-        1024,
-        "--quiet",
-        "--output",
-        tmp_path / "o.h5",
-        check=False,
-    )
+    flags = ("--strands", 100, "--points", 512, "--hair-length", 60, "--precision", "fp64")
+    p = one_frame_on_cuda(tmp_path / "o.h5", *flags, "--variant", "warp", "--block-size", 1024)
     assert p.returncode == 2, p.stderr
     assert "shared memory" in p.stderr and "--block-size" in p.stderr, p.stderr
     assert not (tmp_path / "o.h5").exists()
@@ -349,25 +278,7 @@ def test_state_too_large_for_simulate_is_refused(tmp_path):
     free = int(smi.stdout.split()[0]) * 2**20
     strands = free // 3 // (32 * 3 * 8)
     out = tmp_path / "big.h5"
-    p = run(
-        CUDA_BIN,
-        "--strands",
-        strands,
-        "--points",
-        32,
-        "--precision",
-        "fp64",
-        "--stages",
-        "init,simulate",
-        "--frames",
-        1,
-        "--variant",
-        "strand",
-        "--quiet",
-        "--output",
-        out,
-        check=False,
-    )
+    p = one_frame_on_cuda(out, "--strands", strands, "--points", 32, "--precision", "fp64", "--variant", "strand")
     assert p.returncode == 3, (p.returncode, p.stderr)
     assert "GPU memory" in p.stderr and "simulate" in p.stderr, p.stderr
     assert list(tmp_path.iterdir()) == [], "a refused run must leave no file"

@@ -11,8 +11,6 @@ also recomputed from its own guides by harness/check/followers.py, bit for bit. 
 refuses both features (docs/cuda.md).
 """
 
-import subprocess
-
 import numpy as np
 import pytest
 
@@ -21,6 +19,7 @@ from harness import HarnessError
 from harness.check import diff_dynamic, followers
 from harness.core import variants
 from harness.io.trajectory import open_trajectory
+from support.statecheck import run
 
 pytestmark = pytest.mark.gpu
 
@@ -38,14 +37,6 @@ SCENES = {
     "sagfree": ["--shape-compliance", "1e-4", "--shape-range", "1", "--sag-free", "--head-motion", "tilt"],
 }
 FRAMES = 3
-
-
-def run(binary, *args, check=True):
-    cmd = [str(binary), *[str(a) for a in args]]
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
-    if check and p.returncode != 0:
-        raise AssertionError(f"{' '.join(cmd)} exited {p.returncode}: {p.stderr.strip()}")
-    return p
 
 
 @pytest.fixture(scope="module")

@@ -8,14 +8,13 @@ scenes); a variant that does not must refuse a groom, and a groom's file given t
 with one line and exit 2, writing nothing.
 """
 
-import subprocess
-
 import pytest
 
 from conftest import CPU_BIN, CUDA_BIN
 from harness.check import diff_dynamic
 from harness.core import variants
 from harness.io.trajectory import open_trajectory
+from support.statecheck import run
 
 pytestmark = pytest.mark.gpu
 
@@ -24,13 +23,6 @@ PHYSICS = [
     "--substeps", 4, "--iterations", 2, "--bend-compliance", 1e-6, "--shape-compliance", 1e-4, "--shape-range", 0.5,
     "--wind-speed", 150, "--drag", 0.5, "--gust-amplitude", 0.5, "--head-motion", "nod",
 ]  # fmt: skip
-
-
-def run(binary, *args, check=True):
-    p = subprocess.run([str(binary), *map(str, args)], capture_output=True, text=True, timeout=300)
-    if check and p.returncode != 0:
-        raise AssertionError(f"{binary} {args} exited {p.returncode}: {p.stderr.strip()}")
-    return p
 
 
 def _variants():

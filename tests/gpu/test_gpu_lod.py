@@ -10,7 +10,6 @@ DYN_LOD_KERNEL_K·ε·E of it (E = R + c_m + 2L), the kernel's contraction of th
 """
 
 import json
-import subprocess
 
 import numpy as np
 import pytest
@@ -20,6 +19,7 @@ from harness import HarnessError
 from harness.check import lod
 from harness.core import tolerances, variants
 from harness.io.trajectory import open_trajectory
+from support.statecheck import run
 
 pytestmark = pytest.mark.gpu
 
@@ -32,14 +32,6 @@ except HarnessError:
 SCENE = ["--strands", "200", "--points", str(P), "--hair-length", "30"]
 PHYSICS = ["--substeps", "4", "--iterations", "2", "--bend-compliance", "1e-6", "--head-motion", "nod",
            "--motion-frequency", "4", "--frames", "3", "--velocities", "all", "--render-points", str(PR)]  # fmt: skip
-
-
-def run(binary, *args):
-    cmd = [str(binary), *[str(a) for a in args]]
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
-    if p.returncode != 0:
-        raise AssertionError(f"{' '.join(cmd)} exited {p.returncode}: {p.stderr.strip()}")
-    return p
 
 
 @pytest.fixture(scope="module")

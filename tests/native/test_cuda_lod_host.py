@@ -4,15 +4,8 @@ and velocities, in the canonical and the point-major layout: cuda/hostcheck/lod_
 GPU needed; on the device the normal build contracts FMAs (tests/gpu/test_gpu_lod.py covers that).
 Built by the Makefile (`make hostcheck`). Skipped, with the reason, where nvcc is missing."""
 
-import pytest
-from test_cuda_port_host import build_hostcheck, check_hostcheck
+from test_cuda_port_host import assert_hostcheck_all_identical
 
 
-@pytest.fixture(scope="module")
-def lod_hostcheck():
-    return build_hostcheck("lod_hostcheck")[0]
-
-
-def test_cuda_lod_rendering_matches_c_reference_bit_for_bit(lod_hostcheck):
-    summary = check_hostcheck(lod_hostcheck).strip().splitlines()[-1]
-    assert summary == "lod host check: 48 cases, 0 mismatches (all identical)", summary
+def test_cuda_lod_rendering_matches_c_reference_bit_for_bit():
+    assert_hostcheck_all_identical("lod_hostcheck", "lod host check: 48 cases, 0 mismatches (all identical)")

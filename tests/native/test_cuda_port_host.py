@@ -74,6 +74,12 @@ def check_hostcheck(exe, *args):
     return p.stdout
 
 
+def assert_hostcheck_all_identical(name, summary):
+    """Build and run build/hostcheck/NAME; its last line must be `summary` (every case identical)."""
+    last = check_hostcheck(build_hostcheck(name)[0]).strip().splitlines()[-1]
+    assert last == summary, last
+
+
 def test_cuda_model_matches_c_reference_bit_for_bit(hostcheck):
     """The reference arithmetic (the strict build's): every case bit-identical."""
     out = check_hostcheck(hostcheck["reference"])

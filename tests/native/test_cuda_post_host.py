@@ -4,15 +4,8 @@ canonical and the point-major layout: cuda/hostcheck/post_hostcheck.cu. No GPU n
 device the normal build contracts FMAs (tests/gpu/test_gpu_features.py covers that). Built by
 the Makefile (`make hostcheck`). Skipped, with the reason, where nvcc is missing."""
 
-import pytest
-from test_cuda_port_host import build_hostcheck, check_hostcheck
+from test_cuda_port_host import assert_hostcheck_all_identical
 
 
-@pytest.fixture(scope="module")
-def post_hostcheck():
-    return build_hostcheck("post_hostcheck")[0]
-
-
-def test_cuda_follower_placement_matches_c_reference_bit_for_bit(post_hostcheck):
-    summary = check_hostcheck(post_hostcheck).strip().splitlines()[-1]
-    assert summary == "post host check: 48 cases, 0 mismatches (all identical)", summary
+def test_cuda_follower_placement_matches_c_reference_bit_for_bit():
+    assert_hostcheck_all_identical("post_hostcheck", "post host check: 48 cases, 0 mismatches (all identical)")

@@ -11,6 +11,7 @@ import numpy as np
 from harness.check import invariants
 from harness.core import tolerances
 from harness.io.states import open_state
+from support.statecheck import State, run
 
 
 def assert_invariants(s, tol=None):
@@ -31,3 +32,27 @@ def assert_frames_invariants(path, tol=None):
         report = invariants.check(st, tol)
     assert report.ok, "; ".join(v.message for v in report.violations)
     return report
+
+
+WINDY_STAGES = "init,collide,wind,collide,wind,collide"
+
+
+def assert_windy_runs_keep_invariants(binary, tmp_path, angles, *flags, tag=""):
+    """Run `binary FLAGS` at wind strength 1 from each of `angles` (two wind+collide rounds);
+    assert the invariants on every output."""
+    for angle in angles:
+        out = tmp_path / f"w{tag}_{angle}.h5"
+        run(
+            binary,
+            *flags,
+            "--wind-strength",
+            1,
+            "--wind-angle",
+            angle,
+            "--stages",
+            WINDY_STAGES,
+            "--output",
+            out,
+            "--quiet",
+        )
+        assert_invariants(State(out))

@@ -8,6 +8,8 @@ import json
 import subprocess
 from pathlib import Path
 
+import numpy as np
+
 from harness.check import diff
 from harness.io.states import LoadedState, load_state
 
@@ -37,6 +39,18 @@ def assert_equivalent(path_a, path_b, frames="all", tolerance=None, what=""):
     result = diff.compare(str(path_a), str(path_b), frames=frames, tolerance=tolerance)
     assert result.equivalent, f"{what}: " + diff.format_result(result)
     return result
+
+
+def assert_threads_change_no_bit(binary, tmp_path, *flags, threads=(1, 2, 3)):
+    """Run `binary FLAGS` at each thread count: every frame and every moved count bit-identical."""
+    states = []
+    for n in threads:
+        out = tmp_path / f"t{n}.h5"
+        run(binary, *flags, "--threads", n, "--output", out, "--quiet")
+        states.append(State(out))
+    for s in states[1:]:
+        assert np.array_equal(s.frames, states[0].frames)
+        assert list(s.moved) == list(states[0].moved)
 
 
 def tmp_leftovers(directory: Path):
