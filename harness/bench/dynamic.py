@@ -15,7 +15,8 @@
   2. the sweep configs/sweeps/dynamic.toml (results/<out>/dynamic/runs.csv);
   3. the studies, each into results/<out>/<study>/: what each feature costs (featurecost,
      CPU and every cuda build), modelling less (reduced: guides and followers, LRA, sag-free,
-     LOD; docs/model.md §3.14), speed against accuracy (accuracy --model dynamic), stability at the
+     LOD; docs/model.md §3.14), speed against accuracy (accuracy --model dynamic, on the default
+     scene and on curly hair, configs/scenes/curly.toml), stability at the
      extremes (stability), the peer (pypbd, optional), the animation;
   4. report/dynamic.md with all of it.
 Without a GPU the GPU rows and checks are skipped with one line saying why.
@@ -35,6 +36,7 @@ from harness.io import results_data
 from harness.io.files import write_json
 from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
 from harness.studies import accuracy_dynamic, animate, featurecost, peer, reduced, stability
+from harness.studies.accuracy import DEFAULT_SCENE
 from harness.studies.sweep import run_sweep
 
 VALIDATION_STRANDS = 2000
@@ -221,6 +223,31 @@ def featurecost_size(sweep_dir, allowance_s):
     return largest_that_fits(FEATURECOST_STRANDS, seconds, allowance_s)
 
 
+# (scene, the study's name in the log and the budget): the straight default scene, then curly hair
+ACCURACY_STUDIES = (
+    (DEFAULT_SCENE, "accuracy"),
+    (report_dynamic.CURLY_SCENE, f"accuracy {report_dynamic.CURLY_SCENE}"),
+)
+
+
+def accuracy(root, scene, gpu, quick, say, report_dir=None):
+    """The speed-against-accuracy study of one scene into root/<its results folder>, rendered
+    into report_dir when given. Another scene than the default one skips the analytic tables:
+    they run their own scenes, so they would repeat the default scene's."""
+    acc_dir = root / accuracy_dynamic.results_name(scene)
+    changes = dict(gpu=gpu, scene=scene)
+    if scene != DEFAULT_SCENE:
+        changes["analytic"] = "none"
+    plan = accuracy_dynamic.Plan.quick(**changes) if quick else accuracy_dynamic.Plan(**changes)
+    where = f" --scene {scene} --analytic none" if "analytic" in changes else ""
+    say(f"harness: accuracy --model dynamic{where}{' --quick' if quick else ''} --gpu {gpu}")
+    accuracy_dynamic.run_study(plan, out_dir=acc_dir, force=True, command="python -m harness bench --model dynamic")
+    if report_dir is not None:
+        title = report_dynamic.CURLY_TITLE if scene == report_dynamic.CURLY_SCENE else None
+        accuracy_dynamic_report.write(acc_dir, report_dir, title=title)
+    return acc_dir
+
+
 def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=None):
     """The dynamic studies, each measured into root/<study> (`quick`: their small versions)
     and rendered into report_dir (none with `shard` of several). A shard runs its share of the
@@ -259,13 +286,9 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
         say(f"harness: reduced{' --quick' if quick else ''}")
         plan = reduced.Plan.quick(gpu=gpu) if quick else reduced.Plan(gpu=gpu)
         reduced.measure(plan, out=root / "reduced" / "reduced.csv", progress=say)
-    if first and fits("accuracy"):
-        acc_dir = root / accuracy_dynamic.RESULTS_NAME
-        plan = accuracy_dynamic.Plan.quick(gpu=gpu) if quick else accuracy_dynamic.Plan(gpu=gpu)
-        say(f"harness: accuracy --model dynamic{' --quick' if quick else ''} --gpu {gpu}")
-        accuracy_dynamic.run_study(plan, out_dir=acc_dir, force=True, command="python -m harness bench --model dynamic")
-        if render:
-            accuracy_dynamic_report.write(acc_dir, report_dir)
+    for scene, study in ACCURACY_STUDIES:
+        if first and fits(study):
+            accuracy(root, scene, gpu, quick, say, report_dir)
     if fits("stability"):
         say(f"harness: stability{' --quick' if quick else ''} --gpu {gpu}" + (f" (shard {shard})" if shard else ""))
         csv_path = stability.run_study(quick=quick, gpu=gpu, out_dir=root / "stability", shard=shard)

@@ -176,7 +176,7 @@ def cmd_report(args):
 
 def cmd_report_dynamic(args):
     """Write results/local/report/dynamic.md and its plots from the results of the dynamic bench (ROOT/dynamic/,
-    featurecost/, dynamic-accuracy/, stability/, peer/, headline/): rendering only."""
+    featurecost/, dynamic-accuracy/, dynamic-accuracy-curly/, stability/, peer/, headline/): rendering only."""
     from harness.core.paths import display
     from harness.render import report_dynamic
 
@@ -330,8 +330,9 @@ def cmd_accuracy(args):
     --scene): every solver x substeps x iterations x precision x build against a converged xpbd fp64 reference
     (substeps doubled until S and 2S agree to a tenth of the smallest error), time per frame measured apart,
     small steps against iterations, the analytic checks and a recommendation; writes results/dynamic-accuracy/
-    and results/local/report/dynamic_accuracy.md with its plots (docs/harness.md). Exit 0, or 1 when the dynamic
-    reference did not converge."""
+    and results/local/report/dynamic_accuracy.md with its plots (docs/harness.md; another --scene X:
+    results/dynamic-accuracy-X/ and dynamic_accuracy_X.md). Exit 0, or 1 when the dynamic reference did not
+    converge."""
     if accuracy_model(args) == "dynamic":
         return accuracy_dynamic(args)
     from harness.core.paths import RESULTS
@@ -376,7 +377,7 @@ def accuracy_dynamic(args):
     command = " ".join(["python -m harness", *sys.argv[1:]])
     status = accuracy_dynamic.run_study(plan, out_dir=args.out, force=args.force, command=command)
     for path in accuracy_dynamic_report.write(
-        Path(args.out or RESULTS / accuracy_dynamic.RESULTS_NAME), args.report_dir
+        Path(args.out or RESULTS / accuracy_dynamic.results_name(plan.scene)), args.report_dir
     ):
         print(f"wrote {display(path)}")
     return status
@@ -737,7 +738,8 @@ def parser():
     b.add_argument(
         "--out",
         help="the run's folder (default results/local): the paper sweep in OUT/sweep, the dynamic bench's "
-        "folders (dynamic, featurecost, dynamic-accuracy, stability, peer) beside it, the report in OUT/report",
+        "folders (dynamic, featurecost, dynamic-accuracy, dynamic-accuracy-curly, stability, peer) beside it, the "
+        "report in OUT/report",
     )
     case_options(b, gpu=GPU_HELP)
     output_options(b, report="where to write the report (default OUT/report)")
@@ -850,7 +852,7 @@ def parser():
     a.add_argument("--force", action="store_true", help="dynamic: replace an existing results CSV")
     output_options(
         a,
-        results="results/accuracy or results/dynamic-accuracy",
+        results="results/accuracy or results/dynamic-accuracy (another --scene X: results/dynamic-accuracy-X)",
         report=REPORT_DIR_HELP,
         from_csv="only rewrite the report from an existing CSV (results/accuracy/accuracy.csv, or with "
         "--model dynamic results/dynamic-accuracy/dynamic_accuracy.csv)",

@@ -4,12 +4,15 @@ report/dynamic_accuracy.md with its pictures (the Pareto plot, the error growth 
 small steps against iterations). Every number and sentence comes from those files.
 
 `section(results_dir, report_dir)` gives the main report (report.py) a short section with
-a link to the full page.
+a link to the full page. A study on another scene than the default one (`--scene curly`)
+has its own page and pictures, named with the scene (Names), so the two never overwrite
+each other.
 """
 
 import json
 import math
 import os
+from dataclasses import astuple, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -20,11 +23,14 @@ from harness.core.paths import REPORT, RESULTS, display
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     CSV_NAME,
+    DEFAULT_SCENE,
     LATER_COLUMNS,
     NO_SIMULATION,
     REQUIRED_COLUMNS,
     RESULTS_NAME,
     holds_until,
+    results_name,
+    scene_tag,
     scheme_name,
     smallest,
 )
@@ -33,8 +39,33 @@ PAGE = "dynamic_accuracy.md"
 PARETO_PNG = "dynamic_accuracy_pareto.png"
 GROWTH_PNG = "dynamic_accuracy_growth.png"
 STEPS_PNG = "dynamic_accuracy_steps.png"
+DEFAULT_TITLE = "the dynamic model"
 KEYS = ("backend", "build", "variant", "solver", "ftl_damping", "substeps", "iterations", "precision")
 LONG_CSV = "observables.csv"  # studies/observables_long.py's table
+
+
+@dataclass(frozen=True)
+class Names:
+    """The page and picture names of one scene's study: the default scene's are PAGE and the
+    *_PNG names; another scene's carry its name (dynamic_accuracy_curly.md, ...)."""
+
+    page: str = PAGE
+    pareto: str = PARETO_PNG
+    growth: str = GROWTH_PNG
+    steps: str = STEPS_PNG
+
+    @classmethod
+    def of(cls, scene):
+        tag = scene_tag(scene)
+        if not tag:
+            return cls()
+        return cls(*(n.replace("dynamic_accuracy", f"dynamic_accuracy_{tag}", 1) for n in astuple(cls())))
+
+
+def title_of(scene):
+    """The heading's subject: the dynamic model for the default scene, else the scene."""
+    tag = scene_tag(scene)
+    return f"the {tag} scene" if tag else DEFAULT_TITLE
 
 
 # ---- reading --------------------------------------------------------------------------
@@ -882,12 +913,12 @@ def _all_modes_lines(summ):
     ]
 
 
-def markdown(rows, study, env, analytic, long=None):
+def markdown(rows, study, env, analytic, long=None, names=Names(), title=DEFAULT_TITLE):
     summ = summary(rows, study["horizon_frames"])
     front = front_of(summ)
     pairs = small_steps(summ, study)
     base = baseline(summ)
-    out = ["## Speed against accuracy: the dynamic model", "", *_header(study, env)]
+    out = [f"## Speed against accuracy: {title}", "", *_header(study, env)]
     out += convergence_lines(rows, study)
     out += [reference_error_line(study), ""]
     out += baseline_lines(summ, study)
@@ -902,7 +933,7 @@ def markdown(rows, study, env, analytic, long=None):
         "",
         reference_error_line(study),
         "",
-        f"![error against time per frame]({PARETO_PNG})",
+        f"![error against time per frame]({names.pareto})",
         "",
         "### Error growth over time",
         "",
@@ -911,7 +942,7 @@ def markdown(rows, study, env, analytic, long=None):
         f"comparison is made over the horizon ({study['horizon']:g} s, dotted); "
         f"the rule holds until t = {study['reference']['converged_until_s']:.3f} s.",
         "",
-        f"![error growth over time]({GROWTH_PNG})",
+        f"![error growth over time]({names.growth})",
         "",
         "### Small steps against iterations",
         "",
@@ -937,7 +968,7 @@ def markdown(rows, study, env, analytic, long=None):
     for solver, ps in pairs.items():
         ladder = o[(o["scheme"] == solver) & (o["iterations"] == 1)].sort_values("substeps")
         out += small_steps_verdict(solver, ps, ladder)
-    out += ["", reference_error_line(study), "", f"![small steps against iterations]({STEPS_PNG})", ""]
+    out += ["", reference_error_line(study), "", f"![small steps against iterations]({names.steps})", ""]
     out += long_lines(long, study)
     out += [
         "### Which settings for which use",
@@ -968,51 +999,72 @@ def markdown(rows, study, env, analytic, long=None):
     return out, summ, front, pairs
 
 
-def write(results_dir=None, report_dir=None, csv_path=None):
-    """Write report/dynamic_accuracy.md and its pictures from a results directory (its table
-    or csv_path); return the paths written. Nothing is created when the input is refused."""
+def write(results_dir=None, report_dir=None, csv_path=None, title=None):
+    """Write report/dynamic_accuracy.md (another scene's: Names.of its scene) and its
+    pictures from a results directory (its table or csv_path); return the paths written.
+    Nothing is created when the input is refused."""
     results_dir = Path(results_dir or RESULTS / RESULTS_NAME)
     report_dir = Path(report_dir or REPORT)
     rows, study, env, analytic = load(results_dir, csv_path)
     long = load_long(Path(csv_path).parent if csv_path else results_dir)
+    scene = study.get("scene", DEFAULT_SCENE)
+    names = Names.of(scene)
     report_dir.mkdir(parents=True, exist_ok=True)
-    lines, summ, _, pairs = markdown(rows, study, env, analytic, long)
+    lines, summ, _, pairs = markdown(rows, study, env, analytic, long, names, title or title_of(scene))
     pics = [
-        pareto_plot(summ, study, report_dir / PARETO_PNG),
-        growth_plot(rows, summ, study, report_dir / GROWTH_PNG),
-        steps_plot(pairs, report_dir / STEPS_PNG),
+        pareto_plot(summ, study, report_dir / names.pareto),
+        growth_plot(rows, summ, study, report_dir / names.growth),
+        steps_plot(pairs, report_dir / names.steps),
     ]
-    page = report_dir / PAGE
-    tmp = page.with_name(f"{PAGE}.tmp.{os.getpid()}")
+    page = report_dir / names.page
+    tmp = page.with_name(f"{names.page}.tmp.{os.getpid()}")
     tmp.write_text("\n".join(lines) + "\n")
     os.replace(tmp, page)
     return [page, *pics]
 
 
-def section(results_dir=None, report_dir=None, write_page=True):
+def not_converged_line(rows, study):
+    """What a reference that did not converge over the horizon means for the rows beside it."""
+    ref = study["reference"]
+    table = convergence_table(rows, study["horizon_frames"])
+    last = f"; its last rung still moved by RMS {_e(table[-1]['rms'])}·L" if table else ""
+    return (
+        f"**The reference did NOT converge**: S doubled up to {ref['substeps']} (`--ref-max {study['ref_max']}`) "
+        f"and the RMS rule still fails over the {study['horizon']:g} s horizon{last}. The errors and the "
+        "recommendation below are against that unconverged reference: read them as bounded by its own change, "
+        "not measured."
+    )
+
+
+def section(results_dir=None, report_dir=None, write_page=True, scene=DEFAULT_SCENE, title=None):
     """Markdown lines for the main report: the front, the recommendation and a link to the
     full page (written again into report_dir unless write_page=False), or how to measure it
-    when no results exist."""
-    results_dir = Path(results_dir or RESULTS / RESULTS_NAME)
+    when no results exist. `scene`: the scene the folder is for (its command when missing);
+    `title`: the heading's subject (title_of the study's scene when None)."""
+    results_dir = Path(results_dir or RESULTS / results_name(scene))
     report_dir = Path(report_dir or REPORT)
-    head = ["## Speed against accuracy: the dynamic model", ""]
     if not (results_dir / CSV_NAME).exists():
-        return head + [
+        where = f" --scene {scene}" if scene_tag(scene) else ""
+        return [f"## Speed against accuracy: {title or title_of(scene)}", ""] + [
             f"Not measured with these results (no `{display(results_dir / CSV_NAME)}`): run "
-            "`python3 -m harness accuracy --model dynamic` on this machine.",
+            f"`python3 -m harness accuracy --model dynamic{where}` on this machine.",
             "",
         ]
     if write_page:
-        write(results_dir, report_dir)
-    rows, study, env, _ = load(results_dir)
+        write(results_dir, report_dir, title=title)
+    rows, study, env, analytic = load(results_dir)
+    names = Names.of(study.get("scene", DEFAULT_SCENE))
     summ = summary(rows, study["horizon_frames"])
     front = front_of(summ)
     ref = study["reference"]
+    head = [f"## Speed against accuracy: {title or title_of(study.get('scene', DEFAULT_SCENE))}", ""]
+    if not ref["converged"]:
+        head += [not_converged_line(rows, study), ""]
     return head + [
         f"{len(summ)} modes against {ref['label']} xpbd fp64 at S = {ref['substeps']} "
         f"({'converged' if ref['converged'] else 'NOT converged'} over the {study['horizon']:g} s horizon); "
-        f"the full study, its convergence table, small steps against iterations and the analytic checks: "
-        f"[{PAGE}]({PAGE}).",
+        f"the full study, its convergence table, small steps against iterations"
+        f"{' and the analytic checks' if analytic else ''}: [{names.page}]({names.page}).",
         "",
         *_mode_table(front, numbered=True, base=baseline(summ)),
         "",
@@ -1021,6 +1073,6 @@ def section(results_dir=None, report_dir=None, write_page=True):
         *baseline_lines(summ, study)[2:3],
         *recommend(summ, load_long(results_dir)),
         "",
-        f"![error against time per frame]({PARETO_PNG})",
+        f"![error against time per frame]({names.pareto})",
         "",
     ]

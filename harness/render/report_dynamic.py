@@ -1,7 +1,7 @@
 """report/dynamic.md: the dynamic model's report, rendered from a bench root (the results
 of harness/bench/dynamic.py: <root>/dynamic/{runs.csv, env.json, validation.json},
-<root>/featurecost/*.csv, <root>/peer/, <root>/dynamic-accuracy/, <root>/stability/,
-<root>/headline/headline_dynamic.json, <root>/judge/). Rendering only: every number comes from those
+<root>/featurecost/*.csv, <root>/peer/, <root>/dynamic-accuracy/, <root>/dynamic-accuracy-curly/,
+<root>/stability/, <root>/headline/headline_dynamic.json, <root>/judge/). Rendering only: every number comes from those
 files, every missing piece is named with the command that makes it."""
 
 import json
@@ -25,6 +25,10 @@ from harness.render import (  # noqa: E402
     reduced_report,
     stability_report,
 )
+from harness.studies.accuracy import results_name  # noqa: E402
+
+CURLY_SCENE = "curly"  # configs/scenes/curly.toml: the accuracy study's second scene
+CURLY_TITLE = "curly hair"
 
 
 def _save(fig, path):
@@ -216,13 +220,13 @@ def headline_lines(path):
     return out
 
 
-def _study(root, name, module, what, command, out_dir):
-    """A study's section from its own renderer (section(results_dir, report_dir)), or a
-    line saying how to make it."""
+def _study(root, name, module, what, command, out_dir, **options):
+    """A study's section from its own renderer (section(results_dir, report_dir, **options)),
+    or a line saying how to make it."""
     d = Path(root) / name
     if not d.exists():
         return [f"## {what}", "", f"Not measured with these results (no `{display(d)}`): `{command}`.", ""]
-    return module.section(d, out_dir) + [""]
+    return module.section(d, out_dir, **options) + [""]
 
 
 def build(root, report_dir=None):
@@ -271,6 +275,17 @@ def build(root, report_dir=None):
         "Speed against accuracy",
         "harness accuracy --model dynamic",
         out_dir,
+    )
+    curly = results_name(CURLY_SCENE)
+    lines += _study(
+        root,
+        curly,
+        accuracy_dynamic_report,
+        f"Speed against accuracy: {CURLY_TITLE}",
+        f"harness accuracy --model dynamic --scene {CURLY_SCENE} --quick",
+        out_dir,
+        scene=CURLY_SCENE,
+        title=CURLY_TITLE,
     )
     lines += _study(root, "stability", stability_report, "Stability at the extremes", "harness stability", out_dir)
     lines += _study(root, "judge", judge_report, "The judge's power", "harness judge", out_dir)

@@ -3,7 +3,9 @@ precision; the dynamic model adds solver, substeps S and iterations I) and the p
 error of a run against its reference. The measuring is studies/accuracy_paper.py and
 studies/accuracy_dynamic.py; nothing here runs a binary, so the renderers may read it."""
 
+import re
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -105,6 +107,22 @@ def frame_errors(x, ref, L):
 # ---- the dynamic study's results (results/dynamic-accuracy/), as the renderer reads them ----
 
 RESULTS_NAME = "dynamic-accuracy"
+DEFAULT_SCENE = "dynamic"  # the study's scene whose results and page carry no scene name
+
+
+def scene_tag(scene):
+    """'' for the default dynamic scene, else the scene's name (a path's stem) in letters,
+    digits, '-' and '_': what keeps one scene's study apart from another's."""
+    name = re.sub(r"[^A-Za-z0-9_-]+", "-", Path(str(scene)).stem).strip("-")
+    return "" if name in ("", DEFAULT_SCENE) else name
+
+
+def results_name(scene):
+    """The study's results folder for a scene: dynamic-accuracy, or dynamic-accuracy-<scene>."""
+    tag = scene_tag(scene)
+    return f"{RESULTS_NAME}-{tag}" if tag else RESULTS_NAME
+
+
 CSV_NAME = "dynamic_accuracy.csv"
 ANALYTIC_NAME = "analytic.md"
 # the reference family of the contract (docs/model.md §3.6), in its working precision fp64

@@ -34,7 +34,9 @@ it is the simulate stage's median.
 
 Writes results/dynamic-accuracy/dynamic_accuracy.csv (one row per mode and frame, plus the
 reference ladder and the GPU check), analytic.md (harness/studies/analytic_table.py's tables) and
-env.json; then accuracy_dynamic_report.py writes report/dynamic_accuracy.md and its PNGs.
+env.json; then accuracy_dynamic_report.py writes report/dynamic_accuracy.md and its PNGs. On
+another scene (`--scene curly`) the folder is results/dynamic-accuracy-curly/ and the page
+report/dynamic_accuracy_curly.md.
 """
 
 import itertools
@@ -64,10 +66,10 @@ from harness.studies.accuracy import (
     REF_ITERATIONS,
     REF_PRECISION,
     REF_SOLVER,
-    RESULTS_NAME,
     Mode,
     frame_errors,
     holds_until,
+    results_name,
     smallest,
 )
 
@@ -471,7 +473,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
     draws them); return the exit status (0: reference converged over the horizon, 1: it
     did not)."""
     started = time.monotonic()
-    out_dir = Path(out_dir or RESULTS / RESULTS_NAME)
+    out_dir = Path(out_dir or RESULTS / results_name(plan.scene))
     csv_path = out_dir / CSV_NAME
     if csv_path.exists() and not force:
         raise HarnessError(f"{display(csv_path)} exists: pass --force to replace it")

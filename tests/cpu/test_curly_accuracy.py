@@ -1,0 +1,140 @@
+"""The accuracy study on curly hair (configs/scenes/curly.toml) through the dynamic bench and
+report/dynamic.md: the bench's step (the studies stubbed: no real run), its own results folder
+and page, and the report's section from a tiny real study whose reference does not converge
+(the known case on curls, docs/decisions/grooms.md) and without one."""
+
+import pytest
+
+from harness.bench import dynamic as bench_dynamic
+from harness.core.budget import Budget
+from harness.core.shards import Shard
+from harness.render import accuracy_dynamic_report, report_dynamic
+from harness.studies import accuracy_dynamic, animate, featurecost, peer, reduced, stability
+from harness.studies.accuracy import results_name
+
+CURLY = report_dynamic.CURLY_SCENE
+HEAD = f"## Speed against accuracy: {report_dynamic.CURLY_TITLE}"
+
+
+def test_each_scene_has_its_own_folder_and_page():
+    assert results_name("dynamic") == accuracy_dynamic_report.RESULTS_NAME == "dynamic-accuracy"
+    assert results_name("configs/scenes/dynamic.toml") == "dynamic-accuracy"
+    assert results_name(CURLY) == "dynamic-accuracy-curly"
+    assert results_name("/tmp/my groom.toml") == "dynamic-accuracy-my-groom"
+    straight, curly = accuracy_dynamic_report.Names.of("dynamic"), accuracy_dynamic_report.Names.of(CURLY)
+    assert straight.page == accuracy_dynamic_report.PAGE and straight.pareto == accuracy_dynamic_report.PARETO_PNG
+    assert curly.page == "dynamic_accuracy_curly.md"
+    assert {curly.pareto, curly.growth, curly.steps} == {
+        "dynamic_accuracy_curly_pareto.png",
+        "dynamic_accuracy_curly_growth.png",
+        "dynamic_accuracy_curly_steps.png",
+    }
+
+
+class Clock:
+    def __init__(self):
+        self.t = 0.0
+
+    def __call__(self):
+        return self.t
+
+
+@pytest.fixture
+def stubbed(monkeypatch):
+    """Every dynamic study replaced by a recorder; the accuracy study's calls in `calls`."""
+    calls = []
+    hooks = []  # run after each accuracy call (to spend the budget)
+
+    def run_study(plan, out_dir=None, force=False, command=None, log=print):
+        calls.append((plan, out_dir))
+        for h in hooks:
+            h(plan)
+        return 0
+
+    monkeypatch.setattr(accuracy_dynamic, "run_study", run_study)
+    monkeypatch.setattr(accuracy_dynamic_report, "write", lambda *a, **k: [])
+    monkeypatch.setattr(featurecost, "measure", lambda **k: None)
+    monkeypatch.setattr(reduced, "measure", lambda *a, **k: None)
+    monkeypatch.setattr(stability, "run_study", lambda **k: None)
+    monkeypatch.setattr(peer, "run_study", lambda *a, **k: None)
+    monkeypatch.setattr(bench_dynamic.peer_report, "write", lambda *a, **k: None)
+    monkeypatch.setattr(animate, "run", lambda **k: None)
+    return calls, hooks
+
+
+def test_the_bench_runs_the_quick_accuracy_study_on_curly_hair_beside_the_straight_one(stubbed, tmp_path):
+    calls, _ = stubbed
+    log = []
+    bench_dynamic.studies(tmp_path, [], log.append, quick=True)
+    assert [p.scene for p, _ in calls] == ["dynamic", CURLY]
+    (straight, straight_dir), (curly, curly_dir) = calls
+    assert straight_dir == tmp_path / "dynamic-accuracy" and curly_dir == tmp_path / "dynamic-accuracy-curly"
+    assert curly == accuracy_dynamic.Plan.quick(gpu="no", scene=CURLY, analytic="none")
+    assert straight == accuracy_dynamic.Plan.quick(gpu="no")
+    assert "harness: accuracy --model dynamic --scene curly --analytic none --quick --gpu no" in log
+    calls.clear()
+    bench_dynamic.studies(tmp_path, [], log.append, quick=True, shard=Shard(2, 2))
+    assert calls == []  # one-measurement studies run on shard 1 only
+
+
+def test_the_curly_study_is_left_out_with_a_line_when_the_budget_is_spent(stubbed, tmp_path):
+    calls, hooks = stubbed
+    clock = Clock()
+    budget = Budget(100.0, clock=clock)
+
+    def spend(plan):  # the straight study uses the whole budget
+        if plan.scene == "dynamic":
+            clock.t = 200.0
+
+    hooks.append(spend)
+    log = []
+    bench_dynamic.studies(tmp_path, [], log.append, quick=True, budget=budget)
+    assert [p.scene for p, _ in calls] == ["dynamic"]
+    assert f"harness: accuracy {CURLY}: left out to fit the budget (no time left)" in log
+    left_out = {e["step"]: e["what"] for e in budget.record()["left_out"]}
+    assert left_out.get(f"accuracy {CURLY}") == "the whole study" and "accuracy" not in left_out
+
+
+TINY_CURLY = dict(
+    scene=CURLY,
+    strands=3,
+    seconds=2 / 60,
+    horizon=2 / 60,
+    substeps=(1, 16),
+    iterations=(1,),
+    time_strands=6,
+    repeat=1,
+    ref_start=32,
+    ref_max=64,  # one rung pair: the curls' reference does not converge there
+    analytic="none",
+    jobs=2,
+    ftl_damping=(1.0,),
+    long_seconds=0,
+    ref_extra=0,
+)
+
+
+def test_the_report_renders_curly_hair_from_a_study_whose_reference_did_not_converge(cpu_bin, tmp_path, monkeypatch):
+    monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
+    root, rep = tmp_path / "root", tmp_path / "report"
+    missing = report_dynamic.build(root, rep).read_text()
+    head = missing.index(HEAD)
+    section = missing[head:].split("\n## ")[0].strip().splitlines()
+    assert section[2].startswith("Not measured with these results (no `") and len(section) == 3
+    assert "dynamic-accuracy-curly" in section[2] and "--scene curly" in section[2]
+
+    plan = accuracy_dynamic.Plan(**TINY_CURLY)
+    assert accuracy_dynamic.run_study(plan, root / results_name(CURLY), log=lambda *_: None) == 1
+    text = report_dynamic.build(root, rep).read_text()
+    section = text[text.index(HEAD) :].split("\n## ")[0]
+    assert "Not measured" not in section and "**The reference did NOT converge**" in section
+    names = accuracy_dynamic_report.Names.of(CURLY)
+    assert f"]({names.page})" in section and f"]({names.pareto})" in section
+    page = (rep / names.page).read_text()
+    assert page.startswith(HEAD) and "**NOT converged**" in page and "Scene `configs/scenes/curly.toml`" in page
+    assert "### Analytic checks" not in page  # the default scene's page carries them
+    for png in (names.pareto, names.growth, names.steps):
+        assert (rep / png).stat().st_size > 5000
+    # the straight study's page and pictures are not written, and its section says so
+    assert not (rep / accuracy_dynamic_report.PAGE).exists() and not (rep / accuracy_dynamic_report.PARETO_PNG).exists()
+    assert "## Speed against accuracy\n\nNot measured with these results" in text
