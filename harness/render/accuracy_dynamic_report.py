@@ -1027,7 +1027,7 @@ def not_converged_line(rows, study):
     """What a reference that did not converge over the horizon means for the rows beside it."""
     ref = study["reference"]
     table = convergence_table(rows, study["horizon_frames"])
-    last = f"; its last rung still moved by RMS {_e(table[-1]['rms'])}·L" if table else ""
+    last = f"; S = {table[-1]['S']} and {table[-1]['S2']} still differ by RMS {_e(table[-1]['rms'])}" if table else ""
     return (
         f"**The reference did NOT converge**: S doubled up to {ref['substeps']} (`--ref-max {study['ref_max']}`) "
         f"and the RMS rule still fails over the {study['horizon']:g} s horizon{last}. The errors and the "
