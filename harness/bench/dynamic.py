@@ -36,7 +36,7 @@ from harness.io import results_data
 from harness.io.files import write_json
 from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
 from harness.studies import accuracy_dynamic, animate, featurecost, peer, reduced, stability
-from harness.studies.accuracy import DEFAULT_SCENE
+from harness.studies.accuracy import DEFAULT_SCENE, results_name
 from harness.studies.sweep import run_sweep
 
 VALIDATION_STRANDS = 2000
@@ -234,7 +234,7 @@ def accuracy(root, scene, gpu, quick, say, report_dir=None):
     """The speed-against-accuracy study of one scene into root/<its results folder>, rendered
     into report_dir when given. Another scene than the default one skips the analytic tables:
     they run their own scenes, so they would repeat the default scene's."""
-    acc_dir = root / accuracy_dynamic.results_name(scene)
+    acc_dir = root / results_name(scene)
     changes = dict(gpu=gpu, scene=scene)
     if scene != DEFAULT_SCENE:
         changes["analytic"] = "none"
