@@ -11,6 +11,7 @@ from harness.core.shards import Shard
 from harness.render import accuracy_dynamic_report, report_dynamic
 from harness.studies import accuracy_dynamic, animate, featurecost, peer, reduced, stability
 from harness.studies.accuracy import results_name
+from support.accuracy_plans import TINY
 
 CURLY = report_dynamic.CURLY_SCENE
 HEAD = f"## Speed against accuracy: {report_dynamic.CURLY_TITLE}"
@@ -95,23 +96,12 @@ def test_the_curly_study_is_left_out_with_a_line_when_the_budget_is_spent(stubbe
     assert left_out.get(f"accuracy {CURLY}") == "the whole study" and "accuracy" not in left_out
 
 
-TINY_CURLY = dict(
-    scene=CURLY,
-    strands=3,
-    seconds=2 / 60,
-    horizon=2 / 60,
-    substeps=(1, 16),
-    iterations=(1,),
-    time_strands=6,
-    repeat=1,
-    ref_start=32,
-    ref_max=64,  # one rung pair: the curls' reference does not converge there
-    analytic="none",
-    jobs=2,
-    ftl_damping=(1.0,),
-    long_seconds=0,
-    ref_extra=0,
-)
+# the tiny plan on the curls: one rung pair of the reference, which does not converge there
+TINY_CURLY = {
+    **TINY,
+    **dict(scene=CURLY, strands=3, substeps=(1, 16), time_strands=6, ref_start=32, ref_max=64),
+    **dict(ftl_damping=(1.0,), long_seconds=0, ref_extra=0),
+}
 
 
 def test_the_report_renders_curly_hair_from_a_study_whose_reference_did_not_converge(cpu_bin, tmp_path, monkeypatch):

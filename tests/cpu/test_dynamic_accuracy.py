@@ -12,6 +12,7 @@ from harness.cli import main as cli
 from harness.core import env, tolerances, variants
 from harness.render import accuracy_dynamic_report
 from harness.studies import accuracy_dynamic, observables_long
+from support.accuracy_plans import TINY
 from support.cuda_standin import install
 
 
@@ -82,24 +83,6 @@ def test_bad_options_are_refused_in_one_line_with_exit_2(argv, says, capsys, tmp
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and says in err[0], err
     assert not (tmp_path / "out").exists() and not (tmp_path / "rep").exists()
-
-
-TINY = dict(
-    strands=4,
-    seconds=2 / 60,
-    horizon=2 / 60,
-    substeps=(1, 2),
-    iterations=(1,),
-    time_strands=8,
-    repeat=1,
-    ref_start=64,
-    ref_max=4096,
-    analytic="none",
-    jobs=2,
-    ftl_damping=(0.9, 1.0),
-    long_seconds=6 / 60,
-    long_strands=2,
-)
 
 
 @pytest.fixture

@@ -1,0 +1,18 @@
+"""A tiny plan of the dynamic accuracy study, for tests that run it for real in seconds."""
+
+TINY = dict(
+    strands=4,
+    seconds=2 / 60,
+    horizon=2 / 60,
+    substeps=(1, 2),
+    iterations=(1,),
+    time_strands=8,
+    repeat=1,
+    ref_start=64,
+    ref_max=4096,
+    analytic="none",
+    jobs=2,
+    ftl_damping=(0.9, 1.0),
+    long_seconds=6 / 60,
+    long_strands=2,
+)
