@@ -467,12 +467,12 @@ const hb_variant cuda_variants[] = {
     {"warpreg", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "strand-major like paper; simulate: one warp per strand, lane k holds point k in registers (at most 32 points), "
      "neighbours through warp shuffles",
-     hb::dyn::kWarpregMaxPoints, 0},
+     hb::dyn::kWarpregMaxPoints, 0, 0, 1},
     {"lanes", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "strand-major like paper; simulate: L lanes a strand (16 for xpbd, 8 for ftl), 2 to 8 points a lane in "
      "registers (at most 128 points), nearly every lane busy in every constraint group; free arithmetic outside "
      "the strict build",
-     hb::dyn::kLanesMaxPoints, hb::dyn::kLanesMaxBlock, 0, 0, HB_X_GUIDES | HB_X_LRA},
+     hb::dyn::kLanesMaxPoints, hb::dyn::kLanesMaxBlock, 0, 1, HB_X_GUIDES | HB_X_LRA},
     {NULL, 0, NULL, 0, 0},
 };
 

@@ -367,7 +367,7 @@ static int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char
         HB_CUDA_AS(hbd::prepare_warp<T>(d->m64.features, smem), "raising the warp kernel's shared-memory limit");
     }
     if (c->variant == V_LANES)
-        HB_CUDA_AS(hbd::prepare_lanes<T>(d->m64.features, d->m64.solver, c->P, c->block),
+        HB_CUDA_AS(hbd::prepare_lanes<T>(d->m64.features, d->m64.solver, c->P, c->block, c->scene.dyn.per_segment != 0),
                    "raising the lanes kernel's shared-memory limit");
     HB_CUDA_AS(cudaDeviceSynchronize(), "dyn_load (cudaDeviceSynchronize)");
     return 0;

@@ -186,6 +186,8 @@ __global__ void __launch_bounds__(kMaxThreads)
             r2 = rest[at + 2];
         }
         if (bends) br = bend_rest[i * (int64_t)(P - 2) + (k - 1)];
+        /* §3.15 lane k's stretch rest length ℓ_k (a groom's, else ℓ) */
+        const T ell = (m.seg_rest && inner) ? m.seg_rest[i * m.seg_is + (int64_t)(k - 1) * m.seg_s] : m.seg_len;
         T p0 = x0, p1 = x1, p2 = x2, d0 = 0, d1 = 0, d2 = 0;
         for (int64_t j = 0; j < m.substeps; j++) {
             const T *q = qtab + 9 * j;
@@ -205,7 +207,7 @@ __global__ void __launch_bounds__(kMaxThreads)
                                              const T a0 = from_prev(p0), a1 = from_prev(p1), a2 = from_prev(p2);
                                              Step<T> s{0, 0, 0, 0, 0};
                                              if (inner && (k & 1) == parity) {
-                                                 s.on = distance_step(a0, a1, a2, p0, p1, p2, k - 1 != 0, m.seg_len,
+                                                 s.on = distance_step(a0, a1, a2, p0, p1, p2, k - 1 != 0, ell,
                                                                       m.stretch_at, ls, s.dl, s.n0, s.n1, s.n2);
                                                  if (s.on) move_plus(s, p0, p1, p2);
                                              }
@@ -268,7 +270,7 @@ __global__ void __launch_bounds__(kMaxThreads)
                 for (int kk = 1; kk < P; kk++) {
                     const T a0 = __shfl_sync(kFull, p0, kk - 1), a1 = __shfl_sync(kFull, p1, kk - 1),
                             a2 = __shfl_sync(kFull, p2, kk - 1);
-                    if (k == kk) follow(a0, a1, a2, p0, p1, p2, m.seg_len, has(HB_F_COLLIDE), m.collide_r, d0, d1, d2);
+                    if (k == kk) follow(a0, a1, a2, p0, p1, p2, ell, has(HB_F_COLLIDE), m.collide_r, d0, d1, d2);
                 }
             }
             /* 4. velocities from the motion (ftl: less s·d(k+1)/h), then the positions */

@@ -188,25 +188,26 @@ __device__ __forceinline__ void predict(const DModel<T> &m, Feat has, T phase, c
     }
 }
 
-/* §3.7 one follow-the-leader step of p after its corrected predecessor a; d: the correction. */
+/* §3.7 one follow-the-leader step of p after its corrected predecessor a, ell its segment's
+ * rest length; d: the correction. */
 template <typename T, class Feat>
-__device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, const V3<T> &a, V3<T> &p, V3<T> &d)
+__device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, const V3<T> &a, V3<T> &p, V3<T> &d)
 {
     if constexpr (kFree) {
         const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
         const T q = ex * ex + ey * ey + ez * ez;
         V3<T> n;
         if (q > floor_of<T>()) {
-            const T f = m.seg_len * rsq(q);
+            const T f = ell * rsq(q);
             n = V3<T>{a.x + f * ex, a.y + f * ey, a.z + f * ez};
         } else {
-            n = V3<T>{a.x, a.y - m.seg_len, a.z};
+            n = V3<T>{a.x, a.y - ell, a.z};
         }
         d = V3<T>{n.x - p.x, n.y - p.y, n.z - p.z};
         if (has(HB_F_COLLIDE)) collide(m, n);
         p = n;
     } else {
-        follow(a.x, a.y, a.z, p.x, p.y, p.z, m.seg_len, has(HB_F_COLLIDE), m.collide_r, d.x, d.y, d.z);
+        follow(a.x, a.y, a.z, p.x, p.y, p.z, ell, has(HB_F_COLLIDE), m.collide_r, d.x, d.y, d.z);
     }
 }
 
@@ -278,8 +279,8 @@ __device__ __forceinline__ void pack(T *s, int k0, bool sw, int P, bool live, co
 }
 
 /* The frame of (32/L) strands a warp, L lanes a strand, G points a lane (G·L ≥ P); Ftl: the
- * solver of §3.7, else §3.6. */
-template <typename T, class Feat, int G, int L, bool Ftl>
+ * solver of §3.7, else §3.6; Seg: a groom's per-segment rest lengths (§3.15, m.seg_rest). */
+template <typename T, class Feat, int G, int L, bool Ftl, bool Seg>
 __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>())
     k_lanes(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
             const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N)
@@ -342,6 +343,21 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
             brp = live && l >= 1 && k0 + 1 < P ? sb[k0 - 1] : (T)0;
         }
         const T *R = rs + seg * row; /* the rest shape X̄ of this lane's strand */
+        /* §3.15 (Seg) a groom's ℓ_k of the segment (k − 1, k) ending at this lane's point
+         * k = k0 + i; ell(i): it, or ℓ */
+        T sl[Seg ? G : 1];
+        if constexpr (Seg) {
+#pragma unroll
+            for (int i = 0; i < G; i++) {
+                const int k = k0 + i;
+                sl[i] = live && k >= 1 && k < P ? m.seg_rest[(s0 + seg) * m.seg_is + (int64_t)(k - 1) * m.seg_s]
+                                                : m.seg_len;
+            }
+        }
+        auto ell = [&](int i) {
+            if constexpr (Seg) return sl[i];
+            else return m.seg_len;
+        };
 #pragma unroll
         for (int i = 0; i < G; i++) { /* a lane's points past the tip stay defined */
             D[i] = V3<T>{(T)0, (T)0, (T)0};
@@ -390,10 +406,10 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
 
             auto stretch = [&]() {
                 if constexpr (G == 2) { /* (k0, k0+1) inside the lane; (k0 − 1, k0) across */
-                    if (k0 + 1 < P) dist(Q[0], Q[1], l == 0, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lso[0]);
+                    if (k0 + 1 < P) dist(Q[0], Q[1], l == 0, ell(1), m.stretch_at, m.inv_s1, m.inv_s2, lso[0]);
                     V3<T> a = up<L>(pick(sw, Q[0], Q[1])); /* the lower lane's last point */
                     V3<T> own = pick(sw, Q[1], Q[0]);      /* this lane's first */
-                    if (l >= 1 && k0 < P) dist(a, own, false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lsx);
+                    if (l >= 1 && k0 < P) dist(a, own, false, ell(0), m.stretch_at, m.inv_s1, m.inv_s2, lsx);
                     Q[0] = pick(sw, Q[0], own);
                     Q[1] = pick(sw, own, Q[1]);
                     const V3<T> na = down<L>(a);
@@ -404,13 +420,13 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
 #pragma unroll
                     for (int i = 0; i + 1 < G; i += 2) /* k odd: inside the lane */
                         if (k0 + i + 1 < P)
-                            dist(Q[i], Q[i + 1], k0 + i == 0, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lso[i / 2]);
+                            dist(Q[i], Q[i + 1], k0 + i == 0, ell(i + 1), m.stretch_at, m.inv_s1, m.inv_s2, lso[i / 2]);
 #pragma unroll
                     for (int i = 1; i + 1 < G; i += 2) /* k even: inside the lane … */
                         if (k0 + i + 1 < P)
-                            dist(Q[i], Q[i + 1], false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lse[i / 2]);
+                            dist(Q[i], Q[i + 1], false, ell(i + 1), m.stretch_at, m.inv_s1, m.inv_s2, lse[i / 2]);
                     V3<T> a = up<L>(Q[G - 1]); /* … and (k0 − 1, k0) on this lane, the lower end sent back */
-                    if (l >= 1 && k0 < P) dist(a, Q[0], false, m.seg_len, m.stretch_at, m.inv_s1, m.inv_s2, lsx);
+                    if (l >= 1 && k0 < P) dist(a, Q[0], false, ell(0), m.stretch_at, m.inv_s1, m.inv_s2, lsx);
                     const V3<T> na = down<L>(a);
                     if (l + 1 < L && k0 + G < P) Q[G - 1] = na;
                 }
@@ -487,7 +503,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
 #pragma unroll
                         for (int i = 0; i < G; i++) {
                             const int k = k0 + i;
-                            if (k >= 1 && k < P) follow_one(m, has, i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i]);
+                            if (k >= 1 && k < P)
+                                follow_one(m, has, ell(i), i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i]);
                         }
                     }
                 }
@@ -528,8 +545,8 @@ template <typename T, int G, int L, bool Ftl, unsigned F> constexpr LanesFn<T> l
 {
     constexpr bool own = (!Ftl && G == 2 && L == 16) || (Ftl && G == kFtlG && L == kFtlL);
     if constexpr (!valid_mask(F)) return nullptr;
-    else if constexpr (own && specialised_mask(F)) return &k_lanes<T, StaticF<F>, G, L, Ftl>;
-    else return &k_lanes<T, DynF, G, L, Ftl>;
+    else if constexpr (own && specialised_mask(F)) return &k_lanes<T, StaticF<F>, G, L, Ftl, false>;
+    else return &k_lanes<T, DynF, G, L, Ftl, false>;
 }
 template <typename T, int G, int L, bool Ftl, unsigned... Fs> struct LanesTable {
     static constexpr LanesFn<T> fn[sizeof...(Fs)] = {lanes_entry<T, G, L, Ftl, Fs>()...};
@@ -545,33 +562,35 @@ template <typename T> struct LanesPick {
     int lanes;
     int64_t warp_reals;
 };
-template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int64_t P)
+/* a groom (seg) runs the generic kernel of its layout with per-segment rest lengths */
+template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int64_t P, bool seg)
 {
-    return LanesPick<T>{LanesTableT<T, G, L, Ftl>::fn[f], L, lanes_warp_reals<T, G, L>(P)};
+    return LanesPick<T>{seg ? &k_lanes<T, DynF, G, L, Ftl, true> : LanesTableT<T, G, L, Ftl>::fn[f], L,
+                        lanes_warp_reals<T, G, L>(P)};
 }
-template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P)
+template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P, bool seg)
 {
     if (!valid_mask(f) || P < 2 || P > kLanesMaxPoints) return LanesPick<T>{nullptr, 0, 0};
     if (solver == HB_SOLVER_FTL) {
-        if (P <= 32) return pick<T, kFtlG, kFtlL, true>(f, P);
-        if (P <= 64) return pick<T, 8, 8, true>(f, P);
-        return pick<T, 8, 16, true>(f, P);
+        if (P <= 32) return pick<T, kFtlG, kFtlL, true>(f, P, seg);
+        if (P <= 64) return pick<T, 8, 8, true>(f, P, seg);
+        return pick<T, 8, 16, true>(f, P, seg);
     }
-    if (P <= 32) return pick<T, 2, 16, false>(f, P);
-    if (P <= 64) return pick<T, 4, 16, false>(f, P);
-    return pick<T, 8, 16, false>(f, P);
+    if (P <= 32) return pick<T, 2, 16, false>(f, P, seg);
+    if (P <= 64) return pick<T, 4, 16, false>(f, P, seg);
+    return pick<T, 8, 16, false>(f, P, seg);
 }
 
 } /* namespace */
 
 template <typename T> size_t lanes_smem_bytes(unsigned features, int solver, int64_t P, int block)
 {
-    return (size_t)(block / 32) * (size_t)lanes_pick<T>(features, solver, P).warp_reals * sizeof(T);
+    return (size_t)(block / 32) * (size_t)lanes_pick<T>(features, solver, P, false).warp_reals * sizeof(T);
 }
 
-template <typename T> cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block)
+template <typename T> cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg)
 {
-    const LanesPick<T> k = lanes_pick<T>(features, solver, P);
+    const LanesPick<T> k = lanes_pick<T>(features, solver, P, seg);
     if (!k.fn) return cudaErrorInvalidValue;
     return cudaFuncSetAttribute(k.fn, cudaFuncAttributeMaxDynamicSharedMemorySize,
                                 (int)lanes_smem_bytes<T>(features, solver, P, block));
@@ -581,7 +600,7 @@ template <typename T>
 cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                                const T *bend_rest, int64_t N, int block, cudaStream_t stream)
 {
-    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points);
+    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr);
     if (!k.fn) return cudaErrorInvalidValue;
     const int64_t per_block = (int64_t)(block / 32) * (32 / k.lanes);
     const int64_t g = (N + per_block - 1) / per_block;
@@ -593,7 +612,7 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
 
 #define HB_LANES_INSTANTIATE(T)                                                                                        \
     template size_t lanes_smem_bytes<T>(unsigned, int, int64_t, int);                                                  \
-    template cudaError_t prepare_lanes<T>(unsigned, int, int64_t, int);                                                \
+    template cudaError_t prepare_lanes<T>(unsigned, int, int64_t, int, bool);                                          \
     template cudaError_t launch_frame_lanes<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,           \
                                                const T *, int64_t, int, cudaStream_t);
 HB_LANES_INSTANTIATE(float)

@@ -59,7 +59,7 @@ template <typename T> struct DModel {
     int lra; /* §3.14 long-range attachments: a run-time switch */
     T lra_len;
     /* §3.15 a groom's stretch rest lengths ℓ_k on the device (nullptr: ℓ = seg_len); strand i's
-     * ℓ_k at seg_rest[i·seg_is + (k − 1)·seg_s] (strand and warp variants only) */
+     * ℓ_k at seg_rest[i·seg_is + (k − 1)·seg_s] (point-major for strand, [N][P−1] for the others) */
     const T *seg_rest = nullptr;
     int64_t seg_is = 0, seg_s = 0;
 };

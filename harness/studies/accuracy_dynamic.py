@@ -166,15 +166,25 @@ def check_plan(plan, frame_dt):
         raise HarnessError("accuracy --model dynamic: " + "; ".join(bad))
 
 
-def study_builds(gpu_ok):
+def study_builds(gpu_ok, groom=False):
     """Every binary × variant here that runs simulate: the cpu variants, then (with a GPU)
-    each cuda build present."""
-    out = [variants.Runner("cpu", "default", v) for v in variants.declared("cpu").running(SIMULATE)]
+    each cuda build present; for a groom, only the variants that declare its per-segment
+    rest lengths (docs/model.md §3.15). Returns (runners, the left-out variants' labels)."""
+
+    def runners(backend, build):
+        d = variants.declared(backend, build)
+        got = [variants.Runner(backend, build, v) for v in d.running(SIMULATE)]
+        return [r for r in got if not groom or r.variant in d.per_segment], [
+            r.label for r in got if groom and r.variant not in d.per_segment
+        ]
+
+    out, left = runners("cpu", "default")
     if gpu_ok:
         for build in CUDA_BUILDS:
             if binary_path("cuda", build).exists():
-                out += [variants.Runner("cuda", build, v) for v in variants.declared("cuda", build).running(SIMULATE)]
-    return out
+                got, lost = runners("cuda", build)
+                out, left = out + got, left + lost
+    return out, left
 
 
 def study_modes(builds, plan):
@@ -485,7 +495,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
     gpu_ok, gpu_why = env.gpu_status()
     if gpu_ok and plan.gpu == "no":
         gpu_ok, gpu_why = False, "--gpu no"
-    builds = study_builds(gpu_ok)
+    builds, left_out = study_builds(gpu_ok, groom=bool(study.scene.groom))
     cpu_oracle = variants.Runner("cpu", "default", variants.declared("cpu").default_variant)
     if REF_SOLVER not in variants.declared("cpu").solvers:
         raise HarnessError(f"{display(cpu_oracle.binary)} declares no {REF_SOLVER} solver (--list-variants)")
@@ -493,7 +503,9 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
     log(
         f"dynamic accuracy: {len(modes)} modes ({', '.join(b.label for b in builds)}), "
         f"{plan.strands} strands, {study.frames} frames of {study.frame_dt:.4g} s, horizon "
-        f"{study.horizon_frames} frames" + ("" if gpu_ok else f"; no GPU modes: {gpu_why}")
+        f"{study.horizon_frames} frames"
+        + ("" if gpu_ok else f"; no GPU modes: {gpu_why}")
+        + (f"; left out (no per-segment rest lengths, docs/model.md §3.15): {', '.join(left_out)}" if left_out else "")
     )
 
     # 1. the checked runs (in parallel: nothing here is timed) and the analytic tables

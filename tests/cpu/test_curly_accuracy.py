@@ -6,6 +6,7 @@ and page, and the report's section from a tiny real study whose reference does n
 import pytest
 
 from harness.bench import dynamic as bench_dynamic
+from harness.core import variants
 from harness.core.budget import Budget
 from harness.core.shards import Shard
 from harness.render import accuracy_dynamic_report, report_dynamic
@@ -128,3 +129,23 @@ def test_the_report_renders_curly_hair_from_a_study_whose_reference_did_not_conv
     # the straight study's page and pictures are not written, and its section says so
     assert not (rep / accuracy_dynamic_report.PAGE).exists() and not (rep / accuracy_dynamic_report.PARETO_PNG).exists()
     assert "## Speed against accuracy\n\nNot measured with these results" in text
+
+
+def test_a_groom_study_leaves_out_the_variants_without_per_segment_rest_lengths(monkeypatch):
+    def declared(backend, build="default"):
+        return variants.Declared(
+            backend=backend,
+            build=build,
+            default_variant="a",
+            precisions=("fp32",),
+            variants=("a", "b", "c"),
+            stages={"a": ("simulate",), "b": ("simulate",), "c": ("init",)},
+            max_points={},
+            per_segment=("a",),
+        )
+
+    monkeypatch.setattr(accuracy_dynamic.variants, "declared", declared)
+    straight, none_left = accuracy_dynamic.study_builds(False)
+    assert [r.variant for r in straight] == ["a", "b"] and none_left == []
+    groom, left = accuracy_dynamic.study_builds(False, groom=True)
+    assert [r.variant for r in groom] == ["a"] and left == ["cpu b"]
