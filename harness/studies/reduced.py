@@ -75,7 +75,8 @@ FIELDS = (
     "device",
 )
 FRACTIONS = (1.0, 0.5, 0.25, 0.1, 0.05)
-STUDIED = ("guides", "lra", "sagfree", "lod")  # the §3.14 features the rows declare: a timed variant runs them all
+STUDIED = ("guides", "lra", "sagfree", "lod")  # the §3.14 features the rows declare
+FEATURE_FLAGS = {"--guides": "guides", "--lra": "lra", "--sag-free": "sagfree", "--render-points": "lod"}
 SCHEMES = ("one", "blend3")
 
 
@@ -155,13 +156,18 @@ def _positions(path):
 
 def timing_binaries(plan):
     """(backend, variant) pairs that time the rows: the cpu oracle, and the cuda variants
-    that run simulate where a GPU is usable."""
+    that run simulate where a GPU is usable (each times the rows whose features it runs)."""
     out = [("cpu", "ref")]
     ok, _ = env.gpu_status()
     if plan.gpu != "no" and ok and binary_path("cuda", "default").exists():
         d = variants.declared("cuda")
-        out += [("cuda", v) for v in d.running("simulate") if d.runs_features(v, STUDIED)]
+        out += [("cuda", v) for v in d.running("simulate") if any(d.runs_features(v, [f]) for f in STUDIED)]
     return out
+
+
+def row_features(extra):
+    """The §3.14 features a row's flags declare."""
+    return {FEATURE_FLAGS[str(a)] for a in extra if str(a) in FEATURE_FLAGS}
 
 
 def measure(plan=Plan(), out=None, work=None, progress=print):
@@ -232,8 +238,11 @@ def measure(plan=Plan(), out=None, work=None, progress=print):
                 "blown_up": blown,
             }
             for backend, variant in timers:
-                if backend == "cuda" and not variants.declared("cuda").runs(variant, points=p_sim):
+                d = variants.declared(backend)
+                if backend == "cuda" and not d.runs(variant, points=p_sim):
                     continue  # more points than the variant simulates (warpreg: 32)
+                if not d.runs_features(variant, row_features(extra)):
+                    continue  # a feature the variant does not run (--list-variants)
                 n = plan.time_gpu_strands if backend == "cuda" else plan.time_strands
                 tf = _flags(scene, solver=solver, substeps=s, iterations=it, precision="fp32", strands=n, frames=2,
                             extra=extra, variant=(backend, variant), points=points)  # fmt: skip

@@ -5,6 +5,7 @@ fewest simulated points within each budget."""
 
 import pytest
 
+from harness.core import variants
 from harness.render import reduced_report
 from harness.studies import reduced
 
@@ -68,3 +69,18 @@ def test_recommendations_take_the_fewest_simulated_points_within_each_budget():
     assert "9 simulated points rendered as 33" in lines[0] and "17 simulated points rendered as 33" in lines[1]
     lines = reduced_report.recommend([_row(1.0, "", 0.001), _lod(33, 0.005), _lod(9, 0.5)])
     assert "every point simulated" in lines[1]
+
+
+def test_each_row_is_timed_by_the_variants_that_run_its_features():
+    assert reduced.row_features(["--guides", 0.5, "--follow", "one"]) == {"guides"}
+    assert reduced.row_features(["--lra", "--iterations", 1]) == {"lra"}
+    assert reduced.row_features(["--sag-free", "--render-points", 33]) == {"sagfree", "lod"}
+    assert reduced.row_features([]) == set()
+    # a variant declaring sagfree and lod only (cuda lanes) times those rows, not the guided or LRA ones
+    d = variants.Declared("cuda", "default", "v", ("fp32",), ("v",), {"v": ("simulate",)}, {},
+                          variant_features={"v": ("sagfree", "lod")})  # fmt: skip
+    assert d.runs_features("v", reduced.row_features(["--sag-free"]))
+    assert d.runs_features("v", reduced.row_features(["--render-points", 33]))
+    assert d.runs_features("v", reduced.row_features([]))
+    assert not d.runs_features("v", reduced.row_features(["--guides", 0.1, "--follow", "blend3"]))
+    assert not d.runs_features("v", reduced.row_features(["--lra"]))
