@@ -12,7 +12,8 @@
        bit where the scene has no gusts); and the strict build's variants bit-identical
        to each other;
      anything not equivalent stops the bench before timing;
-  2. the sweep configs/sweeps/dynamic.toml (results/<out>/dynamic/runs.csv);
+  2. the sweeps configs/sweeps/dynamic.toml (results/<out>/dynamic/runs.csv) and, on curly
+     hair, configs/sweeps/dynamic-curly.toml (results/<out>/dynamic-curly/runs.csv);
   3. the studies, each into results/<out>/<study>/: what each feature costs (featurecost,
      CPU and every cuda build), modelling less (reduced: guides and followers, LRA, sag-free,
      LOD; docs/model.md §3.14), speed against accuracy (accuracy --model dynamic, on the default
@@ -42,6 +43,7 @@ from harness.studies.sweep import run_sweep
 VALIDATION_STRANDS = 2000
 BLOCK_SIZES = (32, 256)
 SWEEP = "dynamic"
+CURLY_SWEEP = report_dynamic.CURLY_SWEEP
 
 
 class DynValidator:
@@ -307,6 +309,20 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
         animate.run(out=Path(report_dir) / "dynamic.gif", force=True, log=say, state_dir=root / "animation")
 
 
+def curly_sweep(root, gpu, say, shard=None, budget=None):
+    """The sweep on curly hair (configs/sweeps/dynamic-curly.toml) into <root>/dynamic-curly,
+    its share of the time left under a budget; whether a case failed."""
+    gate = TierGate(budget.allowance("curly sweep")) if budget else None
+    if gate:
+        say(f"harness: budget: the curly sweep gets {gate.allowance:.0f} s of the {budget.left():.0f} s left")
+    _, failed = run_sweep(
+        CURLY_SWEEP, out=root / CURLY_SWEEP, gpu=gpu, log=say, announce_skips=False, shard=shard, gate=gate
+    )
+    if gate and gate.summary():
+        budget.leave_out(f"sweep {CURLY_SWEEP}", gate.summary(), gate.closed)
+    return failed
+
+
 def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, shard=None, budget=None):
     """`shard`: its share of the sweep and the stability map, the other studies on shard 1,
     no report; `budget` (core.budget.Budget): the sweep fits its share of the time left, the
@@ -327,6 +343,7 @@ def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, sha
     _, failed = run_sweep(SWEEP, out=sweep_dir, gpu=gpu_sweep, log=say, announce_skips=False, shard=shard, gate=gate)
     if gate and gate.summary():
         budget.leave_out(f"sweep {SWEEP}", gate.summary(), gate.closed)
+    failed = curly_sweep(root, gpu_sweep, say, shard, budget) or failed
     several = shard is not None and shard.n > 1
     studies(
         root,

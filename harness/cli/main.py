@@ -208,6 +208,7 @@ def cmd_bench(args):
         sweeps["paper"] = load_sweep(args.sweep).path
     if args.model in ("all", "dynamic"):
         sweeps["dynamic"] = load_sweep(bench_dynamic.SWEEP).path
+        sweeps["dynamic-curly"] = load_sweep(bench_dynamic.CURLY_SWEEP).path
     if plan:
         print(
             f"harness: budget {plan.seconds:.0f} s: the sweeps' largest sizes and the studies are left out "

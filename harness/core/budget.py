@@ -15,7 +15,7 @@ from harness import HarnessError
 
 # of the time left when the step starts: the paper sweep, then the dynamic sweep; the
 # dynamic studies get what is left after that (each runs while any is left)
-SHARES = {"paper sweep": 0.45, "dynamic sweep": 0.5}
+SHARES = {"paper sweep": 0.45, "dynamic sweep": 0.5, "curly sweep": 0.15}
 
 _UNIT = {"s": 1, "m": 60, "h": 3600}
 

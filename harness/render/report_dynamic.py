@@ -29,6 +29,7 @@ from harness.studies.accuracy import results_name  # noqa: E402
 
 CURLY_SCENE = "curly"  # configs/scenes/curly.toml: the accuracy study's second scene
 CURLY_TITLE = "curly hair"
+CURLY_SWEEP = "dynamic-curly"  # configs/sweeps/dynamic-curly.toml, in <root>/dynamic-curly
 
 
 def _save(fig, path):
@@ -103,6 +104,26 @@ def best_table(rows):
         cells = " | ".join(cell(best[k]) for k in ("one", "all", "gpu"))
         lines.append(f"| {solver} | {int(n):,} | {cells} | {sp} |")
     return lines
+
+
+def curly_throughput_lines(sweep_dir):
+    """The curly scene's sweep (configs/sweeps/dynamic-curly.toml): the best of each family
+    per strand count, beside the straight scene's."""
+    lines = [f"### Throughput on {CURLY_TITLE}", ""]
+    if not (Path(sweep_dir) / "runs.csv").exists():
+        cmd = f"python -m harness sweep {CURLY_SWEEP} --out {display(sweep_dir)}"
+        return lines + [f"Not measured (no `{display(Path(sweep_dir) / 'runs.csv')}`): `{cmd}`.", ""]
+    rows, env = sim_rows(sweep_dir)
+    sess = (env.get("sessions") or [{}])[-1]
+    host = sess.get("host") or sess
+    lines += [
+        "The same measure on configs/scenes/curly.toml (the default scene's physics on helices, "
+        "per-segment rest lengths, docs/model.md §3.15; GPU block 128):",
+        "",
+    ]
+    lines += best_table(rows) + [""]
+    where = {k: host.get(k) for k in ("cpu_model", "cpu_cores", "gpus", "git_revision") if k in host}
+    return lines + [f"Sweep environment: {json.dumps(where)}", ""]
 
 
 def _num(x):
@@ -266,6 +287,7 @@ def build(root, report_dir=None):
     else:
         cmd = "python -m harness bench --model dynamic"
         lines += [f"Not measured (no `{display(sweep_dir / 'runs.csv')}`): `{cmd}`.", ""]
+    lines += curly_throughput_lines(root / CURLY_SWEEP)
     lines += featurecost_report.section(sorted((root / "featurecost").glob("*.csv"))) + [""]
     lines += reduced_report.section(root / "reduced" / "reduced.csv") + [""]
     lines += _study(

@@ -149,3 +149,35 @@ def test_a_groom_study_leaves_out_the_variants_without_per_segment_rest_lengths(
     assert [r.variant for r in straight] == ["a", "b"] and none_left == []
     groom, left = accuracy_dynamic.study_builds(False, groom=True)
     assert [r.variant for r in groom] == ["a"] and left == ["cpu b"]
+
+
+def test_the_bench_runs_the_curly_sweep_into_its_own_folder_within_its_share(monkeypatch, tmp_path):
+    seen = []
+
+    def run_sweep(name, out=None, gpu=None, log=None, announce_skips=None, shard=None, gate=None):
+        seen.append((name, out, gpu, shard, gate))
+        return [], 0
+
+    monkeypatch.setattr(bench_dynamic, "run_sweep", run_sweep)
+    clock = Clock()
+    plan = Budget(1000.0, clock=clock)
+    assert not bench_dynamic.curly_sweep(tmp_path, "no", lambda m: None, shard=Shard(1, 2), budget=plan)
+    name, out, gpu, shard, gate = seen[0]
+    assert (name, out, gpu, shard) == ("dynamic-curly", tmp_path / "dynamic-curly", "no", Shard(1, 2))
+    assert gate.allowance == pytest.approx(1000.0 * 0.15)
+
+
+def test_the_report_shows_the_curly_sweep_beside_the_straight_one(cpu_bin, tmp_path):
+    sweep = tmp_path / "tiny-curly.toml"
+    sweep.write_text(
+        'name = "tiny-curly"\nscene = "curly"\nframes = 1\nrepeat = 9\nwarmup = 0\n'
+        '[axes]\nstrands = [60]\npoints = [32]\nprecision = ["fp32"]\nsolver = ["xpbd"]\n'
+        '[[cpu]]\nvariant = ["ref"]\nthreads = [1]\n'
+    )
+    root = tmp_path / "run"
+    missing = report_dynamic.curly_throughput_lines(root / report_dynamic.CURLY_SWEEP)
+    assert any(line.startswith("Not measured") for line in missing)
+    bench_dynamic.run_sweep(str(sweep), out=root / report_dynamic.CURLY_SWEEP, gpu="no", log=lambda m: None)
+    lines = report_dynamic.curly_throughput_lines(root / report_dynamic.CURLY_SWEEP)
+    row = next(line for line in lines if line.startswith("| xpbd | 60 |"))
+    assert "cpu ref 1 thread" in row and not any(line.startswith("Not measured") for line in lines)
