@@ -126,7 +126,9 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
             "  --strands N          number of strands (default 1000)\n"
             "  --points P           points per strand incl. the root, >= 2 (default 32)\n"
             "  --seed S             64-bit RNG seed (default 1)\n"
-            "  --head-radius R      head sphere radius (default 10)\n"
+            "  --head-radius R      head sphere radius (default 10; with --groom FILE only with --head-center)\n"
+            "  --head-center X,Y,Z  with --groom FILE: the head sphere's centre in the file's cm, not fitted\n"
+            "                       to the roots; R then defaults to the smallest root distance from it\n"
             "  --hair-offset H      shell offset above the head (default 0.1)\n"
             "  --hair-length L      strand length; L/(P-1) must be >= H (default 30)\n"
             "  --face-margin M      face margin of the root draw (default 1)\n"
@@ -257,6 +259,24 @@ static int parse_f64(const char *flag, const char *v, double *out, char *err, si
     if (!decimal_syntax(v, &plain)) FAIL("%s needs a decimal number (got '%s')", flag, v);
     if (!isfinite(x)) FAIL("%s must be finite (got '%s')", flag, v);
     *out = x;
+    return 0;
+}
+
+/* "X,Y,Z": three finite decimal numbers. */
+static int parse_vec3(const char *flag, const char *v, double out[3], char *err, size_t errlen)
+{
+    char item[64];
+    const char *p = v;
+    for (int c = 0; c < 3; c++) {
+        const char *comma = strchr(p, ',');
+        const size_t n = comma ? (size_t)(comma - p) : strlen(p);
+        if ((c < 2) != (comma != NULL) || n == 0 || n >= sizeof item)
+            FAIL("%s needs three numbers X,Y,Z (got '%s')", flag, v);
+        memcpy(item, p, n);
+        item[n] = '\0';
+        if (parse_f64(flag, item, &out[c], err, errlen)) return -1;
+        p = comma ? comma + 1 : p + n;
+    }
     return 0;
 }
 
@@ -448,6 +468,9 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         } else if (strcmp(name, "--head-radius") == 0) {
             if (parse_f64(name, v, &s->head_radius, err, errlen)) return -1;
             o->given |= HB_GIVEN_RADIUS;
+        } else if (strcmp(name, "--head-center") == 0) {
+            if (parse_vec3(name, v, o->head_center, err, errlen)) return -1;
+            o->given |= HB_GIVEN_CENTER;
         } else if (strcmp(name, "--hair-offset") == 0) {
             if (parse_f64(name, v, &s->hair_offset, err, errlen)) return -1;
             o->given |= HB_GIVEN_OFFSET;
@@ -532,6 +555,8 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         FAIL("--follow needs --guides (every strand is simulated unless --guides is given)");
     if ((o->given & HB_GIVEN_CURL) && o->scene.groom != HB_GROOM_CURLY)
         FAIL("--curl-radius and --curl-pitch need --groom curly");
+    if ((o->given & HB_GIVEN_CENTER) && o->scene.groom != HB_GROOM_FILE)
+        FAIL("--head-center needs --groom FILE (a HAIR file; the drape and the curly groom have their head at 0,0,0)");
     o->scene.dyn.per_segment = o->groom != NULL;
     if (o->scene.dyn.sag_free && !o->scene.dyn.shape)
         FAIL("--sag-free needs --shape-compliance (it moves the shape targets)");

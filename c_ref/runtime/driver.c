@@ -856,7 +856,13 @@ int hb_main(int argc, char **argv, hb_backend *b)
                           run.sim.paper_frames,
                           run.sim.last_frame,
                           (int)o.output_every,
-                          run.sim.features};
+                          run.sim.features,
+                          NULL,
+                          {0.0, 0.0, 0.0}};
+        if (o.scene.groom == HB_GROOM_FILE) {
+            rm.groom_head = run.groom.head_given ? "given" : "fitted";
+            memcpy(rm.groom_head_center, run.groom.head_center, sizeof rm.groom_head_center);
+        }
         double t0 = hb_now_ms(), before = 1e3 * hb_writer_seconds(run.w);
         hb_writer *w = run.w;
         run.w = NULL;

@@ -165,24 +165,31 @@ static int read_hair(const char *path, hb_options *o, hb_groom *g, char *err, si
         pts[i] = (double)lef32(pts_raw + 4 * (size_t)i);
         if (!isfinite(pts[i])) FAIL("--groom %s: point %u holds a NaN or Inf", path, i / 3);
     }
-    /* the head: a sphere fitted to the roots, |p|² = 2c·p + d in the least-squares sense */
-    double a[4][4] = {{0}}, b[4] = {0}, x[4] = {0};
+    /* the head: given by --head-center, or a sphere fitted to the roots, |p|² = 2c·p + d in the
+     * least-squares sense */
+    const int given = (o->given & HB_GIVEN_CENTER) != 0;
+    double x[4] = {0};
     uint64_t first = 0;
-    for (int64_t i = 0; i < N; i++) {
-        const double *r = pts + 3 * first, row[4] = {2 * r[0], 2 * r[1], 2 * r[2], 1.0};
-        const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        for (int p = 0; p < 4; p++) {
-            for (int q = 0; q < 4; q++) a[p][q] += row[p] * row[q];
-            b[p] += row[p] * rr;
+    if (given) {
+        memcpy(x, o->head_center, sizeof o->head_center);
+    } else {
+        double a[4][4] = {{0}}, b[4] = {0};
+        for (int64_t i = 0; i < N; i++) {
+            const double *r = pts + 3 * first, row[4] = {2 * r[0], 2 * r[1], 2 * r[2], 1.0};
+            const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+            for (int p = 0; p < 4; p++) {
+                for (int q = 0; q < 4; q++) a[p][q] += row[p] * row[q];
+                b[p] += row[p] * rr;
+            }
+            first += (flags & HAIR_SEGMENTS) ? (uint64_t)seg_raw[2 * i] + ((uint64_t)seg_raw[2 * i + 1] << 8) + 1
+                                             : (uint64_t)dseg + 1;
         }
-        first += (flags & HAIR_SEGMENTS) ? (uint64_t)seg_raw[2 * i] + ((uint64_t)seg_raw[2 * i + 1] << 8) + 1
-                                         : (uint64_t)dseg + 1;
+        if (solve4(a, b, x) != 0)
+            FAIL("--groom %s: the roots do not determine a sphere (fewer than 4 strands, or the roots on one circle or "
+                 "plane; --head-center gives the head instead)",
+                 path);
     }
-    if (solve4(a, b, x) != 0)
-        FAIL("--groom %s: the roots do not determine a sphere (fewer than 4 strands, or the roots on one circle or "
-             "plane)",
-             path);
-    const double fit_r = sqrt(fmax(x[3] + x[0] * x[0] + x[1] * x[1] + x[2] * x[2], 0.0));
+    const double fit_r = given ? 0.0 : sqrt(fmax(x[3] + x[0] * x[0] + x[1] * x[1] + x[2] * x[2], 0.0));
     double rmin = INFINITY, off = 0.0;
     g->length_min = INFINITY;
     g->length_max = 0.0;
@@ -212,14 +219,16 @@ static int read_hair(const char *path, hb_options *o, hb_groom *g, char *err, si
         g->resample_error = fmax(g->resample_error, e);
         first += n;
     }
-    if (off > HB_GROOM_FIT_TOLERANCE * fit_r)
+    if (!given && off > HB_GROOM_FIT_TOLERANCE * fit_r)
         FAIL("--groom %s: the roots do not lie near one sphere (up to %.3g cm off the %.3g cm sphere fitted to them, "
-             "more than %g of its radius)",
+             "more than %g of its radius; --head-center gives the head instead)",
              path, off, fit_r, HB_GROOM_FIT_TOLERANCE);
-    if (!(rmin > 0.0)) FAIL("--groom %s: a root lies at the fitted head's centre", path);
-    g->fit_offset = off;
+    if (!(rmin > 0.0)) FAIL("--groom %s: a root lies at the %s head's centre", path, given ? "given" : "fitted");
+    g->fit_offset = given ? 0.0 : off;
     g->file_strands = nh;
-    s->head_radius = rmin;
+    g->head_given = given;
+    memcpy(g->head_center, x, sizeof g->head_center);
+    if (!(given && (o->given & HB_GIVEN_RADIUS))) s->head_radius = rmin;
     s->hair_length = g->length_max;
     free(seg_raw);
     free(pts_raw);
@@ -247,10 +256,15 @@ int hb_groom_prepare(hb_options *o, hb_groom *g, char *err, size_t errlen)
         g->length_min = g->length_max = s->hair_length;
         return 0;
     }
-    if (o->given & (HB_GIVEN_RADIUS | HB_GIVEN_LENGTH | HB_GIVEN_OFFSET | HB_GIVEN_MARGIN | HB_GIVEN_SEED))
-        FAIL("--groom %s: the file decides the head and the strands; --head-radius, --hair-length, --hair-offset, "
-             "--face-margin and --seed do not apply",
+    if (o->given & (HB_GIVEN_LENGTH | HB_GIVEN_OFFSET | HB_GIVEN_MARGIN | HB_GIVEN_SEED))
+        FAIL("--groom %s: the file decides the head and the strands; --hair-length, --hair-offset, --face-margin and "
+             "--seed do not apply (--head-radius only beside --head-center)",
              o->groom);
+    if ((o->given & HB_GIVEN_RADIUS) && !(o->given & HB_GIVEN_CENTER))
+        FAIL("--groom %s: the file decides the head unless --head-center gives it; --head-radius needs --head-center",
+             o->groom);
+    if ((o->given & HB_GIVEN_RADIUS) && !(isfinite(s->head_radius) && s->head_radius > 0.0))
+        FAIL("--head-radius must be a finite number > 0 (got %g)", s->head_radius);
     return read_hair(o->groom, o, g, err, errlen);
 fail:
     return -1;

@@ -14,11 +14,13 @@ extern "C" {
 #endif
 
 typedef struct {
-    double *pos;           /* HB_GROOM_FILE: [N][P][3] in cm, the fitted head centre at the origin */
+    double *pos;           /* HB_GROOM_FILE: [N][P][3] in cm, the head centre at the origin */
     int64_t file_strands;  /* strands in the file (N may take the first of them) */
     double resample_error; /* most a file point lies off the resampled strand, cm */
     double length_min, length_max;
-    double fit_offset; /* most a root lies off the sphere fitted to the roots, cm */
+    double fit_offset;     /* most a root lies off the sphere fitted to the roots, cm (fitted head) */
+    int head_given;        /* the head centre came from --head-center, not the fit */
+    double head_center[3]; /* the head centre in the file's coordinates, cm */
 } hb_groom;
 
 /* Reads and checks the groom of o->groom and sets the scene's strands, head radius and

@@ -108,6 +108,8 @@ typedef struct {
     uint64_t dyn_given;    /* which dynamic flags were given: bit i = entry i of cli.c's table */
     /* which scene flags the user gave explicitly (for --input consistency checks) */
     unsigned given;
+    /* --head-center: a groom file's head centre, cm (HB_GIVEN_CENTER) */
+    double head_center[3];
 } hb_options;
 
 /* Bits of hb_options.given. */
@@ -122,6 +124,7 @@ enum {
     HB_GIVEN_PRECISION = 1u << 7,
     HB_GIVEN_ANGLE = 1u << 8,
     HB_GIVEN_CURL = 1u << 9,
+    HB_GIVEN_CENTER = 1u << 10,
 };
 
 /* Derived values, computed once in double on the host and rounded once to the working

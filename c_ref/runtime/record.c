@@ -138,7 +138,15 @@ void hb_record_json(FILE *f, const hb_record *r)
         } else {
             fprintf(f, ", \"file_strands\": %lld", (long long)r->groom->file_strands);
             json_key_num(f, "resample_error", r->groom->resample_error);
-            json_key_num(f, "fit_offset", r->groom->fit_offset);
+            /* the head sphere: fitted to the roots, or given by --head-center (docs/model.md §3.15) */
+            json_key_str(f, "head", r->groom->head_given ? "given" : "fitted");
+            fputs(", \"head_center\": [", f);
+            for (int c = 0; c < 3; c++) {
+                if (c) fputs(", ", f);
+                json_num(f, r->groom->head_center[c]);
+            }
+            fputs("]", f);
+            json_key_num(f, "fit_offset", r->groom->head_given ? NAN : r->groom->fit_offset);
         }
         fputs("}", f);
     }

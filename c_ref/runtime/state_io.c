@@ -74,6 +74,17 @@ static int attr_i64(hid_t loc, const char *name, int64_t v)
     return attr_num(loc, name, H5T_STD_I64LE, H5T_NATIVE_INT64, &v);
 }
 
+static int attr_vec3(hid_t loc, const char *name, const double v[3])
+{
+    const hsize_t n = 3;
+    hid_t sp = H5Screate_simple(1, &n, NULL);
+    hid_t a = sp < 0 ? -1 : H5Acreate2(loc, name, H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = a < 0 ? -1 : H5Awrite(a, H5T_NATIVE_DOUBLE, v);
+    if (a >= 0) H5Aclose(a);
+    if (sp >= 0) H5Sclose(sp);
+    return rc < 0 ? -1 : 0;
+}
+
 static int ds_1d(hid_t loc, const char *name, hid_t file_type, hid_t mem_type, hsize_t n, const void *v)
 {
     hid_t sp = H5Screate_simple(1, &n, NULL);
@@ -582,6 +593,10 @@ int hb_writer_close(hb_writer *w, const hb_run_meta *rm, char *err, size_t errle
     bad |= attr_str(p, "driver", rm->driver) < 0;
     bad |= attr_str(p, "version", HB_VERSION) < 0;
     bad |= attr_f64(p, "end_to_end_ms", rm->end_to_end_ms) < 0;
+    if (rm->groom_head) { /* §3.15: a groom file's head sphere, fitted or given */
+        bad |= attr_str(p, "groom_head", rm->groom_head) < 0;
+        bad |= attr_vec3(p, "groom_head_center", rm->groom_head_center) < 0;
+    }
 
     for (int f = 0; f < F; f++) str[f] = w->frames[f].stage;
     bad |= ds_str(p, "stage", (hsize_t)F, str) < 0;

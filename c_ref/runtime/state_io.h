@@ -39,6 +39,9 @@ typedef struct {
     int64_t simulated_frames; /* simulated frames from the start of the simulation to the last */
     int output_every;
     const char *features;
+    /* a groom file's head (docs/model.md §3.15): "fitted" or "given", NULL otherwise */
+    const char *groom_head;
+    double groom_head_center[3]; /* in the file's coordinates, cm */
 } hb_run_meta;
 
 typedef struct hb_writer hb_writer;

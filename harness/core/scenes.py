@@ -10,6 +10,7 @@ A scene file:
     [head]
     radius = 10.0                # R > 0
     face_margin = 1.0            # m ≥ 0
+    center = [0.0, 0.0, 0.0]     # with groom = "FILE": the head sphere's centre, not fitted (§3.15)
     [hair]
     strands = 1000               # N ≥ 1
     points = 32                  # P ≥ 2
@@ -52,7 +53,11 @@ SCHEMA = {
         "hair": None,
         "wind": None,
     },
-    "head": {"radius": ("head_radius", "pos"), "face_margin": ("face_margin", "nonneg")},
+    "head": {
+        "radius": ("head_radius", "pos"),
+        "face_margin": ("face_margin", "nonneg"),
+        "center": ("head_center", "vec3"),
+    },
     "hair": {
         "strands": ("strands", "count1"),
         "points": ("points", "count2"),
@@ -97,6 +102,10 @@ class Scene:
     groom: str = ""
     curl_radius: float = 1.0
     curl_pitch: float = 2.0
+    # a groom file's head sphere given instead of fitted (docs/model.md §3.15): its centre (x, y, z)
+    # in the file's cm, () = fitted; head.radius is passed with it only when the scene gives it
+    head_center: tuple = ()
+    head_radius_given: bool = False
     # model = "dynamic": the binary flags of [dynamics], [constraints], [wind] and [head]
     # (harness/core/scenes_dynamic.py), flag → value text, in the order they were declared
     dynamic: dict = field(default_factory=dict)
@@ -124,7 +133,11 @@ class Scene:
         changes = {k: v for k, v in overrides.items() if v is not None}
         for k, v in changes.items():
             if k in FIELD_KINDS:
-                _convert(f"scene {self.name}", k, FIELD_KINDS[k], v)
+                converted = _convert(f"scene {self.name}", k, FIELD_KINDS[k], v)
+                if k == "head_center":  # a list becomes the tuple the scene holds
+                    changes[k] = converted
+        if "head_radius" in changes:
+            changes["head_radius_given"] = True
         scene = replace(self, **changes)
         _check_values(scene, f"scene {self.name}")
         return scene
@@ -151,7 +164,11 @@ class Scene:
             *scenes_dynamic.flags(self),
         ]
         if self.groom_file:  # the file decides the head and the strands (docs/model.md §3.15)
-            return ["--points", str(self.points), "--groom", self.groom_file, *tail]
+            head = []
+            if self.head_center:  # unless the scene gives the head
+                head = ["--head-center", ",".join(repr(c) for c in self.head_center)]
+                head += ["--head-radius", repr(self.head_radius)] if self.head_radius_given else []
+            return ["--points", str(self.points), "--groom", self.groom_file, *head, *tail]
         curl = ["--groom", "curly", "--curl-radius", repr(self.curl_radius), "--curl-pitch", repr(self.curl_pitch)]
         return [
             *(curl if self.groom == "curly" else []),
@@ -198,6 +215,10 @@ def _convert(where, key, kind, value):
         return value
     if kind == "stages":
         return parse_stages(value, where, key)
+    if kind == "vec3":
+        if not isinstance(value, (list, tuple)) or len(value) != 3:
+            raise SceneError(f"{where}: {key} must be a list of three numbers [x, y, z], got {value!r}")
+        return tuple(_number(where, f"{key}[{i}]", v) for i, v in enumerate(value))
     if kind in ("count1", "count2", "seed"):
         if isinstance(value, float):
             _number(where, key, value)  # NaN/inf named as such
@@ -266,6 +287,10 @@ def _check_values(scene, where):
             raise SceneError(f"{where}: hair.curl_radius and hair.curl_pitch are both 0 (no helix)")
     elif (scene.curl_radius, scene.curl_pitch) != (1.0, 2.0):
         raise SceneError(f'{where}: hair.curl_radius and hair.curl_pitch need groom = "curly"')
+    if scene.head_center and not scene.groom_file:
+        raise SceneError(f'{where}: head.center needs groom = "FILE" (a HAIR or USD file; otherwise the head is at 0)')
+    if scene.groom_file and scene.head_radius_given and not scene.head_center:
+        raise SceneError(f"{where}: head.radius with a groom file needs head.center (the head is fitted to the roots)")
     if scene.stages[0] != "init":
         raise SceneError(f"{where}: stages must start with init (got '{scene.stages[0]}')")
     if "init" in scene.stages[1:]:
@@ -310,6 +335,7 @@ def scene_from_dict(data, name, where):
             values[name_] = _convert(where, key, kind, value)
     if "stages" not in values:
         raise SceneError(f"{where}: missing key 'stages' (the ordered list of stages to run)")
+    values["head_radius_given"] = "head_radius" in values
     scene = Scene(name=name, source=where, **values)
     _check_values(scene, where)
     return scene

@@ -71,3 +71,30 @@ def test_curly_gpu_equals_cpu_or_is_refused(cpu_curly, tmp_path, solver, precisi
             assert "\n" not in p.stderr.strip() and not out.exists()
             g = run(CUDA_BIN, *CURLY, "--stages", "init,simulate", "--variant", v, "--output", out, check=False)
             assert g.returncode == 2 and "per-segment" in g.stderr and not out.exists(), (v, g.stderr)
+
+
+def test_given_head_on_the_gpu_is_the_cpu_s(tmp_path):
+    """--head-center through the CUDA binary (the runtime both share): on a groom whose roots are not
+    near one sphere, the same init bits, head radius and record's head as the CPU's."""
+    import json
+
+    import numpy as np
+
+    from harness.io import grooms
+
+    axes = np.vstack([np.eye(3), -np.eye(3)])
+    strands = [np.outer(10.0 + np.arange(5.0), n) for n in axes]
+    strands[0] = 2.0 * strands[0]  # a lock off the scalp: refused by the fit
+    hair = grooms.write_hair(tmp_path / "lock.hair", strands)
+    head = ["--head-center", "0.5,-1.0,0.25", "--head-radius", "9.5"]
+    recs = {}
+    for name, binary in (("cpu", CPU_BIN), ("cuda", CUDA_BIN)):
+        out = tmp_path / f"{name}.h5"
+        p = run(binary, "--groom", hair, *head, "--points", 5, "--stages", "init", "--precision", "fp64", "--json",
+                "--quiet", "--output", out)  # fmt: skip
+        recs[name] = json.loads(p.stdout)
+    assert recs["cuda"]["groom"] == recs["cpu"]["groom"] and recs["cuda"]["groom"]["head"] == "given"
+    assert recs["cuda"]["head_radius"] == recs["cpu"]["head_radius"] == 9.5
+    with open_trajectory(tmp_path / "cpu.h5") as a, open_trajectory(tmp_path / "cuda.h5") as b:
+        assert np.array_equal(a.frame(0), b.frame(0))
+        assert list(b.params["groom_head_center"]) == [0.5, -1.0, 0.25]
