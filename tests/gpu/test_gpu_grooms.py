@@ -8,11 +8,15 @@ scenes); a variant that does not must refuse a groom, and a groom's file given t
 with one line and exit 2, writing nothing.
 """
 
+import json
+
+import numpy as np
 import pytest
 
 from conftest import CPU_BIN, CUDA_BIN
 from harness.check import diff_dynamic
 from harness.core import variants
+from harness.io import grooms
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run
 
@@ -76,12 +80,6 @@ def test_curly_gpu_equals_cpu_or_is_refused(cpu_curly, tmp_path, solver, precisi
 def test_given_head_on_the_gpu_is_the_cpu_s(tmp_path):
     """--head-center through the CUDA binary (the runtime both share): on a groom whose roots are not
     near one sphere, the same init bits, head radius and record's head as the CPU's."""
-    import json
-
-    import numpy as np
-
-    from harness.io import grooms
-
     axes = np.vstack([np.eye(3), -np.eye(3)])
     strands = [np.outer(10.0 + np.arange(5.0), n) for n in axes]
     strands[0] = 2.0 * strands[0]  # a lock off the scalp: refused by the fit
