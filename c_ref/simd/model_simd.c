@@ -9,7 +9,7 @@
  *    `simd("notinbranch")` attribute, bits/math-vector.h) only when __FAST_MATH__ is
  *    defined, and GCC defines that only with all of -ffast-math's value-changing flags
  *    (-funsafe-math-optimizations, -ffinite-math-only, -fno-signed-zeros, …). We declare
- *    the same attribute on the eight functions (fp32's sin and cos are now fast_trig.h's),
+ *    the same attribute on the eight functions (fp32's wind atan2, sin and cos are fast_trig.h's),
  *    below: the declarations glibc
  *    makes, without those flags. The vector functions are libmvec's, accurate to 4 ulp
  *    (glibc manual, "Errors in Math Functions").
@@ -67,16 +67,13 @@ const char hb_simd_isa[] = "baseline x86-64 (SSE2)";
 /* The fp32 fused pass's strand walk (model_simd_impl.h) holds a vector of lanes' state in
  * registers: a thin layer over the intrinsics of this build's width. Every operation is the
  * IEEE operation the `omp simd` loops vectorise to (no contraction: the products and sums
- * are separate, as -ffp-contract=off makes them there), and the atan2 is the libmvec
- * function those loops call, so the walk gives their bits. */
+ * are separate, as -ffp-contract=off makes them there), so the walk gives their bits. */
 #include <immintrin.h>
 #if defined(__AVX512F__)
 typedef __m512 hb_vf;
 typedef __m512i hb_vi;
 typedef __mmask16 hb_vm;
 #define HB_VW 16
-__m512 _ZGVeN16vv_atan2f(__m512, __m512);
-#define VATAN2 _ZGVeN16vv_atan2f
 #define VSET _mm512_set1_ps
 #define VLD _mm512_load_ps
 #define VST _mm512_store_ps
@@ -112,8 +109,6 @@ typedef __m256 hb_vf;
 typedef __m256i hb_vi;
 typedef __m256 hb_vm;
 #define HB_VW 8
-__m256 _ZGVdN8vv_atan2f(__m256, __m256);
-#define VATAN2 _ZGVdN8vv_atan2f
 #define VSET _mm256_set1_ps
 #define VLD _mm256_load_ps
 #define VST _mm256_store_ps
@@ -146,6 +141,39 @@ static inline __attribute__((always_inline)) hb_vf hb_v_flip(hb_vf x, hb_vi q) /
 #define VASI _mm256_castps_si256
 #define VIADD1(q) _mm256_add_epi32((q), _mm256_set1_epi32(1))
 #endif
+
+/* fast_trig.h's hb_atan2_fast on a vector, operation for operation (fp32's wind calls the
+ * scalar one in its loop: the same bits) */
+static inline __attribute__((always_inline)) hb_vf hb_v_atan2(hb_vf y, hb_vf x)
+{
+    const hb_vf sign = VSET(-0.0f);
+#if defined(__AVX512F__)
+    const hb_vf ax = _mm512_andnot_ps(sign, x), ay = _mm512_andnot_ps(sign, y);
+#else
+    const hb_vf ax = _mm256_andnot_ps(sign, x), ay = _mm256_andnot_ps(sign, y);
+#endif
+    const hb_vm yg = VCMP(ay, ax, _CMP_GT_OQ);
+    const hb_vf hi = VSEL(yg, ay, ax), lo = VSEL(yg, ax, ay);
+    const hb_vf a = VSEL(VCMP(hi, VSET(HB_FAST_FLOOR), _CMP_GT_OQ), VDIV(lo, hi), VSET(0.0f));
+    const hb_vf s = VMUL(a, a);
+    hb_vf p = VSET(2.84985569e-3f);
+    p = VFMA(p, s, VSET(-1.60685014e-2f));
+    p = VFMA(p, s, VSET(4.26913276e-2f));
+    p = VFMA(p, s, VSET(-7.50427991e-2f));
+    p = VFMA(p, s, VSET(1.06409274e-1f));
+    p = VFMA(p, s, VSET(-1.42036423e-1f));
+    p = VFMA(p, s, VSET(1.99926198e-1f));
+    p = VFMA(p, s, VSET(-3.33330721e-1f));
+    p = VFMA(p, s, VSET(1.0f));
+    hb_vf r = VMUL(a, p);
+    r = VSEL(yg, VSUB(VSET(1.57079632679489661923f), r), r);
+    r = VSEL(VCMP(x, VSET(0.0f), _CMP_LT_OQ), VSUB(VSET(3.14159265358979323846f), r), r);
+#if defined(__AVX512F__) /* copysignf(r, y) */
+    return _mm512_or_ps(_mm512_andnot_ps(sign, r), _mm512_and_ps(sign, y));
+#else
+    return _mm256_or_ps(_mm256_andnot_ps(sign, r), _mm256_and_ps(sign, y));
+#endif
+}
 
 /* fast_trig.h's hb_sincos_fast on a vector, operation for operation (the sign selects as
  * sign flips: the same bits) */

@@ -22,8 +22,8 @@
  * radius ℓ about the root only touches the shell, ℓ = h, √h² turns an ulp into √ε). With FAST_TRIG (fp32) the drape's step angles are computed once per
  * strand (every step after the first goes from the shell to the shell), θ advances by
  * additions as in model_impl.h, and a point's sin and cos are fast_trig.h's inline
- * polynomials (one loop per point); the wind keeps libmvec's atan2 and takes the turned
- * direction's sin and cos from fast_trig.h in one loop (docs/cpu_simd.md). A wind followed
+ * polynomials (one loop per point); the wind takes its atan2 and the turned direction's
+ * sin and cos from fast_trig.h in one loop (docs/cpu_simd.md). A wind followed
  * by collide runs as one pass (hb_simd_wind_collide_block).
  */
 
@@ -204,12 +204,12 @@ static inline __attribute__((always_inline)) void SFX(hb_wind_point)(SFX(hb_wind
     outY = HB_ASSUME_ALIGNED(outY);
     outZ = HB_ASSUME_ALIGNED(outZ);
 #if FAST_TRIG
-    /* one loop: fast_trig.h's inline sincos of the turned direction */
+    /* one loop: fast_trig.h's inline atan2 and sincos (the fused walk's, model_simd.c) */
 #pragma omp simd
     for (int j = 0; j < BLOCK; j++) {
         const REAL cy = inY[j], cz = inZ[j];
         const REAL dy = cy - ws->oy[j], dz = cz - ws->oz[j];
-        const REAL phi = ATAN2(dy, dz);
+        const REAL phi = hb_atan2_fast(dy, dz);
         REAL delta = psi - phi;
         const REAL dm = delta - TWO_PI_R, dp = delta + TWO_PI_R;
         const ITYPE above = delta > PI_R, below = delta <= -PI_R;
@@ -438,7 +438,7 @@ static inline void SFX(hb_prefetch_row)(const REAL *Y, const REAL *Z, int64_t k,
 /* fp32: a strand walk. A group of HB_WALK_NV vectors of lanes walks the points with its
  * wind state (the previous input, the wound predecessor) and collide state (predecessor,
  * shell, moved, count) in registers. Per tile of points, a first loop computes each
- * point's turned angle (the libmvec atan2 call, the wrap; it reads only the input), a
+ * point's turned angle (atan2, the wrap: it reads only the input), a
  * second winds (sincos) and collides (the pull and the projection only where a lane of the
  * vector needs them). The per-lane operations are those of hb_wind_point and
  * hb_collide_point, so the result is the two passes' bit for bit. */
@@ -495,7 +495,7 @@ int64_t SFX(hb_simd_wind_collide_block)(const MODEL *m, int real, REAL *Y, REAL 
                     const hb_vf dy = VSUB(cy, oy[v]), dz = VSUB(cz, oz[v]);
                     oy[v] = cy;
                     oz[v] = cz;
-                    const hb_vf phi = VATAN2(dy, dz);
+                    const hb_vf phi = hb_v_atan2(dy, dz);
                     hb_vf delta = VSUB(psi, phi);
                     const hb_vf dm = VSUB(delta, twopi), dp = VADD(delta, twopi);
                     const hb_vm above = VCMP(delta, pi, _CMP_GT_OQ), below = VCMP(delta, mpi, _CMP_LE_OQ);
