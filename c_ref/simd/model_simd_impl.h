@@ -442,7 +442,9 @@ static inline void SFX(hb_prefetch_row)(const REAL *Y, const REAL *Z, int64_t k,
  * second winds (sincos) and collides (the pull and the projection only where a lane of the
  * vector needs them). The per-lane operations are those of hb_wind_point and
  * hb_collide_point, so the result is the two passes' bit for bit. */
+#ifndef HB_WALK_TILE
 #define HB_WALK_TILE 32
+#endif
 #define HB_WALK_G (HB_WALK_NV * HB_VW)
 _Static_assert(BLOCK % HB_WALK_G == 0, "a block is a whole number of walk groups");
 int64_t SFX(hb_simd_wind_collide_block)(const MODEL *m, int real, REAL *Y, REAL *Z, REAL *WY, REAL *WZ, int64_t stride)
