@@ -5,7 +5,7 @@
  * number of blocks); point k of strand i is element k·S + i. A block is HB_SIMD_BLOCK(prec)
  * consecutive strands; each function below computes one whole block, one strand per SIMD
  * lane from the first point to the last, with the running state of every lane in small
- * arrays on the stack (L1). The block's pointers point at its first strand in row 0 and
+ * arrays on the stack (L1), or, in the fp32 fused pass, in registers. The block's pointers point at its first strand in row 0 and
  * must be 64-byte aligned; every lane of the block is computed (lanes past the last real
  * strand are padding: computed, never read back, never counted).
  *
@@ -46,10 +46,19 @@ extern "C" {
 #define HB_SIMD_CHUNK 64
 #endif
 
-/* The fused wind+collide pass requests the block's rows this many points ahead into the
- * cache (0: none; docs/cpu_simd.md). Overridable with -D; it changes no bit. */
+/* The fp64 fused wind+collide pass requests the block's rows this many points ahead into
+ * the cache (0: none; docs/cpu_simd.md). Overridable with -D; it changes no bit. */
 #ifndef HB_SIMD_PREFETCH_ROWS
 #define HB_SIMD_PREFETCH_ROWS 2
+#endif
+/* The fp32 fused pass is a strand walk: groups of HB_WALK_NV vectors of lanes walk the
+ * points with their state in registers, and each group requests the lanes this many groups
+ * ahead (0: none). Overridable with -D; neither changes a bit. */
+#ifndef HB_WALK_NV
+#define HB_WALK_NV 2
+#endif
+#ifndef HB_SIMD_WALK_PREFETCH
+#define HB_SIMD_WALK_PREFETCH 1
 #endif
 
 /* init: roots (strands first … first + block − 1) and drape; writes X, Y, Z. */

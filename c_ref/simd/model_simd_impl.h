@@ -22,8 +22,8 @@
  * radius ℓ about the root only touches the shell, ℓ = h, √h² turns an ulp into √ε). With FAST_TRIG (fp32) the drape's step angles are computed once per
  * strand (every step after the first goes from the shell to the shell), θ advances by
  * additions as in model_impl.h, and a point's sin and cos are fast_trig.h's inline
- * polynomials (one loop per point); the wind keeps libmvec's atan2 and takes the turned
- * direction's sin and cos from fast_trig.h in one loop (docs/cpu_simd.md). A wind followed
+ * polynomials (one loop per point); the wind takes its atan2 and the turned direction's
+ * sin and cos from fast_trig.h in one loop (docs/cpu_simd.md). A wind followed
  * by collide runs as one pass (hb_simd_wind_collide_block).
  */
 
@@ -204,12 +204,12 @@ static inline __attribute__((always_inline)) void SFX(hb_wind_point)(SFX(hb_wind
     outY = HB_ASSUME_ALIGNED(outY);
     outZ = HB_ASSUME_ALIGNED(outZ);
 #if FAST_TRIG
-    /* one loop: fast_trig.h's inline sincos of the turned direction */
+    /* one loop: fast_trig.h's inline atan2 and sincos (the fused walk's, model_simd.c) */
 #pragma omp simd
     for (int j = 0; j < BLOCK; j++) {
         const REAL cy = inY[j], cz = inZ[j];
         const REAL dy = cy - ws->oy[j], dz = cz - ws->oz[j];
-        const REAL phi = ATAN2(dy, dz);
+        const REAL phi = hb_atan2_fast(dy, dz);
         REAL delta = psi - phi;
         const REAL dm = delta - TWO_PI_R, dp = delta + TWO_PI_R;
         const ITYPE above = delta > PI_R, below = delta <= -PI_R;
@@ -434,6 +434,146 @@ static inline void SFX(hb_prefetch_row)(const REAL *Y, const REAL *Z, int64_t k,
 }
 
 /* ---- wind then collide in one pass (the CUDA fused variant's pair) -------------------- */
+#if FAST_TRIG
+/* fp32: a strand walk. A group of HB_WALK_NV vectors of lanes walks the points with its
+ * wind state (the previous input, the wound predecessor) and collide state (predecessor,
+ * shell, moved, count) in registers. Per tile of points, a first loop computes each
+ * point's turned angle (atan2, the wrap: it reads only the input), a
+ * second winds (sincos) and collides (the pull and the projection only where a lane of the
+ * vector needs them). The per-lane operations are those of hb_wind_point and
+ * hb_collide_point, so the result is the two passes' bit for bit. */
+#ifndef HB_WALK_TILE
+#define HB_WALK_TILE 32
+#endif
+#define HB_WALK_G (HB_WALK_NV * HB_VW)
+_Static_assert(BLOCK % HB_WALK_G == 0, "a block is a whole number of walk groups");
+int64_t SFX(hb_simd_wind_collide_block)(const MODEL *m, int real, REAL *Y, REAL *Z, REAL *WY, REAL *WZ, int64_t stride)
+{
+    const int64_t P = m->points;
+    const REAL w_per_point = m->wind_strength / (REAL)(P - 1);
+    const hb_vf ell = VSET(m->seg_len), psi = VSET(m->wind_angle), h = VSET(m->hair_offset);
+    const hb_vf pi = VSET(PI_R), mpi = VSET(-PI_R), twopi = VSET(TWO_PI_R), zero = VSET((REAL)0);
+    const hb_vf allow = VSET((REAL)HB_SHELL_ULPS * EPS);
+    int32_t changed_l[BLOCK] HB_ALIGNED;
+    hb_vf turned[HB_WALK_TILE][HB_WALK_NV];
+    if (WY) {
+        for (int64_t j = 0; j < BLOCK; j++) {
+            WY[j] = Y[j];
+            WZ[j] = Z[j];
+        }
+    }
+    for (int g = 0; g < BLOCK; g += HB_WALK_G) {
+        hb_vf oy[HB_WALK_NV], oz[HB_WALK_NV], ny[HB_WALK_NV], nz[HB_WALK_NV], py[HB_WALK_NV], pz[HB_WALK_NV],
+            rc[HB_WALK_NV], inner2[HB_WALK_NV];
+        hb_vm moved[HB_WALK_NV];
+        hb_vi changed[HB_WALK_NV];
+        for (int v = 0; v < HB_WALK_NV; v++) { /* hb_wind_start, hb_collide_start */
+            const hb_vf y = VLD(Y + g + v * HB_VW), z = VLD(Z + g + v * HB_VW);
+            const hb_vf c = VADD(VSQRT(VADD(VMUL(y, y), VMUL(z, z))), h);
+            const hb_vf inner = VSUB(c, VMUL(c, allow));
+            oy[v] = ny[v] = py[v] = y;
+            oz[v] = nz[v] = pz[v] = z;
+            rc[v] = c;
+            inner2[v] = VMUL(inner, inner);
+            moved[v] = MNONE;
+            changed[v] = VIZERO;
+        }
+        for (int64_t k0 = 1; k0 < P; k0 += HB_WALK_TILE) {
+            const int64_t k1 = P - k0 < HB_WALK_TILE ? P : k0 + HB_WALK_TILE;
+            /* the wind's turned angles: the input only */
+            for (int64_t k = k0; k < k1; k++) {
+                const hb_vf t = VSET((REAL)k * w_per_point);
+                for (int v = 0; v < HB_WALK_NV; v++) {
+                    const int64_t o = (k - 1) * stride + g + v * HB_VW;
+#if HB_SIMD_WALK_PREFETCH
+                    /* the lanes HB_SIMD_WALK_PREFETCH groups ahead (past the block: the next
+                     * block's, or the next row's; a prefetch never faults) */
+                    if ((v * HB_VW * (int)sizeof(REAL)) % 64 == 0) {
+                        VPREFETCH(Y + o + stride + HB_SIMD_WALK_PREFETCH * HB_WALK_G);
+                        VPREFETCH(Z + o + stride + HB_SIMD_WALK_PREFETCH * HB_WALK_G);
+                    }
+#endif
+                    const hb_vf cy = VLD(Y + o + stride), cz = VLD(Z + o + stride);
+                    const hb_vf dy = VSUB(cy, oy[v]), dz = VSUB(cz, oz[v]);
+                    oy[v] = cy;
+                    oz[v] = cz;
+                    const hb_vf phi = hb_v_atan2(dy, dz);
+                    hb_vf delta = VSUB(psi, phi);
+                    const hb_vf dm = VSUB(delta, twopi), dp = VADD(delta, twopi);
+                    const hb_vm above = VCMP(delta, pi, _CMP_GT_OQ), below = VCMP(delta, mpi, _CMP_LE_OQ);
+                    delta = VSEL(above, dm, VSEL(below, dp, delta));
+                    const hb_vm opposite = VCMP(delta, pi, _CMP_EQ_OQ), up = VCMP(dz, zero, _CMP_GE_OQ);
+                    delta = VSEL(opposite, VSEL(up, pi, mpi), delta);
+                    turned[k - k0][v] = VADD(phi, VMUL(t, delta));
+                }
+            }
+            /* wind (the running sum) and collide, point by point */
+            for (int64_t k = k0; k < k1; k++) {
+                for (int v = 0; v < HB_WALK_NV; v++) {
+                    const int64_t o = k * stride + g + v * HB_VW;
+                    hb_vf sn, cs;
+                    hb_v_sincos(turned[k - k0][v], &sn, &cs);
+                    const hb_vf qz = VADD(nz[v], VMUL(ell, cs)), qy = VADD(ny[v], VMUL(ell, sn));
+                    nz[v] = qz;
+                    ny[v] = qy;
+                    if (WY) {
+                        VST(WY + o, qy);
+                        VST(WZ + o, qz);
+                    }
+                    hb_vf cy = qy, cz = qz;
+                    if (MANY(moved[v])) { /* the pull */
+                        const hb_vf y = py[v], z = pz[v];
+                        const hb_vf dy = VSUB(qy, y), dz = VSUB(qz, z);
+                        const hb_vf len = VSQRT(VADD(VMUL(dy, dy), VMUL(dz, dz)));
+                        const hb_vm dir = VCMP(len, zero, _CMP_GT_OQ);
+                        const hb_vf scale = VDIV(ell, len);
+                        const hb_vf fy = VADD(y, VMUL(dy, scale)), fz = VADD(z, VMUL(dz, scale));
+                        const hb_vf down = VSUB(y, ell);
+                        cy = VSEL(moved[v], VSEL(dir, fy, down), qy);
+                        cz = VSEL(moved[v], VSEL(dir, fz, z), qz);
+                    }
+                    const hb_vm in = VCMP(VADD(VMUL(cy, cy), VMUL(cz, cz)), inner2[v], _CMP_LT_OQ);
+                    if (MANY(in)) { /* the projection */
+                        const hb_vf y = py[v], z = pz[v], c = rc[v];
+                        const hb_vf d2 = VADD(VMUL(y, y), VMUL(z, z));
+                        const hb_vf d = VSQRT(d2);
+                        const hb_vm proj = MAND(in, VCMP(d, zero, _CMP_GT_OQ));
+                        const hb_vf tt =
+                            VDIV(VADD(VMUL(VSUB(d, c), VADD(d, c)), VMUL(ell, ell)), VMUL(VSET((REAL)2), d));
+                        const hb_vf a = VSUB(d, tt);
+                        const hb_vf h2 = VMUL(VADD(VSUB(c, d), tt), VADD(c, a));
+                        const hb_vf hh = VSQRT(VSEL(VCMP(h2, zero, _CMP_GT_OQ), h2, zero));
+                        const hb_vf uy = VDIV(y, d), uz = VDIV(z, d);
+                        const hb_vf fy = VMUL(a, uy), fz = VMUL(a, uz);
+                        const hb_vf y1 = VADD(fy, VMUL(hh, uz)), z1 = VSUB(fz, VMUL(hh, uy));
+                        const hb_vf y2 = VSUB(fy, VMUL(hh, uz)), z2 = VADD(fz, VMUL(hh, uy));
+                        const hb_vf ey1 = VSUB(y1, cy), ez1 = VSUB(z1, cz), ey2 = VSUB(y2, cy), ez2 = VSUB(z2, cz);
+                        const hb_vf e1 = VADD(VMUL(ey1, ey1), VMUL(ez1, ez1));
+                        const hb_vf e2 = VADD(VMUL(ey2, ey2), VMUL(ez2, ez2));
+                        const hb_vm upper =
+                            MOR(VCMP(e1, e2, _CMP_LT_OQ), MAND(VCMP(e1, e2, _CMP_EQ_OQ), VCMP(y1, y2, _CMP_GE_OQ)));
+                        cy = VSEL(proj, VSEL(upper, y1, y2), cy);
+                        cz = VSEL(proj, VSEL(upper, z1, z2), cz);
+                        moved[v] = MOR(moved[v], proj);
+                    }
+                    changed[v] = VICOUNT(changed[v], moved[v]);
+                    py[v] = cy;
+                    pz[v] = cz;
+                    VST(Y + o, cy);
+                    VST(Z + o, cz);
+                }
+            }
+        }
+        for (int v = 0; v < HB_WALK_NV; v++) VIST(changed_l + g + v * HB_VW, changed[v]);
+    }
+    int64_t total = 0;
+    for (int j = 0; j < real && j < BLOCK; j++) total += (int64_t)changed_l[j];
+    return total;
+}
+#undef HB_WALK_TILE
+#undef HB_WALK_G
+#else
+
 /* Each point is read once and written once: wound into the lanes' wind state, then
  * collided from there with exactly the operations of the two passes above, so the result
  * is theirs bit for bit. With WY, WZ (not NULL) the wound state is stored there too. */
@@ -461,6 +601,7 @@ int64_t SFX(hb_simd_wind_collide_block)(const MODEL *m, int real, REAL *Y, REAL 
     }
     return SFX(hb_collide_total)(&cs, real);
 }
+#endif
 
 #undef ROW
 #undef PI_R
