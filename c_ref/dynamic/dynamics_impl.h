@@ -32,6 +32,17 @@ HB_ALWAYS_INLINE void SFX(rotate)(const REAL *q, const REAL *a, REAL *r)
     r[2] = q[6] * a[0] + q[7] * a[1] + q[8] * a[2];
 }
 
+/* r = Q·a when the head moves, else a: a rest point carried with the head. */
+HB_ALWAYS_INLINE void SFX(rest_pose)(const REAL *q, const REAL *a, REAL *r, const unsigned moves)
+{
+    if (moves) SFX(rotate)(q, a, r);
+    else {
+        r[0] = a[0];
+        r[1] = a[1];
+        r[2] = a[2];
+    }
+}
+
 /* §3.5 distance constraint between a = p[3ia] and b = p[3ib] with rest length r and
  * α̃ = at. `move_a` is 0 when a is the root (inverse mass 0), else 1; b is never the root. */
 HB_ALWAYS_INLINE void SFX(distance)(REAL *pa, REAL *pb, int move_a, REAL r, REAL at, REAL *lambda)
@@ -118,12 +129,7 @@ HB_ALWAYS_INLINE void SFX(shape_all)(const DMODEL *m, REAL *p, const REAL *rest,
     for (int64_t k = 1; k <= m->shape_count; k++) {
 #endif
         REAL t[3];
-        if (F & HB_F_MOTION) SFX(rotate)(q, rest + 3 * k, t);
-        else {
-            t[0] = rest[3 * k];
-            t[1] = rest[3 * k + 1];
-            t[2] = rest[3 * k + 2];
-        }
+        SFX(rest_pose)(q, rest + 3 * k, t, F & HB_F_MOTION);
         SFX(shape_pull)(p + 3 * k, t, m->shape_at, &lam[k - 1]);
     }
 }
@@ -177,12 +183,7 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
         if (m->solver == HB_SOLVER_RIGID) {
             for (int64_t k = 1; k < P; k++) {
                 REAL r[3];
-                if (F & HB_F_MOTION) SFX(rotate)(q, rest + 3 * k, r);
-                else {
-                    r[0] = rest[3 * k];
-                    r[1] = rest[3 * k + 1];
-                    r[2] = rest[3 * k + 2];
-                }
+                SFX(rest_pose)(q, rest + 3 * k, r, F & HB_F_MOTION);
                 for (int c = 0; c < 3; c++) {
                     v[3 * k + c] = (r[c] - x[3 * k + c]) / h;
                     x[3 * k + c] = r[c];
