@@ -203,9 +203,9 @@ static void *pm_alloc(size_t bytes)
     return p;
 }
 
-/* First touch: each thread zeroes the rows of the blocks it will compute (the same static
- * schedule over blocks as the stages). */
-static void pm_first_touch(cpu_impl *c, void *const a[3])
+/* dst = src, or zeros without src, block by block: each thread writes the rows of the blocks
+ * it will compute (the same static schedule over blocks as the stages: the first touch). */
+static void pm_fill(cpu_impl *c, void *const dst[3], void *const src[3])
 {
     const size_t rs = hb_real_size(c->scene.precision), chunk = (size_t)c->block * rs;
     const int64_t P = c->scene.points;
@@ -214,21 +214,19 @@ static void pm_first_touch(cpu_impl *c, void *const a[3])
         for (int64_t k = 0; k < P; k++)
             for (int d = 0; d < 3; d++) {
                 size_t off = ((size_t)k * (size_t)c->stride + (size_t)blk * (size_t)c->block) * rs;
-                memset((char *)a[d] + off, 0, chunk);
+                if (src) memcpy((char *)dst[d] + off, (const char *)src[d] + off, chunk);
+                else memset((char *)dst[d] + off, 0, chunk);
             }
+}
+
+static void pm_first_touch(cpu_impl *c, void *const a[3])
+{
+    pm_fill(c, a, NULL);
 }
 
 static void pm_copy(cpu_impl *c, void *const dst[3], void *const src[3])
 {
-    const size_t rs = hb_real_size(c->scene.precision), chunk = (size_t)c->block * rs;
-    const int64_t P = c->scene.points;
-#pragma omp parallel for schedule(static)
-    for (int64_t blk = 0; blk < c->nblocks; blk++)
-        for (int64_t k = 0; k < P; k++)
-            for (int d = 0; d < 3; d++) {
-                size_t off = ((size_t)k * (size_t)c->stride + (size_t)blk * (size_t)c->block) * rs;
-                memcpy((char *)dst[d] + off, (const char *)src[d] + off, chunk);
-            }
+    pm_fill(c, dst, src);
 }
 
 static uint64_t simd_dyn_bytes(const cpu_impl *c, uint64_t one, int need_save);
@@ -322,47 +320,35 @@ static void simd_convert(cpu_impl *c, void *const a[3], void *canonical, int to_
 }
 #undef PM_CONVERT
 
+#define SIMD_STAGE(T, SFX, M)                                                                                          \
+    do {                                                                                                               \
+        T *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2];                                                                 \
+        if (st == HB_STAGE_INIT) {                                                                                     \
+            _Pragma("omp parallel for schedule(static)") for (int64_t b = 0; b < NB; b++)                              \
+                c->sm->init_##SFX(M, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);                           \
+        } else if (st == HB_STAGE_WIND) {                                                                              \
+            _Pragma("omp parallel for schedule(static)") for (int64_t b = 0; b < NB; b++)                              \
+                c->sm->wind_##SFX(M, Y + b * B, Z + b * B, S);                                                         \
+        } else {                                                                                                       \
+            _Pragma("omp parallel for schedule(static) reduction(+ : moved)") for (int64_t b = 0; b < NB; b++)         \
+            {                                                                                                          \
+                const int real = (int)(N - b * B < B ? N - b * B : B); /* strands of the block */                      \
+                moved += c->sm->collide_##SFX(M, real, Y + b * B, Z + b * B, S);                                       \
+            }                                                                                                          \
+        }                                                                                                              \
+    } while (0)
+
 /* One stage over all blocks of strands; the split into blocks does not depend on the
  * thread count, and every strand is one lane of one block from start to finish. */
 static int64_t simd_run_stage(cpu_impl *c, hb_stage st)
 {
     const int64_t N = c->scene.n_strands, B = c->block, NB = c->nblocks, S = c->stride;
     int64_t moved = 0;
-    if (c->scene.precision == HB_FP32) {
-        float *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2];
-        const hb_model_f32 *m = &c->m32;
-        if (st == HB_STAGE_INIT) {
-#pragma omp parallel for schedule(static)
-            for (int64_t b = 0; b < NB; b++) c->sm->init_f32(m, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);
-        } else if (st == HB_STAGE_WIND) {
-#pragma omp parallel for schedule(static)
-            for (int64_t b = 0; b < NB; b++) c->sm->wind_f32(m, Y + b * B, Z + b * B, S);
-        } else {
-#pragma omp parallel for schedule(static) reduction(+ : moved)
-            for (int64_t b = 0; b < NB; b++) {
-                const int real = (int)(N - b * B < B ? N - b * B : B); /* strands of the block */
-                moved += c->sm->collide_f32(m, real, Y + b * B, Z + b * B, S);
-            }
-        }
-    } else {
-        double *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2];
-        const hb_model_f64 *m = &c->m64;
-        if (st == HB_STAGE_INIT) {
-#pragma omp parallel for schedule(static)
-            for (int64_t b = 0; b < NB; b++) c->sm->init_f64(m, (uint64_t)(b * B), X + b * B, Y + b * B, Z + b * B, S);
-        } else if (st == HB_STAGE_WIND) {
-#pragma omp parallel for schedule(static)
-            for (int64_t b = 0; b < NB; b++) c->sm->wind_f64(m, Y + b * B, Z + b * B, S);
-        } else {
-#pragma omp parallel for schedule(static) reduction(+ : moved)
-            for (int64_t b = 0; b < NB; b++) {
-                const int real = (int)(N - b * B < B ? N - b * B : B); /* strands of the block */
-                moved += c->sm->collide_f64(m, real, Y + b * B, Z + b * B, S);
-            }
-        }
-    }
+    if (c->scene.precision == HB_FP32) SIMD_STAGE(float, f32, &c->m32);
+    else SIMD_STAGE(double, f64, &c->m64);
     return moved;
 }
+#undef SIMD_STAGE
 
 /* wind then collide, one pass over the points (model_simd.h), the same bits as the two
  * stages; the wind frame is stored to pm_wind when the driver keeps it. Returns −1 when
@@ -482,6 +468,21 @@ static int simd_dyn_load(cpu_impl *c, const void *velocity, const void *rest)
     return 0;
 }
 
+/* A dynamic frame's stage result (ref and simd), or the error when a thread's scratch
+ * could not be allocated. */
+static int dyn_frame_result(hb_stage_result *r, double t0, int failed, const char *scratch, int64_t P, char *err,
+                            size_t errlen)
+{
+    r->ms = hb_now_ms() - t0;
+    r->moved_points = -1;
+    r->consumed = 1;
+    if (failed) {
+        snprintf(err, errlen, "out of host memory for the %s (%lld points)", scratch, (long long)P);
+        return -1;
+    }
+    return 0;
+}
+
 /* Dynamic blocks over threads (static schedule: the bits do not depend on it); each
  * thread's block scratch (hb_simd_dyn_scratch_reals) is its own. */
 #define SIMD_DYN_FRAME(T, SFX, M)                                                                                      \
@@ -512,14 +513,7 @@ static int simd_dyn_frame(cpu_impl *c, const hb_dyn_frame *f, hb_stage_result *r
     const double t0 = hb_now_ms();
     if (c->scene.precision == HB_FP32) SIMD_DYN_FRAME(float, f32, &c->d32);
     else SIMD_DYN_FRAME(double, f64, &c->d64);
-    r->ms = hb_now_ms() - t0;
-    r->moved_points = -1;
-    r->consumed = 1;
-    if (failed) {
-        snprintf(err, errlen, "out of host memory for the per-thread block scratch (%lld points)", (long long)P);
-        return -1;
-    }
-    return 0;
+    return dyn_frame_result(r, t0, failed, "per-thread block scratch", P, err, errlen);
 }
 #undef SIMD_DYN_FRAME
 
@@ -561,19 +555,21 @@ static int simd_dyn_observe(cpu_impl *c, hb_observables *obs, char *err, size_t 
 
 /* ---- the backend interface ----------------------------------------------------------- */
 
+/* The positions from (to_backend) or to canonical [N][P][3], timed. */
+static double cpu_transfer_positions(cpu_impl *c, void *canonical, int to_backend)
+{
+    const double t0 = hb_now_ms();
+    if (c->simd) simd_convert(c, c->pm, canonical, to_backend);
+    else if (to_backend) memcpy(c->state, canonical, c->bytes);
+    else memcpy(canonical, c->state, c->bytes);
+    return hb_now_ms() - t0;
+}
+
 static int cpu_load(hb_backend *b, const void *canonical, double *ms, char *err, size_t errlen)
 {
     (void)err;
     (void)errlen;
-    cpu_impl *c = b->impl;
-    double t0 = hb_now_ms();
-    if (c->simd) {
-        simd_convert(c, c->pm, (void *)canonical, 1);
-        *ms = hb_now_ms() - t0;
-        return 0;
-    }
-    memcpy(c->state, canonical, c->bytes);
-    *ms = hb_now_ms() - t0;
+    *ms = cpu_transfer_positions(b->impl, (void *)canonical, 1);
     return 0;
 }
 
@@ -581,15 +577,7 @@ static int cpu_fetch(hb_backend *b, void *canonical, double *ms, char *err, size
 {
     (void)err;
     (void)errlen;
-    cpu_impl *c = b->impl;
-    double t0 = hb_now_ms();
-    if (c->simd) {
-        simd_convert(c, c->pm, canonical, 0);
-        *ms = hb_now_ms() - t0;
-        return 0;
-    }
-    memcpy(canonical, c->state, c->bytes);
-    *ms = hb_now_ms() - t0;
+    *ms = cpu_transfer_positions(b->impl, canonical, 0);
     return 0;
 }
 
@@ -612,15 +600,20 @@ static void cpu_keep_intermediate(hb_backend *b, int keep)
     c->keep = keep;
 }
 
+/* Positions and velocities into (to_saved) or back from the saved copies. */
+static void cpu_copy_saved(cpu_impl *c, int to_saved)
+{
+    if (c->simd) pm_copy(c, to_saved ? c->pm_saved : c->pm, to_saved ? c->pm : c->pm_saved);
+    else memcpy(to_saved ? c->saved : c->state, to_saved ? c->state : c->saved, c->bytes);
+    if (c->pv_saved[0]) pm_copy(c, to_saved ? c->pv_saved : c->pv, to_saved ? c->pv : c->pv_saved);
+    if (c->vel_saved) memcpy(to_saved ? c->vel_saved : c->vel, to_saved ? c->vel : c->vel_saved, c->bytes);
+}
+
 static int cpu_save(hb_backend *b, char *err, size_t errlen)
 {
     (void)err;
     (void)errlen;
-    cpu_impl *c = b->impl;
-    if (c->simd) pm_copy(c, c->pm_saved, c->pm);
-    else memcpy(c->saved, c->state, c->bytes);
-    if (c->pv_saved[0]) pm_copy(c, c->pv_saved, c->pv);
-    if (c->vel_saved) memcpy(c->vel_saved, c->vel, c->bytes);
+    cpu_copy_saved(b->impl, 1);
     return 0;
 }
 
@@ -628,13 +621,24 @@ static int cpu_restore(hb_backend *b, char *err, size_t errlen)
 {
     (void)err;
     (void)errlen;
-    cpu_impl *c = b->impl;
-    if (c->simd) pm_copy(c, c->pm, c->pm_saved);
-    else memcpy(c->state, c->saved, c->bytes);
-    if (c->pv_saved[0]) pm_copy(c, c->pv, c->pv_saved);
-    if (c->vel_saved) memcpy(c->vel, c->vel_saved, c->bytes);
+    cpu_copy_saved(b->impl, 0);
     return 0;
 }
+
+#define REF_STAGE(T, SFX, M)                                                                                           \
+    do {                                                                                                               \
+        T *s = c->state;                                                                                               \
+        if (st == HB_STAGE_INIT) {                                                                                     \
+            _Pragma("omp parallel for schedule(static)") for (int64_t k = 0; k < N; k++)                               \
+                hb_init_strand_##SFX(M, (uint64_t)k, s + (size_t)k * stride);                                          \
+        } else if (st == HB_STAGE_WIND) {                                                                              \
+            _Pragma("omp parallel for schedule(static)") for (int64_t k = 0; k < N; k++)                               \
+                hb_wind_strand_##SFX(M, s + (size_t)k * stride);                                                       \
+        } else {                                                                                                       \
+            _Pragma("omp parallel for schedule(static) reduction(+ : moved)") for (int64_t k = 0; k < N; k++) moved += \
+                hb_collide_strand_##SFX(M, s + (size_t)k * stride);                                                    \
+        }                                                                                                              \
+    } while (0)
 
 /* One stage over all strands. Strand i lives at state + 3·P·i (canonical layout). */
 static int cpu_run_stage(hb_backend *b, const hb_stage *stages, int i, int n, hb_stage_result *r, char *err,
@@ -662,37 +666,16 @@ static int cpu_run_stage(hb_backend *b, const hb_stage *stages, int i, int n, hb
     if (c->simd) {
         moved = simd_run_stage(c, st);
     } else if (c->scene.precision == HB_FP32) {
-        float *s = c->state;
-        const hb_model_f32 *m = &c->m32;
-        if (st == HB_STAGE_INIT) {
-#pragma omp parallel for schedule(static)
-            for (int64_t k = 0; k < N; k++) hb_init_strand_f32(m, (uint64_t)k, s + (size_t)k * stride);
-        } else if (st == HB_STAGE_WIND) {
-#pragma omp parallel for schedule(static)
-            for (int64_t k = 0; k < N; k++) hb_wind_strand_f32(m, s + (size_t)k * stride);
-        } else {
-#pragma omp parallel for schedule(static) reduction(+ : moved)
-            for (int64_t k = 0; k < N; k++) moved += hb_collide_strand_f32(m, s + (size_t)k * stride);
-        }
+        REF_STAGE(float, f32, &c->m32);
     } else {
-        double *s = c->state;
-        const hb_model_f64 *m = &c->m64;
-        if (st == HB_STAGE_INIT) {
-#pragma omp parallel for schedule(static)
-            for (int64_t k = 0; k < N; k++) hb_init_strand_f64(m, (uint64_t)k, s + (size_t)k * stride);
-        } else if (st == HB_STAGE_WIND) {
-#pragma omp parallel for schedule(static)
-            for (int64_t k = 0; k < N; k++) hb_wind_strand_f64(m, s + (size_t)k * stride);
-        } else {
-#pragma omp parallel for schedule(static) reduction(+ : moved)
-            for (int64_t k = 0; k < N; k++) moved += hb_collide_strand_f64(m, s + (size_t)k * stride);
-        }
+        REF_STAGE(double, f64, &c->m64);
     }
     r->ms = hb_now_ms() - t0;
     r->moved_points = st == HB_STAGE_COLLIDE ? moved : -1;
     r->consumed = 1;
     return 0;
 }
+#undef REF_STAGE
 
 /* ---- the dynamic model (ref): one strand per thread from start to finish ------------- */
 
@@ -776,14 +759,7 @@ static int cpu_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *
     if (c->scene.precision == HB_FP32) DYN_FRAME(float, f32, &c->d32)
     else DYN_FRAME(double, f64, &c->d64)
     if (c->scene.dyn.guided && !failed) cpu_place_followers(c, f);
-    r->ms = hb_now_ms() - t0;
-    r->moved_points = -1;
-    r->consumed = 1;
-    if (failed) {
-        snprintf(err, errlen, "out of host memory for the per-thread scratch (%lld points)", (long long)P);
-        return -1;
-    }
-    return 0;
+    return dyn_frame_result(r, t0, failed, "per-thread scratch", P, err, errlen);
 }
 #undef DYN_FRAME
 

@@ -33,8 +33,9 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "dynamic/dynamics.h" /* HB_F_*, hb_dyn_model_f32/f64 */
-#include "runtime/params.h"   /* HB_SOLVER_* */
+#include "dynamic/dynamics.h"  /* HB_F_*, hb_dyn_model_f32/f64 */
+#include "dynamic/obs_point.h" /* hb_obs_point: §3.8 per point, shared with the reference */
+#include "runtime/params.h"    /* HB_SOLVER_* */
 
 #if defined(__CUDACC__)
 #define HB_DHD __host__ __device__ __forceinline__
@@ -426,6 +427,18 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
         });
 
         /* 3. constraints; every multiplier starts the substep at 0 */
+        /* one iteration's bend, shape and LRA constraints, in the order both solvers apply them */
+        auto bend_shape_lra = [&]() {
+            if (has(HB_F_BEND)) {
+                bend_group(m, s, ex, 0);
+                bend_group(m, s, ex, 1);
+            }
+            if (has(HB_F_SHAPE)) shape_all(m, s, q, ex, has);
+            if (m.lra)
+                ex.each(1, P, 1, [&](int64_t k) {
+                    lra_point(p(0, 0), p(0, 1), p(0, 2), p(k, 0), p(k, 1), p(k, 2), m.lra_len, k);
+                });
+        };
         ex.each(0, 3 * P, 1, [&](int64_t i) { lam(i) = (T)0; });
         if (m.solver == HB_SOLVER_XPBD) {
             for (int64_t it = 0; it < m.iterations; it++) {
@@ -435,30 +448,12 @@ HB_DHD void frame_body(const DModel<T> &m, const T *qtab, const T *phtab, const 
                 ex.each(2, P, 2, [&](int64_t k) { /* stretch, k even */
                                                   distance(p, k - 1, k, 1, seg(k), m.stretch_at, lam(k - 1));
                 });
-                if (has(HB_F_BEND)) {
-                    bend_group(m, s, ex, 0);
-                    bend_group(m, s, ex, 1);
-                }
-                if (has(HB_F_SHAPE)) shape_all(m, s, q, ex, has);
-                if (m.lra)
-                    ex.each(1, P, 1, [&](int64_t k) {
-                        lra_point(p(0, 0), p(0, 1), p(0, 2), p(k, 0), p(k, 1), p(k, 2), m.lra_len, k);
-                    });
+                bend_shape_lra();
                 if (has(HB_F_COLLIDE))
                     ex.each(1, P, 1, [&](int64_t k) { collide_sphere(p(k, 0), p(k, 1), p(k, 2), m.collide_r); });
             }
         } else {
-            for (int64_t it = 0; it < m.iterations; it++) {
-                if (has(HB_F_BEND)) {
-                    bend_group(m, s, ex, 0);
-                    bend_group(m, s, ex, 1);
-                }
-                if (has(HB_F_SHAPE)) shape_all(m, s, q, ex, has);
-                if (m.lra)
-                    ex.each(1, P, 1, [&](int64_t k) {
-                        lra_point(p(0, 0), p(0, 1), p(0, 2), p(k, 0), p(k, 1), p(k, 2), m.lra_len, k);
-                    });
-            }
+            for (int64_t it = 0; it < m.iterations; it++) { bend_shape_lra(); }
             /* §3.7 follow the leader, k ascending: each point follows its corrected predecessor */
             ex.one([&]() {
                 for (int64_t k = 1; k < P; k++)
@@ -510,24 +505,13 @@ HB_DHD void observe_strand(const ObsScene &sc, const Arr<const T> &x, const Arr<
     long long blown = 0;
     for (int64_t k = 0; k < P; k++)
         for (int c = 0; c < 3; c++) blown |= !finite_d((double)x(k, c)) || !finite_d((double)v(k, c));
+    const double x0[3] = {(double)x(0, 0), (double)x(0, 1), (double)x(0, 2)};
     for (int64_t k = 1; k < P; k++) {
-        double e[3], r[3], r2 = 0.0, l2 = 0.0, n2 = 0.0, w2 = 0.0;
-        for (int c = 0; c < 3; c++) {
-            e[c] = (double)x(k, c) - (double)x(k - 1, c);
-            r[c] = (double)x(k, c) - (double)x(0, c);
-            l2 += e[c] * e[c];
-            r2 += r[c] * r[c];
-            n2 += (double)x(k, c) * (double)x(k, c);
-            w2 += (double)v(k, c) * (double)v(k, c);
-        }
-        const double st = fabs(sqrt(l2) / (sc.seg64 ? sc.seg64[k - 1] : ell) - 1.0);
-        if (st > smax) smax = st;
-        if (sc.collider) {
-            const double pen = rc - sqrt(n2);
-            if (pen > pmax) pmax = pen;
-        }
-        v2 += w2;
-        if (r2 > far2) blown = 1;
+        const double xk[3] = {(double)x(k, 0), (double)x(k, 1), (double)x(k, 2)};
+        const double xp[3] = {(double)x(k - 1, 0), (double)x(k - 1, 1), (double)x(k - 1, 2)};
+        const double vk[3] = {(double)v(k, 0), (double)v(k, 1), (double)v(k, 2)};
+        if (hb_obs_point(xk, xp, x0, vk, sc.seg64 ? sc.seg64[k - 1] : ell, sc.collider, rc, far2, &smax, &pmax, &v2))
+            blown = 1;
     }
     o->stretch_max = smax;
     o->penetration_max = pmax;

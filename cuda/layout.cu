@@ -26,63 +26,35 @@ dim3 tile_grid(int64_t N, int64_t C)
 
 } /* namespace */
 
-template <typename T>
-__global__ void __launch_bounds__(kTile *kRows)
-    k_to_point_major(const T *__restrict__ canon, T *__restrict__ X, T *__restrict__ Y, T *__restrict__ Z,
-                     const int64_t N, const int64_t P)
+/* One kernel for both directions: pass 1 reads the source into tile[j][tx], pass 2 writes
+ * tile[tx][j] to the destination. The canonical side of element (j, tx) is row r0 + j, column
+ * c0 + tx; the point-major side is column c0 + j (point k, coordinate comp), strand r0 + tx;
+ * both are consecutive along tx. */
+template <typename T, bool kToPointMajor>
+__global__ void __launch_bounds__(kTile *kRows) k_transpose(T *__restrict__ canon, T *__restrict__ X, T *__restrict__ Y,
+                                                            T *__restrict__ Z, const int64_t N, const int64_t P)
 {
     __shared__ T tile[kTile][kTile + 1];
     const int64_t C = 3 * P;
     const int tx = threadIdx.x, ty = threadIdx.y;
     for (int64_t r0 = (int64_t)blockIdx.x * kTile; r0 < N; r0 += (int64_t)gridDim.x * kTile) {
         for (int64_t c0 = (int64_t)blockIdx.y * kTile; c0 < C; c0 += (int64_t)gridDim.y * kTile) {
-            /* read rows r0 + j (strands), columns c0 + tx: consecutive along a row */
-            for (int j = ty; j < kTile; j += kRows) {
+            auto canon_at = [&](int j) -> T * {
                 const int64_t r = r0 + j, c = c0 + tx;
-                if (r < N && c < C) tile[j][tx] = canon[r * C + c];
-            }
-            __syncthreads();
-            /* write column c0 + j (point k, coordinate comp), strands r0 + tx: consecutive */
-            for (int j = ty; j < kTile; j += kRows) {
+                return r < N && c < C ? canon + r * C + c : nullptr;
+            };
+            auto point_major_at = [&](int j) -> T * {
                 const int64_t c = c0 + j, r = r0 + tx;
-                if (r < N && c < C) {
-                    const int64_t k = c / 3;
-                    const int comp = (int)(c - 3 * k);
-                    T *dst = comp == 0 ? X : (comp == 1 ? Y : Z);
-                    dst[k * N + r] = tile[tx][j];
-                }
-            }
+                if (r >= N || c >= C) return nullptr;
+                const int64_t k = c / 3;
+                const int comp = (int)(c - 3 * k);
+                return (comp == 0 ? X : (comp == 1 ? Y : Z)) + k * N + r;
+            };
+            for (int j = ty; j < kTile; j += kRows)
+                if (const T *src = kToPointMajor ? canon_at(j) : point_major_at(j)) tile[j][tx] = *src;
             __syncthreads();
-        }
-    }
-}
-
-template <typename T>
-__global__ void __launch_bounds__(kTile *kRows)
-    k_to_canonical(const T *__restrict__ X, const T *__restrict__ Y, const T *__restrict__ Z, T *__restrict__ canon,
-                   const int64_t N, const int64_t P)
-{
-    __shared__ T tile[kTile][kTile + 1];
-    const int64_t C = 3 * P;
-    const int tx = threadIdx.x, ty = threadIdx.y;
-    for (int64_t r0 = (int64_t)blockIdx.x * kTile; r0 < N; r0 += (int64_t)gridDim.x * kTile) {
-        for (int64_t c0 = (int64_t)blockIdx.y * kTile; c0 < C; c0 += (int64_t)gridDim.y * kTile) {
-            /* read column c0 + j (point k, coordinate comp), strands r0 + tx: consecutive */
-            for (int j = ty; j < kTile; j += kRows) {
-                const int64_t c = c0 + j, r = r0 + tx;
-                if (r < N && c < C) {
-                    const int64_t k = c / 3;
-                    const int comp = (int)(c - 3 * k);
-                    const T *src = comp == 0 ? X : (comp == 1 ? Y : Z);
-                    tile[j][tx] = src[k * N + r];
-                }
-            }
-            __syncthreads();
-            /* write rows r0 + j (strands), columns c0 + tx: consecutive along a row */
-            for (int j = ty; j < kTile; j += kRows) {
-                const int64_t r = r0 + j, c = c0 + tx;
-                if (r < N && c < C) canon[r * C + c] = tile[tx][j];
-            }
+            for (int j = ty; j < kTile; j += kRows)
+                if (T *dst = kToPointMajor ? point_major_at(j) : canon_at(j)) *dst = tile[tx][j];
             __syncthreads();
         }
     }
@@ -92,14 +64,16 @@ template <typename T>
 cudaError_t launch_to_point_major(const T *canonical, const PointMajor<T> &pm, int64_t N, int64_t P,
                                   cudaStream_t stream)
 {
-    k_to_point_major<T><<<tile_grid(N, 3 * P), dim3(kTile, kRows, 1), 0, stream>>>(canonical, pm.X, pm.Y, pm.Z, N, P);
+    /* the kernel only reads canonical in this direction */
+    k_transpose<T, true>
+        <<<tile_grid(N, 3 * P), dim3(kTile, kRows, 1), 0, stream>>>(const_cast<T *>(canonical), pm.X, pm.Y, pm.Z, N, P);
     return cudaGetLastError();
 }
 
 template <typename T>
 cudaError_t launch_to_canonical(const PointMajor<T> &pm, T *canonical, int64_t N, int64_t P, cudaStream_t stream)
 {
-    k_to_canonical<T><<<tile_grid(N, 3 * P), dim3(kTile, kRows, 1), 0, stream>>>(pm.X, pm.Y, pm.Z, canonical, N, P);
+    k_transpose<T, false><<<tile_grid(N, 3 * P), dim3(kTile, kRows, 1), 0, stream>>>(canonical, pm.X, pm.Y, pm.Z, N, P);
     return cudaGetLastError();
 }
 

@@ -10,6 +10,8 @@
  * Layout: point k of a strand at s[3k + 0..2] = (x, y, z).
  */
 
+#include "dynamic/obs_point.h" /* hb_obs_point: §3.8 per point, shared with cuda/dyn_model.cuh */
+
 #define HB_ALWAYS_INLINE static inline __attribute__((always_inline))
 #if HB_PLANT == 8 /* judge test: the root given weight 1 in its stretch constraint */
 #define ROOT_MOVES(k) 1
@@ -28,6 +30,17 @@ HB_ALWAYS_INLINE void SFX(rotate)(const REAL *q, const REAL *a, REAL *r)
     r[0] = q[0] * a[0] + q[1] * a[1] + q[2] * a[2];
     r[1] = q[3] * a[0] + q[4] * a[1] + q[5] * a[2];
     r[2] = q[6] * a[0] + q[7] * a[1] + q[8] * a[2];
+}
+
+/* r = Q·a when the head moves, else a: a rest point carried with the head. */
+HB_ALWAYS_INLINE void SFX(rest_pose)(const REAL *q, const REAL *a, REAL *r, const unsigned moves)
+{
+    if (moves) SFX(rotate)(q, a, r);
+    else {
+        r[0] = a[0];
+        r[1] = a[1];
+        r[2] = a[2];
+    }
 }
 
 /* §3.5 distance constraint between a = p[3ia] and b = p[3ib] with rest length r and
@@ -116,12 +129,7 @@ HB_ALWAYS_INLINE void SFX(shape_all)(const DMODEL *m, REAL *p, const REAL *rest,
     for (int64_t k = 1; k <= m->shape_count; k++) {
 #endif
         REAL t[3];
-        if (F & HB_F_MOTION) SFX(rotate)(q, rest + 3 * k, t);
-        else {
-            t[0] = rest[3 * k];
-            t[1] = rest[3 * k + 1];
-            t[2] = rest[3 * k + 2];
-        }
+        SFX(rest_pose)(q, rest + 3 * k, t, F & HB_F_MOTION);
         SFX(shape_pull)(p + 3 * k, t, m->shape_at, &lam[k - 1]);
     }
 }
@@ -175,12 +183,7 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
         if (m->solver == HB_SOLVER_RIGID) {
             for (int64_t k = 1; k < P; k++) {
                 REAL r[3];
-                if (F & HB_F_MOTION) SFX(rotate)(q, rest + 3 * k, r);
-                else {
-                    r[0] = rest[3 * k];
-                    r[1] = rest[3 * k + 1];
-                    r[2] = rest[3 * k + 2];
-                }
+                SFX(rest_pose)(q, rest + 3 * k, r, F & HB_F_MOTION);
                 for (int c = 0; c < 3; c++) {
                     v[3 * k + c] = (r[c] - x[3 * k + c]) / h;
                     x[3 * k + c] = r[c];
@@ -342,24 +345,13 @@ void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v,
     int64_t blown = 0;
     for (int64_t k = 0; k < P; k++)
         for (int c = 0; c < 3; c++) blown |= !isfinite((double)x[3 * k + c]) || !isfinite((double)v[3 * k + c]);
+    const double x0[3] = {(double)x[0], (double)x[1], (double)x[2]};
     for (int64_t k = 1; k < P; k++) {
-        double e[3], r[3], r2 = 0.0, l2 = 0.0, n2 = 0.0, w2 = 0.0;
-        for (int c = 0; c < 3; c++) {
-            e[c] = (double)x[3 * k + c] - (double)x[3 * (k - 1) + c];
-            r[c] = (double)x[3 * k + c] - (double)x[c];
-            l2 += e[c] * e[c];
-            r2 += r[c] * r[c];
-            n2 += (double)x[3 * k + c] * (double)x[3 * k + c];
-            w2 += (double)v[3 * k + c] * (double)v[3 * k + c];
-        }
-        const double st = fabs(sqrt(l2) / (seg64 ? seg64[k - 1] : ell) - 1.0);
-        if (st > smax) smax = st;
-        if (s->dyn.collider) {
-            const double pen = rc - sqrt(n2);
-            if (pen > pmax) pmax = pen;
-        }
-        v2 += w2;
-        if (r2 > far2) blown = 1;
+        const double xk[3] = {(double)x[3 * k], (double)x[3 * k + 1], (double)x[3 * k + 2]};
+        const double xp[3] = {(double)x[3 * k - 3], (double)x[3 * k - 2], (double)x[3 * k - 1]};
+        const double vk[3] = {(double)v[3 * k], (double)v[3 * k + 1], (double)v[3 * k + 2]};
+        if (hb_obs_point(xk, xp, x0, vk, seg64 ? seg64[k - 1] : ell, s->dyn.collider, rc, far2, &smax, &pmax, &v2))
+            blown = 1;
     }
     o->stretch_max = smax;
     o->penetration_max = pmax;

@@ -318,6 +318,21 @@ HB_ALWAYS_INLINE void SFX(update_row)(const SFX(dyn_consts) * K, REAL *scratch, 
     }
 }
 
+/* One iteration's bend, shape and LRA constraints (those the features and the model use),
+ * in the order both solvers apply them. */
+HB_ALWAYS_INLINE void SFX(bend_shape_lra_lanes)(const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q,
+                                                const REAL *RX, const REAL *RY, const REAL *RZ, const REAL *BR,
+                                                const int64_t stride, REAL *scratch, const unsigned F)
+{
+    if (F & HB_F_BEND) {
+        SFX(bend_lanes)(m, K, scratch, BR, stride, 0);
+        SFX(bend_lanes)(m, K, scratch, BR, stride, 1);
+    }
+    if (F & HB_F_SHAPE) SFX(shape_lanes)(m, K, scratch, q, RX, RY, RZ, stride, F);
+    if (m->lra)
+        for (int64_t k = 1; k < m->points; k++) SFX(lra_lanes)(m, scratch, k);
+}
+
 /* Phase 2 of a substep (steps 3 and 4): the constraints of the solver, then the velocities
  * from the motion and the positions. Features: BEND, SHAPE, COLLIDE, MOTION (for shape). */
 HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, REAL *X, REAL *Y,
@@ -346,13 +361,7 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
                 SFX(distance_lanes)(m, scratch, k - 1, k, per_seg, per_seg ? AL(ROWP(SR, k - 1)) : NULL, ell, K->st_at,
                                     K->st_w2, lam_s ? lam_s + (k - 1) * DB : NULL);
             // clang-format on
-            if (F & HB_F_BEND) {
-                SFX(bend_lanes)(m, K, scratch, BR, stride, 0);
-                SFX(bend_lanes)(m, K, scratch, BR, stride, 1);
-            }
-            if (F & HB_F_SHAPE) SFX(shape_lanes)(m, K, scratch, q, RX, RY, RZ, stride, F);
-            if (m->lra)
-                for (int64_t k = 1; k < P; k++) SFX(lra_lanes)(m, scratch, k);
+            SFX(bend_shape_lra_lanes)(m, K, q, RX, RY, RZ, BR, stride, scratch, F);
             if (F & HB_F_COLLIDE)
                 for (int64_t k = 1; k < P; k++) SFX(collide_lanes)(m, scratch, k, K);
         }
@@ -361,13 +370,7 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
         return;
     }
     for (int64_t it = 0; it < m->iterations; it++) {
-        if (F & HB_F_BEND) {
-            SFX(bend_lanes)(m, K, scratch, BR, stride, 0);
-            SFX(bend_lanes)(m, K, scratch, BR, stride, 1);
-        }
-        if (F & HB_F_SHAPE) SFX(shape_lanes)(m, K, scratch, q, RX, RY, RZ, stride, F);
-        if (m->lra)
-            for (int64_t k = 1; k < P; k++) SFX(lra_lanes)(m, scratch, k);
+        SFX(bend_shape_lra_lanes)(m, K, q, RX, RY, RZ, BR, stride, scratch, F);
     }
     /* §3.7 follow the leader, point by point; as soon as d_k is known, point k − 1 is final:
      * v_{k−1} = (p − x)/h − (s/h)·d_k and x_{k−1} = p (the oracle's step 4 for that point) */
