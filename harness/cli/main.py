@@ -516,8 +516,11 @@ def cmd_stability(args):
     if args.from_csv:
         stability_report.report_from_csv(args.from_csv, report_dir=args.report_dir)
         return 0
+    if args.scene and args.slice:
+        raise HarnessError("stability: --scene runs its own slice (substeps against iterations): drop --slice", code=2)
     csv_path = stability.run_study(
         slices=tuple(args.slice or stability.SLICE_NAMES),
+        scene=args.scene,
         out_dir=args.out,
         **options(args, "quick strands frames jobs gpu timeout"),
     )
@@ -1004,6 +1007,11 @@ def parser():
     )
     sb.add_argument("--quick", action="store_true", help="a coarser grid (about a quarter of the cells)")
     sb.add_argument("--slice", action="append", choices=SLICE_NAMES, help="run only this slice (repeatable)")
+    sb.add_argument(
+        "--scene",
+        help="a dynamic scene (name or .toml path, e.g. a groom's): substeps against iterations over it instead of "
+        "the slices",
+    )
     sb.add_argument("--strands", type=whole(1), default=STRANDS, help=f"strands per cell (default {STRANDS})")
     sb.add_argument("--frames", type=whole(1), default=FRAMES, help=f"frames per cell (default {FRAMES}: 1 s)")
     case_options(

@@ -11,7 +11,7 @@ import pandas as pd
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, display
-from harness.studies.stability_slices import BLOWN_UP, LEGACY, OTHER, SLICES, VERDICTS
+from harness.studies.stability_slices import BLOWN_UP, LEGACY, OTHER, SLICES, VERDICTS, axis
 
 ORDER = VERDICTS + LEGACY + OTHER
 COLOURS = {
@@ -65,7 +65,8 @@ def axis_of(name, key):
             for a in (s.rows, s.cols):
                 if a.key == key:
                     return a.label, a.unit
-    return key.lstrip("-"), ""
+    a = axis(key)  # a slice over a user's scene (stability --scene) takes the shared axes
+    return (a.label, a.unit) if a else (key.lstrip("-"), "")
 
 
 def ordered(values):
@@ -253,7 +254,7 @@ def write_markdown(rows, path, info, pngs):
     for s in ordered(rows["slice"]):
         part = rows[rows["slice"] == s]
         title = next((x.title for x in SLICES if x.name == s), s)
-        base = next((x.scene for x in SLICES if x.name == s), "?")
+        base = next((x.scene for x in SLICES if x.name == s), "the scene named in its title")
         lines += [f"### {title}", "", f"Base scene `{base}`; picture: [{pngs[s].name}]({pngs[s].name}).", ""]
         for lab in labels:
             for solver in ordered(part["solver"]):

@@ -45,7 +45,7 @@ from harness.core.progress import Progress
 from harness.io import files
 from harness.io.files import write_json
 from harness.io.trajectory import open_trajectory
-from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES
+from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES, scene_slice
 
 STRANDS = 16
 FRAMES = 60  # one second at the base scenes' Δt = 1/60 s
@@ -209,6 +209,7 @@ def cells(slices, quick):
 
 def measure(
     slices=SLICE_NAMES,
+    scene=None,
     quick=False,
     strands=STRANDS,
     frames=FRAMES,
@@ -223,6 +224,11 @@ def measure(
     if unknown:
         raise HarnessError(f"stability: unknown slice(s) {', '.join(unknown)} (known: {', '.join(SLICE_NAMES)})")
     chosen = [s for s in SLICES if s.name in slices]
+    if scene is not None:  # a user's scene: its own substeps × iterations slice instead
+        base = scenes.load_scene(scene)
+        if base.model != "dynamic":
+            raise HarnessError(f"stability: --scene {scene} is not a dynamic scene", code=2)
+        chosen = [scene_slice(scene)]
     bes = backends(gpu, log)
     declared = {be: variants.declared(be.backend, be.build) for be in bes}  # solvers, precisions
     todo = [

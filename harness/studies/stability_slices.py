@@ -2,6 +2,7 @@
 slices (two axes over a base scene each) and the verdicts of a cell. Runs nothing."""
 
 from dataclasses import dataclass
+from pathlib import Path
 
 # mildest first; a blown-up cell (docs/model.md §3.8) is split by cause: escaped (a point
 # farther than 2L from its root, every number finite) or diverged (a NaN or Inf)
@@ -32,6 +33,7 @@ class Slice:
 
 
 SUBSTEPS = Axis("--substeps", "S", (1, 2, 4, 8, 16, 32, 64), (1, 4, 16, 64))
+ITERATIONS = Axis("--iterations", "I", (1, 2, 4, 8, 16, 32, 64, 128), (1, 8, 128))
 # The base is the shipped still scene (gravity, the collider, damping 0.5, S = 8, I = 2),
 # so that one slice changes one or two things a user would; wind acts only through drag,
 # so the wind slice declares the default scene's drag and gusts.
@@ -74,7 +76,7 @@ SLICES = (
         "dynamic",
         (),
         SUBSTEPS,
-        Axis("--iterations", "I", (1, 2, 4, 8, 16, 32, 64, 128), (1, 8, 128)),
+        ITERATIONS,
     ),
     Slice(
         "curly-substeps-iterations",
@@ -82,7 +84,7 @@ SLICES = (
         "curly",
         (),
         SUBSTEPS,
-        Axis("--iterations", "I", (1, 2, 4, 8, 16, 32, 64, 128), (1, 8, 128)),
+        ITERATIONS,
     ),
     Slice(
         "motion",
@@ -115,3 +117,16 @@ SLICES += (
     ),
 )
 SLICE_NAMES = tuple(s.name for s in SLICES)
+
+
+def scene_slice(scene):
+    """Substeps against iterations over any dynamic scene (a user's groom: `stability --scene`),
+    named after the scene."""
+    stem = Path(scene).stem if str(scene).endswith(".toml") else str(scene)
+    return Slice(f"{stem}-substeps-iterations", f"{stem}: substeps against iterations ({scene})", str(scene), (),
+                 SUBSTEPS, ITERATIONS)  # fmt: skip
+
+
+def axis(key):
+    """An axis of the slices by its flag (the same flag has one label and unit in every slice)."""
+    return next((a for s in SLICES for a in (s.rows, s.cols) if a.key == key), None)

@@ -191,3 +191,22 @@ def test_scene_head_center_refused(data, words):
     with pytest.raises(scenes.SceneError) as e:
         scenes.scene_from_dict({"model": "dynamic", "stages": ["init", "simulate"], **data}, "x", "scene x")
     assert words in str(e.value)
+
+
+def test_the_stability_map_runs_on_a_users_groom(tmp_path, off_sphere):
+    """`harness stability --scene FILE` runs substeps against iterations over a user's groom scene,
+    named after it, and its report reads the shared axes; --scene with --slice is refused."""
+    from harness.cli.main import main as harness_main
+    from harness.render import stability_report
+    from harness.studies import stability, stability_slices
+
+    scene = tmp_path / "mylock.toml"
+    scene.write_text(SCENE.format(head=f"[head]\ncenter = [{centre_arg((0, 0, 0))}]\n"))
+    rows, _, _ = stability.measure(scene=str(scene), quick=True, strands=2, frames=2, jobs=2, gpu="no",
+                                   log=lambda *_: None)  # fmt: skip
+    assert {r["slice"] for r in rows} == {"mylock-substeps-iterations"}
+    assert {(int(r["row"]), int(r["col"])) for r in rows} == {(s, i) for s in (1, 4, 16, 64) for i in (1, 8, 128)}
+    assert all(r["verdict"] in stability_slices.VERDICTS for r in rows), {r["verdict"] for r in rows}
+    assert stability_report.axis_of("mylock-substeps-iterations", "--iterations") == ("I", "")
+    assert harness_main(["stability", "--scene", str(scene), "--slice", "motion", "--out", str(tmp_path / "s")]) == 2
+    assert not (tmp_path / "s").exists()
