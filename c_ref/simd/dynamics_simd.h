@@ -39,6 +39,10 @@ extern "C" {
 #ifndef HB_SIMD_DYN_PREFETCH
 #define HB_SIMD_DYN_PREFETCH 1
 #endif
+/* __builtin_prefetch's locality of those requests (3: L1, 2: L2, 1: L3 on x86). */
+#ifndef HB_SIMD_DYN_PREFETCH_HINT
+#define HB_SIMD_DYN_PREFETCH_HINT 2
+#endif
 
 /* Reals of scratch one block needs (allocate 64-byte aligned). */
 int64_t hb_simd_dyn_scratch_reals(int64_t points);

@@ -196,7 +196,7 @@ HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
             const REAL *rows[6] = {ROWP(X, k), ROWP(Y, k), ROWP(Z, k), ROWP(VX, k), ROWP(VY, k), ROWP(VZ, k)};
             for (int a = 0; a < 6; a++)
                 for (uintptr_t b = DB * sizeof(REAL); b < 2 * DB * sizeof(REAL); b += 64)
-                    __builtin_prefetch((const void *)((uintptr_t)rows[a] + b), 0, 2);
+                    __builtin_prefetch((const void *)((uintptr_t)rows[a] + b), 0, HB_SIMD_DYN_PREFETCH_HINT);
         }
         if (k == 0) continue;
         const REAL *restrict x = AL(ROWP(X, k)), *restrict y = AL(ROWP(Y, k)), *restrict z = AL(ROWP(Z, k));
