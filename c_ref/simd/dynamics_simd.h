@@ -35,9 +35,10 @@ extern "C" {
 #define HB_SIMD_DYN_BLOCK 256
 #endif
 
-/* 1: the last substep of a block requests the next block's rows of x and v (docs/cpu_simd.md). */
+/* 1: the last substep of a block requests the next block's rows of x and v. Off: on the GPU
+ * node's Xeon it made the memory-bound case 18% slower (docs/cpu_simd.md). */
 #ifndef HB_SIMD_DYN_PREFETCH
-#define HB_SIMD_DYN_PREFETCH 1
+#define HB_SIMD_DYN_PREFETCH 0
 #endif
 /* __builtin_prefetch's locality of those requests (3: L1, 2: L2, 1: L3 on x86). */
 #ifndef HB_SIMD_DYN_PREFETCH_HINT

@@ -323,10 +323,21 @@ def curly_sweep(root, gpu, say, shard=None, budget=None):
     return failed
 
 
-def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, shard=None, budget=None):
+def validate_first(out=None, gpu="auto", log=None):
+    """Only the validation of run() (the bench validates both models before it times anything)."""
+    say = log or (lambda m: print(m, flush=True))
+    runner.require_binary(binary_path("cpu"))
+    sweep_dir = (Path(out) if out else LOCAL_RUN) / SWEEP
+    sweep_dir.mkdir(parents=True, exist_ok=True)
+    builds, gpu_note = gpu_plan(gpu)
+    validate(sweep_dir, builds, gpu_note, say)
+
+
+def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, shard=None, budget=None, validated=False):
     """`shard`: its share of the sweep and the stability map, the other studies on shard 1,
     no report; `budget` (core.budget.Budget): the sweep fits its share of the time left, the
-    studies run while time is left; what is left out goes to OUT/budget.json and the report."""
+    studies run while time is left; what is left out goes to OUT/budget.json and the report;
+    `validated`: validate_first ran."""
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
     root = Path(out) if out else LOCAL_RUN
@@ -335,7 +346,8 @@ def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, sha
     builds, gpu_note = gpu_plan(gpu)
     if gpu_note:
         say(f"harness: dynamic GPU rows skipped: {gpu_note}")
-    validate(sweep_dir, builds, gpu_note, say)
+    if not validated:
+        validate(sweep_dir, builds, gpu_note, say)
     gate = TierGate(budget.allowance("dynamic sweep")) if budget else None
     if gate:
         say(f"harness: budget: the dynamic sweep gets {gate.allowance:.0f} s of the {budget.left():.0f} s left")

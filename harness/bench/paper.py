@@ -148,10 +148,29 @@ def validate(sweep, out_dir, builds, gpu_note, say):
     validation.validate(make, "validation", out_dir, builds, gpu_note, say, header)
 
 
-def run(sweep_ref="default", out=None, gpu="auto", report_dir=None, log=None, shard=None, budget=None, root=None):
+def validate_first(sweep_ref="default", out=None, gpu="auto", log=None):
+    """Only the validation of run() (the bench validates both models before it times anything)."""
+    say = log or (lambda m: print(m, flush=True))
+    runner.require_binary(binary_path("cpu"))
+    sweep = load_sweep(sweep_ref)
+    builds, gpu_note = gpu_plan(gpu)
+    validate(sweep, output_dir(out if out else RESULTS / sweep.name), builds, gpu_note, say)
+
+
+def run(
+    sweep_ref="default",
+    out=None,
+    gpu="auto",
+    report_dir=None,
+    log=None,
+    shard=None,
+    budget=None,
+    root=None,
+    validated=False,
+):
     """`shard`: only its share of the sweep (no report: harness merge joins the shards);
     `budget` (core.budget.Budget): the sweep's sizes fit its share of the time left, what is
-    left out recorded in ROOT/budget.json and the report."""
+    left out recorded in ROOT/budget.json and the report; `validated`: validate_first ran."""
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
     sweep = load_sweep(sweep_ref)
@@ -160,7 +179,8 @@ def run(sweep_ref="default", out=None, gpu="auto", report_dir=None, log=None, sh
     builds, gpu_note = gpu_plan(gpu)
     if gpu_note:
         say(f"harness: GPU rows skipped: {gpu_note}")
-    validate(sweep, out_dir, builds, gpu_note, say)
+    if not validated:
+        validate(sweep, out_dir, builds, gpu_note, say)
     gate = TierGate(budget.allowance("paper sweep")) if budget else None
     if gate:
         say(f"harness: budget: the paper sweep gets {gate.allowance:.0f} s of the {budget.left():.0f} s left")

@@ -218,10 +218,25 @@ def cmd_bench(args):
     if shard:
         command = f"bench --model {args.model} --sweep {args.sweep}" + (" --full-studies" if args.full_studies else "")
         merge.write_record(root, shard, sweeps, command)
+    # both models are validated before anything is timed; under a budget the validations are
+    # its fixed cost and the sweeps and studies share what they leave
+    if args.model in ("all", "paper"):
+        bench_paper.validate_first(args.sweep, out=root / "sweep", gpu=args.gpu)
+    if args.model in ("all", "dynamic"):
+        bench_dynamic.validate_first(out=root, gpu=args.gpu)
+    if plan:
+        budget.say_fixed_cost(plan)
     code = 0
     if args.model in ("all", "paper"):
         code = bench_paper.run(
-            args.sweep, out=root / "sweep", gpu=args.gpu, report_dir=report_dir, shard=shard, budget=plan, root=root
+            args.sweep,
+            out=root / "sweep",
+            gpu=args.gpu,
+            report_dir=report_dir,
+            shard=shard,
+            budget=plan,
+            root=root,
+            validated=True,
         )
     if args.model in ("all", "dynamic"):
         code = (
@@ -232,6 +247,7 @@ def cmd_bench(args):
                 quick_studies=not args.full_studies,
                 shard=shard,
                 budget=plan,
+                validated=True,
             )
             or code
         )

@@ -60,6 +60,20 @@ class Budget:
         return {"budget_s": self.seconds, "used_s": round(self.clock() - self.start, 1), "left_out": self.left_out}
 
 
+def say_fixed_cost(plan, say=None):
+    """One line after the validations (which always run): what they took of the budget, and
+    when nothing is left, that only each sweep's smallest tier runs and no study."""
+    say = say or (lambda m: print(m, flush=True))
+    used = plan.seconds - plan.left()
+    if plan.left() > 0:
+        say(f"harness: budget: the validations took {used:.0f} s; {plan.left():.0f} s left for the sweeps and studies")
+    else:
+        say(
+            f"harness: budget: the validations alone took {used:.0f} s of the {plan.seconds:.0f} s budget: "
+            f"each sweep runs its smallest size only and no study runs (give at least {used + 60:.0f} s for more)"
+        )
+
+
 def tiers(cases, size):
     """The cases grouped by size(case), smallest first (the sweep's order kept within a tier)."""
     out = {}

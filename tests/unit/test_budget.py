@@ -100,3 +100,15 @@ def test_a_study_takes_the_largest_size_that_fits():
     assert budget.largest_that_fits(ladder, lambda n: n * per_strand, 500.0) == 100_000
     assert budget.largest_that_fits(ladder, lambda n: n * per_strand, 100.0) == 30_000
     assert budget.largest_that_fits(ladder, lambda n: n * per_strand, 1.0) == 1_000  # none fits: the smallest
+
+
+def test_the_validations_fixed_cost_is_said_and_an_overrun_says_what_still_runs():
+    clock, lines = Clock(), []
+    b = Budget(300.0, clock=clock)
+    clock.t = 120.0
+    budget.say_fixed_cost(b, lines.append)
+    assert lines == ["harness: budget: the validations took 120 s; 180 s left for the sweeps and studies"]
+    clock.t = 330.0
+    budget.say_fixed_cost(b, lines.append)
+    assert "the validations alone took 330 s of the 300 s budget" in lines[1]
+    assert "smallest size only and no study runs (give at least 390 s for more)" in lines[1]
