@@ -30,7 +30,7 @@ from harness.bench import validation
 from harness.bench.validation import gpu_plan
 from harness.check import diff_dynamic
 from harness.core import runner, scenes, variants
-from harness.core.budget import TierGate, largest_that_fits
+from harness.core.budget import TierGate, largest_that_fits, run_study
 from harness.core.paths import LOCAL_RUN, REPORT, binary_path, display
 from harness.core.scenes import with_frames
 from harness.io import results_data
@@ -264,6 +264,13 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
         say(f"harness: {study}: left out to fit the budget (no time left)")
         return False
 
+    def within(study, fn, *outputs):
+        """fn() now, or under a budget stopped when it runs out (core.budget.run_study)."""
+        if budget is None:
+            fn()
+            return True
+        return run_study(budget, study, fn, outputs, say)
+
     first = shard is None or shard.first
     if first and fits("featurecost"):
         fc = root / "featurecost"
@@ -277,36 +284,62 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
                     f"the CPU rows at {FEATURECOST_STRANDS[0]} strands (measured at {strands})",
                     "left out to fit the budget: the larger size's estimate did not fit",
                 )
-        say(f"harness: featurecost --backend cpu --strands {strands}")
-        featurecost.measure(backend="cpu", strands=strands, out=fc / "cpu.csv")
-        if builds:  # the sweep's fastest variant (else every one that simulates), at a size that fills the GPU
-            for v in fastest_gpu_variants(root / SWEEP):
+        gpu_variants = fastest_gpu_variants(root / SWEEP) if builds else []
+
+        def measure_featurecost():
+            say(f"harness: featurecost --backend cpu --strands {strands}")
+            featurecost.measure(backend="cpu", strands=strands, out=fc / "cpu.csv")
+            for v in gpu_variants:  # the sweep's fastest variant (else every one that simulates), filling the GPU
                 say(f"harness: featurecost --backend cuda --variant {v} --strands 1000000")
                 featurecost.measure(backend="cuda", variant=v, strands=1_000_000, out=fc / f"cuda-{v}.csv")
+
+        within("featurecost", measure_featurecost, fc)
     gpu = "auto" if builds else "no"
+    reports = [report_dir] if render else []
     if first and fits("reduced"):
-        say(f"harness: reduced{' --quick' if quick else ''}")
-        plan = reduced.Plan.quick(gpu=gpu) if quick else reduced.Plan(gpu=gpu)
-        reduced.measure(plan, out=root / "reduced" / "reduced.csv", progress=say)
+
+        def measure_reduced():
+            say(f"harness: reduced{' --quick' if quick else ''}")
+            plan = reduced.Plan.quick(gpu=gpu) if quick else reduced.Plan(gpu=gpu)
+            reduced.measure(plan, out=root / "reduced" / "reduced.csv", progress=say)
+
+        within("reduced", measure_reduced, root / "reduced")
     for scene, study in ACCURACY_STUDIES:
         if first and fits(study):
-            accuracy(root, scene, gpu, quick, say, report_dir)
+            within(
+                study,
+                lambda s=scene: accuracy(root, s, gpu, quick, say, report_dir),
+                root / results_name(scene),
+                *reports,
+            )
     if fits("stability"):
-        say(f"harness: stability{' --quick' if quick else ''} --gpu {gpu}" + (f" (shard {shard})" if shard else ""))
-        csv_path = stability.run_study(quick=quick, gpu=gpu, out_dir=root / "stability", shard=shard)
-        if render:
-            stability_report.report_from_csv(csv_path, report_dir=report_dir, log=say)
+
+        def measure_stability():
+            say(f"harness: stability{' --quick' if quick else ''} --gpu {gpu}" + (f" (shard {shard})" if shard else ""))
+            csv_path = stability.run_study(quick=quick, gpu=gpu, out_dir=root / "stability", shard=shard)
+            if render:
+                stability_report.report_from_csv(csv_path, report_dir=report_dir, log=say)
+
+        within("stability", measure_stability, root / "stability", *reports)
     if first and fits("peer"):
-        say("harness: peer")
-        try:
-            peer.run_study(peer.Plan(out=str(root / "peer")), log=say)
-        except peer.PeerUnavailable as e:  # an optional dependency: skipped, not failed
-            say(f"harness: peer: skipped: {e}")
-        else:
-            peer_report.write(root / "peer", root / "peer")
+
+        def measure_peer():
+            say("harness: peer")
+            try:
+                peer.run_study(peer.Plan(out=str(root / "peer")), log=say)
+            except peer.PeerUnavailable as e:  # an optional dependency: skipped, not failed
+                say(f"harness: peer: skipped: {e}")
+            else:
+                peer_report.write(root / "peer", root / "peer")
+
+        within("peer", measure_peer, root / "peer")
     if render and fits("animate"):
-        say("harness: animate")
-        animate.run(out=Path(report_dir) / "dynamic.gif", force=True, log=say, state_dir=root / "animation")
+
+        def make_animation():
+            say("harness: animate")
+            animate.run(out=Path(report_dir) / "dynamic.gif", force=True, log=say, state_dir=root / "animation")
+
+        within("animate", make_animation, root / "animation", *reports)
 
 
 def curly_sweep(root, gpu, say, shard=None, budget=None):

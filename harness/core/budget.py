@@ -7,9 +7,14 @@ per-strand cost only falls as the size grows, so this over-estimates), and the t
 larger ones are left out when the estimate does not fit the time left to the step. The
 bench gives each step a declared share of what is left when it starts (SHARES)."""
 
+import multiprocessing
+import os
 import re
+import signal
+import sys
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from harness import HarnessError
 
@@ -58,6 +63,58 @@ class Budget:
 
     def record(self):
         return {"budget_s": self.seconds, "used_s": round(self.clock() - self.start, 1), "left_out": self.left_out}
+
+
+def _entries(dirs):
+    """Every file and folder in and under `dirs` (the folders themselves included)."""
+    return {q for d in map(Path, dirs) if d.exists() for q in [d, *d.rglob("*")]}
+
+
+def _study_child(fn):
+    os.setsid()  # its own process group: the binaries it starts end with it
+    code = 0
+    try:
+        fn()
+    except HarnessError as e:
+        print(f"harness: error: {e}", file=sys.stderr)
+        code = e.code or 1
+    except Exception as e:  # one line, as the CLI would say it
+        print(f"harness: error: {type(e).__name__}: {e}", file=sys.stderr)
+        code = 1
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
+
+
+def run_study(plan, study, fn, outputs, say):
+    """fn() (a study: it measures and writes into the folders `outputs`) in a child process
+    that is stopped, with every binary it started, when the budget runs out; the files it
+    had added by then are removed and the study is recorded as left out. True when it ran
+    to the end; a HarnessError when it failed."""
+    before = _entries(outputs)
+    child = multiprocessing.get_context("fork").Process(target=_study_child, args=(fn,))
+    sys.stdout.flush()
+    sys.stderr.flush()
+    child.start()
+    child.join(max(plan.left(), 0.0))
+    if child.is_alive():
+        try:
+            os.killpg(child.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        child.join()
+        for q in sorted(_entries(outputs) - before, key=lambda q: len(q.parts), reverse=True):  # deepest first
+            if q.is_dir():
+                q.rmdir()
+            else:
+                q.unlink(missing_ok=True)
+        plan.leave_out(study, "the whole study", "stopped when the budget ran out; what it had written was removed")
+        say(f"harness: {study}: stopped when the budget ran out (what it had written is removed)")
+        return False
+    if child.exitcode != 0:
+        code = child.exitcode if child.exitcode > 0 else 1
+        raise HarnessError(f"{study} failed (exit {child.exitcode}; its error is above)", code=code)
+    return True
 
 
 def say_fixed_cost(plan, say=None):
