@@ -182,19 +182,19 @@ HOSTCHECK_NVCC := $(NVCC) -std=c++17 -Ic_ref -Icuda -Xcompiler -ffp-contract=off
 hostcheck: $(HOSTCHECK_BINS)
 $(BUILD)/hostcheck/model_hostcheck_reference: HOSTCHECK_MODE := -O2 -DHB_REFERENCE_ARITHMETIC=1
 $(BUILD)/hostcheck/model_hostcheck_free: HOSTCHECK_MODE := -O2
-$(BUILD)/hostcheck/model_hostcheck_%: cuda/hostcheck/model_hostcheck.cu cuda/model.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/model_hostcheck_%: cuda/hostcheck/model_hostcheck.cu cuda/model.cuh cuda/tmath.cuh $(C_HEADERS) \
   $(OBJ)/paper/model.o $(OBJ)/runtime/params.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) $(HOSTCHECK_MODE) $< $(OBJ)/paper/model.o $(OBJ)/runtime/params.o -o $@ -lm
-$(BUILD)/hostcheck/dyn_hostcheck: cuda/hostcheck/dyn_hostcheck.cu cuda/dyn_model.cuh cuda/dyn_kernels.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/dyn_hostcheck: cuda/hostcheck/dyn_hostcheck.cu cuda/hostcheck/hostcheck_scene.h cuda/dyn_model.cuh cuda/tmath.cuh cuda/dyn_kernels.cuh $(C_HEADERS) \
   $(OBJ)/dynamic/dynamics_f32.o $(OBJ)/dynamic/dynamics_f64.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
-$(BUILD)/hostcheck/post_hostcheck: cuda/hostcheck/post_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/dyn_post.cuh cuda/dyn_model.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/post_hostcheck: cuda/hostcheck/post_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/hostcheck/hostcheck_scene.h cuda/dyn_post.cuh cuda/dyn_model.cuh cuda/tmath.cuh $(C_HEADERS) \
   $(OBJ)/dynamic/dyn_followers.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
-$(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/dyn_lod.cuh cuda/dyn_model.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/dyn_lod.cuh cuda/dyn_model.cuh cuda/tmath.cuh $(C_HEADERS) \
   $(OBJ)/dynamic/dyn_lod.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm

@@ -350,6 +350,17 @@ static int64_t simd_run_stage(cpu_impl *c, hb_stage st)
 }
 #undef SIMD_STAGE
 
+#define SIMD_WIND_COLLIDE(T, SFX, M)                                                                                   \
+    do {                                                                                                               \
+        T *Y = c->pm[1], *Z = c->pm[2], *WY = c->keep ? c->pm_wind[0] : NULL, *WZ = c->keep ? c->pm_wind[1] : NULL;    \
+        _Pragma("omp parallel for schedule(static) reduction(+ : moved)") for (int64_t b = 0; b < NB; b++)             \
+        {                                                                                                              \
+            const int real = (int)(N - b * B < B ? N - b * B : B);                                                     \
+            moved += c->sm->wind_collide_##SFX(M, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,                  \
+                                               WZ ? WZ + b * B : NULL, S);                                             \
+        }                                                                                                              \
+    } while (0)
+
 /* wind then collide, one pass over the points (model_simd.h), the same bits as the two
  * stages; the wind frame is stored to pm_wind when the driver keeps it. Returns −1 when
  * pm_wind cannot be allocated. */
@@ -361,25 +372,11 @@ static int64_t simd_run_wind_collide(cpu_impl *c)
         if (!c->pm_wind[0] || !c->pm_wind[1]) return -1;
     }
     int64_t moved = 0;
-    if (c->scene.precision == HB_FP32) {
-        float *Y = c->pm[1], *Z = c->pm[2], *WY = c->keep ? c->pm_wind[0] : NULL, *WZ = c->keep ? c->pm_wind[1] : NULL;
-#pragma omp parallel for schedule(static) reduction(+ : moved)
-        for (int64_t b = 0; b < NB; b++) {
-            const int real = (int)(N - b * B < B ? N - b * B : B);
-            moved += c->sm->wind_collide_f32(&c->m32, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,
-                                             WZ ? WZ + b * B : NULL, S);
-        }
-    } else {
-        double *Y = c->pm[1], *Z = c->pm[2], *WY = c->keep ? c->pm_wind[0] : NULL, *WZ = c->keep ? c->pm_wind[1] : NULL;
-#pragma omp parallel for schedule(static) reduction(+ : moved)
-        for (int64_t b = 0; b < NB; b++) {
-            const int real = (int)(N - b * B < B ? N - b * B : B);
-            moved += c->sm->wind_collide_f64(&c->m64, real, Y + b * B, Z + b * B, WY ? WY + b * B : NULL,
-                                             WZ ? WZ + b * B : NULL, S);
-        }
-    }
+    if (c->scene.precision == HB_FP32) SIMD_WIND_COLLIDE(float, f32, &c->m32);
+    else SIMD_WIND_COLLIDE(double, f64, &c->m64);
     return moved;
 }
+#undef SIMD_WIND_COLLIDE
 
 /* ---- the simd variant: the dynamic model (docs/cpu_simd.md, "The dynamic model") ------ */
 

@@ -66,10 +66,6 @@ __global__ void __launch_bounds__(kMaxThreads)
 }
 
 /* ---- the warp variant: one warp per strand, a lane per point ---- */
-template <typename T> __host__ __device__ constexpr int64_t warp_reals(int64_t P)
-{
-    return 15 * P;
-} /* x, v, p, d [3][P]; λ [3P] */
 
 template <typename T, class Feat>
 __global__ void __launch_bounds__(kMaxThreads)
@@ -81,12 +77,7 @@ __global__ void __launch_bounds__(kMaxThreads)
     const int lane = (int)(threadIdx.x & 31u), w = (int)(threadIdx.x >> 5), wpb = (int)(blockDim.x >> 5);
     const int64_t P = m.points, P3 = 3 * P;
     T *base = (T *)hb_dyn_smem + (int64_t)w * warp_reals<T>(P);
-    Strand<T> s;
-    s.x = Arr<T>{base, 1, P};
-    s.v = Arr<T>{base + 3 * P, 1, P};
-    s.p = Arr<T>{base + 6 * P, 1, P};
-    s.d = Arr<T>{base + 9 * P, 1, P};
-    s.lam = Arr1<T>{base + 12 * P, 1};
+    Strand<T> s = warp_strand(base, P);
     const Lanes ex{lane};
     /* the loop bound is the same for every lane of a warp: whole warps take each strand */
     (void)N;

@@ -29,7 +29,7 @@ template <typename T> HB_DHD T lod_knot(const T *x, Layout l, int64_t i, int64_t
 {
     T e[3];
     for (int c = 0; c < 3; c++) e[c] = lod_at(x, l, i, ps, b, c) - lod_at(x, l, i, ps, a, c);
-    return d_sqrt(d_sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]));
+    return m_sqrt(m_sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]));
 }
 
 /* Rendered point j (0 ≤ j < pr) of strand i: the values y (positions x, or velocities with

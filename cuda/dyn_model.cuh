@@ -36,6 +36,7 @@
 #include "dynamic/dynamics.h"  /* HB_F_*, hb_dyn_model_f32/f64 */
 #include "dynamic/obs_point.h" /* hb_obs_point: §3.8 per point, shared with the reference */
 #include "runtime/params.h"    /* HB_SOLVER_* */
+#include "tmath.cuh"           /* m_sqrt, m_sin: the float overloads for float */
 
 #if defined(__CUDACC__)
 #define HB_DHD __host__ __device__ __forceinline__
@@ -121,24 +122,6 @@ inline ObsScene obs_scene(const hb_scene *s)
     return o;
 }
 
-/* ---- math: the float functions for float, the double ones for double ---- */
-HB_DHD float d_sqrt(float x)
-{
-    return sqrtf(x);
-}
-HB_DHD double d_sqrt(double x)
-{
-    return sqrt(x);
-}
-HB_DHD float d_sin(float x)
-{
-    return sinf(x);
-}
-HB_DHD double d_sin(double x)
-{
-    return sin(x);
-}
-
 /* ---- policies ---- */
 template <unsigned F> struct StaticF {
     HB_DHD constexpr bool operator()(unsigned bit) const { return (F & bit) != 0u; }
@@ -171,6 +154,23 @@ template <typename T> struct Strand {
     Arr1<const T> seg_rest = {nullptr, 0}; /* §3.15 a groom's ℓ_k (b = nullptr: m.seg_len) */
 };
 
+/* The warp variant's strand in one warp's shared memory (cuda/dyn_kernels.cu k_warp, and its
+ * host check): x, v, p, d [3][P], λ [3P] from base; rest and bend_rest are the caller's. */
+template <typename T> HB_DHD constexpr int64_t warp_reals(int64_t P)
+{
+    return 15 * P;
+}
+template <typename T> HB_DHD Strand<T> warp_strand(T *base, int64_t P)
+{
+    Strand<T> s;
+    s.x = Arr<T>{base, 1, P};
+    s.v = Arr<T>{base + 3 * P, 1, P};
+    s.p = Arr<T>{base + 6 * P, 1, P};
+    s.d = Arr<T>{base + 9 * P, 1, P};
+    s.lam = Arr1<T>{base + 12 * P, 1};
+    return s;
+}
+
 struct Seq {
     template <class Fn> HB_DHD void each(int64_t b, int64_t e, int64_t step, Fn f) const
     {
@@ -202,7 +202,7 @@ HB_DHD bool distance_step(T ax, T ay, T az, T bx, T by, T bz, int move_a, T r, T
                           T &nz)
 {
     const T ex = bx - ax, ey = by - ay, ez = bz - az;
-    const T len = d_sqrt(ex * ex + ey * ey + ez * ez);
+    const T len = m_sqrt(ex * ex + ey * ey + ez * ez);
     if (len == (T)0) return false;
     const T c = len - r;
     const T wsum = move_a ? (T)2 : (T)1;
@@ -235,7 +235,7 @@ template <typename T> HB_DHD void distance(const Arr<T> &p, int64_t ia, int64_t 
 template <typename T> HB_DHD void shape_pull(T &p0, T &p1, T &p2, const T *t, T at, T &lambda)
 {
     const T ex = p0 - t[0], ey = p1 - t[1], ez = p2 - t[2];
-    const T c = d_sqrt(ex * ex + ey * ey + ez * ez);
+    const T c = m_sqrt(ex * ex + ey * ey + ez * ez);
     if (c == (T)0) return;
     const T dl = (-c - at * lambda) / ((T)1 + at);
     lambda = lambda + dl;
@@ -247,7 +247,7 @@ template <typename T> HB_DHD void shape_pull(T &p0, T &p1, T &p2, const T *t, T 
 /* head collision on a point held in three scalars */
 template <typename T> HB_DHD void collide_sphere(T &p0, T &p1, T &p2, T rc)
 {
-    const T len = d_sqrt(p0 * p0 + p1 * p1 + p2 * p2);
+    const T len = m_sqrt(p0 * p0 + p1 * p1 + p2 * p2);
     if (!(len < rc)) return;
     if (len == (T)0) {
         p0 = (T)0;
@@ -265,7 +265,7 @@ template <typename T> HB_DHD void collide_sphere(T &p0, T &p1, T &p2, T rc)
 template <typename T> HB_DHD void lra_point(T a0, T a1, T a2, T &p0, T &p1, T &p2, T len, int64_t k)
 {
     const T ex = p0 - a0, ey = p1 - a1, ez = p2 - a2;
-    const T d = d_sqrt(ex * ex + ey * ey + ez * ez);
+    const T d = m_sqrt(ex * ex + ey * ey + ez * ez);
     const T r = len * (T)k;
     if (d > r) {
         const T sc = r / d;
@@ -298,7 +298,7 @@ HB_DHD void velocity_predict(const DModel<T> &m, Feat has, T phase, T x0, T x1, 
     T vx = v0, vy = v1, vz = v2;
     if (has(HB_F_WIND)) {
         T gam = (T)1;
-        if (has(HB_F_GUST)) gam = (T)1 + m.gust * d_sin(phase - m.kappa * (m.dir_y * x1 + m.dir_z * x2));
+        if (has(HB_F_GUST)) gam = (T)1 + m.gust * m_sin(phase - m.kappa * (m.dir_y * x1 + m.dir_z * x2));
         vy = vy + h * (m.gravity_y + m.wind_y * gam);
         vz = vz + h * (m.wind_z * gam);
     } else {
@@ -323,7 +323,7 @@ template <typename T>
 HB_DHD void follow(T a0, T a1, T a2, T &p0, T &p1, T &p2, T seg, bool collide, T rc, T &d0, T &d1, T &d2)
 {
     const T ex = p0 - a0, ey = p1 - a1, ez = p2 - a2;
-    const T len = d_sqrt(ex * ex + ey * ey + ez * ez);
+    const T len = m_sqrt(ex * ex + ey * ey + ez * ez);
     T nq0, nq1, nq2;
     if (len > (T)0) {
         nq0 = a0 + seg * (ex / len);
@@ -481,7 +481,7 @@ template <typename T> HB_DHD void bend_rest(int64_t P, const Arr<const T> &rest,
     for (int64_t k = 1; k + 1 < P; k++) {
         const T ex = rest(k + 1, 0) - rest(k - 1, 0), ey = rest(k + 1, 1) - rest(k - 1, 1),
                 ez = rest(k + 1, 2) - rest(k - 1, 2);
-        out(k - 1) = d_sqrt(ex * ex + ey * ey + ez * ez);
+        out(k - 1) = m_sqrt(ex * ex + ey * ey + ez * ez);
     }
 }
 

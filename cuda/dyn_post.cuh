@@ -27,7 +27,7 @@ HB_DHD void carry(const At<T> &x, const At<const T> &rest, int64_t g, int64_t f,
 {
     T e[3], t[3], d[3], a[3], o[3];
     for (int c = 0; c < 3; c++) e[c] = rest(g, k, c) - rest(g, k - 1, c);
-    const T len = d_sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    const T len = m_sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
     for (int c = 0; c < 3; c++) d[c] = rest(f, k, c) - rest(g, k, c);
     for (int c = 0; c < 3; c++) t[c] = len > (T)0 ? e[c] / len : (T)0;
     if (q) {
@@ -40,7 +40,7 @@ HB_DHD void carry(const At<T> &x, const At<const T> &rest, int64_t g, int64_t f,
         }
     }
     for (int c = 0; c < 3; c++) e[c] = x(g, k, c) - x(g, k - 1, c);
-    const T rho = d_sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    const T rho = m_sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
     T r[3] = {o[0], o[1], o[2]};
     if (len > (T)0 && rho > (T)0) {
         T b[3];

@@ -42,6 +42,7 @@
 #include "paper/fast_trig.h" /* hb_atan2_fast, hb_sincos_fast (the free arithmetic, fp32) */
 #include "paper/model.h"     /* HB_SHELL_ULPS, hb_model_f32/f64 */
 #include "runtime/philox.h"  /* hb_draw_block, hb_u01, HB_HD = __host__ __device__ __forceinline__ */
+#include "tmath.cuh"         /* m_sqrt, m_asin, m_atan2: the float overloads for float */
 
 /* The reference arithmetic's per-point steps, written once with the C reference: instantiated
  * here as float and double overloads of one name (SFX(name) = name) at global scope,
@@ -96,31 +97,6 @@ template <typename M, typename T> inline Model<T> model_from(const M &m)
     return r;
 }
 
-/* ---- the math functions: the float overloads for float, the double ones for double ---- */
-HB_HD float m_sqrt(float x)
-{
-    return sqrtf(x);
-}
-HB_HD double m_sqrt(double x)
-{
-    return sqrt(x);
-}
-HB_HD float m_asin(float x)
-{
-    return asinf(x);
-}
-HB_HD double m_asin(double x)
-{
-    return asin(x);
-}
-HB_HD float m_atan2(float y, float x)
-{
-    return atan2f(y, x);
-}
-HB_HD double m_atan2(double y, double x)
-{
-    return atan2(y, x);
-}
 /* ---- the free arithmetic's functions: fp32 fast_trig.h, fp64 the library's ---------- */
 #ifndef HB_PAPER_MUFU
 #define HB_PAPER_MUFU 1

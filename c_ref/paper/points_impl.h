@@ -156,6 +156,31 @@ HB_HD void SFX(hb_collide_begin)(const REAL y0, const REAL z0, const REAL hair_o
     *inner2 = inner * inner;
 }
 
+/* docs/model.md §2.5: the point (y, z) inside the shell moved onto the intersection of the shell
+ * (radius rc, centre 0) with the circle of radius ℓ around the predecessor (qy, qz) at distance
+ * d > 0 from the centre, the candidate closest to (y, z) (ties: the upper one). The chord's foot
+ * lies at a = (d² + rc² − ℓ²) / 2d along the unit u towards the predecessor, the candidates at
+ * a·u ± hh·u⊥ with hh = √(rc² − a²), evaluated through t = d − a = ((d − rc)(d + rc) + ℓ²) / 2d
+ * and hh² = (rc − a)(rc + a), which avoid the cancellation of rc² − a² when ℓ ≪ rc
+ * (docs/decisions/paper-model.md, "collide_short_segment"). Shared by the simd variant's lanes. */
+HB_HD void SFX(hb_shell_chord)(const REAL qy, const REAL qz, const REAL d, const REAL rc, const REAL ell, REAL *y,
+                               REAL *z)
+{
+    const REAL t = ((d - rc) * (d + rc) + ell * ell) / ((REAL)2 * d);
+    const REAL a = d - t;
+    const REAL h2 = ((rc - d) + t) * (rc + a);
+    const REAL hh = SQRT(h2 > (REAL)0 ? h2 : (REAL)0);
+    const REAL uy = qy / d, uz = qz / d;
+    const REAL fy = a * uy, fz = a * uz;
+    const REAL y1 = fy + hh * uz, z1 = fz - hh * uy;
+    const REAL y2 = fy - hh * uz, z2 = fz + hh * uy;
+    const REAL e1 = (y1 - *y) * (y1 - *y) + (z1 - *z) * (z1 - *z);
+    const REAL e2 = (y2 - *y) * (y2 - *y) + (z2 - *z) * (z2 - *z);
+    const int upper = (e1 < e2) | ((e1 == e2) & (y1 >= y2));
+    *y = upper ? y1 : y2;
+    *z = upper ? z1 : z2;
+}
+
 /* Point (cy, cz), in place, after its predecessor (py, pz), which then moves on to it. A
  * point inside the shell moves to the intersection of the shell circle with the circle of
  * radius ℓ around its predecessor that is closest to where it was (a tie takes the upper
@@ -183,33 +208,11 @@ HB_HD int SFX(hb_collide_step)(const REAL ell, const REAL rc, const REAL inner2,
         }
     }
     if (y * y + z * z < inner2) {
-        /* Intersect the shell (radius rc, centre 0) with the circle of radius ℓ around the
-         * predecessor at distance d from the centre: the chord's foot lies at
-         * a = (d² + rc² − ℓ²) / 2d along the unit u towards the predecessor, the candidates
-         * at a·u ± hh·u⊥ with hh = √(rc² − a²). Evaluated through
-         * t = d − a = ((d − rc)(d + rc) + ℓ²) / 2d and hh² = (rc − a)(rc + a), which avoid
-         * the cancellation of rc² − a² when ℓ ≪ rc (docs/decisions/paper-model.md,
-         * "collide_short_segment"). */
+        /* onto the shell's intersection with the circle of radius ℓ around the predecessor */
         const REAL d2 = qy * qy + qz * qz;
         const REAL d = SQRT(d2);
         if (d > (REAL)0) {
-            const REAL t = ((d - rc) * (d + rc) + ell * ell) / ((REAL)2 * d);
-            const REAL a = d - t;
-            const REAL h2 = ((rc - d) + t) * (rc + a);
-            const REAL hh = SQRT(h2 > (REAL)0 ? h2 : (REAL)0);
-            const REAL uy = qy / d, uz = qz / d;
-            const REAL fy = a * uy, fz = a * uz;
-            const REAL y1 = fy + hh * uz, z1 = fz - hh * uy;
-            const REAL y2 = fy - hh * uz, z2 = fz + hh * uy;
-            const REAL e1 = (y1 - y) * (y1 - y) + (z1 - z) * (z1 - z);
-            const REAL e2 = (y2 - y) * (y2 - y) + (z2 - z) * (z2 - z);
-            if (e1 < e2 || (e1 == e2 && y1 >= y2)) {
-                y = y1;
-                z = z1;
-            } else {
-                y = y2;
-                z = z2;
-            }
+            SFX(hb_shell_chord)(qy, qz, d, rc, ell, &y, &z);
             *moved = 1;
         }
     }

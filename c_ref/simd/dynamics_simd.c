@@ -19,6 +19,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "dynamic/obs_point.h" /* hb_obs_point: §3.8 per point, shared with the reference */
 #include "simd/model_simd.h"
 
 #if !defined(__x86_64__) || !defined(__GLIBC__)

@@ -541,31 +541,19 @@ void SFX(hb_simd_dyn_observe)(const hb_scene *s, const REAL *X, const REAL *Y, c
             const REAL *vx = ROWP(VX, k) + base, *vy = ROWP(VY, k) + base, *vz = ROWP(VZ, k) + base;
 #pragma omp simd
             for (int j = 0; j < n; j++) {
-                const double a0 = (double)x[j], a1 = (double)y[j], a2 = (double)z[j];
-                const double w0 = (double)vx[j], w1 = (double)vy[j], w2v = (double)vz[j];
-                const double e0 = a0 - (double)xp[j], e1 = a1 - (double)yp[j], e2 = a2 - (double)zp[j];
-                const double r0 = a0 - (double)x0[j], r1 = a1 - (double)y0[j], r2v = a2 - (double)z0[j];
-                double l2 = 0.0, r2 = 0.0, n2 = 0.0, w2 = 0.0;
-                l2 += e0 * e0;
-                r2 += r0 * r0;
-                n2 += a0 * a0;
-                w2 += w0 * w0;
-                l2 += e1 * e1;
-                r2 += r1 * r1;
-                n2 += a1 * a1;
-                w2 += w1 * w1;
-                l2 += e2 * e2;
-                r2 += r2v * r2v;
-                n2 += a2 * a2;
-                w2 += w2v * w2v;
-                const int fin = (fabs(a0) <= big) & (fabs(a1) <= big) & (fabs(a2) <= big) & (fabs(w0) <= big) &
-                                (fabs(w1) <= big) & (fabs(w2v) <= big);
-                const double st = fabs(sqrt(l2) / (seg64 ? seg64[(base + j) * (P - 1) + k - 1] : ell) - 1.0);
-                smax[j] = st > smax[j] ? st : smax[j];
-                const double pen = rc - sqrt(n2);
-                if (collider) pmax[j] = pen > pmax[j] ? pen : pmax[j];
-                v2[j] += w2;
-                blown[j] |= (!fin) | (r2 > far2);
+                const double xk[3] = {(double)x[j], (double)y[j], (double)z[j]};
+                const double vk[3] = {(double)vx[j], (double)vy[j], (double)vz[j]};
+                const double xq[3] = {(double)xp[j], (double)yp[j], (double)zp[j]};
+                const double xr[3] = {(double)x0[j], (double)y0[j], (double)z0[j]};
+                const int fin = (fabs(xk[0]) <= big) & (fabs(xk[1]) <= big) & (fabs(xk[2]) <= big) &
+                                (fabs(vk[0]) <= big) & (fabs(vk[1]) <= big) & (fabs(vk[2]) <= big);
+                const double seg = seg64 ? seg64[(base + j) * (P - 1) + k - 1] : ell;
+                double sm = smax[j], pm = pmax[j], w2 = v2[j];
+                const int far = hb_obs_point(xk, xq, xr, vk, seg, collider, rc, far2, &sm, &pm, &w2);
+                smax[j] = sm;
+                pmax[j] = pm;
+                v2[j] = w2;
+                blown[j] |= (!fin) | far;
             }
         }
         for (int j = 0; j < n; j++) {

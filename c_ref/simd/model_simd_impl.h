@@ -352,28 +352,18 @@ static inline __attribute__((always_inline)) void SFX(hb_collide_point)(SFX(hb_c
             }
         }
         if (any_inside) {
-            /* inside the shell: the intersection of the shell with the circle of radius ℓ
-             * around the predecessor closest to the point (ties: the upper one), through
-             * t = d − a and hh² = (rc − d + t)(rc + a) as in model_impl.h */
+            /* inside the shell: onto the shell's intersection with the circle of radius ℓ
+             * around the predecessor, points_impl.h's hb_shell_chord lane by lane */
 #pragma omp simd
             for (int j = j0; j < j1; j++) {
-                const REAL y = cs->py[j], z = cs->pz[j], c = cs->rc[j], cy = cs->ny[j], cz = cs->nz[j];
+                const REAL y = cs->py[j], z = cs->pz[j], cy = cs->ny[j], cz = cs->nz[j];
                 const REAL d2 = y * y + z * z;
                 const REAL d = SQRT(d2);
                 const ITYPE proj = cs->inside[j] & (d > (REAL)0);
-                const REAL t = ((d - c) * (d + c) + ell * ell) / ((REAL)2 * d);
-                const REAL a = d - t;
-                const REAL h2 = ((c - d) + t) * (c + a);
-                const REAL hh = SQRT(h2 > (REAL)0 ? h2 : (REAL)0);
-                const REAL uy = y / d, uz = z / d;
-                const REAL fy = a * uy, fz = a * uz;
-                const REAL y1 = fy + hh * uz, z1 = fz - hh * uy;
-                const REAL y2 = fy - hh * uz, z2 = fz + hh * uy;
-                const REAL e1 = (y1 - cy) * (y1 - cy) + (z1 - cz) * (z1 - cz);
-                const REAL e2 = (y2 - cy) * (y2 - cy) + (z2 - cz) * (z2 - cz);
-                const ITYPE upper = (e1 < e2) | ((e1 == e2) & (y1 >= y2));
-                cs->ny[j] = proj ? (upper ? y1 : y2) : cy;
-                cs->nz[j] = proj ? (upper ? z1 : z2) : cz;
+                REAL sy = cy, sz = cz;
+                SFX(hb_shell_chord)(y, z, d, cs->rc[j], ell, &sy, &sz);
+                cs->ny[j] = proj ? sy : cy;
+                cs->nz[j] = proj ? sz : cz;
                 cs->inside[j] = proj;
             }
         }

@@ -38,6 +38,7 @@
 #include "dyn_kernels.cuh"
 #include "dyn_model.cuh"
 #include "dynamic/dynamics.h"
+#include "hostcheck/hostcheck_scene.h"
 #include "runtime/params.h"
 
 using namespace hb::dyn;
@@ -108,20 +109,13 @@ struct Rng {
 
 hb_scene make_scene(unsigned F, int solver, int64_t N, int64_t P, int precision, int variant)
 {
-    hb_scene s;
-    memset(&s, 0, sizeof s);
-    s.n_strands = N;
-    s.points = P;
+    hb_scene s = hostcheck_scene(N, P, 3.0 * (double)(P - 1) / 4.0 + 1.0, precision ? HB_FP64 : HB_FP32);
     s.seed = 7;
-    s.head_radius = 10.0;
     s.hair_offset = 0.1;
-    s.hair_length = 3.0 * (double)(P - 1) / 4.0 + 1.0;
     s.face_margin = 1.0;
     s.wind_strength = 0.0;
     s.wind_angle = 0.7 + 0.3 * variant;
-    s.precision = precision ? HB_FP64 : HB_FP32;
     hb_dynamics *d = &s.dyn;
-    hb_dynamics_defaults(d);
     d->frame_dt = 1.0 / 60.0;
     d->substeps = 4;
     d->iterations = 3;
@@ -261,19 +255,14 @@ void port_frames(Mode mode, Feat has, const DModel<T> &m, const T *q, const T *p
                     v[(size_t)(i * P3 + 3 * k + c2)] = V[(size_t)(c2 * NP + k * N + i)];
                 }
     } else {
-        std::vector<T> sm((size_t)(15 * P), (T)-777);
+        std::vector<T> sm((size_t)warp_reals<T>(P), (T)-777);
         for (int64_t i = 0; i < N; i++) {
             T *base = sm.data();
             for (int64_t e = 0; e < P3; e++) {
                 base[(e % 3) * P + e / 3] = x[(size_t)(i * P3 + e)];
                 base[3 * P + (e % 3) * P + e / 3] = v[(size_t)(i * P3 + e)];
             }
-            Strand<T> s;
-            s.x = Arr<T>{base, 1, P};
-            s.v = Arr<T>{base + 3 * P, 1, P};
-            s.p = Arr<T>{base + 6 * P, 1, P};
-            s.d = Arr<T>{base + 9 * P, 1, P};
-            s.lam = Arr1<T>{base + 12 * P, 1};
+            Strand<T> s = warp_strand(base, P);
             s.rest = Arr<const T>{rest.data() + i * P3, 3, 1};
             s.bend_rest = Arr1<const T>{br.data() + i * B, 1};
             frame_body(m, q, ph, s, HostLanes(), has);

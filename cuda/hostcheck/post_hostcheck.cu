@@ -22,6 +22,7 @@
 #include "dynamic/dyn_followers.h"
 #include "dyn_post.cuh"
 #include "hostcheck/hostcheck_rng.h"
+#include "hostcheck/hostcheck_scene.h"
 
 using namespace hb::dyn;
 
@@ -52,14 +53,7 @@ void place_c(const hb_dyn_model_f64 *m, const hb_followers *fl, int64_t j, const
 template <typename T, typename CM> void check(double guides, hb_follow follow, int motion, int collider, uint64_t seed)
 {
     const int64_t N = 23, P = 9;
-    hb_scene s;
-    memset(&s, 0, sizeof s);
-    s.n_strands = N;
-    s.points = P;
-    s.head_radius = 10.0;
-    s.hair_length = 8.0;
-    s.precision = sizeof(T) == 4 ? HB_FP32 : HB_FP64;
-    hb_dynamics_defaults(&s.dyn);
+    hb_scene s = hostcheck_scene(N, P, 8.0, sizeof(T) == 4 ? HB_FP32 : HB_FP64);
     s.dyn.guided = 1;
     s.dyn.guides = guides;
     s.dyn.follow = follow;
