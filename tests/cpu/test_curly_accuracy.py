@@ -82,7 +82,7 @@ def test_the_bench_runs_the_quick_accuracy_study_on_curly_hair_beside_the_straig
 def test_the_curly_study_is_left_out_with_a_line_when_the_budget_is_spent(stubbed, tmp_path):
     calls, hooks = stubbed
     clock = Clock()
-    budget = Budget(100.0, clock=clock)
+    budget = Budget(100.0, clock=clock, stop_studies=False)  # the fake clock times no child: studies in-process
 
     def spend(plan):  # the straight study uses the whole budget
         if plan.scene == "dynamic":

@@ -73,3 +73,10 @@ def test_a_failing_study_fails_the_bench_in_one_line(tmp_path, capfd):
     assert e.value.code == 2  # the study's own exit status
     err = capfd.readouterr().err
     assert "harness: error: the reference ladder did not converge" in err and "Traceback" not in err
+
+
+def test_a_budget_on_a_fake_clock_runs_the_study_in_process(tmp_path):
+    seen = []
+    plan = Budget(10.0, clock=lambda: 0.0, stop_studies=False)
+    assert run_study(plan, "study", lambda: seen.append(os.getpid()), [tmp_path], lambda m: None) is True
+    assert seen == [os.getpid()]
