@@ -404,21 +404,25 @@ def cmd_headline(args):
     """At one size, measure the copy bandwidths, every CUDA variant's init and wind+collide time and bandwidth
     fraction, and three CPU baselines (ref 1 thread, ref all cores, simd all cores); write
     results/headline/headline.json."""
+    from harness.render import headline_report
+
     if args.model == "dynamic":
         from harness.studies import headline_dynamic
 
-        headline_dynamic.run(
+        result = headline_dynamic.run(
             strands=args.strands,
             repeat=min(args.repeat, 5),
             cpu_repeat=args.cpu_repeat,
+            cpu_rounds=args.cpu_rounds,
             ncu=args.ncu,
             out_dir=args.out,
         )
+        print(headline_report.dynamic_table(result))
         return 0
-    from harness.render import headline_report
     from harness.studies import headline_paper
 
-    result = headline_paper.run(out_dir=args.out, **options(args, "strands points repeat cpu_repeat block_size"))
+    given = options(args, "strands points repeat cpu_repeat cpu_rounds block_size")
+    result = headline_paper.run(out_dir=args.out, **given)
     print(headline_report.table(result))
     return 0
 
@@ -887,6 +891,12 @@ def parser():
     h.add_argument("--points", type=whole(2), default=32)
     h.add_argument("--repeat", type=whole(1), default=9, help="GPU repetitions per stage (default 9)")
     h.add_argument("--cpu-repeat", type=whole(1), default=3, help="CPU repetitions per stage (default 3)")
+    h.add_argument(
+        "--cpu-rounds",
+        type=whole(1),
+        default=5,
+        help="rounds of (CPU copy bandwidth, fast CPU variant) whose median round is reported (default 5)",
+    )
     h.add_argument("--block-size", type=whole(32), default=256)
     h.add_argument(
         "--model",

@@ -25,6 +25,7 @@ from harness.render import (  # noqa: E402
     reduced_report,
     stability_report,
 )
+from harness.render.headline_report import rounds_note  # noqa: E402
 from harness.studies.accuracy import results_name  # noqa: E402
 
 CURLY_SCENE = "curly"  # configs/scenes/curly.toml: the accuracy study's second scene
@@ -214,7 +215,10 @@ def headline_lines(path):
         "cpu",
         "CPU fast variant, memory-bound case",
         f"≥ {100 * t['cpu_fraction']:.0f}% of CPU copy",
-        lambda m: f"{100 * m['fraction']:.1f}%",
+        lambda m: (
+            f"{100 * m['fraction']:.1f}%"
+            + (f" ({rounds_note(m['rounds'], m.get('fraction_of_first_copy'))})" if m.get("rounds") else "")
+        ),
     )
     for case, d in s.get("speedups", {}).items():
         hl = d.get("headline")

@@ -12,7 +12,7 @@ from conftest import CPU_BIN
 from harness import HarnessError
 from harness.core import variants
 from harness.io.sweepfile import load_sweep
-from harness.render import report_dynamic
+from harness.render import headline_report, report_dynamic
 from harness.studies import headline_dynamic, roofline
 from harness.studies.accuracy import results_name
 from harness.studies.sweep import case_flags, run_sweep
@@ -141,7 +141,14 @@ def test_headline_summary_picks_the_best_and_says_met_or_not():
         "realtime_loop": {"frame_loop_ms": 0.021, "frame_loop_graph_ms": 0.02},
         "cpu": [
             _row("cpu ref, 1 thread", "memory", 1e8, 0.05),
-            _row("cpu simd, all cores", "memory", 1e9, 0.55),
+            _row(
+                "cpu simd, all cores",
+                "memory",
+                1e9,
+                0.55,
+                rounds=[{"fraction": f} for f in (0.6, 0.55, 0.41)],
+                fraction_of_first_copy=0.5,
+            ),
             _row("cpu ref, 1 thread", "default", 1e7),
             _row("cpu simd, all cores", "default", 1e8),
         ],
@@ -156,8 +163,10 @@ def test_headline_summary_picks_the_best_and_says_met_or_not():
     assert s["speedups"]["memory"]["headline"]["cpu"] == "cpu simd, all cores"
     assert s["speedups"]["memory"]["headline"]["speedup"] == pytest.approx(50.0)
     assert s["speedups"]["default"]["headline"]["speedup"] == pytest.approx(200.0)
-    text = headline_dynamic.table({**result, "points": 32, "summary": s})
+    text = headline_report.dynamic_table({**result, "points": 32, "summary": s})
     assert "target 1" in text and "NOT met" in text and "target ftl" in text and "stretch goal" in text
+    assert s["cpu"]["rounds"] == [0.6, 0.55, 0.41] and s["cpu"]["fraction_of_first_copy"] == 0.5
+    assert "the median of 3 rounds, each against its own copy (41.0–60.0%); against the run's first copy 50.0%" in text
 
 
 def test_frame_loop_refusals(tmp_path):
