@@ -159,4 +159,14 @@ def section(paths):
                 ]
             else:
                 lines += ["No row is faster than `none` beyond the runs' spread.", ""]
+        dearer = [feat for feat, _, _, b, noisy in costs(rows) if b is not None and b < 0 and not noisy]
+        if dearer:
+            lines += [
+                f"Slower without it than `full`, beyond the spread: {', '.join(dearer)}. A feature "
+                "removed cannot cost time, so these rows are not additive here: the cases run one "
+                "after another (a drift of the machine's speed between them shows this way) and each "
+                "moves the hair differently (the state sets how many points collide or are pulled); "
+                "these runs do not tell which. Read this table's differences as no finer than that.",
+                "",
+            ]
     return lines

@@ -66,6 +66,14 @@ def test_section_names_a_row_faster_than_none(tmp_path):
     assert "### cpu" in text and "| bend |" in text
 
 
+def test_section_names_a_feature_whose_removal_slows_the_full_scene(tmp_path):
+    slower = _rows({"full − collide": (12.0, 11.9, 12.1), "full − gust": (10.05, 9.95, 10.15)})
+    text = "\n".join(featurecost_report.section([_write(tmp_path / "cpu.csv", slower)]))
+    assert "Slower without it than `full`, beyond the spread: collide." in text  # gust: within the spread
+    text = "\n".join(featurecost_report.section([_write(tmp_path / "cpu.csv", _rows({}))]))
+    assert "Slower without it" not in text
+
+
 def test_csv_paths_cpu_first_and_a_note_without_any(tmp_path):
     results = tmp_path / "sweep"
     results.mkdir()
