@@ -92,7 +92,7 @@ help:
 	@echo "make          build build/hairsim-cpu (and the CUDA binaries where nvcc is present)"
 	@echo "make test     build and run the pytest suite (GPU tests skip with a reason without a GPU)"
 	@echo "make bench    validate GPU variants against the CPU, sweep, studies, report into results/local/ (OUT=results/NAME; BUDGET=10m fits the sizes to a time; SHARD=K/N runs a share)"
-	@echo "make report   re-render a run folder's report (REPORT_FROM=results/local, REPORT_TO=REPORT_FROM/report;"
+	@echo "make report   re-render a run folder's report, or one sweep folder's (REPORT_FROM=results/local, REPORT_TO=REPORT_FROM/report;"
 	@echo "             the committed one: REPORT_FROM=results/reference-h200 REPORT_TO=report)"
 	@echo "make report-dynamic  only the dynamic report of REPORT_FROM into REPORT_TO"
 	@echo "make sanitize build the C reference with ASan+UBSan and run the CPU tests under it"
@@ -219,15 +219,17 @@ bench: setup
 	@$(MAKE) --no-print-directory -j$(JOBS) all
 	$(RUN_PY) -m harness bench --out $(OUT)$(if $(BUDGET), --budget $(BUDGET))$(if $(SHARD), --shard $(SHARD))
 
-# REPORT_FROM: the run folder to render (default results/local, make bench's); REPORT_TO: where
+# REPORT_FROM: the run folder to render (default results/local, make bench's), or one sweep's
+# folder (its runs.csv: the paper report alone); REPORT_TO: where
 # (default REPORT_FROM/report). The committed H200 report: make report REPORT_FROM=results/reference-h200 REPORT_TO=report
 REPORT_FROM ?= $(OUT)
 REPORT_TO ?= $(REPORT_FROM)/report
 report: setup
 	@[ -d "$(REPORT_FROM)" ] || { echo "error: $(REPORT_FROM) is not a run folder (run make bench, or give REPORT_FROM=results/reference-h200)"; exit 2; }
+	@if [ -f "$(REPORT_FROM)/runs.csv" ]; then $(RUN_PY) -m harness report "$(REPORT_FROM)" --report-dir "$(REPORT_TO)"; fi
 	@if [ -f "$(REPORT_FROM)/sweep/runs.csv" ]; then $(RUN_PY) -m harness report "$(REPORT_FROM)/sweep" --report-dir "$(REPORT_TO)"; fi
 	@if [ -d "$(REPORT_FROM)/dynamic" ]; then $(RUN_PY) -m harness report-dynamic "$(REPORT_FROM)" --report-dir "$(REPORT_TO)"; fi
-	@[ -f "$(REPORT_FROM)/sweep/runs.csv" ] || [ -d "$(REPORT_FROM)/dynamic" ] || { echo "error: $(REPORT_FROM) has neither sweep/runs.csv nor dynamic/: nothing to render"; exit 2; }
+	@[ -f "$(REPORT_FROM)/runs.csv" ] || [ -f "$(REPORT_FROM)/sweep/runs.csv" ] || [ -d "$(REPORT_FROM)/dynamic" ] || { echo "error: $(REPORT_FROM) has neither runs.csv, sweep/runs.csv nor dynamic/: nothing to render"; exit 2; }
 
 report-dynamic: setup
 	$(RUN_PY) -m harness report-dynamic $(REPORT_FROM) --report-dir $(REPORT_TO)

@@ -172,7 +172,7 @@ def test_plot_command_writes_only_pngs(tmp_path, capsys):
 
 
 def test_report_of_the_reference_run_with_its_accuracy_study(tmp_path, capsys):
-    """`make report REPORT_FROM=results/reference-h200/sweep` (a copy of it): the accuracy/ beside
+    """`python -m harness report results/reference-h200/sweep` (a copy of it): the accuracy/ beside
     the sweep is rendered into the page, the committed hair state draws Fig. 1/2, and nothing is
     written into the results it reads."""
     results = tmp_path / "reference-h200"
