@@ -303,9 +303,7 @@ def run(strands=4 * 1024 * 1024, repeat=5, frames=2, cpu_repeat=3, cpu_rounds=5,
             if v == oracle:
                 result["cpu"].append(measure(bw["copy_gbps"]))
                 continue
-            row = roofline.in_rounds(cpu_bin, cpu_rounds, measure)
-            row["fraction_of_first_copy"] = row["gbps"] / bw["copy_gbps"] if row["gbps"] else None
-            result["cpu"].append(row)
+            result["cpu"].append(roofline.in_rounds(cpu_bin, cpu_rounds, measure, first_copy=bw["copy_gbps"]))
         log(f"headline: {label}: {result['cpu'][-2]['median_ms']:.1f} / {result['cpu'][-1]['median_ms']:.1f} ms")
 
     summarise(result)

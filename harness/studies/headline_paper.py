@@ -115,9 +115,9 @@ def run(
         if extra[1] == oracle:
             row = measure(bw["copy_gbps"])
         else:
-            row = roofline.in_rounds(cpu, cpu_rounds, measure, key="wind_collide_fraction", ms_key="wind_collide_ms")
-            first = row["wind_collide_fraction"] * row["copy_gbps"] / bw["copy_gbps"]
-            row["wind_collide_fraction_of_first_copy"] = first
+            row = roofline.in_rounds(
+                cpu, cpu_rounds, measure, "wind_collide_fraction", "wind_collide_ms", first_copy=bw["copy_gbps"]
+            )
         result["rows"].append(row)
         log(f"headline: {label}: wind+collide {result['rows'][-1]['wind_collide_ms']:.1f} ms")
     gpu_fp32 = [

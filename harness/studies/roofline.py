@@ -74,11 +74,12 @@ def measure_bandwidth(binary, timeout=None):
     return run_binary(binary, ["--measure-bandwidth"], timeout=timeout, expect_keys=("copy_gbps",))
 
 
-def in_rounds(binary, rounds, measure, key="fraction", ms_key="median_ms"):
+def in_rounds(binary, rounds, measure, key="fraction", ms_key="median_ms", first_copy=None):
     """`rounds` rounds of (the copy bandwidth of `binary`, then `measure(copy_gbps)` -> a row
     whose `key` is its fraction of that copy); returns the round whose fraction is the median
     (the lower middle one for an even count) with "copy_gbps" (that round's copy) and
-    "rounds" (every round's copy_gbps, `ms_key` and fraction) added."""
+    "rounds" (every round's copy_gbps, `ms_key` and fraction) added, and with `first_copy`
+    (the run's first copy measurement) `key` + "_of_first_copy": the same row against it."""
     done = []
     for _ in range(max(1, int(rounds))):
         copy = measure_bandwidth(binary)["copy_gbps"]
@@ -86,7 +87,10 @@ def in_rounds(binary, rounds, measure, key="fraction", ms_key="median_ms"):
     ranked = sorted(done, key=lambda cr: cr[1].get(key) or 0.0)
     copy, row = ranked[(len(ranked) - 1) // 2]
     rounds_kept = [{"copy_gbps": c, ms_key: r.get(ms_key), "fraction": r.get(key)} for c, r in done]
-    return dict(row, copy_gbps=copy, rounds=rounds_kept)
+    out = dict(row, copy_gbps=copy, rounds=rounds_kept)
+    if first_copy:
+        out[f"{key}_of_first_copy"] = row[key] * copy / first_copy if row.get(key) is not None else None
+    return out
 
 
 def measure_copy_bandwidth(binary, timeout=300):

@@ -37,3 +37,13 @@ def test_an_even_count_reports_the_lower_middle_round(monkeypatch):
     row = roofline.in_rounds("cpu", 4, lambda copy: {"wind_collide_fraction": next(fr)}, key="wind_collide_fraction")
     assert row["wind_collide_fraction"] == 0.6
     assert len(row["rounds"]) == 4 and row["rounds"][0]["fraction"] == 0.9
+
+
+def test_the_median_round_against_the_first_copy(monkeypatch):
+    _fake_copies(monkeypatch, [50.0, 80.0, 40.0])
+    fr = iter([0.6, 0.5, 0.9])
+    row = roofline.in_rounds("cpu", 3, lambda copy: {"fraction": next(fr)}, first_copy=100.0)
+    assert (row["fraction"], row["copy_gbps"]) == (0.6, 50.0)
+    assert row["fraction_of_first_copy"] == pytest.approx(0.3)  # 0.6 of 50 GB/s is 0.3 of 100
+    _fake_copies(monkeypatch, [50.0])
+    assert "fraction_of_first_copy" not in roofline.in_rounds("cpu", 1, lambda copy: {"fraction": 0.5})
