@@ -111,15 +111,20 @@ class DynValidator:
             self.say(f"harness: NOT EQUIVALENT: {what}: {why}")
         return entry["equivalent"]
 
-    def step(self, ref, binary, extra, tag):
-        """One frame from the reference's second-to-last frame; the new file."""
+    def step(self, ref, binary, extra, tag, pool=None):
+        """One frame from the reference's second-to-last frame; the new file (with `pool`, a
+        future of it: the run started there)."""
         self.count += 1
         out = self.scratch / f"step{self.count}-{tag}.h5"
         with diff_dynamic.open_trajectory(ref) as t:
             k = t.n_frames - 2
         cmd = ["--input", ref, "--input-frame", k, "--stages", "simulate", "--frames", 1, *extra, "--output", out]
-        runner.run_binary(binary, cmd, timeout=600)
-        return out
+
+        def run():
+            runner.run_binary(binary, cmd, timeout=600)
+            return out
+
+        return pool.submit(run) if pool else run()
 
     def last_step(self, path):
         with diff_dynamic.open_trajectory(path) as t:
@@ -151,25 +156,33 @@ class DynValidator:
         return refs
 
     def gpu_checks(self, builds, refs):
-        for (precision, solver), ref in refs.items():
-            strict = {}
-            for build, v, block in self.gpu_cases(builds):
-                tag = f"cuda-{build}-{v}-b{block}-{precision}-{solver}"
-                g = self.step(ref, binary_path("cuda", build), ["--variant", v, "--block-size", block], tag)
-                if build == "strict" and block == BLOCK_SIZES[-1]:
-                    strict[v] = g
-                self.record(
-                    f"cuda {build} {v} b{block} {precision} {solver}: one frame from the cpu state",
-                    lambda a=ref, b=g: diff_dynamic.compare(a, b, frames=[self.last_step(b)], spread=True),
-                )
-            names = list(strict)
-            for other in names[1:]:
-                self.record(
-                    f"cuda strict {precision} {solver}: {names[0]} and {other} bit-identical",
-                    lambda a=strict[names[0]], b=strict[other]: diff_dynamic.compare(
-                        a, b, frames=[self.last_step(b)], exact=True, check_paper=False
-                    ),
-                )
+        with validation.parallel_runs() as pool:
+            started = {}  # every run first, then the comparisons in the same order
+            for (precision, solver), ref in refs.items():
+                for build, v, block in self.gpu_cases(builds):
+                    tag = f"cuda-{build}-{v}-b{block}-{precision}-{solver}"
+                    extra = ["--variant", v, "--block-size", block]
+                    started[(precision, solver, build, v, block)] = self.step(
+                        ref, binary_path("cuda", build), extra, tag, pool=pool
+                    )
+            for (precision, solver), ref in refs.items():
+                strict = {}
+                for build, v, block in self.gpu_cases(builds):
+                    g = started[(precision, solver, build, v, block)].result()
+                    if build == "strict" and block == BLOCK_SIZES[-1]:
+                        strict[v] = g
+                    self.record(
+                        f"cuda {build} {v} b{block} {precision} {solver}: one frame from the cpu state",
+                        lambda a=ref, b=g: diff_dynamic.compare(a, b, frames=[self.last_step(b)], spread=True),
+                    )
+                names = list(strict)
+                for other in names[1:]:
+                    self.record(
+                        f"cuda strict {precision} {solver}: {names[0]} and {other} bit-identical",
+                        lambda a=strict[names[0]], b=strict[other]: diff_dynamic.compare(
+                            a, b, frames=[self.last_step(b)], exact=True, check_paper=False
+                        ),
+                    )
 
 
 def validate(out_dir, builds, gpu_note, say):
@@ -230,6 +243,9 @@ ACCURACY_STUDIES = (
     (DEFAULT_SCENE, "accuracy"),
     (report_dynamic.CURLY_SCENE, f"accuracy {report_dynamic.CURLY_SCENE}"),
 )
+# the studies measured once (the stability map is sharded by its cells instead), in the order
+# `--shard K/N` deals them out: study i runs on shard i mod N + 1
+ONE_MEASUREMENT_STUDIES = ("featurecost", "reduced", *(name for _, name in ACCURACY_STUDIES), "peer")
 
 
 def accuracy(root, scene, gpu, quick, say, report_dir=None):
@@ -253,7 +269,7 @@ def accuracy(root, scene, gpu, quick, say, report_dir=None):
 def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=None):
     """The dynamic studies, each measured into root/<study> (`quick`: their small versions)
     and rendered into report_dir (none with `shard` of several). A shard runs its share of the
-    stability map; the one-measurement studies run on shard 1 only. With `budget`, a study
+    stability map and its share of ONE_MEASUREMENT_STUDIES. With `budget`, a study
     that starts after the budget is spent is left out (and said so)."""
     render = report_dir is not None
 
@@ -271,8 +287,10 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
             return True
         return run_study(budget, study, fn, outputs, say)
 
-    first = shard is None or shard.first
-    if first and fits("featurecost"):
+    def mine(study):
+        return shard is None or shard.takes(ONE_MEASUREMENT_STUDIES.index(study))
+
+    if mine("featurecost") and fits("featurecost"):
         fc = root / "featurecost"
         fc.mkdir(parents=True, exist_ok=True)
         strands = FEATURECOST_STRANDS[0]
@@ -296,7 +314,7 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
         within("featurecost", measure_featurecost, fc)
     gpu = "auto" if builds else "no"
     reports = [report_dir] if render else []
-    if first and fits("reduced"):
+    if mine("reduced") and fits("reduced"):
 
         def measure_reduced():
             say(f"harness: reduced{' --quick' if quick else ''}")
@@ -305,7 +323,7 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
 
         within("reduced", measure_reduced, root / "reduced")
     for scene, study in ACCURACY_STUDIES:
-        if first and fits(study):
+        if mine(study) and fits(study):
             within(
                 study,
                 lambda s=scene: accuracy(root, s, gpu, quick, say, report_dir),
@@ -321,7 +339,7 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
                 stability_report.report_from_csv(csv_path, report_dir=report_dir, log=say)
 
         within("stability", measure_stability, root / "stability", *reports)
-    if first and fits("peer"):
+    if mine("peer") and fits("peer"):
 
         def measure_peer():
             say("harness: peer")
@@ -367,7 +385,7 @@ def validate_first(out=None, gpu="auto", log=None):
 
 
 def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, shard=None, budget=None, validated=False):
-    """`shard`: its share of the sweep and the stability map, the other studies on shard 1,
+    """`shard`: its share of the sweep, the stability map and the one-measurement studies,
     no report; `budget` (core.budget.Budget): the sweep fits its share of the time left, the
     studies run while time is left; what is left out goes to OUT/budget.json and the report;
     `validated`: validate_first ran."""

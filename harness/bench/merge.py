@@ -10,8 +10,8 @@ under the shards is joined by its relative path:
   - a sweep's env.json (with sessions): shard 1's record with every shard's sessions, each
     marked with its shard;
   - validation.json: every shard's comparisons (each node validates before it times);
-  - any other file: shard 1's where it has one (the one-measurement studies run there),
-    else the first shard's that has it.
+  - any other file: the first shard's that has it (a study measured once has its files in
+    one shard only).
 merge.json in OUT names the shards."""
 
 import csv

@@ -57,13 +57,18 @@ class Validator:
         )
         return 2 + resumes + gpu
 
-    def state(self, backend, build="default", precision="fp32", stages=None, input_file=None, **opts):
+    def state(self, backend, build="default", precision="fp32", stages=None, input_file=None, pool=None, **opts):
+        """The state file of one run; with `pool`, a future of it (the run started there)."""
         self.count += 1
         path = self.scratch / f"s{self.count}-{backend}-{build}-{precision}.h5"
         scene = self.scene.with_overrides(precision=precision) if not input_file else self.scene
         flags = runner.run_flags(scene, backend, stages=stages, input_file=input_file, output=path, **opts)
-        runner.run_binary(binary_path(backend, build), flags, timeout=300)
-        return path
+
+        def run():
+            runner.run_binary(binary_path(backend, build), flags, timeout=300)
+            return path
+
+        return pool.submit(run) if pool else run()
 
     def compare(self, what, a, b, **kw):
         try:
@@ -110,32 +115,36 @@ class Validator:
     def gpu_checks(self, builds, ref):
         stages = list(self.scene.stages)
         prefixes = {}
-        for build in builds:
-            for variant in variants.names("cuda", build):
-                for precision in variants.declared("cuda", build).precisions:
-                    for block in BLOCK_SIZES:
-                        g = self.state("cuda", build, precision, variant=variant, block_size=block)
-                        self.compare(f"cuda {build} {variant} b{block} {precision} vs cpu", ref[precision], g)
-                    for k in range(1, len(stages)):
-                        key = (precision, k)
-                        if key not in prefixes:
-                            prefixes[key] = self.state("cpu", precision=precision, stages=stages[:k])
-                        g = self.state(
-                            "cuda",
-                            build,
-                            precision,
-                            variant=variant,
-                            block_size=RESUME_BLOCK,
-                            input_file=prefixes[key],
-                            stages=[stages[k]],
-                        )
-                        self.compare(
-                            f"cuda {build} {variant} b{RESUME_BLOCK} {precision}: stage {k} "
-                            f"({stages[k]}) from the cpu state",
-                            ref[precision],
-                            g,
-                            frames=[k],
-                        )
+        pending = []  # (what, the cpu state, the GPU state's future, compare's options), in order
+        with validation.parallel_runs() as pool:
+            for build in builds:
+                for variant in variants.names("cuda", build):
+                    for precision in variants.declared("cuda", build).precisions:
+                        for block in BLOCK_SIZES:
+                            g = self.state("cuda", build, precision, variant=variant, block_size=block, pool=pool)
+                            what = f"cuda {build} {variant} b{block} {precision} vs cpu"
+                            pending.append((what, ref[precision], g, {}))
+                        for k in range(1, len(stages)):
+                            key = (precision, k)
+                            if key not in prefixes:
+                                prefixes[key] = self.state("cpu", precision=precision, stages=stages[:k])
+                            g = self.state(
+                                "cuda",
+                                build,
+                                precision,
+                                variant=variant,
+                                block_size=RESUME_BLOCK,
+                                input_file=prefixes[key],
+                                stages=[stages[k]],
+                                pool=pool,
+                            )
+                            what = (
+                                f"cuda {build} {variant} b{RESUME_BLOCK} {precision}: stage {k} "
+                                f"({stages[k]}) from the cpu state"
+                            )
+                            pending.append((what, ref[precision], g, {"frames": [k]}))
+            for what, cpu_state, g, kw in pending:
+                self.compare(what, cpu_state, g.result(), **kw)
 
 
 def validate(sweep, out_dir, builds, gpu_note, say):

@@ -1,8 +1,11 @@
 """The bench's first step for either model: a validator's CPU checks, then its GPU checks,
 recorded in validation.json; nothing is timed unless every comparison is equivalent."""
 
+import os
 import shutil
 import tempfile
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from pathlib import Path
 
 from harness import HarnessError
@@ -45,6 +48,24 @@ def validate(make_validator, what, out_dir, builds, gpu_note, say, header):
         )
     _remove(scratch, scratch_root)
     say(f"harness: {what}: all {len(v.checks)} comparisons equivalent")
+
+
+GPU_RUNS_AT_ONCE = 8  # concurrent validation runs on one GPU (docs/decisions/bench-runs.md)
+
+
+@contextmanager
+def parallel_runs(jobs=None):
+    """A pool for a validator's GPU runs: nothing in a validation is timed, so its small runs
+    share the GPU (min(GPU_RUNS_AT_ONCE, cores) at once). The validator submits every run, then
+    compares them in the order submitted, so validation.json is the same as one at a time.
+    On an error the runs not yet started are cancelled."""
+    pool = ThreadPoolExecutor(max_workers=jobs or min(GPU_RUNS_AT_ONCE, os.cpu_count() or 1))
+    try:
+        yield pool
+    except BaseException:
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
 
 
 def _remove(scratch, scratch_root):

@@ -784,7 +784,8 @@ def parser():
         "--shard",
         default=None,
         help="K/N: run the K-th of N deterministic shares of the sweeps' cases and the stability map's cells "
-        "(the other studies on shard 1), record OUT/shard.json and write no report; harness merge joins them",
+        "(the studies measured once dealt out round robin), record OUT/shard.json and write no report; "
+        "harness merge joins them",
     )
     b.add_argument(
         "--full-studies",

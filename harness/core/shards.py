@@ -22,8 +22,13 @@ class Shard:
 
     @property
     def first(self):
-        """The shard that runs the one-measurement studies (featurecost, accuracy, peer, animation)."""
+        """Shard 1 (it keeps the paper sweep's figure state)."""
         return self.k == 1
+
+    def takes(self, index):
+        """Whether this shard runs the index-th (0-based) of a run's one-measurement studies:
+        they go round robin too, study i to shard i mod N + 1, so no shard carries them all."""
+        return index % self.n == self.k - 1
 
 
 WHOLE = Shard(1, 1)

@@ -76,7 +76,28 @@ def test_the_bench_runs_the_quick_accuracy_study_on_curly_hair_beside_the_straig
     assert "harness: accuracy --model dynamic --scene curly --analytic none --quick --gpu no" in log
     calls.clear()
     bench_dynamic.studies(tmp_path, [], log.append, quick=True, shard=Shard(2, 2))
-    assert calls == []  # one-measurement studies run on shard 1 only
+    assert [p.scene for p, _ in calls] == [CURLY]  # the straight study is shard 1's
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 6])
+def test_every_study_measured_once_runs_on_exactly_one_of_n_shards(stubbed, tmp_path, n):
+    started = {  # the line each study says when it starts
+        "featurecost": "harness: featurecost --backend cpu",
+        "reduced": "harness: reduced --quick",
+        "accuracy": "harness: accuracy --model dynamic --quick",
+        f"accuracy {CURLY}": f"harness: accuracy --model dynamic --scene {CURLY}",
+        "peer": "harness: peer",
+    }
+    assert set(started) == set(bench_dynamic.ONE_MEASUREMENT_STUDIES)
+    ran = {}
+    for k in range(1, n + 1):
+        log = []
+        bench_dynamic.studies(tmp_path / f"s{k}", [], log.append, quick=True, shard=Shard(k, n))
+        for study, line in started.items():
+            if any(m.startswith(line) for m in log):
+                ran.setdefault(study, []).append(k)
+        assert any(m.startswith("harness: stability") for m in log)  # every shard runs its cells
+    assert ran == {s: [i % n + 1] for i, s in enumerate(bench_dynamic.ONE_MEASUREMENT_STUDIES)}
 
 
 def test_the_curly_study_is_left_out_with_a_line_when_the_budget_is_spent(stubbed, tmp_path):
