@@ -117,21 +117,26 @@ def validation_section(results_dir):
         f"{ok} of {len(checks)} comparisons equivalent at {v.get('strands')} strands × "
         f"{v.get('points')} points. {v.get('gpu_note', '')}"
     )
+    shards = sorted({c["shard"] for c in checks if "shard" in c})
+    if len(shards) > 1:  # a merged run: each shard validated its own node before it timed
+        lines.append(f"{len(shards)} shards, each validated on its own node before it timed anything.")
     shown = checks
-    if len(checks) > 30:  # every failure, the CPU checks, and the worst of each GPU build × precision
+    if len(checks) > 30:  # every failure, the CPU checks, and the worst of each GPU build × precision × kind
         worst = {}
-        for c in checks:
+        for i, c in enumerate(checks):
             words = c["what"].split()
             if words[0] == "cuda":
-                key = (words[1], next((w for w in words if w.startswith("fp")), ""))
-                if key not in worst or c.get("max_k", 0) > worst[key].get("max_k", 0):
-                    worst[key] = c
+                precision = next((w for w in words if w.startswith("fp")), "").rstrip(":")
+                key = (words[1], precision, "stage" in words)  # a whole run, or one stage resumed
+                if key not in worst or c.get("max_k", 0) > checks[worst[key]].get("max_k", 0):
+                    worst[key] = i
+        keep = set(worst.values())
         shown = [
-            c for c in checks if not c.get("equivalent") or not c["what"].startswith("cuda") or c in worst.values()
+            c for i, c in enumerate(checks) if not c.get("equivalent") or not c["what"].startswith("cuda") or i in keep
         ]
         lines.append(
-            f"Shown: the CPU checks, every failure, and the worst of each GPU build × precision "
-            f"({len(shown)} of {len(checks)}; all in validation.json)."
+            "Shown: the CPU checks, every failure, and the worst of each GPU build × precision, "
+            f"whole run and resumed stage ({len(shown)} of {len(checks)}; all in validation.json)."
         )
     lines += [
         "",
@@ -139,8 +144,9 @@ def validation_section(results_dir):
         "| --- | --- | --- | --- | --- | --- |",
     ]
     for c in shown:
+        what = c["what"] + (f" (shard {c['shard']})" if len(shards) > 1 else "")
         lines.append(
-            f"| {c['what']} | {c.get('pair', '')} | {c.get('max_abs', float('nan')):.3g} | "
+            f"| {what} | {c.get('pair', '')} | {c.get('max_abs', float('nan')):.3g} | "
             f"{c.get('max_k', float('nan')):.3g} | {c.get('over', '')} | "
             f"{'ok' if c.get('equivalent') else 'FAIL'} |"
         )

@@ -206,3 +206,29 @@ def test_both_reports_say_what_a_time_budget_left_out(tmp_path):
         text = path.read_text()
         assert "## Time budget" in text and "budget of 600 s" in text and "used 590 s" in text
         assert "- sweep default: 8 case(s) at sizes 96000000 (strands × points) (over)" in text
+
+
+def test_a_merged_validation_names_each_checks_shard_and_the_worst_of_each_kind(tmp_path):
+    from harness.render.report_paper import validation_section
+
+    def check(what, k, shard):
+        return {"what": what, "pair": "fp32↔fp32", "equivalent": True, "max_abs": k * 1e-6, "max_k": k, "over": 0}
+
+    checks = []
+    for shard in (1, 2):
+        part = [check("cpu fp32 vs cpu fp64", 0.1, shard)]
+        for b in range(16):
+            part.append(check(f"cuda default fused b{b} fp32 vs cpu", 0.1 + b / 100 + shard / 1000, shard))
+        part.append(check("cuda default fused b64 fp32: stage 3 (collide) from the cpu state", 0.05, shard))
+        checks += [dict(c, shard=shard) for c in part]
+    (tmp_path / "validation.json").write_text(json.dumps({"strands": 2000, "points": 32, "checks": checks}))
+    text = "\n".join(validation_section(tmp_path))
+    assert "2 shards, each validated on its own node" in text
+    rows = [ln for ln in text.splitlines() if ln.startswith("| cpu") or ln.startswith("| cuda")]
+    assert rows == [  # in validation.json's order; of equal worst ones, the first
+        "| cpu fp32 vs cpu fp64 (shard 1) | fp32↔fp32 | 1e-07 | 0.1 | 0 | ok |",
+        "| cuda default fused b64 fp32: stage 3 (collide) from the cpu state (shard 1) "
+        "| fp32↔fp32 | 5e-08 | 0.05 | 0 | ok |",
+        "| cpu fp32 vs cpu fp64 (shard 2) | fp32↔fp32 | 1e-07 | 0.1 | 0 | ok |",
+        "| cuda default fused b15 fp32 vs cpu (shard 2) | fp32↔fp32 | 2.52e-07 | 0.252 | 0 | ok |",
+    ]
