@@ -266,11 +266,12 @@ def accuracy(root, scene, gpu, quick, say, report_dir=None):
     return acc_dir
 
 
-def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=None):
+def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=None, times=None):
     """The dynamic studies, each measured into root/<study> (`quick`: their small versions)
     and rendered into report_dir (none with `shard` of several). A shard runs its share of the
     stability map and its share of ONE_MEASUREMENT_STUDIES. With `budget`, a study
-    that starts after the budget is spent is left out (and said so)."""
+    that starts after the budget is spent is left out (and said so). `times`
+    (core.progress.StepTimes): each study timed."""
     render = report_dir is not None
 
     def fits(study):
@@ -281,11 +282,16 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
         return False
 
     def within(study, fn, *outputs):
-        """fn() now, or under a budget stopped when it runs out (core.budget.run_study)."""
-        if budget is None:
-            fn()
-            return True
-        return run_study(budget, study, fn, outputs, say)
+        """fn() now, or under a budget stopped when it runs out (core.budget.run_study); timed
+        into `times` when given."""
+
+        def go():
+            if budget is None:
+                fn()
+                return True
+            return run_study(budget, study, fn, outputs, say)
+
+        return times.step(study, go) if times else go()
 
     def mine(study):
         return shard is None or shard.takes(ONE_MEASUREMENT_STUDIES.index(study))
@@ -384,11 +390,22 @@ def validate_first(out=None, gpu="auto", log=None):
     validate(sweep_dir, builds, gpu_note, say)
 
 
-def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, shard=None, budget=None, validated=False):
+def run(
+    out=None,
+    gpu="auto",
+    report_dir=None,
+    quick_studies=True,
+    log=None,
+    shard=None,
+    budget=None,
+    validated=False,
+    times=None,
+):
     """`shard`: its share of the sweep, the stability map and the one-measurement studies,
     no report; `budget` (core.budget.Budget): the sweep fits its share of the time left, the
     studies run while time is left; what is left out goes to OUT/budget.json and the report;
-    `validated`: validate_first ran."""
+    `validated`: validate_first ran; `times` (core.progress.StepTimes): each sweep and study timed."""
+    timed = times.step if times else (lambda name, fn, *a, **k: fn(*a, **k))
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
     root = Path(out) if out else LOCAL_RUN
@@ -403,10 +420,20 @@ def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, sha
     if gate:
         say(f"harness: budget: the dynamic sweep gets {gate.allowance:.0f} s of the {budget.left():.0f} s left")
     gpu_sweep = "no" if gpu_note else gpu
-    _, failed = run_sweep(SWEEP, out=sweep_dir, gpu=gpu_sweep, log=say, announce_skips=False, shard=shard, gate=gate)
+    _, failed = timed(
+        f"sweep {SWEEP}",
+        run_sweep,
+        SWEEP,
+        out=sweep_dir,
+        gpu=gpu_sweep,
+        log=say,
+        announce_skips=False,
+        shard=shard,
+        gate=gate,
+    )
     if gate and gate.summary():
         budget.leave_out(f"sweep {SWEEP}", gate.summary(), gate.closed)
-    failed = curly_sweep(root, gpu_sweep, say, shard, budget) or failed
+    failed = timed(f"sweep {CURLY_SWEEP}", curly_sweep, root, gpu_sweep, say, shard, budget) or failed
     several = shard is not None and shard.n > 1
     studies(
         root,
@@ -416,6 +443,7 @@ def run(out=None, gpu="auto", report_dir=None, quick_studies=True, log=None, sha
         quick=quick_studies,
         shard=shard,
         budget=budget,
+        times=times,
     )
     if budget:
         write_json(root / "budget.json", budget.record())

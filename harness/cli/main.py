@@ -195,6 +195,7 @@ def cmd_bench(args):
     from harness.bench import paper as bench_paper
     from harness.core import budget, shards
     from harness.core.paths import LOCAL_RUN
+    from harness.core.progress import StepTimes
     from harness.io.sweepfile import load_sweep
 
     # one run folder (docs/decisions/bench-runs.md): the paper sweep in ROOT/sweep, the dynamic
@@ -220,15 +221,18 @@ def cmd_bench(args):
         merge.write_record(root, shard, sweeps, command)
     # both models are validated before anything is timed; under a budget the validations are
     # its fixed cost and the sweeps and studies share what they leave
+    times = StepTimes()  # the log's last line: where the run's time went
     if args.model in ("all", "paper"):
-        bench_paper.validate_first(args.sweep, out=root / "sweep", gpu=args.gpu)
+        times.step("validation", bench_paper.validate_first, args.sweep, out=root / "sweep", gpu=args.gpu)
     if args.model in ("all", "dynamic"):
-        bench_dynamic.validate_first(out=root, gpu=args.gpu)
+        times.step("dynamic validation", bench_dynamic.validate_first, out=root, gpu=args.gpu)
     if plan:
         budget.say_fixed_cost(plan)
     code = 0
     if args.model in ("all", "paper"):
-        code = bench_paper.run(
+        code = times.step(
+            f"sweep {load_sweep(args.sweep).name} and its report",
+            bench_paper.run,
             args.sweep,
             out=root / "sweep",
             gpu=args.gpu,
@@ -248,6 +252,7 @@ def cmd_bench(args):
                 shard=shard,
                 budget=plan,
                 validated=True,
+                times=times,
             )
             or code
         )
@@ -255,6 +260,7 @@ def cmd_bench(args):
         from harness.render import report_paper
 
         report_paper.build(root / "sweep", report_dir)  # again: its time-budget section now lists the dynamic part too
+    print(times.summary("bench"), flush=True)
     return code
 
 

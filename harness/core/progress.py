@@ -90,3 +90,25 @@ class Progress:
             self._thread = None
         if self.bar is not None:
             self.bar.close()
+
+
+class StepTimes:
+    """How long each step of a run took, in the order they ran; summary() is the log's last
+    line, so a CI log says where a run's time went (each step's own lines say how far it got)."""
+
+    def __init__(self, clock=time.monotonic):
+        self.clock = clock
+        self.start = clock()
+        self.steps = []  # (name, seconds)
+
+    def step(self, name, fn, *args, **kwargs):
+        """fn(*args, **kwargs), timed as `name`; its result."""
+        t = self.clock()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            self.steps.append((name, self.clock() - t))
+
+    def summary(self, what):
+        parts = ", ".join(f"{name} {s:.0f} s" for name, s in self.steps)
+        return f"harness: {what} took {self.clock() - self.start:.0f} s" + (f" ({parts})" if parts else "")

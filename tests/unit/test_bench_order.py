@@ -10,6 +10,20 @@ from harness.bench import paper as bench_paper
 from harness.cli import main
 
 
+def bench_args(model, tmp_path):
+    """`harness bench --model MODEL --sweep quick --gpu no --out TMP/run`'s arguments."""
+    return argparse.Namespace(
+        model=model,
+        sweep="quick",
+        out=str(tmp_path / "run"),
+        report_dir=None,
+        shard=None,
+        budget=None,
+        gpu="no",
+        full_studies=False,
+    )
+
+
 @pytest.mark.parametrize(
     ("model", "expected"),
     [
@@ -33,15 +47,21 @@ def test_every_validation_runs_before_any_timing(monkeypatch, tmp_path, model, e
 
     monkeypatch.setattr(bench_paper, "run", timed("paper"))
     monkeypatch.setattr(bench_dynamic, "run", timed("dynamic"))
-    args = argparse.Namespace(
-        model=model,
-        sweep="quick",
-        out=str(tmp_path / "run"),
-        report_dir=None,
-        shard=None,
-        budget=None,
-        gpu="no",
-        full_studies=False,
-    )
-    assert main.cmd_bench(args) == 0
+    assert main.cmd_bench(bench_args(model, tmp_path)) == 0
     assert steps == expected
+
+
+def test_the_bench_log_ends_with_the_time_of_each_step(monkeypatch, tmp_path, capsys):
+    monkeypatch.setattr(bench_paper, "validate_first", lambda *a, **k: None)
+    monkeypatch.setattr(bench_dynamic, "validate_first", lambda *a, **k: None)
+    monkeypatch.setattr(bench_paper, "run", lambda *a, **k: 0)
+
+    def dynamic(*a, times=None, **k):  # the dynamic bench times its own steps into the same record
+        times.step("sweep dynamic", lambda: None)
+        return 0
+
+    monkeypatch.setattr(bench_dynamic, "run", dynamic)
+    assert main.cmd_bench(bench_args("all", tmp_path)) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last.startswith("harness: bench took ")
+    assert last.endswith("(validation 0 s, dynamic validation 0 s, sweep quick and its report 0 s, sweep dynamic 0 s)")

@@ -4,7 +4,9 @@ count, the time elapsed and an estimate of what is left (a CI log shows the step
 import io
 import time
 
-from harness.core.progress import LOG_EVERY_S, Progress
+import pytest
+
+from harness.core.progress import LOG_EVERY_S, Progress, StepTimes
 
 
 class Clock:
@@ -75,3 +77,26 @@ def test_the_timer_thread_prints_without_an_update():
             time.sleep(0.01)
         assert p.done == 0
     assert out.getvalue().startswith("peer: 0/2 done")
+
+
+def test_step_times_say_each_step_in_order_and_the_total():
+    clock = Clock()
+    times = StepTimes(clock=clock)
+
+    def work(seconds, result):
+        clock.t += seconds
+        return result
+
+    assert times.step("validation", work, 72.4, "ok") == "ok"
+
+    def fails():
+        work(337.0, None)
+        raise RuntimeError("stop")
+
+    with pytest.raises(RuntimeError):  # a step that fails is timed too
+        times.step("sweep default", fails)
+    clock.t += 5.0  # time between the steps counts in the total only
+    assert [name for name, _ in times.steps] == ["validation", "sweep default"]
+    assert [s for _, s in times.steps] == pytest.approx([72.4, 337.0])
+    assert times.summary("bench") == "harness: bench took 414 s (validation 72 s, sweep default 337 s)"
+    assert StepTimes(clock=clock).summary("bench") == "harness: bench took 0 s"
