@@ -32,6 +32,7 @@ from harness.check import diff_dynamic
 from harness.core import runner, scenes, variants
 from harness.core.budget import TierGate, largest_that_fits, run_study
 from harness.core.paths import LOCAL_RUN, REPORT, binary_path, display
+from harness.core.progress import StepTimes
 from harness.core.scenes import with_frames
 from harness.io import results_data
 from harness.io.files import write_json
@@ -273,6 +274,7 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
     that starts after the budget is spent is left out (and said so). `times`
     (core.progress.StepTimes): each study timed."""
     render = report_dir is not None
+    times = times or StepTimes()
 
     def fits(study):
         if budget is None or budget.left() > 0:
@@ -282,8 +284,7 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
         return False
 
     def within(study, fn, *outputs):
-        """fn() now, or under a budget stopped when it runs out (core.budget.run_study); timed
-        into `times` when given."""
+        """fn() now, or under a budget stopped when it runs out (core.budget.run_study); timed."""
 
         def go():
             if budget is None:
@@ -291,7 +292,7 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
                 return True
             return run_study(budget, study, fn, outputs, say)
 
-        return times.step(study, go) if times else go()
+        return times.step(study, go)
 
     def mine(study):
         return shard is None or shard.takes(ONE_MEASUREMENT_STUDIES.index(study))
@@ -405,7 +406,7 @@ def run(
     no report; `budget` (core.budget.Budget): the sweep fits its share of the time left, the
     studies run while time is left; what is left out goes to OUT/budget.json and the report;
     `validated`: validate_first ran; `times` (core.progress.StepTimes): each sweep and study timed."""
-    timed = times.step if times else (lambda name, fn, *a, **k: fn(*a, **k))
+    times = times or StepTimes()
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
     root = Path(out) if out else LOCAL_RUN
@@ -420,7 +421,7 @@ def run(
     if gate:
         say(f"harness: budget: the dynamic sweep gets {gate.allowance:.0f} s of the {budget.left():.0f} s left")
     gpu_sweep = "no" if gpu_note else gpu
-    _, failed = timed(
+    _, failed = times.step(
         f"sweep {SWEEP}",
         run_sweep,
         SWEEP,
@@ -433,7 +434,7 @@ def run(
     )
     if gate and gate.summary():
         budget.leave_out(f"sweep {SWEEP}", gate.summary(), gate.closed)
-    failed = timed(f"sweep {CURLY_SWEEP}", curly_sweep, root, gpu_sweep, say, shard, budget) or failed
+    failed = times.step(f"sweep {CURLY_SWEEP}", curly_sweep, root, gpu_sweep, say, shard, budget) or failed
     several = shard is not None and shard.n > 1
     studies(
         root,
