@@ -90,6 +90,15 @@ class Runner:
         return f"gpu {'normal' if self.build == 'default' else self.build} {self.variant}"
 
 
+# The simulate flags that declare a §3.14 feature (docs/model.md), and the feature each names.
+FEATURE_FLAGS = {"--guides": "guides", "--lra": "lra", "--sag-free": "sagfree", "--render-points": "lod"}
+
+
+def features_of(flags):
+    """The §3.14 features that simulate flags declare (a flag list or a dict keyed by flag)."""
+    return {FEATURE_FLAGS[str(a)] for a in flags if str(a) in FEATURE_FLAGS}
+
+
 def simulating(backend, build="default"):
     """The first variant of a binary that simulates strands of any length (no max_points):
     what a study that draws the point count runs."""

@@ -49,6 +49,12 @@ class Mode:
     def tag(self):
         return self.name.replace(" ", "_")
 
+    @property
+    def timing_key(self):
+        """What its time per frame depends on: all but ftl's s, one factor of the velocity
+        update that no kernel branches on (modes alike but for s share one timed run)."""
+        return (self.runner, self.precision, self.solver, self.substeps, self.iterations, self.label)
+
     def columns(self):
         """The mode's columns in a study's rows: its name and what picks its runs."""
         return dict(

@@ -41,10 +41,11 @@ report/dynamic_accuracy_curly.md.
 
 import itertools
 import json
+import multiprocessing
 import os
 import shutil
 import time
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
@@ -261,6 +262,26 @@ def read_run(path):
         )
 
 
+def _mode_rms(path, ref_pos, L):
+    """A mode's RMS error [F] against ref_pos; NaN throughout if it blew up at any frame."""
+    r = read_run(path)
+    rms, _ = frame_errors(r.pos, ref_pos, L)
+    return np.full_like(rms, np.nan) if (r.blown > 0).any() else rms
+
+
+def _mode_metrics(path, ref, L, gravity):
+    """A mode's run (its positions dropped), RMS and max error against `ref`, frame_metrics."""
+    r = read_run(path)
+    rms, mx = frame_errors(r.pos, ref.pos, L)
+    return replace(r, pos=None, vel=None), rms, mx, frame_metrics(r, ref, L, gravity)
+
+
+def reader_pool(jobs):
+    """Processes that read and compare the modes' state files (about 15 ms each, hundreds of
+    them a rung); a fresh interpreter each (forkserver), so no lock of the caller's threads is copied."""
+    return ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("forkserver"))
+
+
 def frame_metrics(run, ref, L, gravity):
     """Per frame of `run`: the verdict, error percentiles and silhouette overlaps against
     `ref` (a Run, or None), stretch p99, kinetic and potential energy per particle."""
@@ -299,6 +320,19 @@ class Study:
         self.gravity = float(self.scene.dynamic.get("--gravity", 981.0))
         self.scratch = Path(out_dir) / "states"
         self.cpu_threads = os.cpu_count() or 1
+        self.jobs = plan.jobs or self.cpu_threads
+        self._readers = None
+
+    def readers(self):
+        """The study's reader processes (reader_pool), started when first needed."""
+        if self._readers is None:
+            self._readers = reader_pool(self.jobs)
+        return self._readers
+
+    def close(self):
+        if self._readers is not None:
+            self._readers.shutdown(cancel_futures=True)
+            self._readers = None
 
     def path(self, tag):
         return self.scratch / f"{tag}.h5"
@@ -351,12 +385,11 @@ class Study:
     def mode_rms(self, paths, ref):
         """{mode name: RMS error [F]} against ref positions; a mode blown up at any frame
         gives NaN throughout (it takes no part in the smallest error)."""
-        out = {}
-        for name, p in paths.items():
-            r = read_run(p)
-            rms, _ = frame_errors(r.pos, ref.pos, self.L)
-            out[name] = np.full_like(rms, np.nan) if (r.blown > 0).any() else rms
-        return out
+        names = list(paths)
+        errs = self.readers().map(
+            _mode_rms, [paths[n] for n in names], itertools.repeat(ref.pos), itertools.repeat(self.L), chunksize=8
+        )
+        return dict(zip(names, errs))
 
     def ladder(self, build, mode_paths, first_path=None):
         """Double S until the criterion holds up to the horizon or --ref-max is reached
@@ -511,7 +544,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
     # 1. the checked runs (in parallel: nothing here is timed) and the analytic tables
     analytic_lines = []
     mode_paths, records = {}, {}
-    jobs = plan.jobs or os.cpu_count() or 1
+    jobs = study.jobs
     try:
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             futures = {}
@@ -587,16 +620,20 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
             long = observables_long.LongRuns(study, ref["build"], ref["steps"][-1]["S2"], log, configured, read_run)
             long_rows = long.measure(oracle_modes, jobs)
 
-        # 3. timing, one mode at a time, nothing else running
-        timing = {}
-        with Progress(len(modes), "dynamic accuracy: timed") as bar:
+        # 3. timing, one run at a time, nothing else running; ftl's damping s is one factor of
+        # the velocity update (no branch on it), so the modes that differ only in s share a run
+        timing, runs = {}, {}
+        with Progress(len({m.timing_key for m in modes}), "dynamic accuracy: timed") as bar:
             for m in modes:
-                timing[m.name] = study.timed(m)
-                bar.update()
+                if m.timing_key not in runs:
+                    runs[m.timing_key] = study.timed(m)
+                    bar.update()
+                timing[m.name] = runs[m.timing_key]
 
         rows = _rows(study, modes, mode_paths, ref, timing) + _ladder_rows(study, ref) + check_rows
         rows += _ref_error_rows(study, ref, ref_err)
     finally:
+        study.close()
         shutil.rmtree(study.scratch, ignore_errors=True)
 
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -667,15 +704,21 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
 def _rows(study, modes, mode_paths, ref, timing):
     rows = []
     final_S = ref["steps"][-1]["S2"]
-    for m in modes:
-        r = read_run(mode_paths[m.name])
-        rms, mx = frame_errors(r.pos, ref["final"].pos, study.L)
+    measured = study.readers().map(
+        _mode_metrics,
+        [mode_paths[m.name] for m in modes],
+        itertools.repeat(ref["final"]),
+        itertools.repeat(study.L),
+        itertools.repeat(study.gravity),
+        chunksize=8,
+    )
+    for m, (r, rms, mx, extra) in zip(modes, measured):
         ms, ms_min, rec = timing[m.name]
         rows += _frame_rows(
             r,
             rms,
             mx,
-            frame_metrics(r, ref["final"], study.L, study.gravity),
+            extra,
             **m.columns(),
             study="mode",
             strands=study.plan.strands,

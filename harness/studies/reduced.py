@@ -76,7 +76,6 @@ FIELDS = (
 )
 FRACTIONS = (1.0, 0.5, 0.25, 0.1, 0.05)
 STUDIED = ("guides", "lra", "sagfree", "lod")  # the §3.14 features the rows declare
-FEATURE_FLAGS = {"--guides": "guides", "--lra": "lra", "--sag-free": "sagfree", "--render-points": "lod"}
 SCHEMES = ("one", "blend3")
 
 
@@ -167,7 +166,7 @@ def timing_binaries(plan):
 
 def row_features(extra):
     """The §3.14 features a row's flags declare."""
-    return {FEATURE_FLAGS[str(a)] for a in extra if str(a) in FEATURE_FLAGS}
+    return variants.features_of(extra)
 
 
 def measure(plan=Plan(), out=None, work=None, progress=print):

@@ -5,8 +5,8 @@ A map, not anecdotes: 2-D slices through the dynamic scene space (substeps again
 speed, stretch compliance, bend compliance and points per strand; head-motion frequency
 against amplitude; long-range attachments on and off against a fast nod's frequency and
 against wind speed, at one iteration), each run for both solvers and both precisions, on the CPU and, where a
-GPU answers, on every CUDA build that is built (each build's default variant, as its
-`--list-variants` declares). Every cell is one run of a few strands over a horizon of
+GPU answers, on every CUDA build that is built (on each, the fastest variant that runs the
+cell: GPU_PREFERENCE). Every cell is one run of a few strands over a horizon of
 about one second (strands are independent, so a few show what many would); its verdict,
 from the per-frame observables of the file (docs/model.md §3.8) and the bounds of
 harness/core/tolerances.py:
@@ -49,6 +49,10 @@ from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES, scene_sli
 
 STRANDS = 16
 FRAMES = 60  # one second at the base scenes' Δt = 1/60 s
+# The variant a GPU cell runs: the first of these that its build declares and that runs the
+# cell (its points, solver and §3.14 features), fastest first (measured on an H200,
+# docs/decisions/bench-runs.md); else the build's variant that simulates any point count.
+GPU_PREFERENCE = ("lanes", "warpreg", "warp", "strand")
 
 COLUMNS = (
     "slice",
@@ -102,8 +106,8 @@ def text(value):
 
 
 def backends(gpu="auto", log=print):
-    """The CPU oracle, and each built CUDA build's first variant that simulates any point
-    count (the map's P axis reaches 128) where a GPU answers."""
+    """The CPU oracle, and each built CUDA build where a GPU answers, with its variant that
+    simulates any point count (a cell runs on the fastest that runs it: cell_backend)."""
     out = [Backend("cpu", "default", variants.declared("cpu").default_variant)]
     if gpu == "no":
         log("stability: GPU builds not run (--gpu no)")
@@ -139,6 +143,24 @@ def cell_scene(slc, row, col, solver, precision, strands, frames):
     dyn["--frames"] = frames
     dyn["--output-every"] = frames  # every frame's observables, the last frame's positions
     return replace(base.with_overrides(strands=strands, precision=precision, points=points), dynamic=dyn)
+
+
+def cell_backend(be, declared, slc, row, col, solver, precision, strands, frames):
+    """The backend a cell runs on: `be` itself on the CPU; on a CUDA build (`declared`: its
+    variants.Declared), the first variant of GPU_PREFERENCE that runs the cell, else `be`'s."""
+    if be.backend != "cuda":
+        return be
+    scene = cell_scene(slc, row, col, solver, precision, strands, frames)
+    features = variants.features_of(scene.dynamic)
+    for v in GPU_PREFERENCE:
+        if (
+            v in declared.variants
+            and declared.runs(v, "simulate", points=scene.points)
+            and declared.runs_features(v, features)
+            and solver in declared.solvers_of(v)
+        ):
+            return replace(be, variant=v)
+    return be
 
 
 def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None, gpu=None):
@@ -232,7 +254,7 @@ def measure(
     bes = backends(gpu, log)
     declared = {be: variants.declared(be.backend, be.build) for be in bes}  # solvers, precisions
     todo = [
-        (slc, r, c, solver, precision, be)
+        (slc, r, c, solver, precision, cell_backend(be, declared[be], slc, r, c, solver, precision, strands, frames))
         for be in bes
         for slc, r, c in cells(chosen, quick)
         for solver in declared[be].dynamic_solvers

@@ -156,6 +156,32 @@ def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, 
     assert (out / accuracy_dynamic.CSV_NAME).read_bytes() == before
 
 
+def test_modes_that_differ_only_in_ftl_damping_share_one_timed_run(cpu_bin, tmp_path, quiet, monkeypatch):
+    """s is one factor of ftl's velocity update (no kernel branches on it): the study times
+    each build × solver × S × I × precision once, and the modes alike but for s take its time."""
+    monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
+    timed, real = [], accuracy_dynamic.Study.timed
+
+    def counting(self, mode):
+        timed.append(mode)
+        return real(self, mode)
+
+    monkeypatch.setattr(accuracy_dynamic.Study, "timed", counting)
+    out = tmp_path / "out"
+    assert accuracy_dynamic.run_study(accuracy_dynamic.Plan(**TINY), out, log=quiet) == 0
+    with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
+        modes = {r["mode"]: r for r in csv.DictReader(fh) if r["study"] == "mode"}
+    keys = {m.timing_key for m in timed}
+    assert len(timed) == len(keys) < len(modes)  # each key once, fewer than the modes
+    ftl = [r for r in modes.values() if r["solver"] == "ftl"]
+    by_key = {}
+    for r in ftl:
+        key = (r["variant"], r["precision"], r["substeps"], r["iterations"])
+        by_key.setdefault(key, set()).add((r["ftl_damping"], r["time_per_frame_ms"]))
+    assert all(len(v) == len(TINY["ftl_damping"]) for v in by_key.values())  # every s is a mode of its own
+    assert all(len({t for _, t in v}) == 1 for v in by_key.values())  # and they share one time
+
+
 def test_the_reference_that_does_not_converge_says_so(cpu_bin, tmp_path, quiet, monkeypatch):
     monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
     plan = accuracy_dynamic.Plan(

@@ -8,6 +8,7 @@ docs/decisions.md ("Stability search of the dynamic model").
 
 import math
 import os
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -322,6 +323,41 @@ def test_the_map_starts_its_heaviest_cells_first_and_keeps_its_row_order(cpu_bin
     assert cells[:: 2 * 2] == [(r, c) for r in slc.rows.quick for c in slc.cols.quick]  # × solvers × precisions
     work = [float(r) * float(c) for r, c in started]
     assert work == sorted(work, reverse=True) and work[0] > work[-1]
+
+
+def test_a_gpu_cell_runs_the_fastest_variant_that_runs_it():
+    """A GPU cell takes the first of GPU_PREFERENCE its build declares that runs its points,
+    solver and features (the fastest: the S = 64, I = 128 cell took 13–34 s on strand and about
+    1 s on lanes); the CPU keeps its variant; with none that runs it, the build's own."""
+    sim = ("init", "simulate")
+    gpu = variants.Declared(
+        backend="cuda",
+        build="strict",
+        default_variant="fused",
+        precisions=("fp32", "fp64"),
+        variants=("fused", "strand", "warp", "warpreg", "lanes"),
+        stages={"fused": ("init",), "strand": sim, "warp": sim, "warpreg": sim, "lanes": sim},
+        max_points={"warpreg": 32, "lanes": 128},
+        solvers=("xpbd", "ftl"),
+        variant_features={"lanes": ("sagfree", "lod")},
+    )
+    be = stability.Backend("cuda", "strict", "strand")
+
+    def variant(name, row, col, solver="xpbd", declared=gpu):
+        return stability.cell_backend(be, declared, slice_named(name), row, col, solver, "fp32", 16, 60).variant
+
+    assert variant("substeps-iterations", 64, 128) == "lanes"
+    assert variant("substeps-points", 4, 128, "ftl") == "lanes"
+    assert variant("lra-nod", 1, 16) == "warpreg"  # lanes runs no long-range attachments
+    assert variant("lra-nod", "off", 16) == "lanes"
+    no_lanes = replace(gpu, variants=gpu.variants[:-1])
+    assert variant("substeps-points", 4, 16, declared=no_lanes) == "warpreg"
+    assert variant("substeps-points", 4, 128, declared=no_lanes) == "warp"  # warpreg: at most 32 points
+    only_ftl = replace(gpu, variant_solvers={v: ("ftl",) for v in ("warp", "warpreg", "lanes")})
+    assert variant("substeps-wind", 4, 0, declared=only_ftl) == "strand"
+    none = replace(gpu, variant_solvers={v: ("ftl",) for v in gpu.variants})
+    assert variant("substeps-wind", 4, 0, declared=none) == "strand"  # be's own: the binary refuses it
+    assert stability.cell_backend(CPU, gpu, slice_named("lra-nod"), 1, 16, "xpbd", "fp32", 16, 60) == CPU
 
 
 def test_verdict_takes_the_worst_that_applies():
