@@ -99,6 +99,28 @@ def features_of(flags):
     return {FEATURE_FLAGS[str(a)] for a in flags if str(a) in FEATURE_FLAGS}
 
 
+# Simulate variants fastest first (16 strands, S = 64, I = 128 on an H200: lanes about 1 s,
+# warp 1.4–2.7 s, strand 13–34 s; docs/decisions/bench-runs.md): what a study that needs only
+# some variant that runs its scene takes.
+FASTEST_FIRST = ("lanes", "warpreg", "warp", "strand")
+
+
+def fastest(declared, points, features=(), solver=None, per_segment=False):
+    """The first of FASTEST_FIRST that `declared` (a Declared) declares and that simulates
+    strands of `points` points with `features` and `solver` (and, with `per_segment`, a
+    groom's per-segment rest lengths); None where none does."""
+    for v in FASTEST_FIRST:
+        if (
+            v in declared.variants
+            and declared.runs(v, "simulate", points=points)
+            and declared.runs_features(v, features)
+            and (solver is None or solver in declared.solvers_of(v))
+            and (not per_segment or v in declared.per_segment)
+        ):
+            return v
+    return None
+
+
 def simulating(backend, build="default"):
     """The first variant of a binary that simulates strands of any length (no max_points):
     what a study that draws the point count runs."""

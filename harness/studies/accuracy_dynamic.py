@@ -481,11 +481,14 @@ class Study:
         return dict(S=S, finest=prev_S, rms=rms, max=mx, est_rms=rms + tail_rms, est_max=mx + tail_max, ratio=q)
 
 
-def _gpu_reference_build(gpu_ok, plan):
+def _gpu_reference_build(gpu_ok, scene):
+    """The default cuda build's fastest variant that runs `scene` with the reference's
+    solver (variants.fastest); None without a GPU or such a variant (the CPU ladder runs)."""
     if not gpu_ok or not binary_path("cuda").exists():
         return None
-    sim = variants.declared("cuda").running(SIMULATE)
-    return variants.Runner("cuda", "default", sim[0]) if sim else None
+    d = variants.declared("cuda")
+    v = variants.fastest(d, scene.points, variants.features_of(scene.dynamic), REF_SOLVER, bool(scene.groom))
+    return variants.Runner("cuda", "default", v) if v else None
 
 
 def _row(**kw):
@@ -577,10 +580,10 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                     mode_paths[m.name], records[m.name] = f.result()
 
         # 2. the reference (GPU fp64 where usable and validated against the CPU)
-        gpu_ref = _gpu_reference_build(gpu_ok, plan)
+        gpu_ref = _gpu_reference_build(gpu_ok, study.scene)
         check_rows, gpu_note = (
             [],
-            f"not used: {gpu_why if not gpu_ok else 'the default cuda build is absent or runs no simulate variant'}",
+            f"not used: {gpu_why if not gpu_ok else 'no default cuda build, or none of its variants runs the scene'}",
         )
         if gpu_ref is not None:
             S0 = plan.first_rung

@@ -6,7 +6,7 @@ speed, stretch compliance, bend compliance and points per strand; head-motion fr
 against amplitude; long-range attachments on and off against a fast nod's frequency and
 against wind speed, at one iteration), each run for both solvers and both precisions, on the CPU and, where a
 GPU answers, on every CUDA build that is built (on each, the fastest variant that runs the
-cell: GPU_PREFERENCE). Every cell is one run of a few strands over a horizon of
+cell: variants.fastest). Every cell is one run of a few strands over a horizon of
 about one second (strands are independent, so a few show what many would); its verdict,
 from the per-frame observables of the file (docs/model.md §3.8) and the bounds of
 harness/core/tolerances.py:
@@ -49,10 +49,6 @@ from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES, scene_sli
 
 STRANDS = 16
 FRAMES = 60  # one second at the base scenes' Δt = 1/60 s
-# The variant a GPU cell runs: the first of these that its build declares and that runs the
-# cell (its points, solver and §3.14 features), fastest first (measured on an H200,
-# docs/decisions/bench-runs.md); else the build's variant that simulates any point count.
-GPU_PREFERENCE = ("lanes", "warpreg", "warp", "strand")
 
 COLUMNS = (
     "slice",
@@ -147,20 +143,12 @@ def cell_scene(slc, row, col, solver, precision, strands, frames):
 
 def cell_backend(be, declared, slc, row, col, solver, precision, strands, frames):
     """The backend a cell runs on: `be` itself on the CPU; on a CUDA build (`declared`: its
-    variants.Declared), the first variant of GPU_PREFERENCE that runs the cell, else `be`'s."""
+    variants.Declared), its fastest variant that runs the cell (variants.fastest), else `be`'s."""
     if be.backend != "cuda":
         return be
     scene = cell_scene(slc, row, col, solver, precision, strands, frames)
-    features = variants.features_of(scene.dynamic)
-    for v in GPU_PREFERENCE:
-        if (
-            v in declared.variants
-            and declared.runs(v, "simulate", points=scene.points)
-            and declared.runs_features(v, features)
-            and solver in declared.solvers_of(v)
-        ):
-            return replace(be, variant=v)
-    return be
+    v = variants.fastest(declared, scene.points, variants.features_of(scene.dynamic), solver)
+    return be if v is None else replace(be, variant=v)
 
 
 def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None, gpu=None):

@@ -326,9 +326,9 @@ def test_the_map_starts_its_heaviest_cells_first_and_keeps_its_row_order(cpu_bin
 
 
 def test_a_gpu_cell_runs_the_fastest_variant_that_runs_it():
-    """A GPU cell takes the first of GPU_PREFERENCE its build declares that runs its points,
-    solver and features (the fastest: the S = 64, I = 128 cell took 13–34 s on strand and about
-    1 s on lanes); the CPU keeps its variant; with none that runs it, the build's own."""
+    """A GPU cell takes the first of variants.FASTEST_FIRST its build declares that runs its
+    points, solver and features (the S = 64, I = 128 cell took 13–34 s on strand and about 1 s
+    on lanes); the CPU keeps its variant; with none that runs it, the build's own."""
     sim = ("init", "simulate")
     gpu = variants.Declared(
         backend="cuda",
@@ -358,6 +358,9 @@ def test_a_gpu_cell_runs_the_fastest_variant_that_runs_it():
     none = replace(gpu, variant_solvers={v: ("ftl",) for v in gpu.variants})
     assert variant("substeps-wind", 4, 0, declared=none) == "strand"  # be's own: the binary refuses it
     assert stability.cell_backend(CPU, gpu, slice_named("lra-nod"), 1, 16, "xpbd", "fp32", 16, 60) == CPU
+    # a groom's per-segment rest lengths (the accuracy study's GPU reference asks for them)
+    assert variants.fastest(replace(gpu, per_segment=("strand", "warp")), 32, (), "xpbd", per_segment=True) == "warp"
+    assert variants.fastest(gpu, 32, (), "xpbd", per_segment=True) is None
 
 
 def test_verdict_takes_the_worst_that_applies():
