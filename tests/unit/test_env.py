@@ -32,3 +32,14 @@ def test_in_this_checkout_git_gives_the_head():
     if head.returncode != 0:
         pytest.skip("this tree is not a git checkout")
     assert env.git_revision().removesuffix("-dirty") == head.stdout.strip()
+
+
+def test_no_revision_file_is_committed():
+    """REVISION is written beside a tree copied to a GPU node, never committed: a committed
+    one would stamp every later commit's binaries and results with its revision."""
+    if shutil.which("git") is None:
+        pytest.skip("git is not installed here")
+    tracked = subprocess.run(["git", "ls-files", "REVISION"], cwd=env.ROOT, capture_output=True, text=True)
+    if tracked.returncode != 0:
+        pytest.skip("this tree is not a git checkout")
+    assert tracked.stdout.strip() == "", "REVISION is tracked: git rm --cached REVISION"
