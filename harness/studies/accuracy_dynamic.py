@@ -44,8 +44,9 @@ import json
 import multiprocessing
 import os
 import shutil
+import signal
 import time
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
@@ -278,8 +279,9 @@ def _mode_metrics(path, ref, L, gravity):
 
 def reader_pool(jobs):
     """Processes that read and compare the modes' state files (about 15 ms each, hundreds of
-    them a rung); a fresh interpreter each (forkserver), so no lock of the caller's threads is copied."""
-    return ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("forkserver"))
+    them a rung). All start at once, forked before the study starts any thread; they ignore
+    Ctrl-C, and the study ends them (Study.close) however it ends."""
+    return multiprocessing.get_context("fork").Pool(jobs, signal.signal, (signal.SIGINT, signal.SIG_IGN))
 
 
 def frame_metrics(run, ref, L, gravity):
@@ -321,18 +323,16 @@ class Study:
         self.scratch = Path(out_dir) / "states"
         self.cpu_threads = os.cpu_count() or 1
         self.jobs = plan.jobs or self.cpu_threads
-        self._readers = None
+        self.readers = None  # reader_pool(), from start_readers() to close()
 
-    def readers(self):
-        """The study's reader processes (reader_pool), started when first needed."""
-        if self._readers is None:
-            self._readers = reader_pool(self.jobs)
-        return self._readers
+    def start_readers(self):
+        self.readers = reader_pool(self.jobs)
 
     def close(self):
-        if self._readers is not None:
-            self._readers.shutdown(cancel_futures=True)
-            self._readers = None
+        if self.readers is not None:
+            self.readers.terminate()  # nothing is left to read: end them at once
+            self.readers.join()
+            self.readers = None
 
     def path(self, tag):
         return self.scratch / f"{tag}.h5"
@@ -386,9 +386,7 @@ class Study:
         """{mode name: RMS error [F]} against ref positions; a mode blown up at any frame
         gives NaN throughout (it takes no part in the smallest error)."""
         names = list(paths)
-        errs = self.readers().map(
-            _mode_rms, [paths[n] for n in names], itertools.repeat(ref.pos), itertools.repeat(self.L), chunksize=8
-        )
+        errs = self.readers.starmap(_mode_rms, [(paths[n], ref.pos, self.L) for n in names], chunksize=8)
         return dict(zip(names, errs))
 
     def ladder(self, build, mode_paths, first_path=None):
@@ -549,6 +547,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
     mode_paths, records = {}, {}
     jobs = study.jobs
     try:
+        study.start_readers()  # before any thread of the study
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             futures = {}
             if plan.analytic != "none":
@@ -707,13 +706,8 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
 def _rows(study, modes, mode_paths, ref, timing):
     rows = []
     final_S = ref["steps"][-1]["S2"]
-    measured = study.readers().map(
-        _mode_metrics,
-        [mode_paths[m.name] for m in modes],
-        itertools.repeat(ref["final"]),
-        itertools.repeat(study.L),
-        itertools.repeat(study.gravity),
-        chunksize=8,
+    measured = study.readers.starmap(
+        _mode_metrics, [(mode_paths[m.name], ref["final"], study.L, study.gravity) for m in modes], chunksize=8
     )
     for m, (r, rms, mx, extra) in zip(modes, measured):
         ms, ms_min, rec = timing[m.name]

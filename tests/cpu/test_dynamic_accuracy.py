@@ -4,12 +4,18 @@ belongs to `make bench`, not here."""
 
 import csv
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pytest
 
 from harness.cli import main as cli
 from harness.core import env, tolerances, variants
+from harness.core.paths import ROOT
 from harness.render import accuracy_dynamic_report
 from harness.studies import accuracy_dynamic, observables_long
 from support.accuracy_plans import TINY
@@ -180,6 +186,33 @@ def test_modes_that_differ_only_in_ftl_damping_share_one_timed_run(cpu_bin, tmp_
         by_key.setdefault(key, set()).add((r["ftl_damping"], r["time_per_frame_ms"]))
     assert all(len(v) == len(TINY["ftl_damping"]) for v in by_key.values())  # every s is a mode of its own
     assert all(len({t for _, t in v}) == 1 for v in by_key.values())  # and they share one time
+
+
+def test_ctrl_c_in_the_study_ends_it_in_one_line_and_leaves_no_process(cpu_bin, tmp_path):
+    """Ctrl-C (SIGINT to the process group, as a terminal sends it) while the study's reader
+    processes are up: one line, exit 130, no traceback from any worker, none left running."""
+    argv = [sys.executable, "-m", "harness", "accuracy", "--model", "dynamic", "--quick", "--gpu", "no"]
+    argv += ["--out", str(tmp_path / "out"), "--report-dir", str(tmp_path / "rep")]
+    env_ = dict(os.environ, PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen(argv, cwd=ROOT, env=env_, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)  # fmt: skip
+    for line in proc.stdout:
+        if "dynamic accuracy: reference cpu ref S = 64:" in line:  # its first comparison next
+            break
+    os.killpg(proc.pid, signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and err.strip().splitlines()[-1] == "harness: interrupted", err
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:  # every process of its group has ended
+        try:
+            os.killpg(proc.pid, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.1)
+    else:
+        pytest.fail("a process of the study outlived it")
+    assert not (tmp_path / "out" / accuracy_dynamic.CSV_NAME).exists()
 
 
 def test_the_reference_that_does_not_converge_says_so(cpu_bin, tmp_path, quiet, monkeypatch):
