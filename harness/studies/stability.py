@@ -147,7 +147,7 @@ def cell_backend(be, declared, slc, row, col, solver, precision, strands, frames
     if be.backend != "cuda":
         return be
     scene = cell_scene(slc, row, col, solver, precision, strands, frames)
-    v = variants.fastest(declared, scene.points, variants.features_of(scene.dynamic), solver)
+    v = variants.fastest(declared, scene.points, variants.features_of(scene.dynamic), solver, bool(scene.groom))
     return be if v is None else replace(be, variant=v)
 
 
