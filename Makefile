@@ -164,15 +164,32 @@ $(BUILD)/planted/hairsim-cpu-plant%: $(BUILD)/planted/obj%/dynamics_f32.o \
 
 ifeq ($(HAVE_NVCC),yes)
 cuda: $(CUDA_BINS)
-$(BUILD)/hairsim-cuda-strict: MODE := strict
-$(BUILD)/hairsim-cuda-fastmath: MODE := fastmath
-$(BUILD)/hairsim-cuda: MODE := normal
-$(CUDA_BINS): $(CUDA_SRC) $(CUDA_HDR) $(C_HEADERS) $(SHARED_OBJ)
-	@if [ -z "$(CUDA_SRC)" ]; then echo "note: no CUDA sources in cuda/ yet"; exit 0; fi
+# One object per source and math mode, so that make -j compiles them side by side; the two
+# sources that hold the dynamic model's kernel tables once per precision (-DHB_DYN_REAL), which
+# halves the longest compile. Only backend_cuda.cu takes the build's flags string.
+CUDA_MODES := normal strict fastmath
+CUDA_SPLIT := dyn_kernels dyn_lanes
+CUDA_UNITS := $(filter-out $(CUDA_SPLIT),$(notdir $(CUDA_SRC:.cu=))) $(foreach s,$(CUDA_SPLIT),$(s)-f32 $(s)-f64)
+define CUDA_MODE_RULES
+CUDA_OBJ_$(1) := $$(CUDA_UNITS:%=$$(OBJ)/cuda-$(1)/%.o)
+$$(OBJ)/cuda-$(1)/%.o: cuda/%.cu $$(CUDA_HDR) $$(C_HEADERS)
+	@mkdir -p $$(@D)
+	$$(NVCC) $$(NVCC_BASE) $$(NVCC_MODE_$(1)) $$(HDF5_CFLAGS) -DHB_FLAGS='"$$(NVCC) $$(NVCC_BASE) $$(NVCC_MODE_$(1))"' \
+	  -DHB_MATH_MODE='"$(1)"' -c $$< -o $$@
+$$(OBJ)/cuda-$(1)/%-f32.o: cuda/%.cu $$(CUDA_HDR) $$(C_HEADERS)
+	@mkdir -p $$(@D)
+	$$(NVCC) $$(NVCC_BASE) $$(NVCC_MODE_$(1)) $$(HDF5_CFLAGS) -DHB_DYN_REAL=float -c $$< -o $$@
+$$(OBJ)/cuda-$(1)/%-f64.o: cuda/%.cu $$(CUDA_HDR) $$(C_HEADERS)
+	@mkdir -p $$(@D)
+	$$(NVCC) $$(NVCC_BASE) $$(NVCC_MODE_$(1)) $$(HDF5_CFLAGS) -DHB_DYN_REAL=double -c $$< -o $$@
+endef
+$(foreach m,$(CUDA_MODES),$(eval $(call CUDA_MODE_RULES,$(m))))
+$(BUILD)/hairsim-cuda: $(CUDA_OBJ_normal) $(SHARED_OBJ)
+$(BUILD)/hairsim-cuda-strict: $(CUDA_OBJ_strict) $(SHARED_OBJ)
+$(BUILD)/hairsim-cuda-fastmath: $(CUDA_OBJ_fastmath) $(SHARED_OBJ)
+$(CUDA_BINS):
 	@mkdir -p $(BUILD)
-	$(NVCC) $(NVCC_BASE) $(NVCC_MODE_$(MODE)) $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' \
-	  -DHB_FLAGS='"$(NVCC) $(NVCC_BASE) $(NVCC_MODE_$(MODE))"' -DHB_MATH_MODE='"$(MODE)"' \
-	  $(CUDA_SRC) $(SHARED_OBJ) -o $@ $(HDF5_LIBS)
+	$(NVCC) -arch=$(CUDA_ARCH) $^ -o $@ $(HDF5_LIBS)
 
 # The host checks (tests/native): the CUDA port's model templates compiled for the host and
 # run against the reference's objects; host code only, with the host compiler told the

@@ -74,6 +74,15 @@ static void first_touch(void *p, const hb_scene *s)
 
 static int simd_setup(cpu_impl *c, const hb_options *o, int need_save, uint64_t driver_bytes, char *err, size_t errlen);
 
+/* The threads of a run without --threads: OpenMP's default, read before any run set another
+ * (a --batch runs several in one process). */
+static int default_threads(void)
+{
+    static int n = 0;
+    if (n == 0) n = omp_get_max_threads();
+    return n;
+}
+
 static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t driver_bytes, char *err, size_t errlen)
 {
     cpu_impl *c = calloc(1, sizeof *c);
@@ -85,7 +94,7 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     c->scene = o->scene;
     c->bytes = hb_state_bytes(&o->scene);
     hb_model_round(&o->scene, &c->m32, &c->m64);
-    if (o->threads > 0) omp_set_num_threads(o->threads);
+    omp_set_num_threads(o->threads > 0 ? o->threads : default_threads());
     b->threads = omp_get_max_threads();
     if (o->variant && strcmp(o->variant, "simd") == 0) {
         const int status = simd_setup(c, o, need_save, driver_bytes, err, errlen);
@@ -866,7 +875,7 @@ static int cpu_dyn_render(hb_backend *b, void *position, void *velocity, double 
 static int cpu_stream(const hb_options *o, double *copy_gbps, double *copy_bytes, double *triad_gbps,
                       double *triad_bytes, char *err, size_t errlen)
 {
-    if (o->threads > 0) omp_set_num_threads(o->threads);
+    omp_set_num_threads(o->threads > 0 ? o->threads : default_threads());
     const size_t n = (size_t)1 << 26;
     double *a = malloc(n * sizeof *a), *c = malloc(n * sizeof *c);
     double *bb = triad_gbps ? malloc(n * sizeof *bb) : NULL;

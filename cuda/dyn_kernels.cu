@@ -441,8 +441,13 @@ cudaError_t launch_observe(const ObsScene &sc, const T *x, const T *v, Layout la
     template cudaError_t launch_bend_rest<T>(const T *, Layout, T *, Layout1, int64_t, int64_t, cudaStream_t);         \
     template cudaError_t launch_observe<T>(const ObsScene &, const T *, const T *, Layout, int64_t, ObsPartial *,      \
                                            cudaStream_t);
+/* the Makefile compiles this file once per precision (-DHB_DYN_REAL), side by side */
+#ifdef HB_DYN_REAL
+HB_DYN_INSTANTIATE(HB_DYN_REAL)
+#else
 HB_DYN_INSTANTIATE(float)
 HB_DYN_INSTANTIATE(double)
+#endif
 #undef HB_DYN_INSTANTIATE
 
 } /* namespace dyn */

@@ -615,8 +615,13 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
     template cudaError_t prepare_lanes<T>(unsigned, int, int64_t, int, bool);                                          \
     template cudaError_t launch_frame_lanes<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,           \
                                                const T *, int64_t, int, cudaStream_t);
+/* the Makefile compiles this file once per precision (-DHB_DYN_REAL), side by side */
+#ifdef HB_DYN_REAL
+HB_LANES_INSTANTIATE(HB_DYN_REAL)
+#else
 HB_LANES_INSTANTIATE(float)
 HB_LANES_INSTANTIATE(double)
+#endif
 #undef HB_LANES_INSTANTIATE
 
 } /* namespace dyn */

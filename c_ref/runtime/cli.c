@@ -156,6 +156,8 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
             "  --measure-bandwidth  only measure the %s copy bandwidth (GB/s, read + write)\n"
             "  --self-test rng      print the Philox4x32-10 known-answer checks and exit\n"
             "  --list-variants      print this binary's variants, the stages each runs and its build as JSON\n"
+            "  --batch FILE         run each line of FILE (a run's flags, separated by tabs) in this one\n"
+            "                       process, in order, until one fails; no other flag with it\n"
             "  --input-frame K      with --input: resume after frame K of the file (default: its last)\n"
             "  --help, --version\n",
             prog, backend, "kernel variant (--list-variants names them)",

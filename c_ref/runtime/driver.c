@@ -511,12 +511,81 @@ static int place_groom(hb_run *r, hb_stage_record *sr, double *times, char *err,
         }                                                                                                              \
     } while (0)
 
+static int run_one(int argc, char **argv, hb_backend *b);
+
+/* --batch FILE: one run a line, its flags separated by tabs, all in this process, so that a
+ * GPU's context is made once for all of them (docs/interfaces.md, "Batches"). The runs go in
+ * order; the first that fails ends the batch with its exit status, after the records of the
+ * runs before it. The backend starts every run as it started the first. */
+#define HB_BATCH_MAX_ARGS 256
+static int run_batch(char *prog, const char *path, hb_backend *b)
+{
+    char err[HB_ERRLEN];
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        snprintf(err, sizeof err, "--batch %s: cannot read it", path);
+        return die(HB_EXIT_USAGE, err);
+    }
+    const hb_backend pristine = *b;
+    char *line = NULL;
+    size_t cap = 0;
+    ssize_t n;
+    int status = HB_EXIT_OK;
+    for (long lineno = 1; status == HB_EXIT_OK && (n = getline(&line, &cap, f)) >= 0; lineno++) {
+        while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r')) line[--n] = '\0';
+        if (n == 0) continue;
+        char *argv[HB_BATCH_MAX_ARGS + 1];
+        int argc = 0;
+        argv[argc++] = prog;
+        for (char *tok = line; tok;) {
+            char *tab = strchr(tok, '\t');
+            if (tab) *tab = '\0';
+            if (argc == HB_BATCH_MAX_ARGS) {
+                snprintf(err, sizeof err, "--batch %s: line %ld has more than %d flags and values", path, lineno,
+                         HB_BATCH_MAX_ARGS - 1);
+                status = die(HB_EXIT_USAGE, err);
+                break;
+            }
+            if (strcmp(tok, "--batch") == 0) {
+                snprintf(err, sizeof err, "--batch %s: line %ld holds --batch (batches do not nest)", path, lineno);
+                status = die(HB_EXIT_USAGE, err);
+                break;
+            }
+            argv[argc++] = tok;
+            tok = tab ? tab + 1 : NULL;
+        }
+        argv[argc] = NULL;
+        if (status == HB_EXIT_OK) status = run_one(argc, argv, b);
+        *b = pristine;
+        fflush(stdout);
+        fflush(stderr);
+    }
+    if (status == HB_EXIT_OK && ferror(f)) {
+        snprintf(err, sizeof err, "--batch %s: a read failed", path);
+        status = die(HB_EXIT_USAGE, err);
+    }
+    free(line);
+    fclose(f);
+    return status;
+}
+
 int hb_main(int argc, char **argv, hb_backend *b)
+{
+    const char *slash = strrchr(argv[0], '/');
+    g_prog = slash ? slash + 1 : argv[0];
+    for (int i = 1; i < argc; i++)
+        if (strcmp(argv[i], "--batch") == 0) {
+            if (argc != 3 || i != 1)
+                return die(HB_EXIT_USAGE, "--batch FILE takes no other flag (each line of FILE holds a run's flags)");
+            return run_batch(argv[0], argv[2], b);
+        }
+    return run_one(argc, argv, b);
+}
+
+static int run_one(int argc, char **argv, hb_backend *b)
 {
     char err[HB_ERRLEN] = "";
     hb_options o;
-    const char *slash = strrchr(argv[0], '/');
-    g_prog = slash ? slash + 1 : argv[0];
 
     int rc = hb_parse_args(argc, argv, b->name, &o, err, sizeof err);
     if (rc < 0) return die(HB_EXIT_USAGE, err);

@@ -7,9 +7,12 @@ sweep can skip the case and go on.
 
 import json
 import os
+import queue
 import signal
 import subprocess
-from collections.abc import Iterable, Sequence
+import tempfile
+import threading
+from collections.abc import Generator, Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -86,18 +89,128 @@ def run_binary(
         why = last_line(proc.stderr) or last_line(proc.stdout) or "no message"
         cls = DoesNotFit if proc.returncode == 3 else BackendError
         raise cls(f"{binary.name} exited with status {proc.returncode}: {why}", code=proc.returncode)
+    return parse_record(binary, proc.stdout, expect_keys)
+
+
+def parse_record(binary: Path, text: str, expect_keys: Iterable[str] = RECORD_KEYS) -> dict[str, Any]:
+    """The JSON record a run printed, checked for the documented keys."""
     try:
-        record = json.loads(proc.stdout)
+        record = json.loads(text)
     except json.JSONDecodeError:
-        raise BackendError(
-            f"{binary.name} printed no JSON record on stdout (got: {last_line(proc.stdout)[:120]!r})"
-        ) from None
+        raise BackendError(f"{binary.name} printed no JSON record on stdout (got: {last_line(text)[:120]!r})") from None
     if not isinstance(record, dict):
         raise BackendError(f"{binary.name} printed JSON that is not an object")
     missing = [k for k in expect_keys if k not in record]
     if missing:
         raise BackendError(f"{binary.name}: JSON record lacks {', '.join(missing)} (docs/interfaces.md)")
     return record
+
+
+BATCH_MAX = 32  # runs one batch process holds at most
+
+
+def run_batch(
+    binary: str | Path,
+    runs: Sequence[Sequence[Any]],
+    timeout: float | None = None,
+    expect_keys: Iterable[str] = RECORD_KEYS,
+    env: dict[str, str] | None = None,
+) -> Iterator[tuple[int, dict[str, Any] | None, BackendError | None]]:
+    """Each argument list of `runs` as run_binary would run it, but all in one process
+    (`binary --batch FILE`, docs/interfaces.md "Batches"), so that a GPU's context is made
+    once. Yields (index, record, error) in order as each run ends: `error` is what
+    run_binary would raise for that run. The process ends at a run that fails; the runs after
+    it go on in a new one. `timeout`: for each run."""
+    binary = require_binary(binary)
+    start = 0
+    while start < len(runs):
+        start = yield from _one_batch(binary, runs, start, timeout, expect_keys, env)
+
+
+def _one_batch(
+    binary: Path,
+    runs: Sequence[Sequence[Any]],
+    start: int,
+    timeout: float | None,
+    expect_keys: Iterable[str],
+    env: dict[str, str] | None,
+) -> Generator[tuple[int, dict[str, Any] | None, BackendError | None], None, int]:
+    """Runs runs[start:] in one process until one fails; returns the index to go on from."""
+    lines = []
+    for args in runs[start:]:
+        words = [*map(str, args), "--json", "--quiet"]
+        if any(c in w for w in words for c in "\t\n\r"):
+            raise HarnessError(f"{binary.name}: a batched run's flags hold a tab or a line break: {' '.join(words)}")
+        lines.append("\t".join(words))
+    child_env = dict(os.environ, **env) if env else None
+    with tempfile.TemporaryDirectory(prefix="hairbench-batch-") as tmp:
+        batch = Path(tmp) / "runs.txt"
+        batch.write_text("\n".join(lines) + "\n")
+        with open(Path(tmp) / "stderr.txt", "w+") as err:
+            try:
+                child = subprocess.Popen(
+                    [str(binary), "--batch", str(batch)], stdout=subprocess.PIPE, stderr=err, text=True, env=child_env
+                )
+            except OSError as e:
+                raise BackendError(f"cannot run {display(binary)}: {e.strerror}") from None
+            out: queue.Queue[str | None] = queue.Queue()
+
+            def read() -> None:
+                assert child.stdout is not None
+                for line in child.stdout:
+                    out.put(line)
+                out.put(None)
+
+            reader = threading.Thread(target=read, name=f"{binary.name} batch", daemon=True)
+            reader.start()
+            i = start
+            try:
+                while i < len(runs):
+                    try:
+                        line = out.get(timeout=timeout)
+                    except queue.Empty:
+                        _kill(child, runs[i])
+                        cmd = " ".join(map(str, runs[i]))
+                        yield i, None, TimedOut(f"{binary.name} did not finish within {timeout} s: {cmd}")
+                        return i + 1
+                    if line is None:
+                        break
+                    try:
+                        record, error = parse_record(binary, line, expect_keys), None
+                    except BackendError as e:
+                        record, error = None, e
+                    yield i, record, error
+                    i += 1
+                    if error is not None:
+                        _kill(child, runs[i - 1])
+                        return i
+                rc = child.wait()
+            except BaseException:  # an interrupt, or the caller stopped early: the child dies
+                _kill(child, runs[i] if i < len(runs) else [])
+                raise
+            finally:
+                reader.join(timeout=5)
+            if i == len(runs) and rc == 0:
+                return i
+            if rc == -signal.SIGINT:
+                raise KeyboardInterrupt
+            if rc < 0:
+                tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(runs[i]))
+            err.seek(0)
+            why = last_line(err.read()) or "no message"
+            if rc == 0:
+                why = "printed fewer records than it had runs"
+            cls = DoesNotFit if rc == 3 else BackendError
+            yield i, None, cls(f"{binary.name} exited with status {rc}: {why}", code=rc)
+            return i + 1
+
+
+def _kill(child: subprocess.Popen[str], args: Sequence[Any]) -> None:
+    """End a batch's process and remove what its current run left."""
+    if child.poll() is None:
+        child.kill()
+    child.wait()
+    tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(args))
 
 
 def run_flags(

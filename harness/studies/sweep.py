@@ -19,7 +19,7 @@ from harness import HarnessError
 from harness.core import budget, env, gpus, scenes
 from harness.core.paths import RESULTS, binary_path, display, output_dir
 from harness.core.progress import Progress
-from harness.core.runner import BackendError, DoesNotFit, run_binary, run_flags
+from harness.core.runner import BATCH_MAX, BackendError, DoesNotFit, run_batch, run_binary, run_flags
 from harness.core.scenes import SceneError
 from harness.io import results_data, runlog
 from harness.io.files import write_json
@@ -292,20 +292,38 @@ def case_size(case):
 
 
 def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list):
-    """Run the cases, appending their rows; the number that failed. With several GPUs the
-    CPU cases run first, alone, then the GPU cases on one worker per GPU (core/gpus.py)."""
+    """Run the cases, appending their rows; the number that failed. The GPU cases of one
+    binary run in batches (runner.run_batch: one process and context for several). With
+    several GPUs the CPU cases run first, alone, then the GPU batches on one worker per GPU
+    (core/gpus.py)."""
     failed = 0
     pin = len(gpu_list) > 1 or bool(os.environ.get("HB_GPUS"))  # else the one GPU as the binary finds it
 
-    def run_case(case, gpu):
-        binary = binary_path(case.backend, case.build or "default")
+    def key(case):
+        return case.backend, case.build or "default"
+
+    def run_cases(cases, gpu):
+        """(case, record, error) of each case, in order, as each ends."""
         env_add = {"CUDA_VISIBLE_DEVICES": gpu.select} if gpu is not None and pin else None
-        return run_binary(binary, case_flags(sweep, case), timeout=sweep.timeout_s, env=env_add)
+        binary = binary_path(*key(cases[0]))
+        if len(cases) == 1:
+            try:
+                yield cases[0], run_binary(binary, case_flags(sweep, cases[0]), sweep.timeout_s, env=env_add), None
+            except (DoesNotFit, SceneError, BackendError) as e:
+                yield cases[0], None, e
+            return
+        ready = []  # (case, its flags)
+        for case in cases:
+            try:
+                ready.append((case, case_flags(sweep, case)))
+            except SceneError as e:
+                yield case, None, e
+        for i, rec, error in run_batch(binary, [f for _, f in ready], sweep.timeout_s, env=env_add):
+            yield ready[i][0], rec, error
 
     def done(case, gpu, rec, error):
         nonlocal failed
-        key = (case.backend, case.build or "default")
-        binary = binary_path(*key)
+        binary = binary_path(*key(case))
         if isinstance(error, (DoesNotFit, SceneError)):
             session["skipped"].append({"case": case.case_id, "reason": str(error)})
             progress.write(f"harness: skipping {case.case_id}: {error}")
@@ -316,7 +334,7 @@ def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, 
         elif error is not None:
             raise error
         else:
-            rows = rows_of_record(case, rec, bandwidth.get(key), session_index, binary)
+            rows = rows_of_record(case, rec, bandwidth.get(key(case)), session_index, binary)
             for r in rows:
                 r["gpu"] = gpu.index if gpu is not None else ""
             runlog.append_case(csv_path, rows)
@@ -330,24 +348,39 @@ def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, 
         write_json(env_path, record)
 
     one = gpu_list[0] if gpu_list else None
+    on_cpu = [c for c in todo if c.backend != "cuda"]
     on_gpu = [c for c in todo if c.backend == "cuda"]
-    if len(gpu_list) <= 1 or not on_gpu:  # one GPU: the cases in the sweep's order, as always
-        for case in todo:
-            gpu = one if case.backend == "cuda" else None
-            try:
-                rec, error = run_case(case, gpu), None
-            except (DoesNotFit, SceneError, BackendError) as e:
-                rec, error = None, e
-            done(case, gpu, rec, error)
+    for case in on_cpu:  # the CPU baselines, one process each, no GPU worker running
+        for c, rec, error in run_cases([case], None):
+            done(c, None, rec, error)
+    if len(gpu_list) <= 1:
+        for chunk in batches(on_gpu, key, BATCH_MAX):
+            for c, rec, error in run_cases(chunk, one):
+                done(c, one, rec, error)
         return failed
-    for case in (c for c in todo if c.backend != "cuda"):  # the CPU baselines, no GPU worker running
-        try:
-            rec, error = run_case(case, None), None
-        except (DoesNotFit, SceneError, BackendError) as e:
-            rec, error = None, e
-        done(case, None, rec, error)
-    gpus.spread(on_gpu, gpu_list, run_case, done)
+    # several GPUs: smaller batches, so that the workers end together
+    size = max(1, min(BATCH_MAX, -(-len(on_gpu) // (4 * len(gpu_list)))))
+
+    def run_chunk(chunk, gpu):
+        return list(run_cases(chunk, gpu))
+
+    def chunk_done(chunk, gpu, results, error):
+        if error is not None:
+            raise error
+        for c, rec, err in results:
+            done(c, gpu, rec, err)
+
+    gpus.spread(batches(on_gpu, key, size), gpu_list, run_chunk, chunk_done)
     return failed
+
+
+def batches(cases, key, size):
+    """The cases grouped by key(case) (one binary), each group in runs of at most `size`, in
+    the order the groups first appear."""
+    groups = {}
+    for c in cases:
+        groups.setdefault(key(c), []).append(c)
+    return [g[i : i + size] for g in groups.values() for i in range(0, len(g), size)]
 
 
 FIGURE_STRANDS = 400  # strands in the Fig. 1/2 state

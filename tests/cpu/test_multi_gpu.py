@@ -84,6 +84,17 @@ def test_gpu_cases_spread_over_both_gpus_after_the_cpu_cases(node):
     gpu_of = {r["gpu"] for r in rows if r["backend"] == "cuda"}
     assert gpu_of == {"0", "1"} and {r["gpu"] for r in rows if r["backend"] == "cpu"} == {""}
     assert len({r["case_id"] for r in rows}) == 3 + 12
+    # the 12 GPU cases in batches of 2 (a quarter of a worker's share), one process each
+    pids = [e[4] for e in cuda if e[0] == "start"]
+    assert len(set(pids)) == 6 and all(pids.count(p) == 2 for p in pids)
+
+
+def test_one_gpu_runs_its_cases_in_one_batch_and_each_cpu_case_alone(node):
+    p, rows, log = sweep(node, HB_GPUS="0")
+    starts = [e for e in log if e[0] == "start"]
+    assert len({e[4] for e in starts if e[1] == "cuda"}) == 1  # 12 cases, one process and context
+    assert len({e[4] for e in starts if e[1] == "cpu"}) == 3
+    assert len({r["case_id"] for r in rows if r["backend"] == "cuda"}) == 12
 
 
 def test_hb_gpus_keeps_one_gpu_and_the_sweep_order(node):

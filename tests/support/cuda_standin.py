@@ -33,9 +33,20 @@ args = sys.argv[1:]
 if "--list-variants" in args:
     print({listing!r})
     sys.exit(0)
-args = ["ref" if a == "strand" else a for a in args]  # the stand-in's variant is the C reference
-if {perturb!r}:
-    args += ["--gravity", "1500"]
+
+def standin(args):
+    args = ["ref" if a == "strand" else a for a in args]  # the stand-in's variant is the C reference
+    return args + ["--gravity", "1500"] if {perturb!r} else args
+
+if args[:1] == ["--batch"]:  # each run of the batch, as above
+    with open(args[1]) as f:
+        lines = ["\\t".join(standin(ln.rstrip("\\n").split("\\t"))) for ln in f if ln.strip()]
+    path = args[1] + ".standin"  # beside the batch, in its caller's temporary folder
+    with open(path, "w") as f:
+        f.write("\\n".join(lines) + "\\n")
+    args = ["--batch", path]
+else:
+    args = standin(args)
 os.execv({cpu!r}, [{cpu!r}, *args])
 """
 

@@ -10,7 +10,8 @@ environment:
   FAKE_TOO_BIG=N          exit 3 (does not fit in memory) for more than N strands
   FAKE_SHIFT_FP32=d       move every fp32 point by d (a planted inequivalence)
   FAKE_BACKEND=name       the backend named in the record (default: from the program name)
-  FAKE_LOG=path           append "start|end backend strands CUDA_VISIBLE_DEVICES" lines per timed run
+  FAKE_LOG=path           append "start|end backend strands CUDA_VISIBLE_DEVICES pid" lines per timed run
+`--batch FILE` runs each line of FILE (flags separated by tabs) in turn, as the binaries do.
 """
 
 import json
@@ -67,6 +68,19 @@ def parse(argv):
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["--batch"]:  # one run a line, flags separated by tabs, until one fails
+        with open(argv[1]) as f:
+            for line in f:
+                if line.strip():
+                    rc = run(line.rstrip("\n").split("\t"))
+                    sys.stdout.flush()
+                    if rc:
+                        return rc
+        return 0
+    return run(argv)
+
+
+def run(argv):
     prog = os.path.basename(os.environ.get("FAKE_PROG", "hairsim-cpu"))
     backend = os.environ.get("FAKE_BACKEND") or ("cuda" if "cuda" in prog else "cpu")
     o = parse(argv)
@@ -89,11 +103,11 @@ def main(argv=None):
     seen = os.environ.get("CUDA_VISIBLE_DEVICES", "-")
     if log:
         with open(log, "a") as f:
-            f.write(f"start {backend} {o.get('strands', '-')} {seen}\n")
+            f.write(f"start {backend} {o.get('strands', '-')} {seen} {os.getpid()}\n")
     time.sleep(float(os.environ.get("FAKE_SLEEP", "0")))
     if log:
         with open(log, "a") as f:
-            f.write(f"end {backend} {o.get('strands', '-')} {seen}\n")
+            f.write(f"end {backend} {o.get('strands', '-')} {seen} {os.getpid()}\n")
     if o.get("measure-bandwidth"):
         if os.environ.get("FAKE_NO_BANDWIDTH"):
             print("hairsim-fake: error: unknown flag --measure-bandwidth", file=sys.stderr)
