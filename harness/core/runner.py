@@ -109,6 +109,15 @@ def parse_record(binary: Path, text: str, expect_keys: Iterable[str] = RECORD_KE
 BATCH_MAX = 32  # runs one batch process holds at most
 
 
+def batches(items: Iterable[Any], key: Any, size: int) -> list[list[Any]]:
+    """`items` grouped by key(item) (one binary, one GPU), each group cut into runs of at most
+    `size`, in the order the groups first appear."""
+    groups: dict[Any, list[Any]] = {}
+    for it in items:
+        groups.setdefault(key(it), []).append(it)
+    return [g[i : i + size] for g in groups.values() for i in range(0, len(g), size)]
+
+
 def run_batch(
     binary: str | Path,
     runs: Sequence[Sequence[Any]],

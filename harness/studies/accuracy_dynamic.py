@@ -76,6 +76,7 @@ from harness.studies.accuracy import (
 )
 
 SIMULATE = "simulate"  # the stage a variant must run to take part
+CHECKED_A_BATCH = 8  # GPU checked runs one process runs (runner.run_batch); the runs go on in parallel
 
 
 @dataclass(frozen=True)
@@ -338,6 +339,23 @@ class Study:
         return self.scratch / f"{tag}.h5"
 
     def checked(self, build, solver, substeps, iterations, precision, tag, threads=None, ftl_damping=None):
+        flags, out = self.checked_flags(build, solver, substeps, iterations, precision, tag, threads, ftl_damping)
+        return out, runner.run_binary(build.binary, flags)
+
+    def checked_modes(self, modes):
+        """The checked runs of modes of one GPU build, in one process (runner.run_batch): (mode,
+        its file, its record) of each."""
+        runs = [self.checked_flags(m.runner, m.solver, m.substeps, m.iterations, m.precision, m.tag, None,
+                                   m.ftl_damping) for m in modes]  # fmt: skip
+        done = []
+        for i, rec, error in runner.run_batch(modes[0].runner.binary, [f for f, _ in runs]):
+            if error is not None:
+                raise error
+            done.append((modes[i], runs[i][1], rec))
+        return done
+
+    def checked_flags(self, build, solver, substeps, iterations, precision, tag, threads=None, ftl_damping=None):
+        """(the flags of a checked run, its file)."""
         sc = configured(
             self.scene,
             solver=solver,
@@ -351,10 +369,28 @@ class Study:
         out = self.path(tag)
         flags = runner.run_flags(sc, build.backend, variant=build.variant, threads=threads, output=out, force=True)
         flags += ["--velocities", "all"]  # the energy of every frame
-        rec = runner.run_binary(build.binary, flags)
-        return out, rec
+        return flags, out
 
-    def timed(self, mode):
+    def timed_all(self, modes):
+        """name → (median ms, min ms, record) of each mode's timed run, one run at a time, nothing
+        else running. ftl's damping s is one factor of the velocity update (no branch on it), so
+        modes that differ only in s share a run (Mode.timing_key); the runs of one binary go in
+        batches (runner.run_batch: one process and GPU context for several)."""
+        first = {}
+        for m in modes:
+            first.setdefault(m.timing_key, m)
+        runs = {}
+        with Progress(len(first), "dynamic accuracy: timed") as bar:
+            for chunk in runner.batches(first.values(), lambda m: m.runner.binary, runner.BATCH_MAX):
+                flags = [self.timed_flags(m) for m in chunk]
+                for i, rec, error in runner.run_batch(chunk[0].runner.binary, flags):
+                    if error is not None:
+                        raise error
+                    runs[chunk[i].timing_key] = self.timed_result(chunk[i], rec)
+                    bar.update()
+        return {m.name: runs[m.timing_key] for m in modes}
+
+    def timed_flags(self, mode):
         sc = configured(
             self.scene,
             solver=mode.solver,
@@ -365,8 +401,9 @@ class Study:
             strands=self.plan.time_strands,
             ftl_damping=mode.ftl_damping,
         )
-        flags = runner.run_flags(sc, mode.runner.backend, variant=mode.runner.variant, repeat=self.plan.repeat)
-        rec = runner.run_binary(mode.runner.binary, flags)
+        return runner.run_flags(sc, mode.runner.backend, variant=mode.runner.variant, repeat=self.plan.repeat)
+
+    def timed_result(self, mode, rec):
         sim = [s for s in rec["stages"] if s.get("stage") == SIMULATE]
         if not sim:
             raise HarnessError(f"{mode.runner.binary.name}: its record has no simulate stage")
@@ -554,29 +591,28 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                 from harness.studies import analytic_table
 
                 futures[pool.submit(analytic_table.tables, str(cpu_oracle.binary), plan.analytic == "quick")] = None
-            for m in modes:
-                threads = 1 if m.runner.backend == "cpu" else None
+            for m in (m for m in modes if m.runner.backend == "cpu"):  # one process each, one thread
                 f = pool.submit(
-                    study.checked,
-                    m.runner,
-                    m.solver,
-                    m.substeps,
-                    m.iterations,
-                    m.precision,
-                    m.tag,
-                    threads,
-                    m.ftl_damping,
+                    study.checked, m.runner, m.solver, m.substeps, m.iterations, m.precision, m.tag, 1, m.ftl_damping
                 )
-                futures[f] = m
-            with Progress(len(futures), "dynamic accuracy: checked runs") as bar:
+                futures[f] = [m]
+            on_gpu = [m for m in modes if m.runner.backend != "cpu"]
+            for chunk in runner.batches(on_gpu, lambda m: m.runner.binary, CHECKED_A_BATCH):
+                futures[pool.submit(study.checked_modes, chunk)] = chunk
+            with Progress(len(modes) + (plan.analytic != "none"), "dynamic accuracy: checked runs") as bar:
                 for f in as_completed(futures):
-                    m = futures[f]
-                    bar.update()
-                    if m is None:
+                    ms = futures[f]
+                    if ms is None:
                         analytic_lines = f.result()
+                        bar.update()
                         bar.write("dynamic accuracy: analytic tables done")
                         continue
-                    mode_paths[m.name], records[m.name] = f.result()
+                    ended = f.result()
+                    if len(ms) == 1 and ms[0].runner.backend == "cpu":
+                        ended = [(ms[0], *ended)]
+                    for m, path, rec in ended:
+                        mode_paths[m.name], records[m.name] = path, rec
+                    bar.update(len(ms))
 
         # 2. the reference (GPU fp64 where usable and validated against the CPU)
         gpu_ref = _gpu_reference_build(gpu_ok, study.scene)
@@ -622,15 +658,8 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
             long = observables_long.LongRuns(study, ref["build"], ref["steps"][-1]["S2"], log, configured, read_run)
             long_rows = long.measure(oracle_modes, jobs)
 
-        # 3. timing, one run at a time, nothing else running; ftl's damping s is one factor of
-        # the velocity update (no branch on it), so the modes that differ only in s share a run
-        timing, runs = {}, {}
-        with Progress(len({m.timing_key for m in modes}), "dynamic accuracy: timed") as bar:
-            for m in modes:
-                if m.timing_key not in runs:
-                    runs[m.timing_key] = study.timed(m)
-                    bar.update()
-                timing[m.name] = runs[m.timing_key]
+        # 3. timing, one run at a time, nothing else running
+        timing = study.timed_all(modes)
 
         rows = _rows(study, modes, mode_paths, ref, timing) + _ladder_rows(study, ref) + check_rows
         rows += _ref_error_rows(study, ref, ref_err)

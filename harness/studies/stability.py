@@ -49,6 +49,7 @@ from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES, scene_sli
 
 STRANDS = 16
 FRAMES = 60  # one second at the base scenes' Δt = 1/60 s
+GPU_CELLS_A_BATCH = 8  # GPU cells one process runs (runner.run_batch); the map's jobs share the GPU
 
 COLUMNS = (
     "slice",
@@ -153,6 +154,42 @@ def cell_backend(be, declared, slc, row, col, solver, precision, strands, frames
 
 def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None, gpu=None):
     """Run one cell (`gpu`: a core.gpus.Gpu its child alone sees); return its CSV row."""
+    return run_cells([(slc, row, col, solver, precision, be)], strands, frames, timeout, gpu)[0]
+
+
+def run_cells(jobs, strands, frames, timeout=None, gpu=None):
+    """Run cells of one binary, several in one process (runner.run_batch); their CSV rows in
+    order, each row's wall_s the time from the end of the cell before it."""
+    be = jobs[0][-1]
+    binary = binary_path(be.backend, be.build)
+    pin = {"CUDA_VISIBLE_DEVICES": gpu.select} if gpu is not None else None
+    with tempfile.TemporaryDirectory(prefix="hb-stab-") as tmp:
+        cells = [_cell_run(*job, strands, frames, Path(tmp) / f"cell{k}.h5") for k, job in enumerate(jobs)]
+        flags = [f for _, f, _ in cells]
+        if len(cells) == 1:
+
+            def ended():
+                try:
+                    yield 0, runner.run_binary(binary, flags[0], timeout=timeout, env=pin), None
+                except runner.BackendError as e:
+                    yield 0, None, e
+
+            results = ended()
+        else:
+            results = runner.run_batch(binary, flags, timeout=timeout, env=pin)
+        rows = []
+        t0 = time.perf_counter()
+        for i, _, error in results:
+            out, _, path = cells[i]
+            rows.append(_cell_row(out, path, error))
+            out["wall_s"] = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            path.unlink(missing_ok=True)
+    return rows
+
+
+def _cell_run(slc, row, col, solver, precision, be, strands, frames, path):
+    """(the cell's row as far as it is known before the run, its flags, its output file)."""
     scene = cell_scene(slc, row, col, solver, precision, strands, frames)
     out = {
         "slice": slc.name,
@@ -173,27 +210,26 @@ def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None
         "violations": "",
         "message": "",
     }
-    t0 = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix="hb-stab-") as tmp:
-        path = Path(tmp) / "cell.h5"
-        flags = runner.run_flags(
-            scene, be.backend, variant=be.variant, threads=1 if be.backend == "cpu" else None, output=path
-        )
-        try:
-            pin = {"CUDA_VISIBLE_DEVICES": gpu.select} if gpu is not None else None
-            runner.run_binary(binary_path(be.backend, be.build), flags, timeout=timeout, env=pin)
-        except runner.BackendError as e:
-            why = "timed out" if isinstance(e, runner.TimedOut) else "refused" if e.code == 2 else "failed"
-            out.update(verdict=why, message=str(e), wall_s=time.perf_counter() - t0)
-            return out
-        with open_trajectory(path) as t:
-            obs = t.observables
-            stretch = float(obs["stretch_max"].max())
-            pen = float(obs["penetration_max"].max())
-            blown = obs["blown_up_strands"].to_numpy() > 0
-            rep = invariants_dynamic.check(t, exact=invariants_dynamic.is_reference_build(t), paper=False)
-            rel = pen / t.collide_radius
-            diverged = not (np.isfinite(t.frame(-1)).all() and np.isfinite(t.velocity(-1)).all())
+    flags = runner.run_flags(
+        scene, be.backend, variant=be.variant, threads=1 if be.backend == "cpu" else None, output=path
+    )
+    return out, flags, path
+
+
+def _cell_row(out, path, error):
+    """The cell's row: its verdict from the run's file, or from its error."""
+    if error is not None:
+        why = "timed out" if isinstance(error, runner.TimedOut) else "refused" if error.code == 2 else "failed"
+        out.update(verdict=why, message=str(error))
+        return out
+    with open_trajectory(path) as t:
+        obs = t.observables
+        stretch = float(obs["stretch_max"].max())
+        pen = float(obs["penetration_max"].max())
+        blown = obs["blown_up_strands"].to_numpy() > 0
+        rep = invariants_dynamic.check(t, exact=invariants_dynamic.is_reference_build(t), paper=False)
+        rel = pen / t.collide_radius
+        diverged = not (np.isfinite(t.frame(-1)).all() and np.isfinite(t.velocity(-1)).all())
     out.update(
         stretch_max=stretch,
         penetration_max=pen,
@@ -202,7 +238,6 @@ def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None
         first_blown_frame=int(blown.argmax()) + 1 if blown.any() else "",
         verdict=verdict(stretch, rel, int(blown.sum()), diverged),
         violations="+".join(sorted({v.invariant for v in rep.violations})),
-        wall_s=time.perf_counter() - t0,
     )
     return out
 
@@ -266,14 +301,29 @@ def measure(
     t0 = time.perf_counter()
     bar = Progress(len(todo), "stability")
     # the heaviest cells (most substep iterations a frame, GPU before CPU) start first, so that
-    # none is left running alone at the end; the rows keep the order of `todo`
+    # none is left running alone at the end; the rows keep the order of `todo`. A GPU cell runs
+    # with others of its binary and GPU in one process (a context made once a batch).
     order = sorted(range(len(todo)), key=lambda i: -cell_weight(todo[i], strands, frames))
+    units = [[i] for i in order if todo[i][-1].backend != "cuda"]
+    gpu_cells = [i for i in order if todo[i][-1].backend == "cuda"]
+    units += runner.batches(gpu_cells, lambda i: (todo[i][-1], gpu_for(i, todo[i])), GPU_CELLS_A_BATCH)
+    units.sort(key=lambda u: -cell_weight(todo[u[0]], strands, frames))
     rows = [None] * len(todo)
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {pool.submit(run_cell, *todo[i], strands, frames, timeout, gpu_for(i, todo[i])): i for i in order}
+        futures = {}
+        for u in units:
+            gpu = gpu_for(u[0], todo[u[0]])
+            if len(u) == 1:
+                f = pool.submit(run_cell, *todo[u[0]], strands, frames, timeout, gpu)
+            else:
+                f = pool.submit(run_cells, [todo[i] for i in u], strands, frames, timeout, gpu)
+            futures[f] = u
         for f in as_completed(futures):
-            rows[futures[f]] = f.result()
-            bar.update()
+            u = futures[f]
+            got = f.result()
+            for i, row in zip(u, got if len(u) > 1 else [got]):
+                rows[i] = row
+            bar.update(len(u))
     bar.close()
     return rows, bes, time.perf_counter() - t0
 

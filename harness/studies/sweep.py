@@ -19,7 +19,7 @@ from harness import HarnessError
 from harness.core import budget, env, gpus, scenes
 from harness.core.paths import RESULTS, binary_path, display, output_dir
 from harness.core.progress import Progress
-from harness.core.runner import BATCH_MAX, BackendError, DoesNotFit, run_batch, run_binary, run_flags
+from harness.core.runner import BATCH_MAX, BackendError, DoesNotFit, batches, run_batch, run_binary, run_flags
 from harness.core.scenes import SceneError
 from harness.io import results_data, runlog
 from harness.io.files import write_json
@@ -372,15 +372,6 @@ def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, 
 
     gpus.spread(batches(on_gpu, key, size), gpu_list, run_chunk, chunk_done)
     return failed
-
-
-def batches(cases, key, size):
-    """The cases grouped by key(case) (one binary), each group in runs of at most `size`, in
-    the order the groups first appear."""
-    groups = {}
-    for c in cases:
-        groups.setdefault(key(c), []).append(c)
-    return [g[i : i + size] for g in groups.values() for i in range(0, len(g), size)]
 
 
 FIGURE_STRANDS = 400  # strands in the Fig. 1/2 state

@@ -166,13 +166,13 @@ def test_modes_that_differ_only_in_ftl_damping_share_one_timed_run(cpu_bin, tmp_
     """s is one factor of ftl's velocity update (no kernel branches on it): the study times
     each build × solver × S × I × precision once, and the modes alike but for s take its time."""
     monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
-    timed, real = [], accuracy_dynamic.Study.timed
+    timed, real = [], accuracy_dynamic.Study.timed_flags
 
-    def counting(self, mode):
+    def counting(self, mode):  # the flags of each timed run
         timed.append(mode)
         return real(self, mode)
 
-    monkeypatch.setattr(accuracy_dynamic.Study, "timed", counting)
+    monkeypatch.setattr(accuracy_dynamic.Study, "timed_flags", counting)
     out = tmp_path / "out"
     assert accuracy_dynamic.run_study(accuracy_dynamic.Plan(**TINY), out, log=quiet) == 0
     with open(out / accuracy_dynamic.CSV_NAME, newline="") as fh:
