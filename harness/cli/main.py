@@ -203,7 +203,7 @@ def cmd_bench(args):
     root = Path(args.out) if args.out else LOCAL_RUN
     report_dir = Path(args.report_dir) if args.report_dir else root / "report"
     shard = shards.parse(args.shard) if args.shard else None
-    plan = budget.Budget(budget.parse_duration(args.budget)) if args.budget else None
+    plan = budget.Budget(budget.parse_duration(args.budget), reserve=budget.REPORT_RESERVE_S) if args.budget else None
     sweeps = {}
     if args.model in ("all", "paper"):
         sweeps["paper"] = load_sweep(args.sweep).path

@@ -94,6 +94,16 @@ def test_the_budget_shares_what_is_left_and_records_what_it_left_out():
     }
 
 
+def test_the_reports_reserve_is_never_handed_to_a_step():
+    clock = Clock()
+    b = Budget(600.0, clock=clock, reserve=20.0)
+    assert b.left() == pytest.approx(580.0)
+    assert b.allowance("paper sweep") == pytest.approx(580.0 * budget.SHARES["paper sweep"])
+    clock.t = 590.0  # the studies stop at 580 s; the reports have the last 20
+    assert b.left() == pytest.approx(-10.0) and b.allowance("curly sweep") == 0.0
+    assert b.record()["budget_s"] == 600.0 and b.record()["used_s"] == 590.0
+
+
 def test_a_study_takes_the_largest_size_that_fits():
     ladder = (100_000, 30_000, 10_000, 1_000)
     per_strand = 0.002  # s: 100 000 strands take 200 s
