@@ -343,10 +343,10 @@ class Study:
         return out, runner.run_binary(build.binary, flags)
 
     def checked_modes(self, modes):
-        """The checked runs of modes of one GPU build, in one process (runner.run_batch): (mode,
-        its file, its record) of each."""
-        runs = [self.checked_flags(m.runner, m.solver, m.substeps, m.iterations, m.precision, m.tag, None,
-                                   m.ftl_damping) for m in modes]  # fmt: skip
+        """The checked runs of modes of one build, in one process (runner.run_batch; the CPU's on
+        one thread): (mode, its file, its record) of each."""
+        runs = [self.checked_flags(m.runner, m.solver, m.substeps, m.iterations, m.precision, m.tag,
+                                   1 if m.runner.backend == "cpu" else None, m.ftl_damping) for m in modes]  # fmt: skip
         done = []
         for i, rec, error in runner.run_batch(modes[0].runner.binary, [f for f, _ in runs]):
             if error is not None:
@@ -591,13 +591,10 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                 from harness.studies import analytic_table
 
                 futures[pool.submit(analytic_table.tables, str(cpu_oracle.binary), plan.analytic == "quick")] = None
-            for m in (m for m in modes if m.runner.backend == "cpu"):  # one process each, one thread
-                f = pool.submit(
-                    study.checked, m.runner, m.solver, m.substeps, m.iterations, m.precision, m.tag, 1, m.ftl_damping
-                )
-                futures[f] = [m]
+            units = [[m] for m in modes if m.runner.backend == "cpu"]  # a process each, the pool's jobs in parallel
             on_gpu = [m for m in modes if m.runner.backend != "cpu"]
-            for chunk in runner.batches(on_gpu, lambda m: m.runner.binary, CHECKED_A_BATCH):
+            units += runner.batches(on_gpu, lambda m: m.runner.binary, CHECKED_A_BATCH)
+            for chunk in units:
                 futures[pool.submit(study.checked_modes, chunk)] = chunk
             with Progress(len(modes) + (plan.analytic != "none"), "dynamic accuracy: checked runs") as bar:
                 for f in as_completed(futures):
@@ -607,10 +604,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                         bar.update()
                         bar.write("dynamic accuracy: analytic tables done")
                         continue
-                    ended = f.result()
-                    if len(ms) == 1 and ms[0].runner.backend == "cpu":
-                        ended = [(ms[0], *ended)]
-                    for m, path, rec in ended:
+                    for m, path, rec in f.result():
                         mode_paths[m.name], records[m.name] = path, rec
                     bar.update(len(ms))
 

@@ -158,7 +158,7 @@ def run_cell(slc, row, col, solver, precision, be, strands, frames, timeout=None
 
 
 def run_cells(jobs, strands, frames, timeout=None, gpu=None):
-    """Run cells of one binary, several in one process (runner.run_batch); their CSV rows in
+    """Run cells of one binary in one process (runner.run_batch); their CSV rows in
     order, each row's wall_s the time from the end of the cell before it."""
     be = jobs[0][-1]
     binary = binary_path(be.backend, be.build)
@@ -166,20 +166,9 @@ def run_cells(jobs, strands, frames, timeout=None, gpu=None):
     with tempfile.TemporaryDirectory(prefix="hb-stab-") as tmp:
         cells = [_cell_run(*job, strands, frames, Path(tmp) / f"cell{k}.h5") for k, job in enumerate(jobs)]
         flags = [f for _, f, _ in cells]
-        if len(cells) == 1:
-
-            def ended():
-                try:
-                    yield 0, runner.run_binary(binary, flags[0], timeout=timeout, env=pin), None
-                except runner.BackendError as e:
-                    yield 0, None, e
-
-            results = ended()
-        else:
-            results = runner.run_batch(binary, flags, timeout=timeout, env=pin)
         rows = []
         t0 = time.perf_counter()
-        for i, _, error in results:
+        for i, _, error in runner.run_batch(binary, flags, timeout=timeout, env=pin):
             out, _, path = cells[i]
             rows.append(_cell_row(out, path, error))
             out["wall_s"] = time.perf_counter() - t0
@@ -312,16 +301,11 @@ def measure(
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         futures = {}
         for u in units:
-            gpu = gpu_for(u[0], todo[u[0]])
-            if len(u) == 1:
-                f = pool.submit(run_cell, *todo[u[0]], strands, frames, timeout, gpu)
-            else:
-                f = pool.submit(run_cells, [todo[i] for i in u], strands, frames, timeout, gpu)
+            f = pool.submit(run_cells, [todo[i] for i in u], strands, frames, timeout, gpu_for(u[0], todo[u[0]]))
             futures[f] = u
         for f in as_completed(futures):
             u = futures[f]
-            got = f.result()
-            for i, row in zip(u, got if len(u) > 1 else [got]):
+            for i, row in zip(u, f.result()):
                 rows[i] = row
             bar.update(len(u))
     bar.close()

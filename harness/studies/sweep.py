@@ -292,8 +292,9 @@ def case_size(case):
 
 
 def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list):
-    """Run the cases, appending their rows; the number that failed. The GPU cases of one
-    binary run in batches (runner.run_batch: one process and context for several). With
+    """Run the cases, appending their rows; the number that failed. Every case runs through
+    runner.run_batch: a CPU case alone, the GPU cases of one binary several to a process (one
+    context for them). With
     several GPUs the CPU cases run first, alone, then the GPU batches on one worker per GPU
     (core/gpus.py)."""
     failed = 0
@@ -306,12 +307,6 @@ def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, 
         """(case, record, error) of each case, in order, as each ends."""
         env_add = {"CUDA_VISIBLE_DEVICES": gpu.select} if gpu is not None and pin else None
         binary = binary_path(*key(cases[0]))
-        if len(cases) == 1:
-            try:
-                yield cases[0], run_binary(binary, case_flags(sweep, cases[0]), sweep.timeout_s, env=env_add), None
-            except (DoesNotFit, SceneError, BackendError) as e:
-                yield cases[0], None, e
-            return
         ready = []  # (case, its flags)
         for case in cases:
             try:

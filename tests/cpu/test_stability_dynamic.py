@@ -312,11 +312,14 @@ def test_a_cell_past_its_timeout_is_timed_out_not_refused(cpu_bin):
 def test_the_map_starts_its_heaviest_cells_first_and_keeps_its_row_order(cpu_bin, monkeypatch):
     started = []
 
-    def fake_cell(slc, row, col, solver, precision, be, *rest):
-        started.append((row, col))
-        return {"slice": slc.name, "row": row, "col": col, "solver": solver, "precision": precision}
+    def fake_cells(jobs, *rest):
+        rows = []
+        for slc, row, col, solver, precision, be in jobs:
+            started.append((row, col))
+            rows.append({"slice": slc.name, "row": row, "col": col, "solver": solver, "precision": precision})
+        return rows
 
-    monkeypatch.setattr(stability, "run_cell", fake_cell)
+    monkeypatch.setattr(stability, "run_cells", fake_cells)
     rows, _, _ = stability.measure(["substeps-iterations"], quick=True, gpu="no", jobs=1, log=lambda *_: None)
     slc = slice_named("substeps-iterations")
     cells = [(r, c) for r, c in ((r["row"], r["col"]) for r in rows)]
