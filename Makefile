@@ -226,9 +226,17 @@ endif
 # setup runs first, then the build (a recursive make, so that -j cannot build before it),
 # on every core: the CUDA binaries and the C reference's feature instantiations take minutes
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+# The suite on TEST_JOBS workers (pytest-xdist, requirements-dev.txt; worksteal: an idle worker
+# takes queued tests) where xdist is installed and TEST_JOBS > 1; else in one process, said.
+TEST_JOBS ?= $(JOBS)
 test: setup
 	@$(MAKE) --no-print-directory -j$(JOBS) all planted $(if $(HAVE_NVCC),hostcheck)
-	$(RUN_PY) -m pytest tests -q -ra
+	@if [ "$(TEST_JOBS)" -gt 1 ] 2>/dev/null && $(RUN_PY) -c "import xdist" 2>/dev/null; then \
+	  workers="-n $(TEST_JOBS) --dist worksteal"; \
+	elif [ "$(TEST_JOBS)" -gt 1 ] 2>/dev/null; then \
+	  echo "note: pytest-xdist is not installed: the suite runs in one process (make lint installs it)"; \
+	fi; \
+	echo "pytest tests -q -ra $$workers"; $(RUN_PY) -m pytest tests -q -ra $$workers
 
 # make bench's run folder (untracked): results, then the report in $(OUT)/report
 OUT ?= results/local

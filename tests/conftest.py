@@ -9,6 +9,7 @@ import os
 from pathlib import Path
 
 import pytest
+from hypothesis.configuration import set_hypothesis_home_dir
 
 ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "build"
@@ -33,6 +34,9 @@ def _gpu_reason():
 
 
 GPU_REASON = _gpu_reason()
+
+# hypothesis's files (its example database) under build/, beside pytest's cache (pyproject.toml)
+set_hypothesis_home_dir(str(BUILD / "hypothesis"))
 
 
 def pytest_collection_modifyitems(config, items):
