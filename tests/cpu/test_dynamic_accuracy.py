@@ -194,8 +194,10 @@ def test_ctrl_c_in_the_study_ends_it_in_one_line_and_leaves_no_process(cpu_bin, 
     argv = [sys.executable, "-m", "harness", "accuracy", "--model", "dynamic", "--quick", "--gpu", "no"]
     argv += ["--out", str(tmp_path / "out"), "--report-dir", str(tmp_path / "rep")]
     env_ = dict(os.environ, PYTHONUNBUFFERED="1")
+    # a shell's background job ignores SIGINT (a CI runner's may): the study gets it as a terminal delivers it
     proc = subprocess.Popen(argv, cwd=ROOT, env=env_, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)  # fmt: skip
+                            start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # fmt: skip
     for line in proc.stdout:
         if "dynamic accuracy: reference cpu ref S = 64:" in line:  # its first comparison next
             break
