@@ -1,8 +1,8 @@
 """Progress of a long step: a bar (tqdm) on a terminal; elsewhere (a CI job's log, a file)
-a line at least every `every` seconds and at the end: done/total, time elapsed, an estimate
-of what is left. A timer thread prints the line when no case has ended for `every` seconds
-(one case can take minutes), so the log never goes quiet for longer. Without tqdm the lines
-are printed on a terminal too."""
+a line when it starts (how many to do), then at least every LOG_EVERY_S seconds and at the
+end: done/total, time elapsed, an estimate of what is left. A timer thread prints the line
+when no case has ended for `every` seconds (one case can take minutes), so the log never goes
+quiet for longer. Without tqdm the lines are printed on a terminal too."""
 
 import sys
 import threading
@@ -14,10 +14,11 @@ except ImportError:  # the harness works without it
     _tqdm = None
 
 LOG_EVERY_S = 30.0  # a log shows a step is alive at least this often
+LINE_AFTER_S = LOG_EVERY_S - 1.0  # a line is due this long after the last: the second left covers the timer's wake-up
 
 
 class Progress:
-    def __init__(self, total, desc, stream=None, clock=time.monotonic, every=LOG_EVERY_S, timer=None):
+    def __init__(self, total, desc, stream=None, clock=time.monotonic, every=LINE_AFTER_S, timer=None):
         """`timer`: run the thread that prints when nothing ends for `every` s (default: with
         the real clock off a terminal; tests drive tick() with a fake clock instead)."""
         self.total, self.desc, self.clock, self.every = total, desc, clock, every
@@ -29,6 +30,8 @@ class Progress:
         self.lines = bool(total) and self.bar is None
         self.done = 0
         self.start = self.last = clock()
+        if self.lines:
+            print(f"{desc}: {total} to do", file=self.stream, flush=True)
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread = None
@@ -62,7 +65,8 @@ class Progress:
                 self._line(now)
 
     def _beat(self):
-        while not self._stop.wait(self.every / 6):
+        """Wake when the next line is due (a case ending in between moves that time on)."""
+        while not self._stop.wait(max(0.01, self.last + self.every - self.clock())):
             self.tick()
 
     def _line(self, now):

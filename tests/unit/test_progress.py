@@ -1,12 +1,13 @@
-"""harness.core.progress off a terminal: a line at most every 30 s and at the end, with the
-count, the time elapsed and an estimate of what is left (a CI log shows the step is alive)."""
+"""harness.core.progress off a terminal: a line at the start, then at least every 30 s and at
+the end, with the count, the time elapsed and an estimate of what is left (a CI log shows the
+step is alive)."""
 
 import io
 import time
 
 import pytest
 
-from harness.core.progress import LOG_EVERY_S, Progress, StepTimes
+from harness.core.progress import LINE_AFTER_S, LOG_EVERY_S, Progress, StepTimes
 
 
 class Clock:
@@ -17,7 +18,7 @@ class Clock:
         return self.t
 
 
-def test_lines_at_most_every_30_s_and_at_the_end():
+def test_a_start_line_then_lines_every_30_s_and_at_the_end():
     out, clock = io.StringIO(), Clock()
     p = Progress(10, "sweep", stream=out, clock=clock)
     for _ in range(10):
@@ -25,11 +26,12 @@ def test_lines_at_most_every_30_s_and_at_the_end():
         p.update()
     p.close()
     lines = out.getvalue().splitlines()
+    assert lines[0] == "sweep: 10 to do"
     # 30 s, 60 s and 90 s pass after cases 3, 6, 9; case 10 ends the step
-    assert [ln.split(":")[1].split()[0] for ln in lines] == ["3/10", "6/10", "9/10", "10/10"]
-    assert lines[0] == "sweep: 3/10 done, 30 s elapsed, about 70 s left"
+    assert [ln.split(":")[1].split()[0] for ln in lines[1:]] == ["3/10", "6/10", "9/10", "10/10"]
+    assert lines[1] == "sweep: 3/10 done, 30 s elapsed, about 70 s left"
     assert lines[-1] == "sweep: 10/10 done, 100 s elapsed, about 0 s left"
-    assert LOG_EVERY_S == 30.0
+    assert LOG_EVERY_S == 30.0 and LINE_AFTER_S < LOG_EVERY_S
 
 
 def test_quick_steps_print_only_the_end_line():
@@ -38,7 +40,7 @@ def test_quick_steps_print_only_the_end_line():
     for _ in range(4):
         clock.t += 1.0
         p.update()
-    assert out.getvalue().splitlines() == ["validation: 4/4 done, 4 s elapsed, about 0 s left"]
+    assert out.getvalue().splitlines() == ["validation: 4 to do", "validation: 4/4 done, 4 s elapsed, about 0 s left"]
 
 
 def test_messages_pass_through_and_an_empty_step_prints_nothing():
@@ -50,22 +52,23 @@ def test_messages_pass_through_and_an_empty_step_prints_nothing():
 
 
 def test_a_long_case_still_prints_a_line_every_30_s():
-    """One case can take minutes: the timer's tick prints the line while nothing ends."""
+    """One case can take minutes: the timer's tick prints the line while nothing ends, a
+    second before the 30 s are up."""
     out, clock = io.StringIO(), Clock()
     p = Progress(3, "featurecost", stream=out, clock=clock)
-    clock.t += 29.0
+    clock.t += 28.5
     p.tick()
-    assert out.getvalue() == ""
-    clock.t += 1.0
+    assert out.getvalue().splitlines() == ["featurecost: 3 to do"]
+    clock.t += 0.5
     p.tick()
     clock.t += 10.0
     p.tick()  # 10 s after the last line: nothing
-    clock.t += 20.0
+    clock.t += 19.0
     p.tick()
     p.close()
-    assert out.getvalue().splitlines() == [
-        "featurecost: 0/3 done, 30 s elapsed, no estimate before the first is done",
-        "featurecost: 0/3 done, 60 s elapsed, no estimate before the first is done",
+    assert out.getvalue().splitlines()[1:] == [
+        "featurecost: 0/3 done, 29 s elapsed, no estimate before the first is done",
+        "featurecost: 0/3 done, 58 s elapsed, no estimate before the first is done",
     ]
 
 
@@ -73,10 +76,12 @@ def test_the_timer_thread_prints_without_an_update():
     out = io.StringIO()
     with Progress(2, "peer", stream=out, every=0.05, timer=True) as p:
         deadline = time.monotonic() + 5.0
-        while not out.getvalue() and time.monotonic() < deadline:
+        while "done" not in out.getvalue() and time.monotonic() < deadline:
             time.sleep(0.01)
         assert p.done == 0
-    assert out.getvalue().startswith("peer: 0/2 done")
+    first, line = out.getvalue().splitlines()[:2]
+    assert first == "peer: 2 to do"
+    assert line == "peer: 0/2 done, 0 s elapsed, no estimate before the first is done"
 
 
 def test_step_times_say_each_step_in_order_and_the_total():
