@@ -226,11 +226,18 @@ endif
 # setup runs first, then the build (a recursive make, so that -j cannot build before it),
 # on every core: the CUDA binaries and the C reference's feature instantiations take minutes
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+# The build on every core. In a log (not a terminal) a line at least every 25 s while it runs:
+# make prints one a command started, and one nvcc command can take longer than that.
+define BUILD_LOGGED
+if [ -t 1 ]; then $(MAKE) --no-print-directory -j$(JOBS) $(1); else \
+	  ( s=0; while sleep 1; do s=$$((s + 1)); if [ $$((s % 25)) -eq 0 ]; then echo "build: $$s s elapsed"; fi; done ) & beat=$$!; \
+	  $(MAKE) --no-print-directory -j$(JOBS) $(1); rc=$$?; kill $$beat 2>/dev/null; wait $$beat 2>/dev/null; exit $$rc; fi
+endef
 # The suite on TEST_JOBS workers (pytest-xdist, requirements-dev.txt; worksteal: an idle worker
 # takes queued tests) where xdist is installed and TEST_JOBS > 1; else in one process, said.
 TEST_JOBS ?= $(JOBS)
 test: setup
-	@$(MAKE) --no-print-directory -j$(JOBS) all planted $(if $(HAVE_NVCC),hostcheck)
+	@$(call BUILD_LOGGED,all planted $(if $(HAVE_NVCC),hostcheck))
 	@if [ "$(TEST_JOBS)" -gt 1 ] 2>/dev/null && $(RUN_PY) -c "import xdist" 2>/dev/null; then \
 	  workers="-n $(TEST_JOBS) --dist worksteal"; \
 	elif [ "$(TEST_JOBS)" -gt 1 ] 2>/dev/null; then \
@@ -241,7 +248,7 @@ test: setup
 # make bench's run folder (untracked): results, then the report in $(OUT)/report
 OUT ?= results/local
 bench: setup
-	@$(MAKE) --no-print-directory -j$(JOBS) all
+	@$(call BUILD_LOGGED,all)
 	$(RUN_PY) -m harness bench --out $(OUT)$(if $(BUDGET), --budget $(BUDGET))$(if $(SHARD), --shard $(SHARD))
 
 # REPORT_FROM: the run folder to render (default results/local, make bench's), or one sweep's

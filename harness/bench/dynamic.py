@@ -74,7 +74,7 @@ class DynValidator:
     def planned(self, builds):
         """How many comparisons cpu_checks and gpu_checks(builds) make."""
         cpu = variants.declared("cpu")
-        pairs = len(cpu.precisions) * len(cpu.solvers)
+        pairs = len(cpu.precisions) * len(cpu.dynamic_solvers)  # the pairs cpu_checks makes
         cases = self.gpu_cases(builds)
         strict = {v for b, v, blk in cases if b == "strict" and blk == BLOCK_SIZES[-1]}
         return pairs * (2 + len(self.cpu_others()) + len(cases) + max(0, len(strict) - 1))

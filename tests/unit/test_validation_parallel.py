@@ -58,7 +58,8 @@ def paper_scene():
 
 @pytest.fixture
 def fake(monkeypatch):
-    decl = SimpleNamespace(variants=VARIANTS, precisions=PRECISIONS, runs=lambda *a, **k: True)
+    decl = SimpleNamespace(variants=VARIANTS, precisions=PRECISIONS, runs=lambda *a, **k: True, default_variant="alpha")
+    decl.solvers, decl.dynamic_solvers = ("xpbd", "ftl", "rigid"), ("xpbd", "ftl")  # rigid: no simulation
     monkeypatch.setattr(variants, "names", lambda backend, build="default": VARIANTS)
     monkeypatch.setattr(variants, "declared", lambda backend, build="default": decl)
     binaries = FakeBinaries()
@@ -115,6 +116,7 @@ def test_dynamic_validation_runs_in_parallel_and_compares_in_order(fake, tmp_pat
     refs = {(p, s): f"cpu-{p}-{s}.h5" for p in PRECISIONS for s in ("xpbd", "ftl")}
     builds = ["default", "strict"]
     v.gpu_checks(builds, refs)
+    gpu_checks = len(v.checks)
     expected = []
     for (p, s), ref in refs.items():
         cases = [(b, var, blk) for b in builds for var in VARIANTS for blk in bench_dynamic.BLOCK_SIZES]
@@ -132,6 +134,11 @@ def test_dynamic_validation_runs_in_parallel_and_compares_in_order(fake, tmp_pat
         assert a == ref and flag(flags, "--input") == ref, what
         assert flag(flags, "--variant") == var and flag(flags, "--block-size") == str(blk), what
     assert 1 < binaries.most <= validation.GPU_RUNS_AT_ONCE
+    # the progress line's total: every comparison made, the CPU's of the simulating solvers only
+    v.checks = []
+    cpu_checks = len(v.cpu_checks() and v.checks)
+    assert cpu_checks == len(PRECISIONS) * 2 * 3  # 1 thread, resumed, the other CPU variant; xpbd and ftl
+    assert v.planned(builds) == cpu_checks + gpu_checks
 
 
 def test_a_failing_run_stops_the_validation_and_cancels_the_runs_not_started(paper_scene, fake, tmp_path, monkeypatch):
