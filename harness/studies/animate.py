@@ -157,6 +157,15 @@ def render(traj, paths, max_strands=150, every=None, fps=None, log=print):
     return written
 
 
+def _dynamic_trajectory(state):
+    """The open trajectory of a dynamic-model state; HarnessError for any other file."""
+    traj = open_trajectory(state)
+    if not traj.is_dynamic:
+        traj.close()
+        raise HarnessError(f"animate: {display(state)} is a paper-model state (no simulated frames)")
+    return traj
+
+
 def run(
     state=None,
     out=None,
@@ -172,13 +181,13 @@ def run(
     """The `animate` command: the written paths (`state_dir`: where the simulated state goes,
     default results/animation)."""
     paths = _outputs(out, force)
+    if state is not None:  # a bad file is refused in one line, before the progress starts
+        _dynamic_trajectory(state).close()
     with Progress(2 if state is None else 1, "animate: simulate and draw") as bar:
         if state is None:
             state = simulate_default(strands, frames, out_dir=state_dir, log=log)
             bar.update()
-        with open_trajectory(state) as traj:
-            if not traj.is_dynamic:
-                raise HarnessError(f"animate: {display(state)} is a paper-model state (no simulated frames)")
+        with _dynamic_trajectory(state) as traj:
             written = render(traj, paths, max_strands=max_strands, every=every, fps=fps, log=log)
         bar.update()
         return written

@@ -23,8 +23,9 @@ PRECISIONS = ("fp32", "fp64")
 
 
 class FakeBinaries:
-    """runner.run_binary: records each run's flags by its --output, how many ran at once, and
-    fails the runs whose flags contain `fail_on`."""
+    """runner.run_binary: records each run's flags by its --output, how many GPU runs (those
+    with --block-size) ran at once (a CPU prefix state is made beside them, outside the pool),
+    and fails the runs whose flags contain `fail_on`."""
 
     def __init__(self, fail_on=None, seconds=0.02):
         self.flags, self.lock, self.active, self.most = {}, threading.Lock(), 0, 0
@@ -32,11 +33,12 @@ class FakeBinaries:
 
     def __call__(self, binary, flags, timeout=None, **kw):
         flags = [str(f) for f in flags]
+        gpu = "--block-size" in flags
         with self.lock:
-            self.active += 1
+            self.active += gpu
             self.most = max(self.most, self.active)
         try:
-            if "--block-size" in flags:  # a GPU run takes a while; the CPU's prefix states none
+            if gpu:  # a GPU run takes a while; the CPU's prefix states none
                 time.sleep(self.seconds)
             if self.fail_on and all(f in flags for f in self.fail_on):
                 raise BackendError("hairsim-cuda exited with status 1: stood-in failure")
@@ -44,7 +46,7 @@ class FakeBinaries:
             return {}
         finally:
             with self.lock:
-                self.active -= 1
+                self.active -= gpu
 
 
 def flag(flags, name):
