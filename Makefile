@@ -90,7 +90,8 @@ cpu: $(BUILD)/hairsim-cpu $(BUILD)/hairsim-cpu-contract
 
 help:
 	@echo "make          build build/hairsim-cpu (and the CUDA binaries where nvcc is present)"
-	@echo "make test     build and run the pytest suite (GPU tests skip with a reason without a GPU)"
+	@echo "make test     build and run the pytest suite (GPU tests skip with a reason without a GPU;"
+	@echo "             one pytest-xdist worker a core where xdist is installed, TEST_JOBS=N for N)"
 	@echo "make bench    validate GPU variants against the CPU, sweep, studies, report into results/local/ (OUT=results/NAME; BUDGET=10m fits the sizes to a time; SHARD=K/N runs a share)"
 	@echo "make report   re-render a run folder's report, or one sweep folder's (REPORT_FROM=results/local, REPORT_TO=REPORT_FROM/report;"
 	@echo "             the committed one: REPORT_FROM=results/reference-h200 REPORT_TO=report)"
