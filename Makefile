@@ -228,7 +228,7 @@ endif
 # on every core: the CUDA binaries and the C reference's feature instantiations take minutes
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 # The build on every core. In a log (not a terminal) a line at least every 25 s while it runs:
-# make prints one a command started, and one nvcc command can take longer than that.
+# make prints a line per command started, and one nvcc command can take longer than that.
 define BUILD_LOGGED
 if [ -t 1 ]; then $(MAKE) --no-print-directory -j$(JOBS) $(1); else \
 	  ( s=0; while sleep 1; do s=$$((s + 1)); if [ $$((s % 25)) -eq 0 ]; then echo "build: $$s s elapsed"; fi; done ) & beat=$$!; \

@@ -34,7 +34,7 @@ def test_a_start_line_then_lines_every_30_s_and_at_the_end():
     assert LOG_EVERY_S == 30.0 and LINE_AFTER_S < LOG_EVERY_S
 
 
-def test_quick_steps_print_only_the_end_line():
+def test_quick_steps_print_only_the_start_and_end_lines():
     out, clock = io.StringIO(), Clock()
     p = Progress(4, "validation", stream=out, clock=clock)
     for _ in range(4):

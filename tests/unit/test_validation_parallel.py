@@ -138,7 +138,8 @@ def test_dynamic_validation_runs_in_parallel_and_compares_in_order(fake, tmp_pat
     assert 1 < binaries.most <= validation.GPU_RUNS_AT_ONCE
     # the progress line's total: every comparison made, the CPU's of the simulating solvers only
     v.checks = []
-    cpu_checks = len(v.cpu_checks() and v.checks)
+    v.cpu_checks()
+    cpu_checks = len(v.checks)
     assert cpu_checks == len(PRECISIONS) * 2 * 3  # 1 thread, resumed, the other CPU variant; xpbd and ftl
     assert v.planned(builds) == cpu_checks + gpu_checks
 
