@@ -13,6 +13,7 @@ import io
 import os
 
 from harness import HarnessError
+from harness.io import tables
 
 # what makes a case (its rows, one a stage, share these)
 CASE = ["scene", "backend", "build", "variant", "precision", "block_size", "threads", "strands", "points"]
@@ -148,9 +149,7 @@ def append_case(path, rows):
 
 def read_rows(path):
     """Every complete case's rows, as a pandas DataFrame (duplicates of a case keep the last)."""
-    import pandas as pd
-
-    df = pd.read_csv(path, dtype={"threads": str, "build": str, "fused": str})
+    df = tables.read_csv(path, dtype={"threads": str, "build": str, "fused": str})
     if df.empty:
         return df
     counts = df.groupby("case_id")["stage_index"].transform("nunique")

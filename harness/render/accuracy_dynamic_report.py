@@ -20,6 +20,7 @@ import numpy as np
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, RESULTS, display
+from harness.io import tables
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     CSV_NAME,
@@ -74,12 +75,10 @@ def title_of(scene):
 def load(results_dir, csv_path=None):
     """(rows DataFrame, study dict of env.json, env dict, analytic Markdown lines); the rows
     from csv_path when given, else from results_dir's table."""
-    import pandas as pd
-
     results_dir = Path(results_dir)
     csv_path = Path(csv_path) if csv_path else results_dir / CSV_NAME
     try:
-        rows = pd.read_csv(csv_path)
+        rows = tables.read_csv(csv_path)
     except FileNotFoundError:
         raise HarnessError(f"{display(csv_path)} not found: run `python -m harness accuracy --model dynamic`") from None
     except (OSError, ValueError) as e:
@@ -106,13 +105,11 @@ def load(results_dir, csv_path=None):
 
 def load_long(results_dir):
     """The long runs' table (observables.csv) as a DataFrame, or None where the study ran none."""
-    import pandas as pd
-
     path = Path(results_dir) / LONG_CSV
     if not path.exists():
         return None
     try:
-        return pd.read_csv(path)
+        return tables.read_csv(path)
     except (OSError, ValueError) as e:
         raise HarnessError(f"{display(path)}: cannot read ({e})") from None
 

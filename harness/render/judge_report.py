@@ -5,9 +5,8 @@ import json
 import math
 from pathlib import Path
 
-import pandas as pd
-
 from harness.core.paths import display
+from harness.io import tables
 
 
 def _g(x):
@@ -53,7 +52,7 @@ def section(results_dir, out_dir=None):
         lines.append(f"| {n} | {p.get('model', 'dynamic')} | {p['what']} | {seen} |")
     csv = d / "judge.csv"
     if csv.exists():
-        rows = pd.read_csv(csv)
+        rows = tables.read_csv(csv)
         honest = rows[rows["kind"] == "honest"]
         if not honest.empty:
             honest = honest.assign(ratio=honest["max_abs"] / honest["limit"])

@@ -11,11 +11,10 @@ import math
 import os
 from pathlib import Path
 
-import pandas as pd
-
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, RESULTS, display
+from harness.io import tables
 
 PEER = "pypbd"
 OURS = "hairsim-cpu"
@@ -29,9 +28,9 @@ def load(results_dir):
         raise HarnessError(f"peer report: missing {', '.join(missing)} (run `python -m harness peer`)")
     try:
         return (
-            pd.read_csv(need[0]),
-            pd.read_csv(need[1]),
-            pd.read_csv(need[2]),
+            tables.read_csv(need[0]),
+            tables.read_csv(need[1]),
+            tables.read_csv(need[2]),
             json.loads(need[3].read_text()),
         )
     except (ValueError, OSError) as e:

@@ -11,6 +11,7 @@ import pandas as pd
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, display
+from harness.io import tables
 from harness.studies.stability_slices import BLOWN_UP, LEGACY, OTHER, SLICES, VERDICTS, axis
 
 ORDER = VERDICTS + LEGACY + OTHER
@@ -41,7 +42,7 @@ WORST_FIRST = ("diverged", "escaped", *LEGACY, "penetrating", "over-stretched", 
 
 def load(csv_path):
     try:
-        rows = pd.read_csv(csv_path, dtype={"row": str, "col": str}, keep_default_na=False)
+        rows = tables.read_csv(csv_path, dtype={"row": str, "col": str}, keep_default_na=False)
     except (OSError, ValueError) as e:  # ValueError: a parse error, no data, or not text at all
         raise HarnessError(f"{display(csv_path)}: cannot read as a stability CSV ({e})") from None
     need = {"slice", "backend", "build", "solver", "precision", "row", "col", "verdict", "stretch_max"}

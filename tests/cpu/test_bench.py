@@ -79,6 +79,20 @@ def test_bench_end_to_end_on_cpu(tmp_path):
     assert f"{n} of {n} comparisons equivalent" in md
     for png in ("speedup_fp32.png", "fig1_initialized.png", "fig2_after_wind.png"):
         assert (tmp_path / "run" / "report" / png).stat().st_size > 5000
+    # the report is what its results render to: rendered again from the run's files, the
+    # same page but for the line that says when and from where
+    again = subprocess.run(
+        [sys.executable, "-m", "harness", "report", str(results), "--report-dir", str(tmp_path / "again")],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert again.returncode == 0, again.stdout + again.stderr
+    page = [ln for ln in md.splitlines() if not ln.startswith("Generated ")]
+    assert page == [
+        ln for ln in (tmp_path / "again" / "report.md").read_text().splitlines() if not ln.startswith("Generated ")
+    ]
     # run again: the sweep resumes (nothing to do), the report is rebuilt
     p = bench(tmp_path, env={"HAIRBENCH_NO_GPU": "1"})
     assert p.returncode == 0 and "8 case(s) already complete" in p.stdout

@@ -7,11 +7,11 @@ everywhere by hiding the module."""
 import sys
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from harness.cli.main import main as harness_main
 from harness.core import tolerances as tol
+from harness.io import tables
 from harness.studies import analytic as an
 from harness.studies import analytic_runs as ar
 from harness.studies import peer, peer_pypbd
@@ -89,8 +89,8 @@ def test_peer_command_end_to_end_tiny(tmp_path, capsys):
     argv = ["peer", "--points", "8", "--tilts", "45", "--frames", "4", "--settings", "4x1", "2x2"]
     argv += ["--strands", "1", "3", "--time-frames", "1", "--repeat", "1", "--ref-start", "8", "--ref-max", "256"]
     assert harness_main([*argv, "--out", str(out), "--report-dir", str(rep)]) == 0
-    acc = pd.read_csv(out / "accuracy.csv")
-    tim = pd.read_csv(out / "timing.csv")
+    acc = tables.read_csv(out / "accuracy.csv")
+    tim = tables.read_csv(out / "timing.csv")
     assert sorted(acc["solver"].unique()) == ["hairsim-cpu", "pypbd"] and len(acc) == 2 * 3
     assert set(tim["strands"]) == {1, 3} and (tim["median_ms"] > 0).all()
     mine = acc[acc["solver"] == "pypbd"]
