@@ -46,11 +46,12 @@ constexpr int kFtlG = HB_LANES_FTL_G, kFtlL = 32 / HB_LANES_FTL_G;
 static_assert(kFtlG == 4 || kFtlG == 8, "ftl at P ≤ 32 runs 4 or 8 points a lane");
 constexpr unsigned kAll = 0xffffffffu;
 
-__device__ __forceinline__ float rsq(float x)
+/* maybe_unused: each object is one precision, and the strict build calls neither */
+[[maybe_unused]] __device__ __forceinline__ float rsq(float x)
 {
     return hb_rsqrt_fast(x);
 }
-__device__ __forceinline__ double rsq(double x)
+[[maybe_unused]] __device__ __forceinline__ double rsq(double x)
 {
     return rsqrt(x);
 }
@@ -61,11 +62,11 @@ template <typename T> __device__ __forceinline__ constexpr T floor_of()
 }
 /* the gust's sine: the phase table is reduced to [0, 2π) on the host (§3.3), so the argument
  * stays within a few radians, where __sinf is within 2^-21 of sin */
-__device__ __forceinline__ float gust_sin(float x)
+[[maybe_unused]] __device__ __forceinline__ float gust_sin(float x)
 {
     return __sinf(x);
 }
-__device__ __forceinline__ double gust_sin(double x)
+[[maybe_unused]] __device__ __forceinline__ double gust_sin(double x)
 {
     return sin(x);
 }
