@@ -11,7 +11,7 @@ import re
 
 def read_csv(path, **kwargs):
     """pandas.read_csv(path, **kwargs), floats parsed exactly on every pandas version."""
-    import pandas as pd  # here, not at the top: the sweep's workers import this package without pandas
+    import pandas as pd  # lazily: runlog imports this module, and its writers need no pandas
 
     major, minor = (int(x) for x in re.match(r"(\d+)\.(\d+)", pd.__version__).groups())
     if (major, minor) < (3, 1):
