@@ -7,8 +7,8 @@ conftest.py skips them where there is no usable GPU.
 As tests/gpu/test_gpu_dynamic.py: the CPU runs K frames with --velocities all, each GPU
 build resumes from the CPU's frame K−1 for one frame, and harness.check.diff_dynamic.compare
 judges it (the strict build bit for bit: no gusts here). The strict build's followers are
-also recomputed from its own guides by harness/check/followers.py, bit for bit. `lanes`
-refuses both features (docs/cuda.md).
+also recomputed from its own guides by harness/check/followers.py, bit for bit. Each variant
+runs the scenes whose features it declares; `lanes` refuses guides and LRA (docs/cuda.md).
 """
 
 import numpy as np
@@ -27,7 +27,7 @@ try:
     _DECLARED = variants.declared("cuda")
     VARIANTS = tuple(v for v in _DECLARED.variants if _DECLARED.runs(v, points=24))
 except HarnessError:
-    VARIANTS = ()
+    _DECLARED, VARIANTS = None, ()
 BUILDS = {"normal": CUDA_BIN, "strict": CUDA_STRICT_BIN}
 BASE = ["--strands", "300", "--points", "24", "--substeps", "4", "--iterations", "2"]
 SCENES = {
@@ -37,6 +37,9 @@ SCENES = {
     "sagfree": ["--shape-compliance", "1e-4", "--shape-range", "1", "--sag-free", "--head-motion", "tilt"],
 }
 FRAMES = 3
+# (variant, scene) where the variant declares the scene's features (--list-variants); `lanes`
+# declares neither guides nor LRA, and its refusal is tested below
+RUNS = [(v, s) for v in VARIANTS for s in SCENES if _DECLARED.runs_features(v, variants.features_of(SCENES[s]))]
 
 
 @pytest.fixture(scope="module")
@@ -58,12 +61,9 @@ def cpu_files(tmp_path_factory):
 
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 @pytest.mark.parametrize("solver", ["xpbd", "ftl"])
-@pytest.mark.parametrize("scene", tuple(SCENES))
-@pytest.mark.parametrize("variant", VARIANTS)
+@pytest.mark.parametrize("variant,scene", RUNS)
 @pytest.mark.parametrize("build", tuple(BUILDS))
 def test_gpu_frame_matches_cpu(cpu_files, build, variant, scene, solver, precision):
-    if variant == "lanes" and scene != "sagfree":
-        pytest.skip("lanes refuses --guides and --lra (tested below)")
     work, cpu = cpu_files(scene, solver, precision)
     with open_trajectory(cpu) as t:
         k = t.n_frames - 2
