@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 from harness import HarnessError, __version__
+from harness.core import interrupts
 from harness.core.paths import CUDA_BUILDS
 from harness.studies import peer
 
@@ -1087,8 +1088,9 @@ def parser():
 def main(argv=None):
     args = parser().parse_args(argv)
     try:
-        rc = args.func(args)
-        sys.stdout.flush()  # a closed pipe shows here, inside the handlers below
+        with interrupts.redelivered():
+            rc = args.func(args)
+            sys.stdout.flush()  # a closed pipe shows here, inside the handlers below
         return rc
     except HarnessError as e:
         print(f"harness: error: {e}", file=sys.stderr)
