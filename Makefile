@@ -58,10 +58,11 @@ CPU_FLAGS_STR_V4 := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (c_ref/simd/, x86
 # output), paper/ and dynamic/ (the two models' reference), simd/ (the CPU simd variant), and
 # backend_cpu.c (the CPU backend that puts them together). Included as "runtime/params.h".
 SHARED_SRC := $(wildcard c_ref/runtime/*.c) c_ref/paper/model_host.c c_ref/dynamic/dynamics_host.c \
-              c_ref/dynamic/dyn_followers.c c_ref/dynamic/dyn_sagfree.c c_ref/dynamic/dyn_lod.c
+              c_ref/dynamic/dyn_followers.c c_ref/dynamic/dyn_sagfree.c c_ref/dynamic/dyn_lod.c \
+              c_ref/dynamic/colliders.c c_ref/dynamic/sdf_mesh.c c_ref/dynamic/hair_grid.c c_ref/dynamic/world_host.c
 SHARED_OBJ := $(SHARED_SRC:c_ref/%.c=$(OBJ)/%.o)
 CPU_SRC    := c_ref/paper/model.c c_ref/dynamic/dynamics_f32.c c_ref/dynamic/dynamics_f64.c $(wildcard c_ref/simd/*.c) \
-              c_ref/backend_cpu.c
+              c_ref/dynamic/world_build.c c_ref/backend_cpu.c
 CPU_OBJ    := $(CPU_SRC:c_ref/%.c=$(OBJ)/%.o)
 C_HEADERS  := $(wildcard c_ref/*/*.h)
 

@@ -22,6 +22,7 @@
 #include "dynamic/dyn_followers.h"
 #include "dynamic/dyn_sagfree.h"
 #include "dynamic/dynamics.h"
+#include "dynamic/world_host.h"
 #include "simd/dynamics_simd.h"
 #include "runtime/host.h"
 #include "dynamic/dyn_lod.h"
@@ -60,6 +61,8 @@ typedef struct {
     void *ps;         /* a groom's ℓ_k as rows [P−1][stride] (seg_rest and seg64 canonical beside it) */
     hb_followers fl;  /* ref with --guides (docs/model.md §3.14) */
     void *shape_rest; /* ref with --sag-free: the rest shape the frame reads (root, shape targets) */
+    hb_host_world world;    /* ref: the grid and colliders (docs/model.md §3.16, §3.17) */
+    const void *last_pose;  /* the last frame's colliders at its end, for the observables */
 } cpu_impl;
 
 
@@ -112,7 +115,9 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     if (o->scene.dyn.per_segment)
         hb_mul3_u64((uint64_t)o->scene.n_strands, (uint64_t)(o->scene.points - 1),
                     hb_real_size(o->scene.precision) + sizeof(double), &seg_bytes);
-    const uint64_t dyn = c->dynamic ? hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes), seg_bytes) : 0;
+    const uint64_t dyn = c->dynamic ? hb_add_sat(hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes), seg_bytes),
+                                                 hb_host_world_bytes(&o->scene, omp_get_max_threads()))
+                                    : 0;
     const uint64_t need = hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, need_save ? 2u : 1u), dyn), driver_bytes);
     if (need == UINT64_MAX) {
         snprintf(err, errlen, "--strands x --points: the run's memory does not fit in 64 bits");
@@ -715,11 +720,12 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
     if (c->shape_rest) hb_sagfree_targets(&c->scene, c->rest, c->shape_rest);    /* §3.14 */
     hb_followers_free(&c->fl);
     if (c->scene.dyn.guided && hb_followers_plan(&c->scene, c->rest, &c->fl, err, errlen) != 0) return -1;
-    return 0;
+    hb_host_world_free(&c->world);
+    return hb_host_world_make(&c->world, &c->scene, c->rest, 1, err, errlen);
 }
 
-/* Strands over threads; each thread's scratch (9·P reals) is its own. */
-#define DYN_FRAME(T, SFX, M)                                                                                           \
+/* Strands over threads, substeps j0 … j1 − 1; each thread's scratch (9·P reals) is its own. */
+#define DYN_FRAME(T, SFX, M, W)                                                                                        \
     _Pragma("omp parallel")                                                                                            \
     {                                                                                                                  \
         T *scratch = malloc((size_t)hb_mul_sat((uint64_t)P, 9u * sizeof(T)));                                          \
@@ -729,7 +735,8 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
             _Pragma("omp for schedule(static)") for (int64_t j = 0; j < NS; j++)                                       \
             {                                                                                                          \
                 const int64_t i = c->scene.dyn.guided ? c->fl.guide[j] : j;                                            \
-                hb_dyn_frame_strand_##SFX(M, f, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride,  \
+                hb_dyn_frame_strand_##SFX(M, W, f, j0, j1, (T *)c->state + (size_t)i * stride,                         \
+                                          (T *)c->vel + (size_t)i * stride,                                            \
                                           (const T *)(c->shape_rest ? c->shape_rest : c->rest) + (size_t)i * stride,   \
                                           (const T *)c->bend_rest + (size_t)i * bstride,                               \
                                           c->seg_rest ? (const T *)c->seg_rest + (size_t)i * (P - 1) : NULL, scratch); \
@@ -762,8 +769,24 @@ static int cpu_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *
     const size_t stride = (size_t)P * 3u, bstride = (size_t)(P - 2 > 0 ? P - 2 : 0);
     int failed = 0;
     const double t0 = hb_now_ms();
-    if (c->scene.precision == HB_FP32) DYN_FRAME(float, f32, &c->d32)
-    else DYN_FRAME(double, f64, &c->d64)
+    const hb_host_world *hw = &c->world;
+    const int fp32 = c->scene.precision == HB_FP32, still = c->scene.dyn.motion == HB_MOTION_STILL;
+    /* §3.16: without the grid, or built once a frame, the frame's substeps at once; built every
+     * substep, substep by substep over all strands */
+    const int64_t S = f->substeps, step = c->scene.dyn.grid && c->scene.dyn.grid_rebuild == HB_GRID_SUBSTEP ? 1 : S;
+    for (int64_t j0 = 0, j1 = step; j0 < S && !failed; j0 = j1, j1 += step) {
+        if (c->scene.dyn.grid) {
+            const void *qg = still ? NULL
+                             : j0 == 0 ? (fp32 ? (const void *)f->qs32 : (const void *)f->qs64)
+                                       : (fp32 ? (const void *)(f->q32 + 9 * (j0 - 1)) : (const void *)(f->q64 + 9 * (j0 - 1)));
+            if (hb_host_world_build(&c->world, &c->scene, c->state, c->vel, qg)) failed = 1;
+        }
+        if (fp32) DYN_FRAME(float, f32, &c->d32, hw->on ? &hw->w32 : NULL)
+        else DYN_FRAME(double, f64, &c->d64, hw->on ? &hw->w64 : NULL)
+    }
+    c->last_pose = !f->back64 ? NULL
+                   : fp32     ? (const void *)(f->pose32 + (size_t)(S - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE)
+                              : (const void *)(f->pose64 + (size_t)(S - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE);
     if (c->scene.dyn.guided && !failed) cpu_place_followers(c, f);
     return dyn_frame_result(r, t0, failed, "per-thread scratch", P, err, errlen);
 }
@@ -792,11 +815,13 @@ static int cpu_dyn_observe(hb_backend *b, hb_observables *obs, char *err, size_t
         for (int64_t i = ch * OBS_CHUNK; i < i1; i++) {
             hb_obs_partial o;
             if (c->scene.precision == HB_FP32)
-                hb_dyn_observe_strand_f32(&c->scene, (const float *)c->state + (size_t)i * stride,
+                hb_dyn_observe_strand_f32(&c->scene, c->world.on ? &c->world.w32 : NULL, (const float *)c->last_pose,
+                                          (const float *)c->state + (size_t)i * stride,
                                           (const float *)c->vel + (size_t)i * stride,
                                           c->seg64 ? c->seg64 + (size_t)i * (P - 1) : NULL, &o);
             else
-                hb_dyn_observe_strand_f64(&c->scene, (const double *)c->state + (size_t)i * stride,
+                hb_dyn_observe_strand_f64(&c->scene, c->world.on ? &c->world.w64 : NULL, (const double *)c->last_pose,
+                                          (const double *)c->state + (size_t)i * stride,
                                           (const double *)c->vel + (size_t)i * stride,
                                           c->seg64 ? c->seg64 + (size_t)i * (P - 1) : NULL, &o);
             hb_dyn_reduce_into(&acc, &o);
@@ -975,6 +1000,7 @@ static void cpu_teardown(hb_backend *b)
     free(c->pm_wind[1]);
     free(c->pb);
     free(c->ps);
+    hb_host_world_free(&c->world);
     free(c);
     b->impl = NULL;
 }
@@ -987,7 +1013,7 @@ static const hb_variant cpu_variants[] = {
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks; built for x86-64-v3 and "
      "x86-64-v4, the CPU's widest runs (the record's flags say which)",
-     0, 0, 0, 1, HB_X_GUIDES},
+     0, 0, 0, 1, HB_X_GUIDES | HB_X_GRID | HB_X_COLLIDERS | HB_X_FRICTION},
     {NULL, 0, NULL, 0, 0, 0, 0, 0},
 };
 

@@ -37,6 +37,7 @@
 #include "dyn_post.cuh"
 #include "dynamic/dyn_followers.h"
 #include "dynamic/dyn_sagfree.h"
+#include "dynamic/world_host.h"
 #include "runtime/checked.h"
 #include "runtime/host.h"
 
@@ -66,6 +67,20 @@ struct DynState {
     /* §3.14 --render-points: a rendered frame and its velocities, canonical [N·P_r][3] */
     uint64_t render_bytes;
     void *d_render, *d_vrender;
+    /* §3.16 the grid and §3.17 the colliders: the host tables, their device copies, the grid's
+     * sums and node fields, the frame's pose tables, and the world struct on the device (for
+     * the observables) */
+    hb_host_world hw;
+    int64_t *g_mass, *g_mom;
+    void *g_node_v, *g_node_a, *g_target, *g_ftab;
+    int *c_kind, *c_frame;
+    int64_t *c_sdf_n;
+    void *c_mu, *c_geo, *c_sdf_ptrs;
+    void *c_sdf[HB_MAX_COLLIDERS];
+    void *f_pose, *f_back, *f_qs;
+    void *d_world;
+    void *perm; /* lanes: the strands' order (hb_grid_order) */
+    uint64_t pose_bytes, back_bytes;
 };
 
 int dyn_is_strand_major(const cuda_impl *c)
@@ -150,6 +165,11 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
     }
     if (d->guided) /* guide and follower numbers, up to 3 guides and weights a follower */
         need = sat_add(need, hb_mul_sat((uint64_t)N, 8u + 3u * (8u + rs)));
+    if (s->dyn.grid) { /* §3.16 the sums and the node fields */
+        const uint64_t nodes = (uint64_t)s->dyn.grid_n * (uint64_t)s->dyn.grid_n * (uint64_t)s->dyn.grid_n;
+        need = sat_add(need, hb_mul_sat(nodes, 32u + 9u * rs));
+    }
+    need = sat_add(need, hb_host_world_bytes(s, 0)); /* §3.17 the meshes' fields */
     if (c->variant == V_STRAND) {
         const int64_t resident = (int64_t)prop.multiProcessorCount * prop.maxThreadsPerMultiProcessor;
         d->grid = dyn_strand_grid(N, c->block, resident);
@@ -239,6 +259,14 @@ void dyn_free(cuda_impl *c)
                     d->shape_rest, d->seg_rest,  d->seg64,   d->d_render,   d->d_vrender};
     for (void *p : ptrs)
         if (p) cudaFree(p);
+    void *world[] = {d->g_mass, d->g_mom,   d->g_node_v,   d->g_node_a, d->g_target, d->g_ftab, d->c_kind,
+                     d->c_frame, d->c_sdf_n, d->c_mu,     d->c_geo,    d->c_sdf_ptrs, d->f_pose, d->f_back,
+                     d->f_qs,   d->d_world, d->perm};
+    for (void *p : world)
+        if (p) cudaFree(p);
+    for (void *p : d->c_sdf)
+        if (p) cudaFree(p);
+    hb_host_world_free(&d->hw);
     free(d->h_obs);
     free(d->h_part);
     hb_followers_free(&d->fl);
@@ -295,6 +323,105 @@ template <> hbd::DModel<float> &dyn_model<float>(DynState *d)
 template <> hbd::DModel<double> &dyn_model<double>(DynState *d)
 {
     return d->m64;
+}
+
+/* a host table to a new device array (nothing for n = 0) */
+static int dev_copy(void **dst, const void *src, size_t n, cuda_impl *c, const char *what, char *err, size_t errlen)
+{
+    if (n == 0) return 0;
+    int rc;
+    if ((rc = device_alloc(dst, n, c, what, err, errlen))) return rc;
+    HB_CUDA_AS(cudaMemcpy(*dst, src, n, cudaMemcpyHostToDevice), what);
+    return 0;
+}
+
+/* §3.16–3.17: the run's grid and colliders planned on the host (world_host.c, the same tables as
+ * the C reference's), copied to the device; the world struct points at the device copies. */
+template <typename T> static int dyn_world_load(cuda_impl *c, const void *rest, char *err, size_t errlen)
+{
+    DynState *d = c->dyn;
+    hbd::DModel<T> &m = dyn_model<T>(d);
+    hb_host_world_free(&d->hw);
+    if (hb_host_world_make(&d->hw, &c->scene, rest, 0, err, errlen)) return HB_EXIT_USAGE;
+    if (!d->hw.on) return 0;
+    const hb_host_world *hw = &d->hw;
+    hbd::World<T> w = *(const hbd::World<T> *)(sizeof(T) == 4 ? (const void *)&hw->w32 : (const void *)&hw->w64);
+    const size_t rs = sizeof(T);
+    const int64_t nodes = hw->nodes;
+    int rc;
+    if (c->scene.dyn.grid) {
+        if ((rc = device_alloc((void **)&d->g_mass, (uint64_t)nodes * 8u, c, "grid sums", err, errlen)) ||
+            (rc = device_alloc((void **)&d->g_mom, (uint64_t)nodes * 24u, c, "grid sums", err, errlen)))
+            return rc;
+        if (c->scene.dyn.grid_friction_declared &&
+            (rc = device_alloc(&d->g_node_v, (uint64_t)nodes * 4u * rs, c, "grid velocities", err, errlen)))
+            return rc;
+        if (c->scene.dyn.grid_volume_declared &&
+            (rc = device_alloc(&d->g_node_a, (uint64_t)nodes * 4u * rs, c, "grid accelerations", err, errlen)))
+            return rc;
+        if ((rc = dev_copy(&d->g_target, hw->target, hw->target ? (size_t)nodes * rs : 0, c, "grid targets", err,
+                           errlen)) ||
+            (rc = dev_copy(&d->g_ftab, hw->ftab, hw->ftab ? (size_t)c->P * rs : 0, c, "friction profile", err, errlen)))
+            return rc;
+        w.ftab = (const T *)d->g_ftab;
+        w.node_v = (const T *)d->g_node_v;
+        w.node_a = (const T *)d->g_node_a;
+    }
+    const int nc = hw->ncol;
+    if (nc > 0) {
+        std::vector<const void *> ptrs((size_t)nc, nullptr);
+        for (int i = 0; i < nc; i++)
+            if (hw->sdf[i]) {
+                const size_t n3 = (size_t)(hw->sdf_n[i] * hw->sdf_n[i] * hw->sdf_n[i]);
+                if ((rc = dev_copy(&d->c_sdf[i], hw->sdf[i], n3 * rs, c, "a mesh's SDF", err, errlen))) return rc;
+                ptrs[(size_t)i] = d->c_sdf[i];
+            }
+        if ((rc = dev_copy((void **)&d->c_kind, hw->kind, (size_t)nc * sizeof(int), c, "colliders", err, errlen)) ||
+            (rc = dev_copy((void **)&d->c_frame, hw->frame, (size_t)nc * sizeof(int), c, "colliders", err, errlen)) ||
+            (rc = dev_copy((void **)&d->c_sdf_n, hw->sdf_n, (size_t)nc * 8u, c, "colliders", err, errlen)) ||
+            (rc = dev_copy(&d->c_mu, hw->mu, (size_t)nc * 2u * rs, c, "colliders", err, errlen)) ||
+            (rc = dev_copy(&d->c_geo, hw->sdf_geo, (size_t)nc * 4u * rs, c, "colliders", err, errlen)) ||
+            (rc = dev_copy(&d->c_sdf_ptrs, ptrs.data(), (size_t)nc * sizeof(void *), c, "colliders", err, errlen)))
+            return rc;
+        w.col_kind = d->c_kind;
+        w.col_frame = d->c_frame;
+        w.col_mu = (const T *)d->c_mu;
+        w.sdf = (const T *const *)d->c_sdf_ptrs;
+        w.sdf_n = d->c_sdf_n;
+        w.sdf_geo = (const T *)d->c_geo;
+    }
+    if (hb_dyn_has_world(&c->scene)) {
+        d->pose_bytes = (uint64_t)d->S * (uint64_t)(nc > 0 ? nc : 1) * HB_COL_POSE * rs;
+        d->back_bytes = (uint64_t)d->S * HB_COL_BACK * rs;
+        if ((rc = device_alloc(&d->f_pose, d->pose_bytes, c, "collider poses", err, errlen)) ||
+            (rc = device_alloc(&d->f_back, d->back_bytes, c, "collider poses", err, errlen)))
+            return rc;
+    }
+    if ((rc = device_alloc(&d->f_qs, 9u * rs, c, "grid rotation", err, errlen))) return rc;
+    if (c->variant == V_LANES) { /* the strands by their roots' place: a block's points share nodes */
+        double lo[3], hi[3];
+        for (int k = 0; k < 3; k++) {
+            lo[k] = c->scene.dyn.grid ? hw->plan.lo[k] : -2.0 * (c->scene.head_radius + c->scene.hair_length);
+            hi[k] = c->scene.dyn.grid ? hw->plan.hi[k] : 2.0 * (c->scene.head_radius + c->scene.hair_length);
+        }
+        std::vector<int64_t> perm((size_t)c->N);
+        if (hb_grid_order(&c->scene, rest, lo, hi, perm.data())) {
+            snprintf(err, errlen, "out of host memory for the strands' order");
+            return HB_EXIT_MEMORY;
+        }
+        if ((rc = dev_copy(&d->perm, perm.data(), perm.size() * 8u, c, "the strands' order", err, errlen))) return rc;
+        m.perm = (const int64_t *)d->perm;
+    }
+    if ((rc = dev_copy(&d->d_world, &w, sizeof w, c, "the world", err, errlen))) return rc;
+    m.has_world = 1;
+    m.world = w;
+    m.pose = (const T *)d->f_pose;
+    m.back = (const T *)d->f_back;
+    m.qs = (const T *)d->f_qs;
+    d->obs.ncol = nc;
+    if (sizeof(T) == 4) d->obs.w32 = (const hbd::World<float> *)d->d_world;
+    else d->obs.w64 = (const hbd::World<double> *)d->d_world;
+    return 0;
 }
 
 template <typename T>
@@ -362,12 +489,14 @@ static int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char
         HB_CUDA(cudaMemcpy(d->d_src, fl->src, (size_t)nw * 8u, cudaMemcpyHostToDevice));
         HB_CUDA(cudaMemcpy(d->d_w, w, (size_t)nw * sizeof(T), cudaMemcpyHostToDevice));
     }
+    if (dyn_world_load<T>(c, rest, err, errlen)) return -1;
     if (c->variant == V_WARP) {
         const size_t smem = hbd::warp_smem_bytes<T>(c->P) * (size_t)(c->block / 32);
         HB_CUDA_AS(hbd::prepare_warp<T>(d->m64.features, smem), "raising the warp kernel's shared-memory limit");
     }
     if (c->variant == V_LANES)
-        HB_CUDA_AS(hbd::prepare_lanes<T>(d->m64.features, d->m64.solver, c->P, c->block, c->scene.dyn.per_segment != 0),
+        HB_CUDA_AS(hbd::prepare_lanes<T>(d->m64.features, d->m64.solver, c->P, c->block, c->scene.dyn.per_segment != 0,
+                                         d->hw.on != 0),
                    "raising the lanes kernel's shared-memory limit");
     HB_CUDA_AS(cudaDeviceSynchronize(), "dyn_load (cudaDeviceSynchronize)");
     return 0;
@@ -414,6 +543,38 @@ static cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m, const void 
                                           stream);
 }
 
+/* §3.16 the grid built from the current state with the rotation qg (device; nullptr: still). */
+template <typename T> static cudaError_t dyn_grid_build(cuda_impl *c, const hbd::DModel<T> &m, const T *qg, cudaStream_t st)
+{
+    DynState *d = c->dyn;
+    const hb_host_world *hw = &d->hw;
+    cudaError_t e = hbd::launch_grid_splat<T>(m.world, qg, (const T *)c->state, (const T *)d->vel, c->N, c->P, m.perm,
+                                              d->g_mass, d->g_mom, st);
+    if (e != cudaSuccess) return e;
+    return hbd::launch_grid_nodes<T>(m.world, qg, d->g_mass, d->g_mom, (const T *)d->g_target, (T)hw->inv_rho0,
+                                     (T)hw->neg_kv, (T *)d->g_node_v, (T *)d->g_node_a, st);
+}
+
+/* A frame: without the grid its one kernel; with it the grid's build first, once (`frame`), or
+ * before each substep's launch (`substep`, docs/model.md §3.16). */
+template <typename T> static cudaError_t dyn_frame_launches(cuda_impl *c, const hbd::DModel<T> &m, cudaStream_t st)
+{
+    DynState *d = c->dyn;
+    if (!c->scene.dyn.grid) return dyn_launch<T>(c, m, d->q, d->ph, st);
+    const int still = c->scene.dyn.motion == HB_MOTION_STILL;
+    const int64_t S = d->S, step = c->scene.dyn.grid_rebuild == HB_GRID_SUBSTEP ? 1 : S;
+    for (int64_t j0 = 0; j0 < S; j0 += step) {
+        const T *qg = still ? nullptr : j0 == 0 ? (const T *)d->f_qs : (const T *)d->q + 9 * (j0 - 1);
+        cudaError_t e = dyn_grid_build<T>(c, m, qg, st);
+        if (e != cudaSuccess) return e;
+        hbd::DModel<T> ms = m;
+        ms.j0 = (int)j0;
+        ms.j1 = (int)(j0 + step);
+        if ((e = dyn_launch<T>(c, ms, d->q, d->ph, st)) != cudaSuccess) return e;
+    }
+    return cudaSuccess;
+}
+
 static const char *dyn_launch_name(const cuda_impl *c)
 {
     return c->variant == V_STRAND    ? "the simulate kernel launch (strand)"
@@ -438,10 +599,21 @@ int cuda_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *r, cha
                             cudaMemcpyHostToDevice, 0));
     HB_CUDA(cudaMemcpyAsync(d->ph, fp32 ? (const void *)f->phase32 : (const void *)f->phase64, (size_t)d->S * rs,
                             cudaMemcpyHostToDevice, 0));
+    if (d->f_pose) { /* §3.17 the colliders' poses and back-transforms, with the frame's tables */
+        HB_CUDA(cudaMemcpyAsync(d->f_pose, fp32 ? (const void *)f->pose32 : (const void *)f->pose64,
+                                (size_t)d->pose_bytes, cudaMemcpyHostToDevice, 0));
+        HB_CUDA(cudaMemcpyAsync(d->f_back, fp32 ? (const void *)f->back32 : (const void *)f->back64,
+                                (size_t)d->back_bytes, cudaMemcpyHostToDevice, 0));
+        const size_t last = (size_t)(d->S - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE;
+        if (fp32) d->obs.pose32 = (const float *)d->f_pose + last;
+        else d->obs.pose64 = (const double *)d->f_pose + last;
+    }
+    if (d->f_qs)
+        HB_CUDA(cudaMemcpyAsync(d->f_qs, fp32 ? (const void *)f->qs32 : (const void *)f->qs64, 9u * rs,
+                                cudaMemcpyHostToDevice, 0));
     HB_CUDA_AS(hold_stream(0), "the hold kernel launch");
     HB_CUDA(cudaEventRecord(c->ev0, 0));
-    const cudaError_t e =
-        fp32 ? dyn_launch<float>(c, d->m32, d->q, d->ph, 0) : dyn_launch<double>(c, d->m64, d->q, d->ph, 0);
+    const cudaError_t e = fp32 ? dyn_frame_launches<float>(c, d->m32, 0) : dyn_frame_launches<double>(c, d->m64, 0);
     HB_CUDA_AS(e, dyn_launch_name(c));
     HB_CUDA(cudaEventRecord(c->ev1, 0));
     HB_CUDA_AS(cudaEventSynchronize(c->ev1), "the simulate kernel (cudaEventSynchronize)");

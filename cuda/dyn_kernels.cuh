@@ -130,7 +130,8 @@ constexpr int64_t kLanesMaxPoints = 128;
 constexpr int kLanesMaxBlock = 256; /* __launch_bounds__: up to 255 registers a thread */
 template <typename T> size_t lanes_smem_bytes(unsigned features, int solver, int64_t P, int block);
 /* seg: a groom's per-segment rest lengths (docs/model.md §3.15; launch with m.seg_rest set) */
-template <typename T> cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg);
+template <typename T>
+cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg, bool world = false);
 template <typename T>
 cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                                const T *bend_rest, int64_t N, int block, cudaStream_t stream);

@@ -189,11 +189,114 @@ __device__ __forceinline__ void predict(const DModel<T> &m, Feat has, T phase, c
     }
 }
 
-/* §3.7 one follow-the-leader step of p after its corrected predecessor a, ell its segment's
- * rest length; d: the correction. */
-template <typename T, class Feat>
-__device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, const V3<T> &a, V3<T> &p, V3<T> &d)
+/* §3.16 the hair–hair correction of point k at x (velocity v): the strict build runs the
+ * reference (contact_impl.h) itself; the free builds the same sums from registers, the eight
+ * corners' nodes read as vectors through the read-only cache. */
+template <typename T> struct Node4;
+template <> struct Node4<float> {
+    __device__ static float4 load(const float *p) { return __ldg(reinterpret_cast<const float4 *>(p)); }
+};
+template <> struct Node4<double> {
+    __device__ static double4 load(const double *p)
+    {
+        const double2 a = __ldg(reinterpret_cast<const double2 *>(p)), b = __ldg(reinterpret_cast<const double2 *>(p) + 1);
+        return double4{a.x, a.y, b.x, b.y};
+    }
+};
+template <typename T>
+__device__ __forceinline__ void grid_fix(const DModel<T> &m, const T *qg, int k, const V3<T> &x, V3<T> &v)
 {
+    const World<T> &w = m.world;
+    if constexpr (!kFree) {
+        const T xx[3] = {x.x, x.y, x.z};
+        T vv[3] = {v.x, v.y, v.z};
+        grid_correct(w, qg, m.h, k, xx, vv);
+        v = V3<T>{vv[0], vv[1], vv[2]};
+    } else {
+        V3<T> u = x;
+        if (qg) u = V3<T>{(qg[0] * x.x + qg[3] * x.y) + qg[6] * x.z, (qg[1] * x.x + qg[4] * x.y) + qg[7] * x.z,
+                          (qg[2] * x.x + qg[5] * x.y) + qg[8] * x.z};
+        const T gx = (u.x - w.glo[0]) * w.gsc[0], gy = (u.y - w.glo[1]) * w.gsc[1], gz = (u.z - w.glo[2]) * w.gsc[2];
+        const T top = (T)(w.gn - 1);
+        if (!(gx >= (T)0 && gx < top && gy >= (T)0 && gy < top && gz >= (T)0 && gz < top)) return;
+        const int ix = (int)gx, iy = (int)gy, iz = (int)gz;
+        const T fx = gx - (T)ix, fy = gy - (T)iy, fz = gz - (T)iz;
+        const int64_t n = w.gn, b = ix + n * (iy + n * (int64_t)iz);
+        T sw = 0, svx = 0, svy = 0, svz = 0, ax = 0, ay = 0, az = 0;
+#pragma unroll
+        for (int c = 0; c < 8; c++) {
+            const T wx = (c & 1) ? fx : (T)1 - fx, wy = (c & 2) ? fy : (T)1 - fy, wz = (c & 4) ? fz : (T)1 - fz;
+            const T wt = (wx * wy) * wz;
+            const int64_t j = b + ((c & 1) ? 1 : 0) + ((c & 2) ? n : 0) + ((c & 4) ? n * n : 0);
+            if (w.grid_friction) {
+                const auto nv = Node4<T>::load(w.node_v + 4 * j);
+                const T wo = wt * nv.w; /* o ∈ {0, 1}; V is 0 where o is */
+                sw += wo;
+                svx += wt * nv.x;
+                svy += wt * nv.y;
+                svz += wt * nv.z;
+            }
+            if (w.grid_volume) {
+                const auto na = Node4<T>::load(w.node_a + 4 * j);
+                ax += wt * na.x;
+                ay += wt * na.y;
+                az += wt * na.z;
+            }
+        }
+        if (w.grid_friction && sw > (T)0) {
+            const T f = w.ftab[k], inv = (T)1 / sw;
+            v = V3<T>{v.x + f * (svx * inv - v.x), v.y + f * (svy * inv - v.y), v.z + f * (svz * inv - v.z)};
+        }
+        if (w.grid_volume) v = V3<T>{v.x + m.h * ax, v.y + m.h * ay, v.z + m.h * az};
+    }
+}
+
+/* §3.6 step 7 and §3.7 with the colliders of §3.17: the head sphere (with its friction or a
+ * bounded depenetration), then each collider with its friction; x: p's start of the substep. */
+template <typename T, class Feat>
+__device__ __forceinline__ void collide_world(const DModel<T> &m, Feat has, const T *pose, const T *back, V3<T> &p,
+                                              const V3<T> &x)
+{
+    const World<T> &w = m.world;
+    T pp[3] = {p.x, p.y, p.z};
+    const T xx[3] = {x.x, x.y, x.z};
+    if (has(HB_F_COLLIDE)) {
+        if (w.head_friction || w.bounded) collide_head(w, m.collide_r, back, pp, xx);
+        else {
+            collide(m, p);
+            pp[0] = p.x, pp[1] = p.y, pp[2] = p.z;
+        }
+    }
+    for (int i = 0; i < w.ncol; i++) collide_one(w, i, pose + i * HB_COL_POSE, back, pp, xx);
+    p = V3<T>{pp[0], pp[1], pp[2]};
+}
+
+/* §3.7 one follow-the-leader step of p after its corrected predecessor a, ell its segment's
+ * rest length; d: the correction; wc: the colliders of §3.17 (pose, back, x) instead of the head sphere. */
+template <typename T, class Feat>
+__device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, const V3<T> &a, V3<T> &p, V3<T> &d,
+                                           bool wc = false, const T *pose = nullptr, const T *back = nullptr,
+                                           const V3<T> *x = nullptr)
+{
+    if (wc) {
+        if constexpr (kFree) {
+            const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
+            const T q = ex * ex + ey * ey + ez * ez;
+            V3<T> n;
+            if (q > floor_of<T>()) {
+                const T f = ell * rsq(q);
+                n = V3<T>{a.x + f * ex, a.y + f * ey, a.z + f * ez};
+            } else {
+                n = V3<T>{a.x, a.y - ell, a.z};
+            }
+            d = V3<T>{n.x - p.x, n.y - p.y, n.z - p.z};
+            p = n;
+        } else {
+            follow(a.x, a.y, a.z, p.x, p.y, p.z, ell, false, m.collide_r, d.x, d.y, d.z);
+        }
+        collide_world(m, has, pose, back, p, *x);
+        return;
+    }
     if constexpr (kFree) {
         const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
         const T q = ex * ex + ey * ey + ez * ez;
@@ -280,8 +383,10 @@ __device__ __forceinline__ void pack(T *s, int k0, bool sw, int P, bool live, co
 }
 
 /* The frame of (32/L) strands a warp, L lanes a strand, G points a lane (G·L ≥ P); Ftl: the
- * solver of §3.7, else §3.6; Seg: a groom's per-segment rest lengths (§3.15, m.seg_rest). */
-template <typename T, class Feat, int G, int L, bool Ftl, bool Seg>
+ * solver of §3.7, else §3.6; Seg: a groom's per-segment rest lengths (§3.15, m.seg_rest); W: the
+ * grid and colliders of §3.16–3.17 (m.world), with the strands taken in the order m.perm (slot
+ * s holds strand perm[s], nearby strands together, so a block's points share grid nodes). */
+template <typename T, class Feat, int G, int L, bool Ftl, bool Seg, bool W>
 __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>())
     k_lanes(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
             const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N)
@@ -306,6 +411,19 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
         const bool live = seg < ns;
         const int64_t base = s0 * row;
         const int n = ns * row;
+        /* where element e (< n) of the warp's strands lies: base + e, or in strand perm[s0 + e/row] */
+        auto at = [&](int e) -> int64_t {
+            if constexpr (W) {
+                if (m.perm) return m.perm[s0 + e / row] * (int64_t)row + e % row;
+            }
+            return base + e;
+        };
+        auto bat = [&](int e) -> int64_t { /* the same for the bend rest lengths, P − 2 a strand */
+            if constexpr (W) {
+                if (m.perm) return m.perm[s0 + e / (P - 2)] * (int64_t)(P - 2) + e % (P - 2);
+            }
+            return s0 * (int64_t)(P - 2) + e;
+        };
         V3<T> X[G], V[G], Q[G], D[G];
         T *bs = rs + SPW * row; /* the bend rest lengths of the warp's strands */
         const bool need_bend = has(HB_F_BEND) && P > 2;
@@ -315,13 +433,14 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
 #pragma unroll
             for (int u = 0; u < 3 * G; u++) {
                 const int e = lane + 32 * u < n ? lane + 32 * u : n - 1;
-                rx[u] = x[base + e];
-                rv[u] = v[base + e];
-                if (need_rest) rr[u] = rest[base + e];
+                const int64_t a = at(e);
+                rx[u] = x[a];
+                rv[u] = v[a];
+                if (need_rest) rr[u] = rest[a];
             }
 #pragma unroll
             for (int u = 0; u < G; u++) /* nb ≤ (32/L)·(G·L − 2) < 32·G */
-                if (need_bend) rb[u] = bend_rest[s0 * (int64_t)(P - 2) + (lane + 32 * u < nb ? lane + 32 * u : nb - 1)];
+                if (need_bend) rb[u] = bend_rest[bat(lane + 32 * u < nb ? lane + 32 * u : nb - 1)];
 #pragma unroll
             for (int u = 0; u < 3 * G; u++)
                 if (lane + 32 * u < n) {
@@ -351,8 +470,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
 #pragma unroll
             for (int i = 0; i < G; i++) {
                 const int k = k0 + i;
-                sl[i] = live && k >= 1 && k < P ? m.seg_rest[(s0 + seg) * m.seg_is + (int64_t)(k - 1) * m.seg_s]
-                                                : m.seg_len;
+                const int64_t st = W && m.perm ? m.perm[s0 + seg] : s0 + seg;
+                sl[i] = live && k >= 1 && k < P ? m.seg_rest[st * m.seg_is + (int64_t)(k - 1) * m.seg_s] : m.seg_len;
             }
         }
         auto ell = [&](int i) {
@@ -365,8 +484,17 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
             Q[i] = X[i];
         }
 
-        for (int j = 0; j < (int)m.substeps; j++) {
+        const int jend = m.j1 < 0 ? (int)m.substeps : m.j1;
+        const bool wgrid = W && m.world.grid && (m.world.grid_friction || m.world.grid_volume);
+        const bool wcol = W && (m.world.ncol > 0 || m.world.head_friction || m.world.bounded);
+        for (int j = m.j0; j < jend; j++) {
             const T *q = qtab + 9 * j;
+            /* §3.16 the rotation of the grid in use (nullptr: still); §3.17 this substep's poses */
+            const T *qg = !has(HB_F_MOTION)                                           ? nullptr
+                          : (m.world.grid_rebuild == HB_GRID_SUBSTEP && j > 0) ? qtab + 9 * (j - 1)
+                                                                                : m.qs;
+            const T *pose = wcol ? m.pose + (int64_t)j * (m.world.ncol > 0 ? m.world.ncol : 1) * HB_COL_POSE : nullptr;
+            const T *back = wcol ? m.back + HB_COL_BACK * j : nullptr;
             /* 1. the root on the head, then p0 = x0 */
             if (l == 0) {
                 if (has(HB_F_MOTION)) {
@@ -384,8 +512,15 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
             /* 2. velocities and the prediction */
             const T phase = has(HB_F_GUST) ? phtab[j] : (T)0;
 #pragma unroll
-            for (int i = 0; i < G; i++)
-                if (point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P) predict(m, has, phase, X[i], V[i], Q[i]);
+            for (int i = 0; i < G; i++) {
+                const int k = point_of<G>(k0, sw, i);
+                if (k >= 1 && k < P) {
+                    if constexpr (W) {
+                        if (wgrid) grid_fix(m, qg, k, X[i], V[i]); /* §3.16 friction, then volume */
+                    }
+                    predict(m, has, phase, X[i], V[i], Q[i]);
+                }
+            }
             /* the shape targets T_k = Q(t+h)·X̄_k of this substep (the same in every iteration) */
             V3<T> S[G];
 #pragma unroll
@@ -483,7 +618,12 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
                         bend(1);
                     }
                     if (has(HB_F_SHAPE)) shapes();
-                    if (has(HB_F_COLLIDE)) {
+                    if (W && wcol) {
+#pragma unroll
+                        for (int i = 0; i < G; i++)
+                            if (point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P)
+                                collide_world(m, has, pose, back, Q[i], X[i]);
+                    } else if (has(HB_F_COLLIDE)) {
 #pragma unroll
                         for (int i = 0; i < G; i++)
                             if (point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P) collide(m, Q[i]);
@@ -505,7 +645,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
                         for (int i = 0; i < G; i++) {
                             const int k = k0 + i;
                             if (k >= 1 && k < P)
-                                follow_one(m, has, ell(i), i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i]);
+                                follow_one(m, has, ell(i), i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i], W && wcol,
+                                           pose, back, &X[i]);
                         }
                     }
                 }
@@ -527,8 +668,9 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>
 #pragma unroll
         for (int u = 0; u < 3 * G; u++)
             if (lane + 32 * u < n) {
-                x[base + lane + 32 * u] = xv[lane + 32 * u];
-                v[base + lane + 32 * u] = xv[SPW * row + lane + 32 * u];
+                const int64_t a = at(lane + 32 * u);
+                x[a] = xv[lane + 32 * u];
+                v[a] = xv[SPW * row + lane + 32 * u];
             }
         __syncwarp();
     }
@@ -546,8 +688,8 @@ template <typename T, int G, int L, bool Ftl, unsigned F> constexpr LanesFn<T> l
 {
     constexpr bool own = (!Ftl && G == 2 && L == 16) || (Ftl && G == kFtlG && L == kFtlL);
     if constexpr (!valid_mask(F)) return nullptr;
-    else if constexpr (own && specialised_mask(F)) return &k_lanes<T, StaticF<F>, G, L, Ftl, false>;
-    else return &k_lanes<T, DynF, G, L, Ftl, false>;
+    else if constexpr (own && specialised_mask(F)) return &k_lanes<T, StaticF<F>, G, L, Ftl, false, false>;
+    else return &k_lanes<T, DynF, G, L, Ftl, false, false>;
 }
 template <typename T, int G, int L, bool Ftl, unsigned... Fs> struct LanesTable {
     static constexpr LanesFn<T> fn[sizeof...(Fs)] = {lanes_entry<T, G, L, Ftl, Fs>()...};
@@ -563,35 +705,39 @@ template <typename T> struct LanesPick {
     int lanes;
     int64_t warp_reals;
 };
-/* a groom (seg) runs the generic kernel of its layout with per-segment rest lengths */
-template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int64_t P, bool seg)
+/* a groom (seg) runs the generic kernel of its layout with per-segment rest lengths; a run with
+ * the grid or colliders (world) the generic kernel with them */
+template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int64_t P, bool seg, bool world)
 {
-    return LanesPick<T>{seg ? &k_lanes<T, DynF, G, L, Ftl, true> : LanesTableT<T, G, L, Ftl>::fn[f], L,
-                        lanes_warp_reals<T, G, L>(P)};
+    LanesFn<T> fn = LanesTableT<T, G, L, Ftl>::fn[f];
+    if (world) fn = seg ? &k_lanes<T, DynF, G, L, Ftl, true, true> : &k_lanes<T, DynF, G, L, Ftl, false, true>;
+    else if (seg) fn = &k_lanes<T, DynF, G, L, Ftl, true, false>;
+    return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P)};
 }
-template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P, bool seg)
+template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P, bool seg, bool world)
 {
     if (!valid_mask(f) || P < 2 || P > kLanesMaxPoints) return LanesPick<T>{nullptr, 0, 0};
     if (solver == HB_SOLVER_FTL) {
-        if (P <= 32) return pick<T, kFtlG, kFtlL, true>(f, P, seg);
-        if (P <= 64) return pick<T, 8, 8, true>(f, P, seg);
-        return pick<T, 8, 16, true>(f, P, seg);
+        if (P <= 32) return pick<T, kFtlG, kFtlL, true>(f, P, seg, world);
+        if (P <= 64) return pick<T, 8, 8, true>(f, P, seg, world);
+        return pick<T, 8, 16, true>(f, P, seg, world);
     }
-    if (P <= 32) return pick<T, 2, 16, false>(f, P, seg);
-    if (P <= 64) return pick<T, 4, 16, false>(f, P, seg);
-    return pick<T, 8, 16, false>(f, P, seg);
+    if (P <= 32) return pick<T, 2, 16, false>(f, P, seg, world);
+    if (P <= 64) return pick<T, 4, 16, false>(f, P, seg, world);
+    return pick<T, 8, 16, false>(f, P, seg, world);
 }
 
 } /* namespace */
 
 template <typename T> size_t lanes_smem_bytes(unsigned features, int solver, int64_t P, int block)
 {
-    return (size_t)(block / 32) * (size_t)lanes_pick<T>(features, solver, P, false).warp_reals * sizeof(T);
+    return (size_t)(block / 32) * (size_t)lanes_pick<T>(features, solver, P, false, false).warp_reals * sizeof(T);
 }
 
-template <typename T> cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg)
+template <typename T>
+cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg, bool world)
 {
-    const LanesPick<T> k = lanes_pick<T>(features, solver, P, seg);
+    const LanesPick<T> k = lanes_pick<T>(features, solver, P, seg, world);
     if (!k.fn) return cudaErrorInvalidValue;
     return cudaFuncSetAttribute(k.fn, cudaFuncAttributeMaxDynamicSharedMemorySize,
                                 (int)lanes_smem_bytes<T>(features, solver, P, block));
@@ -601,7 +747,7 @@ template <typename T>
 cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                                const T *bend_rest, int64_t N, int block, cudaStream_t stream)
 {
-    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr);
+    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, m.has_world != 0);
     if (!k.fn) return cudaErrorInvalidValue;
     const int64_t per_block = (int64_t)(block / 32) * (32 / k.lanes);
     const int64_t g = (N + per_block - 1) / per_block;
@@ -613,7 +759,7 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
 
 #define HB_LANES_INSTANTIATE(T)                                                                                        \
     template size_t lanes_smem_bytes<T>(unsigned, int, int64_t, int);                                                  \
-    template cudaError_t prepare_lanes<T>(unsigned, int, int64_t, int, bool);                                          \
+    template cudaError_t prepare_lanes<T>(unsigned, int, int64_t, int, bool, bool);                                    \
     template cudaError_t launch_frame_lanes<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,           \
                                                const T *, int64_t, int, cudaStream_t);
 /* the Makefile compiles this file once per precision (-DHB_DYN_REAL), side by side */

@@ -37,6 +37,7 @@
 #include "dynamic/obs_point.h" /* hb_obs_point: §3.8 per point, shared with the reference */
 #include "runtime/params.h"    /* HB_SOLVER_* */
 #include "tmath.cuh"           /* m_sqrt, m_sin: the float overloads for float */
+#include "dyn_world.cuh"        /* §3.16 grid, §3.17 colliders: contact_impl.h for float and double */
 
 #if defined(__CUDACC__)
 #define HB_DHD __host__ __device__ __forceinline__
@@ -64,6 +65,15 @@ template <typename T> struct DModel {
      * ℓ_k at seg_rest[i·seg_is + (k − 1)·seg_s] (point-major for strand, [N][P−1] for the others) */
     const T *seg_rest = nullptr;
     int64_t seg_is = 0, seg_s = 0;
+    /* §3.16 the grid and §3.17 the colliders (has_world = 0: none); the frame's device tables:
+     * the colliders' poses [S][max(ncol, 1)][HB_COL_POSE], back-transforms [S][HB_COL_BACK] and
+     * Q at the frame's start (the frame's first grid build) */
+    int has_world = 0;
+    World<T> world{};
+    const int64_t *perm = nullptr; /* the strands' order (lanes with a world): slot s runs strand perm[s] */
+    const T *pose = nullptr, *back = nullptr, *qs = nullptr;
+    /* the substeps a launch runs: j0 … j1 − 1 (j1 < 0: all of the frame's) */
+    int j0 = 0, j1 = -1;
 };
 
 template <typename T, typename M> inline DModel<T> dmodel_from(const M &m)
@@ -109,6 +119,12 @@ struct ObsScene {
     double ell, far2, rc;
     int collider;
     const double *seg64 = nullptr; /* §3.15 a groom's ℓ_k in double, [N][P−1] on the device; nullptr: ell */
+    /* §3.17 the colliders at the frame's end (the depth of a point in each), one precision's */
+    int ncol = 0;
+    const World<float> *w32 = nullptr;
+    const World<double> *w64 = nullptr;
+    const float *pose32 = nullptr;
+    const double *pose64 = nullptr;
 };
 
 inline ObsScene obs_scene(const hb_scene *s)
@@ -512,6 +528,11 @@ HB_DHD void observe_strand(const ObsScene &sc, const Arr<const T> &x, const Arr<
         const double vk[3] = {(double)v(k, 0), (double)v(k, 1), (double)v(k, 2)};
         if (hb_obs_point(xk, xp, x0, vk, sc.seg64 ? sc.seg64[k - 1] : ell, sc.collider, rc, far2, &smax, &pmax, &v2))
             blown = 1;
+        for (int i = 0; i < sc.ncol; i++) { /* §3.17 */
+            const double dep = sc.w32 ? collider_depth(*sc.w32, i, sc.pose32 + i * HB_COL_POSE, xk)
+                                      : collider_depth(*sc.w64, i, sc.pose64 + i * HB_COL_POSE, xk);
+            if (dep > pmax) pmax = dep;
+        }
     }
     o->stretch_max = smax;
     o->penetration_max = pmax;

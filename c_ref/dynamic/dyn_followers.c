@@ -26,6 +26,13 @@ void hb_dyn_scene_feature_names(const hb_scene *s, char *out, size_t n)
     if (s->dyn.lra) snprintf(out + strlen(out), n - strlen(out), "%slra", out[0] ? "+" : "");
     if (s->dyn.sag_free) snprintf(out + strlen(out), n - strlen(out), "%ssagfree", out[0] ? "+" : "");
     if (s->dyn.render_points) snprintf(out + strlen(out), n - strlen(out), "%slod", out[0] ? "+" : "");
+    if (s->dyn.grid) /* §3.16 */
+        snprintf(out + strlen(out), n - strlen(out), "%sgrid%s%s", out[0] ? "+" : "",
+                 s->dyn.grid_friction_declared ? "+gridfriction" : "", s->dyn.grid_volume_declared ? "+volume" : "");
+    if (s->dyn.colliders_path) snprintf(out + strlen(out), n - strlen(out), "%scolliders", out[0] ? "+" : "");
+    int friction = s->dyn.friction_declared;
+    for (int i = 0; s->dyn.cols && i < s->dyn.cols->n; i++) friction |= s->dyn.cols->c[i].mu_s > 0.0;
+    if (friction) snprintf(out + strlen(out), n - strlen(out), "%sfriction", out[0] ? "+" : "");
     if (!out[0]) snprintf(out, n, "none");
 }
 

@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "runtime/params.h"
+#include "dynamic/world.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -57,6 +58,14 @@ typedef struct {
     int64_t substeps;
     double *q64, *phase64; /* [S·9], [S] */
     float *q32, *phase32;
+    /* §3.16: Q(t) at the start of the frame's first substep (the frame's first grid build) */
+    double qs64[9];
+    float qs32[9];
+    /* §3.17 (hb_dyn_frame_alloc_world): each substep's collider poses [S][ncol][HB_COL_POSE]
+     * and back-transforms [S][HB_COL_BACK] (NULL without colliders or friction) */
+    int ncol;
+    double *pose64, *back64;
+    float *pose32, *back32;
 } hb_dyn_frame;
 
 /* Observables of a frame (docs/model.md §3.8), in double. */
@@ -78,6 +87,10 @@ void hb_dyn_feature_names(unsigned features, char *out, size_t n);
 void hb_dyn_round(const hb_scene *s, hb_dyn_model_f32 *m32, hb_dyn_model_f64 *m64);
 /* Allocates the per-substep tables for S substeps; 0 on success. */
 int hb_dyn_frame_alloc(hb_dyn_frame *f, int64_t substeps);
+/* Adds the tables of §3.17 for the scene's colliders and friction (nothing without them); 0 on success. */
+int hb_dyn_frame_alloc_world(hb_dyn_frame *f, const hb_scene *s);
+/* Whether a scene's frames need the tables of §3.17 (colliders, head friction or a bounded depenetration). */
+int hb_dyn_has_world(const hb_scene *s);
 void hb_dyn_frame_free(hb_dyn_frame *f);
 /* Fills the tables for the frame whose first substep is m0 (§3.2, §3.3, §3.4). */
 void hb_dyn_frame_plan(const hb_scene *s, int64_t m0, hb_dyn_frame *f);
@@ -94,15 +107,19 @@ void hb_dyn_reduce_into(hb_obs_partial *acc, const hb_obs_partial *o);
 void hb_dyn_bend_rest_f32(const hb_dyn_model_f32 *m, const float *rest, float *bend_rest);
 void hb_dyn_bend_rest_f64(const hb_dyn_model_f64 *m, const double *rest, double *bend_rest);
 /* `seg_rest` holds the P − 1 stretch rest lengths ℓ_k of a groom (§3.15), NULL for ℓ = L/(P−1). */
-void hb_dyn_frame_strand_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *x, float *v, const float *rest,
-                             const float *bend_rest, const float *seg_rest, float *scratch);
-void hb_dyn_frame_strand_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *x, double *v, const double *rest,
-                             const double *bend_rest, const double *seg_rest, double *scratch);
+/* Substeps j0 … j1 − 1 of the frame; w: the grid and colliders (§3.16, §3.17), NULL without them. */
+void hb_dyn_frame_strand_f32(const hb_dyn_model_f32 *m, const hb_dyn_world_f32 *w, const hb_dyn_frame *f, int64_t j0,
+                             int64_t j1, float *x, float *v, const float *rest, const float *bend_rest,
+                             const float *seg_rest, float *scratch);
+void hb_dyn_frame_strand_f64(const hb_dyn_model_f64 *m, const hb_dyn_world_f64 *w, const hb_dyn_frame *f, int64_t j0,
+                             int64_t j1, double *x, double *v, const double *rest, const double *bend_rest,
+                             const double *seg_rest, double *scratch);
 /* `seg64`: the strand's ℓ_k in double (§3.15), NULL for ℓ = L/(P−1). */
-void hb_dyn_observe_strand_f32(const hb_scene *s, const float *x, const float *v, const double *seg64,
-                               hb_obs_partial *o);
-void hb_dyn_observe_strand_f64(const hb_scene *s, const double *x, const double *v, const double *seg64,
-                               hb_obs_partial *o);
+/* w, pose: the colliders of §3.17 and their poses at the frame's end (NULL: none). */
+void hb_dyn_observe_strand_f32(const hb_scene *s, const hb_dyn_world_f32 *w, const float *pose, const float *x,
+                               const float *v, const double *seg64, hb_obs_partial *o);
+void hb_dyn_observe_strand_f64(const hb_scene *s, const hb_dyn_world_f64 *w, const double *pose, const double *x,
+                               const double *v, const double *seg64, hb_obs_partial *o);
 /* §3.15: the N·(P − 1) rest lengths |X̄_k − X̄_{k−1}| of a rest shape in the run's precision,
  * computed in double (seg64) and rounded once (seg, float or double as the precision). */
 void hb_dyn_seg_rest(const hb_scene *s, const void *rest, double *seg64, void *seg);

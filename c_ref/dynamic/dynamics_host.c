@@ -92,12 +92,39 @@ int hb_dyn_frame_alloc(hb_dyn_frame *f, int64_t substeps)
     return 0;
 }
 
+int hb_dyn_has_world(const hb_scene *s)
+{
+    const hb_dynamics *d = &s->dyn;
+    return (d->cols && d->cols->n > 0) || d->friction_declared || d->depen_declared;
+}
+
+int hb_dyn_frame_alloc_world(hb_dyn_frame *f, const hb_scene *s)
+{
+    if (!hb_dyn_has_world(s)) return 0;
+    const int ncol = s->dyn.cols ? s->dyn.cols->n : 0;
+    uint64_t np, nb;
+    if (hb_mul3_u64((uint64_t)f->substeps, (uint64_t)(ncol > 0 ? ncol : 1), HB_COL_POSE * sizeof(double), &np) ||
+        hb_mul_u64((uint64_t)f->substeps, HB_COL_BACK * sizeof(double), &nb) || np > SIZE_MAX / 2 || nb > SIZE_MAX / 2)
+        return -1;
+    f->ncol = ncol;
+    f->pose64 = malloc((size_t)np);
+    f->pose32 = malloc((size_t)np / 2);
+    f->back64 = malloc((size_t)nb);
+    f->back32 = malloc((size_t)nb / 2);
+    if (!f->pose64 || !f->pose32 || !f->back64 || !f->back32) return -1;
+    return 0;
+}
+
 void hb_dyn_frame_free(hb_dyn_frame *f)
 {
     free(f->q64);
     free(f->phase64);
     free(f->q32);
     free(f->phase32);
+    free(f->pose64);
+    free(f->pose32);
+    free(f->back64);
+    free(f->back32);
     memset(f, 0, sizeof *f);
 }
 
@@ -156,7 +183,20 @@ void hb_dyn_frame_plan(const hb_scene *s, int64_t m0, hb_dyn_frame *f)
         const double phase = 2.0 * M_PI * (ft - floor(ft));
         f->phase64[j] = phase;
         f->phase32[j] = (float)phase;
+        if (f->back64) { /* §3.17 the colliders at t + h, and the frames' back-transforms */
+            const int nc = f->ncol;
+            hb_colliders_pose(s, d->cols, t, t1, f->pose64 + (size_t)j * (size_t)(nc > 0 ? nc : 1) * HB_COL_POSE,
+                              f->back64 + HB_COL_BACK * j);
+        }
     }
+    if (f->back64) {
+        const size_t np = (size_t)f->substeps * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE;
+        for (size_t e = 0; e < np; e++) f->pose32[e] = (float)f->pose64[e];
+        for (size_t e = 0; e < (size_t)f->substeps * HB_COL_BACK; e++) f->back32[e] = (float)f->back64[e];
+    }
+    /* §3.16 the rotation of the frame's first grid build: Q at the start of its first substep */
+    hb_head_rotation(d, (double)m0 * h, f->qs64);
+    for (int e = 0; e < 9; e++) f->qs32[e] = (float)f->qs64[e];
 }
 
 void hb_dyn_reduce_into(hb_obs_partial *acc, const hb_obs_partial *o)

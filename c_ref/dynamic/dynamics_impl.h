@@ -10,7 +10,8 @@
  * Layout: point k of a strand at s[3k + 0..2] = (x, y, z).
  */
 
-#include "dynamic/obs_point.h" /* hb_obs_point: §3.8 per point, shared with cuda/dyn_model.cuh */
+#include "dynamic/obs_point.h"    /* hb_obs_point: §3.8 per point, shared with cuda/dyn_model.cuh */
+#include "dynamic/contact_impl.h" /* §3.16 grid, §3.17 colliders: shared with cuda/ */
 
 #define HB_ALWAYS_INLINE static inline __attribute__((always_inline))
 #if HB_PLANT == 8 /* judge test: the root given weight 1 in its stretch constraint */
@@ -152,9 +153,24 @@ HB_ALWAYS_INLINE void SFX(lra_all)(const DMODEL *m, REAL *p)
     }
 }
 
-/* One frame of one strand: S substeps of §3.4, the solver of §3.6, §3.7 or §3.13 (rigid). */
-HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, REAL *x, REAL *v, const REAL *rest,
-                                      const REAL *bend_rest, const REAL *seg_rest, REAL *scratch, const unsigned F)
+/* §3.6 step 7 / §3.7's collision of one point p (x: where it was at the substep's start): the
+ * head sphere, then the colliders of §3.17, each with its friction. */
+HB_ALWAYS_INLINE void SFX(collide_point)(const DMODEL *m, const WORLD *w, const REAL *pose, const REAL *back, REAL *p,
+                                         const REAL *x, int64_t k, const unsigned F)
+{
+    if ((F & HB_F_COLLIDE) && !PLANT_SKIPPED(k)) {
+        if (w && (w->head_friction || w->bounded)) SFX(hb_collide_head)(w, m->collide_r, back, p, x);
+        else SFX(collide_sphere)(p, m->collide_r);
+    }
+    if (w)
+        for (int i = 0; i < w->ncol; i++) SFX(hb_collide_one)(w, i, pose + (size_t)i * HB_COL_POSE, back, p, x);
+}
+
+/* Substeps j0 … j1 − 1 of a frame of one strand: §3.4, the solver of §3.6, §3.7 or §3.13 (rigid).
+ * w: the grid and colliders (§3.16, §3.17), NULL without them. */
+HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_dyn_frame *fr, int64_t j0, int64_t j1,
+                                      REAL *x, REAL *v, const REAL *rest, const REAL *bend_rest, const REAL *seg_rest,
+                                      REAL *scratch, const unsigned F)
 {
     const int64_t P = m->points;
     const REAL h = m->h;
@@ -163,11 +179,20 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
     REAL *lam_s = lam, *lam_b = lam + P, *lam_g = lam + 2 * P;
     REAL *d = scratch + 6 * P; /* ftl corrections d_k, 3P */
 
-    for (int64_t j = 0; j < m->substeps; j++) {
+    const int wgrid = w && w->grid && (w->grid_friction || w->grid_volume);
+    const int wcol = w && (w->ncol > 0 || w->head_friction || w->bounded);
+    for (int64_t j = j0; j < j1; j++) {
         const REAL *q = QTABLE(fr) + 9 * j; /* Q(t + h) */
         const REAL phase = PHASE(fr)[j];    /* φ(t) */
+        /* §3.16 the rotation of the grid in use (NULL: still), §3.17 this substep's poses */
+        const REAL *qg = !(F & HB_F_MOTION)                                 ? NULL
+                         : (w && w->grid_rebuild == HB_GRID_SUBSTEP && j > 0) ? QTABLE(fr) + 9 * (j - 1)
+                                                                              : QSTART(fr);
+        const REAL *pose = wcol ? POSES(fr) + (size_t)j * (size_t)(w->ncol > 0 ? w->ncol : 1) * HB_COL_POSE : NULL;
+        const REAL *back = wcol ? BACKS(fr) + HB_COL_BACK * j : NULL;
         (void)q;
         (void)phase;
+        (void)qg;
 
         /* 1. root on the head: x0 ← Q(t+h)·X̄0, v0 ← (x0_new − x0_old)/h */
         if (F & HB_F_MOTION) {
@@ -199,6 +224,7 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
         for (int64_t k = 1; k < P; k++) {
             REAL *vk = v + 3 * k;
             const REAL *xk = x + 3 * k;
+            if (wgrid) SFX(hb_grid_correct)(w, qg, h, k, xk, vk); /* §3.16 friction, then volume */
             REAL vx = vk[0], vy = vk[1], vz = vk[2];
             if (F & HB_F_WIND) {
                 REAL gam = (REAL)1;
@@ -251,7 +277,9 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
                 }
                 if (F & HB_F_SHAPE) SFX(shape_all)(m, p, rest, q, lam_g, F);
                 if (m->lra) SFX(lra_all)(m, p);
-                if (F & HB_F_COLLIDE)
+                if (wcol)
+                    for (int64_t k = 1; k < P; k++) SFX(collide_point)(m, w, pose, back, p + 3 * k, x + 3 * k, k, F);
+                else if (F & HB_F_COLLIDE)
                     for (int64_t k = 1; k < P; k++)
                         if (!PLANT_SKIPPED(k)) SFX(collide_sphere)(p + 3 * k, m->collide_r);
             }
@@ -282,7 +310,8 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
                     nq[2] = pp[2];
                 }
                 for (int c = 0; c < 3; c++) d[3 * k + c] = nq[c] - pk[c];
-                if ((F & HB_F_COLLIDE) && !PLANT_SKIPPED(k)) SFX(collide_sphere)(nq, m->collide_r);
+                if (wcol) SFX(collide_point)(m, w, pose, back, nq, x + 3 * k, k, F);
+                else if ((F & HB_F_COLLIDE) && !PLANT_SKIPPED(k)) SFX(collide_sphere)(nq, m->collide_r);
                 for (int c = 0; c < 3; c++) pk[c] = nq[c];
             }
         }
@@ -302,14 +331,14 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const hb_dyn_frame *fr, R
 }
 
 /* One function per feature set: the switch's constant F specialises frame_body. */
-void SFX(hb_dyn_frame_strand)(const DMODEL *m, const hb_dyn_frame *fr, REAL *x, REAL *v, const REAL *rest,
-                              const REAL *bend_rest, const REAL *seg_rest, REAL *scratch)
+void SFX(hb_dyn_frame_strand)(const DMODEL *m, const WORLD *w, const hb_dyn_frame *fr, int64_t j0, int64_t j1, REAL *x,
+                              REAL *v, const REAL *rest, const REAL *bend_rest, const REAL *seg_rest, REAL *scratch)
 {
 // clang-format off
 #define HB_F_CASE(n)                                                                         \
     case (n):                                                                                \
         if (((n) & HB_F_GUST) && !((n) & HB_F_WIND)) break; /* no gusts without wind */     \
-        SFX(frame_body)(m, fr, x, v, rest, bend_rest, seg_rest, scratch, (n));               \
+        SFX(frame_body)(m, w, fr, j0, j1, x, v, rest, bend_rest, seg_rest, scratch, (n));    \
         break;
 #define HB_F_CASE8(n) HB_F_CASE(n) HB_F_CASE(n + 1) HB_F_CASE(n + 2) HB_F_CASE(n + 3)      \
     HB_F_CASE(n + 4) HB_F_CASE(n + 5) HB_F_CASE(n + 6) HB_F_CASE(n + 7)
@@ -336,7 +365,8 @@ void SFX(hb_dyn_bend_rest)(const DMODEL *m, const REAL *rest, REAL *bend_rest)
 }
 
 /* §3.8 observables of one strand, in double. */
-void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v, const double *seg64, hb_obs_partial *o)
+void SFX(hb_dyn_observe_strand)(const hb_scene *s, const WORLD *w, const REAL *pose, const REAL *x, const REAL *v,
+                                const double *seg64, hb_obs_partial *o)
 {
     const int64_t P = s->points;
     const double ell = hb_segment_length(s), far2 = 4.0 * s->hair_length * s->hair_length;
@@ -352,6 +382,10 @@ void SFX(hb_dyn_observe_strand)(const hb_scene *s, const REAL *x, const REAL *v,
         const double vk[3] = {(double)v[3 * k], (double)v[3 * k + 1], (double)v[3 * k + 2]};
         if (hb_obs_point(xk, xp, x0, vk, seg64 ? seg64[k - 1] : ell, s->dyn.collider, rc, far2, &smax, &pmax, &v2))
             blown = 1;
+        for (int i = 0; w && pose && i < w->ncol; i++) { /* §3.17: the depth in each collider */
+            const double dep = SFX(hb_collider_depth)(w, i, pose + (size_t)i * HB_COL_POSE, xk);
+            if (dep > pmax) pmax = dep;
+        }
     }
     o->stretch_max = smax;
     o->penetration_max = pmax;

@@ -2,7 +2,11 @@
 #undef REAL
 #undef SFX
 #undef DMODEL
+#undef WORLD
 #undef SQRT
 #undef SIN
 #undef QTABLE
 #undef PHASE
+#undef QSTART
+#undef POSES
+#undef BACKS

@@ -4,7 +4,11 @@
 #define REAL float
 #define SFX(name) name##_f32
 #define DMODEL hb_dyn_model_f32
+#define WORLD hb_dyn_world_f32
 #define SQRT sqrtf
 #define SIN sinf
 #define QTABLE(fr) ((fr)->q32)
 #define PHASE(fr) ((fr)->phase32)
+#define QSTART(fr) ((fr)->qs32)
+#define POSES(fr) ((fr)->pose32)
+#define BACKS(fr) ((fr)->back32)

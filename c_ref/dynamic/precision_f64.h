@@ -2,7 +2,11 @@
 #define REAL double
 #define SFX(name) name##_f64
 #define DMODEL hb_dyn_model_f64
+#define WORLD hb_dyn_world_f64
 #define SQRT sqrt
 #define SIN sin
 #define QTABLE(fr) ((fr)->q64)
 #define PHASE(fr) ((fr)->phase64)
+#define QSTART(fr) ((fr)->qs64)
+#define POSES(fr) ((fr)->pose64)
+#define BACKS(fr) ((fr)->back64)

@@ -20,8 +20,17 @@ extern "C" {
 
 typedef struct hb_backend hb_backend;
 
-/* The declared features of docs/model.md §3.14, as a variant's `lacks` names them. */
-enum { HB_X_GUIDES = 1u << 0, HB_X_LRA = 1u << 1, HB_X_SAGFREE = 1u << 2, HB_X_LOD = 1u << 3, HB_X_COUNT = 4 };
+/* The declared features of docs/model.md §3.14, §3.16 and §3.17, as a variant's `lacks` names them. */
+enum {
+    HB_X_GUIDES = 1u << 0,
+    HB_X_LRA = 1u << 1,
+    HB_X_SAGFREE = 1u << 2,
+    HB_X_LOD = 1u << 3,
+    HB_X_GRID = 1u << 4,      /* §3.16 the hair–hair grid */
+    HB_X_COLLIDERS = 1u << 5, /* §3.17 colliders beyond the head sphere */
+    HB_X_FRICTION = 1u << 6,  /* §3.17 friction and a bounded depenetration */
+    HB_X_COUNT = 7
+};
 
 /* One kernel variant of a backend: its name, the stages it runs (bit 1 << hb_stage), a
  * one-line summary, the most points per strand it can simulate (0: no limit), the most

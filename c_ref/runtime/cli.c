@@ -39,7 +39,21 @@ void hb_default_options(hb_options *o)
 }
 
 /* ---- the dynamic model's flags (docs/model.md §3), one table -------------------------- */
-typedef enum { DF_REAL, DF_COUNT, DF_SOLVER, DF_MOTION, DF_SWITCH, DF_FOLLOW, DF_OPTREAL, DF_FLAG } dyn_kind;
+typedef enum {
+    DF_REAL,
+    DF_COUNT,
+    DF_SOLVER,
+    DF_MOTION,
+    DF_SWITCH,
+    DF_FOLLOW,
+    DF_OPTREAL,
+    DF_FLAG,
+    DF_PAIR,    /* A[,B]: two doubles, B = A when omitted */
+    DF_BOX,     /* six doubles X0,Y0,Z0,X1,Y1,Z1 */
+    DF_REBUILD, /* frame | substep */
+    DF_BODY,    /* still | sway */
+    DF_PATH,    /* a file name */
+} dyn_kind;
 typedef struct {
     const char *flag;
     dyn_kind kind;
@@ -78,6 +92,25 @@ static const dyn_flag dyn_flags[] = {
     {"--lra", DF_OPTREAL, DYN(lra_scale), DYN(lra), "long-range attachments |p_k - p_0| <= S k l (S >= 1, default 1)"},
     {"--render-points", DF_COUNT, DYN(render_points), 0,
      "write P_r > P points a strand, a Catmull-Rom spline through the simulated ones; P_r - 1 a multiple of P - 1"},
+    {"--grid", DF_COUNT, DYN(grid_n), DYN(grid), "hair-hair grid of N^3 nodes, 2..512 (docs/model.md §3.16); declares it"},
+    {"--grid-rebuild", DF_REBUILD, DYN(grid_rebuild), 0, "frame | substep: when the grid is built (default frame)"},
+    {"--grid-box", DF_BOX, DYN(grid_box), DYN(grid_box_given),
+     "the grid's box X0,Y0,Z0,X1,Y1,Z1 in the head frame, cm (default: the rest shape's bounds + padding)"},
+    {"--grid-padding", DF_REAL, DYN(grid_padding), 0, "padding b of the derived grid box, cm (default 2)"},
+    {"--grid-friction", DF_PAIR, DYN(grid_friction), DYN(grid_friction_declared),
+     "F[,F_TIP] in [0, 1]: blend toward the grid velocity, root to tip; declares hair-hair friction"},
+    {"--grid-volume", DF_REAL, DYN(grid_volume), DYN(grid_volume_declared),
+     "K, cm²/s²: push down the excess-density gradient; declares the volume term"},
+    {"--colliders", DF_PATH, DYN(colliders_path), 0,
+     "FILE: spheres, capsules, planes and meshes with friction, one a line (docs/model.md §3.17)"},
+    {"--friction", DF_PAIR, DYN(friction), DYN(friction_declared),
+     "MU_S[,MU_K]: the head sphere's Coulomb friction (default: frictionless)"},
+    {"--depenetration-speed", DF_REAL, DYN(depen_speed), DYN(depen_declared),
+     "V, cm/s: a point leaves a collider by at most V*h a substep (default: unbounded)"},
+    {"--body-motion", DF_BODY, DYN(body_motion), 0,
+     "still | sway (along x) | rise (from A_b below, in 1/f_b s): the body frame's motion (default still)"},
+    {"--body-amplitude", DF_REAL, DYN(body_amplitude), 0, "the body's sway or rise A_b, cm (default 2)"},
+    {"--body-frequency", DF_REAL, DYN(body_frequency), 0, "the sway's frequency f_b, Hz, or the rise's 1/duration (default 1)"},
 };
 #undef DYN
 #define N_DYN_FLAGS (sizeof dyn_flags / sizeof dyn_flags[0])
@@ -103,6 +136,11 @@ int hb_dyn_flag_differs(int i, const hb_dynamics *a, const hb_dynamics *b)
     case DF_FOLLOW: return *(const hb_follow *)pa != *(const hb_follow *)pb;
     case DF_OPTREAL: return *(const double *)pa != *(const double *)pb;
     case DF_FLAG: return *(const int *)pa != *(const int *)pb;
+    case DF_PAIR: return memcmp(pa, pb, 2 * sizeof(double)) != 0;
+    case DF_BOX: return memcmp(pa, pb, 6 * sizeof(double)) != 0;
+    case DF_REBUILD:
+    case DF_BODY: return *(const int *)pa != *(const int *)pb;
+    case DF_PATH: return 1; /* a file's contents can change under its name: never taken as the same */
     }
     return 0;
 }
@@ -264,6 +302,11 @@ static int parse_f64(const char *flag, const char *v, double *out, char *err, si
     return 0;
 }
 
+int hb_parse_number(const char *what, const char *v, double *out, char *err, size_t errlen)
+{
+    return parse_f64(what, v, out, err, errlen);
+}
+
 /* "X,Y,Z": three finite decimal numbers. */
 static int parse_vec3(const char *flag, const char *v, double out[3], char *err, size_t errlen)
 {
@@ -279,6 +322,33 @@ static int parse_vec3(const char *flag, const char *v, double out[3], char *err,
         if (parse_f64(flag, item, &out[c], err, errlen)) return -1;
         p = comma ? comma + 1 : p + n;
     }
+    return 0;
+}
+
+/* "A,B,…": exactly n finite decimal numbers (n_min … n_max of them; the rest copy the last). */
+static int parse_list(const char *flag, const char *v, double *out, int n_min, int n_max, char *err, size_t errlen)
+{
+    char item[64];
+    const char *p = v;
+    int n = 0;
+    while (1) {
+        const char *comma = strchr(p, ',');
+        const size_t len = comma ? (size_t)(comma - p) : strlen(p);
+        if (len == 0 || len >= sizeof item || n == n_max) {
+            if (n_min == n_max) FAIL("%s needs %d numbers separated by commas (got '%s')", flag, n_max, v);
+            FAIL("%s needs %d to %d numbers separated by commas (got '%s')", flag, n_min, n_max, v);
+        }
+        memcpy(item, p, len);
+        item[len] = '\0';
+        if (parse_f64(flag, item, &out[n++], err, errlen)) return -1;
+        if (!comma) break;
+        p = comma + 1;
+    }
+    if (n < n_min) {
+        if (n_min == n_max) FAIL("%s needs %d numbers separated by commas (got '%s')", flag, n_max, v);
+        FAIL("%s needs %d to %d numbers separated by commas (got '%s')", flag, n_min, n_max, v);
+    }
+    for (int i = n; i < n_max; i++) out[i] = out[n - 1];
     return 0;
 }
 
@@ -331,6 +401,27 @@ static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err
     case DF_FLAG: *(int *)(base + df->offset) = 1; break;
     case DF_OPTREAL: /* no value: the default stays */
         if (v[0] && parse_f64(df->flag, v, (double *)(base + df->offset), err, errlen)) return -1;
+        break;
+    case DF_PAIR:
+        if (parse_list(df->flag, v, (double *)(base + df->offset), 1, 2, err, errlen)) return -1;
+        break;
+    case DF_BOX:
+        if (parse_list(df->flag, v, (double *)(base + df->offset), 6, 6, err, errlen)) return -1;
+        break;
+    case DF_REBUILD:
+        if (strcmp(v, "frame") == 0) o->scene.dyn.grid_rebuild = HB_GRID_FRAME;
+        else if (strcmp(v, "substep") == 0) o->scene.dyn.grid_rebuild = HB_GRID_SUBSTEP;
+        else FAIL("--grid-rebuild must be frame or substep (got '%s')", v);
+        break;
+    case DF_BODY:
+        if (strcmp(v, "still") == 0) o->scene.dyn.body_motion = HB_BODY_STILL;
+        else if (strcmp(v, "sway") == 0) o->scene.dyn.body_motion = HB_BODY_SWAY;
+        else if (strcmp(v, "rise") == 0) o->scene.dyn.body_motion = HB_BODY_RISE;
+        else FAIL("--body-motion must be still, sway or rise (got '%s')", v);
+        break;
+    case DF_PATH:
+        if (v[0] == '\0') FAIL("%s needs a file name", df->flag);
+        *(const char **)(base + df->offset) = v;
         break;
     }
     if (df->declares) *(int *)(base + df->declares) = 1;
@@ -564,6 +655,19 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         FAIL("--sag-free needs --shape-compliance (it moves the shape targets)");
     if (o->scene.dyn.shape == 0 && (o->dyn_given & (1ull << hb_dyn_flag_index("--shape-range"))))
         FAIL("--shape-range needs --shape-compliance (shape is off unless its compliance is given)");
+    {
+        static const char *const needs_grid[] = {"--grid-rebuild", "--grid-box", "--grid-padding", "--grid-friction",
+                                                 "--grid-volume"};
+        for (size_t i = 0; i < sizeof needs_grid / sizeof needs_grid[0]; i++)
+            if (!o->scene.dyn.grid && (o->dyn_given & (1ull << hb_dyn_flag_index(needs_grid[i]))))
+                FAIL("%s needs --grid N (the hair-hair grid is off unless its size is given)", needs_grid[i]);
+        static const char *const needs_body[] = {"--body-amplitude", "--body-frequency"};
+        for (size_t i = 0; i < sizeof needs_body / sizeof needs_body[0]; i++)
+            if (o->scene.dyn.body_motion == HB_BODY_STILL && (o->dyn_given & (1ull << hb_dyn_flag_index(needs_body[i]))))
+                FAIL("%s needs --body-motion sway or rise", needs_body[i]);
+        if (o->scene.dyn.friction_declared && !o->scene.dyn.collider)
+            FAIL("--friction is the head sphere's friction, and --no-collider removes the head sphere");
+    }
     return 0;
 }
 

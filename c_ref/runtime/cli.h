@@ -23,6 +23,9 @@ const char *hb_dyn_flag_name(int i);
 int hb_dyn_flag_index(const char *flag);
 /* Whether the field of flag i differs between a and b. */
 int hb_dyn_flag_differs(int i, const hb_dynamics *a, const hb_dynamics *b);
+/* A number in the command line's grammar (docs/interfaces.md, "Numbers"): 0, or −1 with one
+ * line naming `what` in err. */
+int hb_parse_number(const char *what, const char *v, double *out, char *err, size_t errlen);
 
 #ifdef __cplusplus
 }

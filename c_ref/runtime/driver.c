@@ -14,6 +14,7 @@
 #include "runtime/groom.h"
 #include "dynamic/dyn_followers.h"
 #include "dynamic/dyn_lod.h"
+#include "dynamic/world.h"
 #include "runtime/host.h"
 #include "runtime/philox.h"
 #include "runtime/record.h"
@@ -75,17 +76,22 @@ static int self_test_rng(void)
     return failed ? 1 : 0;
 }
 
-/* The §3.14 features by HB_X_* bit: the name --list-variants gives, the flag that declares it. */
+/* The §3.14, §3.16, §3.17 features by HB_X_* bit: the name --list-variants gives, the flag that declares it. */
 static const struct {
     const char *name, *flag;
 } x_features[HB_X_COUNT] = {
-    {"guides", "--guides"}, {"lra", "--lra"}, {"sagfree", "--sag-free"}, {"lod", "--render-points"}};
+    {"guides", "--guides"}, {"lra", "--lra"},           {"sagfree", "--sag-free"},
+    {"lod", "--render-points"}, {"grid", "--grid"},  {"colliders", "--colliders"},
+    {"friction", "--friction or --depenetration-speed"}};
 
 /* The §3.14 features a scene declares, HB_X_* bits. */
 static unsigned x_declared(const hb_dynamics *d)
 {
+    int friction = d->friction_declared || d->depen_declared;
+    for (int i = 0; d->cols && i < d->cols->n; i++) friction |= d->cols->c[i].mu_s > 0.0;
     return (d->guided ? HB_X_GUIDES : 0u) | (d->lra ? HB_X_LRA : 0u) | (d->sag_free ? HB_X_SAGFREE : 0u) |
-           (d->render_points ? HB_X_LOD : 0u);
+           (d->render_points ? HB_X_LOD : 0u) | (d->grid ? HB_X_GRID : 0u) | (d->colliders_path ? HB_X_COLLIDERS : 0u) |
+           (friction ? HB_X_FRICTION : 0u);
 }
 
 /* A JSON list of the solvers in the bit set `set` (bit 1 << hb_solver), after `key`. */
@@ -144,7 +150,7 @@ static int list_variants(const hb_backend *b)
         hb_dyn_feature_names(1u << i, name, sizeof name);
         printf("%s\"%s\"", i ? ", " : "", name);
     }
-    printf(", \"guides\", \"lra\", \"sagfree\", \"lod\"]}\n"); /* §3.14's, declared by their own flags */
+    printf(", \"guides\", \"lra\", \"sagfree\", \"lod\", \"grid\", \"colliders\", \"friction\"]}\n"); /* §3.14, §3.16, §3.17's */
     return HB_EXIT_OK;
 }
 
@@ -222,12 +228,13 @@ typedef struct {
     void *render, *vrender, *vhost; /* --render-points: a rendered frame and its velocities; simulated velocities */
     hb_input in;
     int have_input;
-    hb_groom groom; /* --groom: what init places (docs/model.md §3.15) */
-    double *times;  /* all stages' timed runs */
+    hb_groom groom;    /* --groom: what init places (docs/model.md §3.15) */
+    hb_colliders cols; /* --colliders (docs/model.md §3.17) */
+    double *times;     /* all stages' timed runs */
     struct {        /* the simulation, for the file's /parameters */
         int dynamic;
         int64_t paper_frames, last_frame;
-        char features[96];
+        char features[192];
     } sim;
 } hb_run;
 
@@ -236,6 +243,7 @@ static void run_free(hb_run *r)
     if (r->w) hb_writer_abort(r->w);
     if (r->have_input) hb_input_close(&r->in);
     hb_groom_free(&r->groom);
+    hb_colliders_free(&r->cols);
     if (r->b->teardown) r->b->teardown(r->b);
     free(r->host);
     free(r->input);
@@ -307,7 +315,7 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         snprintf(err, errlen, "out of host memory for the rendering times");
         FAIL_IF(1, HB_EXIT_MEMORY);
     }
-    if (!rest || hb_dyn_frame_alloc(&plan, d->substeps) != 0) {
+    if (!rest || hb_dyn_frame_alloc(&plan, d->substeps) != 0 || hb_dyn_frame_alloc_world(&plan, s) != 0) {
         snprintf(err, errlen, "out of host memory for the simulation's rest shape and substep tables");
         FAIL_IF(1, HB_EXIT_MEMORY);
     }
@@ -439,7 +447,10 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
         }
         plans = calloc((size_t)o->frames, sizeof *plans);
         for (int64_t j = 0; plans && j < o->frames; j++) {
-            if (hb_dyn_frame_alloc(&plans[j], d->substeps) != 0) break;
+            if (hb_dyn_frame_alloc(&plans[j], d->substeps) != 0 || hb_dyn_frame_alloc_world(&plans[j], s) != 0) {
+                hb_dyn_frame_free(&plans[j]);
+                break;
+            }
             n_plans = j + 1;
             hb_dyn_frame_plan(s, (gf0 + o->frames + j) * d->substeps, &plans[j]);
         }
@@ -660,6 +671,10 @@ static int run_one(int argc, char **argv, hb_backend *b)
             }
     }
     if (o.groom) CHECK(check_groom(&o, &run.groom, err, sizeof err), HB_EXIT_USAGE);
+    if (o.scene.dyn.colliders_path && !o.scene.dyn.cols) { /* docs/model.md §3.17 (a resumed run has the file's) */
+        CHECK(hb_colliders_load(o.scene.dyn.colliders_path, &run.cols, err, sizeof err), HB_EXIT_USAGE);
+        o.scene.dyn.cols = &run.cols;
+    }
     if (!o.input && o.stages[0] != HB_STAGE_INIT) {
         snprintf(err, sizeof err, "--stages: '%s' needs a state: list init first or give --input",
                  hb_stage_name(o.stages[0]));
@@ -704,6 +719,10 @@ static int run_one(int argc, char **argv, hb_backend *b)
                      "--block-size %d: the %s variant %s simulates with at most %d threads a block (see "
                      "--list-variants)",
                      o.block_size, b->name, var->name, var->max_block);
+            CHECK(1, HB_EXIT_USAGE);
+        }
+        if (o.frame_loop && (o.scene.dyn.grid || hb_dyn_has_world(&o.scene))) {
+            snprintf(err, sizeof err, "--frame-loop does not yet loop over the grid and colliders (docs/model.md §3.16, §3.17)");
             CHECK(1, HB_EXIT_USAGE);
         }
         if (o.frame_loop && !b->dyn_loop) {

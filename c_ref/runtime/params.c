@@ -146,6 +146,10 @@ void hb_dynamics_defaults(hb_dynamics *d)
     d->motion_frequency = 1.0;
     d->follow = HB_FOLLOW_BLEND3;
     d->lra_scale = 1.0;
+    d->grid_n = 32;
+    d->grid_padding = 2.0;
+    d->body_amplitude = 2.0;
+    d->body_frequency = 1.0;
 }
 
 int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
@@ -169,6 +173,11 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
         {"--gust-wavelength", d->gust_wavelength, 1},
         {"--motion-amplitude", d->motion_amplitude, 0},
         {"--motion-frequency", d->motion_frequency, 0},
+        {"--grid-padding", d->grid_padding, 0},
+        {"--grid-volume", d->grid_volume, 0},
+        {"--depenetration-speed", d->depen_speed, 0},
+        {"--body-amplitude", d->body_amplitude, 0},
+        {"--body-frequency", d->body_frequency, 0},
     };
     for (size_t i = 0; i < sizeof nonneg / sizeof nonneg[0]; i++) {
         double v = nonneg[i].v;
@@ -187,6 +196,21 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
         FAIL("--guides must be a fraction in (0, 1] or a whole count > 1 (got %g)", d->guides);
     if (d->lra && !(isfinite(d->lra_scale) && d->lra_scale >= 1.0))
         FAIL("--lra scale must be a finite number >= 1 (got %g)", d->lra_scale);
+    if (d->grid && (d->grid_n < 2 || d->grid_n > 512))
+        FAIL("--grid must be from 2 to 512 nodes per axis (got %lld)", (long long)d->grid_n);
+    if (d->grid_box_given)
+        for (int c = 0; c < 3; c++)
+            if (!(d->grid_box[c] < d->grid_box[c + 3]))
+                FAIL("--grid-box needs X0 < X1, Y0 < Y1 and Z0 < Z1 (got %g >= %g on axis %c)", d->grid_box[c],
+                     d->grid_box[c + 3], "xyz"[c]);
+    for (int c = 0; c < 2; c++)
+        if (!(d->grid_friction[c] >= 0.0 && d->grid_friction[c] <= 1.0))
+            FAIL("--grid-friction must be in [0, 1] (got %g)", d->grid_friction[c]);
+    if (!(d->friction[0] >= 0.0 && d->friction[1] >= 0.0 && d->friction[1] <= d->friction[0] &&
+          isfinite(d->friction[0])))
+        FAIL("--friction needs 0 <= MU_K <= MU_S, finite (got %g,%g)", d->friction[0], d->friction[1]);
+    if (d->depen_declared && !(d->depen_speed > 0.0))
+        FAIL("--depenetration-speed must be > 0 (got %g)", d->depen_speed);
     /* h = Δt/S and α/h² must stay normal numbers in double */
     const double h = d->frame_dt / (double)d->substeps;
     if (!(h >= 1e-12 && h <= 1e3))
@@ -228,6 +252,9 @@ int hb_dynamics_validate_scene(const hb_scene *s, char *err, size_t errlen)
     const int shape = d->shape && floor(d->shape_range * (double)(s->points - 1)) >= 1.0; /* K ≥ 1 */
     const double hi = length_max(p);
     const double rc = s->head_radius + d->collision_margin;
+    if (d->grid && (uint64_t)s->n_strands * (uint64_t)s->points > (UINT64_C(1) << 31))
+        FAIL("--grid: --strands x --points must be at most 2^31 points, the bound that keeps the grid's fixed-point "
+             "sums from overflowing (docs/model.md §3.16)");
     /* the largest acceleration of the velocity step, c_d·U·(1 + A_g) for the wind's share */
     const double wind_a = wind ? d->drag * d->wind_speed * (1.0 + (gust ? d->gust_amplitude : 0.0)) : 0.0;
     const struct {

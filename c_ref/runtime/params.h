@@ -58,7 +58,30 @@ typedef struct {
     int sag_free;          /* --sag-free: shape targets that hold the rest shape against gravity */
     int64_t render_points; /* --render-points P_r: strands written with P_r points (§3.14); 0: as simulated */
     int per_segment;       /* §3.15: stretch rest lengths per segment from X̄ (a groom), not ℓ = L/(P−1) */
+    /* §3.16 the hair–hair grid (run-time switches: not among the compiled feature sets) */
+    int grid;                   /* --grid given */
+    int64_t grid_n;             /* n_g, nodes per axis */
+    int grid_rebuild;           /* hb_grid_rebuild */
+    int grid_box_given;         /* --grid-box given, else derived from the rest shape */
+    double grid_box[6];         /* lo x, y, z, hi x, y, z in the head frame, cm */
+    double grid_padding;        /* b, cm */
+    int grid_friction_declared; /* --grid-friction given */
+    double grid_friction[2];    /* f_r, f_t in [0, 1] */
+    int grid_volume_declared;   /* --grid-volume given */
+    double grid_volume;         /* K_v, cm²/s² */
+    /* §3.17 colliders and friction */
+    const char *colliders_path;       /* --colliders FILE (NULL: none) */
+    const struct hb_colliders *cols;  /* the loaded colliders (runtime/colliders.c), NULL: none */
+    int friction_declared;            /* --friction given: the head sphere's friction */
+    double friction[2];               /* μ_s, μ_k of the head sphere */
+    int depen_declared;               /* --depenetration-speed given */
+    double depen_speed;               /* V, cm/s */
+    int body_motion;                  /* hb_body_motion */
+    double body_amplitude, body_frequency; /* A_b (cm), f_b (Hz) */
 } hb_dynamics;
+
+typedef enum { HB_GRID_FRAME = 0, HB_GRID_SUBSTEP = 1 } hb_grid_rebuild;
+typedef enum { HB_BODY_STILL = 0, HB_BODY_SWAY = 1, HB_BODY_RISE = 2 } hb_body_motion;
 
 /* The scene: everything that decides the bits of a state. */
 typedef struct {

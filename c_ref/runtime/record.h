@@ -22,7 +22,7 @@ typedef struct {
     /* simulate: frames advanced (the times are per frame), the features compiled in, the
      * last frame's observables and the frames that blew up */
     int64_t frames;
-    char features[96];
+    char features[192];
     hb_observables last;
     int64_t blown_frames;
     double observe_ms;             /* computing the observables, all frames, apart from the frame times */

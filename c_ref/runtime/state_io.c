@@ -85,6 +85,16 @@ static int attr_vec3(hid_t loc, const char *name, const double v[3])
     return rc < 0 ? -1 : 0;
 }
 
+static int attr_f64v(hid_t loc, const char *name, const double *v, hsize_t n)
+{
+    hid_t sp = H5Screate_simple(1, &n, NULL);
+    hid_t a = sp < 0 ? -1 : H5Acreate2(loc, name, H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = a < 0 ? -1 : H5Awrite(a, H5T_NATIVE_DOUBLE, v);
+    if (a >= 0) H5Aclose(a);
+    if (sp >= 0) H5Sclose(sp);
+    return rc < 0 ? -1 : 0;
+}
+
 static int ds_1d(hid_t loc, const char *name, hid_t file_type, hid_t mem_type, hsize_t n, const void *v)
 {
     hid_t sp = H5Screate_simple(1, &n, NULL);
@@ -452,6 +462,66 @@ static int write_lod(hb_writer *w, hid_t p)
     return bad ? -1 : 0;
 }
 
+/* §3.16 the grid's and §3.17 the colliders' parameters (docs/interfaces.md): attributes, and the
+ * colliders as /parameters/colliders [n][HB_COLLIDER_ROW] with each mesh's SDF beside it. */
+#define HB_COLLIDER_ROW 13 /* kind, frame, g[7], mu_s, mu_k, sdf_n, band */
+static int write_world(hid_t p, const hb_dynamics *d)
+{
+    int bad = attr_i64(p, "grid", d->grid) < 0;
+    if (d->grid) {
+        bad |= attr_i64(p, "grid_n", d->grid_n) < 0;
+        bad |= attr_str(p, "grid_rebuild", d->grid_rebuild == HB_GRID_SUBSTEP ? "substep" : "frame") < 0;
+        bad |= attr_i64(p, "grid_box_given", d->grid_box_given) < 0;
+        bad |= attr_f64v(p, "grid_box", d->grid_box, 6) < 0;
+        bad |= attr_f64(p, "grid_padding", d->grid_padding) < 0;
+        bad |= attr_i64(p, "grid_friction_declared", d->grid_friction_declared) < 0;
+        bad |= attr_f64v(p, "grid_friction", d->grid_friction, 2) < 0;
+        bad |= attr_i64(p, "grid_volume_declared", d->grid_volume_declared) < 0;
+        bad |= attr_f64(p, "grid_volume", d->grid_volume) < 0;
+    }
+    bad |= attr_i64(p, "friction_declared", d->friction_declared) < 0;
+    bad |= attr_f64v(p, "friction", d->friction, 2) < 0;
+    bad |= attr_i64(p, "depenetration_declared", d->depen_declared) < 0;
+    bad |= attr_f64(p, "depenetration_speed", d->depen_speed) < 0;
+    bad |= attr_str(p, "body_motion",
+                    d->body_motion == HB_BODY_SWAY   ? "sway"
+                    : d->body_motion == HB_BODY_RISE ? "rise"
+                                                     : "still") < 0;
+    bad |= attr_f64(p, "body_amplitude", d->body_amplitude) < 0;
+    bad |= attr_f64(p, "body_frequency", d->body_frequency) < 0;
+    const hb_colliders *c = d->cols;
+    bad |= attr_i64(p, "colliders", c ? c->n : 0) < 0;
+    if (!c || c->n == 0 || bad) return bad ? -1 : 0;
+    if (d->colliders_path) bad |= attr_str(p, "colliders_file", d->colliders_path) < 0;
+    double rows[HB_MAX_COLLIDERS * HB_COLLIDER_ROW];
+    for (int i = 0; i < c->n; i++) {
+        const hb_collider *k = &c->c[i];
+        double *r = rows + i * HB_COLLIDER_ROW;
+        r[0] = k->kind, r[1] = k->frame;
+        memcpy(r + 2, k->g, 7 * sizeof *r);
+        r[9] = k->mu_s, r[10] = k->mu_k, r[11] = (double)k->sdf_n, r[12] = (double)k->band;
+    }
+    const hsize_t dims[2] = {(hsize_t)c->n, HB_COLLIDER_ROW};
+    hid_t sp = H5Screate_simple(2, dims, NULL);
+    hid_t ds = sp < 0 ? -1 : H5Dcreate2(p, "colliders", H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    bad |= ds < 0 || H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) < 0;
+    if (ds >= 0) H5Dclose(ds);
+    if (sp >= 0) H5Sclose(sp);
+    for (int i = 0; i < c->n && !bad; i++) {
+        const hb_collider *k = &c->c[i];
+        if (!k->sdf) continue;
+        char name[64];
+        snprintf(name, sizeof name, "collider_sdf_%d", i);
+        const hsize_t n = (hsize_t)(k->sdf_n * k->sdf_n * k->sdf_n);
+        bad |= ds_1d(p, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, k->sdf) < 0;
+        hid_t a = bad ? -1 : H5Dopen2(p, name, H5P_DEFAULT);
+        bad |= a < 0 || attr_vec3(a, "lo", k->sdf_lo) < 0 || attr_f64(a, "spacing", k->sdf_h) < 0 ||
+               attr_str(a, "source", k->source) < 0;
+        if (a >= 0) H5Dclose(a);
+    }
+    return bad ? -1 : 0;
+}
+
 /* The dynamic model's datasets and parameters (docs/interfaces.md, "dynamic files"). */
 static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
 {
@@ -476,6 +546,7 @@ static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
     bad |= attr_i64(p, "per_segment", d->per_segment) < 0; /* §3.15 */
     if (d->render_points) bad |= write_lod(w, p) < 0;
     if (d->guided) bad |= attr_str(p, "follow", hb_follow_name(d->follow)) < 0;
+    bad |= write_world(p, d) < 0; /* §3.16, §3.17 */
     const struct {
         const char *name;
         double v;
@@ -746,6 +817,7 @@ static int read_frames_str(hid_t p, const char *name, hsize_t F, hb_frame_meta *
 
 void hb_input_close(hb_input *in)
 {
+    hb_colliders_free(&in->cols);
     if (in->hid > 0) H5Fclose((hid_t)in->hid);
     in->hid = 0;
     free(in->frames);
@@ -797,6 +869,110 @@ static int check_rows(hid_t f, const char *path, int rank, uint64_t rows, hb_pre
     H5Sclose(sp);
     H5Dclose(d);
     return ok ? 0 : -1;
+}
+
+static int read_attr_f64v(hid_t loc, const char *name, double *v, hssize_t n)
+{
+    if (H5Aexists(loc, name) <= 0) return -1;
+    hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+    if (a < 0) return -1;
+    hid_t sp = H5Aget_space(a);
+    int ok = H5Sget_simple_extent_npoints(sp) == n && H5Aread(a, H5T_NATIVE_DOUBLE, v) >= 0;
+    H5Sclose(sp);
+    H5Aclose(a);
+    return ok ? 0 : -1;
+}
+
+/* §3.16–3.17 from an --input file (absent in files written before them: none). */
+static int input_world(hb_input *in, const char *path, hid_t p, char *err, size_t errlen)
+{
+    hb_dynamics *d = &in->scene.dyn;
+    int64_t v = 0, nc = 0;
+    char word[16] = "";
+#define BAD(what) return snprintf(err, errlen, "--input %s: /parameters has a bad or missing %s", path, what), -1
+    if (read_attr(p, "grid", H5T_NATIVE_INT64, &v) == 0 && v) {
+        d->grid = 1;
+        int64_t given = 0, fr = 0, vol = 0;
+        if (read_attr(p, "grid_n", H5T_NATIVE_INT64, &d->grid_n) < 0) BAD("grid_n");
+        if (read_attr_str(p, "grid_rebuild", word, sizeof word) < 0 ||
+            (strcmp(word, "frame") != 0 && strcmp(word, "substep") != 0))
+            BAD("grid_rebuild");
+        d->grid_rebuild = strcmp(word, "substep") == 0 ? HB_GRID_SUBSTEP : HB_GRID_FRAME;
+        if (read_attr(p, "grid_box_given", H5T_NATIVE_INT64, &given) < 0 || read_attr_f64v(p, "grid_box", d->grid_box, 6) < 0 ||
+            read_attr(p, "grid_padding", H5T_NATIVE_DOUBLE, &d->grid_padding) < 0)
+            BAD("grid box");
+        if (read_attr(p, "grid_friction_declared", H5T_NATIVE_INT64, &fr) < 0 ||
+            read_attr_f64v(p, "grid_friction", d->grid_friction, 2) < 0 ||
+            read_attr(p, "grid_volume_declared", H5T_NATIVE_INT64, &vol) < 0 ||
+            read_attr(p, "grid_volume", H5T_NATIVE_DOUBLE, &d->grid_volume) < 0)
+            BAD("grid friction or volume");
+        d->grid_box_given = given != 0, d->grid_friction_declared = fr != 0, d->grid_volume_declared = vol != 0;
+    }
+    if (read_attr(p, "friction_declared", H5T_NATIVE_INT64, &v) == 0 && v) {
+        d->friction_declared = 1;
+        if (read_attr_f64v(p, "friction", d->friction, 2) < 0) BAD("friction");
+    }
+    if (read_attr(p, "depenetration_declared", H5T_NATIVE_INT64, &v) == 0 && v) {
+        d->depen_declared = 1;
+        if (read_attr(p, "depenetration_speed", H5T_NATIVE_DOUBLE, &d->depen_speed) < 0) BAD("depenetration_speed");
+    }
+    if (read_attr_str(p, "body_motion", word, sizeof word) == 0) {
+        if (strcmp(word, "sway") == 0) d->body_motion = HB_BODY_SWAY;
+        else if (strcmp(word, "rise") == 0) d->body_motion = HB_BODY_RISE;
+        else if (strcmp(word, "still") != 0) BAD("body_motion");
+        if (read_attr(p, "body_amplitude", H5T_NATIVE_DOUBLE, &d->body_amplitude) < 0 ||
+            read_attr(p, "body_frequency", H5T_NATIVE_DOUBLE, &d->body_frequency) < 0)
+            BAD("body sway");
+    }
+    if (read_attr(p, "colliders", H5T_NATIVE_INT64, &nc) < 0 || nc == 0) return 0;
+    if (nc < 0 || nc > HB_MAX_COLLIDERS) BAD("colliders count");
+    double rows[HB_MAX_COLLIDERS * HB_COLLIDER_ROW];
+    hid_t ds = H5Dopen2(p, "colliders", H5P_DEFAULT);
+    hid_t sp = ds < 0 ? -1 : H5Dget_space(ds);
+    hsize_t dims[2] = {0, 0};
+    const int ok = sp >= 0 && H5Sget_simple_extent_ndims(sp) == 2 && H5Sget_simple_extent_dims(sp, dims, NULL) == 2 &&
+                   dims[0] == (hsize_t)nc && dims[1] == HB_COLLIDER_ROW &&
+                   H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) >= 0;
+    if (sp >= 0) H5Sclose(sp);
+    if (ds >= 0) H5Dclose(ds);
+    if (!ok) BAD("colliders dataset");
+    hb_colliders *c = &in->cols;
+    for (int i = 0; i < (int)nc; i++) {
+        hb_collider *k = &c->c[i];
+        const double *r = rows + i * HB_COLLIDER_ROW;
+        memset(k, 0, sizeof *k);
+        k->kind = (int)r[0], k->frame = (int)r[1];
+        memcpy(k->g, r + 2, 7 * sizeof *r);
+        k->mu_s = r[9], k->mu_k = r[10], k->sdf_n = (int64_t)r[11], k->band = (int64_t)r[12];
+        c->n = i + 1;
+        if (!(k->kind >= HB_COL_SPHERE && k->kind <= HB_COL_MESH && (k->frame == 0 || k->frame == 1) &&
+              k->mu_s >= 0.0 && k->mu_k >= 0.0 && k->mu_k <= k->mu_s))
+            BAD("collider row");
+        if (k->kind != HB_COL_MESH) continue;
+        char name[64];
+        snprintf(name, sizeof name, "collider_sdf_%d", i);
+        if (!(k->sdf_n >= 8 && k->sdf_n <= 512)) BAD("mesh SDF size");
+        const int64_t n3 = k->sdf_n * k->sdf_n * k->sdf_n;
+        hid_t m = H5Dopen2(p, name, H5P_DEFAULT);
+        hid_t ms = m < 0 ? -1 : H5Dget_space(m);
+        k->sdf = malloc((size_t)n3 * sizeof *k->sdf);
+        const int good = ms >= 0 && k->sdf && H5Sget_simple_extent_npoints(ms) == n3 &&
+                         H5Dread(m, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, k->sdf) >= 0 &&
+                         read_attr_f64v(m, "lo", k->sdf_lo, 3) == 0 &&
+                         read_attr(m, "spacing", H5T_NATIVE_DOUBLE, &k->sdf_h) == 0 &&
+                         read_attr_str(m, "source", k->source, sizeof k->source) == 0;
+        if (ms >= 0) H5Sclose(ms);
+        if (m >= 0) H5Dclose(m);
+        if (!good || !(k->sdf_h > 0.0)) BAD(name);
+        for (int64_t j = 0; j < n3; j++)
+            if (!isfinite(k->sdf[j])) BAD(name);
+    }
+    if (read_attr_str(p, "colliders_file", in->colliders_file, sizeof in->colliders_file) < 0)
+        snprintf(in->colliders_file, sizeof in->colliders_file, "%s", path);
+    d->cols = c;
+    d->colliders_path = in->colliders_file;
+#undef BAD
+    return 0;
 }
 
 /* The dynamic part of an --input file (docs/interfaces.md, "dynamic files"). */
@@ -876,6 +1052,7 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
             return snprintf(err, errlen, "--input %s: /parameters has lra = 1 but lacks lra_scale", path), -1;
         d->lra = 1;
     }
+    if (input_world(in, path, p, err, errlen)) return -1;
     d->bend = bend != 0;
     d->shape = shape != 0;
     d->collider = collider != 0;

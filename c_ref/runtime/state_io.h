@@ -78,6 +78,9 @@ typedef struct {
     hb_observables *obs;
     int64_t *obs_step;
     double *obs_time;
+    /* §3.17 a dynamic file's colliders (scene.dyn.cols points here) and their file's name */
+    hb_colliders cols;
+    char colliders_file[1024];
 } hb_input;
 
 /* Opens and checks the layout and the scene; one line in err on failure. */

@@ -41,6 +41,13 @@ from harness.core.guides import guide_count, guide_strands
 from harness.io.states import State, as_text
 
 
+def collider_depths(traj, points, t):
+    """Each point's depth in each collider of §3.17 (harness.check.colliders), [ncol][M]."""
+    from harness.check.colliders import depths
+
+    return depths(traj, points, t)
+
+
 @dataclass
 class DynamicReport:
     path: str
@@ -118,9 +125,10 @@ def expected_roots(traj, f, rest_roots):
     return out
 
 
-def observe(traj, x, v=None):
-    """§3.8 recomputed in double from stored positions x [N][P][3] (and velocities v):
-    (stretch_max, penetration_max, kinetic_energy or None, blown-up count)."""
+def observe(traj, x, v=None, t=None):
+    """§3.8 recomputed in double from stored positions x [N][P][3] (and velocities v) at time t
+    (the colliders' poses, §3.17): (stretch_max, penetration_max, kinetic_energy or None,
+    blown-up count)."""
     N, P = traj.n_strands, traj.points
     ell = traj.segment_rest()
     xd = x.astype(np.float64)
@@ -134,6 +142,9 @@ def observe(traj, x, v=None):
             n2 = (xd[:, 1:, 0] * xd[:, 1:, 0] + xd[:, 1:, 1] * xd[:, 1:, 1]) + xd[:, 1:, 2] * xd[:, 1:, 2]
             depth = traj.collide_radius - np.sqrt(n2)
             pen = float(np.max(depth, initial=0.0, where=~np.isnan(depth)))
+        if traj.colliders and t is not None:  # §3.17: each collider's depth
+            d = collider_depths(traj, xd[:, 1:, :], t)
+            pen = max(pen, float(np.max(d, initial=0.0, where=~np.isnan(d))))
         r = xd[:, 1:, :] - xd[:, :1, :]
         r2 = (r[..., 0] * r[..., 0] + r[..., 1] * r[..., 1]) + r[..., 2] * r[..., 2]
         far = np.any(r2 > 4.0 * traj.hair_length * traj.hair_length, axis=1)
@@ -257,7 +268,10 @@ def check(traj, exact=True, frames=None, paper=True):
         xd = x.astype(np.float64)
         with np.errstate(invalid="ignore", over="ignore"):
             r = np.sqrt((xd[:, :, 0] * xd[:, :, 0] + xd[:, :, 1] * xd[:, :, 1]) + xd[:, :, 2] * xd[:, :, 2])
-            if traj.collider:
+            # with §3.17's colliders a later collider may push a point back into the head, and a
+            # bounded depenetration leaves it inside on purpose: the bound holds without them
+            bounded = int(traj.dynamic_params.get("depenetration_declared", 0))
+            if traj.collider and not traj.colliders and not bounded:
                 bound(
                     f,
                     "collider",
@@ -274,6 +288,9 @@ def check(traj, exact=True, frames=None, paper=True):
                 free = np.ones_like(err, dtype=bool)
                 if traj.collider:
                     free = r[:, 1:] > rc + pen_allow  # the collider did not move point k
+                if traj.colliders:  # §3.17: nor any other collider (a point in contact, where friction acts too)
+                    d = collider_depths(traj, xd[:, 1:, :], frame_end_time(traj, f))
+                    free &= ~np.any(np.nan_to_num(d, nan=-np.inf) > -pen_allow, axis=0).reshape(free.shape)
                 err = np.where(free, err, 0.0)
                 if traj.guided:  # §3.14: followers are placed, not followed; only guides hold ℓ
                     g = guide_count(traj.n_strands, float(traj.dynamic_params["guides"]))
@@ -292,7 +309,7 @@ def check(traj, exact=True, frames=None, paper=True):
             add(f, "observables", 1, 0, "no observables row for this step")
             continue
         row = obs.loc[step]
-        stretch, pen, ke, blown = observe(traj, x, v)
+        stretch, pen, ke, blown = observe(traj, x, v, frame_end_time(traj, f))
         msgs = []
         # the reference computes both exactly as observe() does; another build may contract
         # or reorder the double sums: DYN_OBSERVABLE_K·ε64 of the quantity's scale

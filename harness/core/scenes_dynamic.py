@@ -31,6 +31,20 @@ A scene with `model = "dynamic"` may hold, besides the paper keys:
     motion = "nod"             # still | nod | shake | tilt   --head-motion
     motion_amplitude = 0.25    # A ≥ 0 (rad)    --motion-amplitude
     motion_frequency = 1.0     # f ≥ 0 (Hz)     --motion-frequency
+    [grid]                     # the hair–hair grid (§3.16); a table declares it
+    nodes = 32                 # n_g in 2 … 512 --grid
+    rebuild = "frame"          # frame | substep  --grid-rebuild
+    box = [x0, y0, z0, x1, y1, z1]  # cm, head frame  --grid-box (default: the rest shape's bounds)
+    padding = 2.0              # b ≥ 0 (cm)     --grid-padding
+    friction = [0.05, 0.01]    # f_r[, f_t] in [0, 1]  --grid-friction
+    volume = 2000.0            # K_v ≥ 0 (cm²/s²)  --grid-volume
+    [body]                     # colliders and friction (§3.17)
+    colliders = "FILE"         # relative to the scene file's folder  --colliders
+    friction = [0.3, 0.2]      # the head sphere's μ_s[, μ_k]  --friction
+    depenetration_speed = 200  # V > 0 (cm/s)   --depenetration-speed
+    motion = "rise"            # still | sway | rise  --body-motion
+    amplitude = 20.0           # A_b ≥ 0 (cm)   --body-amplitude
+    frequency = 2.0            # f_b ≥ 0 (Hz)   --body-frequency
 
 A key left out is not passed, so the binary's default (docs/model.md §3) applies. Unknown
 keys, wrong types, NaN/∞ and values out of range are refused naming the key; the dynamic
@@ -38,6 +52,7 @@ keys in a scene whose model is not "dynamic" are refused too.
 """
 
 import math
+import os
 
 DEFAULT_STAGES = ("init", "collide", "simulate")
 SOLVERS = ("xpbd", "ftl", "rigid")  # rigid: no dynamics (docs/model.md §3.13)
@@ -65,6 +80,22 @@ TABLES = {
         "collision_margin": ("--collision-margin", "nonneg"),
         "collider": ("--no-collider", "bool"),
     },
+    "grid": {
+        "nodes": ("--grid", "count"),
+        "rebuild": ("--grid-rebuild", ("frame", "substep")),
+        "box": ("--grid-box", "box"),
+        "padding": ("--grid-padding", "nonneg"),
+        "friction": ("--grid-friction", "pair_unit"),
+        "volume": ("--grid-volume", "nonneg"),
+    },
+    "body": {
+        "colliders": ("--colliders", "path"),
+        "friction": ("--friction", "pair"),
+        "depenetration_speed": ("--depenetration-speed", "pos"),
+        "motion": ("--body-motion", ("still", "sway", "rise")),
+        "amplitude": ("--body-amplitude", "nonneg"),
+        "frequency": ("--body-frequency", "nonneg"),
+    },
 }
 # dynamic keys inside the paper model's [wind] and [head] tables
 SHARED = {
@@ -84,6 +115,26 @@ MAX_COUNT = 10**6  # the binaries' bound on S and I (docs/model.md §3)
 
 
 def _value(where, key, kind, value, error):
+    if kind == "path":
+        if not isinstance(value, str) or not value:
+            raise error(f"{where}: {key} must be a file name, got {value!r}")
+        return value
+    if kind in ("box", "pair", "pair_unit"):
+        items = value if isinstance(value, list) else [value]
+        n = (6, 6) if kind == "box" else (1, 2)
+        if not n[0] <= len(items) <= n[1]:
+            raise error(f"{where}: {key} must be {'6 numbers' if kind == 'box' else 'a number or 2 numbers'}, got {value!r}")
+        part = "nonneg" if kind == "pair" else "unit" if kind == "pair_unit" else None
+        for x in items:
+            if part:
+                _value(where, key, part, x, error)
+            else:  # a box: any finite number
+                _value(where, key, "real", x, error)
+        if kind == "box" and not all(items[i] < items[i + 3] for i in range(3)):
+            raise error(f"{where}: {key} needs x0 < x1, y0 < y1 and z0 < z1, got {value!r}")
+        if kind == "pair" and len(items) == 2 and items[1] > items[0]:
+            raise error(f"{where}: {key} needs μ_k ≤ μ_s, got {value!r}")
+        return list(items)
     if isinstance(kind, tuple):
         if not isinstance(value, str) or value not in kind:
             raise error(f"{where}: {key} must be one of {', '.join(kind)}, got {value!r}")
@@ -105,6 +156,8 @@ def _value(where, key, kind, value, error):
             raise error(f"{where}: {key} must be at most {MAX_COUNT}, got {value}")
         return value
     x = float(value)
+    if kind == "count" or kind == "real":
+        return value
     ok = {"pos": x > 0, "nonneg": x >= 0, "unit": 0 <= x <= 1, "range": 0 < x <= 1}[kind]
     if not ok:
         want = {"pos": "> 0", "nonneg": "≥ 0", "unit": "in [0, 1]", "range": "in (0, 1]"}[kind]
@@ -145,6 +198,10 @@ def split(data, where, error):
         paper[key] = value
     if not dynamic:
         return paper, None
+    if "--grid" in flags and not 2 <= flags["--grid"] <= 512:
+        raise error(f"{where}: grid.nodes must be from 2 to 512, got {flags['--grid']!r}")
+    if any(f.startswith("--grid-") for f in flags) and "--grid" not in flags:
+        raise error(f"{where}: the [grid] table needs grid.nodes (the grid is off without it)")
     if "--shape-range" in flags and "--shape-compliance" not in flags:
         raise error(f"{where}: constraints.shape_range needs constraints.shape_compliance (shape is off without it)")
     if "--frame-dt" in flags or "--substeps" in flags:
@@ -166,13 +223,19 @@ def check(scene, where, error):
 
 
 def flags(scene):
-    """The binary flags of a scene's dynamic part ([] for a paper scene)."""
+    """The binary flags of a scene's dynamic part ([] for a paper scene); a colliders file is
+    taken relative to the scene file's folder."""
     out = []
     for flag, value in scene.dynamic.items():
         if flag == "--no-collider":
             if value is False:
                 out.append(flag)
             continue
+        if flag == "--colliders":
+            src = scene.source.removeprefix("scene ")
+            value = str(os.path.join(os.path.dirname(src), value)) if src and not os.path.isabs(value) else value
+        if isinstance(value, list):
+            value = ",".join(repr(float(v)) for v in value)
         out += [flag, value if isinstance(value, str) else repr(value)]
     return out
 

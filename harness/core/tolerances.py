@@ -574,3 +574,11 @@ OBS_REST_MOVE_ABS_L = 1e-14  # of L = 30 cm: 3e-13 cm (measured 4.6e-14 cm; marg
 # linearised discrete chain's ω1/2π: −1.33e-4 relative (the scheme's 4e-5, tolerances above,
 # plus the spectral estimate's floor over 5.5 periods).
 OBS_CHAIN_SWING_FREQUENCY_REL = 5e-4  # measured 1.33e-4; margin 3.8×
+
+# ---------------------------------------------------------------------------------------
+# THE HAIR–HAIR GRID (docs/model.md §3.16; tests/cpu/test_hair_grid.py, tests/cpu/c/grid_known.c).
+# A point adds rint((w·v)·2^10) to a node's momentum: a rounding of at most half of 2^-10 cm/s
+# a contribution, so a node velocity V = P/M of points that all sit on the node is off their
+# mean by at most that (measured on 200 points at one node: 2.1e-5 cm/s; a uniform field of
+# 2000 points moved by at most 8.5e-4 cm/s, the Galilean shift's residue 2.8e-4 cm/s).
+GRID_FIXED_POINT_VELOCITY = 2.0**-10  # cm/s a contribution (twice the rounding bound)

@@ -90,12 +90,23 @@ class Runner:
         return f"gpu {'normal' if self.build == 'default' else self.build} {self.variant}"
 
 
-# The simulate flags that declare a §3.14 feature (docs/model.md), and the feature each names.
-FEATURE_FLAGS = {"--guides": "guides", "--lra": "lra", "--sag-free": "sagfree", "--render-points": "lod"}
+# The simulate flags that declare a §3.14, §3.16 or §3.17 feature (docs/model.md), and the
+# feature each names (a colliders file's own friction is read by the binary, which refuses it
+# on a variant without "friction").
+FEATURE_FLAGS = {
+    "--guides": "guides",
+    "--lra": "lra",
+    "--sag-free": "sagfree",
+    "--render-points": "lod",
+    "--grid": "grid",
+    "--colliders": "colliders",
+    "--friction": "friction",
+    "--depenetration-speed": "friction",
+}
 
 
 def features_of(flags):
-    """The §3.14 features that simulate flags declare (a flag list or a dict keyed by flag)."""
+    """The features that simulate flags declare (a flag list or a dict keyed by flag)."""
     return {FEATURE_FLAGS[str(a)] for a in flags if str(a) in FEATURE_FLAGS}
 
 

@@ -28,3 +28,15 @@ def write_csv(path, fields, rows, extrasaction="raise"):
         w.writerows(rows)
     os.replace(tmp, path)
     return path
+
+
+def write_text(path, text):
+    """`text` at `path`, whole or not at all; returns the path."""
+    path = Path(path)
+    tmp = path.with_name(f"{path.name}.tmp.{os.getpid()}")
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return path

@@ -13,7 +13,9 @@ model = "dynamic") holds beyond the paper frames:
   stretch_max, penetration_max, kinetic_energy, blown_up, blown_up_strands);
 - `frame_at_step(step)`: the position frame index written at that step (None if the frame
   was not written, e.g. with --output-every);
-- `dynamic_params`: the /parameters attributes of the dynamic model as a dict.
+- `dynamic_params`: the /parameters attributes of the dynamic model as a dict;
+- `colliders`: the colliders of docs/model.md §3.17 (harness.io.colliders.Collider, each
+  mesh with its stored SDF), [] without them.
 
 A paper-model file opens too (`is_dynamic` False, no rest, no velocities, empty
 observables), so callers can take either. Any departure from the layout (a missing
@@ -69,6 +71,26 @@ DYNAMIC_ATTRS = (
     "per_segment",
     "render_points",
     "simulated_points",
+    # §3.16 the grid, §3.17 colliders and friction (absent in older files: none)
+    "grid",
+    "grid_n",
+    "grid_rebuild",
+    "grid_box_given",
+    "grid_box",
+    "grid_padding",
+    "grid_friction_declared",
+    "grid_friction",
+    "grid_volume_declared",
+    "grid_volume",
+    "friction_declared",
+    "friction",
+    "depenetration_declared",
+    "depenetration_speed",
+    "body_motion",
+    "body_amplitude",
+    "body_frequency",
+    "colliders",
+    "colliders_file",
 )
 REQUIRED_DYNAMIC = (
     "paper_frames",
@@ -98,6 +120,7 @@ class Trajectory(State):
     _rest: object = field(repr=False, default=None)
     _vel: object = field(repr=False, default=None)
     simulated_rows: np.ndarray = None  # --render-points: which rows of a strand are simulated points (§3.14)
+    colliders: list = field(default_factory=list)  # §3.17
 
     @property
     def rest(self):
@@ -280,6 +303,10 @@ def _check_dynamic(t, f):
     t.observables = _observables(f, path)
     if t.render_points:
         _check_lod(t, f)
+    if int(params.get("colliders", 0)) > 0:
+        from harness.io.colliders import read_colliders
+
+        t.colliders = read_colliders(f, path, int(params["colliders"]))
 
 
 def _check_lod(t, f):

@@ -1,0 +1,348 @@
+/* contact_impl.h — the per-point math of the hair–hair grid (docs/model.md §3.16) and of the
+ * colliders with friction (§3.17), written once for a floating type REAL (SFX, SQRT,
+ * WORLD, as precision_f32.h / precision_f64.h name them) in the common subset of C and CUDA
+ * C++: the C reference (dynamics_impl.h) and the CUDA port (cuda/dyn_contact.cuh) include this
+ * same text, so the strict CUDA build performs these operations exactly as the reference.
+ * Every expression is evaluated in the order written (docs/model.md §3.10).
+ */
+#include <math.h>
+#include <stdint.h>
+
+#include "runtime/philox.h" /* HB_HD */
+
+#ifndef HB_CONTACT_ONCE
+#define HB_CONTACT_ONCE
+/* rint to a 64-bit integer, ties to even (the value is within ±2^62 by construction) */
+#if defined(__CUDA_ARCH__)
+#define HB_RINT64(x) __double2ll_rn((double)(x))
+#else
+#define HB_RINT64(x) ((int64_t)llrint((double)(x)))
+#endif
+#define HB_GRID_MASS_SCALE 16777216.0 /* 2^24 */
+#define HB_GRID_MOM_SCALE 1024.0      /* 2^10 */
+#define HB_GRID_VEL_SCALE 16384.0     /* 2^14 = 2^24 / 2^10 */
+#define HB_GRID_VEL_CLAMP 1048576.0   /* 2^20 cm/s */
+#define HB_GRID_INV_MASS_SCALE 5.9604644775390625e-08 /* 2^-24 */
+#endif
+
+/* §3.16 the grid coordinates of x (u = Q_gᵀ·x, or x with qg = NULL): 1 and the index of its
+ * lowest corner and the eight corner weights (corner a + 2b + 4c) when x is in the grid. */
+HB_HD int SFX(hb_grid_locate)(const REAL *qg, const REAL *glo, const REAL *gsc, int64_t gn, const REAL *x,
+                              int64_t *base, REAL *w)
+{
+    REAL u[3], f[3];
+    int64_t i[3];
+    for (int c = 0; c < 3; c++) u[c] = qg ? (qg[c] * x[0] + qg[3 + c] * x[1]) + qg[6 + c] * x[2] : x[c];
+    for (int c = 0; c < 3; c++) {
+        const REAL g = (u[c] - glo[c]) * gsc[c];
+        if (!(g >= (REAL)0 && g < (REAL)(gn - 1))) return 0;
+        i[c] = (int64_t)g;
+        f[c] = g - (REAL)i[c];
+    }
+    *base = i[0] + gn * (i[1] + gn * i[2]);
+    for (int k = 0; k < 8; k++) {
+        const REAL wx = (k & 1) ? f[0] : (REAL)1 - f[0];
+        const REAL wy = (k & 2) ? f[1] : (REAL)1 - f[1];
+        const REAL wz = (k & 4) ? f[2] : (REAL)1 - f[2];
+        w[k] = (wx * wy) * wz;
+    }
+    return 1;
+}
+
+/* The node index of corner k of the cell whose lowest corner is `base`. */
+HB_HD int64_t SFX(hb_grid_corner)(int64_t base, int64_t gn, int k)
+{
+    return base + ((k & 1) ? 1 : 0) + ((k & 2) ? gn : 0) + ((k & 4) ? gn * gn : 0);
+}
+
+/* §3.16 one point's splat: its fixed-point mass and momentum at its eight corners. Returns 0
+ * (nothing to add) for a point outside the grid or not finite. v may be NULL (mass only). */
+HB_HD int SFX(hb_grid_splat_point)(const REAL *qg, const REAL *glo, const REAL *gsc, int64_t gn, const REAL *x,
+                                   const REAL *v, int64_t *base, int64_t *mass, int64_t *mom)
+{
+    REAL w[8], vc[3] = {(REAL)0, (REAL)0, (REAL)0};
+    for (int c = 0; c < 3; c++)
+        if (!isfinite(x[c]) || (v && !isfinite(v[c]))) return 0;
+    if (!SFX(hb_grid_locate)(qg, glo, gsc, gn, x, base, w)) return 0;
+    if (v)
+        for (int c = 0; c < 3; c++)
+            vc[c] = v[c] < (REAL)-HB_GRID_VEL_CLAMP  ? (REAL)-HB_GRID_VEL_CLAMP
+                    : v[c] > (REAL)HB_GRID_VEL_CLAMP ? (REAL)HB_GRID_VEL_CLAMP
+                                                     : v[c];
+    for (int k = 0; k < 8; k++) {
+        mass[k] = HB_RINT64(w[k] * (REAL)HB_GRID_MASS_SCALE);
+        for (int c = 0; c < 3; c++) mom[3 * k + c] = v ? HB_RINT64((w[k] * vc[c]) * (REAL)HB_GRID_MOM_SCALE) : 0;
+    }
+    return 1;
+}
+
+/* §3.16 the excess density e of node j (volume): max(ρ − T, 0)·(1/ρ̄₀). */
+HB_HD REAL SFX(hb_grid_excess)(const int64_t *mass, const REAL *target, REAL inv_rho0, int64_t j)
+{
+    const REAL e = (REAL)mass[j] * (REAL)HB_GRID_INV_MASS_SCALE - target[j];
+    return (e > (REAL)0 ? e : (REAL)0) * inv_rho0;
+}
+
+/* §3.16 node j's fields from the sums: out_v = (o·V, o), and with volume out_a = (A, 0),
+ * A = Q_g·(−K_v·G) (qg = NULL: not turned). */
+HB_HD void SFX(hb_grid_node)(int64_t j, int64_t gn, const int64_t *mass, const int64_t *mom, const REAL *target,
+                             REAL inv_rho0, REAL neg_kv, const REAL *gsc, const REAL *qg, REAL *out_v, REAL *out_a)
+{
+    if (out_v) {
+        const int64_t m = mass[j];
+        for (int c = 0; c < 3; c++)
+            out_v[4 * j + c] = m > 0 ? ((REAL)mom[3 * j + c] / (REAL)m) * (REAL)HB_GRID_VEL_SCALE : (REAL)0;
+        out_v[4 * j + 3] = m > 0 ? (REAL)1 : (REAL)0;
+    }
+    if (out_a) {
+        const int64_t idx[3] = {j % gn, (j / gn) % gn, j / (gn * gn)};
+        const int64_t step[3] = {1, gn, gn * gn};
+        REAL g[3], a[3];
+        for (int c = 0; c < 3; c++) {
+            const int lo = idx[c] > 0, hi = idx[c] + 1 < gn;
+            const REAL ep = SFX(hb_grid_excess)(mass, target, inv_rho0, hi ? j + step[c] : j);
+            const REAL em = SFX(hb_grid_excess)(mass, target, inv_rho0, lo ? j - step[c] : j);
+            g[c] = (lo && hi) ? (ep - em) * (gsc[c] * (REAL)0.5) : (ep - em) * gsc[c];
+        }
+        for (int c = 0; c < 3; c++) a[c] = neg_kv * g[c];
+        for (int r = 0; r < 3; r++)
+            out_a[4 * j + r] = qg ? (qg[3 * r] * a[0] + qg[3 * r + 1] * a[1]) + qg[3 * r + 2] * a[2] : a[r];
+        out_a[4 * j + 3] = (REAL)0;
+    }
+}
+
+/* §3.16 the hair–hair correction of point k (≥ 1) at x, velocity v, in step 2 of §3.4. */
+HB_HD void SFX(hb_grid_correct)(const WORLD *w, const REAL *qg, REAL h, int64_t k, const REAL *x, REAL *v)
+{
+    int64_t base;
+    REAL wt[8];
+    if (!SFX(hb_grid_locate)(qg, w->glo, w->gsc, w->gn, x, &base, wt)) return;
+    if (w->grid_friction) {
+        REAL sw = (REAL)0, sv[3] = {(REAL)0, (REAL)0, (REAL)0};
+        for (int c8 = 0; c8 < 8; c8++) {
+            const REAL *nv = w->node_v + 4 * SFX(hb_grid_corner)(base, w->gn, c8);
+            if (nv[3] != (REAL)0) {
+                sw = sw + wt[c8];
+                for (int c = 0; c < 3; c++) sv[c] = sv[c] + wt[c8] * nv[c];
+            }
+        }
+        if (sw > (REAL)0) {
+            const REAL f = w->ftab[k];
+            for (int c = 0; c < 3; c++) {
+                const REAL vbar = sv[c] / sw;
+                v[c] = v[c] + f * (vbar - v[c]);
+            }
+        }
+    }
+    if (w->grid_volume) {
+        REAL a[3] = {(REAL)0, (REAL)0, (REAL)0};
+        for (int c8 = 0; c8 < 8; c8++) {
+            const REAL *na = w->node_a + 4 * SFX(hb_grid_corner)(base, w->gn, c8);
+            for (int c = 0; c < 3; c++) a[c] = a[c] + wt[c8] * na[c];
+        }
+        for (int c = 0; c < 3; c++) v[c] = v[c] + h * a[c];
+    }
+}
+
+/* ---- §3.17 colliders ---- */
+
+/* Friction after a projection that removed depth m along the unit normal n: the motion of p
+ * relative to the collider's surface since x (the start of the substep), made tangential and
+ * removed (static) or shortened by μ_k·m (kinetic). turn: the frame turned (back = its
+ * Q(t)·Q(t+h)ᵀ); sway: it moved (back + 9 = b(t) − b(t+h)). */
+HB_HD void SFX(hb_friction)(REAL *p, const REAL *x, const REAL *n, REAL m, REAL mu_s, REAL mu_k, int turn, int sway,
+                            const REAL *back)
+{
+    REAL r[3], t[3];
+    for (int c = 0; c < 3; c++) {
+        const REAL bp = turn   ? (back[3 * c] * p[0] + back[3 * c + 1] * p[1]) + back[3 * c + 2] * p[2]
+                        : sway ? p[c] + back[9 + c]
+                               : p[c];
+        r[c] = bp - x[c];
+    }
+    const REAL rn = (r[0] * n[0] + r[1] * n[1]) + r[2] * n[2];
+    for (int c = 0; c < 3; c++) t[c] = r[c] - rn * n[c];
+    const REAL tau = SQRT((t[0] * t[0] + t[1] * t[1]) + t[2] * t[2]);
+    if (tau < mu_s * m) {
+        for (int c = 0; c < 3; c++) p[c] = p[c] - t[c];
+    } else if (tau > (REAL)0) {
+        REAL k = (mu_k * m) / tau;
+        if (k > (REAL)1) k = (REAL)1;
+        for (int c = 0; c < 3; c++) p[c] = p[c] - k * t[c];
+    }
+}
+
+/* A sphere of radius rc about c: moves p out; returns the depth removed (0: p was outside)
+ * and the normal in n. With exact = 1 (unbounded) p lands on the surface as c + (rc/ρ)·e. */
+HB_HD REAL SFX(hb_push_sphere)(REAL *p, const REAL *c, REAL rc, const REAL *nperp, int bounded, REAL depen, REAL *n)
+{
+    const REAL e[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    const REAL rho = SQRT((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2]);
+    if (!(rho < rc)) return (REAL)0;
+    const REAL d = rc - rho;
+    if (rho == (REAL)0) {
+        for (int k = 0; k < 3; k++) n[k] = nperp ? nperp[k] : (k == 1 ? (REAL)1 : (REAL)0);
+    } else {
+        for (int k = 0; k < 3; k++) n[k] = e[k] / rho;
+    }
+    if (!bounded) {
+        if (rho == (REAL)0) {
+            for (int k = 0; k < 3; k++) p[k] = c[k] + rc * n[k];
+        } else {
+            const REAL sg = rc / rho;
+            for (int k = 0; k < 3; k++) p[k] = c[k] + e[k] * sg;
+        }
+        return d;
+    }
+    const REAL m = d < depen ? d : depen;
+    for (int k = 0; k < 3; k++) p[k] = p[k] + m * n[k];
+    return m;
+}
+
+/* A mesh's SDF at the mesh-frame point u: 1, the value φ and the (unnormalised) gradient g in
+ * grid units when u is inside the cube. geo: lo x, y, z and the scale 1/Δ_s. */
+HB_HD int SFX(hb_sdf_sample)(const REAL *sdf, int64_t n, const REAL *geo, const REAL *u, REAL *phi, REAL *g)
+{
+    REAL f[3];
+    int64_t i[3];
+    for (int c = 0; c < 3; c++) {
+        const REAL gc = (u[c] - geo[c]) * geo[3];
+        if (!(gc >= (REAL)0 && gc < (REAL)(n - 1))) return 0;
+        i[c] = (int64_t)gc;
+        f[c] = gc - (REAL)i[c];
+    }
+    const int64_t b = i[0] + n * (i[1] + n * i[2]);
+    REAL v[8], w[8];
+    for (int k = 0; k < 8; k++) {
+        v[k] = sdf[SFX(hb_grid_corner)(b, n, k)];
+        const REAL wx = (k & 1) ? f[0] : (REAL)1 - f[0];
+        const REAL wy = (k & 2) ? f[1] : (REAL)1 - f[1];
+        const REAL wz = (k & 4) ? f[2] : (REAL)1 - f[2];
+        w[k] = (wx * wy) * wz;
+    }
+    REAL s = (REAL)0;
+    for (int k = 0; k < 8; k++) s = s + w[k] * v[k];
+    *phi = s;
+    /* ∂/∂g_c of the trilinear interpolant: the four edges along c, each weighted by the other two */
+    for (int c = 0; c < 3; c++) {
+        const int a1 = c == 0 ? 1 : 0, a2 = c == 2 ? 1 : 2; /* the other two axes */
+        const int bit = 1 << c, b1 = 1 << a1, b2 = 1 << a2;
+        REAL acc = (REAL)0;
+        for (int e = 0; e < 4; e++) {
+            const int k0 = ((e & 1) ? b1 : 0) | ((e & 2) ? b2 : 0);
+            const REAL w1 = (e & 1) ? f[a1] : (REAL)1 - f[a1];
+            const REAL w2 = (e & 2) ? f[a2] : (REAL)1 - f[a2];
+            acc = acc + (w1 * w2) * (v[k0 | bit] - v[k0]);
+        }
+        g[c] = acc;
+    }
+    return 1;
+}
+
+/* Collider i (kind, pose) on p: its projection and friction. x: the point at the start of the
+ * substep; back: the substep's back-transforms. */
+HB_HD void SFX(hb_collide_one)(const WORLD *w, int i, const REAL *pose, const REAL *back, REAL *p, const REAL *x)
+{
+    { /* outside the bounding sphere nothing can happen: skipped (the same bits as testing) */
+        const REAL bx = p[0] - pose[16], by = p[1] - pose[17], bz = p[2] - pose[18];
+        if (!((bx * bx + by * by) + bz * bz < pose[19])) return;
+    }
+    const int kind = w->col_kind[i], frame = w->col_frame[i];
+    const int turn = frame == HB_FRAME_HEAD && w->motion, sway = frame == HB_FRAME_BODY && w->sway;
+    REAL n[3], m = (REAL)0;
+    if (kind == HB_COL_SPHERE) {
+        m = SFX(hb_push_sphere)(p, pose, pose[3], NULL, w->bounded, w->depen, n);
+    } else if (kind == HB_COL_CAPSULE) {
+        const REAL ab[3] = {pose[3] - pose[0], pose[4] - pose[1], pose[5] - pose[2]};
+        const REAL ap[3] = {p[0] - pose[0], p[1] - pose[1], p[2] - pose[2]};
+        REAL t = ((ap[0] * ab[0] + ap[1] * ab[1]) + ap[2] * ab[2]) / pose[10];
+        t = t < (REAL)0 ? (REAL)0 : t > (REAL)1 ? (REAL)1 : t;
+        const REAL c[3] = {pose[0] + t * ab[0], pose[1] + t * ab[1], pose[2] + t * ab[2]};
+        m = SFX(hb_push_sphere)(p, c, pose[6], pose + 7, w->bounded, w->depen, n);
+    } else if (kind == HB_COL_PLANE) {
+        const REAL rho = ((p[0] - pose[0]) * pose[3] + (p[1] - pose[1]) * pose[4]) + (p[2] - pose[2]) * pose[5];
+        if (!(rho < pose[6])) return;
+        const REAL d = pose[6] - rho;
+        m = w->bounded && w->depen < d ? w->depen : d;
+        for (int c = 0; c < 3; c++) {
+            n[c] = pose[3 + c];
+            p[c] = p[c] + m * n[c];
+        }
+    } else { /* mesh */
+        REAL u[3], phi, g[3];
+        for (int c = 0; c < 3; c++)
+            u[c] = turn   ? (pose[c] * p[0] + pose[3 + c] * p[1]) + pose[6 + c] * p[2]
+                   : sway ? p[c] - pose[9 + c]
+                          : p[c];
+        if (!SFX(hb_sdf_sample)(w->sdf[i], w->sdf_n[i], w->sdf_geo + 4 * i, u, &phi, g)) return;
+        const REAL gl = SQRT((g[0] * g[0] + g[1] * g[1]) + g[2] * g[2]);
+        if (!(phi < pose[12] && gl > (REAL)0)) return;
+        const REAL d = pose[12] - phi;
+        REAL nl[3];
+        for (int c = 0; c < 3; c++) nl[c] = g[c] / gl;
+        for (int r = 0; r < 3; r++) n[r] = turn ? (pose[3 * r] * nl[0] + pose[3 * r + 1] * nl[1]) + pose[3 * r + 2] * nl[2] : nl[r];
+        m = w->bounded && w->depen < d ? w->depen : d;
+        for (int c = 0; c < 3; c++) p[c] = p[c] + m * n[c];
+    }
+    const REAL mu_s = w->col_mu[2 * i];
+    if (m > (REAL)0 && mu_s > (REAL)0) SFX(hb_friction)(p, x, n, m, mu_s, w->col_mu[2 * i + 1], turn, sway, back);
+}
+
+/* The head sphere of §3.5 with friction or a bounded depenetration (§3.17). */
+HB_HD void SFX(hb_collide_head)(const WORLD *w, REAL rc, const REAL *back, REAL *p, const REAL *x)
+{
+    const REAL origin[3] = {(REAL)0, (REAL)0, (REAL)0};
+    REAL n[3];
+    const REAL m = SFX(hb_push_sphere)(p, origin, rc, NULL, w->bounded, w->depen, n);
+    if (m > (REAL)0 && w->head_friction && w->head_mu_s > (REAL)0)
+        SFX(hb_friction)(p, x, n, m, w->head_mu_s, w->head_mu_k, w->motion, 0, back);
+}
+
+/* The depth of x (double) inside collider i with pose `pose` (§3.8 penetration_max), or 0. */
+HB_HD double SFX(hb_collider_depth)(const WORLD *w, int i, const REAL *pose, const double *x)
+{
+    const int kind = w->col_kind[i], frame = w->col_frame[i];
+    const int turn = frame == HB_FRAME_HEAD && w->motion, sway = frame == HB_FRAME_BODY && w->sway;
+    double d = 0.0;
+    if (kind == HB_COL_SPHERE || kind == HB_COL_CAPSULE) {
+        double c[3] = {(double)pose[0], (double)pose[1], (double)pose[2]};
+        double rc = (double)pose[3];
+        if (kind == HB_COL_CAPSULE) {
+            const double ab[3] = {(double)pose[3] - c[0], (double)pose[4] - c[1], (double)pose[5] - c[2]};
+            double t = (((x[0] - c[0]) * ab[0] + (x[1] - c[1]) * ab[1]) + (x[2] - c[2]) * ab[2]) / (double)pose[10];
+            t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+            for (int k = 0; k < 3; k++) c[k] = c[k] + t * ab[k];
+            rc = (double)pose[6];
+        }
+        const double e[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
+        d = rc - sqrt((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2]);
+    } else if (kind == HB_COL_PLANE) {
+        d = (double)pose[6] - (((x[0] - (double)pose[0]) * (double)pose[3] + (x[1] - (double)pose[1]) * (double)pose[4]) +
+                               (x[2] - (double)pose[2]) * (double)pose[5]);
+    } else {
+        double u[3], f[3];
+        int64_t ii[3];
+        const int64_t n = w->sdf_n[i];
+        const REAL *geo = w->sdf_geo + 4 * i;
+        for (int c = 0; c < 3; c++)
+            u[c] = turn   ? ((double)pose[c] * x[0] + (double)pose[3 + c] * x[1]) + (double)pose[6 + c] * x[2]
+                   : sway ? x[c] - (double)pose[9 + c]
+                          : x[c];
+        for (int c = 0; c < 3; c++) {
+            const double g = (u[c] - (double)geo[c]) * (double)geo[3];
+            if (!(g >= 0.0 && g < (double)(n - 1))) return 0.0;
+            ii[c] = (int64_t)g;
+            f[c] = g - (double)ii[c];
+        }
+        const int64_t b = ii[0] + n * (ii[1] + n * ii[2]);
+        double phi = 0.0;
+        for (int k = 0; k < 8; k++) {
+            const double wx = (k & 1) ? f[0] : 1.0 - f[0];
+            const double wy = (k & 2) ? f[1] : 1.0 - f[1];
+            const double wz = (k & 4) ? f[2] : 1.0 - f[2];
+            phi = phi + ((wx * wy) * wz) * (double)w->sdf[i][SFX(hb_grid_corner)(b, n, k)];
+        }
+        d = (double)pose[12] - phi;
+    }
+    return d > 0.0 ? d : 0.0;
+}

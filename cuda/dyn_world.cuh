@@ -1,0 +1,86 @@
+/* dyn_world.cuh — the hair–hair grid (docs/model.md §3.16) and the colliders with friction
+ * (§3.17) for the CUDA port: c_ref/dynamic/contact_impl.h itself, included once for float and
+ * once for double, so the strict build performs the reference's operations on the device
+ * (the normal build contracts them into FMAs). The launchers of the grid's kernels are in
+ * cuda/dyn_world.cu.
+ */
+#ifndef HB_DYN_WORLD_CUH
+#define HB_DYN_WORLD_CUH
+
+#include <cuda_runtime.h>
+#include <math.h>
+#include <stdint.h>
+
+#include "dynamic/world.h"
+
+#include "dynamic/precision_f32.h"
+#include "dynamic/contact_impl.h"
+#include "dynamic/precision_end.h"
+#include "dynamic/precision_f64.h"
+#include "dynamic/contact_impl.h"
+#include "dynamic/precision_end.h"
+
+namespace hb {
+namespace dyn {
+
+template <typename T> struct WorldOf;
+template <> struct WorldOf<float> {
+    using type = hb_dyn_world_f32;
+};
+template <> struct WorldOf<double> {
+    using type = hb_dyn_world_f64;
+};
+/* The run's grid and colliders in T, pointing at device memory. */
+template <typename T> using World = typename WorldOf<T>::type;
+
+/* The precision's functions of contact_impl.h by overload. */
+HB_HD void grid_correct(const World<float> &w, const float *qg, float h, int64_t k, const float *x, float *v)
+{
+    hb_grid_correct_f32(&w, qg, h, k, x, v);
+}
+HB_HD void grid_correct(const World<double> &w, const double *qg, double h, int64_t k, const double *x, double *v)
+{
+    hb_grid_correct_f64(&w, qg, h, k, x, v);
+}
+HB_HD void collide_one(const World<float> &w, int i, const float *pose, const float *back, float *p, const float *x)
+{
+    hb_collide_one_f32(&w, i, pose, back, p, x);
+}
+HB_HD void collide_one(const World<double> &w, int i, const double *pose, const double *back, double *p,
+                       const double *x)
+{
+    hb_collide_one_f64(&w, i, pose, back, p, x);
+}
+HB_HD void collide_head(const World<float> &w, float rc, const float *back, float *p, const float *x)
+{
+    hb_collide_head_f32(&w, rc, back, p, x);
+}
+HB_HD void collide_head(const World<double> &w, double rc, const double *back, double *p, const double *x)
+{
+    hb_collide_head_f64(&w, rc, back, p, x);
+}
+HB_HD double collider_depth(const World<float> &w, int i, const float *pose, const double *x)
+{
+    return hb_collider_depth_f32(&w, i, pose, x);
+}
+HB_HD double collider_depth(const World<double> &w, int i, const double *pose, const double *x)
+{
+    return hb_collider_depth_f64(&w, i, pose, x);
+}
+
+/* ---- the grid's kernels (cuda/dyn_world.cu) ---- */
+/* §3.16 the splat of every point of x, v (canonical [N][P][3]) into mass [n³] and mom [n³][3]
+ * (zeroed first by the launcher), with the grid rotation qg (device, nullptr: still); the strands
+ * taken in the order perm (device, nullptr: as stored). */
+template <typename T>
+cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const T *v, int64_t N, int64_t P,
+                              const int64_t *perm, int64_t *mass, int64_t *mom, cudaStream_t stream);
+/* §3.16 the node fields from the sums (target, inv_rho0, neg_kv: volume). */
+template <typename T>
+cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mass, const int64_t *mom, const T *target,
+                              T inv_rho0, T neg_kv, T *node_v, T *node_a, cudaStream_t stream);
+
+} /* namespace dyn */
+} /* namespace hb */
+
+#endif

@@ -1,0 +1,103 @@
+"""GPU tests of the hair–hair grid (docs/model.md §3.16) and the colliders with friction (§3.17)
+in the CUDA port: the variants that declare them (--list-variants: `lanes`) against the C
+reference, one frame at a time from the reference's frame K−1 (as tests/gpu/test_gpu_dynamic.py):
+the strict build bit for bit (the grid's sums are integers, so their order on the GPU changes no
+bit; no gusts here), the normal build by the one-frame rule. Variants that do not declare a
+feature refuse it in one line. Marked `gpu`; conftest.py skips them where there is no usable GPU.
+"""
+
+import pytest
+
+from conftest import CPU_BIN, CUDA_BIN, CUDA_STRICT_BIN
+from harness import HarnessError
+from harness.check import diff_dynamic
+from harness.core import variants
+from harness.io.meshes import icosphere, write_obj
+from harness.io.trajectory import open_trajectory
+from support.statecheck import run
+
+pytestmark = pytest.mark.gpu
+
+try:
+    _DECLARED = variants.declared("cuda")
+    VARIANTS = tuple(v for v in _DECLARED.variants if _DECLARED.runs(v, points=24))
+except HarnessError:
+    _DECLARED, VARIANTS = None, ()
+BUILDS = {"normal": CUDA_BIN, "strict": CUDA_STRICT_BIN}
+BASE = ["--strands", "300", "--points", "24", "--substeps", "4", "--iterations", "2", "--bend-compliance", "1e-6",
+        "--shape-compliance", "1e-4", "--shape-range", "0.5", "--drag", "0.5", "--wind-speed", "150"]  # fmt: skip
+BODY = (
+    "capsule body 0 -10 -1 0 -24 -1 4.5 mu_s 0.3 mu_k 0.2\n"
+    "capsule body -4 -24 -2 -19 -27 -2 5.5 mu_s 0.3 mu_k 0.2\n"
+    "sphere head 0 4 9 2 mu_s 0.5\n"
+    "plane body 0 -45 0 0 1 0\n"
+    "mesh head chin.obj 32 band 4 mu_s 0.2 mu_k 0.1\n"
+)
+SCENES = {
+    "grid-frame": ["--head-motion", "nod", "--grid", "16", "--grid-friction", "0.1,0.02", "--grid-volume", "2000"],
+    "grid-substep": ["--head-motion", "shake", "--grid", "20", "--grid-friction", "0.05", "--grid-rebuild", "substep"],
+    "grid-still": ["--grid", "12", "--grid-volume", "5000"],
+    "body": ["--head-motion", "nod", "--friction", "0.4,0.3", "--depenetration-speed", "150", "--colliders", "BODY"],
+    "body-sway": ["--colliders", "BODY", "--body-motion", "sway", "--body-amplitude", "3"],
+    "all": ["--head-motion", "tilt", "--grid", "16", "--grid-friction", "0.05", "--grid-volume", "1000",
+            "--friction", "0.3", "--colliders", "BODY"],  # fmt: skip
+}
+FRAMES = 3
+RUNS = [(v, s) for v in VARIANTS for s in SCENES if _DECLARED.runs_features(v, variants.features_of(SCENES[s]))]
+REFUSING = [v for v in VARIANTS if not _DECLARED.runs_features(v, {"grid"})]
+
+
+@pytest.fixture(scope="module")
+def work(tmp_path_factory):
+    w = tmp_path_factory.mktemp("gpu_world")
+    v, f = icosphere(3, radius=4.0, center=(0.0, -9.0, 5.0), scale=(1.0, 0.8, 1.0))
+    write_obj(w / "chin.obj", v, f)
+    (w / "body.txt").write_text(BODY)
+    return w
+
+
+def scene_args(work, scene):
+    return [str(work / "body.txt") if a == "BODY" else a for a in SCENES[scene]]
+
+
+@pytest.fixture(scope="module")
+def cpu_files(work):
+    cache = {}
+
+    def get(scene, solver, precision):
+        key = (scene, solver, precision)
+        if key not in cache:
+            out = work / f"cpu_{scene}_{solver}_{precision}.h5"
+            run(CPU_BIN, "--stages", "init,collide,simulate", *BASE, *scene_args(work, scene), "--solver", solver,
+                "--precision", precision, "--frames", FRAMES, "--velocities", "all", "--output", out, "--quiet")  # fmt: skip
+            cache[key] = out
+        return cache[key]
+
+    return get
+
+
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+@pytest.mark.parametrize("variant,scene", RUNS)
+@pytest.mark.parametrize("build", tuple(BUILDS))
+def test_gpu_frame_matches_cpu(work, cpu_files, build, variant, scene, solver, precision):
+    cpu = cpu_files(scene, solver, precision)
+    with open_trajectory(cpu) as t:
+        k = t.n_frames - 2
+        step = int(t.step[-1])
+    out = work / f"gpu_{build}_{variant}_{scene}_{solver}_{precision}.h5"
+    run(BUILDS[build], "--input", cpu, "--input-frame", k, "--stages", "simulate", "--frames", 1,
+        "--variant", variant, "--output", out, "--force", "--quiet")  # fmt: skip
+    exact = build == "strict"
+    r = diff_dynamic.compare(cpu, out, frames=[step], exact=exact, check_paper=False)
+    assert r.equivalent, f"{build} {variant} {scene}: " + "; ".join(r.failures()[:5])
+
+
+@pytest.mark.parametrize("variant", REFUSING)
+@pytest.mark.parametrize("flags", [["--grid", "16"], ["--friction", "0.2"]])
+def test_variants_without_the_features_refuse_them(tmp_path, variant, flags):
+    out = tmp_path / "o.h5"
+    p = run(CUDA_BIN, "--stages", "init,collide,simulate", *BASE, *flags, "--variant", variant, "--output", out,
+            "--quiet", check=False)  # fmt: skip
+    assert p.returncode == 2 and f"--variant {variant} does not run" in p.stderr
+    assert not out.exists()
