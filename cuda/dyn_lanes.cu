@@ -70,9 +70,10 @@ template <typename T> __device__ __forceinline__ constexpr T floor_of()
 {
     return sin(x);
 }
-template <typename T, int G, int L, bool Ftl> constexpr int lanes_min_blocks()
+template <typename T, int G, int L, bool Ftl, bool W = false> constexpr int lanes_min_blocks()
 {
     return sizeof(T) != 4                      ? 1
+           : W                                 ? 2 /* the grid and colliders' code: up to 128 registers */
            : (!Ftl && G == 2)                  ? HB_LANES_MINB
            : (Ftl && G == kFtlG && L == kFtlL) ? HB_LANES_FTL_MINB
                                                : 1;
@@ -387,7 +388,7 @@ __device__ __forceinline__ void pack(T *s, int k0, bool sw, int P, bool live, co
  * grid and colliders of §3.16–3.17 (m.world), with the strands taken in the order m.perm (slot
  * s holds strand perm[s], nearby strands together, so a block's points share grid nodes). */
 template <typename T, class Feat, int G, int L, bool Ftl, bool Seg, bool W>
-__global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl>())
+__global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl, W>())
     k_lanes(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
             const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N)
 {

@@ -3,6 +3,8 @@
  * changes no bit, and the node fields. */
 #include "dyn_world.cuh"
 
+#include <climits>
+
 namespace hb {
 namespace dyn {
 namespace {
@@ -44,35 +46,117 @@ __device__ __forceinline__ int64_t group_sum(unsigned group, int64_t x)
     return (int64_t)hi * 65536 + (int64_t)lo;
 }
 
-/* One thread a strand, its points one after another; the strands in the order perm (nullptr:
- * as stored), so the 32 lanes of a warp hold point k of 32 neighbouring strands, mostly in one
- * cell: the lanes of each cell sum their shares first, then one atomic a node and channel. */
+/* The splat (docs/cuda.md "The hair–hair grid"). A block takes 32 neighbouring strands (the
+ * order perm; nullptr: as stored): lane l of every warp holds strand s0 + l, and warp w its
+ * points k ≡ w (mod warps), so a warp's 32 lanes hold point k of 32 neighbours, mostly in one
+ * cell. Pass 1 finds the block's box of cells; when its nodes fit the shared window, pass 2
+ * adds each cell's lanes' shares there (one shared atomic a node and channel a cell), and the
+ * window goes to the grid with one global atomic a touched node and channel; otherwise pass 2
+ * adds to the grid directly. Integer sums: no order changes a bit. */
+constexpr int kSplatStrands = 32, kSplatWarps = 8, kWindow = 1024; /* nodes: 32 KB of int64 × 4 */
+
+template <typename T> struct Locate;
+template <> struct Locate<float> {
+    __device__ static int at(const World<float> &w, const float *qg, const float *x, int64_t *b, float *wt)
+    {
+        return hb_grid_locate_f32(qg, w.glo, w.gsc, w.gn, x, b, wt);
+    }
+};
+template <> struct Locate<double> {
+    __device__ static int at(const World<double> &w, const double *qg, const double *x, int64_t *b, double *wt)
+    {
+        return hb_grid_locate_f64(qg, w.glo, w.gsc, w.gn, x, b, wt);
+    }
+};
+
 template <typename T>
-__global__ void k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, const int64_t *perm,
-                             int64_t *mass, int64_t *mom)
+__device__ __forceinline__ bool finite3(const T *p)
 {
-    const int64_t s = (int64_t)blockIdx.x * blockDim.x + threadIdx.x;
-    const bool live = s < N;
-    const int64_t strand = live ? (perm ? perm[s] : s) : 0;
-    const int lane = (int)(threadIdx.x & 31u);
-    for (int k = 0; k < P; k++) {
-        int64_t base = -1, m[8], p[24];
+    return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+}
+
+template <typename T>
+__global__ void __launch_bounds__(kSplatWarps * 32) k_grid_splat(World<T> w, const T *qg, const T *x, const T *v,
+                                                                 int64_t N, int P, const int64_t *perm, int64_t *mass,
+                                                                 int64_t *mom)
+{
+    __shared__ int64_t win[4 * kWindow];
+    __shared__ int lo[3], hi[3];
+    const int lane = (int)(threadIdx.x & 31u), warp = (int)(threadIdx.x >> 5);
+    const int64_t slot = (int64_t)blockIdx.x * kSplatStrands + lane;
+    const bool live = slot < N;
+    const int64_t strand = live ? (perm ? perm[slot] : slot) : 0;
+    const int64_t n = w.gn;
+    if (threadIdx.x < 3) lo[threadIdx.x] = INT_MAX, hi[threadIdx.x] = -1;
+    __syncthreads();
+    /* pass 1: the block's box of cells */
+    for (int k = warp; k < P; k += kSplatWarps) {
+        const T *xp = x + 3 * (strand * P + k);
+        int64_t b;
+        T wt[8];
+        const bool in = live && finite3(xp) && finite3(v + 3 * (strand * P + k)) && Locate<T>::at(w, qg, xp, &b, wt);
+        const int c[3] = {in ? (int)(b % n) : INT_MAX, in ? (int)((b / n) % n) : INT_MAX,
+                          in ? (int)(b / (n * n)) : INT_MAX};
+        for (int a = 0; a < 3; a++) { /* the warp's extremes first: one shared atomic a warp */
+            const int mn = __reduce_min_sync(0xffffffffu, c[a]);
+            const int mx = __reduce_max_sync(0xffffffffu, in ? c[a] + 1 : -1);
+            if (lane == 0 && mx >= 0) {
+                atomicMin(&lo[a], mn);
+                atomicMax(&hi[a], mx);
+            }
+        }
+    }
+    __syncthreads();
+    const int ex = hi[0] - lo[0] + 1, ey = hi[1] - lo[1] + 1, ez = hi[2] - lo[2] + 1;
+    const bool windowed = hi[0] >= 0 && (int64_t)ex * ey * ez <= kWindow;
+    if (hi[0] < 0) return; /* no point of the block in the grid */
+    if (windowed) {
+        for (int i = threadIdx.x; i < 4 * ex * ey * ez; i += blockDim.x) win[i] = 0;
+        __syncthreads();
+    }
+    /* pass 2: each cell's lanes sum their shares, one atomic a node and channel */
+    for (int k = warp; k < P; k += kSplatWarps) {
         const int64_t r = strand * P + k;
-        const bool in = live && Splat<T>::point(w, qg, x + 3 * r, v + 3 * r, &base, m, p);
-        if (!in) base = -1;
-        const unsigned same = __match_any_sync(0xffffffffu, (unsigned long long)base);
+        const T *xp = x + 3 * r, *vp = v + 3 * r;
+        int64_t b = -1;
+        T wt[8];
+        const bool in = live && finite3(xp) && finite3(vp) && Locate<T>::at(w, qg, xp, &b, wt);
+        if (!in) b = -1;
+        T vc[3];
+        for (int c = 0; c < 3; c++) {
+            const T lim = (T)HB_GRID_VEL_CLAMP;
+            vc[c] = in ? (vp[c] < -lim ? -lim : vp[c] > lim ? lim : vp[c]) : (T)0;
+        }
+        const unsigned same = __match_any_sync(0xffffffffu, (unsigned long long)b);
         const bool leader = lane == __ffs(same) - 1;
-#pragma unroll
         for (int c8 = 0; c8 < 8; c8++) {
-            const int64_t sm = group_sum(same, in ? m[c8] : 0);
+            /* the point's fixed-point shares at corner c8, as hb_grid_splat_point computes them */
+            const T wc = in ? wt[c8] : (T)0;
+            const int64_t sm = group_sum(same, HB_RINT64(wc * (T)HB_GRID_MASS_SCALE));
             int64_t sp[3];
-            for (int c = 0; c < 3; c++) sp[c] = group_sum(same, in ? p[3 * c8 + c] : 0);
-            if (in && leader) {
-                const int64_t j = hb_grid_corner_f64(base, w.gn, c8);
+            for (int c = 0; c < 3; c++) sp[c] = group_sum(same, HB_RINT64((wc * vc[c]) * (T)HB_GRID_MOM_SCALE));
+            if (!(in && leader)) continue;
+            const int64_t j = hb_grid_corner_f64(b, n, c8);
+            if (windowed) {
+                const int jx = (int)(j % n) - lo[0], jy = (int)((j / n) % n) - lo[1], jz = (int)(j / (n * n)) - lo[2];
+                int64_t *cell = win + 4 * (jx + ex * (jy + ey * jz));
+                atomicAdd((unsigned long long *)&cell[0], (unsigned long long)sm);
+                for (int c = 0; c < 3; c++) atomicAdd((unsigned long long *)&cell[1 + c], (unsigned long long)sp[c]);
+            } else {
                 atomicAdd((unsigned long long *)&mass[j], (unsigned long long)sm);
                 for (int c = 0; c < 3; c++) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sp[c]);
             }
         }
+    }
+    if (!windowed) return;
+    __syncthreads();
+    for (int i = threadIdx.x; i < ex * ey * ez; i += blockDim.x) {
+        const int64_t *cell = win + 4 * i;
+        if (cell[0] == 0 && cell[1] == 0 && cell[2] == 0 && cell[3] == 0) continue;
+        const int jx = i % ex + lo[0], jy = (i / ex) % ey + lo[1], jz = i / (ex * ey) + lo[2];
+        const int64_t j = jx + n * (jy + n * (int64_t)jz);
+        atomicAdd((unsigned long long *)&mass[j], (unsigned long long)cell[0]);
+        for (int c = 0; c < 3; c++) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)cell[1 + c]);
     }
 }
 
@@ -100,7 +184,9 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
     cudaError_t e = cudaMemsetAsync(mass, 0, (size_t)nodes * sizeof *mass, stream);
     if (e == cudaSuccess) e = cudaMemsetAsync(mom, 0, (size_t)nodes * 3 * sizeof *mom, stream);
     if (e != cudaSuccess) return e;
-    k_grid_splat<T><<<blocks_for(N, 128), 128, 0, stream>>>(w, qg, x, v, N, (int)P, perm, mass, mom);
+    const int64_t blocks = (N + kSplatStrands - 1) / kSplatStrands;
+    k_grid_splat<T><<<(int)(blocks < 1 ? 1 : blocks), kSplatWarps * 32, 0, stream>>>(w, qg, x, v, N, (int)P, perm,
+                                                                                     mass, mom);
     return cudaGetLastError();
 }
 

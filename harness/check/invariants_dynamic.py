@@ -286,11 +286,16 @@ def check(traj, exact=True, frames=None, paper=True):
                 seg = np.sqrt(np.sum(np.diff(xd, axis=1) ** 2, axis=2))
                 err = np.abs(seg - ell) / (eps * E)
                 free = np.ones_like(err, dtype=bool)
+                # §3.17: friction moves a point in contact along the surface, which lifts it off a
+                # curved one: with friction a point within a segment's length of a surface counts as moved
+                near = pen_allow
+                if int(traj.dynamic_params.get("friction_declared", 0)) or any(c.mu_s > 0 for c in traj.colliders):
+                    near = float(np.max(ell)) if np.ndim(ell) else float(ell)
                 if traj.collider:
-                    free = r[:, 1:] > rc + pen_allow  # the collider did not move point k
-                if traj.colliders:  # §3.17: nor any other collider (a point in contact, where friction acts too)
+                    free = r[:, 1:] > rc + near  # the collider did not move point k
+                if traj.colliders:  # nor any other collider
                     d = collider_depths(traj, xd[:, 1:, :], frame_end_time(traj, f))
-                    free &= ~np.any(np.nan_to_num(d, nan=-np.inf) > -pen_allow, axis=0).reshape(free.shape)
+                    free &= ~np.any(np.nan_to_num(d, nan=-np.inf) > -near, axis=0).reshape(free.shape)
                 err = np.where(free, err, 0.0)
                 if traj.guided:  # §3.14: followers are placed, not followed; only guides hold ℓ
                     g = guide_count(traj.n_strands, float(traj.dynamic_params["guides"]))
