@@ -1,0 +1,117 @@
+"""`python -m harness render STATE`: PNG frames of a state file (paper or dynamic) from the
+named views, and with --animate an animation of its simulated frames from each view. The
+head is the state's sphere (bodies.head), turned with the head motion. Everything that
+would be refused (a bad file, a view, an output that exists without --force, no EGL) is
+refused in one line before anything is drawn or written."""
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from harness import HarnessError
+from harness.core.paths import display
+from harness.io.trajectory import open_trajectory
+from harness.render.gl import bodies, output
+from harness.render.gl.camera import fitted
+from harness.render.gl.context import context, describe
+from harness.render.gl.renderer import Renderer, scene_points
+from harness.render.gl.shadows import ShadowSettings
+
+ANIMATION_FRAMES = 60  # frames an animation holds at most, evenly picked
+FIT_SAMPLE = 20_000  # points per frame the animation's camera is fitted to
+
+
+def pick(n, most):
+    """Indices of at most `most` of n items, evenly spread, first and last included."""
+    if n <= most:
+        return np.arange(n)
+    return np.unique(np.round(np.linspace(0, n - 1, most)).astype(int))
+
+
+def chosen_frames(traj, frames):
+    """Frame indices from the --frame values (negative counts from the end; default: the last)."""
+    out = []
+    for k in frames or [-1]:
+        if not -traj.n_frames <= k < traj.n_frames:
+            raise HarnessError(f"render: {display(traj.path)} has no frame {k} (it has {traj.n_frames})")
+        out.append(k % traj.n_frames)
+    return out
+
+
+def animation_frames(traj, most=ANIMATION_FRAMES):
+    """The rest shape (the last paper frame), then at most `most` − 1 simulated frames evenly
+    picked, and the frame step between them (1 when every frame is drawn)."""
+    sim = traj.simulated
+    if not sim:
+        raise HarnessError(f"render: {display(traj.path)} has no simulated frame to animate (a paper-model state)")
+    every = max(1, math.ceil(len(sim) / (most - 1)))
+    return [traj.paper_frames - 1, *sim[every - 1 :: every]], every
+
+
+def strands_at(traj, frame, strands):
+    """Frame `frame`'s strands [n][P][3] (double), only those indexed by `strands`."""
+    return traj.frame(frame).reshape(traj.n_strands, traj.points, 3)[strands].astype(np.float64)
+
+
+def caption(traj, frame):
+    if traj.is_dynamic and frame >= traj.paper_frames:
+        return f"t = {traj.time[frame]:.3f} s"
+    return f"frame {frame}: {traj.stages[frame]}"
+
+
+def draw_frames(traj, renderer, frames, view, strands, fit_frames=None, captions=False):
+    """Images of `frames` from `view`, the camera fitted once to `fit_frames` (default: the
+    same frames) so that the head stays in place from one image to the next."""
+    fit_frames = frames if fit_frames is None else fit_frames
+    sample = pick(len(strands) * traj.points, FIT_SAMPLE)
+    cloud = [scene_points(strands_at(traj, f, strands).reshape(-1, 3)[sample][:, None], [bodies.head(traj, f)]) for f in fit_frames]
+    cam = fitted(view, np.concatenate(cloud), renderer.size[0] / renderer.size[1])
+    images = []
+    for f in frames:
+        img = renderer.draw(strands_at(traj, f, strands), [bodies.head(traj, f)], cam)
+        images.append(output.captioned(img, caption(traj, f)) if captions else img)
+    return images
+
+
+def run(
+    state,
+    out_dir,
+    views=("front", "side", "three-quarter"),
+    frames=None,
+    size=(960, 720),
+    animate=False,
+    force=False,
+    shadows=True,
+    max_strands=None,
+    log=print,
+):
+    """The `render` command; returns the paths written."""
+    out_dir = Path(out_dir)
+    with open_trajectory(state) as traj:
+        picked = chosen_frames(traj, frames)
+        stem = Path(state).stem
+        pngs = {(f, v): out_dir / f"{stem}-frame{f}-{v}.png" for f in picked for v in views}
+        movies = {v: out_dir / f"{stem}-{v}.gif" for v in views} if animate else {}
+        anim = animation_frames(traj) if animate else None
+        output.refuse_existing([*pngs.values(), *(p for g in movies.values() for p in output.animation_paths(g))], force)
+        context()  # no EGL: one line, nothing written
+        strands = pick(traj.n_strands, max_strands or traj.n_strands)
+        written = []
+        start = time.perf_counter()
+        with Renderer(*size, shadows=ShadowSettings(enabled=shadows)) as renderer:
+            for v in views:
+                for f in picked:
+                    img = draw_frames(traj, renderer, [f], v, strands)[0]
+                    written.append(output.write_png(img, pngs[(f, v)]))
+                if anim:
+                    drawn, every = anim
+                    images = draw_frames(traj, renderer, drawn, v, strands, captions=True)
+                    dt = float(traj.dynamic_params.get("frame_dt", 1 / 60))
+                    written += output.write_animation(images, movies[v], max(1, round(1.0 / (every * dt))))
+        log(
+            f"render: {len(written)} files from {display(state)} ({len(strands)} of {traj.n_strands} strands) "
+            f"in {time.perf_counter() - start:.1f} s on {describe()}"
+        )
+    return written
