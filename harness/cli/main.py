@@ -1,8 +1,8 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
 Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, accuracy, headline,
-export, groom, calibrate, featurecost, reduced, peer, animate, render, stability, judge, docs (`--help` on each; docs/harness.md
-lists them). User errors print one line
+export, groom, calibrate, featurecost, reduced, peer, animate, render, stability, judge, docs (`--help`
+on each; docs/harness.md lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
 
 import argparse

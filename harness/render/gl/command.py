@@ -41,13 +41,21 @@ def chosen_frames(traj, frames):
 
 
 def animation_frames(traj, most=ANIMATION_FRAMES):
-    """The rest shape (the last paper frame), then at most `most` − 1 simulated frames evenly
-    picked, and the frame step between them (1 when every frame is drawn)."""
+    """The rest shape (the last paper frame), then at most `most` simulated frames, every
+    K-th written one."""
     sim = traj.simulated
     if not sim:
         raise HarnessError(f"render: {display(traj.path)} has no simulated frame to animate (a paper-model state)")
-    every = max(1, math.ceil(len(sim) / (most - 1)))
-    return [traj.paper_frames - 1, *sim[every - 1 :: every]], every
+    every = max(1, math.ceil(len(sim) / most))
+    return [traj.paper_frames - 1, *sim[every - 1 :: every]]
+
+
+def frame_rate(traj, frames):
+    """Frames a second that play the drawn frames in real time (from their times; 1 to 50)."""
+    sim = [f for f in frames if f >= traj.paper_frames]
+    span = traj.time[sim[-1]] - traj.time[sim[0]] if len(sim) > 1 else 0.0
+    rate = (len(sim) - 1) / span if span > 0 else 1.0 / float(traj.dynamic_params.get("frame_dt", 1 / 60))
+    return int(min(output.MAX_GIF_FPS, max(1, round(rate))))
 
 
 def strands_at(traj, frame, strands):
@@ -61,18 +69,28 @@ def caption(traj, frame):
     return f"frame {frame}: {traj.stages[frame]}"
 
 
-def draw_frames(traj, renderer, frames, view, strands, fit_frames=None, captions=False):
-    """Images of `frames` from `view`, the camera fitted once to `fit_frames` (default: the
-    same frames) so that the head stays in place from one image to the next."""
-    fit_frames = frames if fit_frames is None else fit_frames
-    sample = pick(len(strands) * traj.points, FIT_SAMPLE)
-    cloud = [scene_points(strands_at(traj, f, strands).reshape(-1, 3)[sample][:, None], [bodies.head(traj, f)]) for f in fit_frames]
-    cam = fitted(view, np.concatenate(cloud), renderer.size[0] / renderer.size[1])
-    images = []
-    for f in frames:
-        img = renderer.draw(strands_at(traj, f, strands), [bodies.head(traj, f)], cam)
-        images.append(output.captioned(img, caption(traj, f)) if captions else img)
-    return images
+def frame_cloud(traj, frame, strands):
+    """Points a camera is fitted to: a sample of the frame's strand points and its head."""
+    points = strands_at(traj, frame, strands).reshape(-1, 3)
+    return scene_points(points[pick(len(points), FIT_SAMPLE)][:, None], [bodies.head(traj, frame)])
+
+
+def camera_for(renderer, view, clouds):
+    """The named view fitted to every cloud (one camera for several frames or states)."""
+    return fitted(view, np.concatenate(clouds), renderer.size[0] / renderer.size[1])
+
+
+def draw(traj, renderer, frame, strands, cam):
+    """The image of one frame: its strands and its head, turned by Q(t)."""
+    return renderer.draw(strands_at(traj, frame, strands), [bodies.head(traj, frame)], cam)
+
+
+def draw_frames(traj, renderer, frames, view, strands, captions=False):
+    """Images of `frames` from `view`, the camera fitted once to all of them, so that the
+    head stays in place from one image to the next."""
+    cam = camera_for(renderer, view, [frame_cloud(traj, f, strands) for f in frames])
+    images = [draw(traj, renderer, f, strands, cam) for f in frames]
+    return [output.captioned(img, caption(traj, f)) for img, f in zip(images, frames)] if captions else images
 
 
 def run(
@@ -95,7 +113,9 @@ def run(
         pngs = {(f, v): out_dir / f"{stem}-frame{f}-{v}.png" for f in picked for v in views}
         movies = {v: out_dir / f"{stem}-{v}.gif" for v in views} if animate else {}
         anim = animation_frames(traj) if animate else None
-        output.refuse_existing([*pngs.values(), *(p for g in movies.values() for p in output.animation_paths(g))], force)
+        output.refuse_existing(
+            [*pngs.values(), *(p for g in movies.values() for p in output.animation_paths(g))], force
+        )
         context()  # no EGL: one line, nothing written
         strands = pick(traj.n_strands, max_strands or traj.n_strands)
         written = []
@@ -106,10 +126,8 @@ def run(
                     img = draw_frames(traj, renderer, [f], v, strands)[0]
                     written.append(output.write_png(img, pngs[(f, v)]))
                 if anim:
-                    drawn, every = anim
-                    images = draw_frames(traj, renderer, drawn, v, strands, captions=True)
-                    dt = float(traj.dynamic_params.get("frame_dt", 1 / 60))
-                    written += output.write_animation(images, movies[v], max(1, round(1.0 / (every * dt))))
+                    images = draw_frames(traj, renderer, anim, v, strands, captions=True)
+                    written += output.write_animation(images, movies[v], frame_rate(traj, anim))
         log(
             f"render: {len(written)} files from {display(state)} ({len(strands)} of {traj.n_strands} strands) "
             f"in {time.perf_counter() - start:.1f} s on {describe()}"

@@ -59,6 +59,23 @@ def captioned(image, text):
     return np.asarray(im)
 
 
+def side_by_side(images, captions=(), gap=6, caption_px=18):
+    """One image of equally tall images in a row, each captioned below (Pillow's default font)."""
+    from PIL import Image, ImageDraw
+
+    h = max(np.shape(i)[0] for i in images)
+    w = sum(np.shape(i)[1] for i in images) + gap * (len(images) - 1)
+    sheet = Image.new("RGB", (w, h + (caption_px if captions else 0)), (255, 255, 255))
+    x = 0
+    draw = ImageDraw.Draw(sheet)
+    for k, img in enumerate(images):
+        sheet.paste(Image.fromarray(np.asarray(img, np.uint8)), (x, 0))
+        if k < len(captions):
+            draw.text((x + 4, h + 3), captions[k], fill=(30, 30, 30))
+        x += np.shape(img)[1] + gap
+    return np.asarray(sheet)
+
+
 def write_gif(frames, path, fps):
     from PIL import Image
 
@@ -88,7 +105,9 @@ def write_mp4(frames, path, fps):
         done = subprocess.run(cmd, input=data, capture_output=True)
         if done.returncode:
             why = done.stderr.decode(errors="replace").strip().splitlines()
-            raise HarnessError(f"render: ffmpeg could not write {display(path)} ({why[-1] if why else done.returncode})")
+            raise HarnessError(
+                f"render: ffmpeg could not write {display(path)} ({why[-1] if why else done.returncode})"
+            )
 
     return _atomic(path, encode)
 

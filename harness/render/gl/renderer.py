@@ -102,7 +102,9 @@ class Renderer:
     def _hair_array(self, program, strands, seed):
         vertices, indices = geometry.strand_vertices(strands, seed)
         vbo, ibo = self.ctx.buffer(vertices.tobytes()), self.ctx.buffer(indices.tobytes())
-        vao = self.ctx.vertex_array(program, [(vbo, *_layout(program, geometry.STRAND_FORMAT, geometry.STRAND_ATTRIBUTES))], ibo)
+        vao = self.ctx.vertex_array(
+            program, [(vbo, *_layout(program, geometry.STRAND_FORMAT, geometry.STRAND_ATTRIBUTES))], ibo
+        )
         return vao, (vao, vbo, ibo), len(indices)
 
     def _body_arrays(self, program, bodies):
@@ -149,7 +151,9 @@ class Renderer:
         import moderngl
 
         ctx = self.ctx
-        strands = np.asarray(strands, float).reshape(-1, *np.shape(strands)[-2:]) if len(strands) else np.zeros((0, 2, 3))
+        strands = (
+            np.asarray(strands, float).reshape(-1, *np.shape(strands)[-2:]) if len(strands) else np.zeros((0, 2, 3))
+        )
         l_dir = world_light(camera, light)
         sh, sd = self.shading, self.shadows
         ctx.enable(moderngl.DEPTH_TEST)

@@ -1,7 +1,7 @@
 """Self-shadowing by an opacity shadow map: the hair and the bodies are drawn from the
 light (orthographic, SIZE² texels) into a depth texture holding the first surface the
 light meets. A fragment that lies Δ cm behind that surface receives exp(−σ·Δ) of the
-light (a 3×3 filter over the neighbouring texels): hair in front of other hair darkens it
+light (the depth map filtered bilinearly): hair in front of other hair darkens it
 the more hair it has passed through, the way opacity and deep shadow maps do, at the cost
 of one depth pass. The numbers and the choice: docs/decisions/render.md."""
 
