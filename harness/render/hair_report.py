@@ -11,7 +11,6 @@ harness/bench/renders.py); where no OpenGL context can be made, the sections say
 """
 
 import json
-import time
 from pathlib import Path
 
 import numpy as np
@@ -47,20 +46,6 @@ PAPER_FIGURES = (
 )
 
 
-class Timer:
-    """Seconds spent drawing, summed over the sections of one report."""
-
-    def __init__(self):
-        self.seconds = 0.0
-
-    def __enter__(self):
-        self.start = time.perf_counter()
-        return self
-
-    def __exit__(self, *exc):
-        self.seconds += time.perf_counter() - self.start
-
-
 def _image_line(path, out_dir, alt):
     return f"![{alt}]({Path(path).relative_to(out_dir)})"
 
@@ -73,8 +58,7 @@ def paper_lines(state, out_dir):
     if why or state is None or not Path(state).exists():
         return lines + [f"Not rendered: {why or 'no figure state (the paper sweep makes it)'}.", ""]
     out_dir = Path(out_dir)
-    timer = Timer()
-    with open_trajectory(state) as traj, Renderer(*FIG_SIZE) as r, timer:
+    with open_trajectory(state) as traj, Renderer(*FIG_SIZE) as r:
         every = np.arange(traj.n_strands)
         frames = {
             "fig1_rendered.png": traj.stages.index("collide") if "collide" in traj.stages else 0,
@@ -93,7 +77,7 @@ def paper_lines(state, out_dir):
                 _image_line(out_dir / name, out_dir, title),
                 "",
             ]
-    lines += [f"Drawn in {timer.seconds:.1f} s on {context.describe()} (`python -m harness render`).", ""]
+    lines += [f"Drawn on {context.describe()} (`python -m harness render`).", ""]
     return lines
 
 
@@ -107,14 +91,14 @@ def _frame_at(traj, t):
     return sim[int(np.argmin(np.abs(traj.time[sim] - t)))]
 
 
-def motion_lines(traj, out_dir, timer):
+def motion_lines(traj, out_dir):
     """The animation and the hero frame of the default scene's state."""
     every = np.arange(traj.n_strands)
-    with Renderer(*ANIMATION_SIZE) as r, timer:
+    with Renderer(*ANIMATION_SIZE) as r:
         frames = command.animation_frames(traj)
         images = command.draw_frames(traj, r, frames, "three-quarter", every, captions=True)
         movies = output.write_animation(images, out_dir / ANIMATION, command.frame_rate(traj, frames))
-    with Renderer(*HERO_SIZE) as r, timer:
+    with Renderer(*HERO_SIZE) as r:
         hero = _frame_at(traj, HERO_TIME)
         output.write_png(command.draw_frames(traj, r, [hero], "three-quarter", every)[0], out_dir / HERO)
     return [
@@ -132,7 +116,7 @@ def motion_lines(traj, out_dir, timer):
     ]
 
 
-def mode_lines(record, folder, out_dir, timer):
+def mode_lines(record, folder, out_dir):
     """Per use, its recommended modes' last frames beside the reference's, one camera for all."""
     ref = record.get("reference")
     if not record.get("modes") or not ref:
@@ -149,7 +133,7 @@ def mode_lines(record, folder, out_dir, timer):
         "reference with each mode's settings, seen from the side:",
         "",
     ]
-    with Renderer(*MODE_SIZE) as r, timer:
+    with Renderer(*MODE_SIZE) as r:
         trajs = {s: open_trajectory(folder / s) for s in {s for v in uses.values() for s, _ in v} | {ref["state"]}}
         try:
             every = np.arange(trajs[ref["state"]].n_strands)
@@ -179,13 +163,8 @@ def dynamic_lines(root, out_dir):
     if why or record is None:
         return lines + [f"Not rendered: {why or f'no {display(folder)}/renders.json (make bench makes it)'}.", ""]
     out_dir = Path(out_dir)
-    timer = Timer()
     with open_trajectory(folder / record["dynamic"]) as traj:
-        lines += motion_lines(traj, out_dir, timer)
-    lines += ["### The accuracy recommendations, seen", ""] + mode_lines(record, folder, out_dir, timer)
-    lines += [
-        f"Drawn in {timer.seconds:.1f} s on {context.describe()} from the states in `{display(folder)}` "
-        f"(simulated in {record.get('simulate_s', float('nan')):.0f} s by `make bench`).",
-        "",
-    ]
+        lines += motion_lines(traj, out_dir)
+    lines += ["### The accuracy recommendations, seen", ""] + mode_lines(record, folder, out_dir)
+    lines += [f"Drawn on {context.describe()} from the states in `{display(folder)}` (made by `make bench`).", ""]
     return lines
