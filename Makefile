@@ -191,7 +191,7 @@ $(BUILD)/hairsim-cuda-strict: $(CUDA_OBJ_strict) $(SHARED_OBJ)
 $(BUILD)/hairsim-cuda-fastmath: $(CUDA_OBJ_fastmath) $(SHARED_OBJ)
 $(CUDA_BINS):
 	@mkdir -p $(BUILD)
-	$(NVCC) -arch=$(CUDA_ARCH) $^ -o $@ $(HDF5_LIBS)
+	$(NVCC) -arch=$(CUDA_ARCH) $^ -o $@ $(HDF5_LIBS) -ldl
 
 # The host checks (tests/native): the CUDA port's model templates compiled for the host and
 # run against the reference's objects; host code only, with the host compiler told the
