@@ -1,8 +1,8 @@
 """Solid bodies drawn with the hair: spheres, capsules (two end points and a radius) and
 triangle meshes, each with its transform of the frame. `head(traj, frame)` is the head
 sphere of a state (docs/model.md §3.2: R = head_radius about the origin, turned by Q(t) of
-the file's head motion); a caller with more colliders passes them to the renderer beside it
-(renderer.Renderer.draw(strands, bodies, camera)).
+the file's head motion); `of_frame(traj, frame)` lists every body of a frame, and
+renderer.Renderer.draw(strands, bodies, camera) draws any list of them.
 
 Every body becomes (vertices, normals, triangles) in its own space and a 4×4 model matrix
 (a rotation and a translation, no scale) that places it in the world."""
@@ -98,3 +98,10 @@ def head_rotation_at(traj, frame):
 def head(traj, frame):
     """The head sphere of frame `frame`: radius head_radius about the origin, turned by Q(t)."""
     return Sphere((0.0, 0.0, 0.0), float(traj.params["head_radius"]), head_rotation_at(traj, frame), face_marks=True)
+
+
+def of_frame(traj, frame):
+    """Every solid body of frame `frame` of a state, placed for that frame: the one place a
+    state's bodies are listed (today the head; colliders the model gains go here, as Capsule
+    or Mesh with their transforms of the frame), so every render draws them."""
+    return [head(traj, frame)]

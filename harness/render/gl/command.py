@@ -72,7 +72,7 @@ def caption(traj, frame):
 def frame_cloud(traj, frame, strands):
     """Points a camera is fitted to: a sample of the frame's strand points and its head."""
     points = strands_at(traj, frame, strands).reshape(-1, 3)
-    return scene_points(points[pick(len(points), FIT_SAMPLE)][:, None], [bodies.head(traj, frame)])
+    return scene_points(points[pick(len(points), FIT_SAMPLE)][:, None], bodies.of_frame(traj, frame))
 
 
 def camera_for(renderer, view, clouds):
@@ -82,7 +82,7 @@ def camera_for(renderer, view, clouds):
 
 def draw(traj, renderer, frame, strands, cam):
     """The image of one frame: its strands and its head, turned by Q(t)."""
-    return renderer.draw(strands_at(traj, frame, strands), [bodies.head(traj, frame)], cam)
+    return renderer.draw(strands_at(traj, frame, strands), bodies.of_frame(traj, frame), cam)
 
 
 def draw_frames(traj, renderer, frames, view, strands, captions=False):
