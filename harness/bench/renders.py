@@ -24,6 +24,7 @@ from harness.core import runner, scenes
 from harness.core.paths import binary_path, display
 from harness.io.files import write_json
 from harness.render import accuracy_dynamic_report
+from harness.render.gl import context
 from harness.studies.accuracy import results_name
 from harness.studies.accuracy_dynamic import configured
 
@@ -80,7 +81,12 @@ def mode_states(root, out, say):
 
 
 def simulate(root, say):
-    """Make ROOT/renders/ (states and renders.json); the record's path."""
+    """Make ROOT/renders/ (states and renders.json); the record's path, or None (nothing made)
+    where no OpenGL context can be made to draw them (one line says why)."""
+    why = context.unavailable()
+    if why:
+        say(f"harness: renders: skipped: {why}")
+        return None
     start = time.perf_counter()
     out = Path(root) / FOLDER
     out.mkdir(parents=True, exist_ok=True)
