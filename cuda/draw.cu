@@ -62,9 +62,15 @@ __global__ void k_head(unsigned long long *fb, hb_draw::View v)
     if (c < v.W) fb[(int64_t)r * v.W + c] = hb_draw::head_pixel(v, c, r);
 }
 
+/* the nearest fragment wins; a plain read first skips the atomic for a fragment already
+ * behind what the pixel holds (most of them, where hair lies over hair or behind the head) */
 struct DeviceMin {
     unsigned long long *fb;
-    __device__ void operator()(int64_t i, uint64_t value) const { atomicMin(fb + i, (unsigned long long)value); }
+    __device__ void operator()(int64_t i, uint64_t value) const
+    {
+        if ((unsigned long long)value < *(volatile unsigned long long *)(fb + i))
+            atomicMin(fb + i, (unsigned long long)value);
+    }
 };
 
 template <typename T> __global__ void k_segments(unsigned long long *fb, hb_draw::View v, Positions p)
