@@ -120,14 +120,19 @@ def run(
         strands = pick(traj.n_strands, max_strands or traj.n_strands)
         written = []
         start = time.perf_counter()
-        with Renderer(*size, shadows=ShadowSettings(enabled=shadows)) as renderer:
-            for v in views:
-                for f in picked:
-                    img = draw_frames(traj, renderer, [f], v, strands)[0]
-                    written.append(output.write_png(img, pngs[(f, v)]))
-                if anim:
-                    images = draw_frames(traj, renderer, anim, v, strands, captions=True)
-                    written += output.write_animation(images, movies[v], frame_rate(traj, anim))
+        try:
+            with Renderer(*size, shadows=ShadowSettings(enabled=shadows)) as renderer:
+                for v in views:
+                    for f in picked:
+                        img = draw_frames(traj, renderer, [f], v, strands)[0]
+                        written.append(output.write_png(img, pngs[(f, v)]))
+                    if anim:
+                        images = draw_frames(traj, renderer, anim, v, strands, captions=True)
+                        written += output.write_animation(images, movies[v], frame_rate(traj, anim))
+        except BaseException:  # an error or Ctrl-C part way: what this run wrote goes too
+            for path in written:
+                path.unlink(missing_ok=True)
+            raise
         log(
             f"render: {len(written)} files from {display(state)} ({len(strands)} of {traj.n_strands} strands) "
             f"in {time.perf_counter() - start:.1f} s on {describe()}"
