@@ -42,8 +42,14 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--binary", default=str(ROOT / "build" / "hairsim-cuda"))
     ap.add_argument("--frames", type=int, default=40)
-    ap.add_argument("--variant", default=None, help="a simulate variant (default: the binary's default)")
+    ap.add_argument("--variant", default=None, help="a simulate variant (default: lanes, else the first declared)")
     args = ap.parse_args()
+    if args.variant is None:
+        from harness.core import variants
+
+        running = variants.declared("cuda").running("simulate", points=32)
+        args.variant = "lanes" if "lanes" in running else running[0]
+    print(f"{args.binary} --variant {args.variant}, 1920x1080, {args.frames} frames drawn")
     print("strands   path     simulate_ms  draw_ms  frame_ms  targets")
     for n in (10_000, 100_000, 1_000_000):
         d = measure(args.binary, n, args.frames, args.variant)

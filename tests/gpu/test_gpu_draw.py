@@ -18,6 +18,8 @@ import numpy as np
 import pytest
 
 from conftest import CUDA_BIN
+from harness import HarnessError
+from harness.core import variants
 from support.statecheck import run
 from support.synthetic import crafted_state
 
@@ -27,15 +29,20 @@ P, SIZE, PX_CM = 9, 682, 10
 A = [(-12.0 + 3 * k, 15.05, 12.0) for k in range(P)]
 B = [(-12.0 + 3 * k, 0.05, -12.0) for k in range(P)]
 STILL = ["--stages", "simulate", "--gravity", "0", "--frames", "8"]
+try:  # every simulating variant: the strand variant's positions are point-major, the others' canonical
+    VARIANTS = variants.declared("cuda").running("simulate", points=P)
+except HarnessError:
+    VARIANTS = ()
 
 
-@pytest.fixture(scope="module")
-def drawn(tmp_path_factory):
+@pytest.fixture(scope="module", params=VARIANTS)
+def drawn(tmp_path_factory, request):
     from PIL import Image
 
     work = tmp_path_factory.mktemp("gpu_draw")
     state = crafted_state(work / "two.h5", [A, B], precision="fp32", L=24.0)
-    p = run(CUDA_BIN, "--input", state, *STILL, "--draw", f"{SIZE}x{SIZE}", "--draw-image", work / "img", "--json")
+    draw = ["--draw", f"{SIZE}x{SIZE}", "--draw-image", work / "img", "--json"]
+    p = run(CUDA_BIN, "--input", state, "--variant", request.param, *STILL, *draw)
     record = json.loads(p.stdout)["stages"][-1]["draw"]
     images = {}
     for path in ("compute", "gl"):
