@@ -76,7 +76,8 @@ NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DH
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
 HOSTCHECK_BINS := $(BUILD)/hostcheck/model_hostcheck_reference $(BUILD)/hostcheck/model_hostcheck_free \
-                  $(BUILD)/hostcheck/dyn_hostcheck $(BUILD)/hostcheck/post_hostcheck $(BUILD)/hostcheck/lod_hostcheck
+                  $(BUILD)/hostcheck/dyn_hostcheck $(BUILD)/hostcheck/post_hostcheck $(BUILD)/hostcheck/lod_hostcheck \
+                  $(BUILD)/hostcheck/draw_hostcheck
 
 .PHONY: all cpu planted cuda hostcheck test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt docs
 
@@ -191,7 +192,7 @@ $(BUILD)/hairsim-cuda-strict: $(CUDA_OBJ_strict) $(SHARED_OBJ)
 $(BUILD)/hairsim-cuda-fastmath: $(CUDA_OBJ_fastmath) $(SHARED_OBJ)
 $(CUDA_BINS):
 	@mkdir -p $(BUILD)
-	$(NVCC) -arch=$(CUDA_ARCH) $^ -o $@ $(HDF5_LIBS)
+	$(NVCC) -arch=$(CUDA_ARCH) $^ -o $@ $(HDF5_LIBS) -ldl
 
 # The host checks (tests/native): the CUDA port's model templates compiled for the host and
 # run against the reference's objects; host code only, with the host compiler told the
@@ -217,6 +218,10 @@ $(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/hostcheck
   $(OBJ)/dynamic/dyn_lod.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
+# --draw's two paths on the host (OpenGL through EGL: loaded at run time, no GL library linked)
+$(BUILD)/hostcheck/draw_hostcheck: cuda/hostcheck/draw_hostcheck.cu cuda/draw_view.cuh cuda/egl_gl.cuh
+	@mkdir -p $(@D)
+	$(HOSTCHECK_NVCC) -O1 $< -o $@ -ldl -lm
 else
 hostcheck:
 	@echo "error: nvcc not found: the host checks (cuda/hostcheck/) need it"; exit 1

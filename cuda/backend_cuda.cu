@@ -520,6 +520,7 @@ int main(int argc, char **argv)
     b.dyn_observe = cuda_dyn_observe;
     b.dyn_fetch_velocity = cuda_dyn_fetch_velocity;
     b.dyn_loop = cuda_dyn_loop;
+    b.dyn_draw = cuda_dyn_draw;
     b.dyn_render = cuda_dyn_render;
     return hb_main(argc, argv, &b);
 }

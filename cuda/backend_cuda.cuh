@@ -85,6 +85,12 @@ int cuda_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, size_t er
 int cuda_dyn_render(hb_backend *b, void *position, void *velocity, double *ms, char *err, size_t errlen);
 int cuda_dyn_loop(hb_backend *b, const hb_dyn_frame *plans, int n, double *ms, double *graph_ms, char *err,
                   size_t errlen);
+/* --draw (draw.cu): one frame's simulation from the device tables q, ph on `stream`; the strides
+ * of the positions in c->state (strand i, point k, component: base[i·s[0] + k·s[1] + c·s[2]]) */
+cudaError_t dyn_launch_tables(cuda_impl *c, const void *q, const void *ph, cudaStream_t stream);
+void dyn_position_strides(const cuda_impl *c, int64_t s[3]);
+int cuda_dyn_draw(hb_backend *b, const hb_dyn_frame *plans, int n, int width, int height, const char *image,
+                  hb_draw_result *out, char *err, size_t errlen);
 
 } // namespace hb_cuda
 

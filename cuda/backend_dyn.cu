@@ -575,6 +575,18 @@ template <typename T> static cudaError_t dyn_frame_launches(cuda_impl *c, const 
     return cudaSuccess;
 }
 
+cudaError_t dyn_launch_tables(cuda_impl *c, const void *q, const void *ph, cudaStream_t stream)
+{
+    return c->scene.precision == HB_FP32 ? dyn_launch<float>(c, c->dyn->m32, q, ph, stream)
+                                         : dyn_launch<double>(c, c->dyn->m64, q, ph, stream);
+}
+
+void dyn_position_strides(const cuda_impl *c, int64_t s[3])
+{
+    const hbd::Layout l = dyn_layout(c);
+    s[0] = l.is, s[1] = l.ks, s[2] = l.cs;
+}
+
 static const char *dyn_launch_name(const cuda_impl *c)
 {
     return c->variant == V_STRAND    ? "the simulate kernel launch (strand)"

@@ -7,6 +7,8 @@
 # 2. Python >= 3.11 with the packages of requirements.lock. If $PYTHON already imports them,
 #    nothing is installed (machines without a network work from what is there). Else pip
 #    installs the lock into $PYTHON, or into ./.venv when $PYTHON refuses (PEP 668).
+#    The renderer (moderngl) is tried on its own when it is the one thing missing, and not
+#    required: without it `harness render` and the report's renders say why and skip.
 # The interpreter to use is written to OUT (make reads it). Environment: PYTHON (default
 # python3), CC (default cc), HAIRBENCH_READERS=1 also installs requirements-readers.lock.
 set -euo pipefail
@@ -61,7 +63,17 @@ fi
   die "$PY is Python $("$PY" -c 'import platform; print(platform.python_version())'); hairbench needs Python >= 3.11 (set PYTHON=/path/to/python3.11 or newer)"
 
 imports() { "$1" -c "import $(echo "$MODULES" | tr ' ' ',')" >/dev/null 2>&1; }
+# The renderer (moderngl on EGL) is installed with the lock but not required: where pip cannot
+# bring it (no network), one line says so and the renders are skipped with that reason.
+renderer() {
+  "$1" -c "import moderngl" >/dev/null 2>&1 && return 0
+  say "installing the renderer (moderngl, glcontext from requirements.lock) into $1"
+  grep -E '^(moderngl|glcontext)==' requirements.lock |
+    xargs "$1" -m pip install -q --disable-pip-version-check --retries 1 --timeout 30 >>"$LOG" 2>&1 ||
+    say "moderngl could not be installed into $1 (see $LOG): harness render and the report's renders are skipped"
+}
 done_with() {
+  renderer "$1"
   if [ "${HAIRBENCH_READERS:-}" = 1 ] && ! "$1" -c "import MDAnalysis, vtkmodules.vtkIOXdmf2, pxr" >/dev/null 2>&1; then
     say "installing the optional readers (requirements-readers.lock) into $1"
     "$1" -m pip install -q --disable-pip-version-check --retries 1 --timeout 30 -r requirements-readers.lock >>"$LOG" 2>&1 ||

@@ -55,6 +55,21 @@ static inline unsigned hb_variant_solvers(const hb_variant *v)
     return v->solvers ? v->solvers : (1u << HB_SOLVER_XPBD) | (1u << HB_SOLVER_FTL);
 }
 
+/* --draw: F frames simulated and drawn on the device, each path timed (docs/interfaces.md,
+ * "Drawing on the GPU"). Times are per frame, the mean over the frames after a warm-up
+ * frame; NaN where not measured. */
+typedef struct {
+    int width, height, frames;
+    double simulate_ms;      /* the simulation kernel (CUDA events), the compute path's frames */
+    double compute_ms;       /* the compute rasteriser: clear with the head, strands, resolve (CUDA events) */
+    double compute_frame_ms; /* simulation and compute drawing back to back, first event to last / F */
+    double gl_write_ms;      /* OpenGL path: CUDA writing the GL vertex buffer (map, kernel, unmap) */
+    double gl_ms;            /* OpenGL path: the draw's GPU time (GL_TIME_ELAPSED) */
+    double gl_frame_ms;      /* OpenGL path: simulation, write and draw, host wall time per frame */
+    char gl[160];            /* the GL renderer and version, "" where the GL path did not run */
+    char gl_missing[256];    /* why the GL path did not run, "" where it did */
+} hb_draw_result;
+
 /* The result of running one stage (or a fused group) once. */
 typedef struct {
     double ms;            /* the stage's own time: kernels only (cuda events) or the loop (cpu) */
@@ -119,6 +134,13 @@ struct hb_backend {
     /* Descriptions for the metadata. */
     void (*describe)(hb_backend *b, char *device, size_t dlen, char *driver, size_t vlen);
     void (*teardown)(hb_backend *b);
+    /* Optional (NULL: --draw refused): advance the current state by n frames, drawing each
+     * into a W×H image on the device through each path (OpenGL through EGL from a vertex
+     * buffer CUDA writes, and a CUDA compute rasteriser), nothing copied through the host;
+     * with `image` (a path prefix) the last frame of each path is written as PREFIX-PATH.ppm
+     * after the timing. A missing EGL or GL fills out->gl_missing and is not an error. */
+    int (*dyn_draw)(hb_backend *b, const hb_dyn_frame *plans, int n, int width, int height, const char *image,
+                    hb_draw_result *out, char *err, size_t errlen);
 };
 
 /* Bytes of host memory available for a new allocation (MemAvailable); 0 if unknown. */

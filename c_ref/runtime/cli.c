@@ -207,7 +207,12 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
                "  --output-every K     write every K-th simulated frame; the last always (default 1)\n"
                "  --velocities W       last | all: write the velocities of the last or of every written frame\n"
                "  --frame-loop         after the run, time F more frames back to back as an application's frame\n"
-               "                       loop would (launches and the frame's tables included; cuda only)\n");
+               "                       loop would (launches and the frame's tables included; cuda only)\n"
+               "  --draw WxH           after the run, simulate F more frames and draw each into a WxH image on\n"
+               "                       the GPU, through OpenGL on EGL and through a CUDA rasteriser, timed\n"
+               "                       (cuda only; docs/interfaces.md)\n"
+               "  --draw-image PREFIX  with --draw: the last drawn frame of each path as PREFIX-gl.ppm and\n"
+               "                       PREFIX-compute.ppm\n");
     for (size_t i = 0; i < N_DYN_FLAGS; i++) {
         char name[64];
         snprintf(name, sizeof name, "%s%s", dyn_flags[i].flag,
@@ -545,6 +550,23 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
             else if (strcmp(v, "last") == 0) o->all_velocities = 0;
             else FAIL("--velocities must be last or all (got '%s')", v);
             o->dyn_given |= HB_DYN_GIVEN_RUN;
+        } else if (strcmp(name, "--draw") == 0) {
+            /* WxH, each a whole number of pixels in 16..16384 */
+            char *x = NULL;
+            const long w = strtol(v, &x, 10);
+            char *end = NULL;
+            const long h = x && *x == 'x' ? strtol(x + 1, &end, 10) : 0;
+            if (!(x && *x == 'x' && end && *end == '\0' && x != v && end != x + 1 && v[0] >= '0' && v[0] <= '9' &&
+                  x[1] >= '0' && x[1] <= '9') ||
+                w < 16 || h < 16 || w > 16384 || h > 16384)
+                FAIL("--draw needs WIDTHxHEIGHT in pixels, each 16..16384 (got '%s')", v);
+            o->draw_w = (int)w;
+            o->draw_h = (int)h;
+            o->dyn_given |= HB_DYN_GIVEN_RUN;
+        } else if (strcmp(name, "--draw-image") == 0) {
+            if (!*v) FAIL("--draw-image needs a path prefix");
+            o->draw_image = v;
+            o->dyn_given |= HB_DYN_GIVEN_RUN;
         } else if (strcmp(name, "--input-frame") == 0) {
             if (parse_i64(name, v, 0, &iv, err, errlen)) return -1;
             if (iv > INT32_MAX) FAIL("--input-frame is out of range (got %lld)", (long long)iv);
@@ -642,7 +664,8 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         for (size_t i = 0; i < N_DYN_FLAGS; i++)
             if (o->dyn_given & (1ull << i))
                 FAIL("%s belongs to the simulate stage, which --stages does not list", dyn_flags[i].flag);
-        FAIL("--frames, --output-every and --velocities belong to the simulate stage, which --stages does not list");
+        FAIL("--frames, --output-every, --velocities and --draw belong to the simulate stage, which --stages does not "
+             "list");
     }
     if (!o->scene.dyn.guided && (o->dyn_given & (1ull << hb_dyn_flag_index("--follow"))))
         FAIL("--follow needs --guides (every strand is simulated unless --guides is given)");

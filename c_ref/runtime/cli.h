@@ -17,7 +17,7 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend);
 void hb_default_options(hb_options *o);
 
 /* The dynamic flags' table: bit i of hb_options.dyn_given is entry i; the run-shape flags
- * (--frames, --output-every, --velocities) set HB_DYN_GIVEN_RUN. */
+ * (--frames, --output-every, --velocities, --draw, --draw-image) set HB_DYN_GIVEN_RUN. */
 #define HB_DYN_GIVEN_RUN (1ull << 63)
 const char *hb_dyn_flag_name(int i);
 int hb_dyn_flag_index(const char *flag);

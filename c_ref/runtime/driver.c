@@ -288,6 +288,9 @@ static int render_frame(hb_run *r, int vel, double *ms, char *err, size_t errlen
  * that file's rest shape, velocities and time. Each frame is timed on its own (--repeat
  * times from the same state); the observables and the file's frames are taken between the
  * timed frames, outside them. Memory does not grow with the frame count: one host frame. */
+static int frame_plans(const hb_scene *s, int64_t first, int64_t n, hb_dyn_frame **plans, int64_t *n_plans, char *err,
+                       size_t errlen);
+
 static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times, char *err, size_t errlen)
 {
     hb_backend *b = r->b;
@@ -366,7 +369,8 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
                  (long long)o->frames, (long long)d->substeps, (long long)gf0);
         FAIL_IF(1, HB_EXIT_USAGE);
     }
-    const double t_end = (double)(gf0 + (o->frame_loop ? 2 : 1) * o->frames) * d->frame_dt;
+    const int64_t after = (o->frame_loop ? 1 : 0) + (o->draw_w ? 1 : 0); /* F more frames each */
+    const double t_end = (double)(gf0 + (1 + after) * o->frames) * d->frame_dt;
     FAIL_IF(hb_dynamics_validate_time(s, t_end, err, errlen), HB_EXIT_USAGE);
     FAIL_IF(b->dyn_load(b, vel, rest, err, errlen), HB_EXIT_RUNTIME);
     if (r->w) FAIL_IF(hb_writer_rest(r->w, as_written(r, rest), err, errlen), HB_EXIT_RUNTIME);
@@ -438,27 +442,24 @@ static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times
     }
     hb_time_stats(sr->times_ms, sr->n_times, &sr->meta.median_ms, &sr->meta.min_ms, &sr->meta.max_ms);
     sr->loop_ms = sr->loop_graph_ms = NAN;
+    if (after > 0 && (o->frames > INT32_MAX || gf0 + (1 + after) * o->frames > (INT64_C(1) << 53) / d->substeps)) {
+        snprintf(err, errlen, "%s: --frames %lld is too many frames to run again",
+                 o->draw_w ? "--draw" : "--frame-loop", (long long)o->frames);
+        FAIL_IF(1, HB_EXIT_USAGE);
+    }
+    int64_t next = gf0 + o->frames; /* the global frame the next of these runs starts from */
     if (o->frame_loop) {
         /* F more frames from the final state, after everything above is written: the frames
          * an application would run next, their tables made here as for any frame */
-        if (o->frames > INT32_MAX || gf0 + 2 * o->frames > (INT64_C(1) << 53) / d->substeps) {
-            snprintf(err, errlen, "--frame-loop: --frames %lld is too many frames to loop over", (long long)o->frames);
-            FAIL_IF(1, HB_EXIT_USAGE);
-        }
-        plans = calloc((size_t)o->frames, sizeof *plans);
-        for (int64_t j = 0; plans && j < o->frames; j++) {
-            if (hb_dyn_frame_alloc(&plans[j], d->substeps) != 0 || hb_dyn_frame_alloc_world(&plans[j], s) != 0) {
-                hb_dyn_frame_free(&plans[j]);
-                break;
-            }
-            n_plans = j + 1;
-            hb_dyn_frame_plan(s, (gf0 + o->frames + j) * d->substeps, &plans[j]);
-        }
-        if (n_plans < o->frames) {
-            snprintf(err, errlen, "out of host memory for the frame loop's tables");
-            FAIL_IF(1, HB_EXIT_MEMORY);
-        }
+        FAIL_IF(frame_plans(s, next, o->frames, &plans, &n_plans, err, errlen), HB_EXIT_MEMORY);
         FAIL_IF(b->dyn_loop(b, plans, (int)o->frames, &sr->loop_ms, &sr->loop_graph_ms, err, errlen), HB_EXIT_RUNTIME);
+        next += o->frames;
+    }
+    if (o->draw_w) { /* F more frames, each simulated and drawn on the device (docs/interfaces.md) */
+        FAIL_IF(frame_plans(s, next, o->frames, &plans, &n_plans, err, errlen), HB_EXIT_MEMORY);
+        FAIL_IF(b->dyn_draw(b, plans, (int)o->frames, o->draw_w, o->draw_h, o->draw_image, &sr->draw, err, errlen),
+                HB_EXIT_RUNTIME);
+        sr->drawn = 1;
     }
 out:
 #undef FAIL_IF
@@ -469,6 +470,27 @@ out:
     free(vel);
     free(rt);
     return status;
+}
+
+/* The tables of n frames from global frame `first` (its substeps first·S …) into *plans,
+ * the ones there before freed; −1 with one line when the host memory runs out. */
+static int frame_plans(const hb_scene *s, int64_t first, int64_t n, hb_dyn_frame **plans, int64_t *n_plans, char *err,
+                       size_t errlen)
+{
+    for (int64_t j = 0; j < *n_plans; j++) hb_dyn_frame_free(&(*plans)[j]);
+    free(*plans);
+    *n_plans = 0;
+    *plans = calloc((size_t)n, sizeof **plans);
+    for (int64_t j = 0; *plans && j < n; j++) {
+        if (hb_dyn_frame_alloc(&(*plans)[j], s->dyn.substeps) != 0 || hb_dyn_frame_alloc_world(&(*plans)[j], s) != 0) {
+            hb_dyn_frame_free(&(*plans)[j]);
+            break;
+        }
+        *n_plans = j + 1;
+        hb_dyn_frame_plan(s, (first + j) * s->dyn.substeps, &(*plans)[j]);
+    }
+    if (*n_plans < n) return snprintf(err, errlen, "out of host memory for the frames' tables"), -1;
+    return 0;
 }
 
 /* --groom (docs/model.md §3.15): init places the groom; the paper stages, which keep each
@@ -721,16 +743,28 @@ static int run_one(int argc, char **argv, hb_backend *b)
                      o.block_size, b->name, var->name, var->max_block);
             CHECK(1, HB_EXIT_USAGE);
         }
-        if (o.frame_loop && (o.scene.dyn.grid || hb_dyn_has_world(&o.scene))) {
-            snprintf(err, sizeof err, "--frame-loop does not yet loop over the grid and colliders (docs/model.md §3.16, §3.17)");
+        if ((o.frame_loop || o.draw_w) && (o.scene.dyn.grid || hb_dyn_has_world(&o.scene))) {
+            snprintf(err, sizeof err, "%s does not yet run the grid and colliders (docs/model.md §3.16, §3.17)",
+                     o.frame_loop ? "--frame-loop" : "--draw");
             CHECK(1, HB_EXIT_USAGE);
         }
         if (o.frame_loop && !b->dyn_loop) {
             snprintf(err, sizeof err, "--frame-loop is measured by the cuda backend only");
             CHECK(1, HB_EXIT_USAGE);
         }
+        if (o.draw_w && !b->dyn_draw) {
+            snprintf(err, sizeof err, "--draw draws on the GPU: the cuda backend only");
+            CHECK(1, HB_EXIT_USAGE);
+        }
     } else if (o.frame_loop) {
         snprintf(err, sizeof err, "--frame-loop needs simulate in --stages");
+        CHECK(1, HB_EXIT_USAGE);
+    } else if (o.draw_w) {
+        snprintf(err, sizeof err, "--draw needs simulate in --stages");
+        CHECK(1, HB_EXIT_USAGE);
+    }
+    if (o.draw_image && !o.draw_w) {
+        snprintf(err, sizeof err, "--draw-image needs --draw");
         CHECK(1, HB_EXIT_USAGE);
     }
     if (o.input) {

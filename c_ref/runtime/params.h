@@ -119,16 +119,18 @@ typedef struct {
     int warmup; /* -1: default (1 if repeat > 1, else 0) */
     int json;
     int quiet;
-    int end_to_end;        /* measure one extra untimed-by-stage pass */
-    int measure_bandwidth; /* only measure the copy bandwidth */
-    const char *self_test; /* "rng": print the known-answer checks */
-    int list_variants;     /* print the backend's variants as JSON and exit */
-    int input_frame;       /* --input-frame: resume after this frame of --input; −1 = its last */
-    int64_t frames;        /* simulate: frames to advance (F) */
-    int64_t output_every;  /* simulate: write every K-th frame (the last always) */
-    int all_velocities;    /* simulate: write the velocities of every written frame */
-    int frame_loop;        /* simulate: also time F more frames back to back (backend dyn_loop) */
-    uint64_t dyn_given;    /* which dynamic flags were given: bit i = entry i of cli.c's table */
+    int end_to_end;         /* measure one extra untimed-by-stage pass */
+    int measure_bandwidth;  /* only measure the copy bandwidth */
+    const char *self_test;  /* "rng": print the known-answer checks */
+    int list_variants;      /* print the backend's variants as JSON and exit */
+    int input_frame;        /* --input-frame: resume after this frame of --input; −1 = its last */
+    int64_t frames;         /* simulate: frames to advance (F) */
+    int64_t output_every;   /* simulate: write every K-th frame (the last always) */
+    int all_velocities;     /* simulate: write the velocities of every written frame */
+    int frame_loop;         /* simulate: also time F more frames back to back (backend dyn_loop) */
+    int draw_w, draw_h;     /* --draw WxH: also simulate and draw F more frames on the GPU (backend dyn_draw) */
+    const char *draw_image; /* --draw-image PREFIX: the last drawn frame of each path as PREFIX-PATH.ppm */
+    uint64_t dyn_given;     /* which dynamic flags were given: bit i = entry i of cli.c's table */
     /* which scene flags the user gave explicitly (for --input consistency checks) */
     unsigned given;
     /* --head-center: a groom file's head centre, cm (HB_GIVEN_CENTER) */

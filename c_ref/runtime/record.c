@@ -93,6 +93,31 @@ static void json_num(FILE *f, double v)
 }
 
 /* `, "key": value` */
+static void json_key_num(FILE *f, const char *key, double v);
+static void json_key_str(FILE *f, const char *key, const char *v);
+
+/* the simulate entry's "draw" (docs/interfaces.md "Drawing on the GPU"), null without --draw */
+static void json_draw(FILE *f, const hb_stage_record *st)
+{
+    if (!st->drawn) {
+        fputs(", \"draw\": null", f);
+        return;
+    }
+    const hb_draw_result *d = &st->draw;
+    fprintf(f, ", \"draw\": {\"width\": %d, \"height\": %d, \"frames\": %d", d->width, d->height, d->frames);
+    json_key_num(f, "simulate_ms", d->simulate_ms);
+    json_key_num(f, "compute_ms", d->compute_ms);
+    json_key_num(f, "compute_frame_ms", d->compute_frame_ms);
+    json_key_num(f, "gl_write_ms", d->gl_write_ms);
+    json_key_num(f, "gl_ms", d->gl_ms);
+    json_key_num(f, "gl_frame_ms", d->gl_frame_ms);
+    if (d->gl[0]) json_key_str(f, "gl", d->gl);
+    else fputs(", \"gl\": null", f);
+    if (d->gl_missing[0]) json_key_str(f, "gl_missing", d->gl_missing);
+    else fputs(", \"gl_missing\": null", f);
+    fputc('}', f);
+}
+
 static void json_key_num(FILE *f, const char *key, double v)
 {
     fprintf(f, ", \"%s\": ", key);
@@ -184,6 +209,7 @@ void hb_record_json(FILE *f, const hb_record *r)
             if (d->render_points) fprintf(f, ", \"render_points\": %lld", (long long)d->render_points);
             else fputs(", \"render_points\": null", f);
             json_key_num(f, "render_ms", st->render_ms);
+            json_draw(f, st);
             fputs(", \"last_observables\": {\"stretch_max\": ", f);
             json_num(f, st->last.stretch_max);
             json_key_num(f, "penetration_max", st->last.penetration_max);

@@ -5,6 +5,7 @@
 
 #include <stdio.h>
 
+#include "runtime/backend.h"
 #include "runtime/groom.h"
 #include "runtime/params.h"
 #include "runtime/state_io.h"
@@ -28,6 +29,8 @@ typedef struct {
     double observe_ms;             /* computing the observables, all frames, apart from the frame times */
     double loop_ms, loop_graph_ms; /* --frame-loop: per frame, back to back / as a graph (NaN: not run) */
     double render_ms;              /* --render-points: median time to render a written frame (NaN: none) */
+    int drawn;                     /* --draw ran: `draw` holds its result */
+    hb_draw_result draw;
 } hb_stage_record;
 
 typedef struct {

@@ -26,7 +26,7 @@ Without a GPU the GPU rows and checks are skipped with one line saying why.
 from pathlib import Path
 
 from harness import HarnessError
-from harness.bench import validation
+from harness.bench import renders, validation
 from harness.bench.validation import gpu_plan
 from harness.check import diff_dynamic
 from harness.core import runner, scenes, variants
@@ -365,6 +365,8 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
             animate.run(out=Path(report_dir) / "dynamic.gif", force=True, log=say, state_dir=root / "animation")
 
         within("animate", make_animation, root / "animation", *reports)
+    if render and fits("renders"):
+        within("renders", lambda: renders.simulate(root, say), root / renders.FOLDER)
 
 
 def curly_sweep(root, gpu, say, shard=None, budget=None):

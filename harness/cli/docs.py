@@ -59,10 +59,12 @@ def modules():
         folder = package / layer
         doc = ast.get_docstring(ast.parse((folder / "__init__.py").read_text()))
         lines += ["", f"`harness/{layer}/`: {_summary(doc)}", "", "| module | job |", "| --- | --- |"]
-        for path in sorted(folder.glob("*.py")):
-            if path.name != "__init__.py":
-                summary = _summary(ast.get_docstring(ast.parse(path.read_text())))
-                lines.append(f"| `{path.stem}` | {_cell(summary)} |")
+        for path in sorted(folder.rglob("*.py")):  # a subpackage's modules as `sub/name`, its own as `sub/`
+            if path.parent == folder and path.name == "__init__.py":
+                continue
+            name = path.relative_to(folder).with_suffix("").as_posix().removesuffix("__init__")
+            summary = _summary(ast.get_docstring(ast.parse(path.read_text())))
+            lines.append(f"| `{name}` | {_cell(summary)} |")
     return lines
 
 

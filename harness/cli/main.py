@@ -1,8 +1,8 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
 Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, accuracy, headline,
-export, groom, calibrate, featurecost, reduced, peer, animate, stability, judge, docs (`--help` on each; docs/harness.md
-lists them). User errors print one line
+export, groom, calibrate, featurecost, reduced, peer, animate, render, stability, judge, docs (`--help`
+on each; docs/harness.md lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
 
 import argparse
@@ -530,6 +530,43 @@ def cmd_animate(args):
     return 0
 
 
+def size_of(text):
+    """An argparse type: 'WxH' → (W, H), each 16…8192 pixels."""
+    try:
+        w, h = (int(v, 10) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs WIDTHxHEIGHT in pixels, e.g. 960x720 (got '{text}')") from None
+    if not (16 <= w <= 8192 and 16 <= h <= 8192):
+        raise argparse.ArgumentTypeError(f"each side must lie in 16…8192 pixels (got '{text}')")
+    return w, h
+
+
+def cmd_render(args):
+    """Render a state file (paper or dynamic) as shaded hair with OpenGL on EGL (no display needed): strands as
+    camera-facing ribbons with Kajiya–Kay shading and an opacity shadow map, the head sphere turning with the
+    head motion, 4× MSAA. Writes OUT/STEM-frameK-VIEW.png for each frame and view, and with --animate
+    OUT/STEM-VIEW.gif (and .mp4 where ffmpeg is on PATH). No EGL context: one line, exit 2."""
+    from harness.core.paths import REPORT, display
+    from harness.render.gl import camera, command
+
+    views = camera.parse_views(args.view)
+    out = args.out if args.out else REPORT.parent / "render"
+    written = command.run(
+        args.state,
+        out,
+        views=views,
+        frames=args.frame,
+        size=args.size,
+        animate=args.animate,
+        force=args.force,
+        shadows=not args.no_shadows,
+        max_strands=args.max_strands,
+    )
+    for path in written:
+        print(f"wrote {display(path)}")
+    return 0
+
+
 def cmd_stability(args):
     """Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend compliance, points and
     iterations, iterations on curly hair; head-motion frequency against amplitude; long-range attachments on and
@@ -1031,6 +1068,21 @@ def parser():
     an.add_argument("--strands", type=whole(1), default=300, help="without STATE: strands simulated (default 300)")
     an.add_argument("--frames", type=whole(1), default=120, help="without STATE: frames simulated (default 120)")
     an.add_argument("--force", action="store_true", help="replace existing output files")
+
+    rd = command(sub, cmd_render, help="shaded hair from a state file: PNG frames and animations (OpenGL on EGL)")
+    rd.add_argument("state", help="a state file (paper or dynamic model)")
+    rd.add_argument("--out", default=None, help="the folder written into (default results/local/render)")
+    rd.add_argument(
+        "--view", default="front,side,three-quarter", help="views, comma-separated: front, side, three-quarter, all"
+    )
+    rd.add_argument(
+        "--frame", type=int, action="append", help="a frame to draw (repeatable; negative from the end; default -1)"
+    )
+    rd.add_argument("--size", type=size_of, default=(960, 720), help="image size WxH in pixels (default 960x720)")
+    rd.add_argument("--animate", action="store_true", help="also animate the simulated frames from each view")
+    rd.add_argument("--max-strands", type=whole(1), default=None, help="strands drawn at most (default all)")
+    rd.add_argument("--no-shadows", action="store_true", help="no self-shadowing (the opacity shadow map)")
+    rd.add_argument("--force", action="store_true", help="replace existing output files")
 
     from harness.studies.stability import FRAMES, SLICE_NAMES, STRANDS
 

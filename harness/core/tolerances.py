@@ -582,3 +582,16 @@ OBS_CHAIN_SWING_FREQUENCY_REL = 5e-4  # measured 1.33e-4; margin 3.8×
 # mean by at most that (measured on 200 points at one node: 2.1e-5 cm/s; a uniform field of
 # 2000 points moved by at most 8.5e-4 cm/s, the Galilean shift's residue 2.8e-4 cm/s).
 GRID_FIXED_POINT_VELOCITY = 2.0**-10  # cm/s a contribution (twice the rounding bound)
+
+# ---- the renderer (harness/render/gl, tests/unit/test_render.py) ---------------------------
+# One step of an 8-bit channel: the shading tests compare a channel with its formula within
+# 1.5 of it (the rounding to 8 bits is half a step; llvmpipe's fp32 shading adds far less).
+RENDER_QUANTUM = 1.0 / 255.0
+# The committed small scene (160×120) against a new render of it: at most `fraction` of the
+# pixels may differ by more than `level` (0–255) in a channel, and the mean |Δ| over all
+# channels at most `mean`. Measured (Mesa 22.3.6): llvmpipe with 1 or 2 threads, 128- or
+# 256-bit vectors, 2 or 4 MSAA samples draws it identically (0 pixels, mean 0); without
+# anti-aliasing (llvmpipe 0 samples, or softpipe) 6.6 % of the pixels differ by more than 24
+# and the mean is 3.65. The bounds lie between: another driver's 4× MSAA passes, a renderer
+# that lost its anti-aliasing (or its shading) fails.
+RENDER_REFERENCE = {"level": 24, "fraction": 0.02, "mean": 2.0}

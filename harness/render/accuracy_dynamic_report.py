@@ -407,6 +407,40 @@ def checks(r, use, longm):
     return out
 
 
+def _passing(summ, use, longm):
+    """({mode: its checks against the use's budgets}, the usable rows that pass them all)."""
+    verdicts = {r["mode"]: checks(r, use, longm) for _, r in summ.iterrows()}
+    passes = summ[[all(v is not False for v in verdicts[m].values()) for m in summ["mode"]]]
+    return verdicts, passes[passes["usable"]]
+
+
+def recommended_modes(results_dir):
+    """The modes recommend() names, as data: [{use, backend, meets, mode, solver, ftl_damping,
+    substeps, iterations, precision}], the cheapest passing mode of each use and backend (where
+    none passes, meets False and the most accurate usable one, as recommend() names it), and
+    the study's record (env.json's "study": its scene, horizon and reference)."""
+    rows, study, _, _ = load(results_dir)
+    summ = summary(rows, study["horizon_frames"])
+    longm, _ = long_metrics(load_long(results_dir))
+    out = []
+    for use in tolerances.DYN_ACC_USES:
+        _, passes = _passing(summ, use, longm)
+        for backend in ("cpu", "cuda"):
+            f = passes[passes["backend"] == backend]
+            usable = summ[(summ["backend"] == backend) & summ["usable"]]
+            if f.empty and usable.empty:
+                continue
+            best = usable.loc[usable["rms"].idxmin()] if f.empty else f.loc[f["time_per_frame_ms"].idxmin()]
+            damping = best["ftl_damping"] if best["solver"] == "ftl" else None
+            out.append(
+                {"use": use, "backend": backend, "meets": not f.empty, "mode": str(best["mode"])}
+                | {"solver": str(best["solver"])}
+                | {"ftl_damping": None if damping is None else float(damping), "precision": str(best["precision"])}
+                | {"substeps": int(best["substeps"]), "iterations": int(best["iterations"])}
+            )
+    return out, study
+
+
 def recommend(summ, long=None):
     """Per use (tolerances.DYN_ACC_USES and DYN_ACC_USES_LONG) and per backend: the cheapest
     mode that meets every budget measured for it, naming its solver, s, S, I, precision and
@@ -416,9 +450,7 @@ def recommend(summ, long=None):
     longm, _ = long_metrics(long)
     base = baseline(summ)
     for use, (rms_budget, stretch_budget, why) in tolerances.DYN_ACC_USES.items():
-        verdicts = {r["mode"]: checks(r, use, longm) for _, r in summ.iterrows()}
-        passes = summ[[all(v is not False for v in verdicts[m].values()) for m in summ["mode"]]]
-        passes = passes[passes["usable"]]
+        verdicts, passes = _passing(summ, use, longm)
         picks = []
         for backend, what in (("cpu", "CPU"), ("cuda", "GPU")):
             if not (summ["backend"] == backend).any():

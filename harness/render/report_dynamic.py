@@ -20,6 +20,7 @@ from harness.render import (  # noqa: E402
     accuracy_dynamic_report,
     budget_report,
     featurecost_report,
+    hair_report,
     judge_report,
     peer_report,
     reduced_report,
@@ -316,8 +317,9 @@ def build(root, report_dir=None):
     lines += _study(root, "stability", stability_report, "Stability at the extremes", "harness stability", out_dir)
     lines += _study(root, "judge", judge_report, "The judge's power", "harness judge", out_dir)
     lines += peer_report.section(root / "peer", out_dir, missing_ok=True) + [""]
+    lines += hair_report.dynamic_lines(root, out_dir)
     gif = out_dir / "dynamic.gif"
-    lines += ["## The default scene in motion", ""]
+    lines += ["## The default scene in motion, plotted", ""]
     if gif.exists():
         lines += [f"![the default dynamic scene, side and front]({os.path.relpath(gif, out_dir)})", ""]
     else:

@@ -16,7 +16,7 @@ from pathlib import Path
 from harness.core.paths import REPORT, display, output_dir
 from harness.io import results_data
 from harness.io.results_data import curve_of, interp_time, strands_at_time
-from harness.render import budget_report
+from harness.render import budget_report, hair_report
 from harness.render.accuracy_paper_report import report_from_csv
 from harness.render.headline_report import table
 from harness.render.plots import make_all
@@ -291,6 +291,7 @@ def build(results_dir="results/default", report_dir=None):
     lines += gpu_section(cases, env)
     lines += scenes_section(env, cases)
     lines += validation_section(results_dir)
+    lines += hair_report.paper_lines(Path(results_dir) / results_data.FIGURE_STATE, out_dir)
     lines += paper_section(cases) if not cases.empty else []
     lines += ["## Plots", ""]
     for p in pictures:

@@ -369,7 +369,7 @@ def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, 
     return failed
 
 
-FIGURE_STRANDS = 400  # strands in the Fig. 1/2 state
+FIGURE_STRANDS = 2000  # strands in the Fig. 1/2 state (the plots draw 160 of them, the renders all)
 
 
 def figure_state(results_dir):

@@ -13,6 +13,7 @@ import sys
 import pytest
 
 from conftest import CPU_BIN, ROOT
+from harness.render.gl import context
 from support.fakebackend import install
 
 needs_cpu = pytest.mark.skipif(not CPU_BIN.exists(), reason=f"{CPU_BIN} is not built (run make)")
@@ -79,6 +80,12 @@ def test_bench_end_to_end_on_cpu(tmp_path):
     assert f"{n} of {n} comparisons equivalent" in md
     for png in ("speedup_fp32.png", "fig1_initialized.png", "fig2_after_wind.png"):
         assert (tmp_path / "run" / "report" / png).stat().st_size > 5000
+    if context.unavailable() is None:  # the paper's figures rendered too (harness/render/hair_report.py)
+        for png in ("fig1_rendered.png", "fig2_rendered.png"):
+            assert (tmp_path / "run" / "report" / png).stat().st_size > 5000
+        assert "![Fig. 2, hair after wind](fig2_rendered.png)" in md
+    else:
+        assert f"Not rendered: {context.unavailable()}" in md
     # the report is what its results render to: rendered again from the run's files, the
     # same page but for the line that says when and from where
     again = subprocess.run(

@@ -61,6 +61,7 @@ def stubbed(monkeypatch):
     monkeypatch.setattr(peer, "run_study", lambda *a, **k: None)
     monkeypatch.setattr(bench_dynamic.peer_report, "write", lambda *a, **k: None)
     monkeypatch.setattr(animate, "run", lambda **k: None)
+    monkeypatch.setattr(bench_dynamic.renders, "simulate", lambda *a, **k: None)
     return calls, hooks
 
 

@@ -52,6 +52,11 @@ FLAG_CASES = [
     ("frames_without_simulate", ["--stages", "init", "--frames", "3"], "belong to the simulate stage"),
     ("motion_without_simulate", ["--stages", "init", "--head-motion", "nod"], "belongs to the simulate stage"),
     ("simulate_not_last", ["--stages", "init,simulate,collide"], "simulate may appear once, as the last stage"),
+    ("draw_on_the_cpu", ["--draw", "64x64"], "--draw draws on the GPU: the cuda backend only"),
+    ("draw_too_small", ["--draw", "8x64"], "--draw needs WIDTHxHEIGHT in pixels, each 16..16384"),
+    ("draw_not_a_size", ["--draw", "64"], "--draw needs WIDTHxHEIGHT in pixels"),
+    ("draw_without_simulate", ["--stages", "init", "--draw", "64x64"], "belong to the simulate stage"),
+    ("draw_image_without_draw", ["--draw-image", "x"], "--draw-image needs --draw"),
 ]
 
 
