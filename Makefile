@@ -198,6 +198,8 @@ $(CUDA_BINS):
 # run against the reference's objects; host code only, with the host compiler told the
 # reference's rules (no FMA contraction, no fast math). The dynamic one at -O1: its many
 # instantiations compile faster, and without contraction the level changes no IEEE result.
+# dynamics_host.o plans the colliders' poses (docs/model.md §3.17): their objects link beside it
+HOSTCHECK_WORLD_OBJ := $(OBJ)/dynamic/colliders.o $(OBJ)/dynamic/sdf_mesh.o $(OBJ)/runtime/cli.o
 HOSTCHECK_NVCC := $(NVCC) -std=c++17 -Ic_ref -Icuda -Xcompiler -ffp-contract=off,-fno-fast-math
 hostcheck: $(HOSTCHECK_BINS)
 $(BUILD)/hostcheck/model_hostcheck_reference: HOSTCHECK_MODE := -O2 -DHB_REFERENCE_ARITHMETIC=1
@@ -207,11 +209,12 @@ $(BUILD)/hostcheck/model_hostcheck_%: cuda/hostcheck/model_hostcheck.cu cuda/mod
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) $(HOSTCHECK_MODE) $< $(OBJ)/paper/model.o $(OBJ)/runtime/params.o -o $@ -lm
 $(BUILD)/hostcheck/dyn_hostcheck: cuda/hostcheck/dyn_hostcheck.cu cuda/hostcheck/hostcheck_scene.h cuda/dyn_model.cuh cuda/tmath.cuh cuda/dyn_kernels.cuh $(C_HEADERS) \
-  $(OBJ)/dynamic/dynamics_f32.o $(OBJ)/dynamic/dynamics_f64.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o
+  $(OBJ)/dynamic/dynamics_f32.o $(OBJ)/dynamic/dynamics_f64.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o \
+  $(HOSTCHECK_WORLD_OBJ)
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
 $(BUILD)/hostcheck/post_hostcheck: cuda/hostcheck/post_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/hostcheck/hostcheck_scene.h cuda/dyn_post.cuh cuda/dyn_model.cuh cuda/tmath.cuh $(C_HEADERS) \
-  $(OBJ)/dynamic/dyn_followers.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o
+  $(OBJ)/dynamic/dyn_followers.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o $(HOSTCHECK_WORLD_OBJ)
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
 $(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/dyn_lod.cuh cuda/dyn_model.cuh cuda/tmath.cuh $(C_HEADERS) \

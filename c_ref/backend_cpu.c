@@ -58,11 +58,11 @@ typedef struct {
     hb_dyn_model_f64 d64;
     /* simulate (simd): velocities, saved velocities, rest shape as [P][stride], bend rest [P−2][stride] */
     void *pv[3], *pv_saved[3], *pr[3], *pb;
-    void *ps;         /* a groom's ℓ_k as rows [P−1][stride] (seg_rest and seg64 canonical beside it) */
-    hb_followers fl;  /* ref with --guides (docs/model.md §3.14) */
-    void *shape_rest; /* ref with --sag-free: the rest shape the frame reads (root, shape targets) */
-    hb_host_world world;    /* ref: the grid and colliders (docs/model.md §3.16, §3.17) */
-    const void *last_pose;  /* the last frame's colliders at its end, for the observables */
+    void *ps;              /* a groom's ℓ_k as rows [P−1][stride] (seg_rest and seg64 canonical beside it) */
+    hb_followers fl;       /* ref with --guides (docs/model.md §3.14) */
+    void *shape_rest;      /* ref with --sag-free: the rest shape the frame reads (root, shape targets) */
+    hb_host_world world;   /* ref: the grid and colliders (docs/model.md §3.16, §3.17) */
+    const void *last_pose; /* the last frame's colliders at its end, for the observables */
 } cpu_impl;
 
 
@@ -115,9 +115,10 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     if (o->scene.dyn.per_segment)
         hb_mul3_u64((uint64_t)o->scene.n_strands, (uint64_t)(o->scene.points - 1),
                     hb_real_size(o->scene.precision) + sizeof(double), &seg_bytes);
-    const uint64_t dyn = c->dynamic ? hb_add_sat(hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes), seg_bytes),
-                                                 hb_host_world_bytes(&o->scene, omp_get_max_threads()))
-                                    : 0;
+    const uint64_t dyn = c->dynamic
+                             ? hb_add_sat(hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes), seg_bytes),
+                                          hb_host_world_bytes(&o->scene, omp_get_max_threads()))
+                             : 0;
     const uint64_t need = hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, need_save ? 2u : 1u), dyn), driver_bytes);
     if (need == UINT64_MAX) {
         snprintf(err, errlen, "--strands x --points: the run's memory does not fit in 64 bits");
@@ -776,17 +777,19 @@ static int cpu_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *
     const int64_t S = f->substeps, step = c->scene.dyn.grid && c->scene.dyn.grid_rebuild == HB_GRID_SUBSTEP ? 1 : S;
     for (int64_t j0 = 0, j1 = step; j0 < S && !failed; j0 = j1, j1 += step) {
         if (c->scene.dyn.grid) {
-            const void *qg = still ? NULL
-                             : j0 == 0 ? (fp32 ? (const void *)f->qs32 : (const void *)f->qs64)
-                                       : (fp32 ? (const void *)(f->q32 + 9 * (j0 - 1)) : (const void *)(f->q64 + 9 * (j0 - 1)));
+            const void *qg =
+                still     ? NULL
+                : j0 == 0 ? (fp32 ? (const void *)f->qs32 : (const void *)f->qs64)
+                          : (fp32 ? (const void *)(f->q32 + 9 * (j0 - 1)) : (const void *)(f->q64 + 9 * (j0 - 1)));
             if (hb_host_world_build(&c->world, &c->scene, c->state, c->vel, qg)) failed = 1;
         }
         if (fp32) DYN_FRAME(float, f32, &c->d32, hw->on ? &hw->w32 : NULL)
         else DYN_FRAME(double, f64, &c->d64, hw->on ? &hw->w64 : NULL)
     }
-    c->last_pose = !f->back64 ? NULL
-                   : fp32     ? (const void *)(f->pose32 + (size_t)(S - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE)
-                              : (const void *)(f->pose64 + (size_t)(S - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE);
+    c->last_pose =
+        !f->back64 ? NULL
+        : fp32     ? (const void *)(f->pose32 + (size_t)(S - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE)
+                   : (const void *)(f->pose64 + (size_t)(S - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE);
     if (c->scene.dyn.guided && !failed) cpu_place_followers(c, f);
     return dyn_frame_result(r, t0, failed, "per-thread scratch", P, err, errlen);
 }

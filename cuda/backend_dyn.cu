@@ -259,9 +259,9 @@ void dyn_free(cuda_impl *c)
                     d->shape_rest, d->seg_rest,  d->seg64,   d->d_render,   d->d_vrender};
     for (void *p : ptrs)
         if (p) cudaFree(p);
-    void *world[] = {d->g_mass, d->g_mom,   d->g_node_v,   d->g_node_a, d->g_target, d->g_ftab, d->c_kind,
-                     d->c_frame, d->c_sdf_n, d->c_mu,     d->c_geo,    d->c_sdf_ptrs, d->f_pose, d->f_back,
-                     d->f_qs,   d->d_world, d->perm};
+    void *world[] = {d->g_mass, d->g_mom,   d->g_node_v, d->g_node_a, d->g_target, d->g_ftab,
+                     d->c_kind, d->c_frame, d->c_sdf_n,  d->c_mu,     d->c_geo,    d->c_sdf_ptrs,
+                     d->f_pose, d->f_back,  d->f_qs,     d->d_world,  d->perm};
     for (void *p : world)
         if (p) cudaFree(p);
     for (void *p : d->c_sdf)
@@ -544,7 +544,8 @@ static cudaError_t dyn_launch(cuda_impl *c, const hbd::DModel<T> &m, const void 
 }
 
 /* §3.16 the grid built from the current state with the rotation qg (device; nullptr: still). */
-template <typename T> static cudaError_t dyn_grid_build(cuda_impl *c, const hbd::DModel<T> &m, const T *qg, cudaStream_t st)
+template <typename T>
+static cudaError_t dyn_grid_build(cuda_impl *c, const hbd::DModel<T> &m, const T *qg, cudaStream_t st)
 {
     DynState *d = c->dyn;
     const hb_host_world *hw = &d->hw;

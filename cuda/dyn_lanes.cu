@@ -200,7 +200,8 @@ template <> struct Node4<float> {
 template <> struct Node4<double> {
     __device__ static double4 load(const double *p)
     {
-        const double2 a = __ldg(reinterpret_cast<const double2 *>(p)), b = __ldg(reinterpret_cast<const double2 *>(p) + 1);
+        const double2 a = __ldg(reinterpret_cast<const double2 *>(p)),
+                      b = __ldg(reinterpret_cast<const double2 *>(p) + 1);
         return double4{a.x, a.y, b.x, b.y};
     }
 };
@@ -215,8 +216,9 @@ __device__ __forceinline__ void grid_fix(const DModel<T> &m, const T *qg, int k,
         v = V3<T>{vv[0], vv[1], vv[2]};
     } else {
         V3<T> u = x;
-        if (qg) u = V3<T>{(qg[0] * x.x + qg[3] * x.y) + qg[6] * x.z, (qg[1] * x.x + qg[4] * x.y) + qg[7] * x.z,
-                          (qg[2] * x.x + qg[5] * x.y) + qg[8] * x.z};
+        if (qg)
+            u = V3<T>{(qg[0] * x.x + qg[3] * x.y) + qg[6] * x.z, (qg[1] * x.x + qg[4] * x.y) + qg[7] * x.z,
+                      (qg[2] * x.x + qg[5] * x.y) + qg[8] * x.z};
         const T gx = (u.x - w.glo[0]) * w.gsc[0], gy = (u.y - w.glo[1]) * w.gsc[1], gz = (u.z - w.glo[2]) * w.gsc[2];
         const T top = (T)(w.gn - 1);
         if (!(gx >= (T)0 && gx < top && gy >= (T)0 && gy < top && gz >= (T)0 && gz < top)) return;
@@ -420,10 +422,11 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
             return base + e;
         };
         auto bat = [&](int e) -> int64_t { /* the same for the bend rest lengths, P − 2 a strand */
-            if constexpr (W) {
-                if (m.perm) return m.perm[s0 + e / (P - 2)] * (int64_t)(P - 2) + e % (P - 2);
-            }
-            return s0 * (int64_t)(P - 2) + e;
+                                           if constexpr (W) {
+                                               if (m.perm)
+                                                   return m.perm[s0 + e / (P - 2)] * (int64_t)(P - 2) + e % (P - 2);
+                                           }
+                                           return s0 * (int64_t)(P - 2) + e;
         };
         V3<T> X[G], V[G], Q[G], D[G];
         T *bs = rs + SPW * row; /* the bend rest lengths of the warp's strands */
@@ -491,9 +494,9 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         for (int j = m.j0; j < jend; j++) {
             const T *q = qtab + 9 * j;
             /* §3.16 the rotation of the grid in use (nullptr: still); §3.17 this substep's poses */
-            const T *qg = !has(HB_F_MOTION)                                           ? nullptr
+            const T *qg = !has(HB_F_MOTION)                                    ? nullptr
                           : (m.world.grid_rebuild == HB_GRID_SUBSTEP && j > 0) ? qtab + 9 * (j - 1)
-                                                                                : m.qs;
+                                                                               : m.qs;
             const T *pose = wcol ? m.pose + (int64_t)j * (m.world.ncol > 0 ? m.world.ncol : 1) * HB_COL_POSE : nullptr;
             const T *back = wcol ? m.back + HB_COL_BACK * j : nullptr;
             /* 1. the root on the head, then p0 = x0 */

@@ -69,16 +69,15 @@ template <> struct Locate<double> {
     }
 };
 
-template <typename T>
-__device__ __forceinline__ bool finite3(const T *p)
+template <typename T> __device__ __forceinline__ bool finite3(const T *p)
 {
     return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
 }
 
 template <typename T>
-__global__ void __launch_bounds__(kSplatWarps * 32) k_grid_splat(World<T> w, const T *qg, const T *x, const T *v,
-                                                                 int64_t N, int P, const int64_t *perm, int64_t *mass,
-                                                                 int64_t *mom)
+__global__ void __launch_bounds__(kSplatWarps * 32)
+    k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, const int64_t *perm, int64_t *mass,
+                 int64_t *mom)
 {
     __shared__ int64_t win[4 * kWindow];
     __shared__ int lo[3], hi[3];
@@ -185,8 +184,8 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
     if (e == cudaSuccess) e = cudaMemsetAsync(mom, 0, (size_t)nodes * 3 * sizeof *mom, stream);
     if (e != cudaSuccess) return e;
     const int64_t blocks = (N + kSplatStrands - 1) / kSplatStrands;
-    k_grid_splat<T><<<(int)(blocks < 1 ? 1 : blocks), kSplatWarps * 32, 0, stream>>>(w, qg, x, v, N, (int)P, perm,
-                                                                                     mass, mom);
+    k_grid_splat<T>
+        <<<(int)(blocks < 1 ? 1 : blocks), kSplatWarps * 32, 0, stream>>>(w, qg, x, v, N, (int)P, perm, mass, mom);
     return cudaGetLastError();
 }
 
@@ -194,8 +193,8 @@ template <typename T>
 cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mass, const int64_t *mom, const T *target,
                               T inv_rho0, T neg_kv, T *node_v, T *node_a, cudaStream_t stream)
 {
-    k_grid_nodes<T><<<blocks_for(w.gn * w.gn * w.gn, 256), 256, 0, stream>>>(w, qg, mass, mom, target, inv_rho0,
-                                                                             neg_kv, node_v, node_a);
+    k_grid_nodes<T><<<blocks_for(w.gn * w.gn * w.gn, 256), 256, 0, stream>>>(w, qg, mass, mom, target, inv_rho0, neg_kv,
+                                                                             node_v, node_a);
     return cudaGetLastError();
 }
 
@@ -205,9 +204,8 @@ template cudaError_t launch_grid_splat<double>(const World<double> &, const doub
                                                int64_t, int64_t, const int64_t *, int64_t *, int64_t *, cudaStream_t);
 template cudaError_t launch_grid_nodes<float>(const World<float> &, const float *, const int64_t *, const int64_t *,
                                               const float *, float, float, float *, float *, cudaStream_t);
-template cudaError_t launch_grid_nodes<double>(const World<double> &, const double *, const int64_t *,
-                                               const int64_t *, const double *, double, double, double *, double *,
-                                               cudaStream_t);
+template cudaError_t launch_grid_nodes<double>(const World<double> &, const double *, const int64_t *, const int64_t *,
+                                               const double *, double, double, double *, double *, cudaStream_t);
 
 } /* namespace dyn */
 } /* namespace hb */

@@ -63,7 +63,9 @@ static int parse_line(const char *path, int ln, char **w, int nw, hb_collider *c
     static const struct {
         const char *kind;
         int id, nums;
-    } kinds[] = {{"sphere", HB_COL_SPHERE, 4}, {"capsule", HB_COL_CAPSULE, 7}, {"plane", HB_COL_PLANE, 6},
+    } kinds[] = {{"sphere", HB_COL_SPHERE, 4},
+                 {"capsule", HB_COL_CAPSULE, 7},
+                 {"plane", HB_COL_PLANE, 6},
                  {"mesh", HB_COL_MESH, 0}};
     int k = -1;
     for (int i = 0; i < 4; i++)
@@ -221,7 +223,8 @@ void hb_colliders_pose(const hb_scene *s, const hb_colliders *c, double t, doubl
     hb_body_translation(d, t_next, b1);
     /* back-transforms: the head's Q(t)·Q(t+h)ᵀ, the body's b(t) − b(t+h) */
     for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) back[3 * i + j] = (q0[3 * i] * q1[3 * j] + q0[3 * i + 1] * q1[3 * j + 1]) + q0[3 * i + 2] * q1[3 * j + 2];
+        for (int j = 0; j < 3; j++)
+            back[3 * i + j] = (q0[3 * i] * q1[3 * j] + q0[3 * i + 1] * q1[3 * j + 1]) + q0[3 * i + 2] * q1[3 * j + 2];
     for (int i = 0; i < 3; i++) back[9 + i] = b0[i] - b1[i];
     const double cm = d->collision_margin;
     for (int i = 0; c && i < c->n; i++) {

@@ -18,10 +18,10 @@
 #else
 #define HB_RINT64(x) ((int64_t)llrint((double)(x)))
 #endif
-#define HB_GRID_MASS_SCALE 16777216.0 /* 2^24 */
-#define HB_GRID_MOM_SCALE 1024.0      /* 2^10 */
-#define HB_GRID_VEL_SCALE 16384.0     /* 2^14 = 2^24 / 2^10 */
-#define HB_GRID_VEL_CLAMP 1048576.0   /* 2^20 cm/s */
+#define HB_GRID_MASS_SCALE 16777216.0                 /* 2^24 */
+#define HB_GRID_MOM_SCALE 1024.0                      /* 2^10 */
+#define HB_GRID_VEL_SCALE 16384.0                     /* 2^14 = 2^24 / 2^10 */
+#define HB_GRID_VEL_CLAMP 1048576.0                   /* 2^20 cm/s */
 #define HB_GRID_INV_MASS_SCALE 5.9604644775390625e-08 /* 2^-24 */
 #endif
 
@@ -271,16 +271,15 @@ HB_HD void SFX(hb_collide_one)(const WORLD *w, int i, const REAL *pose, const RE
     } else { /* mesh */
         REAL u[3], phi, g[3];
         for (int c = 0; c < 3; c++)
-            u[c] = turn   ? (pose[c] * p[0] + pose[3 + c] * p[1]) + pose[6 + c] * p[2]
-                   : sway ? p[c] - pose[9 + c]
-                          : p[c];
+            u[c] = turn ? (pose[c] * p[0] + pose[3 + c] * p[1]) + pose[6 + c] * p[2] : sway ? p[c] - pose[9 + c] : p[c];
         if (!SFX(hb_sdf_sample)(w->sdf[i], w->sdf_n[i], w->sdf_geo + 4 * i, u, &phi, g)) return;
         const REAL gl = SQRT((g[0] * g[0] + g[1] * g[1]) + g[2] * g[2]);
         if (!(phi < pose[12] && gl > (REAL)0)) return;
         const REAL d = pose[12] - phi;
         REAL nl[3];
         for (int c = 0; c < 3; c++) nl[c] = g[c] / gl;
-        for (int r = 0; r < 3; r++) n[r] = turn ? (pose[3 * r] * nl[0] + pose[3 * r + 1] * nl[1]) + pose[3 * r + 2] * nl[2] : nl[r];
+        for (int r = 0; r < 3; r++)
+            n[r] = turn ? (pose[3 * r] * nl[0] + pose[3 * r + 1] * nl[1]) + pose[3 * r + 2] * nl[2] : nl[r];
         m = w->bounded && w->depen < d ? w->depen : d;
         for (int c = 0; c < 3; c++) p[c] = p[c] + m * n[c];
     }
@@ -317,8 +316,9 @@ HB_HD double SFX(hb_collider_depth)(const WORLD *w, int i, const REAL *pose, con
         const double e[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
         d = rc - sqrt((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2]);
     } else if (kind == HB_COL_PLANE) {
-        d = (double)pose[6] - (((x[0] - (double)pose[0]) * (double)pose[3] + (x[1] - (double)pose[1]) * (double)pose[4]) +
-                               (x[2] - (double)pose[2]) * (double)pose[5]);
+        d = (double)pose[6] -
+            (((x[0] - (double)pose[0]) * (double)pose[3] + (x[1] - (double)pose[1]) * (double)pose[4]) +
+             (x[2] - (double)pose[2]) * (double)pose[5]);
     } else {
         double u[3], f[3];
         int64_t ii[3];

@@ -185,7 +185,7 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_
         const REAL *q = QTABLE(fr) + 9 * j; /* Q(t + h) */
         const REAL phase = PHASE(fr)[j];    /* φ(t) */
         /* §3.16 the rotation of the grid in use (NULL: still), §3.17 this substep's poses */
-        const REAL *qg = !(F & HB_F_MOTION)                                 ? NULL
+        const REAL *qg = !(F & HB_F_MOTION)                                   ? NULL
                          : (w && w->grid_rebuild == HB_GRID_SUBSTEP && j > 0) ? QTABLE(fr) + 9 * (j - 1)
                                                                               : QSTART(fr);
         const REAL *pose = wcol ? POSES(fr) + (size_t)j * (size_t)(w->ncol > 0 ? w->ncol : 1) * HB_COL_POSE : NULL;

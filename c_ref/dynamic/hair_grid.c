@@ -85,8 +85,8 @@ int hb_grid_plan_make(const hb_scene *s, const void *rest, hb_grid_plan *g, char
         const double h = d->frame_dt / (double)d->substeps, h0 = 1.0 / 480.0;
         if (!(g->ftab = malloc((size_t)s->points * sizeof *g->ftab))) goto oom;
         for (int64_t k = 0; k < s->points; k++) {
-            const double f = d->grid_friction[0] + (d->grid_friction[1] - d->grid_friction[0]) * (double)k /
-                                                       (double)(s->points - 1);
+            const double f =
+                d->grid_friction[0] + (d->grid_friction[1] - d->grid_friction[0]) * (double)k / (double)(s->points - 1);
             g->ftab[k] = 1.0 - pow(1.0 - f, h / h0);
         }
     }

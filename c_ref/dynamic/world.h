@@ -31,7 +31,7 @@ enum { HB_FRAME_HEAD = 0, HB_FRAME_BODY = 1 };
 
 typedef struct {
     int kind, frame;
-    double g[7];      /* at rest: sphere c, r; capsule a, b, r; plane o, n (normalised) */
+    double g[7]; /* at rest: sphere c, r; capsule a, b, r; plane o, n (normalised) */
     double mu_s, mu_k;
     /* a mesh's signed distance field (§3.17), in its own frame (the head or body frame at rest) */
     int64_t sdf_n;    /* nodes per axis */
@@ -51,25 +51,25 @@ typedef struct hb_colliders {
  * the reference, device for the CUDA kernels). */
 #define HB_DYN_WORLD(T)                                                                                                \
     struct {                                                                                                           \
-        /* §3.16 the grid: on, its parts, nodes per axis, box corner and scale (n − 1)/(hi − lo) */                     \
+        /* §3.16 the grid: on, its parts, nodes per axis, box corner and scale (n − 1)/(hi − lo) */               \
         int grid, grid_friction, grid_volume, grid_rebuild;                                                            \
         int64_t gn;                                                                                                    \
         T glo[3], gsc[3];                                                                                              \
-        const T *ftab;   /* f̃_k, k = 0 … P − 1 */                                                                   \
-        const T *node_v; /* [gn³][4]: o·V_x, o·V_y, o·V_z, o (the current build) */                                    \
-        const T *node_a; /* [gn³][4]: A_x, A_y, A_z, 0 */                                                              \
+        const T *ftab;   /* f̃_k, k = 0 … P − 1 */                                                                \
+        const T *node_v; /* [gn³][4]: o·V_x, o·V_y, o·V_z, o (the current build) */                                \
+        const T *node_a; /* [gn³][4]: A_x, A_y, A_z, 0 */                                                             \
         /* §3.17 colliders after the head sphere, and friction */                                                     \
         int ncol;                                                                                                      \
-        int bounded;     /* --depenetration-speed declared */                                                          \
-        T depen;         /* V·h */                                                                                     \
+        int bounded; /* --depenetration-speed declared */                                                              \
+        T depen;     /* V·h */                                                                                        \
         int head_friction;                                                                                             \
         T head_mu_s, head_mu_k;                                                                                        \
         int motion, sway; /* the head turns (its back-transform is evaluated); the body sways */                       \
         const int *col_kind, *col_frame;                                                                               \
-        const T *col_mu;           /* μ_s, μ_k of each collider */                                                     \
-        const T *const *sdf;       /* each mesh collider's field (NULL for the others) */                              \
-        const int64_t *sdf_n;      /* its nodes per axis */                                                            \
-        const T *sdf_geo;          /* its cube: lo x, y, z and scale 1/Δ_s, 4 a collider */                            \
+        const T *col_mu;      /* μ_s, μ_k of each collider */                                                        \
+        const T *const *sdf;  /* each mesh collider's field (NULL for the others) */                                   \
+        const int64_t *sdf_n; /* its nodes per axis */                                                                 \
+        const T *sdf_geo;     /* its cube: lo x, y, z and scale 1/Δ_s, 4 a collider */                                \
     }
 typedef HB_DYN_WORLD(float) hb_dyn_world_f32;
 typedef HB_DYN_WORLD(double) hb_dyn_world_f64;
@@ -80,8 +80,7 @@ int hb_colliders_load(const char *path, hb_colliders *out, char *err, size_t err
 void hb_colliders_free(hb_colliders *c);
 /* The poses of substep m (the world at t + h, t = m·h) of every collider, [HB_COL_POSE] each, and
  * the back-transforms [HB_COL_BACK], in double. */
-void hb_colliders_pose(const hb_scene *s, const hb_colliders *c, double t, double t_next, double *pose,
-                       double *back);
+void hb_colliders_pose(const hb_scene *s, const hb_colliders *c, double t, double t_next, double *pose, double *back);
 /* The body frame's translation b(t) (§3.17), in double. */
 void hb_body_translation(const hb_dynamics *d, double t, double b[3]);
 /* The collider of a file for the given SDF input: one mesh read from an OBJ file. */
@@ -89,12 +88,12 @@ int hb_mesh_sdf(const char *path, int64_t n, int64_t band, hb_collider *out, cha
 
 /* ---- host side (hair_grid.c): §3.16 run constants ---- */
 typedef struct {
-    int64_t n;            /* nodes per axis */
-    double lo[3], hi[3];  /* the box in the head frame */
-    double sc[3];         /* (n − 1)/(hi − lo) */
-    double rho0_mean;     /* ρ̄₀ */
-    double *target;       /* T per node, n³, double (NULL without volume) */
-    double *ftab;         /* f̃_k, P values (NULL without friction) */
+    int64_t n;           /* nodes per axis */
+    double lo[3], hi[3]; /* the box in the head frame */
+    double sc[3];        /* (n − 1)/(hi − lo) */
+    double rho0_mean;    /* ρ̄₀ */
+    double *target;      /* T per node, n³, double (NULL without volume) */
+    double *ftab;        /* f̃_k, P values (NULL without friction) */
 } hb_grid_plan;
 /* Plans the grid from the rest shape (canonical [N·P][3] in the scene's precision). */
 int hb_grid_plan_make(const hb_scene *s, const void *rest, hb_grid_plan *g, char *err, size_t errlen);

@@ -17,8 +17,8 @@
  * else atomically: integer sums, so the order changes nothing), then the node fields. */
 #define BUILD(T, SFX, W)                                                                                               \
     do {                                                                                                               \
-        const T *xs = (const T *)x, *vs = (const T *)v, *q = (const T *)qg;                                          \
-        const int64_t n = hw->plan.n, nodes = hw->nodes, rows = s->n_strands * s->points;                               \
+        const T *xs = (const T *)x, *vs = (const T *)v, *q = (const T *)qg;                                            \
+        const int64_t n = hw->plan.n, nodes = hw->nodes, rows = s->n_strands * s->points;                              \
         memset(hw->mass, 0, (size_t)nodes * sizeof *hw->mass);                                                         \
         memset(hw->mom, 0, (size_t)nodes * 3 * sizeof *hw->mom);                                                       \
         const int nt = omp_get_max_threads();                                                                          \
@@ -37,9 +37,7 @@
                         for (int c = 0; c < 3; c++) pm[4 * j + 1 + c] += p[3 * k + c];                                 \
                     } else {                                                                                           \
                         _Pragma("omp atomic") hw->mass[j] += m[k];                                                     \
-                        for (int c = 0; c < 3; c++) {                                                                  \
-                            _Pragma("omp atomic") hw->mom[3 * j + c] += p[3 * k + c];                                  \
-                        }                                                                                              \
+                        for (int c = 0; c < 3; c++) { _Pragma("omp atomic") hw->mom[3 * j + c] += p[3 * k + c]; }      \
                     }                                                                                                  \
                 }                                                                                                      \
             }                                                                                                          \

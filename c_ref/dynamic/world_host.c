@@ -149,4 +149,3 @@ oom:
     return -1;
 }
 #undef FILL_WORLD
-

@@ -16,10 +16,10 @@ extern "C" {
 #endif
 
 typedef struct {
-    int on;           /* the grid, colliders or friction: the frame runs with a world */
+    int on; /* the grid, colliders or friction: the frame runs with a world */
     hb_grid_plan plan;
-    int64_t nodes;    /* n³ (0 without the grid) */
-    size_t real;      /* bytes of a real */
+    int64_t nodes; /* n³ (0 without the grid) */
+    size_t real;   /* bytes of a real */
     /* working-precision tables (host): ftab [P], target [n³], the node fields [n³][4] (C reference) */
     void *ftab, *target, *node_v, *node_a;
     int64_t *mass, *mom; /* the grid's sums [n³], [n³][3] (C reference) */

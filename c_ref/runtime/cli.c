@@ -92,7 +92,8 @@ static const dyn_flag dyn_flags[] = {
     {"--lra", DF_OPTREAL, DYN(lra_scale), DYN(lra), "long-range attachments |p_k - p_0| <= S k l (S >= 1, default 1)"},
     {"--render-points", DF_COUNT, DYN(render_points), 0,
      "write P_r > P points a strand, a Catmull-Rom spline through the simulated ones; P_r - 1 a multiple of P - 1"},
-    {"--grid", DF_COUNT, DYN(grid_n), DYN(grid), "hair-hair grid of N^3 nodes, 2..512 (docs/model.md §3.16); declares it"},
+    {"--grid", DF_COUNT, DYN(grid_n), DYN(grid),
+     "hair-hair grid of N^3 nodes, 2..512 (docs/model.md §3.16); declares it"},
     {"--grid-rebuild", DF_REBUILD, DYN(grid_rebuild), 0, "frame | substep: when the grid is built (default frame)"},
     {"--grid-box", DF_BOX, DYN(grid_box), DYN(grid_box_given),
      "the grid's box X0,Y0,Z0,X1,Y1,Z1 in the head frame, cm (default: the rest shape's bounds + padding)"},
@@ -110,7 +111,8 @@ static const dyn_flag dyn_flags[] = {
     {"--body-motion", DF_BODY, DYN(body_motion), 0,
      "still | sway (along x) | rise (from A_b below, in 1/f_b s): the body frame's motion (default still)"},
     {"--body-amplitude", DF_REAL, DYN(body_amplitude), 0, "the body's sway or rise A_b, cm (default 2)"},
-    {"--body-frequency", DF_REAL, DYN(body_frequency), 0, "the sway's frequency f_b, Hz, or the rise's 1/duration (default 1)"},
+    {"--body-frequency", DF_REAL, DYN(body_frequency), 0,
+     "the sway's frequency f_b, Hz, or the rise's 1/duration (default 1)"},
 };
 #undef DYN
 #define N_DYN_FLAGS (sizeof dyn_flags / sizeof dyn_flags[0])
@@ -686,7 +688,8 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
                 FAIL("%s needs --grid N (the hair-hair grid is off unless its size is given)", needs_grid[i]);
         static const char *const needs_body[] = {"--body-amplitude", "--body-frequency"};
         for (size_t i = 0; i < sizeof needs_body / sizeof needs_body[0]; i++)
-            if (o->scene.dyn.body_motion == HB_BODY_STILL && (o->dyn_given & (1ull << hb_dyn_flag_index(needs_body[i]))))
+            if (o->scene.dyn.body_motion == HB_BODY_STILL &&
+                (o->dyn_given & (1ull << hb_dyn_flag_index(needs_body[i]))))
                 FAIL("%s needs --body-motion sway or rise", needs_body[i]);
         if (o->scene.dyn.friction_declared && !o->scene.dyn.collider)
             FAIL("--friction is the head sphere's friction, and --no-collider removes the head sphere");

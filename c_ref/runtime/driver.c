@@ -79,10 +79,13 @@ static int self_test_rng(void)
 /* The §3.14, §3.16, §3.17 features by HB_X_* bit: the name --list-variants gives, the flag that declares it. */
 static const struct {
     const char *name, *flag;
-} x_features[HB_X_COUNT] = {
-    {"guides", "--guides"}, {"lra", "--lra"},           {"sagfree", "--sag-free"},
-    {"lod", "--render-points"}, {"grid", "--grid"},  {"colliders", "--colliders"},
-    {"friction", "--friction or --depenetration-speed"}};
+} x_features[HB_X_COUNT] = {{"guides", "--guides"},
+                            {"lra", "--lra"},
+                            {"sagfree", "--sag-free"},
+                            {"lod", "--render-points"},
+                            {"grid", "--grid"},
+                            {"colliders", "--colliders"},
+                            {"friction", "--friction or --depenetration-speed"}};
 
 /* The §3.14 features a scene declares, HB_X_* bits. */
 static unsigned x_declared(const hb_dynamics *d)
@@ -150,7 +153,8 @@ static int list_variants(const hb_backend *b)
         hb_dyn_feature_names(1u << i, name, sizeof name);
         printf("%s\"%s\"", i ? ", " : "", name);
     }
-    printf(", \"guides\", \"lra\", \"sagfree\", \"lod\", \"grid\", \"colliders\", \"friction\"]}\n"); /* §3.14, §3.16, §3.17's */
+    printf(
+        ", \"guides\", \"lra\", \"sagfree\", \"lod\", \"grid\", \"colliders\", \"friction\"]}\n"); /* §3.14, §3.16, §3.17's */
     return HB_EXIT_OK;
 }
 
@@ -231,7 +235,7 @@ typedef struct {
     hb_groom groom;    /* --groom: what init places (docs/model.md §3.15) */
     hb_colliders cols; /* --colliders (docs/model.md §3.17) */
     double *times;     /* all stages' timed runs */
-    struct {        /* the simulation, for the file's /parameters */
+    struct {           /* the simulation, for the file's /parameters */
         int dynamic;
         int64_t paper_frames, last_frame;
         char features[192];

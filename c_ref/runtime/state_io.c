@@ -898,7 +898,8 @@ static int input_world(hb_input *in, const char *path, hid_t p, char *err, size_
             (strcmp(word, "frame") != 0 && strcmp(word, "substep") != 0))
             BAD("grid_rebuild");
         d->grid_rebuild = strcmp(word, "substep") == 0 ? HB_GRID_SUBSTEP : HB_GRID_FRAME;
-        if (read_attr(p, "grid_box_given", H5T_NATIVE_INT64, &given) < 0 || read_attr_f64v(p, "grid_box", d->grid_box, 6) < 0 ||
+        if (read_attr(p, "grid_box_given", H5T_NATIVE_INT64, &given) < 0 ||
+            read_attr_f64v(p, "grid_box", d->grid_box, 6) < 0 ||
             read_attr(p, "grid_padding", H5T_NATIVE_DOUBLE, &d->grid_padding) < 0)
             BAD("grid box");
         if (read_attr(p, "grid_friction_declared", H5T_NATIVE_INT64, &fr) < 0 ||

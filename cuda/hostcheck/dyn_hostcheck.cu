@@ -49,12 +49,12 @@ namespace {
 void ref_frame(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *x, float *v, const float *r, const float *b,
                float *s)
 {
-    hb_dyn_frame_strand_f32(m, f, x, v, r, b, NULL, s);
+    hb_dyn_frame_strand_f32(m, NULL, f, 0, f->substeps, x, v, r, b, NULL, s);
 }
 void ref_frame(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *x, double *v, const double *r, const double *b,
                double *s)
 {
-    hb_dyn_frame_strand_f64(m, f, x, v, r, b, NULL, s);
+    hb_dyn_frame_strand_f64(m, NULL, f, 0, f->substeps, x, v, r, b, NULL, s);
 }
 void ref_bend(const hb_dyn_model_f32 *m, const float *r, float *b)
 {
@@ -66,11 +66,11 @@ void ref_bend(const hb_dyn_model_f64 *m, const double *r, double *b)
 }
 void ref_obs(const hb_scene *s, const float *x, const float *v, hb_obs_partial *o)
 {
-    hb_dyn_observe_strand_f32(s, x, v, NULL, o);
+    hb_dyn_observe_strand_f32(s, NULL, NULL, x, v, NULL, o);
 }
 void ref_obs(const hb_scene *s, const double *x, const double *v, hb_obs_partial *o)
 {
-    hb_dyn_observe_strand_f64(s, x, v, NULL, o);
+    hb_dyn_observe_strand_f64(s, NULL, NULL, x, v, NULL, o);
 }
 template <typename T> struct CM;
 template <> struct CM<float> {

@@ -10,6 +10,8 @@ simulated on the C reference into ROOT/renders/, listed in ROOT/renders/renders.
                        MODE_STRANDS strands up to the study's horizon
   reference.h5         the study's converged reference (xpbd fp64 I = 1 at its S), the same
                        strands and frames, so each mode's last frame is seen beside it
+  world-<k>.h5         the default scene, with the hair-hair grid, and on the body with the
+                       grid (docs/model.md §3.16, §3.17): the grid's and the body's effect
 
 A GPU pick's settings run on the CPU oracle: the model is the same (docs/model.md §1.3) and
 the picture cannot show a build's arithmetic. Where the accuracy study has no results, only
@@ -80,6 +82,26 @@ def mode_states(root, out, say):
     return modes, {**reference, "horizon_frames": frames, "converged": bool(ref.get("converged"))}
 
 
+WORLD_STRANDS = 1000
+WORLD_FRAMES = 120  # 2 s: the body rises into place in the first 0.5 s
+
+
+def world_states(out):
+    """The default scene, with the grid, and on the body with the grid (configs/scenes/body.toml):
+    the same strands and frames, for the report's picture and table of their effect
+    (docs/model.md §3.16, §3.17). [(label, state file)]."""
+    base = scenes.with_frames(scenes.load_scene("dynamic").with_overrides(strands=WORLD_STRANDS), WORLD_FRAMES)
+    body = scenes.with_frames(scenes.load_scene("body").with_overrides(strands=WORLD_STRANDS), WORLD_FRAMES)
+    grid = {k: v for k, v in body.dynamic.items() if k.startswith("--grid")}
+    every = {"--output-every": WORLD_FRAMES // 4}
+    runs = [
+        ("default scene", replace(base, dynamic={**base.dynamic, **every})),
+        ("+ hair-hair grid", replace(base, dynamic={**base.dynamic, **grid, **every})),
+        ("+ grid + body", replace(body, dynamic={**body.dynamic, **every})),
+    ]
+    return [(label, _simulate(sc, out / f"world-{k}.h5")) for k, (label, sc) in enumerate(runs)]
+
+
 def simulate(root, say):
     """Make ROOT/renders/ (states and renders.json); the record's path, or None (nothing made)
     where no OpenGL context can be made to draw them (one line says why)."""
@@ -95,8 +117,11 @@ def simulate(root, say):
     scene = replace(scene, dynamic={**scene.dynamic, "--output-every": ANIMATION_EVERY})
     dynamic = _simulate(scene, out / "dynamic.h5")
     modes, reference = mode_states(root, out, say)
+    say(f"harness: renders: the grid and the body's effect at {WORLD_STRANDS} strands, {WORLD_FRAMES} frames")
+    world = world_states(out)
     record = {
         "dynamic": dynamic,
+        "world": world,
         "modes": modes,
         "reference": reference,
         "mode_strands": MODE_STRANDS,

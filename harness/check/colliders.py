@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from harness.check.invariants_dynamic import head_rotation
+from harness.check.head_motion import head_rotation
 
 
 def body_translation(params, t):
@@ -72,7 +72,9 @@ def depths(traj, points, t):
                 e = g[3:6] - g[:3]
                 l2 = float(rnd((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2]))
                 ab = bb - a
-                s = np.clip((((x[:, 0] - a[0]) * ab[0] + (x[:, 1] - a[1]) * ab[1]) + (x[:, 2] - a[2]) * ab[2]) / l2, 0, 1)
+                s = np.clip(
+                    (((x[:, 0] - a[0]) * ab[0] + (x[:, 1] - a[1]) * ab[1]) + (x[:, 2] - a[2]) * ab[2]) / l2, 0, 1
+                )
                 centre = a + s[:, None] * ab
             e = x - centre
             out.append(r - np.sqrt((e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1]) + e[:, 2] * e[:, 2]))

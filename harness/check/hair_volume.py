@@ -46,7 +46,11 @@ def _segment_distance(p0, p1, q0, q1):
     with np.errstate(divide="ignore", invalid="ignore"):
         s = np.where(den > 1e-30 * np.maximum(a * e, 1e-300), np.clip((b * f - c * e) / den, 0, 1), 0.0)
         t = np.where(e > 0, (b * s + f) / e, 0.0)
-        s = np.where(t < 0, np.where(a > 0, np.clip(-c / a, 0, 1), 0.0), np.where(t > 1, np.where(a > 0, np.clip((b - c) / a, 0, 1), 0.0), s))
+        s = np.where(
+            t < 0,
+            np.where(a > 0, np.clip(-c / a, 0, 1), 0.0),
+            np.where(t > 1, np.where(a > 0, np.clip((b - c) / a, 0, 1), 0.0), s),
+        )
         t = np.clip(t, 0, 1)
     return np.linalg.norm(p0 + d1 * s[:, None] - (q0 + d2 * t[:, None]), axis=1)
 
@@ -65,7 +69,12 @@ def close_pairs(strands, sample=SAMPLE_STRANDS, close=CLOSE_CM):
     for i in range(len(seg0)):  # bounding boxes first: the distance only where they overlap
         cand = np.nonzero((owner > owner[i]) & np.all(lo <= hi[i], axis=1) & np.all(hi >= lo[i], axis=1))[0]
         if len(cand):
-            d = _segment_distance(np.repeat(seg0[i : i + 1], len(cand), 0), np.repeat(seg1[i : i + 1], len(cand), 0), seg0[cand], seg1[cand])
+            d = _segment_distance(
+                np.repeat(seg0[i : i + 1], len(cand), 0),
+                np.repeat(seg1[i : i + 1], len(cand), 0),
+                seg0[cand],
+                seg1[cand],
+            )
             count += int(np.count_nonzero(d < close))
     return count
 
@@ -76,6 +85,10 @@ def frame_volume(trajectory, f):
     q = None
     params = trajectory.dynamic_params if trajectory.is_dynamic else {}
     if params and trajectory.head_motion != "still":
-        q = head_rotation(trajectory.head_motion, float(params["motion_amplitude"]), float(params["motion_frequency"]),
-                          float(trajectory.time[f]))
+        q = head_rotation(
+            trajectory.head_motion,
+            float(params["motion_amplitude"]),
+            float(params["motion_frequency"]),
+            float(trajectory.time[f]),
+        )
     return {"hair_volume": hair_volume(x, q), "envelope_radius": envelope_radius(x), "close_pairs": close_pairs(x)}

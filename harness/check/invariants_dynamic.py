@@ -35,6 +35,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from harness.check import invariants
+from harness.check.head_motion import head_rotation  # noqa: F401 (read from here by other modules)
 from harness.check.invariants import Violation
 from harness.core import tolerances
 from harness.core.guides import guide_count, guide_strands
@@ -81,20 +82,6 @@ class DynamicReport:
             "worst_observable_k": self.worst_observable_k,
             "violations": [v.as_dict() for v in self.all_violations()],
         }
-
-
-def head_rotation(motion, amplitude, frequency, t):
-    """Q(t) of §3.2 in double, row-major, as c_ref/dynamic/dynamics_host.c hb_head_rotation."""
-    th = amplitude * math.sin(2.0 * math.pi * frequency * t)
-    c, s = math.cos(th), math.sin(th)
-    q = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
-    if motion == "nod":
-        q[4], q[5], q[7], q[8] = c, -s, s, c
-    elif motion == "shake":
-        q[0], q[2], q[6], q[8] = c, s, -s, c
-    elif motion == "tilt":
-        q[0], q[1], q[3], q[4] = c, -s, s, c
-    return q
 
 
 def frame_end_time(traj, f):

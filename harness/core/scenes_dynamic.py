@@ -123,7 +123,9 @@ def _value(where, key, kind, value, error):
         items = value if isinstance(value, list) else [value]
         n = (6, 6) if kind == "box" else (1, 2)
         if not n[0] <= len(items) <= n[1]:
-            raise error(f"{where}: {key} must be {'6 numbers' if kind == 'box' else 'a number or 2 numbers'}, got {value!r}")
+            raise error(
+                f"{where}: {key} must be {'6 numbers' if kind == 'box' else 'a number or 2 numbers'}, got {value!r}"
+            )
         part = "nonneg" if kind == "pair" else "unit" if kind == "pair_unit" else None
         for x in items:
             if part:

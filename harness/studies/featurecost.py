@@ -1,6 +1,7 @@
 """What each feature of the dynamic model costs (docs/model.md §3.9): time per frame of one
 scene with every feature undeclared, each alone, each removed from the full scene, and
-the full scene, on one binary and variant. Measures and writes CSV; the Markdown table is
+the full scene, on one binary and variant, and the full scene with the hair–hair grid and a
+body to collide with (§3.16, §3.17) where the variant runs them. Measures and writes CSV; the Markdown table is
 harness/render/featurecost_report.py.
 
 A feature is taken out by removing its flags from the scene's command line (so the binary
@@ -15,7 +16,7 @@ compiles it out), never by setting it to zero:
 import shutil
 
 from harness import HarnessError
-from harness.core import runner, scenes
+from harness.core import runner, scenes, variants
 from harness.core.paths import binary_path
 from harness.core.progress import Progress
 from harness.core.scenes_dynamic import DECLARING, FEATURES, NEEDS
@@ -66,8 +67,34 @@ def declared(record):
     return sim[0]
 
 
-def cases(flags):
-    """(row name, flags) for the table: none, each alone, full minus each, full."""
+# The rows beyond the full scene (docs/model.md §3.16, §3.17): the grid and the body of
+# configs/scenes/body.toml added to it, each declared by its own flags (their cost beside it).
+WORLD_SCENE = "body"
+
+
+def world_rows(flags):
+    """(row name, flags): the full scene with the grid once a frame, every substep, the body
+    (colliders and friction), and both, from WORLD_SCENE's [grid] and [body] tables."""
+    extra = scenes.load_scene(WORLD_SCENE).flags()
+    grid = _pick(extra, lambda f: f.startswith("--grid"))
+    body = _pick(extra, lambda f: f in ("--colliders", "--friction", "--depenetration-speed") or f.startswith("--body"))
+    substep = _set(grid, "--grid-rebuild", "substep")
+    return [
+        ("full + grid (once a frame)", [*flags, *grid]),
+        ("full + grid (every substep)", [*flags, *substep]),
+        ("full + body", [*flags, *body]),
+        ("full + body + grid", [*flags, *body, *grid]),
+    ]
+
+
+def _pick(flags, keep):
+    """The `flag value` pairs of a flag list whose flag `keep` accepts."""
+    return [a for i in range(0, len(flags) - 1, 2) if keep(flags[i]) for a in (flags[i], flags[i + 1])]
+
+
+def cases(flags, world=True):
+    """(row name, flags) for the table: none, each alone, full minus each, full (and with
+    `world` the full scene with the grid and the body)."""
     rows = [("none (gravity, stretch)", without(flags, FEATURES))]
     for feat in FEATURES:
         keep = {feat, *NEEDS.get(feat, ())}
@@ -75,7 +102,7 @@ def cases(flags):
     for feat in FEATURES:
         rows.append((f"full − {feat}", without(flags, [feat])))
     rows.append(("full", list(flags)))
-    return rows
+    return rows + (world_rows(flags) if world else [])
 
 
 def measure(
@@ -101,7 +128,9 @@ def measure(
     base = _set(base, "--frames", str(frames))
     binary = binary_path(backend, build)
     rows = []
-    todo = cases(base)
+    declared_ = variants.declared(backend, build)
+    used = variant or declared_.default_variant
+    todo = cases(base, world=declared_.runs_features(used, {"grid", "colliders", "friction"}))
     with Progress(len(todo), f"featurecost {backend}") as bar:
         for name, flags in todo:
             rows.append(_row(binary, name, flags, timeout, instructions, progress))

@@ -42,8 +42,9 @@ def particles(tmp_path, points, roots=None, name="g.hair"):
 
 def simulate(cpu_bin, tmp_path, groom, *args, frames=1, out="o.h5", precision="fp64"):
     path = tmp_path / out
-    run(cpu_bin, "--groom", groom, "--head-center", "0,0,0", "--head-radius", "1", "--stages", "init,simulate",
-        "--precision", precision, "--frames", frames, "--velocities", "all", *args, "--output", path, "--quiet")  # fmt: skip
+    head = ["--groom", groom, "--head-center", "0,0,0", "--head-radius", "1", "--stages", "init,simulate"]
+    run(cpu_bin, *head, "--precision", precision, "--frames", frames, "--velocities", "all", *args,
+        "--output", path, "--quiet")  # fmt: skip
     return path
 
 

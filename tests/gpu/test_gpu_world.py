@@ -39,8 +39,20 @@ SCENES = {
     "grid-still": ["--grid", "12", "--grid-volume", "5000"],
     "body": ["--head-motion", "nod", "--friction", "0.4,0.3", "--depenetration-speed", "150", "--colliders", "BODY"],
     "body-sway": ["--colliders", "BODY", "--body-motion", "sway", "--body-amplitude", "3"],
-    "all": ["--head-motion", "tilt", "--grid", "16", "--grid-friction", "0.05", "--grid-volume", "1000",
-            "--friction", "0.3", "--colliders", "BODY"],  # fmt: skip
+    "all": [
+        "--head-motion",
+        "tilt",
+        "--grid",
+        "16",
+        "--grid-friction",
+        "0.05",
+        "--grid-volume",
+        "1000",
+        "--friction",
+        "0.3",
+        "--colliders",
+        "BODY",
+    ],  # fmt: skip
 }
 FRAMES = 3
 RUNS = [(v, s) for v in VARIANTS for s in SCENES if _DECLARED.runs_features(v, variants.features_of(SCENES[s]))]
@@ -68,8 +80,9 @@ def cpu_files(work):
         key = (scene, solver, precision)
         if key not in cache:
             out = work / f"cpu_{scene}_{solver}_{precision}.h5"
-            run(CPU_BIN, "--stages", "init,collide,simulate", *BASE, *scene_args(work, scene), "--solver", solver,
-                "--precision", precision, "--frames", FRAMES, "--velocities", "all", "--output", out, "--quiet")  # fmt: skip
+            args = [*BASE, *scene_args(work, scene), "--solver", solver, "--precision", precision]
+            run(CPU_BIN, "--stages", "init,collide,simulate", *args, "--frames", FRAMES, "--velocities", "all",
+                "--output", out, "--quiet")  # fmt: skip
             cache[key] = out
         return cache[key]
 

@@ -100,8 +100,59 @@ def head(traj, frame):
     return Sphere((0.0, 0.0, 0.0), float(traj.params["head_radius"]), head_rotation_at(traj, frame), face_marks=True)
 
 
+BODY = (0.55, 0.58, 0.66)  # colliders of docs/model.md §3.17
+
+
+def _mesh_file(traj, collider):
+    """A mesh collider's OBJ file beside the colliders file the run named, if it is still there."""
+    import os
+
+    cols = str(traj.dynamic_params.get("colliders_file", ""))
+    path = os.path.join(os.path.dirname(cols), collider.source) if cols else collider.source
+    return path if collider.source and os.path.isfile(path) else None
+
+
+def _read_obj(path):
+    verts, tris = [], []
+    with open(path) as f:
+        for line in f:
+            w = line.split()
+            if w and w[0] == "v":
+                verts.append([float(x) for x in w[1:4]])
+            elif w and w[0] == "f":
+                idx = [int(x.split("/")[0]) for x in w[1:]]
+                idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
+                tris += [(idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
+    return np.array(verts), np.array(tris, dtype=np.int64)
+
+
+def colliders(traj, frame):
+    """The colliders of a state (docs/model.md §3.17) placed at frame `frame`: spheres and
+    capsules as drawn bodies, a mesh from its OBJ file where that file is still beside the
+    colliders file (the state holds its SDF, not its triangles); planes are not drawn."""
+    from harness.check.colliders import body_translation
+
+    if not getattr(traj, "colliders", None) or frame < traj.paper_frames:
+        return []
+    t = frame_end_time(traj, frame)
+    q = head_rotation_at(traj, frame)
+    b = body_translation(traj.dynamic_params, t)
+    out = []
+    for c in traj.colliders:
+        place = (lambda p: q @ np.asarray(p)) if c.frame == "head" else (lambda p: np.asarray(p) + b)
+        g = c.geometry
+        if c.kind == "sphere":
+            out.append(Sphere(tuple(place(g[:3])), float(g[3]), color=BODY))
+        elif c.kind == "capsule":
+            out.append(Capsule(tuple(place(g[:3])), tuple(place(g[3:6])), float(g[6]), color=BODY))
+        elif c.kind == "mesh" and _mesh_file(traj, c):
+            v, tri = _read_obj(_mesh_file(traj, c))
+            m = placement(q) if c.frame == "head" else placement(None, b)
+            out.append(Mesh(v, tri, m, color=SKIN))
+    return out
+
+
 def of_frame(traj, frame):
     """Every solid body of frame `frame` of a state, placed for that frame: the one place a
-    state's bodies are listed (today the head; colliders the model gains go here, as Capsule
-    or Mesh with their transforms of the frame), so every render draws them."""
-    return [head(traj, frame)]
+    state's bodies are listed (the head and the colliders of §3.17), so every render draws them."""
+    return [head(traj, frame), *colliders(traj, frame)]

@@ -83,7 +83,8 @@ int main(void)
     }
     printf("one_node_mean_error %.17g\n", worst);
     printf("one_node_momentum_error %.17g\n",
-           fmax(fabs(mom_after[0] - mom_before[0]), fmax(fabs(mom_after[1] - mom_before[1]), fabs(mom_after[2] - mom_before[2]))));
+           fmax(fabs(mom_after[0] - mom_before[0]),
+                fmax(fabs(mom_after[1] - mom_before[1]), fabs(mom_after[2] - mom_before[2]))));
 
     /* 2. a cloud spread over the grid, friction 1, the grid from the same state: momentum kept */
     const int n2 = 2000;
@@ -100,7 +101,8 @@ int main(void)
         for (int c = 0; c < 3; c++) mom_after[c] += v[i][c];
     }
     printf("cloud_momentum_error %.17g\n",
-           fmax(fabs(mom_after[0] - mom_before[0]), fmax(fabs(mom_after[1] - mom_before[1]), fabs(mom_after[2] - mom_before[2]))));
+           fmax(fabs(mom_after[0] - mom_before[0]),
+                fmax(fabs(mom_after[1] - mom_before[1]), fabs(mom_after[2] - mom_before[2]))));
     printf("cloud_momentum_scale %.17g\n", fabs(mom_before[0]) + fabs(mom_before[1]) + fabs(mom_before[2]) + n2);
 
     /* 3. a uniform velocity passes unchanged */
