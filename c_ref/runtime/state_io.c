@@ -3,6 +3,7 @@
 #include "runtime/safe_write.h"
 #include "runtime/checked.h"
 #include "runtime/h5md_meta.h"
+#include "runtime/input.h"
 
 #include <errno.h>
 #include <stddef.h>
@@ -1020,11 +1021,8 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
 {
     quiet_hdf5();
     memset(in, 0, sizeof *in);
-    if (access(path, F_OK) != 0) FAIL("--input %s: no such file", path);
-    struct stat st; /* a FIFO or device would block or never end: only regular files */
-    if (stat(path, &st) != 0) FAIL("--input %s: cannot read it (%s)", path, strerror(errno));
-    if (!S_ISREG(st.st_mode)) FAIL("--input %s is %s; --input must be a regular file", path, hb_file_kind(st.st_mode));
-    if (access(path, R_OK) != 0) FAIL("--input %s: not readable (%s)", path, strerror(errno));
+    /* a FIFO or device would block or never end: a regular file, at least HDF5's superblock */
+    if (hb_input_check("--input", path, "an HDF5 file", 8, err, errlen)) return -1;
     if (H5Fis_hdf5(path) <= 0) FAIL("--input %s is not an HDF5 file", path);
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     if (f < 0) FAIL("--input %s: HDF5 cannot open it (truncated or damaged?)", path);
