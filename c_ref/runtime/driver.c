@@ -805,8 +805,9 @@ static int run_one(int argc, char **argv, hb_backend *b)
         CHECK(1, HB_EXIT_MEMORY);
     }
     if (o.output) {
-        run.w = hb_writer_open(o.output, o.force, &o.scene, err, sizeof err);
-        if (!run.w) CHECK(1, HB_EXIT_USAGE);
+        int open_status;
+        run.w = hb_writer_open(o.output, o.force, &o.scene, &open_status, err, sizeof err);
+        if (!run.w) CHECK(1, open_status);
     }
 
     /* ---- the input state: its frames go into the output first ---- */

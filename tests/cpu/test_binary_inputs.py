@@ -12,6 +12,7 @@ import threading
 import pytest
 from test_grooms import hair_bytes, radial_strands
 
+from support import fulldisk
 from support.statecheck import run, tmp_leftovers
 
 SIM = ["--stages", "init,simulate"]
@@ -223,3 +224,26 @@ def test_fifo_batch_does_not_wait_for_a_writer(cpu_bin, tmp_path):
         t.join(10)
         pytest.fail("--batch FIFO waited for a writer")
     refused(result["p"], "is a FIFO")
+
+
+# ---- D15, M2: a full disk ------------------------------------------------------------------
+
+
+def test_full_disk_exit_4_old_output_kept(cpu_bin, tmp_path):
+    p = fulldisk.run(
+        tmp_path,
+        f'printf old > "$D/o.h5"; "{cpu_bin}" --strands 20000 --points 32 --output "$D/o.h5" --force --quiet\n'
+        'echo "rc=$?"; cat "$D/o.h5"; echo; ls -A "$D"',
+    )
+    assert p.stdout.split() == ["rc=4", "old", "o.h5"], (p.stdout, p.stderr)
+    assert len(p.stderr.strip().splitlines()) == 1 and "disk full" in p.stderr, p.stderr
+
+
+def test_full_disk_temporary_not_created_exit_4(cpu_bin, tmp_path):
+    p = fulldisk.run(
+        tmp_path,
+        f'head -c 4M /dev/zero > "$D/fill" 2>/dev/null; "{cpu_bin}" {" ".join(TINY)} --output "$D/o.h5"\n'
+        'echo "rc=$?"; ls -A "$D"',
+    )
+    assert p.stdout.split() == ["rc=4", "fill"], (p.stdout, p.stderr)
+    assert len(p.stderr.strip().splitlines()) == 1 and "No space left" in p.stderr, p.stderr
