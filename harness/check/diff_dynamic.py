@@ -58,10 +58,11 @@ OBS_SHOWN = ("stretch_max", "penetration_max", "kinetic_energy", "blown_up_stran
 
 
 def is_dynamic_file(path):
-    try:
-        import h5py
+    from harness.core import inputs
 
-        with h5py.File(path, "r") as f:
+    inputs.regular(path, "diff:")  # a FIFO would block any reader: refused here, before it
+    try:
+        with inputs.open_h5(path, "diff:") as f:
             return "parameters" in f and as_text(f["parameters"].attrs.get("model", "paper")) == "dynamic"
     except Exception:
         return False

@@ -91,26 +91,20 @@ def cmd_run(args):
     )
     if scene.model == "dynamic" and args.frames:
         scene = scenes.with_frames(scene, args.frames)
-    if scene.groom_file:
-        from harness.io import grooms
+    from harness.io import grooms
 
-        if grooms.is_usd(scene.groom_file):  # the binaries read HAIR: a USD groom passes through one
-            import dataclasses
-            import tempfile
-
-            tmpdir = tempfile.TemporaryDirectory(prefix="hairbench-groom-")
-            hair = os.path.join(tmpdir.name, "groom.hair")
-            grooms.convert(scene.groom_file, hair)
-            scene = dataclasses.replace(scene, groom=hair)
     binary = binary_path(args.backend, args.build)
-    flags = runner.run_flags(
-        scene, args.backend, **options(args, "variant block_size threads repeat warmup output force")
-    )
-    if scene.model == "dynamic":  # per-frame observables (harness/check/run_dynamic.py)
-        from harness.check import run_dynamic
+    # the binaries read HAIR: a USD groom passes through one, named as the user named it
+    with grooms.hair_for(scene) as (scene, named):
+        flags = runner.run_flags(
+            scene, args.backend, **options(args, "variant block_size threads repeat warmup output force")
+        )
+        if scene.model == "dynamic":  # per-frame observables (harness/check/run_dynamic.py)
+            from harness.check import run_dynamic
 
-        return run_dynamic.run(binary, flags, args.output, timeout=args.timeout, as_json=args.json, every=args.every)
-    record = runner.run_binary(binary, flags, timeout=args.timeout)
+            given = options(args, "timeout every")
+            return run_dynamic.run(binary, flags, args.output, as_json=args.json, named=named, **given)
+        record = named(runner.run_binary(binary, flags, timeout=args.timeout))
     print(json.dumps(record, indent=1) if args.json else runner.summary(record))
     return 0
 
@@ -324,8 +318,10 @@ def accuracy_model(args):
 
     model = args.model
     if args.from_csv and model is None:
+        from harness.core import inputs
         from harness.studies.accuracy import REQUIRED_COLUMNS
 
+        inputs.regular(args.from_csv, "accuracy: --from-csv")
         try:
             with open(args.from_csv, encoding="utf-8") as fh:
                 header = fh.readline().strip().split(",")
@@ -1087,11 +1083,16 @@ def parser():
 
 def main(argv=None):
     args = parser().parse_args(argv)
+    from harness.core import runner
+
     try:
-        with interrupts.redelivered():
+        with runner.forwarding(), interrupts.redelivered():
             rc = args.func(args)
             sys.stdout.flush()  # a closed pipe shows here, inside the handlers below
         return rc
+    except runner.Stopped as e:  # forwarded to every child, each waited for: nothing runs on
+        print(f"harness: stopped by {e}", file=sys.stderr)
+        return 128 + e.signum
     except HarnessError as e:
         print(f"harness: error: {e}", file=sys.stderr)
         return e.code if e.code else 2

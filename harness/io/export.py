@@ -54,12 +54,9 @@ def _replace(tmp, path):
 
 
 def _open_state(path):
-    import h5py
+    from harness.core import inputs
 
-    try:
-        f = h5py.File(path, "r")
-    except (OSError, ValueError) as e:
-        raise HarnessError(f"export: cannot open {path} as HDF5 ({e})") from None
+    f = inputs.open_h5(path, "export:")
     try:
         value = f[f"{POSITION}/value"]
         n = int(f["parameters"].attrs["n_strands"])
@@ -318,8 +315,9 @@ def run(state, xdmf=True, usd=False, out=None, force=False):
     """Write the sidecars; return their paths. Everything that can refuse does so before
     anything is written: no such state, USD asked for without usd-core, a target that is a
     symbolic link or not a regular file, or one that exists without `force`."""
-    if not Path(state).is_file():
-        raise HarnessError(f"export: {state}: no such file")
+    from harness.core import inputs
+
+    inputs.regular(state, "export:")
     if usd:
         _pxr()
     paths = targets(state, out, xdmf, usd)

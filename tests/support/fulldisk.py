@@ -14,7 +14,9 @@ def _unshare():
     """The unshare command that may mount here, or None."""
     for cmd in (["unshare", "-m"], ["unshare", "-rm"]):
         try:
-            p = subprocess.run([*cmd, "sh", "-c", "mount -t tmpfs -o size=64k tmpfs /mnt"], capture_output=True, timeout=30)
+            p = subprocess.run(
+                [*cmd, "sh", "-c", "mount -t tmpfs -o size=64k tmpfs /mnt"], capture_output=True, timeout=30
+            )
         except (OSError, subprocess.TimeoutExpired):
             continue
         if p.returncode == 0:

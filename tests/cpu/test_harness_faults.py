@@ -1,0 +1,219 @@
+"""The harness's rows of the second fault probe (issue #46): signals forwarded to every child
+and waited for, every input through one guarded opener, grooms from USD named as the user named
+them, TOML that is not TOML, merges that know a shard's completeness, result folders owned by one
+run at a time, writes whole or not at all on a full disk. Each test failed before its fix."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from test_fault_probe import harness, no_traceback, temporaries, wait_for_child
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def one_line(p, code=2, words=None):
+    no_traceback(p)
+    lines = p.stderr.strip().splitlines()
+    assert p.returncode == code and len(lines) == 1, (p.returncode, p.stderr)
+    assert words is None or words in lines[0], lines[0]
+    return lines[0]
+
+
+def alive(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def child_pids(pid):
+    out = []
+    for p in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{p}/stat") as f:
+                if int(f.read().rsplit(")", 1)[1].split()[1]) == pid:
+                    out.append(int(p))
+        except (OSError, ValueError, IndexError):
+            pass
+    return out
+
+
+# ---- D1: every terminating signal forwarded to the child's group, waited for ---------------
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT, signal.SIGINT], ids=lambda s: s.name)
+def test_signal_to_the_harness_stops_its_binary(cpu_bin, tmp_path, sig):
+    out = tmp_path / "x.h5"
+    out.write_bytes(b"mine")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "harness", "run", "dynamic", "--strands", "2000", "--frames", "4000", "--threads", "1"]
+        + ["--output", str(out), "--force"],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    assert wait_for_child(proc, "hairsim-cpu", timeout=60)
+    kids = child_pids(proc.pid)
+    time.sleep(0.3)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 128 + sig, (proc.returncode, err)
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    assert kids and not any(alive(k) for k in kids), kids
+    assert out.read_bytes() == b"mine" and temporaries(tmp_path) == []
+
+
+# ---- D3: every input of the harness through one opener --------------------------------------
+
+
+@pytest.fixture
+def fifo(tmp_path):
+    path = tmp_path / "ff"
+    os.mkfifo(path)
+    return path
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["diff", "{f}", "{f}"],
+        ["stability", "--from-csv", "{f}", "--report-dir", "{t}/rep"],
+        ["accuracy", "--from-csv", "{f}", "--report-dir", "{t}/rep"],
+        ["export", "{f}", "--out", "{t}/e"],
+        ["run", "{f}"],
+        ["sweep", "{f}", "--out", "{t}/s"],
+    ],
+    ids=lambda a: a[0] + (a[1] if a[1].startswith("--") else ""),
+)
+def test_fifo_input_refused_without_waiting(tmp_path, fifo, args):
+    words = [a.format(f=fifo, t=tmp_path) for a in args]
+    p = harness(*words, timeout=30)
+    line = one_line(p, words="FIFO")
+    assert str(fifo) in line or "ff" in line, line
+
+
+def test_missing_input_named_as_missing(tmp_path):
+    line = one_line(harness("export", tmp_path / "none.h5"), words="no such file")
+    assert "none.h5" in line
+
+
+def test_scene_groom_fifo_refused(tmp_path, fifo):
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'model = "dynamic"\nstages = ["init", "simulate"]\ngroom = "{fifo}"\n')
+    p = harness("run", scene, "--frames", "1", timeout=30)
+    one_line(p, words="FIFO")
+
+
+# ---- D12: TOML that is not TOML --------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "text", ["a = " + "[" * 5000 + "]" * 5000 + "\n", "a = " + "9" * 5000 + "\n"], ids=["deep", "long-integer"]
+)
+def test_scene_toml_beyond_the_parser_refused(tmp_path, text):
+    scene = tmp_path / "s.toml"
+    scene.write_text(text)
+    one_line(harness("run", scene), words="not valid TOML")
+
+
+# ---- M6: HB_GPUS checked where there is no GPU too -----------------------------------------
+
+
+def test_hb_gpus_checked_without_a_gpu(tmp_path):
+    from harness import HarnessError
+    from harness.core import gpus
+
+    with pytest.raises(HarnessError, match="HB_GPUS"):
+        gpus.visible(listed=[], environ={"HB_GPUS": "x"})
+
+
+# ---- M5: a budget that starts with a minus ----------------------------------------------------
+
+
+def test_negative_budget_said_as_a_budget(tmp_path):
+    p = subprocess.run(
+        ["make", "-s", "--no-print-directory", "bench", "BUDGET=-5m", f"OUT={tmp_path / 'b'}"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert p.returncode == 2 and "--budget" in p.stderr and "expected one argument" not in p.stderr, p.stderr
+    assert not (tmp_path / "b").exists()
+
+
+# ---- the record's names -------------------------------------------------------------------
+
+
+def test_json_of_a_run_names_no_removed_file(cpu_bin, tmp_path):
+    p = harness("run", "dynamic", "--strands", 10, "--frames", 2, "--json")
+    assert p.returncode == 0, p.stderr
+    assert json.loads(p.stdout)["output"] is None
+
+
+# ---- D8, D9, M4: USD grooms -----------------------------------------------------------------
+
+
+def usd_groom(path, meters=0.01, nan=False):
+    """Six radial strands of 6 cm around a 10 cm head, as a USD BasisCurves file (usd-core)."""
+    pytest.importorskip("pxr", reason="usd-core is not installed (optional: USD grooms need it)")
+    from pxr import Usd, UsdGeom
+    from test_grooms import radial_strands
+
+    strands = radial_strands((0, 0, 0), 10.0, [6.0] * 6, [4] * 6)
+    points = [tuple(map(float, p)) for s in strands for p in s]
+    if nan:
+        points[5] = (float("nan"), 0.0, 0.0)
+    stage = Usd.Stage.CreateNew(str(path))
+    UsdGeom.SetStageMetersPerUnit(stage, meters)
+    curves = UsdGeom.BasisCurves.Define(stage, "/hair")
+    curves.CreateTypeAttr("linear")
+    curves.CreatePointsAttr(points)
+    curves.CreateCurveVertexCountsAttr([len(s) for s in strands])
+    stage.GetRootLayer().Save()
+    return path
+
+
+@pytest.mark.parametrize(
+    "name, data",
+    [("garbage.usda", b"#usda 1.0\n(\n  this is not usd\n"), ("random.usdc", bytes(range(256)) * 8)],
+)
+def test_unreadable_usd_refused_in_one_line(tmp_path, name, data):
+    pytest.importorskip("pxr", reason="usd-core is not installed (optional: USD grooms need it)")
+    (tmp_path / name).write_bytes(data)
+    line = one_line(harness("groom", "convert", tmp_path / name, tmp_path / "o.hair"))
+    assert name in line and not (tmp_path / "o.hair").exists()
+
+
+@pytest.mark.parametrize("meters", [0.0, -1.0, float("nan")], ids=["zero", "negative", "nan"])
+def test_usd_meters_per_unit_must_be_positive(tmp_path, meters):
+    usd_groom(tmp_path / "g.usda", meters=meters)
+    one_line(harness("groom", "convert", tmp_path / "g.usda", tmp_path / "o.hair"), words="metersPerUnit")
+
+
+def scene_of(tmp_path, groom):
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'model = "dynamic"\nstages = ["init", "simulate"]\ngroom = "{groom}"\n[hair]\npoints = 5\n')
+    return scene
+
+
+def test_usd_groom_errors_name_the_users_file(cpu_bin, tmp_path):
+    usd_groom(tmp_path / "nan.usda", nan=True)
+    line = one_line(harness("run", scene_of(tmp_path, "nan.usda"), "--frames", 1))
+    assert "nan.usda" in line and "hairbench-groom" not in line and "groom.hair" not in line, line
+
+
+def test_usd_groom_record_names_the_users_file(cpu_bin, tmp_path):
+    usd_groom(tmp_path / "g.usda")
+    p = harness("run", scene_of(tmp_path, "g.usda"), "--frames", 1, "--json")
+    assert p.returncode == 0, p.stderr
+    assert json.loads(p.stdout)["groom"]["source"] == str(tmp_path / "g.usda")
