@@ -250,7 +250,7 @@ test: setup
 OUT ?= results/local
 bench: setup
 	@$(call BUILD_LOGGED,all)
-	$(RUN_PY) -m harness bench --out $(OUT)$(if $(BUDGET), --budget $(BUDGET))$(if $(SHARD), --shard $(SHARD))
+	$(RUN_PY) -m harness bench --out $(OUT)$(if $(BUDGET), --budget=$(BUDGET))$(if $(SHARD), --shard=$(SHARD))
 
 # REPORT_FROM: the run folder to render (default results/local, make bench's), or one sweep's
 # folder (its runs.csv: the paper report alone); REPORT_TO: where

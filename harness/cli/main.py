@@ -1083,9 +1083,10 @@ def parser():
 
 def main(argv=None):
     args = parser().parse_args(argv)
-    from harness.core import runner
+    from harness.core import gpus, runner
 
     try:
+        gpus.wanted()  # a bad HB_GPUS is refused on every machine, with or without a GPU
         with runner.forwarding(), interrupts.redelivered():
             rc = args.func(args)
             sys.stdout.flush()  # a closed pipe shows here, inside the handlers below

@@ -277,6 +277,8 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
             )
             if gate is not None:
                 gate.measured(size, len(tier), time.monotonic() - t0)
+        session["finished_at"] = env.now()
+        write_json(env_path, record)
     finally:
         progress.close()
     say(
@@ -339,7 +341,7 @@ def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, 
                 {k: rec.get(k) for k in ("version", "git_revision", "compiler", "flags", "device", "driver")},
             )
         progress.update()
-        session["finished_at"] = env.now()
+        session["last_case_at"] = env.now()  # finished_at only when the whole session ends
         write_json(env_path, record)
 
     one = gpu_list[0] if gpu_list else None

@@ -129,11 +129,16 @@ def test_scene_toml_beyond_the_parser_refused(tmp_path, text):
 
 
 def test_hb_gpus_checked_without_a_gpu(tmp_path):
-    from harness import HarnessError
-    from harness.core import gpus
-
-    with pytest.raises(HarnessError, match="HB_GPUS"):
-        gpus.visible(listed=[], environ={"HB_GPUS": "x"})
+    p = subprocess.run(
+        [sys.executable, "-m", "harness", "sweep", "quick", "--gpu", "no", "--out", str(tmp_path / "s")],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=dict(os.environ, HB_GPUS="x"),
+    )
+    one_line(p, words="HB_GPUS")
+    assert not (tmp_path / "s").exists()
 
 
 # ---- M5: a budget that starts with a minus ----------------------------------------------------

@@ -192,3 +192,25 @@ def test_a_sweep_does_not_resume_rows_of_another_machine(tmp_path):
     check_same_machine(h200, dict(h200), tmp_path)  # same machine: fine
     with pytest.raises(HarnessError, match="another machine .*NVIDIA H200.*this one is AMD EPYC, 2 cores, no GPU"):
         check_same_machine(h200, laptop, tmp_path)
+
+
+def test_a_killed_session_is_not_marked_finished(fake, tmp_path):
+    """#46 M9: env.json's session of a sweep killed mid-way has no finished_at; the one that
+    resumes it to the end has."""
+    import json
+
+    out = tmp_path / "res"
+    env = dict(os.environ, FAKE_SLEEP="0.25", PYTHONPATH=str(ROOT))
+    cmd = [sys.executable, "-m", "harness", "sweep", str(fake), "--out", str(out), "--gpu", "no"]
+    p = subprocess.Popen(
+        cmd, cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+    )
+    deadline = time.time() + 60
+    while time.time() < deadline and not ((out / "runs.csv").exists() and len(read_csv(out / "runs.csv")) >= STAGES):
+        time.sleep(0.05)
+    os.killpg(p.pid, signal.SIGKILL)
+    p.wait()
+    killed = json.loads((out / "env.json").read_text())["sessions"][-1]
+    assert killed["cases_run"] >= 1 and "finished_at" not in killed, killed
+    assert subprocess.run(cmd, cwd=ROOT, env=dict(env, FAKE_SLEEP="0"), capture_output=True).returncode == 0
+    assert "finished_at" in json.loads((out / "env.json").read_text())["sessions"][-1]
