@@ -11,7 +11,6 @@ import os
 import queue
 import re
 import shutil
-import subprocess
 import threading
 from dataclasses import dataclass
 
@@ -41,9 +40,11 @@ def _smi_list():
     smi = shutil.which("nvidia-smi")
     if smi is None:
         return []
+    from harness.core import runner
+
     try:
-        return parse_smi(subprocess.run([smi, "-L"], capture_output=True, text=True, timeout=30).stdout)
-    except (OSError, subprocess.TimeoutExpired):
+        return parse_smi(runner.run_command([smi, "-L"], timeout=30).stdout)
+    except (OSError, runner.TimedOut):
         return []
 
 

@@ -15,9 +15,10 @@ plays no part and the root need not lie on it.
 
 import math
 import os
-import subprocess
 
 import numpy as np
+
+from harness.core import runner
 
 
 def write_paper_state(path, positions, hair_length, precision="fp64", hair_offset=0.1, head_radius=10.0):
@@ -144,7 +145,7 @@ def simulate(
         "--quiet",
     ]
     cmd += [str(a) for a in extra]
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    r = runner.run_command(cmd, timeout=timeout)
     if r.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} exited {r.returncode}: {r.stderr.strip()}")
     return output_path

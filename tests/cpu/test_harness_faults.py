@@ -222,3 +222,46 @@ def test_usd_groom_record_names_the_users_file(cpu_bin, tmp_path):
     p = harness("run", scene_of(tmp_path, "g.usda"), "--frames", 1, "--json")
     assert p.returncode == 0, p.stderr
     assert json.loads(p.stdout)["groom"]["source"] == str(tmp_path / "g.usda")
+
+
+# ---- D19: Ctrl-C during a study run in its own session ---------------------------------------
+
+STUDY = """
+import contextlib, sys, time
+from pathlib import Path
+from harness.core import budget, runner
+
+out = Path(sys.argv[1])
+
+def study():
+    (out / "reduced").mkdir()
+    for i in range(1200):
+        (out / "reduced" / f"part{i}.csv").write_text("x")
+        time.sleep(0.05)
+
+with getattr(runner, "forwarding", contextlib.nullcontext)():  # as harness/cli/main.py runs a command
+    try:
+        budget.run_study(budget.Budget(600), "reduced", study, [out], print)
+    except KeyboardInterrupt:
+        sys.exit(130)
+"""
+
+
+def test_interrupt_stops_a_budgeted_study_and_removes_what_it_added(tmp_path):
+    (tmp_path / "mine.txt").write_text("mine")
+    proc = subprocess.Popen(
+        [sys.executable, "-c", STUDY, str(tmp_path)],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (tmp_path / "reduced" / "part3.csv").exists():
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "Traceback" not in err, err
+    time.sleep(0.5)  # a study left running would write on
+    assert sorted(os.listdir(tmp_path)) == ["mine.txt"], os.listdir(tmp_path)

@@ -130,7 +130,10 @@ def test_layers_import_downwards_only():
 
 
 def test_renderers_never_reach_the_runner():
+    """No renderer measures: none reaches the runner, except through harness.core.variants, which
+    asks a binary for its declarations (--list-variants), through the runner like every child."""
     graph = import_graph()
+    graph = {m: ({} if m == "harness.core.variants" else t) for m, t in graph.items()}
     render = [m for m in graph if m.startswith("harness.render")]
     assert render, "no module under harness/render"
     chains = [" -> ".join(c) for m in render if (c := reaches(graph, m, RUNNER))]
@@ -157,3 +160,35 @@ def test_rendering_commands_live_in_render(command):
     used = {n.module for n in ast.walk(func) if isinstance(n, ast.ImportFrom)}
     assert used and all(m in ("harness.render", "harness.core.paths") for m in used), used
     assert graph["harness.cli.main"]
+
+
+def calls_and_imports(path):
+    """(imported module names, dotted names called) of a file, read with ast."""
+    tree = ast.parse(path.read_text(), str(path))
+    imported, called = set(), set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            imported |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            imported.add(node.module)
+        elif isinstance(node, ast.Call):
+            called.add(ast.unparse(node.func))
+    return imported, called
+
+
+def test_every_child_starts_through_the_runner():
+    """#47: harness/core/runner.py is the one module that starts a program (subprocess); no
+    os.system, os.popen, os.fork or os.exec* anywhere; a forked multiprocessing.Process is watched by
+    runner.supervised in the same module, so that a signal reaching the harness reaches it."""
+    bad = []
+    for path in PACKAGE.rglob("*.py"):
+        name = module_name(path)
+        imported, called = calls_and_imports(path)
+        if "subprocess" in imported and name != RUNNER:
+            bad.append(f"{name} imports subprocess (use harness.core.runner.run_command or run_binary)")
+        bad += [
+            f"{name} calls {c}" for c in called if c in ("os.system", "os.popen", "os.fork") or c.startswith("os.exec")
+        ]
+        if any(c.endswith(".Process") for c in called) and "runner.supervised" not in called:
+            bad.append(f"{name} forks a process without runner.supervised")
+    assert not bad, "\n".join(bad)
