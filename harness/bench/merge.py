@@ -23,6 +23,7 @@ from pathlib import Path
 from harness import HarnessError
 from harness.core import env
 from harness.core.paths import display
+from harness.io import files
 from harness.io.files import write_json
 from harness.studies.sweep import machine_of
 
@@ -124,7 +125,7 @@ def merge(out, folders, log=print):
             elif rel.name == "validation.json" and len(found) > 1:
                 _join_validation(target, found)
             else:
-                shutil.copy2(found[0][1], target)
+                files.copy(found[0][1], target)
         n = len(shards)
         write_json(
             out / "merge.json",
@@ -161,10 +162,7 @@ def _join_csv(target, found):
                 row[i] = str(int(row[i]) + offset) if row[i] else row[i]
             offset += sessions
         rows += part
-    with open(target, "w", newline="") as f:
-        w = csv.writer(f, lineterminator="\n")
-        w.writerow(header)
-        w.writerows(rows)
+    files.write_rows(target, header, rows)
 
 
 def _sessions(env_path):

@@ -19,6 +19,7 @@ import numpy as np
 
 from harness import HarnessError
 from harness.core import inputs
+from harness.io import files
 
 USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
 HAIR_SEGMENTS, HAIR_POINTS = 1, 2
@@ -102,14 +103,7 @@ def write_hair(path, strands, force=False):
         raise HarnessError(f"groom: {path} is a symbolic link or not a regular file; refusing to replace it")
     if path.exists() and not force:
         raise HarnessError(f"groom: {path} exists (give --force to replace it)")
-    data = hair_bytes(strands)
-    tmp = path.with_name(f"{path.name}.tmp.{os.getpid()}")
-    try:
-        tmp.write_bytes(data)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return path
+    return files.write_bytes(path, hair_bytes(strands))
 
 
 @contextlib.contextmanager

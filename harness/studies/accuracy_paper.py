@@ -20,8 +20,6 @@ Writes results/accuracy/accuracy.csv and env.json (render/accuracy_paper_report.
 report/accuracy_pareto.png and writes report/accuracy.md from them).
 """
 
-import json
-
 import numpy as np
 
 from harness.check import invariants
@@ -228,7 +226,7 @@ def run_study(
     csv_path = out_dir / "accuracy.csv"
     files.write_csv(csv_path, COLUMNS, rows, extrasaction="ignore")
     meta = dict(env.collect(), resolution_strands=res_strands, gpu_absent=None if gpu_ok else why)
-    (out_dir / "env.json").write_text(json.dumps(meta, indent=1) + "\n")
+    files.write_json(out_dir / "env.json", meta)
     for p in scratch.glob("*.h5"):
         p.unlink()
     scratch.rmdir()

@@ -19,6 +19,7 @@ import os
 import numpy as np
 
 from harness.core import runner
+from harness.io import files
 
 
 def write_paper_state(path, positions, hair_length, precision="fp64", hair_offset=0.1, head_radius=10.0):
@@ -28,8 +29,7 @@ def write_paper_state(path, positions, hair_length, precision="fp64", hair_offse
     positions = np.asarray(positions, dtype=np.float64)
     n, p, _ = positions.shape
     dtype = np.float64 if precision == "fp64" else np.float32
-    tmp = f"{path}.tmp.{os.getpid()}"
-    with h5py.File(tmp, "w") as f:
+    with files.writing(path) as tmp, h5py.File(tmp, "w") as f:
         h = f.create_group("h5md")
         h.attrs["version"] = np.array([1, 1], dtype=np.int32)
         h.create_group("author").attrs["name"] = "hairbench analytic tests"
@@ -55,7 +55,6 @@ def write_paper_state(path, positions, hair_length, precision="fp64", hair_offse
         ):
             g.attrs[key] = value
         g.create_dataset("stage", data=np.array(["init"], dtype=h5py.string_dtype()))
-    os.replace(tmp, path)
     return path
 
 

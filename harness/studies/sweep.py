@@ -384,7 +384,5 @@ def figure_state(results_dir):
         return None
     path.parent.mkdir(parents=True, exist_ok=True)
     scene = scenes.load_scene("paper").with_overrides(strands=FIGURE_STRANDS)
-    tmp = path.with_name(path.stem + f".part{os.getpid()}.h5")
-    run_binary(binary, run_flags(scene, "cpu", output=tmp, force=True))
-    os.replace(tmp, path)
+    run_binary(binary, run_flags(scene, "cpu", output=path, force=True))  # the binary writes it whole or not at all
     return path

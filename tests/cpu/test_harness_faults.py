@@ -14,6 +14,9 @@ from pathlib import Path
 import pytest
 from test_fault_probe import harness, no_traceback, temporaries, wait_for_child
 
+from support import fulldisk
+from support.sweeps import sweep_toml
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -265,3 +268,39 @@ def test_interrupt_stops_a_budgeted_study_and_removes_what_it_added(tmp_path):
     assert proc.returncode == 130 and "Traceback" not in err, err
     time.sleep(0.5)  # a study left running would write on
     assert sorted(os.listdir(tmp_path)) == ["mine.txt"], os.listdir(tmp_path)
+
+
+# ---- D16, D20: writes on a full disk ---------------------------------------------------------
+
+
+def test_usd_export_on_a_full_disk_leaves_nothing(cpu_bin, tmp_path):
+    pytest.importorskip("pxr", reason="usd-core is not installed (optional: USD export needs it)")
+    state = tmp_path / "s.h5"
+    subprocess.run([str(cpu_bin), "--strands", "20000", "--points", "32", "--output", str(state)], check=True)
+    p = fulldisk.run(
+        tmp_path,
+        f'cd "$HERE"; printf mine > "$D/mine"; "{sys.executable}" -m harness export {state} --usd-only --force '
+        '--out "$D/x"; echo "rc=$?"; ls -A "$D"',
+    )
+    assert p.stdout.split() == ["rc=4", "mine"], (p.stdout, p.stderr)
+    one_line(subprocess.CompletedProcess([], 4, "", p.stderr), code=4, words="x.usdc")
+
+
+SWEEP_TOML = sweep_toml("disk", strands=list(range(10, 410, 10)), points=[4], precision=["fp32"])
+
+
+def test_sweep_on_a_full_disk_names_the_file_and_leaves_no_temporary(tmp_path):
+    from support.fakebackend import install
+
+    build = install(tmp_path / "build", ["hairsim-cpu"])
+    (tmp_path / "disk.toml").write_text(SWEEP_TOML)
+    p = fulldisk.run(
+        tmp_path,
+        f'cd "$HERE"; HAIRBENCH_BUILD_DIR={build} HAIRBENCH_NO_GPU=1 "{sys.executable}" -m harness sweep '
+        f'{tmp_path / "disk.toml"} --out "$D/s" --gpu no; echo "rc=$?"; ls -A "$D/s"',
+        size="16k",
+    )
+    lines = p.stdout.split()
+    assert "rc=4" in lines and not [n for n in lines if ".tmp" in n], (p.stdout, p.stderr)
+    line = p.stderr.strip().splitlines()[-1]
+    assert "No space left on device" in line and "/s/" in line, p.stderr

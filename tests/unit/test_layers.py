@@ -192,3 +192,47 @@ def test_every_child_starts_through_the_runner():
         if any(c.endswith(".Process") for c in called) and "runner.supervised" not in called:
             bad.append(f"{name} forks a process without runner.supervised")
     assert not bad, "\n".join(bad)
+
+
+WRITERS = ("harness.io.files", "harness.io.runlog", RUNNER)  # the one writer; the append-only log; the runner's scratch
+WRITE_CALLS = ("os.replace", "os.rename", "shutil.copy", "shutil.copy2", "shutil.copyfile", "shutil.move")
+WRITE_METHODS = (".write_text", ".write_bytes", ".savefig", ".rename", ".to_csv", ".to_json")
+
+
+def file_writes(path):
+    """The calls in a file that write a file around harness/io/files.py."""
+    tree = ast.parse(path.read_text(), str(path))
+    uses_writing = any(
+        isinstance(n, ast.Call) and ast.unparse(n.func).endswith("files.writing") for n in ast.walk(tree)
+    )
+    found = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call):
+            continue
+        func = ast.unparse(node.func)
+        modes = [a.value for a in [*node.args[1:2], *(k.value for k in node.keywords if k.arg == "mode")]
+                 if isinstance(a, ast.Constant) and isinstance(a.value, str)]  # fmt: skip
+        writes_mode = any(set(m) & set("wax+") for m in modes)
+        into_temporary = uses_writing and func.split(".")[0].startswith("tmp")  # a name files.writing gave
+        if func.startswith("files.") or into_temporary:
+            continue
+        if func in WRITE_CALLS or func.endswith(WRITE_METHODS) or (func == "open" and writes_mode):
+            found.append(f"line {node.lineno}: {func}")
+        elif func.endswith("h5py.File") and writes_mode and not uses_writing:
+            found.append(f"line {node.lineno}: {func} for writing outside files.writing")
+    return found
+
+
+def test_every_file_write_goes_through_files():
+    """#47: every file the harness writes goes through harness/io/files.py (whole or not at all,
+    its temporary removed in `finally`); an h5py file written inside files.writing."""
+    bad = [
+        f"{module_name(p)} {w}" for p in PACKAGE.rglob("*.py") if module_name(p) not in WRITERS for w in file_writes(p)
+    ]
+    assert not bad, "writes around harness/io/files.py:\n" + "\n".join(bad)
+
+
+def test_the_write_check_sees_a_hidden_write(tmp_path):
+    path = tmp_path / "m.py"
+    path.write_text("def f(p, t):\n    with open(p, 'w') as x:\n        x.write(t)\n    t.replace('a', 'b')\n")
+    assert file_writes(path) == ["line 2: open"]
