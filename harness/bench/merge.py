@@ -23,7 +23,7 @@ from pathlib import Path
 from harness import HarnessError
 from harness.core import env
 from harness.core.paths import display
-from harness.io import files
+from harness.io import files, runfolder
 from harness.io.files import write_json
 from harness.studies.sweep import machine_of
 
@@ -103,6 +103,7 @@ def merge(out, folders, log=print):
     out = Path(out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise HarnessError(f"merge: {display(out)} exists and is not an empty folder: give a new OUT")
+    runfolder.claim(out, "merge", what="merge: OUT")  # locked; not the repository or a folder above it
     for f in folders:
         if not Path(f).is_dir():
             raise HarnessError(f"merge: {f} is not a folder")

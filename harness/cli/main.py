@@ -144,12 +144,13 @@ def cmd_sweep(args):
     shard = shards.parse(args.shard) if args.shard else None
     if shard:
         from harness.bench import merge
-        from harness.core.paths import RESULTS, output_dir
+        from harness.core.paths import RESULTS
+        from harness.io import runfolder
 
         spec = load_sweep(args.sweep)
-        out = output_dir(args.out if args.out else RESULTS / spec.name)
+        out = runfolder.claim(args.out if args.out else RESULTS / spec.name, f"sweep {spec.name}", force=args.force)
         merge.write_record(out, shard, {"sweep": spec.path}, f"sweep {spec.name}")
-    _, failed = sweep.run_sweep(args.sweep, out=args.out, gpu=args.gpu, shard=shard)
+    _, failed = sweep.run_sweep(args.sweep, out=args.out, gpu=args.gpu, shard=shard, force=args.force)
     return 1 if failed else 0
 
 
@@ -191,11 +192,14 @@ def cmd_bench(args):
     from harness.core import budget, shards
     from harness.core.paths import LOCAL_RUN
     from harness.core.progress import StepTimes
-    from harness.io.sweepfile import load_sweep
 
     # one run folder (docs/decisions/bench-runs.md): the paper sweep in ROOT/sweep, the dynamic
     # bench's folders beside it, the report in ROOT/report; nothing tracked is written
+    from harness.io import runfolder
+    from harness.io.sweepfile import load_sweep
+
     root = Path(args.out) if args.out else LOCAL_RUN
+    runfolder.claim(root, "bench", force=args.force)  # before anything is measured or written
     report_dir = Path(args.report_dir) if args.report_dir else root / "report"
     shard = shards.parse(args.shard) if args.shard else None
     plan = budget.Budget(budget.parse_duration(args.budget), reserve=budget.REPORT_RESERVE_S) if args.budget else None
@@ -598,6 +602,7 @@ def cmd_docs(args):
     return docs.run(parser(), check=args.check)
 
 
+FORCE_FOLDER_HELP = "write into a folder that holds files but is not a hairbench run folder (no .hairbench-run.json)"
 REPORT_DIR_HELP = "where to write (default results/local/report/)"
 GPU_CHOICES = ("auto", "yes", "no")
 GPU_HELP = "run cuda cases: auto (if a GPU is usable), yes (fail without), no"
@@ -731,6 +736,11 @@ def parser():
         default=None,
         help="K/N: run the K-th of N deterministic shares of the cases (harness merge joins them)",
     )
+    s.add_argument(
+        "--force",
+        action="store_true",
+        help=FORCE_FOLDER_HELP,
+    )
 
     for name, helptext, fn in (
         ("plot", "draw the PNG plots of a results directory", cmd_plot),
@@ -795,6 +805,11 @@ def parser():
         action="store_true",
         help="dynamic: the full accuracy study and stability map (tens of minutes) instead of the "
         "bench's size (accuracy --quick, stability --quick: minutes on a 16-core + H200 node)",
+    )
+    b.add_argument(
+        "--force",
+        action="store_true",
+        help=FORCE_FOLDER_HELP,
     )
 
     mg = command(sub, cmd_merge, help="join shard folders (bench --shard K/N) into one results folder")

@@ -304,3 +304,37 @@ def test_sweep_on_a_full_disk_names_the_file_and_leaves_no_temporary(tmp_path):
     assert "rc=4" in lines and not [n for n in lines if ".tmp" in n], (p.stdout, p.stderr)
     line = p.stderr.strip().splitlines()[-1]
     assert "No space left on device" in line and "/s/" in line, p.stderr
+
+
+# ---- D17, D18: one owner of a results folder -------------------------------------------------
+
+
+def tree(folder):
+    return sorted((str(p.relative_to(folder)), p.read_bytes() if p.is_file() else b"") for p in folder.rglob("*"))
+
+
+def test_bench_refuses_a_users_folder(tmp_path):
+    user = tmp_path / "U"
+    (user / "report").mkdir(parents=True)
+    (user / "report" / "report.md").write_text("my report")
+    (user / "stability").mkdir()
+    before = tree(user)
+    line = one_line(harness("bench", "--out", user, "--budget", "1m"), words="not a hairbench run folder")
+    assert str(user) in line and tree(user) == before
+
+
+@pytest.mark.parametrize("where", ["..", "/", "."], ids=["parent", "root", "repository"])
+def test_bench_refuses_the_repository_and_above(where):
+    one_line(harness("bench", "--out", where, "--budget", "1m"), words="refusing to write results into")
+
+
+def test_a_run_folder_in_use_is_refused(tmp_path):
+    from harness.io import runfolder
+
+    folder = runfolder.claim(tmp_path / "S", "test")
+    try:
+        p = harness("sweep", "quick", "--out", folder, "--gpu", "no")
+        one_line(p, words="in use by another hairbench run")
+    finally:
+        runfolder.release(folder)
+    assert sorted(os.listdir(folder)) == [".hairbench-run.json", ".hairbench-run.lock"]
