@@ -137,20 +137,22 @@ def cmd_stepdiff(args):
 def cmd_sweep(args):
     """Run every case of a sweep (configs/sweeps/NAME.toml), one row per (case, stage) in results/NAME/runs.csv;
     a killed sweep resumes."""
+    from harness.bench import merge
     from harness.core import shards
     from harness.io.sweepfile import load_sweep
     from harness.studies import sweep
 
     shard = shards.parse(args.shard) if args.shard else None
     if shard:
-        from harness.bench import merge
         from harness.core.paths import RESULTS
         from harness.io import runfolder
 
         spec = load_sweep(args.sweep)
         out = runfolder.claim(args.out if args.out else RESULTS / spec.name, f"sweep {spec.name}", force=args.force)
         merge.write_record(out, shard, {"sweep": spec.path}, f"sweep {spec.name}")
-    _, failed = sweep.run_sweep(args.sweep, out=args.out, gpu=args.gpu, shard=shard, force=args.force)
+    out_dir, failed = sweep.run_sweep(args.sweep, out=args.out, gpu=args.gpu, shard=shard, force=args.force)
+    if shard:
+        merge.finish_record(out_dir)  # the shard finished: merge takes it, with the cases it holds
     return 1 if failed else 0
 
 
@@ -259,6 +261,8 @@ def cmd_bench(args):
         from harness.render import report_paper
 
         report_paper.build(root / "sweep", report_dir)  # again: its time-budget section now lists the dynamic part too
+    if shard:
+        merge.finish_record(root)  # the shard finished: merge takes it, with the cases it holds
     print(times.summary("bench"), flush=True)
     return code
 
