@@ -1113,8 +1113,8 @@ def main(argv=None):
     except runner.Stopped as e:  # forwarded to every child, each waited for: nothing runs on
         print(f"harness: stopped by {e}", file=sys.stderr)
         return 128 + e.signum
-    except HarnessError as e:
-        print(f"harness: error: {e}", file=sys.stderr)
+    except HarnessError as e:  # one line, whatever a library's text it quotes holds
+        print(f"harness: error: {' '.join(str(e).split(chr(10)))}", file=sys.stderr)
         return e.code if e.code else 2
     except BrokenPipeError:  # the reader went away (`| head`): quiet, as other tools
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
