@@ -332,7 +332,7 @@ sanitize-gpu: cuda
 
 # ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----
 PY_SRC     := harness tests
-C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*/*.c c_ref/*/*.h cuda/*.cu cuda/*.cuh cuda/hostcheck/*.cu tests/cpu/c/*.c)
+C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*/*.c c_ref/*/*.h cuda/*.cu cuda/*.cuh cuda/hostcheck/*.cu tests/cpu/c/*.c tests/fuzz/*.c)
 CLANG_FORMAT ?= clang-format
 
 lint: lint-py lint-c
