@@ -148,9 +148,13 @@ def cmd_sweep(args):
         from harness.io import runfolder
 
         spec = load_sweep(args.sweep)
-        out = runfolder.claim(args.out if args.out else RESULTS / spec.name, f"sweep {spec.name}", force=args.force)
+        out = runfolder.claim(
+            args.out if args.out else RESULTS / spec.name, f"sweep {spec.name}", force=getattr(args, "force", False)
+        )
         merge.write_record(out, shard, {"sweep": spec.path}, f"sweep {spec.name}")
-    out_dir, failed = sweep.run_sweep(args.sweep, out=args.out, gpu=args.gpu, shard=shard, force=args.force)
+    out_dir, failed = sweep.run_sweep(
+        args.sweep, out=args.out, gpu=args.gpu, shard=shard, force=getattr(args, "force", False)
+    )
     if shard:
         merge.finish_record(out_dir)  # the shard finished: merge takes it, with the cases it holds
     return 1 if failed else 0
@@ -201,10 +205,10 @@ def cmd_bench(args):
     from harness.io.sweepfile import load_sweep
 
     root = Path(args.out) if args.out else LOCAL_RUN
-    runfolder.claim(root, "bench", force=args.force)  # before anything is measured or written
     report_dir = Path(args.report_dir) if args.report_dir else root / "report"
     shard = shards.parse(args.shard) if args.shard else None
     plan = budget.Budget(budget.parse_duration(args.budget), reserve=budget.REPORT_RESERVE_S) if args.budget else None
+    runfolder.claim(root, "bench", force=getattr(args, "force", False))  # before anything is measured or written
     sweeps = {}
     if args.model in ("all", "paper"):
         sweeps["paper"] = load_sweep(args.sweep).path
@@ -1103,6 +1107,7 @@ def parser():
 def main(argv=None):
     args = parser().parse_args(argv)
     from harness.core import gpus, runner
+    from harness.io import runfolder
 
     try:
         gpus.wanted()  # a bad HB_GPUS is refused on every machine, with or without a GPU
@@ -1111,9 +1116,11 @@ def main(argv=None):
             sys.stdout.flush()  # a closed pipe shows here, inside the handlers below
         return rc
     except runner.Stopped as e:  # forwarded to every child, each waited for: nothing runs on
+        runfolder.abandon_unused()
         print(f"harness: stopped by {e}", file=sys.stderr)
         return 128 + e.signum
     except HarnessError as e:  # one line, whatever a library's text it quotes holds
+        runfolder.abandon_unused()  # a refused command creates nothing
         print(f"harness: error: {' '.join(str(e).split(chr(10)))}", file=sys.stderr)
         return e.code if e.code else 2
     except BrokenPipeError:  # the reader went away (`| head`): quiet, as other tools

@@ -5,6 +5,7 @@ of a folder that is not ours: one that holds files but no marker (a user's folde
 `force`, and always `/`, the home folder, the repository itself and any folder above it. A
 sub-folder of a run folder (the bench's sweep/, stability/) belongs to that run."""
 
+import contextlib
 import fcntl
 import json
 import os
@@ -17,6 +18,7 @@ from harness.io import files
 MARKER = ".hairbench-run.json"
 LOCK = ".hairbench-run.lock"
 _held: dict[Path, int] = {}  # folder → the locked descriptor, kept until the process ends
+_made: list[Path] = []  # the folders a claim created, outermost first
 
 
 def _forbidden(path: Path) -> str | None:
@@ -48,8 +50,10 @@ def claim(folder: str | Path, command: str, force: bool = False, what: str = "--
             f"{what} {folder} holds files but is not a hairbench run folder (no {MARKER}); give a new or empty "
             "folder, or --force to write into it"
         )
+    new = [q for q in (path, *path.parents) if not q.exists()][::-1]
     try:
         path.mkdir(parents=True, exist_ok=True)
+        _made.extend(new)
         fd = os.open(path / LOCK, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
     except OSError as e:
         raise HarnessError(f"{what} {folder}: cannot make the folder ({e.strerror or e})") from None
@@ -64,6 +68,20 @@ def claim(folder: str | Path, command: str, force: bool = False, what: str = "--
     if not (path / MARKER).is_file():
         files.write_text(path / MARKER, json.dumps({"hairbench": "run folder", "command": command}) + "\n")
     return path
+
+
+def abandon_unused() -> None:
+    """After a command that failed: each folder a claim created that holds nothing but its marker
+    and lock is removed (deepest first), with the lock given up; a refused command creates nothing."""
+    for path in reversed(_made):
+        names = set(os.listdir(path)) if path.is_dir() else {""}
+        if names <= {MARKER, LOCK}:
+            release(path)
+            for name in names:
+                (path / name).unlink(missing_ok=True)
+            with contextlib.suppress(OSError):
+                path.rmdir()
+    _made.clear()
 
 
 def release(folder: str | Path) -> None:

@@ -146,8 +146,11 @@ def test_a_foreign_csv_is_never_truncated(fake, tmp_path):
     out = tmp_path / "res"
     out.mkdir()
     (out / "runs.csv").write_text("a,b,c\n1,2,3\n")
-    with pytest.raises(Exception) as e:
+    with pytest.raises(Exception) as e:  # a folder that is not a run's: refused before anything
         run_sweep(fake, out=out, gpu="no")
+    assert "not a hairbench run folder" in str(e.value)
+    with pytest.raises(Exception) as e:  # and with --force, its foreign runs.csv is still not touched
+        run_sweep(fake, out=out, gpu="no", force=True)
     assert "other columns" in str(e.value)
     assert (out / "runs.csv").read_text() == "a,b,c\n1,2,3\n"
 
