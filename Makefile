@@ -79,7 +79,7 @@ HOSTCHECK_BINS := $(BUILD)/hostcheck/model_hostcheck_reference $(BUILD)/hostchec
                   $(BUILD)/hostcheck/dyn_hostcheck $(BUILD)/hostcheck/post_hostcheck $(BUILD)/hostcheck/lod_hostcheck \
                   $(BUILD)/hostcheck/draw_hostcheck
 
-.PHONY: all cpu planted cuda hostcheck test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu lint lint-py lint-c fmt docs
+.PHONY: all cpu planted cuda hostcheck test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu fuzz lint lint-py lint-c fmt docs
 
 # The Python that runs the tests and the harness: harness/setup.sh picks it (PYTHON when it has
 # the packages, else ./.venv) after installing what is missing, and writes its path here.
@@ -99,6 +99,7 @@ help:
 	@echo "             the committed one: REPORT_FROM=results/reference-h200 REPORT_TO=report)"
 	@echo "make report-dynamic  only the dynamic report of REPORT_FROM into REPORT_TO"
 	@echo "make sanitize build the C reference with ASan+UBSan and run the CPU tests under it"
+	@echo "make fuzz     libFuzzer over the HAIR groom reader under ASan+UBSan for FUZZ_SECONDS (default 30) from tests/fuzz/corpus/"
 	@echo "make sanitize-gpu  compute-sanitizer memcheck + racecheck over every CUDA variant (GPU node)"
 	@echo "make lint     ruff check, ruff format --check, mypy (lint-py) and clang-format --dry-run (lint-c)"
 	@echo "make fmt      ruff format the Python and clang-format -i the C and CUDA sources"
@@ -199,7 +200,7 @@ $(CUDA_BINS):
 # reference's rules (no FMA contraction, no fast math). The dynamic one at -O1: its many
 # instantiations compile faster, and without contraction the level changes no IEEE result.
 # dynamics_host.o plans the colliders' poses (docs/model.md §3.17): their objects link beside it
-HOSTCHECK_WORLD_OBJ := $(OBJ)/dynamic/colliders.o $(OBJ)/dynamic/sdf_mesh.o $(OBJ)/runtime/cli.o
+HOSTCHECK_WORLD_OBJ := $(OBJ)/dynamic/colliders.o $(OBJ)/dynamic/sdf_mesh.o $(OBJ)/runtime/cli.o $(OBJ)/runtime/input.o
 HOSTCHECK_NVCC := $(NVCC) -std=c++17 -Ic_ref -Icuda -Xcompiler -ffp-contract=off,-fno-fast-math
 hostcheck: $(HOSTCHECK_BINS)
 $(BUILD)/hostcheck/model_hostcheck_reference: HOSTCHECK_MODE := -O2 -DHB_REFERENCE_ARITHMETIC=1
@@ -259,7 +260,7 @@ test: setup
 OUT ?= results/local
 bench: setup
 	@$(call BUILD_LOGGED,all)
-	$(RUN_PY) -m harness bench --out $(OUT)$(if $(BUDGET), --budget $(BUDGET))$(if $(SHARD), --shard $(SHARD))
+	$(RUN_PY) -m harness bench --out $(OUT)$(if $(BUDGET), --budget=$(BUDGET))$(if $(SHARD), --shard=$(SHARD))
 
 # REPORT_FROM: the run folder to render (default results/local, make bench's), or one sweep's
 # folder (its runs.csv: the paper report alone); REPORT_TO: where
@@ -284,7 +285,25 @@ docs: setup
 sanitize: setup check-hdf5
 	$(MAKE) BUILD=build/asan COPT="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" \
 	  CC="$(CC) -fsanitize=address,undefined" build/asan/hairsim-cpu
-	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(RUN_PY) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume or fault_probe"
+	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(RUN_PY) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume or fault_probe or fault_matrix or binary_inputs"
+	@for f in tests/fuzz/corpus/hair/*; do ASAN_OPTIONS=detect_leaks=1 build/asan/hairsim-cpu --groom $$f --stages init,simulate \
+	  --quiet >/dev/null 2>&1; rc=$$?; if [ $$rc -ne 0 ] && [ $$rc -ne 2 ] && [ $$rc -ne 3 ]; then \
+	  echo "error: build/asan/hairsim-cpu --groom $$f exited $$rc"; exit 1; fi; done; echo "sanitize: the HAIR seed corpus ran clean"
+
+# libFuzzer over the HAIR groom reader (tests/fuzz/hair_fuzz.c) under ASan and UBSan, for FUZZ_SECONDS,
+# from the committed seed corpus (tests/fuzz/corpus/hair/); the inputs it finds go to build/fuzz/corpus,
+# a crash to build/fuzz/crash-*. Needs clang with libFuzzer (CI installs it: .ci/run).
+FUZZ_CC ?= clang
+FUZZ_SECONDS ?= 30
+FUZZ_SRC := tests/fuzz/hair_fuzz.c c_ref/runtime/groom.c c_ref/runtime/params.c c_ref/runtime/input.c \
+            c_ref/runtime/safe_write.c c_ref/runtime/cli.c
+fuzz:
+	@command -v $(FUZZ_CC) >/dev/null 2>&1 || { echo "error: $(FUZZ_CC) not found: make fuzz needs clang with libFuzzer (apt-get install clang)"; exit 1; }
+	@mkdir -p $(BUILD)/fuzz/corpus
+	$(FUZZ_CC) -std=c11 -D_DEFAULT_SOURCE -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
+	  -Ic_ref $(FUZZ_SRC) -o $(BUILD)/fuzz/hair_fuzz -lm
+	set -o pipefail; cd $(BUILD)/fuzz && ./hair_fuzz -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -rss_limit_mb=2048 -print_final_stats=1 \
+	  corpus $(CURDIR)/tests/fuzz/corpus/hair 2>&1 | tail -15
 
 # compute-sanitizer (memcheck, racecheck) over every CUDA variant on a small run that also
 # exercises the output, resume and end-to-end paths, and simulate on the strand and warp
@@ -322,7 +341,7 @@ sanitize-gpu: cuda
 
 # ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----
 PY_SRC     := harness tests
-C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*/*.c c_ref/*/*.h cuda/*.cu cuda/*.cuh cuda/hostcheck/*.cu tests/cpu/c/*.c)
+C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*/*.c c_ref/*/*.h cuda/*.cu cuda/*.cuh cuda/hostcheck/*.cu tests/cpu/c/*.c tests/fuzz/*.c)
 CLANG_FORMAT ?= clang-format
 
 lint: lint-py lint-c

@@ -97,7 +97,8 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     c->scene = o->scene;
     c->bytes = hb_state_bytes(&o->scene);
     hb_model_round(&o->scene, &c->m32, &c->m64);
-    omp_set_num_threads(o->threads > 0 ? o->threads : default_threads());
+    const int all_cores = default_threads(); /* read before this run sets its own */
+    omp_set_num_threads(o->threads > 0 ? o->threads : all_cores);
     b->threads = omp_get_max_threads();
     if (o->variant && strcmp(o->variant, "simd") == 0) {
         const int status = simd_setup(c, o, need_save, driver_bytes, err, errlen);
@@ -903,7 +904,8 @@ static int cpu_dyn_render(hb_backend *b, void *position, void *velocity, double 
 static int cpu_stream(const hb_options *o, double *copy_gbps, double *copy_bytes, double *triad_gbps,
                       double *triad_bytes, char *err, size_t errlen)
 {
-    omp_set_num_threads(o->threads > 0 ? o->threads : default_threads());
+    const int all_cores = default_threads(); /* read before this run sets its own */
+    omp_set_num_threads(o->threads > 0 ? o->threads : all_cores);
     const size_t n = (size_t)1 << 26;
     double *a = malloc(n * sizeof *a), *c = malloc(n * sizeof *c);
     double *bb = triad_gbps ? malloc(n * sizeof *bb) : NULL;

@@ -61,21 +61,23 @@ def cuda_bin():
 
 
 def pytest_terminal_summary(terminalreporter):
-    """The fault probe's matrix (tests/cpu/test_fault_probe.py): its cases by test, and outcomes."""
-    counts: dict[str, dict[str, int]] = {}
-    for outcome in ("passed", "failed", "skipped", "error"):
-        for rep in terminalreporter.stats.get(outcome, []):
-            nodeid = getattr(rep, "nodeid", "")
-            if "test_fault_probe.py::" not in nodeid or getattr(rep, "when", "call") not in ("call", "setup"):
-                continue
-            if outcome == "passed" and rep.when != "call":
-                continue
-            name = nodeid.split("::", 1)[1].split("[", 1)[0]
-            counts.setdefault(name, {}).setdefault(outcome, 0)
-            counts[name][outcome] += 1
-    if counts:
-        total = {o: sum(c.get(o, 0) for c in counts.values()) for o in ("passed", "failed", "skipped", "error")}
-        terminalreporter.write_line(
-            f"fault probe: {sum(total.values())} cases in {len(counts)} rows of the matrix: "
-            + ", ".join(f"{n} {o}" for o, n in total.items() if n)
-        )
+    """The fault matrices' counts (tests/cpu/test_fault_probe.py, listed; tests/cpu/test_fault_matrix.py,
+    generated from the declared inputs): their cases by row, and outcomes."""
+    for module, title in (("test_fault_probe.py", "fault probe"), ("test_fault_matrix.py", "generated fault matrix")):
+        counts: dict[str, dict[str, int]] = {}
+        for outcome in ("passed", "failed", "skipped", "error"):
+            for rep in terminalreporter.stats.get(outcome, []):
+                nodeid = getattr(rep, "nodeid", "")
+                if f"{module}::" not in nodeid or getattr(rep, "when", "call") not in ("call", "setup"):
+                    continue
+                if outcome == "passed" and rep.when != "call":
+                    continue
+                name = nodeid.split("::", 1)[1].split("[", 1)[0]
+                counts.setdefault(name, {}).setdefault(outcome, 0)
+                counts[name][outcome] += 1
+        if counts:
+            total = {o: sum(c.get(o, 0) for c in counts.values()) for o in ("passed", "failed", "skipped", "error")}
+            terminalreporter.write_line(
+                f"{title}: {sum(total.values())} cases in {len(counts)} rows of the matrix: "
+                + ", ".join(f"{n} {o}" for o, n in total.items() if n)
+            )

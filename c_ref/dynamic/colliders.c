@@ -8,10 +8,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "dynamic/dynamics.h"
 #include "runtime/cli.h"
+#include "runtime/input.h"
 
 #define FAIL(...)                                                                                                      \
     do {                                                                                                               \
@@ -132,14 +132,11 @@ fail:
 int hb_colliders_load(const char *path, hb_colliders *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
-    struct stat st;
     FILE *f = NULL;
     char *line = NULL;
     size_t cap = 0;
-    if (stat(path, &st) != 0) FAIL("--colliders %s: %s", path, strerror(errno));
-    if (!S_ISREG(st.st_mode)) FAIL("--colliders %s: not a regular file", path);
-    f = fopen(path, "r");
-    if (!f) FAIL("--colliders %s: cannot open the file (%s)", path, strerror(errno));
+    f = hb_input_fopen("--colliders", path, "a colliders file", 1, NULL, err, errlen);
+    if (!f) goto fail_quiet;
     ssize_t got;
     for (int ln = 1; (got = getline(&line, &cap, f)) >= 0; ln++) {
         if ((size_t)got != strlen(line)) FAIL("--colliders %s, line %d: holds a NUL byte", path, ln);

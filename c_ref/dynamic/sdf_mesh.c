@@ -8,10 +8,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "runtime/checked.h"
 #include "runtime/cli.h"
+#include "runtime/input.h"
 
 #define FAIL(...)                                                                                                      \
     do {                                                                                                               \
@@ -53,12 +53,9 @@ static int vref(const char *w, int64_t nv, int64_t *out)
 
 static int read_obj(const char *path, mesh *m, char *err, size_t errlen)
 {
-    struct stat st;
     char line[4096], what[512];
     FILE *f = NULL;
-    if (stat(path, &st) != 0) FAIL("mesh %s: %s", path, strerror(errno));
-    if (!S_ISREG(st.st_mode)) FAIL("mesh %s: not a regular file", path);
-    if (!(f = fopen(path, "r"))) FAIL("mesh %s: cannot open the file (%s)", path, strerror(errno));
+    if (!(f = hb_input_fopen("--colliders mesh", path, "an OBJ mesh", 1, NULL, err, errlen))) return -1;
     for (int ln = 1; fgets(line, sizeof line, f); ln++) {
         if (!strchr(line, '\n') && !feof(f)) FAIL("mesh %s, line %d: longer than %zu bytes", path, ln, sizeof line);
         char *save = NULL, *w = strtok_r(line, " \t\r\n", &save);

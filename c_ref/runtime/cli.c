@@ -9,6 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "runtime/checked.h"
+
 void hb_default_options(hb_options *o)
 {
     memset(o, 0, sizeof *o);
@@ -38,8 +40,12 @@ void hb_default_options(hb_options *o)
     hb_dynamics_defaults(&o->scene.dyn);
 }
 
-/* ---- the dynamic model's flags (docs/model.md §3), one table -------------------------- */
+/* ---- every flag, one table (docs/interfaces.md "Command line", docs/model.md §3) ---------
+ * Each entry names its flag, how its value is parsed, where it goes and its --help line. The
+ * dynamic model's flags come last, in their own block: bit i of hb_options.dyn_given is the
+ * i-th of them. A NULL flag is a heading of --help. */
 typedef enum {
+    /* the dynamic model's: `offset` into hb_dynamics, `declares` an int set to 1 when given */
     DF_REAL,
     DF_COUNT,
     DF_SOLVER,
@@ -51,19 +57,261 @@ typedef enum {
     DF_PAIR,    /* A[,B]: two doubles, B = A when omitted */
     DF_BOX,     /* six doubles X0,Y0,Z0,X1,Y1,Z1 */
     DF_REBUILD, /* frame | substep */
-    DF_BODY,    /* still | sway */
+    DF_BODY,    /* still | sway | rise */
     DF_PATH,    /* a file name */
-} dyn_kind;
+    /* the run's and the scene's: `offset` into hb_options */
+    F_ON,       /* int set to 1, no value */
+    F_I64,      /* int64_t in [lo, hi] (hi 0: no bound) */
+    F_INT,      /* int in [lo, hi] */
+    F_U64,      /* uint64_t, 0 to 2^64 - 1 */
+    F_REAL,     /* double, finite */
+    F_NONNEG,   /* double, finite, >= 0 */
+    F_VEC3,     /* double[3], "X,Y,Z" */
+    F_STAGES,   /* --stages */
+    F_PREC,     /* --precision */
+    F_VEL,      /* --velocities */
+    F_DRAW,     /* --draw WxH */
+    F_GROOM,    /* --groom: "curly" or a file */
+    F_PATH,     /* const char *, not empty */
+    F_WORD,     /* const char * */
+    F_SELFTEST, /* --self-test rng */
+    F_HELP,     /* --help, --version: printed, then exit 0 */
+    F_BATCH     /* --batch FILE: alone on the command line (driver.c) */
+} flag_kind;
+
 typedef struct {
     const char *flag;
-    dyn_kind kind;
-    size_t offset;   /* into hb_dynamics */
-    size_t declares; /* an int in hb_dynamics set to 1 when the flag is given (0: none) */
+    flag_kind kind;
+    size_t offset;
+    size_t declares; /* DF_*: the offset of an int in hb_dynamics set to 1 when given (0: none) */
     const char *help;
-} dyn_flag;
+    const char *arg;  /* F_*: the value's name in --help */
+    int64_t lo, hi;   /* F_I64, F_INT: the range */
+    unsigned given;   /* F_*: the HB_GIVEN_* bit it sets; HB_GIVEN_SIM: HB_DYN_GIVEN_RUN */
+    const char *only; /* "cpu" or "cuda": the one backend that takes it */
+} flag_spec;
 
+#define HB_GIVEN_SIM (1u << 31)
+#define OPT(field) offsetof(hb_options, field)
 #define DYN(field) offsetof(hb_dynamics, field)
-static const dyn_flag dyn_flags[] = {
+/* the dynamic flags' entries give the first five fields only */
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+static const flag_spec flags[] = {
+    {.help = "scene:"},
+    {.flag = "--strands",
+     .kind = F_I64,
+     .offset = OPT(scene.n_strands),
+     .arg = "N",
+     .lo = 1,
+     .given = HB_GIVEN_STRANDS,
+     .help = "number of strands (default 1000)"},
+    {.flag = "--points",
+     .kind = F_I64,
+     .offset = OPT(scene.points),
+     .arg = "P",
+     .lo = 2,
+     .given = HB_GIVEN_POINTS,
+     .help = "points per strand incl. the root, >= 2 (default 32)"},
+    {.flag = "--seed",
+     .kind = F_U64,
+     .offset = OPT(scene.seed),
+     .arg = "S",
+     .given = HB_GIVEN_SEED,
+     .help = "64-bit RNG seed (default 1)"},
+    {.flag = "--head-radius",
+     .kind = F_REAL,
+     .offset = OPT(scene.head_radius),
+     .arg = "R",
+     .given = HB_GIVEN_RADIUS,
+     .help = "head sphere radius (default 10; with --groom FILE only with --head-center)"},
+    {.flag = "--head-center",
+     .kind = F_VEC3,
+     .offset = OPT(head_center),
+     .arg = "X,Y,Z",
+     .given = HB_GIVEN_CENTER,
+     .help = "with --groom FILE: the head sphere's centre in the file's cm, not fitted\n"
+             "to the roots; R then defaults to the smallest root distance from it"},
+    {.flag = "--hair-offset",
+     .kind = F_REAL,
+     .offset = OPT(scene.hair_offset),
+     .arg = "H",
+     .given = HB_GIVEN_OFFSET,
+     .help = "shell offset above the head (default 0.1)"},
+    {.flag = "--hair-length",
+     .kind = F_REAL,
+     .offset = OPT(scene.hair_length),
+     .arg = "L",
+     .given = HB_GIVEN_LENGTH,
+     .help = "strand length; L/(P-1) must be >= H (default 30)"},
+    {.flag = "--face-margin",
+     .kind = F_REAL,
+     .offset = OPT(scene.face_margin),
+     .arg = "M",
+     .given = HB_GIVEN_MARGIN,
+     .help = "face margin of the root draw (default 1)"},
+    {.flag = "--wind-strength",
+     .kind = F_REAL,
+     .offset = OPT(scene.wind_strength),
+     .arg = "W",
+     .help = "wind strength in [0, 1] (default 0.5)"},
+    {.flag = "--wind-angle",
+     .kind = F_REAL,
+     .offset = OPT(scene.wind_angle),
+     .arg = "PSI",
+     .given = HB_GIVEN_ANGLE,
+     .help = "wind direction, radians from +z toward +y (default pi)"},
+    {.flag = "--stages",
+     .kind = F_STAGES,
+     .arg = "LIST",
+     .help = "comma-separated, in order: init,collide,wind of the paper model (repeats\n"
+             "allowed, init first), then simulate of the dynamic model, once and last\n"
+             "(default init,collide,wind,collide)"},
+    {.flag = "--precision",
+     .kind = F_PREC,
+     .arg = "P",
+     .given = HB_GIVEN_PRECISION,
+     .help = "fp32 or fp64 (default fp32)"},
+    {.flag = "--groom",
+     .kind = F_GROOM,
+     .offset = OPT(groom),
+     .arg = "G",
+     .help = "init places a groom, not the drape: 'curly' (helices) or a HAIR file\n"
+             "(docs/model.md §3.15; per-segment rest lengths, stages init,simulate)"},
+    {.flag = "--curl-radius",
+     .kind = F_NONNEG,
+     .offset = OPT(scene.curl_radius),
+     .arg = "C",
+     .given = HB_GIVEN_CURL,
+     .help = "with --groom curly: helix radius, cm (default 1)"},
+    {.flag = "--curl-pitch",
+     .kind = F_NONNEG,
+     .offset = OPT(scene.curl_pitch),
+     .arg = "Q",
+     .given = HB_GIVEN_CURL,
+     .help = "with --groom curly: advance per turn along the root normal, cm (default 2)"},
+    {.help = "run:"},
+    {.flag = "--variant",
+     .kind = F_WORD,
+     .offset = OPT(variant),
+     .arg = "NAME",
+     .help = "kernel variant (--list-variants names them)"},
+    {.flag = "--threads",
+     .kind = F_INT,
+     .offset = OPT(threads),
+     .arg = "T",
+     .lo = 1,
+     .hi = 4096,
+     .only = "cpu",
+     .help = "OpenMP threads over strands (default: all cores)"},
+    {.flag = "--block-size",
+     .kind = F_INT,
+     .offset = OPT(block_size),
+     .arg = "B",
+     .lo = 32,
+     .hi = 1024,
+     .only = "cuda",
+     .help = "threads per block, a multiple of 32 from 32 to 1024 (default 256)"},
+    {.flag = "--input",
+     .kind = F_PATH,
+     .offset = OPT(input),
+     .arg = "FILE",
+     .help = "resume from the last frame of FILE"},
+    {.flag = "--output",
+     .kind = F_PATH,
+     .offset = OPT(output),
+     .arg = "FILE",
+     .help = "write the HDF5 state (refuses an existing file unless --force)"},
+    {.flag = "--force", .kind = F_ON, .offset = OPT(force), .help = "allow replacing --output"},
+    {.flag = "--repeat",
+     .kind = F_INT,
+     .offset = OPT(repeat),
+     .arg = "K",
+     .lo = 1,
+     .hi = 100000,
+     .help = "time each stage K times from the same input (default 1)"},
+    {.flag = "--warmup",
+     .kind = F_INT,
+     .offset = OPT(warmup),
+     .arg = "W",
+     .lo = 0,
+     .hi = 1000,
+     .help = "untimed runs before the timed ones (default 1 if K > 1, else 0)"},
+    {.flag = "--end-to-end",
+     .kind = F_ON,
+     .offset = OPT(end_to_end),
+     .help = "also time one whole pass (transfers included)"},
+    {.flag = "--json", .kind = F_ON, .offset = OPT(json), .help = "print the run record as one JSON object on stdout"},
+    {.flag = "--quiet", .kind = F_ON, .offset = OPT(quiet), .help = "no summary on stderr"},
+    {.flag = "--measure-bandwidth",
+     .kind = F_ON,
+     .offset = OPT(measure_bandwidth),
+     .help = "only measure the copy bandwidth (GB/s, read + write; cpu: all-core\n"
+             "memory, cuda: device-to-device)"},
+    {.flag = "--self-test",
+     .kind = F_SELFTEST,
+     .offset = OPT(self_test),
+     .arg = "rng",
+     .help = "print the Philox4x32-10 known-answer checks and exit"},
+    {.flag = "--list-variants",
+     .kind = F_ON,
+     .offset = OPT(list_variants),
+     .help = "print this binary's variants, the stages each runs and its build as JSON"},
+    {.flag = "--batch",
+     .kind = F_BATCH,
+     .arg = "FILE",
+     .help = "run each line of FILE (a run's flags, separated by tabs) in this one\n"
+             "process, in order, until one fails; no other flag with it"},
+    {.flag = "--input-frame",
+     .kind = F_INT,
+     .offset = OPT(input_frame),
+     .arg = "K",
+     .lo = 0,
+     .hi = INT32_MAX,
+     .help = "with --input: resume after frame K of the file (default: its last)"},
+    {.flag = "--help", .kind = F_HELP, .help = "this text (also -h)"},
+    {.flag = "--version", .kind = F_HELP, .help = "the version"},
+    {.help = "the simulate stage (docs/model.md §3; a feature left undeclared is not evaluated):"},
+    {.flag = "--frames",
+     .kind = F_I64,
+     .offset = OPT(frames),
+     .arg = "F",
+     .lo = 1,
+     .given = HB_GIVEN_SIM,
+     .help = "frames to simulate (default 1)"},
+    {.flag = "--output-every",
+     .kind = F_I64,
+     .offset = OPT(output_every),
+     .arg = "K",
+     .lo = 1,
+     .given = HB_GIVEN_SIM,
+     .help = "write every K-th simulated frame; the last always (default 1)"},
+    {.flag = "--velocities",
+     .kind = F_VEL,
+     .offset = OPT(all_velocities),
+     .arg = "W",
+     .given = HB_GIVEN_SIM,
+     .help = "last | all: write the velocities of the last or of every written frame"},
+    {.flag = "--frame-loop",
+     .kind = F_ON,
+     .offset = OPT(frame_loop),
+     .help = "after the run, time F more frames back to back as an application's frame\n"
+             "loop would (launches and the frame's tables included; cuda only)"},
+    {.flag = "--draw",
+     .kind = F_DRAW,
+     .arg = "WxH",
+     .given = HB_GIVEN_SIM,
+     .help = "after the run, simulate F more frames and draw each into a WxH image on\n"
+             "the GPU, through OpenGL on EGL and through a CUDA rasteriser, timed\n"
+             "(cuda only; docs/interfaces.md)"},
+    {.flag = "--draw-image",
+     .kind = F_PATH,
+     .offset = OPT(draw_image),
+     .arg = "PREFIX",
+     .given = HB_GIVEN_SIM,
+     .help = "with --draw: the last drawn frame of each path as PREFIX-gl.ppm and\n"
+             "PREFIX-compute.ppm"},
+    /* the dynamic model's flags (docs/model.md §3) */
     {"--frame-dt", DF_REAL, DYN(frame_dt), 0, "frame length Δt, s (default 1/60)"},
     {"--substeps", DF_COUNT, DYN(substeps), 0, "substeps S per frame (default 1)"},
     {"--iterations", DF_COUNT, DYN(iterations), 0, "solver iterations I per substep (default 1)"},
@@ -114,17 +362,33 @@ static const dyn_flag dyn_flags[] = {
     {"--body-frequency", DF_REAL, DYN(body_frequency), 0,
      "the sway's frequency f_b, Hz, or the rise's 1/duration (default 1)"},
 };
+#pragma GCC diagnostic pop
 #undef DYN
-#define N_DYN_FLAGS (sizeof dyn_flags / sizeof dyn_flags[0])
+#undef OPT
+#define N_FLAGS (sizeof flags / sizeof flags[0])
+
+static int is_dyn(const flag_spec *f)
+{
+    return f->flag && f->kind <= DF_PATH;
+}
+
+/* The index in flags[] of the first dynamic flag (they end the table). */
+static size_t first_dyn(void)
+{
+    size_t i = 0;
+    while (i < N_FLAGS && !is_dyn(&flags[i])) i++;
+    return i;
+}
 
 const char *hb_dyn_flag_name(int i)
 {
-    return i >= 0 && i < (int)N_DYN_FLAGS ? dyn_flags[i].flag : NULL;
+    const size_t k = first_dyn() + (size_t)i;
+    return i >= 0 && k < N_FLAGS ? flags[k].flag : NULL;
 }
 
 int hb_dyn_flag_differs(int i, const hb_dynamics *a, const hb_dynamics *b)
 {
-    const dyn_flag *df = &dyn_flags[i];
+    const flag_spec *df = &flags[first_dyn() + (size_t)i];
     const char *pa = (const char *)a + df->offset, *pb = (const char *)b + df->offset;
     if (df->declares &&
         *(const int *)((const char *)a + df->declares) != *(const int *)((const char *)b + df->declares))
@@ -143,85 +407,56 @@ int hb_dyn_flag_differs(int i, const hb_dynamics *a, const hb_dynamics *b)
     case DF_REBUILD:
     case DF_BODY: return *(const int *)pa != *(const int *)pb;
     case DF_PATH: return 1; /* a file's contents can change under its name: never taken as the same */
+    default: return 0;
     }
-    return 0;
+}
+
+static const flag_spec *find_flag(const char *name)
+{
+    for (size_t i = 0; i < N_FLAGS; i++)
+        if (flags[i].flag && strcmp(flags[i].flag, name) == 0) return &flags[i];
+    return NULL;
 }
 
 int hb_dyn_flag_index(const char *flag)
 {
-    for (size_t i = 0; i < N_DYN_FLAGS; i++)
-        if (strcmp(dyn_flags[i].flag, flag) == 0) return (int)i;
-    return -1;
+    const flag_spec *f = find_flag(flag);
+    return f && is_dyn(f) ? (int)((size_t)(f - flags) - first_dyn()) : -1;
+}
+
+/* Whether the flag takes no value (an optional one for DF_OPTREAL). */
+static int takes_no_value(const flag_spec *f)
+{
+    return f->kind == DF_SWITCH || f->kind == DF_FLAG || f->kind == F_ON || f->kind == DF_OPTREAL || f->kind == F_HELP;
 }
 
 void hb_print_usage(FILE *f, const char *prog, const char *backend)
 {
-    int cuda = strcmp(backend, "cuda") == 0;
     fprintf(f,
             "usage: %s [options]\n"
             "Hair-strand simulation (%s backend) with two models (docs/model.md): the paper model's one-shot\n"
             "stages init, collide and wind, and the dynamic model's time-stepped simulate stage. Writes HDF5\n"
-            "states and a JSON record (docs/interfaces.md).\n"
-            "\nscene:\n"
-            "  --strands N          number of strands (default 1000)\n"
-            "  --points P           points per strand incl. the root, >= 2 (default 32)\n"
-            "  --seed S             64-bit RNG seed (default 1)\n"
-            "  --head-radius R      head sphere radius (default 10; with --groom FILE only with --head-center)\n"
-            "  --head-center X,Y,Z  with --groom FILE: the head sphere's centre in the file's cm, not fitted\n"
-            "                       to the roots; R then defaults to the smallest root distance from it\n"
-            "  --hair-offset H      shell offset above the head (default 0.1)\n"
-            "  --hair-length L      strand length; L/(P-1) must be >= H (default 30)\n"
-            "  --face-margin M      face margin of the root draw (default 1)\n"
-            "  --wind-strength W    wind strength in [0, 1] (default 0.5)\n"
-            "  --wind-angle PSI     wind direction, radians from +z toward +y (default pi)\n"
-            "  --stages LIST        comma-separated, in order: init,collide,wind of the paper model (repeats\n"
-            "                       allowed, init first), then simulate of the dynamic model, once and last\n"
-            "                       (default init,collide,wind,collide)\n"
-            "  --precision P        fp32 or fp64 (default fp32)\n"
-            "  --groom G            init places a groom, not the drape: 'curly' (helices) or a HAIR file\n"
-            "                       (docs/model.md §3.15; per-segment rest lengths, stages init,simulate)\n"
-            "  --curl-radius C      with --groom curly: helix radius, cm (default 1)\n"
-            "  --curl-pitch Q       with --groom curly: advance per turn along the root normal, cm (default 2)\n"
-            "\nrun:\n"
-            "  --variant NAME       %s\n"
-            "%s"
-            "  --input FILE         resume from the last frame of FILE\n"
-            "  --output FILE        write the HDF5 state (refuses an existing file unless --force)\n"
-            "  --force              allow replacing --output\n"
-            "  --repeat K           time each stage K times from the same input (default 1)\n"
-            "  --warmup W           untimed runs before the timed ones (default 1 if K > 1, else 0)\n"
-            "  --end-to-end         also time one whole pass (transfers included)\n"
-            "  --json               print the run record as one JSON object on stdout\n"
-            "  --quiet              no summary on stderr\n"
-            "  --measure-bandwidth  only measure the %s copy bandwidth (GB/s, read + write)\n"
-            "  --self-test rng      print the Philox4x32-10 known-answer checks and exit\n"
-            "  --list-variants      print this binary's variants, the stages each runs and its build as JSON\n"
-            "  --batch FILE         run each line of FILE (a run's flags, separated by tabs) in this one\n"
-            "                       process, in order, until one fails; no other flag with it\n"
-            "  --input-frame K      with --input: resume after frame K of the file (default: its last)\n"
-            "  --help, --version\n",
-            prog, backend, "kernel variant (--list-variants names them)",
-            cuda ? "  --block-size B       threads per block, 32..1024 (default 256)\n"
-                 : "  --threads T          OpenMP threads over strands (default: all cores)\n",
-            cuda ? "device-to-device" : "all-core memory");
-    fprintf(f, "\nthe simulate stage (docs/model.md §3; a feature left undeclared is not evaluated):\n"
-               "  --frames F           frames to simulate (default 1)\n"
-               "  --output-every K     write every K-th simulated frame; the last always (default 1)\n"
-               "  --velocities W       last | all: write the velocities of the last or of every written frame\n"
-               "  --frame-loop         after the run, time F more frames back to back as an application's frame\n"
-               "                       loop would (launches and the frame's tables included; cuda only)\n"
-               "  --draw WxH           after the run, simulate F more frames and draw each into a WxH image on\n"
-               "                       the GPU, through OpenGL on EGL and through a CUDA rasteriser, timed\n"
-               "                       (cuda only; docs/interfaces.md)\n"
-               "  --draw-image PREFIX  with --draw: the last drawn frame of each path as PREFIX-gl.ppm and\n"
-               "                       PREFIX-compute.ppm\n");
-    for (size_t i = 0; i < N_DYN_FLAGS; i++) {
+            "states and a JSON record (docs/interfaces.md).\n",
+            prog, backend);
+    for (size_t i = 0; i < N_FLAGS; i++) {
+        const flag_spec *fl = &flags[i];
+        if (!fl->flag) {
+            fprintf(f, "\n%s\n", fl->help);
+            continue;
+        }
+        if (fl->only && strcmp(fl->only, backend) != 0) continue;
         char name[64];
-        snprintf(name, sizeof name, "%s%s", dyn_flags[i].flag,
-                 dyn_flags[i].kind == DF_SWITCH || dyn_flags[i].kind == DF_FLAG ? ""
-                 : dyn_flags[i].kind == DF_OPTREAL                              ? " [S]"
-                                                                                : " V");
-        fprintf(f, "  %-20s %s\n", name, dyn_flags[i].help);
+        const char *arg = is_dyn(fl) ? (fl->kind == DF_SWITCH || fl->kind == DF_FLAG ? ""
+                                        : fl->kind == DF_OPTREAL                     ? "[S]"
+                                                                                     : "V")
+                          : fl->arg  ? fl->arg
+                                     : "";
+        snprintf(name, sizeof name, "%s%s%s", fl->flag, arg[0] ? " " : "", arg);
+        fprintf(f, "  %-20s ", name);
+        for (const char *c = fl->help; *c; c++) /* a help of several lines: each under the first */
+            if (*c == '\n') fprintf(f, "\n%23s", "");
+            else fputc(*c, f);
+        fputc('\n', f);
     }
 }
 
@@ -233,85 +468,104 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
 
 /* The one grammar of every number on the command line (docs/interfaces.md, "Numbers"):
  * [+-]digits[.digits][(e|E)[+-]digits] or [+-].digits[…], decimal only; no spaces, hex,
- * inf or nan. Returns 1 when v matches it, and *plain = 1 when it is [+-]digits alone. */
-static int decimal_syntax(const char *v, int *plain)
+ * inf or nan. Returns 1 when v matches it. */
+static int decimal_syntax(const char *v)
 {
     const char *c = v;
     if (*c == '+' || *c == '-') c++;
-    int digits = 0, dot = 0, expo = 0;
+    int digits = 0;
     for (; *c >= '0' && *c <= '9'; c++) digits++;
-    if (*c == '.') {
-        dot = 1;
+    if (*c == '.')
         for (c++; *c >= '0' && *c <= '9'; c++) digits++;
-    }
     if (!digits) return 0;
     if (*c == 'e' || *c == 'E') {
-        expo = 1;
         c++;
         if (*c == '+' || *c == '-') c++;
         if (!(*c >= '0' && *c <= '9')) return 0;
         while (*c >= '0' && *c <= '9') c++;
     }
-    *plain = !dot && !expo;
     return *c == '\0';
 }
 
-static int parse_i64(const char *flag, const char *v, int64_t lo, int64_t *out, char *err, size_t errlen)
+/* A number of the one grammar read exactly as a whole number, with no rounding through a
+ * double: 0 with its sign and magnitude; 1 when it is not whole (a non-zero digit below the
+ * units once the exponent is applied); 2 when its magnitude exceeds 2^64 - 1. */
+static int exact_whole(const char *v, int *neg, uint64_t *mag)
 {
-    char *end;
-    int plain;
-    if (!decimal_syntax(v, &plain)) FAIL("%s needs a whole number (got '%s')", flag, v);
-    errno = 0;
-    long long x = strtoll(v, &end, 10);
-    if (!plain) {
-        /* accept 1e6-style integers */
-        double d = strtod(v, &end);
-        if (end == v || *end != '\0' || !isfinite(d) || d != floor(d) || fabs(d) > 9.2e18)
-            FAIL("%s needs a whole number (got '%s')", flag, v);
-        x = (long long)d;
-    } else if (errno == ERANGE) {
-        FAIL("%s is out of range (got '%s')", flag, v);
+    const char *c = v;
+    *neg = *c == '-';
+    if (*c == '+' || *c == '-') c++;
+    const char *digits = c;
+    int64_t n_int = 0, n_all = 0;
+    for (; (*c >= '0' && *c <= '9') || *c == '.'; c++)
+        if (*c != '.') n_all++;
+        else n_int = n_all + 1; /* marks the point: n_int - 1 digits before it */
+    n_int = n_int ? n_int - 1 : n_all;
+    int64_t e = 0; /* clamped: beyond it every non-zero number is out of range or not whole */
+    if (*c == 'e' || *c == 'E') {
+        c++;
+        const int eneg = *c == '-';
+        if (*c == '+' || *c == '-') c++;
+        for (; *c >= '0' && *c <= '9'; c++)
+            if (e < 100000000) e = 10 * e + (*c - '0');
+        if (eneg) e = -e;
     }
-    if (x < lo) FAIL("%s must be at least %lld (got %lld)", flag, (long long)lo, x);
+    uint64_t m = 0;
+    int64_t j = 0; /* the digit's index: its place is 10^(n_int - 1 - j + e) */
+    for (const char *d = digits; d < c && *d != 'e' && *d != 'E'; d++) {
+        if (*d == '.') continue;
+        const int64_t place = n_int - 1 - j++ + e;
+        if (place < 0) {
+            if (*d != '0') return 1;
+            continue;
+        }
+        if (hb_mul_u64(m, 10u, &m) || hb_add_u64(m, (uint64_t)(*d - '0'), &m)) return 2;
+    }
+    for (int64_t place = n_int - n_all + e; place > 0 && m != 0; place--)
+        if (hb_mul_u64(m, 10u, &m)) return 2;
+    *mag = m;
+    return 0;
+}
+
+static int parse_i64(const char *flag, const char *v, int64_t lo, int64_t hi, int64_t *out, char *err, size_t errlen)
+{
+    int neg;
+    uint64_t m;
+    if (!decimal_syntax(v)) FAIL("%s needs a whole number (got '%s')", flag, v);
+    const int r = exact_whole(v, &neg, &m);
+    if (r == 1) FAIL("%s needs a whole number (got '%s')", flag, v);
+    if (r == 2 || m > (neg ? (uint64_t)INT64_MAX + 1u : (uint64_t)INT64_MAX))
+        FAIL("%s is out of range (got '%s')", flag, v);
+    const int64_t x = neg ? (int64_t)(0u - m) : (int64_t)m;
+    if (x < lo) FAIL("%s must be at least %lld (got %s)", flag, (long long)lo, v);
+    if (hi && x > hi) FAIL("%s must be at most %lld (got %s)", flag, (long long)hi, v);
     *out = x;
     return 0;
 }
 
 static int parse_u64(const char *flag, const char *v, uint64_t *out, char *err, size_t errlen)
 {
-    char *end;
-    int plain;
-    if (!decimal_syntax(v, &plain)) FAIL("%s needs a whole number (got '%s')", flag, v);
-    if (v[0] == '-') FAIL("%s needs a non-negative whole number (got '%s')", flag, v);
-    errno = 0;
-    if (!plain) { /* 1e6-style, as for the other whole numbers */
-        double d = strtod(v, &end);
-        if (d != floor(d) || !(d < 18446744073709551616.0)) FAIL("%s needs a whole number (got '%s')", flag, v);
-        *out = (uint64_t)d;
-        return 0;
-    }
-    unsigned long long x = strtoull(v, &end, 10); /* base 10: 010 is ten */
-    if (errno == ERANGE) FAIL("%s is out of range (got '%s')", flag, v);
-    *out = x;
+    int neg;
+    uint64_t m;
+    if (!decimal_syntax(v)) FAIL("%s needs a whole number (got '%s')", flag, v);
+    const int r = exact_whole(v, &neg, &m);
+    if (r == 1) FAIL("%s needs a whole number (got '%s')", flag, v);
+    if (r == 2) FAIL("%s is out of range (got '%s')", flag, v);
+    if (neg && m) FAIL("%s needs a non-negative whole number (got '%s')", flag, v);
+    *out = m;
     return 0;
 }
 
 static int parse_f64(const char *flag, const char *v, double *out, char *err, size_t errlen)
 {
     char *end;
-    int plain;
     errno = 0;
     double x = strtod(v, &end);
     if (end != v && *end == '\0' && !isfinite(x)) FAIL("%s must be finite (got '%s')", flag, v);
-    if (!decimal_syntax(v, &plain)) FAIL("%s needs a decimal number (got '%s')", flag, v);
+    if (!decimal_syntax(v)) FAIL("%s needs a decimal number (got '%s')", flag, v);
     if (!isfinite(x)) FAIL("%s must be finite (got '%s')", flag, v);
     *out = x;
     return 0;
-}
-
-int hb_parse_number(const char *what, const char *v, double *out, char *err, size_t errlen)
-{
-    return parse_f64(what, v, out, err, errlen);
 }
 
 /* "X,Y,Z": three finite decimal numbers. */
@@ -359,7 +613,12 @@ static int parse_list(const char *flag, const char *v, double *out, int n_min, i
     return 0;
 }
 
-static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err, size_t errlen)
+int hb_parse_number(const char *what, const char *v, double *out, char *err, size_t errlen)
+{
+    return parse_f64(what, v, out, err, errlen);
+}
+
+static int parse_dyn(const flag_spec *df, const char *v, hb_options *o, char *err, size_t errlen)
 {
     char *base = (char *)&o->scene.dyn;
     int64_t iv;
@@ -383,7 +642,7 @@ static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err
         break;
     }
     case DF_COUNT:
-        if (parse_i64(df->flag, v, 1, &iv, err, errlen)) return -1;
+        if (parse_i64(df->flag, v, 1, 0, &iv, err, errlen)) return -1;
         *(int64_t *)(base + df->offset) = iv;
         break;
     case DF_SOLVER:
@@ -430,8 +689,10 @@ static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err
         if (v[0] == '\0') FAIL("%s needs a file name", df->flag);
         *(const char **)(base + df->offset) = v;
         break;
+    default: FAIL("%s: not a flag of the simulate stage", df->flag);
     }
     if (df->declares) *(int *)(base + df->declares) = 1;
+    o->dyn_given |= 1ull << ((size_t)(df - flags) - first_dyn());
     return 0;
 }
 
@@ -459,201 +720,89 @@ static int parse_stages(const char *v, hb_options *o, char *err, size_t errlen)
     return 0;
 }
 
-int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, char *err, size_t errlen)
+/* A run or scene flag's value into o (the flags of flags[] that are not the dynamic model's). */
+static int parse_run_flag(const flag_spec *fl, const char *v, const char *backend, hb_options *o, char *err,
+                          size_t errlen)
 {
-    int cuda = strcmp(backend, "cuda") == 0;
-    hb_default_options(o);
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            hb_print_usage(stdout, argv[0], backend);
-            return 1;
-        }
-        if (strcmp(a, "--version") == 0) {
-            printf("hairbench %s (%s backend)\n", HB_VERSION, backend);
-            return 1;
-        }
-        if (strcmp(a, "--force") == 0) {
-            o->force = 1;
-            continue;
-        }
-        if (strcmp(a, "--json") == 0) {
-            o->json = 1;
-            continue;
-        }
-        if (strcmp(a, "--quiet") == 0) {
-            o->quiet = 1;
-            continue;
-        }
-        if (strcmp(a, "--end-to-end") == 0) {
-            o->end_to_end = 1;
-            continue;
-        }
-        if (strcmp(a, "--frame-loop") == 0) {
-            o->frame_loop = 1;
-            continue;
-        }
-        if (strcmp(a, "--measure-bandwidth") == 0) {
-            o->measure_bandwidth = 1;
-            continue;
-        }
-        if (strcmp(a, "--list-variants") == 0) {
-            o->list_variants = 1;
-            continue;
-        }
-        {
-            int di = hb_dyn_flag_index(a);
-            if (di >= 0 && (dyn_flags[di].kind == DF_SWITCH || dyn_flags[di].kind == DF_FLAG ||
-                            dyn_flags[di].kind == DF_OPTREAL)) {
-                /* an optional value follows when the next word is a number */
-                const char *v = "";
-                char *end = NULL;
-                if (dyn_flags[di].kind == DF_OPTREAL && i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0) {
-                    (void)strtod(argv[i + 1], &end);
-                    if (end != argv[i + 1] && *end == '\0') v = argv[++i];
-                }
-                if (parse_dyn(&dyn_flags[di], v, o, err, errlen)) return -1;
-                o->dyn_given |= 1ull << di;
-                continue;
-            }
-        }
-        if (strncmp(a, "--", 2) != 0) FAIL("unexpected argument '%s' (see --help)", a);
-        /* every other flag takes a value: --flag V or --flag=V */
-        const char *eq = strchr(a, '=');
-        char name[64];
-        const char *v;
-        if (eq) {
-            size_t n = (size_t)(eq - a);
-            if (n >= sizeof name) FAIL("unknown flag '%s' (see --help)", a);
-            memcpy(name, a, n);
-            name[n] = '\0';
-            v = eq + 1;
-        } else {
-            if (strlen(a) >= sizeof name) FAIL("unknown flag '%s' (see --help)", a);
-            strcpy(name, a);
-            if (i + 1 >= argc || strncmp(argv[i + 1], "--", 2) == 0) FAIL("%s needs a value", name);
-            v = argv[++i];
-        }
-        int64_t iv;
-        hb_scene *s = &o->scene;
-        const int di = hb_dyn_flag_index(name);
-        if (di >= 0) {
-            if (dyn_flags[di].kind == DF_SWITCH || dyn_flags[di].kind == DF_FLAG) FAIL("%s takes no value", name);
-            if (parse_dyn(&dyn_flags[di], v, o, err, errlen)) return -1;
-            o->dyn_given |= 1ull << di;
-        } else if (strcmp(name, "--frames") == 0) {
-            if (parse_i64(name, v, 1, &o->frames, err, errlen)) return -1;
-            o->dyn_given |= HB_DYN_GIVEN_RUN;
-        } else if (strcmp(name, "--output-every") == 0) {
-            if (parse_i64(name, v, 1, &o->output_every, err, errlen)) return -1;
-            o->dyn_given |= HB_DYN_GIVEN_RUN;
-        } else if (strcmp(name, "--velocities") == 0) {
-            if (strcmp(v, "all") == 0) o->all_velocities = 1;
-            else if (strcmp(v, "last") == 0) o->all_velocities = 0;
-            else FAIL("--velocities must be last or all (got '%s')", v);
-            o->dyn_given |= HB_DYN_GIVEN_RUN;
-        } else if (strcmp(name, "--draw") == 0) {
-            /* WxH, each a whole number of pixels in 16..16384 */
-            char *x = NULL;
-            const long w = strtol(v, &x, 10);
-            char *end = NULL;
-            const long h = x && *x == 'x' ? strtol(x + 1, &end, 10) : 0;
-            if (!(x && *x == 'x' && end && *end == '\0' && x != v && end != x + 1 && v[0] >= '0' && v[0] <= '9' &&
-                  x[1] >= '0' && x[1] <= '9') ||
-                w < 16 || h < 16 || w > 16384 || h > 16384)
-                FAIL("--draw needs WIDTHxHEIGHT in pixels, each 16..16384 (got '%s')", v);
-            o->draw_w = (int)w;
-            o->draw_h = (int)h;
-            o->dyn_given |= HB_DYN_GIVEN_RUN;
-        } else if (strcmp(name, "--draw-image") == 0) {
-            if (!*v) FAIL("--draw-image needs a path prefix");
-            o->draw_image = v;
-            o->dyn_given |= HB_DYN_GIVEN_RUN;
-        } else if (strcmp(name, "--input-frame") == 0) {
-            if (parse_i64(name, v, 0, &iv, err, errlen)) return -1;
-            if (iv > INT32_MAX) FAIL("--input-frame is out of range (got %lld)", (long long)iv);
-            o->input_frame = (int)iv;
-        } else if (strcmp(name, "--strands") == 0) {
-            if (parse_i64(name, v, 1, &s->n_strands, err, errlen)) return -1;
-            o->given |= HB_GIVEN_STRANDS;
-        } else if (strcmp(name, "--points") == 0) {
-            if (parse_i64(name, v, 2, &s->points, err, errlen)) return -1;
-            o->given |= HB_GIVEN_POINTS;
-        } else if (strcmp(name, "--seed") == 0) {
-            if (parse_u64(name, v, &s->seed, err, errlen)) return -1;
-            o->given |= HB_GIVEN_SEED;
-        } else if (strcmp(name, "--head-radius") == 0) {
-            if (parse_f64(name, v, &s->head_radius, err, errlen)) return -1;
-            o->given |= HB_GIVEN_RADIUS;
-        } else if (strcmp(name, "--head-center") == 0) {
-            if (parse_vec3(name, v, o->head_center, err, errlen)) return -1;
-            o->given |= HB_GIVEN_CENTER;
-        } else if (strcmp(name, "--hair-offset") == 0) {
-            if (parse_f64(name, v, &s->hair_offset, err, errlen)) return -1;
-            o->given |= HB_GIVEN_OFFSET;
-        } else if (strcmp(name, "--hair-length") == 0) {
-            if (parse_f64(name, v, &s->hair_length, err, errlen)) return -1;
-            o->given |= HB_GIVEN_LENGTH;
-        } else if (strcmp(name, "--face-margin") == 0) {
-            if (parse_f64(name, v, &s->face_margin, err, errlen)) return -1;
-            o->given |= HB_GIVEN_MARGIN;
-        } else if (strcmp(name, "--wind-strength") == 0) {
-            if (parse_f64(name, v, &s->wind_strength, err, errlen)) return -1;
-        } else if (strcmp(name, "--wind-angle") == 0) {
-            if (parse_f64(name, v, &s->wind_angle, err, errlen)) return -1;
-            o->given |= HB_GIVEN_ANGLE;
-        } else if (strcmp(name, "--stages") == 0) {
-            if (parse_stages(v, o, err, errlen)) return -1;
-        } else if (strcmp(name, "--precision") == 0) {
-            if (strcmp(v, "fp32") == 0) s->precision = HB_FP32;
-            else if (strcmp(v, "fp64") == 0) s->precision = HB_FP64;
-            else FAIL("--precision must be fp32 or fp64 (got '%s')", v);
-            o->given |= HB_GIVEN_PRECISION;
-        } else if (strcmp(name, "--variant") == 0) {
-            o->variant = v;
-        } else if (strcmp(name, "--threads") == 0) {
-            if (cuda) FAIL("--threads is a flag of hairsim-cpu; the cuda backend takes --block-size");
-            if (parse_i64(name, v, 1, &iv, err, errlen)) return -1;
-            if (iv > 4096) FAIL("--threads must be at most 4096 (got %lld)", (long long)iv);
-            o->threads = (int)iv;
-        } else if (strcmp(name, "--block-size") == 0) {
-            if (!cuda) FAIL("--block-size is a flag of hairsim-cuda; the cpu backend takes --threads");
-            if (parse_i64(name, v, 1, &iv, err, errlen)) return -1;
-            if (iv < 32 || iv > 1024 || iv % 32 != 0)
-                FAIL("--block-size must be a multiple of 32 from 32 to 1024 (got %lld)", (long long)iv);
-            o->block_size = (int)iv;
-        } else if (strcmp(name, "--input") == 0) {
-            o->input = v;
-        } else if (strcmp(name, "--groom") == 0) {
-            if (v[0] == '\0') FAIL("--groom needs 'curly' or a HAIR file name");
-            o->groom = v;
-            s->groom = strcmp(v, "curly") == 0 ? HB_GROOM_CURLY : HB_GROOM_FILE;
-        } else if (strcmp(name, "--curl-radius") == 0) {
-            if (parse_f64(name, v, &s->curl_radius, err, errlen)) return -1;
-            if (!(s->curl_radius >= 0.0)) FAIL("--curl-radius must be >= 0 (got %s)", v);
-            o->given |= HB_GIVEN_CURL;
-        } else if (strcmp(name, "--curl-pitch") == 0) {
-            if (parse_f64(name, v, &s->curl_pitch, err, errlen)) return -1;
-            if (!(s->curl_pitch >= 0.0)) FAIL("--curl-pitch must be >= 0 (got %s)", v);
-            o->given |= HB_GIVEN_CURL;
-        } else if (strcmp(name, "--output") == 0) {
-            if (v[0] == '\0') FAIL("--output needs a file name");
-            o->output = v;
-        } else if (strcmp(name, "--repeat") == 0) {
-            if (parse_i64(name, v, 1, &iv, err, errlen)) return -1;
-            if (iv > 100000) FAIL("--repeat must be at most 100000 (got %lld)", (long long)iv);
-            o->repeat = (int)iv;
-        } else if (strcmp(name, "--warmup") == 0) {
-            if (parse_i64(name, v, 0, &iv, err, errlen)) return -1;
-            if (iv > 1000) FAIL("--warmup must be at most 1000 (got %lld)", (long long)iv);
-            o->warmup = (int)iv;
-        } else if (strcmp(name, "--self-test") == 0) {
-            if (strcmp(v, "rng") != 0) FAIL("--self-test knows only 'rng' (got '%s')", v);
-            o->self_test = v;
-        } else {
-            FAIL("unknown flag '%s' (see --help)", name);
-        }
+    char *at = (char *)o + fl->offset;
+    const char *name = fl->flag;
+    int64_t iv;
+    if (fl->only && strcmp(fl->only, backend) != 0)
+        FAIL("%s is a flag of hairsim-%s; the %s backend takes %s", name, fl->only, backend,
+             strcmp(backend, "cuda") == 0 ? "--block-size" : "--threads");
+    switch (fl->kind) {
+    case F_ON: *(int *)at = 1; break;
+    case F_I64:
+        if (parse_i64(name, v, fl->lo, fl->hi, (int64_t *)at, err, errlen)) return -1;
+        break;
+    case F_INT:
+        if (parse_i64(name, v, fl->lo, fl->hi, &iv, err, errlen)) return -1;
+        if (fl->offset == offsetof(hb_options, block_size) && iv % 32 != 0)
+            FAIL("--block-size must be a multiple of 32 from 32 to 1024 (got %s)", v);
+        *(int *)at = (int)iv;
+        break;
+    case F_U64:
+        if (parse_u64(name, v, (uint64_t *)at, err, errlen)) return -1;
+        break;
+    case F_REAL:
+    case F_NONNEG:
+        if (parse_f64(name, v, (double *)at, err, errlen)) return -1;
+        if (fl->kind == F_NONNEG && !(*(double *)at >= 0.0)) FAIL("%s must be >= 0 (got %s)", name, v);
+        break;
+    case F_VEC3:
+        if (parse_vec3(name, v, (double *)at, err, errlen)) return -1;
+        break;
+    case F_STAGES:
+        if (parse_stages(v, o, err, errlen)) return -1;
+        break;
+    case F_PREC:
+        if (strcmp(v, "fp32") == 0) o->scene.precision = HB_FP32;
+        else if (strcmp(v, "fp64") == 0) o->scene.precision = HB_FP64;
+        else FAIL("--precision must be fp32 or fp64 (got '%s')", v);
+        break;
+    case F_VEL:
+        if (strcmp(v, "all") == 0) o->all_velocities = 1;
+        else if (strcmp(v, "last") == 0) o->all_velocities = 0;
+        else FAIL("--velocities must be last or all (got '%s')", v);
+        break;
+    case F_DRAW: { /* WxH, each a whole number of pixels in 16..16384 */
+        char *x = NULL;
+        const long w = strtol(v, &x, 10);
+        char *end = NULL;
+        const long h = x && *x == 'x' ? strtol(x + 1, &end, 10) : 0;
+        if (!(x && *x == 'x' && end && *end == '\0' && x != v && end != x + 1 && v[0] >= '0' && v[0] <= '9' &&
+              x[1] >= '0' && x[1] <= '9') ||
+            w < 16 || h < 16 || w > 16384 || h > 16384)
+            FAIL("--draw needs WIDTHxHEIGHT in pixels, each 16..16384 (got '%s')", v);
+        o->draw_w = (int)w;
+        o->draw_h = (int)h;
+        break;
     }
+    case F_GROOM:
+        if (v[0] == '\0') FAIL("--groom needs 'curly' or a HAIR file name");
+        o->groom = v;
+        o->scene.groom = strcmp(v, "curly") == 0 ? HB_GROOM_CURLY : HB_GROOM_FILE;
+        break;
+    case F_PATH:
+        if (v[0] == '\0') FAIL("%s needs a file name", name);
+        *(const char **)at = v;
+        break;
+    case F_WORD: *(const char **)at = v; break;
+    case F_SELFTEST:
+        if (strcmp(v, "rng") != 0) FAIL("--self-test knows only 'rng' (got '%s')", v);
+        o->self_test = v;
+        break;
+    case F_BATCH: FAIL("--batch FILE takes no other flag (each line of FILE holds a run's flags)");
+    default: FAIL("%s: not a run or scene flag", name);
+    }
+    if (fl->given == HB_GIVEN_SIM) o->dyn_given |= HB_DYN_GIVEN_RUN;
+    else o->given |= fl->given;
+    return 0;
+}
+
+/* The rules between flags, once all are read. */
+static int check_combinations(hb_options *o, char *err, size_t errlen)
+{
     if (o->warmup < 0) o->warmup = o->repeat > 1 ? 1 : 0;
     /* simulate runs once, last: the paper stages assume a strand in its slice plane */
     int sim = 0;
@@ -663,9 +812,9 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
             sim = 1;
         }
     if (!sim && o->dyn_given) {
-        for (size_t i = 0; i < N_DYN_FLAGS; i++)
+        for (int i = 0; hb_dyn_flag_name(i); i++)
             if (o->dyn_given & (1ull << i))
-                FAIL("%s belongs to the simulate stage, which --stages does not list", dyn_flags[i].flag);
+                FAIL("%s belongs to the simulate stage, which --stages does not list", hb_dyn_flag_name(i));
         FAIL("--frames, --output-every, --velocities and --draw belong to the simulate stage, which --stages does not "
              "list");
     }
@@ -695,6 +844,47 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
             FAIL("--friction is the head sphere's friction, and --no-collider removes the head sphere");
     }
     return 0;
+}
+
+int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, char *err, size_t errlen)
+{
+    hb_default_options(o);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            hb_print_usage(stdout, argv[0], backend);
+            return 1;
+        }
+        if (strcmp(a, "--version") == 0) {
+            printf("hairbench %s (%s backend)\n", HB_VERSION, backend);
+            return 1;
+        }
+        if (strncmp(a, "--", 2) != 0) FAIL("unexpected argument '%s' (see --help)", a);
+        /* --flag V or --flag=V */
+        const char *eq = strchr(a, '=');
+        char name[64];
+        const size_t n = eq ? (size_t)(eq - a) : strlen(a);
+        if (n >= sizeof name) FAIL("unknown flag '%s' (see --help)", a);
+        memcpy(name, a, n);
+        name[n] = '\0';
+        const flag_spec *fl = find_flag(name);
+        if (!fl) FAIL("unknown flag '%s' (see --help)", name);
+        const char *v = eq ? eq + 1 : "";
+        if (takes_no_value(fl)) {
+            if (eq && fl->kind != DF_OPTREAL) FAIL("%s takes no value", name);
+            /* DF_OPTREAL: an optional value follows when the next word is a number */
+            char *end = NULL;
+            if (fl->kind == DF_OPTREAL && !eq && i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0) {
+                (void)strtod(argv[i + 1], &end);
+                if (end != argv[i + 1] && *end == '\0') v = argv[++i];
+            }
+        } else if (!eq) {
+            if (i + 1 >= argc || strncmp(argv[i + 1], "--", 2) == 0) FAIL("%s needs a value", name);
+            v = argv[++i];
+        }
+        if (is_dyn(fl) ? parse_dyn(fl, v, o, err, errlen) : parse_run_flag(fl, v, backend, o, err, errlen)) return -1;
+    }
+    return check_combinations(o, err, errlen);
 }
 
 /* The stage-list rule shared with the harness (harness/core/scenes.py parse_stages): no empty

@@ -16,6 +16,7 @@
 #include "dynamic/dyn_lod.h"
 #include "dynamic/world.h"
 #include "runtime/host.h"
+#include "runtime/input.h"
 #include "runtime/philox.h"
 #include "runtime/record.h"
 #include "runtime/safe_write.h"
@@ -555,14 +556,20 @@ static int run_one(int argc, char **argv, hb_backend *b);
  * order; the first that fails ends the batch with its exit status, after the records of the
  * runs before it. The backend starts every run as it started the first. */
 #define HB_BATCH_MAX_ARGS 256
+
+/* A batch line is a run: the words that print something else on stdout are not. */
+static int batch_word_allowed(const char *w)
+{
+    static const char *const not_runs[] = {"--help", "-h", "--version", "--list-variants", "--self-test"};
+    for (size_t i = 0; i < sizeof not_runs / sizeof not_runs[0]; i++)
+        if (strcmp(w, not_runs[i]) == 0) return 0;
+    return 1;
+}
 static int run_batch(char *prog, const char *path, hb_backend *b)
 {
     char err[HB_ERRLEN];
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        snprintf(err, sizeof err, "--batch %s: cannot read it", path);
-        return die(HB_EXIT_USAGE, err);
-    }
+    FILE *f = hb_input_fopen("--batch", path, "a batch file: a run's flags a line", 1, NULL, err, sizeof err);
+    if (!f) return die(HB_EXIT_USAGE, err);
     const hb_backend pristine = *b;
     char *line = NULL;
     size_t cap = 0;
@@ -571,6 +578,11 @@ static int run_batch(char *prog, const char *path, hb_backend *b)
     for (long lineno = 1; status == HB_EXIT_OK && (n = getline(&line, &cap, f)) >= 0; lineno++) {
         while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r')) line[--n] = '\0';
         if (n == 0) continue;
+        if (memchr(line, '\0', (size_t)n)) { /* the flags after it would be lost without a word */
+            snprintf(err, sizeof err, "--batch %s: line %ld holds a NUL byte", path, lineno);
+            status = die(HB_EXIT_USAGE, err);
+            break;
+        }
         char *argv[HB_BATCH_MAX_ARGS + 1];
         int argc = 0;
         argv[argc++] = prog;
@@ -585,6 +597,11 @@ static int run_batch(char *prog, const char *path, hb_backend *b)
             }
             if (strcmp(tok, "--batch") == 0) {
                 snprintf(err, sizeof err, "--batch %s: line %ld holds --batch (batches do not nest)", path, lineno);
+                status = die(HB_EXIT_USAGE, err);
+                break;
+            }
+            if (!batch_word_allowed(tok)) { /* it would print among the records on stdout */
+                snprintf(err, sizeof err, "--batch %s: line %ld holds %s (each line is a run)", path, lineno, tok);
                 status = die(HB_EXIT_USAGE, err);
                 break;
             }
@@ -696,7 +713,10 @@ static int run_one(int argc, char **argv, hb_backend *b)
                 CHECK(1, HB_EXIT_USAGE);
             }
     }
-    if (o.groom) CHECK(check_groom(&o, &run.groom, err, sizeof err), HB_EXIT_USAGE);
+    if (o.groom) {
+        const int groom_status = check_groom(&o, &run.groom, err, sizeof err);
+        CHECK(groom_status, groom_status < 0 ? HB_EXIT_USAGE : groom_status);
+    }
     if (o.scene.dyn.colliders_path && !o.scene.dyn.cols) { /* docs/model.md §3.17 (a resumed run has the file's) */
         CHECK(hb_colliders_load(o.scene.dyn.colliders_path, &run.cols, err, sizeof err), HB_EXIT_USAGE);
         o.scene.dyn.cols = &run.cols;
@@ -842,8 +862,9 @@ static int run_one(int argc, char **argv, hb_backend *b)
         CHECK(1, HB_EXIT_MEMORY);
     }
     if (o.output) {
-        run.w = hb_writer_open(o.output, o.force, &o.scene, err, sizeof err);
-        if (!run.w) CHECK(1, HB_EXIT_USAGE);
+        int open_status;
+        run.w = hb_writer_open(o.output, o.force, &o.scene, &open_status, err, sizeof err);
+        if (!run.w) CHECK(1, open_status);
     }
 
     /* ---- the input state: its frames go into the output first ---- */

@@ -6,6 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "runtime/backend.h"
+#include "runtime/checked.h"
+#include "runtime/input.h"
+
 #define HAIR_HEADER 128
 #define HAIR_SEGMENTS (1u << 0)
 #define HAIR_POINTS (1u << 1)
@@ -36,8 +40,9 @@ static float lef32(const unsigned char *b)
     return f;
 }
 
-/* Solves the 4×4 system a·x = b by elimination with partial pivoting; −1 when singular. */
-static int solve4(double a[4][4], double b[4], double x[4])
+/* Solves the 4×4 system a·x = b by elimination with partial pivoting; −1 when a pivot falls
+ * below `rel` times the largest entry (a rank below 4 at that conditioning). */
+static int solve4(double a[4][4], double b[4], double x[4], double rel)
 {
     double scale = 0.0;
     for (int i = 0; i < 4; i++)
@@ -46,7 +51,7 @@ static int solve4(double a[4][4], double b[4], double x[4])
         int piv = c;
         for (int r = c + 1; r < 4; r++)
             if (fabs(a[r][c]) > fabs(a[piv][c])) piv = r;
-        if (!(fabs(a[piv][c]) > 1e-12 * scale)) return -1;
+        if (!(fabs(a[piv][c]) > rel * scale)) return -1;
         for (int j = 0; j < 4; j++) {
             const double t = a[c][j];
             a[c][j] = a[piv][j];
@@ -66,6 +71,44 @@ static int solve4(double a[4][4], double b[4], double x[4])
         for (int j = r + 1; j < 4; j++) v -= a[r][j] * x[j];
         x[r] = v / a[r][r];
     }
+    return 0;
+}
+
+/* The points of strand i in a file's segment counts: its own, or the default's. */
+static uint64_t strand_points(const unsigned char *seg_raw, uint32_t dseg, int64_t i)
+{
+    return seg_raw ? (uint64_t)seg_raw[2 * i] + ((uint64_t)seg_raw[2 * i + 1] << 8) + 1 : (uint64_t)dseg + 1;
+}
+
+/* The sphere |p − c| = r fitted to the N roots in the least-squares sense of |p|² = 2c·p + d,
+ * solved for the roots moved to their mean and scaled to unit spread, so that the rank test
+ * is relative to the roots' own conditioning, not to where they lie. 0, or −1 when the roots
+ * do not determine a sphere. */
+#define HB_FIT_RANK (1e-9)
+static int fit_sphere(const double *pts, const unsigned char *seg_raw, uint32_t dseg, int64_t N, double c[3], double *r)
+{
+    double mean[3] = {0.0, 0.0, 0.0}, spread = 0.0;
+    uint64_t first = 0;
+    for (int64_t i = 0; i < N; first += strand_points(seg_raw, dseg, i), i++)
+        for (int k = 0; k < 3; k++) mean[k] += pts[3 * first + k] / (double)N;
+    first = 0;
+    for (int64_t i = 0; i < N; first += strand_points(seg_raw, dseg, i), i++)
+        for (int k = 0; k < 3; k++) spread = fmax(spread, fabs(pts[3 * first + k] - mean[k]));
+    if (!(spread > 0.0)) return -1;
+    double a[4][4] = {{0}}, b[4] = {0}, x[4] = {0};
+    first = 0;
+    for (int64_t i = 0; i < N; first += strand_points(seg_raw, dseg, i), i++) {
+        double q[3];
+        for (int k = 0; k < 3; k++) q[k] = (pts[3 * first + k] - mean[k]) / spread;
+        const double row[4] = {2 * q[0], 2 * q[1], 2 * q[2], 1.0}, qq = q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
+        for (int p = 0; p < 4; p++) {
+            for (int k = 0; k < 4; k++) a[p][k] += row[p] * row[k];
+            b[p] += row[p] * qq;
+        }
+    }
+    if (solve4(a, b, x, HB_FIT_RANK) != 0) return -1;
+    for (int k = 0; k < 3; k++) c[k] = mean[k] + spread * x[k];
+    *r = spread * sqrt(fmax(x[3] + x[0] * x[0] + x[1] * x[1] + x[2] * x[2], 0.0));
     return 0;
 }
 
@@ -113,94 +156,145 @@ static double resample(const double *in, int64_t n, const double *arc, int64_t P
     return worst;
 }
 
+/* Whether strand i's resampled points (P of them at out) keep every segment in the working
+ * precision: the points rounded to it, each segment's length at least the shortest length it
+ * squares. The length of the shortest one in *seg. */
+static int segments_representable(const double *out, int64_t P, hb_precision prec, double *seg)
+{
+    *seg = INFINITY;
+    for (int64_t k = 1; k < P; k++) {
+        double e2 = 0.0;
+        for (int c = 0; c < 3; c++) {
+            const double a = out[3 * (k - 1) + c], b = out[3 * k + c];
+            const double d = prec == HB_FP32 ? (double)(float)b - (double)(float)a : b - a;
+            e2 += d * d;
+        }
+        *seg = fmin(*seg, sqrt(e2));
+    }
+    return *seg >= hb_length_min(prec);
+}
+
+/* The HAIR header's sizes against the file and the run, before anything is allocated: the
+ * segments array's bytes, the strands taken (*N), the resampled state's bytes. */
+static int check_sizes(const char *path, hb_options *o, const unsigned char *h, uint64_t size, int64_t *N, char *err,
+                       size_t errlen)
+{
+    hb_scene *s = &o->scene;
+    const uint32_t nh = le32(h + 4), np = le32(h + 8), flags = le32(h + 12);
+    if (nh == 0 || np == 0) return snprintf(err, errlen, "--groom %s: the file holds no strands", path), HB_EXIT_USAGE;
+    if (!(flags & HAIR_POINTS))
+        return snprintf(err, errlen, "--groom %s: the file has no points array", path), HB_EXIT_USAGE;
+    if ((flags & HAIR_SEGMENTS) && size < HAIR_HEADER + 2u * (uint64_t)nh)
+        return snprintf(err, errlen, "--groom %s: truncated in its segments array", path), HB_EXIT_USAGE;
+    if ((o->given & HB_GIVEN_STRANDS) && s->n_strands > (int64_t)nh)
+        return snprintf(err, errlen, "--strands %lld: --groom %s holds %u strands", (long long)s->n_strands, path, nh),
+               HB_EXIT_USAGE;
+    *N = (o->given & HB_GIVEN_STRANDS) ? s->n_strands : (int64_t)nh;
+    if (!(o->given & HB_GIVEN_CENTER) && *N < 4)
+        return snprintf(err, errlen,
+                        "--groom %s: %lld strands: fewer than 4 strands do not determine a sphere (--head-center gives "
+                        "the head instead)",
+                        path, (long long)*N),
+               HB_EXIT_USAGE;
+    uint64_t bytes;
+    if (hb_mul3_u64((uint64_t)*N, (uint64_t)s->points, 3u * sizeof(double), &bytes) || bytes > SIZE_MAX / 2)
+        return snprintf(err, errlen, "--points %lld: %lld strands of %lld points are too large to address",
+                        (long long)s->points, (long long)*N, (long long)s->points),
+               HB_EXIT_USAGE;
+    const uint64_t avail = hb_host_memory_available();
+    if (avail && bytes > avail)
+        return snprintf(err, errlen,
+                        "--points %lld: --groom %s's %lld strands resampled to %lld points need %.3g GB of host "
+                        "memory, %.3g GB is available",
+                        (long long)s->points, path, (long long)*N, (long long)s->points, (double)bytes / 1e9,
+                        (double)avail / 1e9),
+               HB_EXIT_MEMORY;
+    return 0;
+}
+
 static int read_hair(const char *path, hb_options *o, hb_groom *g, char *err, size_t errlen)
 {
     hb_scene *s = &o->scene;
     unsigned char h[HAIR_HEADER];
     unsigned char *seg_raw = NULL, *pts_raw = NULL;
     double *pts = NULL, *arc = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f) FAIL("--groom %s: cannot open the file", path);
+    int status = HB_EXIT_USAGE;
+    uint64_t size = 0;
+    int64_t N = 0;
+    FILE *f = hb_input_fopen("--groom", path, "a HAIR file", 1, &size, err, errlen);
+    if (!f) return HB_EXIT_USAGE;
     if (fread(h, 1, sizeof h, f) != sizeof h) FAIL("--groom %s: truncated HAIR header (under 128 bytes)", path);
     if (memcmp(h, "HAIR", 4) != 0) FAIL("--groom %s: not a HAIR file (its first 4 bytes are not 'HAIR')", path);
+    if ((status = check_sizes(path, o, h, size, &N, err, errlen)) != 0) goto fail;
+    status = HB_EXIT_USAGE;
     const uint32_t nh = le32(h + 4), np = le32(h + 8), flags = le32(h + 12), dseg = le32(h + 16);
-    if (nh == 0 || np == 0) FAIL("--groom %s: the file holds no strands", path);
-    if (!(flags & HAIR_POINTS)) FAIL("--groom %s: the file has no points array", path);
-    /* the arrays follow the header in this order, each present when its bit is set */
-    const double want = HAIR_HEADER + ((flags & HAIR_SEGMENTS) ? 2.0 * nh : 0.0) + 12.0 * np +
-                        ((flags & HAIR_THICKNESS) ? 4.0 * np : 0.0) + ((flags & HAIR_TRANSPARENCY) ? 4.0 * np : 0.0) +
-                        ((flags & HAIR_COLOR) ? 12.0 * np : 0.0);
+    const int64_t P = s->points;
     uint64_t total = 0;
     if (flags & HAIR_SEGMENTS) {
         seg_raw = malloc(2u * (size_t)nh);
         if (!seg_raw || fread(seg_raw, 2, nh, f) != nh) FAIL("--groom %s: truncated in its segments array", path);
-        for (uint32_t i = 0; i < nh; i++) total += (uint64_t)seg_raw[2 * i] + ((uint64_t)seg_raw[2 * i + 1] << 8) + 1;
+        for (uint32_t i = 0; i < nh; i++) total += strand_points(seg_raw, dseg, i);
     } else {
         total = (uint64_t)nh * ((uint64_t)dseg + 1);
     }
     if (total != np)
         FAIL("--groom %s: wrong counts: the strands' segments need %llu points, the header says %u", path,
              (unsigned long long)total, np);
-    if (fseek(f, 0, SEEK_END) != 0) FAIL("--groom %s: cannot seek in the file", path);
-    const long size = ftell(f);
-    if (size < 0 || (double)size < want)
-        FAIL("--groom %s: truncated (%ld bytes; its header's %u strands and %u points need %.0f)", path, size, nh, np,
-             want);
-    if (fseek(f, (long)(HAIR_HEADER + ((flags & HAIR_SEGMENTS) ? 2u * (size_t)nh : 0u)), SEEK_SET) != 0)
-        FAIL("--groom %s: cannot seek in the file", path);
-    pts_raw = malloc(12u * (size_t)np);
+    /* the arrays follow the header in this order, each present when its bit is set */
+    const double want = HAIR_HEADER + ((flags & HAIR_SEGMENTS) ? 2.0 * nh : 0.0) + 12.0 * np +
+                        ((flags & HAIR_THICKNESS) ? 4.0 * np : 0.0) + ((flags & HAIR_TRANSPARENCY) ? 4.0 * np : 0.0) +
+                        ((flags & HAIR_COLOR) ? 12.0 * np : 0.0);
+    if ((double)size < want)
+        FAIL("--groom %s: truncated (%llu bytes; its header's %u strands and %u points need %.0f)", path,
+             (unsigned long long)size, nh, np, want);
+    pts_raw = malloc(12u * (size_t)np); /* np points fit in the file: checked against its size */
     if (!pts_raw || fread(pts_raw, 12, np, f) != np) FAIL("--groom %s: cannot read the points array", path);
     fclose(f);
     f = NULL;
-
-    if ((o->given & HB_GIVEN_STRANDS) && s->n_strands > (int64_t)nh)
-        FAIL("--strands %lld: --groom %s holds %u strands", (long long)s->n_strands, path, nh);
     if (!(o->given & HB_GIVEN_STRANDS)) s->n_strands = nh;
-    const int64_t N = s->n_strands, P = s->points;
     pts = malloc(sizeof *pts * 3u * (size_t)np);
     arc = malloc(sizeof *arc * (size_t)np);
-    g->pos = malloc(sizeof *g->pos * 3u * (size_t)N * (size_t)P);
-    if (!pts || !arc || !g->pos) FAIL("--groom %s: out of host memory", path);
+    g->pos = malloc(sizeof *g->pos * 3u * (size_t)N * (size_t)P); /* its size checked by check_sizes */
+    if (!pts || !arc || !g->pos) {
+        status = HB_EXIT_MEMORY;
+        FAIL("--groom %s: out of host memory", path);
+    }
     for (uint32_t i = 0; i < 3 * np; i++) {
         pts[i] = (double)lef32(pts_raw + 4 * (size_t)i);
         if (!isfinite(pts[i])) FAIL("--groom %s: point %u holds a NaN or Inf", path, i / 3);
     }
-    /* the head: given by --head-center, or a sphere fitted to the roots, |p|² = 2c·p + d in the
-     * least-squares sense */
+    /* the head: given by --head-center, or a sphere fitted to the roots */
     const int given = (o->given & HB_GIVEN_CENTER) != 0;
-    double x[4] = {0};
-    uint64_t first = 0;
+    const double far = hb_length_max(s->precision);
+    double x[3] = {0}, fit_r = 0.0;
     if (given) {
-        memcpy(x, o->head_center, sizeof o->head_center);
-    } else {
-        double a[4][4] = {{0}}, b[4] = {0};
-        for (int64_t i = 0; i < N; i++) {
-            const double *r = pts + 3 * first, row[4] = {2 * r[0], 2 * r[1], 2 * r[2], 1.0};
-            const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-            for (int p = 0; p < 4; p++) {
-                for (int q = 0; q < 4; q++) a[p][q] += row[p] * row[q];
-                b[p] += row[p] * rr;
-            }
-            first += (flags & HAIR_SEGMENTS) ? (uint64_t)seg_raw[2 * i] + ((uint64_t)seg_raw[2 * i + 1] << 8) + 1
-                                             : (uint64_t)dseg + 1;
-        }
-        if (solve4(a, b, x) != 0)
-            FAIL("--groom %s: the roots do not determine a sphere (fewer than 4 strands, or the roots on one circle or "
-                 "plane; --head-center gives the head instead)",
-                 path);
+        memcpy(x, o->head_center, sizeof x);
+        for (int c = 0; c < 3; c++)
+            if (!(fabs(x[c]) <= far))
+                FAIL("--head-center %g,%g,%g: beyond the lengths %s can square (%g cm; docs/decisions/paper-model.md)",
+                     x[0], x[1], x[2], hb_precision_name(s->precision), far);
+    } else if (fit_sphere(pts, seg_raw, dseg, N, x, &fit_r) != 0) {
+        FAIL("--groom %s: the roots do not determine a sphere (the roots on one circle or plane; --head-center gives "
+             "the head instead)",
+             path);
     }
-    const double fit_r = given ? 0.0 : sqrt(fmax(x[3] + x[0] * x[0] + x[1] * x[1] + x[2] * x[2], 0.0));
     double rmin = INFINITY, off = 0.0;
     g->length_min = INFINITY;
     g->length_max = 0.0;
     g->resample_error = 0.0;
-    first = 0;
+    uint64_t first = 0;
     for (int64_t i = 0; i < N; i++) {
-        const uint64_t n = (flags & HAIR_SEGMENTS) ? (uint64_t)seg_raw[2 * i] + ((uint64_t)seg_raw[2 * i + 1] << 8) + 1
-                                                   : (uint64_t)dseg + 1;
+        const uint64_t n = strand_points(seg_raw, dseg, i);
         double *in = pts + 3 * first;
         for (uint64_t j = 0; j < n; j++)
-            for (int c = 0; c < 3; c++) in[3 * j + c] -= x[c];
+            for (int c = 0; c < 3; c++) {
+                in[3 * j + c] -= x[c];
+                if (!(fabs(in[3 * j + c]) <= far))
+                    FAIL("--groom %s: point %llu lies %g cm from the head's centre, beyond the lengths %s can square "
+                         "(%g cm)",
+                         path, (unsigned long long)(first + j), fabs(in[3 * j + c]), hb_precision_name(s->precision),
+                         far);
+            }
         const double rho = sqrt(in[0] * in[0] + in[1] * in[1] + in[2] * in[2]);
         rmin = fmin(rmin, rho);
         off = fmax(off, fabs(rho - fit_r));
@@ -215,7 +309,12 @@ static int read_hair(const char *path, hb_options *o, hb_groom *g, char *err, si
         if (n < 2 || !(len > 0.0)) FAIL("--groom %s: strand %lld has zero length", path, (long long)i);
         g->length_min = fmin(g->length_min, len);
         g->length_max = fmax(g->length_max, len);
-        const double e = resample(in, (int64_t)n, arc + first, P, g->pos + 3 * (size_t)i * (size_t)P);
+        double *out = g->pos + 3 * (size_t)i * (size_t)P, seg;
+        const double e = resample(in, (int64_t)n, arc + first, P, out);
+        if (!segments_representable(out, P, s->precision, &seg))
+            FAIL("--groom %s: strand %lld resampled to %lld points has segments of %.3g cm, which %s cannot hold "
+                 "(shorter than %g cm once rounded; give fewer --points, or --precision fp64)",
+                 path, (long long)i, (long long)P, seg, hb_precision_name(s->precision), hb_length_min(s->precision));
         g->resample_error = fmax(g->resample_error, e);
         first += n;
     }
@@ -243,7 +342,7 @@ fail:
     free(arc);
     free(g->pos);
     g->pos = NULL;
-    return -1;
+    return status;
 }
 
 int hb_groom_prepare(hb_options *o, hb_groom *g, char *err, size_t errlen)
@@ -267,7 +366,7 @@ int hb_groom_prepare(hb_options *o, hb_groom *g, char *err, size_t errlen)
         FAIL("--head-radius must be a finite number > 0 (got %g)", s->head_radius);
     return read_hair(o->groom, o, g, err, errlen);
 fail:
-    return -1;
+    return HB_EXIT_USAGE;
 }
 
 /* §3.15 the curly groom: strand i's root on the head at the i-th point of a golden-angle

@@ -24,7 +24,8 @@ typedef struct {
 } hb_groom;
 
 /* Reads and checks the groom of o->groom and sets the scene's strands, head radius and
- * hair length from it (a file groom); one line in err and −1 on a bad groom. */
+ * hair length from it (a file groom); 0, or one line in err and the exit status: HB_EXIT_USAGE
+ * for a bad groom, HB_EXIT_MEMORY for one whose resampled state does not fit in memory. */
 int hb_groom_prepare(hb_options *o, hb_groom *g, char *err, size_t errlen);
 /* The groom's state, canonical [N·P][3] in the scene's precision. */
 void hb_groom_state(const hb_scene *s, const hb_groom *g, void *out);

@@ -49,12 +49,12 @@ double hb_wind_angle_reduced(const hb_scene *s)
 
 /* The lengths a precision can square without underflow or overflow (docs/decisions/paper-model.md,
  * "Representable scenes"). */
-static double length_min(hb_precision p)
+double hb_length_min(hb_precision p)
 {
     return p == HB_FP32 ? 1e-18 : 1e-150;
 }
 
-static double length_max(hb_precision p)
+double hb_length_max(hb_precision p)
 {
     return p == HB_FP32 ? 1e18 : 1e150;
 }
@@ -78,15 +78,16 @@ int hb_scene_validate(const hb_scene *s, char *err, size_t errlen)
     if (!isfinite(s->wind_angle)) FAIL("--wind-angle must be a finite number of radians (got %g)", s->wind_angle);
     double ell = hb_segment_length(s);
     /* ℓ = L/(P−1) computed in double may round just below h when the user asked for ℓ = h
-     * exactly; a relative allowance of 1e-12 keeps that edge usable. */
-    if (!(ell >= s->hair_offset * (1.0 - 1e-12)))
+     * exactly; a relative allowance of 1e-12 keeps that edge usable. A groom runs no collide
+     * stage (init and simulate only), so the rule is the drape's. */
+    if (s->groom == HB_GROOM_DRAPE && !s->dyn.per_segment && !(ell >= s->hair_offset * (1.0 - 1e-12)))
         FAIL("--hair-length/(--points - 1) = %g is shorter than --hair-offset %g: a segment could not reach the "
              "shell (docs/model.md §2.5: collide needs l >= h)",
              ell, s->hair_offset);
     /* Every length must square without leaving the precision's normal range, or the
      * model's r², ℓ² and ρ·rc underflow to denormals or zero (docs/decisions/paper-model.md,
      * "fp32_near_denormal_range"). */
-    const double lo = length_min(s->precision), hi = length_max(s->precision);
+    const double lo = hb_length_min(s->precision), hi = hb_length_max(s->precision);
     const struct {
         const char *flag;
         double v;
@@ -250,7 +251,7 @@ int hb_dynamics_validate_scene(const hb_scene *s, char *err, size_t errlen)
     const int wind = d->wind_speed > 0.0 && d->drag > 0.0, gust = wind && d->gust_amplitude > 0.0;
     const int bend = d->bend && s->points >= 3; /* P = 2 has no bend constraint */
     const int shape = d->shape && floor(d->shape_range * (double)(s->points - 1)) >= 1.0; /* K ≥ 1 */
-    const double hi = length_max(p);
+    const double hi = hb_length_max(p);
     const double rc = s->head_radius + d->collision_margin;
     if (d->grid && (uint64_t)s->n_strands * (uint64_t)s->points > (UINT64_C(1) << 31))
         FAIL("--grid: --strands x --points must be at most 2^31 points, the bound that keeps the grid's fixed-point "

@@ -182,6 +182,11 @@ const char *hb_solver_name(hb_solver s);
 const char *hb_motion_name(hb_motion m);
 const char *hb_follow_name(hb_follow f);
 
+/* The lengths precision p can square without underflow or overflow (docs/decisions/paper-model.md,
+ * "Representable scenes"). */
+double hb_length_min(hb_precision p);
+double hb_length_max(hb_precision p);
+
 /* Bytes of one state [N·P][3] in the scene's precision; 0 on overflow. */
 uint64_t hb_state_bytes(const hb_scene *s);
 

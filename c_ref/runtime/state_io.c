@@ -3,6 +3,7 @@
 #include "runtime/safe_write.h"
 #include "runtime/checked.h"
 #include "runtime/h5md_meta.h"
+#include "runtime/input.h"
 
 #include <errno.h>
 #include <stddef.h>
@@ -30,7 +31,20 @@ static double now_s(void)
 
 static void quiet_hdf5(void)
 {
+    /* No clean-up of HDF5 at exit(): after a close that failed (a full disk), HDF5 1.10's
+     * clean-up dies of SIGSEGV on that file (exit 139 for the 4 the error set). Every file is
+     * closed explicitly; the process's end frees the rest. Takes effect before HDF5 starts. */
+    H5dont_atexit();
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+/* The exit status of a failure to create or write the temporary file: the user's path (2),
+ * or the machine's fault (4: a full disk, an I/O error). */
+static int create_status(int e)
+{
+    return e == ENOENT || e == ENOTDIR || e == EACCES || e == EPERM || e == EROFS || e == ENAMETOOLONG || e == ELOOP
+               ? HB_EXIT_USAGE
+               : HB_EXIT_RUNTIME;
 }
 
 static hid_t str_type(void)
@@ -170,9 +184,10 @@ void hb_writer_abort(hb_writer *w)
     writer_free(w);
 }
 
-hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, char *err, size_t errlen)
+hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, int *status, char *err, size_t errlen)
 {
     quiet_hdf5();
+    *status = HB_EXIT_USAGE;
     double t0 = now_s();
     hb_writer *w = calloc(1, sizeof *w);
     if (!w) {
@@ -205,13 +220,21 @@ hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, ch
     w->file = H5Fcreate(w->tmp, H5F_ACC_EXCL, fcpl, H5P_DEFAULT);
     H5Pclose(fcpl);
     if (w->file < 0) {
-        hb_safe_forget(); /* not ours to remove: it may exist already */
+        const int e = errno;
+        *status = create_status(e);
+        hb_safe_forget();
+        if (e != EEXIST) unlink(w->tmp); /* its random name is this run's: a full disk leaves it empty */
+        errno = e;
         snprintf(err, errlen, "--output %s: cannot create %s (%s)", path, w->tmp, strerror(errno));
         free(w->tmp);
         w->tmp = NULL;
         goto fail;
     }
-    if (hb_safe_mark(w->tmp)) FAIL("--output %s: cannot write %s (%s)", path, w->tmp, strerror(errno));
+    if (hb_safe_mark(w->tmp)) {
+        *status = create_status(errno);
+        FAIL("--output %s: cannot write %s (%s)", path, w->tmp, strerror(errno));
+    }
+    *status = HB_EXIT_RUNTIME; /* the path is good: what fails from here on is the machine's */
 
     /* /h5md: version, author, creator (H5MD 1.1 §"H5MD metadata") */
     hid_t h5md = make_group(w->file, "h5md");
@@ -1198,11 +1221,8 @@ int hb_input_open(const char *path, hb_input *in, char *err, size_t errlen)
 {
     quiet_hdf5();
     memset(in, 0, sizeof *in);
-    if (access(path, F_OK) != 0) FAIL("--input %s: no such file", path);
-    struct stat st; /* a FIFO or device would block or never end: only regular files */
-    if (stat(path, &st) != 0) FAIL("--input %s: cannot read it (%s)", path, strerror(errno));
-    if (!S_ISREG(st.st_mode)) FAIL("--input %s is %s; --input must be a regular file", path, hb_file_kind(st.st_mode));
-    if (access(path, R_OK) != 0) FAIL("--input %s: not readable (%s)", path, strerror(errno));
+    /* a FIFO or device would block or never end: a regular file, at least HDF5's superblock */
+    if (hb_input_check("--input", path, "an HDF5 file", 8, err, errlen)) return -1;
     if (H5Fis_hdf5(path) <= 0) FAIL("--input %s is not an HDF5 file", path);
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     if (f < 0) FAIL("--input %s: HDF5 cannot open it (truncated or damaged?)", path);

@@ -47,8 +47,9 @@ typedef struct {
 typedef struct hb_writer hb_writer;
 
 /* Opens a marked temporary file beside `path` (safe_write.h); refuses an existing `path`
- * unless `force`. */
-hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, char *err, size_t errlen);
+ * unless `force`. NULL on failure, with *status the exit status: 2 for the user's path, 4 for
+ * the machine's fault (a full disk). */
+hb_writer *hb_writer_open(const char *path, int force, const hb_scene *scene, int *status, char *err, size_t errlen);
 int hb_writer_append(hb_writer *w, const void *frame, const hb_frame_meta *fm, char *err, size_t errlen);
 /* Writes /parameters, closes, renames to the final name (HB_SAFE_EXISTS when the name was
  * taken during the run and `force` was not given). Frees w in every case. */

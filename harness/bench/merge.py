@@ -12,7 +12,12 @@ under the shards is joined by its relative path:
   - validation.json: every shard's comparisons (each node validates before it times);
   - any other file: the first shard's that has it (a study measured once has its files in
     one shard only).
-merge.json in OUT names the shards."""
+merge.json in OUT names the shards.
+
+A shard records its completeness: shard.json says `finished: false` while it runs and, when its
+command ends, `finished: true` with the cases each of its runs.csv holds (`cases`). A merge
+refuses, in one line naming the file (and line), a shard that did not finish, one whose runs.csv
+lost cases or holds a torn or short row, and a shard.json, env.json or CSV that is damaged."""
 
 import csv
 import hashlib
@@ -21,8 +26,9 @@ import shutil
 from pathlib import Path
 
 from harness import HarnessError
-from harness.core import env
+from harness.core import env, inputs
 from harness.core.paths import display
+from harness.io import files, runfolder
 from harness.io.files import write_json
 from harness.studies.sweep import machine_of
 
@@ -48,6 +54,7 @@ def write_record(folder, shard, sweep_files, command):
         "command": command,
         "hostname": host["hostname"],
         "date": host["date"],
+        "finished": False,
     }
     path = Path(folder) / RECORD
     if path.exists():  # a resumed shard: the same shard of the same run, or refused
@@ -63,16 +70,74 @@ def write_record(folder, shard, sweep_files, command):
     return record
 
 
+def finish_record(folder):
+    """shard.json marked finished, with the cases each runs.csv of the shard holds."""
+    path = Path(folder) / RECORD
+    record = inputs.read_json(path, "shard")
+    record["cases"] = {str(c.relative_to(folder)): len(_case_ids(c)) for c in sorted(Path(folder).rglob("runs.csv"))}
+    record["finished"] = True
+    record["finished_at"] = env.now()
+    write_json(path, record)
+
+
+def _case_ids(path):
+    """The distinct case_id of a runs.csv, every row checked (a torn or short row refused)."""
+    header, rows = _csv_rows(path)
+    i = header.index("case_id") if "case_id" in header else None
+    return {r[i] for r in rows} if i is not None else set()
+
+
+def _csv_rows(path):
+    """A CSV's header and rows; a row of another length than the header (a torn last line) refused
+    in one line naming the file and the line."""
+    text = inputs.read_text(path, "merge:")
+    reader = csv.reader(text.splitlines())
+    header = next(reader, None) or []
+    rows = []
+    for row in reader:
+        if len(row) != len(header):
+            raise HarnessError(
+                f"merge: {display(path)} line {reader.line_num}: {len(row)} fields, its header has {len(header)} "
+                "(a torn or short row: the shard did not finish writing it)"
+            )
+        rows.append(row)
+    return header, rows
+
+
+FIELDS = {"k": int, "n": int, "shard": str, "revision": str, "command": str, "machine": dict, "sweeps": dict}
+
+
 def _read_record(folder):
     path = Path(folder) / RECORD
-    try:
-        return json.loads(path.read_text())
-    except FileNotFoundError:
+    if not path.exists():
+        raise HarnessError(f"merge: {display(folder)} is not a shard folder (no {RECORD}; run with --shard K/N)")
+    record = inputs.read_json(path, "merge:")
+    if not isinstance(record, dict):
+        raise HarnessError(f"merge: {display(path)}: not a shard record (a JSON object)")
+    for key, kind in FIELDS.items():
+        if not isinstance(record.get(key), kind) or isinstance(record.get(key), bool):
+            raise HarnessError(f"merge: {display(path)}: '{key}' is missing or not a {kind.__name__}")
+    if not 1 <= record["k"] <= record["n"]:
         raise HarnessError(
-            f"merge: {display(folder)} is not a shard folder (no {RECORD}; run with --shard K/N)"
-        ) from None
-    except (OSError, json.JSONDecodeError) as e:
-        raise HarnessError(f"merge: {display(path)}: not readable JSON ({e})") from None
+            f"merge: {display(path)}: k = {record['k']} is not a shard of n = {record['n']} (1 <= k <= n)"
+        )
+    return record
+
+
+def _check_complete(folder, record):
+    """Refuse a shard that did not finish, or whose runs.csv lost the cases it recorded."""
+    where = f"shard {record['k']}/{record['n']} ({display(folder)})"
+    if record.get("finished") is not True or not isinstance(record.get("cases"), dict):
+        raise HarnessError(
+            f"merge: {where} did not finish (its {RECORD} is not marked finished): run it again to its end, it resumes"
+        )
+    for rel, n in record["cases"].items():
+        path = Path(folder) / rel
+        if not path.is_file():
+            raise HarnessError(f"merge: {where}: {rel} is missing (it held {n} case(s) when the shard finished)")
+        have = len(_case_ids(path))
+        if have != n:
+            raise HarnessError(f"merge: {display(path)} holds {have} case(s); the shard finished with {n}")
 
 
 def check(records):
@@ -106,15 +171,23 @@ def merge(out, folders, log=print):
         if not Path(f).is_dir():
             raise HarnessError(f"merge: {f} is not a folder")
     shards = check([(Path(f), _read_record(f)) for f in folders])
-    files = {}
+    for folder, record in shards:
+        _check_complete(folder, record)
+    runfolder.claim(out, "merge", what="merge: OUT")  # locked; not the repository or a folder above it
+    found_files = {}
     for k, (folder, _) in enumerate(shards, 1):
         for path in sorted(folder.rglob("*")):
             rel = path.relative_to(folder)
-            if path.is_file() and rel.parts[0] not in ("report", "_scratch") and rel.name != RECORD:
-                files.setdefault(rel, []).append((k, path))
+            if (
+                path.is_file()
+                and rel.parts[0] not in ("report", "_scratch")
+                and rel.name != RECORD
+                and not rel.name.startswith(".hairbench-run")
+            ):
+                found_files.setdefault(rel, []).append((k, path))
     out.mkdir(parents=True, exist_ok=True)
     try:
-        for rel, found in sorted(files.items()):
+        for rel, found in sorted(found_files.items()):
             target = out / rel
             target.parent.mkdir(parents=True, exist_ok=True)
             if rel.suffix == ".csv" and len(found) > 1:
@@ -124,7 +197,7 @@ def merge(out, folders, log=print):
             elif rel.name == "validation.json" and len(found) > 1:
                 _join_validation(target, found)
             else:
-                shutil.copy2(found[0][1], target)
+                files.copy(found[0][1], target)
         n = len(shards)
         write_json(
             out / "merge.json",
@@ -138,7 +211,10 @@ def merge(out, folders, log=print):
 
 
 def _json(path):
-    return json.loads(Path(path).read_text())
+    record = inputs.read_json(path, "merge:")
+    if not isinstance(record, dict):
+        raise HarnessError(f"merge: {display(path)}: not a JSON object")
+    return record
 
 
 def _join_csv(target, found):
@@ -146,33 +222,31 @@ def _join_csv(target, found):
     env.json's sessions (each shard's follow the previous shards')."""
     header, rows, offset = None, [], 0
     for k, path in found:
-        with open(path, newline="") as f:
-            r = csv.reader(f)
-            h = next(r, None)
-            if header is None:
-                header = h
-            elif h != header:
-                raise HarnessError(f"merge: {display(path)}: its columns differ from shard 1's")
-            part = list(r)
+        h, part = _csv_rows(path)
+        if header is None:
+            header = h
+        elif h != header:
+            raise HarnessError(f"merge: {display(path)}: its columns differ from shard 1's")
         sessions = _sessions(path.parent / "env.json")
         if header and "session" in header and sessions is not None:
             i = header.index("session")
-            for row in part:
+            for line, row in enumerate(part, 2):
+                if row[i] and not row[i].isdigit():
+                    raise HarnessError(f"merge: {display(path)} line {line}: session '{row[i]}' is not a whole number")
                 row[i] = str(int(row[i]) + offset) if row[i] else row[i]
             offset += sessions
         rows += part
-    with open(target, "w", newline="") as f:
-        w = csv.writer(f, lineterminator="\n")
-        w.writerow(header)
-        w.writerows(rows)
+    files.write_rows(target, header, rows)
 
 
 def _sessions(env_path):
     """How many sessions a sweep's env.json records (None: not a sweep's)."""
-    try:
-        return len(_json(env_path)["sessions"])
-    except (OSError, ValueError, KeyError, TypeError):
+    if not Path(env_path).exists():
         return None
+    sessions = _json(env_path).get("sessions")
+    if not isinstance(sessions, list):
+        raise HarnessError(f"merge: {display(env_path)}: no list of sessions (a sweep's env.json has one)")
+    return len(sessions)
 
 
 def _join_env(target, found):

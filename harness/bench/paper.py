@@ -24,7 +24,8 @@ from harness.bench.validation import gpu_plan
 from harness.check import diff
 from harness.core import runner, variants
 from harness.core.budget import TierGate
-from harness.core.paths import RESULTS, binary_path, display, output_dir
+from harness.core.paths import RESULTS, binary_path, display
+from harness.io import runfolder
 from harness.io.files import write_json
 from harness.io.sweepfile import load_sweep
 from harness.render import report_paper
@@ -163,7 +164,7 @@ def validate_first(sweep_ref="default", out=None, gpu="auto", log=None):
     runner.require_binary(binary_path("cpu"))
     sweep = load_sweep(sweep_ref)
     builds, gpu_note = gpu_plan(gpu)
-    validate(sweep, output_dir(out if out else RESULTS / sweep.name), builds, gpu_note, say)
+    validate(sweep, runfolder.claim(out if out else RESULTS / sweep.name, "bench"), builds, gpu_note, say)
 
 
 def run(
@@ -183,7 +184,7 @@ def run(
     say = log or (lambda m: print(m, flush=True))
     runner.require_binary(binary_path("cpu"))
     sweep = load_sweep(sweep_ref)
-    out_dir = output_dir(out if out else RESULTS / sweep.name)
+    out_dir = runfolder.claim(out if out else RESULTS / sweep.name, "bench")
     root = Path(root) if root else out_dir.parent
     builds, gpu_note = gpu_plan(gpu)
     if gpu_note:

@@ -39,7 +39,6 @@ Exit status as for diff: 0 equivalent, 1 not, 2 could not compare.
 import math
 import os
 import shutil
-import subprocess
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -48,7 +47,7 @@ import numpy as np
 
 from harness import HarnessError
 from harness.check import diff, invariants_dynamic
-from harness.core import tolerances
+from harness.core import runner, tolerances
 from harness.core.paths import build_dir, display
 from harness.core.ulp import coarser, ulp_distance
 from harness.io.states import StateError, as_text
@@ -58,10 +57,11 @@ OBS_SHOWN = ("stretch_max", "penetration_max", "kinetic_energy", "blown_up_stran
 
 
 def is_dynamic_file(path):
-    try:
-        import h5py
+    from harness.core import inputs
 
-        with h5py.File(path, "r") as f:
+    inputs.regular(path, "diff:")  # a FIFO would block any reader: refused here, before it
+    try:
+        with inputs.open_h5(path, "diff:") as f:
             return "parameters" in f and as_text(f["parameters"].attrs.get("model", "paper")) == "dynamic"
     except Exception:
         return False
@@ -157,8 +157,8 @@ def _step_once(binary, reference, k, out, timeout):
     cmd = [str(binary), "--input", str(reference), "--input-frame", str(k), "--stages", "simulate"]
     cmd += ["--frames", "1", "--output", str(out), "--force", "--quiet"]
     try:
-        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
+        p = runner.run_command(cmd, timeout=timeout)
+    except runner.TimedOut:
         raise HarnessError(f"{display(binary)} did not finish within {timeout} s", code=2) from None
     if p.returncode != 0:
         msg = (p.stderr.strip().splitlines() or [f"status {p.returncode}"])[-1]
@@ -543,8 +543,8 @@ def stepdiff(reference, binary, flags=(), frames="all", exact=False, keep=None, 
                 "--quiet",
             ]
             try:
-                p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-            except subprocess.TimeoutExpired:
+                p = runner.run_command(cmd, timeout=timeout)
+            except runner.TimedOut:
                 raise HarnessError(f"{binary.name} did not finish within {timeout} s", code=2) from None
             if p.returncode != 0:
                 msg = (p.stderr.strip().splitlines() or ["no message"])[-1]

@@ -31,7 +31,9 @@ def table(obs, every=None):
     return lines
 
 
-def run(binary, flags, output=None, timeout=None, as_json=False, every=None, out=print):
+def run(binary, flags, output=None, timeout=None, as_json=False, every=None, out=print, named=lambda x: x):
+    """Run the binary, then print its observables and verdict; `named` maps the record's names
+    (a USD groom's temporary HAIR file back to the user's file)."""
     tmp = None
     if not output:
         tmp = Path(tempfile.mkdtemp(prefix="hb-run-"))
@@ -40,7 +42,7 @@ def run(binary, flags, output=None, timeout=None, as_json=False, every=None, out
     else:
         path = Path(output)
     try:
-        record = runner.run_binary(binary, flags, timeout=timeout)
+        record = named(runner.run_binary(binary, flags, timeout=timeout))
         if tmp:  # removed below: no path to claim
             record["output"] = None
         with open_trajectory(path) as t:

@@ -91,26 +91,20 @@ def cmd_run(args):
     )
     if scene.model == "dynamic" and args.frames:
         scene = scenes.with_frames(scene, args.frames)
-    if scene.groom_file:
-        from harness.io import grooms
+    from harness.io import grooms
 
-        if grooms.is_usd(scene.groom_file):  # the binaries read HAIR: a USD groom passes through one
-            import dataclasses
-            import tempfile
-
-            tmpdir = tempfile.TemporaryDirectory(prefix="hairbench-groom-")
-            hair = os.path.join(tmpdir.name, "groom.hair")
-            grooms.convert(scene.groom_file, hair)
-            scene = dataclasses.replace(scene, groom=hair)
     binary = binary_path(args.backend, args.build)
-    flags = runner.run_flags(
-        scene, args.backend, **options(args, "variant block_size threads repeat warmup output force")
-    )
-    if scene.model == "dynamic":  # per-frame observables (harness/check/run_dynamic.py)
-        from harness.check import run_dynamic
+    # the binaries read HAIR: a USD groom passes through one, named as the user named it
+    with grooms.hair_for(scene) as (scene, named):
+        flags = runner.run_flags(
+            scene, args.backend, **options(args, "variant block_size threads repeat warmup output force")
+        )
+        if scene.model == "dynamic":  # per-frame observables (harness/check/run_dynamic.py)
+            from harness.check import run_dynamic
 
-        return run_dynamic.run(binary, flags, args.output, timeout=args.timeout, as_json=args.json, every=args.every)
-    record = runner.run_binary(binary, flags, timeout=args.timeout)
+            given = options(args, "timeout every")
+            return run_dynamic.run(binary, flags, args.output, as_json=args.json, named=named, **given)
+        record = named(runner.run_binary(binary, flags, timeout=args.timeout))
     print(json.dumps(record, indent=1) if args.json else runner.summary(record))
     return 0
 
@@ -143,19 +137,26 @@ def cmd_stepdiff(args):
 def cmd_sweep(args):
     """Run every case of a sweep (configs/sweeps/NAME.toml), one row per (case, stage) in results/NAME/runs.csv;
     a killed sweep resumes."""
+    from harness.bench import merge
     from harness.core import shards
     from harness.io.sweepfile import load_sweep
     from harness.studies import sweep
 
     shard = shards.parse(args.shard) if args.shard else None
     if shard:
-        from harness.bench import merge
-        from harness.core.paths import RESULTS, output_dir
+        from harness.core.paths import RESULTS
+        from harness.io import runfolder
 
         spec = load_sweep(args.sweep)
-        out = output_dir(args.out if args.out else RESULTS / spec.name)
+        out = runfolder.claim(
+            args.out if args.out else RESULTS / spec.name, f"sweep {spec.name}", force=getattr(args, "force", False)
+        )
         merge.write_record(out, shard, {"sweep": spec.path}, f"sweep {spec.name}")
-    _, failed = sweep.run_sweep(args.sweep, out=args.out, gpu=args.gpu, shard=shard)
+    out_dir, failed = sweep.run_sweep(
+        args.sweep, out=args.out, gpu=args.gpu, shard=shard, force=getattr(args, "force", False)
+    )
+    if shard:
+        merge.finish_record(out_dir)  # the shard finished: merge takes it, with the cases it holds
     return 1 if failed else 0
 
 
@@ -197,14 +198,17 @@ def cmd_bench(args):
     from harness.core import budget, shards
     from harness.core.paths import LOCAL_RUN
     from harness.core.progress import StepTimes
-    from harness.io.sweepfile import load_sweep
 
     # one run folder (docs/decisions/bench-runs.md): the paper sweep in ROOT/sweep, the dynamic
     # bench's folders beside it, the report in ROOT/report; nothing tracked is written
+    from harness.io import runfolder
+    from harness.io.sweepfile import load_sweep
+
     root = Path(args.out) if args.out else LOCAL_RUN
     report_dir = Path(args.report_dir) if args.report_dir else root / "report"
     shard = shards.parse(args.shard) if args.shard else None
     plan = budget.Budget(budget.parse_duration(args.budget), reserve=budget.REPORT_RESERVE_S) if args.budget else None
+    runfolder.claim(root, "bench", force=getattr(args, "force", False))  # before anything is measured or written
     sweeps = {}
     if args.model in ("all", "paper"):
         sweeps["paper"] = load_sweep(args.sweep).path
@@ -261,6 +265,8 @@ def cmd_bench(args):
         from harness.render import report_paper
 
         report_paper.build(root / "sweep", report_dir)  # again: its time-budget section now lists the dynamic part too
+    if shard:
+        merge.finish_record(root)  # the shard finished: merge takes it, with the cases it holds
     print(times.summary("bench"), flush=True)
     return code
 
@@ -324,8 +330,10 @@ def accuracy_model(args):
 
     model = args.model
     if args.from_csv and model is None:
+        from harness.core import inputs
         from harness.studies.accuracy import REQUIRED_COLUMNS
 
+        inputs.regular(args.from_csv, "accuracy: --from-csv")
         try:
             with open(args.from_csv, encoding="utf-8") as fh:
                 header = fh.readline().strip().split(",")
@@ -639,6 +647,7 @@ def cmd_docs(args):
     return docs.run(parser(), check=args.check)
 
 
+FORCE_FOLDER_HELP = "write into a folder that holds files but is not a hairbench run folder (no .hairbench-run.json)"
 REPORT_DIR_HELP = "where to write (default results/local/report/)"
 GPU_CHOICES = ("auto", "yes", "no")
 GPU_HELP = "run cuda cases: auto (if a GPU is usable), yes (fail without), no"
@@ -772,6 +781,11 @@ def parser():
         default=None,
         help="K/N: run the K-th of N deterministic shares of the cases (harness merge joins them)",
     )
+    s.add_argument(
+        "--force",
+        action="store_true",
+        help=FORCE_FOLDER_HELP,
+    )
 
     for name, helptext, fn in (
         ("plot", "draw the PNG plots of a results directory", cmd_plot),
@@ -836,6 +850,11 @@ def parser():
         action="store_true",
         help="dynamic: the full accuracy study and stability map (tens of minutes) instead of the "
         "bench's size (accuracy --quick, stability --quick: minutes on a 16-core + H200 node)",
+    )
+    b.add_argument(
+        "--force",
+        action="store_true",
+        help=FORCE_FOLDER_HELP,
     )
 
     mg = command(sub, cmd_merge, help="join shard folders (bench --shard K/N) into one results folder")
@@ -1139,13 +1158,22 @@ def parser():
 
 def main(argv=None):
     args = parser().parse_args(argv)
+    from harness.core import gpus, runner
+    from harness.io import runfolder
+
     try:
-        with interrupts.redelivered():
+        gpus.wanted()  # a bad HB_GPUS is refused on every machine, with or without a GPU
+        with runner.forwarding(), interrupts.redelivered():
             rc = args.func(args)
             sys.stdout.flush()  # a closed pipe shows here, inside the handlers below
         return rc
-    except HarnessError as e:
-        print(f"harness: error: {e}", file=sys.stderr)
+    except runner.Stopped as e:  # forwarded to every child, each waited for: nothing runs on
+        runfolder.abandon_unused()
+        print(f"harness: stopped by {e}", file=sys.stderr)
+        return 128 + e.signum
+    except HarnessError as e:  # one line, whatever a library's text it quotes holds
+        runfolder.abandon_unused()  # a refused command creates nothing
+        print(f"harness: error: {' '.join(str(e).split(chr(10)))}", file=sys.stderr)
         return e.code if e.code else 2
     except BrokenPipeError:  # the reader went away (`| head`): quiet, as other tools
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit

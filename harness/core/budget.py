@@ -7,6 +7,7 @@ per-strand cost only falls as the size grows, so this over-estimates), and the t
 larger ones are left out when the estimate does not fit the time left to the step. The
 bench gives each step a declared share of what is left when it starts (SHARES)."""
 
+import contextlib
 import multiprocessing
 import os
 import re
@@ -17,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from harness import HarnessError
+from harness.core import runner
 
 # of the time left when the step starts: the paper sweep, then the dynamic sweep; the
 # dynamic studies get what is left after that (each runs while any is left)
@@ -77,11 +79,26 @@ def _entries(dirs):
     return {q for d in map(Path, dirs) if d.exists() for q in [d, *d.rglob("*")]}
 
 
+def _remove_added(outputs, before):
+    """What a stopped study added to its folders since `before`, deepest first."""
+    for q in sorted(_entries(outputs) - before, key=lambda q: len(q.parts), reverse=True):
+        if q.is_dir():
+            with contextlib.suppress(OSError):
+                q.rmdir()
+        else:
+            q.unlink(missing_ok=True)
+
+
 def _study_child(fn):
     os.setsid()  # its own process group: the binaries it starts end with it
+    runner.reset_after_fork()
     code = 0
     try:
         fn()
+    except KeyboardInterrupt:  # forwarded by the parent (runner): its own children are stopped by now
+        code = 130
+    except runner.Stopped as e:
+        code = 128 + e.signum
     except HarnessError as e:
         print(f"harness: error: {e}", file=sys.stderr)
         code = e.code or 1
@@ -106,18 +123,19 @@ def run_study(plan, study, fn, outputs, say):
     sys.stdout.flush()
     sys.stderr.flush()
     child.start()
-    child.join(max(plan.left(), 0.0))
+    try:
+        with runner.supervised(child):  # a signal to the harness reaches the study's group, waited for
+            child.join(max(plan.left(), 0.0))
+    except BaseException:
+        _remove_added(outputs, before)
+        raise
     if child.is_alive():
         try:
             os.killpg(child.pid, signal.SIGKILL)
         except ProcessLookupError:
             pass
         child.join()
-        for q in sorted(_entries(outputs) - before, key=lambda q: len(q.parts), reverse=True):  # deepest first
-            if q.is_dir():
-                q.rmdir()
-            else:
-                q.unlink(missing_ok=True)
+        _remove_added(outputs, before)
         plan.leave_out(study, "the whole study", "stopped when the budget ran out; what it had written was removed")
         say(f"harness: {study}: stopped when the budget ran out (what it had written is removed)")
         return False

@@ -6,16 +6,17 @@ import datetime
 import os
 import platform
 import shutil
-import subprocess
 import sys
 
 from harness.core.paths import ROOT
 
 
 def _cmd(args, timeout=20):
+    from harness.core import runner
+
     try:
-        out = subprocess.run(args, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
-    except (OSError, subprocess.TimeoutExpired):
+        out = runner.run_command(args, timeout=timeout, cwd=ROOT)
+    except (OSError, runner.TimedOut):
         return None
     return out.stdout.strip() if out.returncode == 0 else None
 

@@ -11,7 +11,6 @@ import os
 import queue
 import re
 import shutil
-import subprocess
 import threading
 from dataclasses import dataclass
 
@@ -41,10 +40,28 @@ def _smi_list():
     smi = shutil.which("nvidia-smi")
     if smi is None:
         return []
+    from harness.core import runner
+
     try:
-        return parse_smi(subprocess.run([smi, "-L"], capture_output=True, text=True, timeout=30).stdout)
-    except (OSError, subprocess.TimeoutExpired):
+        return parse_smi(runner.run_command([smi, "-L"], timeout=30).stdout)
+    except (OSError, runner.TimedOut):
         return []
+
+
+def wanted(environ=None):
+    """HB_GPUS's indices, or None when it is unset or 'all'; a value that is not indices is refused
+    in one line whether or not this machine has a GPU (harness/cli/main.py checks it first)."""
+    environ = os.environ if environ is None else environ
+    text = environ.get("HB_GPUS", "").strip()
+    if not text or text == "all":
+        return None
+    try:
+        indices = [int(x, 10) for x in text.split(",")]
+    except ValueError:
+        raise HarnessError(f"HB_GPUS needs GPU indices like 0,1 (got '{text}')") from None
+    if any(i < 0 for i in indices):
+        raise HarnessError(f"HB_GPUS needs GPU indices like 0,1 (got '{text}')")
+    return indices
 
 
 def visible(listed=None, environ=None):
@@ -58,12 +75,8 @@ def visible(listed=None, environ=None):
         gpus = [
             g for g in gpus if str(g.index) in keep or g.uuid in keep or any(k and g.uuid.startswith(k) for k in keep)
         ]
-    wanted = environ.get("HB_GPUS", "").strip()
-    if wanted and wanted != "all":
-        try:
-            indices = [int(x, 10) for x in wanted.split(",")]
-        except ValueError:
-            raise HarnessError(f"HB_GPUS needs GPU indices like 0,1 (got '{wanted}')") from None
+    indices = wanted(environ)
+    if indices is not None:
         by_index = {g.index: g for g in gpus}
         missing = [i for i in indices if i not in by_index]
         if missing:

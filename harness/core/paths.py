@@ -56,7 +56,7 @@ def config_file(ref, directory):
     """A config path as given, or a bare name looked up as `directory`/<name>.toml (SCENES
     or SWEEPS); None if neither."""
     p = Path(ref)
-    if p.is_file():
+    if p.is_file() or (p.exists() and not p.is_dir()):  # a FIFO or device: read_toml says what it is
         return p
     candidate = Path(directory) / f"{ref}.toml"
     if p.suffix == "" and candidate.is_file():
@@ -68,15 +68,21 @@ def read_toml(path, where, error):
     """A TOML file as a dict; an unreadable or invalid file raises `error` with one line."""
     import tomllib
 
+    from harness import HarnessError
+    from harness.core import inputs
+
     try:
-        with open(path, "rb") as f:
-            return tomllib.load(f)
+        data = inputs.read_bytes(path, where)
+    except HarnessError as e:
+        raise error(str(e)) from None
+    try:
+        return tomllib.loads(data.decode("utf-8"))
     except tomllib.TOMLDecodeError as e:
         raise error(f"{where}: not valid TOML: {e}") from None
     except UnicodeDecodeError as e:
         raise error(f"{where}: not UTF-8 text (byte {e.start}); TOML files are UTF-8") from None
-    except OSError as e:
-        raise error(f"{where}: cannot read: {e.strerror}") from None
+    except (RecursionError, ValueError) as e:  # nested past the parser's depth, an integer past its digits
+        raise error(f"{where}: not valid TOML: {type(e).__name__}: {str(e)[:80]}") from None
 
 
 def output_dir(path, what="--out"):

@@ -1,10 +1,20 @@
-"""Run a backend binary with --json and return its parsed record (docs/interfaces.md).
+"""Every child the harness starts, and the one way it starts them (docs/interfaces.md).
+
+`run_binary` runs a backend binary with --json and returns its parsed record; `run_batch`
+runs many in one process; `run_command` runs any other program (a binary without a record, a
+tool such as git or nvidia-smi); `supervised` watches a forked child (a study in its own
+session). Every child gets a session and process group of its own and is registered while it
+lives: SIGINT, SIGTERM, SIGHUP and SIGQUIT reaching the harness (`forwarding`, around every
+command) are forwarded to every registered child's group, the child is waited for, what a
+killed binary left is removed (harness/core/tempfiles.py), and the command ends with
+128 + n. No child starts once a stop was asked for.
 
 A failure is one HarnessError line naming the binary, its exit status and the last line
 it wrote on stderr; exit status 3 (state does not fit in memory) is a `DoesNotFit`, so a
 sweep can skip the case and go on.
 """
 
+import contextlib
 import json
 import os
 import queue
@@ -43,6 +53,153 @@ class MissingBinary(HarnessError):
     pass
 
 
+FORWARDED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT)
+
+
+class Stopped(BaseException):
+    """A terminating signal other than SIGINT reached the harness (SIGINT is KeyboardInterrupt):
+    raised in the main thread after the signal went to every child; the command exits 128 + n."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+_live: dict[int, Any] = {}  # pid → the child (a Popen or a forked process), while it runs
+_lock = threading.Lock()
+_stopping: list[int] = []  # the signal that asked for the stop, once one did
+
+
+def _forward(signum: int) -> None:
+    """The signal to every live child's process group (the child itself where it has none yet)."""
+    with _lock:
+        pids = list(_live)
+    for pid in pids:
+        try:
+            os.killpg(pid, signum)
+        except (ProcessLookupError, PermissionError):
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.kill(pid, signum)
+
+
+def _on_signal(signum: int, frame: Any) -> None:
+    _stopping.append(signum)
+    _forward(signum)
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    raise Stopped(signum)
+
+
+@contextlib.contextmanager
+def forwarding() -> Iterator[None]:
+    """Around a command (harness/cli/main.py): the four signals forwarded to the children and
+    raised here (KeyboardInterrupt, Stopped). In the main thread only; elsewhere a no-op."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {s: signal.getsignal(s) for s in FORWARDED}
+    for s in FORWARDED:
+        if previous[s] != signal.SIG_IGN:  # a signal the caller ignores stays ignored (nohup)
+            signal.signal(s, _on_signal)
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h if h is not None else signal.SIG_DFL)
+
+
+def reset_after_fork() -> None:
+    """In a forked child: its parent's children are not its own."""
+    with _lock:
+        _live.clear()
+    _stopping.clear()
+
+
+def _check_not_stopping() -> None:
+    if _stopping:
+        if _stopping[0] == signal.SIGINT:
+            raise KeyboardInterrupt
+        raise Stopped(_stopping[0])
+
+
+def spawn(cmd: Sequence[str], **kw: Any) -> subprocess.Popen[Any]:
+    """A child in a session of its own, registered until `reap`; OSError as from Popen."""
+    _check_not_stopping()
+    child = subprocess.Popen(list(cmd), start_new_session=True, **kw)
+    with _lock:
+        _live[child.pid] = child
+    if _stopping:  # a signal came between the check and the registration
+        _forward(_stopping[0])
+    return child
+
+
+GRACE_S = 10.0  # how long a child that was forwarded a stop signal has to remove its files and die of it
+
+
+def reap(child: Any, kill: bool = False) -> None:
+    """Wait for a registered child (killed first, with its group, when `kill`; after a stop
+    signal was forwarded to it, only once GRACE_S has passed), then forget it."""
+    if kill and _stopping:
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            child.wait(GRACE_S)
+    if kill and child.poll() is None:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(child.pid, signal.SIGKILL)
+        with contextlib.suppress(ProcessLookupError):
+            child.kill()
+    child.wait()
+    with _lock:
+        _live.pop(child.pid, None)
+
+
+@contextlib.contextmanager
+def supervised(process: Any) -> Iterator[None]:
+    """A forked child (multiprocessing.Process, started, in a session of its own) registered
+    while the block runs, so that a signal reaching the harness reaches it; on any exit from
+    the block by an exception it is waited for, and killed if it outlives a grace period."""
+    with _lock:
+        _live[process.pid] = process
+    try:
+        yield
+    except BaseException:
+        process.join(30)
+        if process.is_alive():
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.killpg(process.pid, signal.SIGKILL)
+            process.join()
+        raise
+    finally:
+        with _lock:
+            _live.pop(process.pid, None)
+
+
+def run_command(
+    cmd: Sequence[Any],
+    timeout: float | None = None,
+    env: dict[str, str] | None = None,
+    cwd: str | Path | None = None,
+) -> subprocess.CompletedProcess[str]:
+    """Any program other than a JSON record's run (a binary's stepped run, a tool): its
+    CompletedProcess (text, stdout and stderr captured). A timeout kills it and raises TimedOut;
+    a binary's temporaries of --output are removed when it died of a signal or was killed;
+    OSError when it cannot start."""
+    words = [str(c) for c in cmd]
+    child = spawn(words, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=cwd)
+    try:
+        stdout, stderr = child.communicate(timeout=timeout)
+    except BaseException as e:
+        reap(child, kill=True)
+        tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(words))
+        if isinstance(e, subprocess.TimeoutExpired):
+            raise TimedOut(f"{Path(words[0]).name} did not finish within {timeout} s: {' '.join(words[1:])}") from None
+        raise
+    reap(child)
+    if child.returncode < 0:
+        tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(words))
+        _check_not_stopping()
+    return subprocess.CompletedProcess(words, child.returncode, stdout, stderr)
+
+
 def require_binary(path: str | Path) -> Path:
     path = Path(path)
     if not path.exists():
@@ -68,21 +225,9 @@ def run_binary(
     cmd = [str(binary), *map(str, args), "--json", "--quiet"]
     child_env = dict(os.environ, **env) if env else None
     try:
-        child = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=child_env)
+        proc = run_command(cmd, timeout=timeout, env=child_env)
     except OSError as e:
         raise BackendError(f"cannot run {display(binary)}: {e.strerror}") from None
-    try:
-        stdout, stderr = child.communicate(timeout=timeout)
-    except BaseException as e:  # a timeout or an interrupt: the child dies, and what it left goes
-        child.kill()
-        child.wait()
-        tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(args))
-        if isinstance(e, subprocess.TimeoutExpired):
-            raise TimedOut(f"{binary.name} did not finish within {timeout} s: {' '.join(cmd[1:])}") from None
-        raise
-    proc = subprocess.CompletedProcess(cmd, child.returncode, stdout, stderr)
-    if proc.returncode < 0:  # killed by a signal: the binary removes its own on these, SIGKILL aside
-        tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(args))
     if proc.returncode == -signal.SIGINT:
         raise KeyboardInterrupt
     if proc.returncode != 0:
@@ -157,7 +302,7 @@ def _one_batch(
         batch.write_text("\n".join(lines) + "\n")
         with open(Path(tmp) / "stderr.txt", "w+") as err:
             try:
-                child = subprocess.Popen(
+                child = spawn(
                     [str(binary), "--batch", str(batch)], stdout=subprocess.PIPE, stderr=err, text=True, env=child_env
                 )
             except OSError as e:
@@ -193,7 +338,8 @@ def _one_batch(
                     if error is not None:
                         _kill(child, runs[i - 1])
                         return i
-                rc = child.wait()
+                reap(child)
+                rc = child.returncode
             except BaseException:  # an interrupt, or the caller stopped early: the child dies
                 _kill(child, runs[i] if i < len(runs) else [])
                 raise
@@ -201,6 +347,8 @@ def _one_batch(
                 reader.join(timeout=5)
             if i == len(runs) and rc == 0:
                 return i
+            if rc < 0:
+                _check_not_stopping()
             if rc == -signal.SIGINT:
                 raise KeyboardInterrupt
             if rc < 0:
@@ -216,9 +364,7 @@ def _one_batch(
 
 def _kill(child: subprocess.Popen[str], args: Sequence[Any]) -> None:
     """End a batch's process and remove what its current run left."""
-    if child.poll() is None:
-        child.kill()
-    child.wait()
+    reap(child, kill=True)
     tempfiles.remove_left_by(child.pid, tempfiles.output_dirs(args))
 
 

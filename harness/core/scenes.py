@@ -29,7 +29,6 @@ the copies a backend holds) would not fit in this machine's memory.
 
 import math
 import os
-import tomllib
 from dataclasses import dataclass, field, replace
 
 from harness import HarnessError
@@ -352,12 +351,13 @@ def find_scene_file(ref):
 
 def is_scene_file(path):
     """A file with a `stages` key: a scene, not a sweep (a check; the directory is the rule)."""
+    from harness import HarnessError
+
     try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-        return "stages" in data or data.get("model") == "dynamic"
-    except (OSError, ValueError):  # TOMLDecodeError and UnicodeDecodeError are ValueErrors
+        data = read_toml(path, str(path), HarnessError)
+    except HarnessError:  # not readable TOML: the sweep's own reading says why
         return False
+    return "stages" in data or data.get("model") == "dynamic"
 
 
 def load_scene(ref):

@@ -14,7 +14,6 @@ declares more (solvers, stages) still reads.
 """
 
 import json
-import subprocess
 from dataclasses import dataclass, field
 from functools import lru_cache
 
@@ -144,11 +143,13 @@ def simulating(backend, build="default"):
 
 @lru_cache(maxsize=None)
 def _read(path):
+    from harness.core import runner
+
     try:
-        p = subprocess.run([path, "--list-variants"], capture_output=True, text=True, timeout=60)
+        p = runner.run_command([path, "--list-variants"], timeout=60)
     except OSError as e:
         raise HarnessError(f"{path}: cannot run: {e.strerror}") from None
-    except subprocess.TimeoutExpired:
+    except runner.TimedOut:
         raise HarnessError(f"{path} --list-variants did not finish in 60 s") from None
     if p.returncode != 0:
         raise HarnessError(f"{path} --list-variants exited {p.returncode}: {p.stderr.strip()}")

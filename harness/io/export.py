@@ -18,6 +18,7 @@ Sidecars that exist are replaced only with --force; every refusal (no state, --u
 without usd-core, a symlinked target, an existing one) comes before anything is written.
 """
 
+import errno
 import math
 import os
 from pathlib import Path
@@ -26,6 +27,7 @@ from xml.sax.saxutils import escape
 import numpy as np
 
 from harness import HarnessError
+from harness.io import files
 
 POSITION = "particles/hair/position"
 VELOCITY = "particles/hair/velocity"
@@ -35,31 +37,17 @@ BLOCK_ROWS = 1 << 20  # rows written or read at a time
 
 def _writable(path):
     """Refuse, as the binaries do for --output, a target that is a symlink or exists and is
-    not a regular file; the caller writes PATH.tmp.<pid> and renames it over PATH."""
+    not a regular file (harness/io/files.py then writes it whole or not at all)."""
     path = Path(path)
     if path.is_symlink() or (path.exists() and not path.is_file()):
         raise HarnessError(f"export: {path} is a symbolic link or not a regular file; refusing to replace it")
-    return path.with_name(f"{path.name}.tmp.{os.getpid()}")
-
-
-def _replace(tmp, path):
-    """fsync the finished temporary, then rename it over path (as the binaries do)."""
-    fd = os.open(tmp, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-    os.replace(tmp, path)
-    return Path(path)
+    return path
 
 
 def _open_state(path):
-    import h5py
+    from harness.core import inputs
 
-    try:
-        f = h5py.File(path, "r")
-    except (OSError, ValueError) as e:
-        raise HarnessError(f"export: cannot open {path} as HDF5 ({e})") from None
+    f = inputs.open_h5(path, "export:")
     try:
         value = f[f"{POSITION}/value"]
         n = int(f["parameters"].attrs["n_strands"])
@@ -232,17 +220,14 @@ def export_xdmf(state, out_prefix=None):
             "n_velocity": f[f"{VELOCITY}/value"].shape[0] if f"{VELOCITY}/value" in f else 0,
             "rest": REST in f,
         }
-    tmp_topo, tmp_xdmf = _writable(topo_path), _writable(xdmf_path)
-    try:
-        int_bytes = np.dtype(write_connectivity(tmp_topo, n, p)).itemsize
-    except BaseException:
-        tmp_topo.unlink(missing_ok=True)
-        raise
     here = xdmf_path.parent.resolve()
     state_ref = escape(os.path.relpath(state.resolve(), here))
     topo_ref = escape(os.path.relpath(topo_path.resolve(), here))
-    tmp_xdmf.write_text(_xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_strand, dyn))
-    return _replace(tmp_xdmf, xdmf_path), _replace(tmp_topo, topo_path)
+    with files.writing(_writable(topo_path)) as tmp_topo, files.writing(_writable(xdmf_path)) as tmp_xdmf:
+        int_bytes = np.dtype(write_connectivity(tmp_topo, n, p)).itemsize
+        text = _xdmf(state_ref, topo_ref, n, p, frames, times, float_bytes, int_bytes, has_strand, dyn)
+        tmp_xdmf.write_bytes(text.encode("utf-8"))
+    return xdmf_path, topo_path
 
 
 def export_usd(state, out_prefix=None):
@@ -256,47 +241,50 @@ def export_usd(state, out_prefix=None):
         value = f[f"{POSITION}/value"]
         frames = value.shape[0]
         times = frame_times(f)
-        _writable(usd_path)
-        tmp = usd_path.with_name(f"{usd_path.stem}.tmp{os.getpid()}.usdc")  # USD picks the format by suffix
-        tmp.unlink(missing_ok=True)
-        stage = Usd.Stage.CreateNew(str(tmp))
-        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)  # column 1 is up
-        UsdGeom.SetStageMetersPerUnit(stage, 0.01)  # positions are in cm
-        stage.SetStartTimeCode(0)
-        stage.SetEndTimeCode(frames - 1)
-        # time code = frame index; a dynamic state's frame rate makes its velocities (per second) agree
-        stage.SetTimeCodesPerSecond(time_codes_per_second(f))
-        root = UsdGeom.Xform.Define(stage, "/hair")
-        stage.SetDefaultPrim(root.GetPrim())
-        curves = UsdGeom.BasisCurves.Define(stage, "/hair/strands")
-        curves.CreateTypeAttr(UsdGeom.Tokens.linear)
-        curves.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(n, p, dtype=np.int32)))
-        curves.CreateWidthsAttr(Vt.FloatArray([0.01]))
-        curves.SetWidthsInterpolation(UsdGeom.Tokens.constant)
-        points = curves.CreatePointsAttr()
-        for k in range(frames):
-            frame = np.ascontiguousarray(value[k], dtype=np.float32)
-            points.Set(Vt.Vec3fArray.FromNumpy(frame), Usd.TimeCode(k))
-        vel = velocity_frames(f)
-        if vel:
-            velocities = curves.CreateVelocitiesAttr()
-            for k, j in vel.items():
-                frame = np.ascontiguousarray(f[f"{VELOCITY}/value"][j], dtype=np.float32)
-                velocities.Set(Vt.Vec3fArray.FromNumpy(frame), Usd.TimeCode(k))
-        if REST in f:
-            rest = UsdGeom.PrimvarsAPI(curves).CreatePrimvar(
-                "rest", Sdf.ValueTypeNames.Point3fArray, UsdGeom.Tokens.vertex
-            )
-            rest.Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(f[REST][()], dtype=np.float32)))
-        prim = curves.GetPrim()
-        prim.CreateAttribute("hairbench:frameTime", Sdf.ValueTypeNames.DoubleArray).Set(Vt.DoubleArray.FromNumpy(times))
-        try:
-            stage.GetRootLayer().Save()
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
+        with files.writing(_writable(usd_path), create=False) as tmp:  # USD creates it, by its suffix
+            _write_usd(Sdf, Usd, UsdGeom, Vt, tmp, f, value, frames, times, n, p)
+    return usd_path
+
+
+def _write_usd(Sdf, Usd, UsdGeom, Vt, tmp, f, value, frames, times, n, p):  # noqa: N803 (pxr's names)
+    """The stage at tmp, saved; a save USD refuses (a full disk) as an OSError naming tmp."""
+    stage = Usd.Stage.CreateNew(str(tmp))
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)  # column 1 is up
+    UsdGeom.SetStageMetersPerUnit(stage, 0.01)  # positions are in cm
+    stage.SetStartTimeCode(0)
+    stage.SetEndTimeCode(frames - 1)
+    # time code = frame index; a dynamic state's frame rate makes its velocities (per second) agree
+    stage.SetTimeCodesPerSecond(time_codes_per_second(f))
+    root = UsdGeom.Xform.Define(stage, "/hair")
+    stage.SetDefaultPrim(root.GetPrim())
+    curves = UsdGeom.BasisCurves.Define(stage, "/hair/strands")
+    curves.CreateTypeAttr(UsdGeom.Tokens.linear)
+    curves.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(n, p, dtype=np.int32)))
+    curves.CreateWidthsAttr(Vt.FloatArray([0.01]))
+    curves.SetWidthsInterpolation(UsdGeom.Tokens.constant)
+    points = curves.CreatePointsAttr()
+    for k in range(frames):
+        frame = np.ascontiguousarray(value[k], dtype=np.float32)
+        points.Set(Vt.Vec3fArray.FromNumpy(frame), Usd.TimeCode(k))
+    vel = velocity_frames(f)
+    if vel:
+        velocities = curves.CreateVelocitiesAttr()
+        for k, j in vel.items():
+            frame = np.ascontiguousarray(f[f"{VELOCITY}/value"][j], dtype=np.float32)
+            velocities.Set(Vt.Vec3fArray.FromNumpy(frame), Usd.TimeCode(k))
+    if REST in f:
+        rest = UsdGeom.PrimvarsAPI(curves).CreatePrimvar("rest", Sdf.ValueTypeNames.Point3fArray, UsdGeom.Tokens.vertex)
+        rest.Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(f[REST][()], dtype=np.float32)))
+    prim = curves.GetPrim()
+    prim.CreateAttribute("hairbench:frameTime", Sdf.ValueTypeNames.DoubleArray).Set(Vt.DoubleArray.FromNumpy(times))
+    try:
+        saved = stage.GetRootLayer().Save()
+    except Exception as e:  # USD's own error type (pxr.Tf.ErrorException)
+        why = (str(e).strip().splitlines() or [type(e).__name__])[-1].strip()
+        raise OSError(errno.EIO, f"USD could not save it ({why[:120]})") from None
+    if not saved:
+        raise OSError(errno.EIO, "USD could not save it")
     del stage
-    return _replace(tmp, usd_path)
 
 
 def _pxr():
@@ -318,8 +306,9 @@ def run(state, xdmf=True, usd=False, out=None, force=False):
     """Write the sidecars; return their paths. Everything that can refuse does so before
     anything is written: no such state, USD asked for without usd-core, a target that is a
     symbolic link or not a regular file, or one that exists without `force`."""
-    if not Path(state).is_file():
-        raise HarnessError(f"export: {state}: no such file")
+    from harness.core import inputs
+
+    inputs.regular(state, "export:")
     if usd:
         _pxr()
     paths = targets(state, out, xdmf, usd)

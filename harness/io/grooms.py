@@ -7,13 +7,19 @@ stage's metersPerUnit to cm, turned Y-up when the stage is Z-up, and written as 
 (segments and points arrays). usd-core is optional: without it a USD groom is refused in one line.
 """
 
+import contextlib
+import dataclasses
+import math
 import os
 import struct
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from harness import HarnessError
+from harness.core import inputs
+from harness.io import files
 
 USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
 HAIR_SEGMENTS, HAIR_POINTS = 1, 2
@@ -34,12 +40,24 @@ def _pxr():
 def read_usd_curves(path):
     """The strands of every BasisCurves prim in a USD file, as float64 [n][3] arrays in cm, Y up."""
     Usd, UsdGeom = _pxr()
-    if not Path(path).is_file():
-        raise HarnessError(f"groom {path}: no such file")
+    inputs.regular(path, "groom")
+    try:  # USD raises its own error type (pxr.Tf.ErrorException) for a file it cannot parse
+        return _curves(Usd, UsdGeom, path)
+    except HarnessError:
+        raise
+    except Exception as e:
+        why = (str(e).strip().splitlines() or [type(e).__name__])[-1].strip()
+        raise HarnessError(f"groom {path}: USD could not read it ({why[:160]})") from None
+
+
+def _curves(Usd, UsdGeom, path):  # noqa: N803 (pxr's module names)
     stage = Usd.Stage.Open(str(path))
     if stage is None:
         raise HarnessError(f"groom {path}: USD could not open it")
-    to_cm = UsdGeom.GetStageMetersPerUnit(stage) / 0.01
+    meters = UsdGeom.GetStageMetersPerUnit(stage)
+    if not (math.isfinite(meters) and meters > 0):
+        raise HarnessError(f"groom {path}: metersPerUnit is {meters}; it must be a finite number > 0")
+    to_cm = meters / 0.01
     z_up = UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.z
     cache = UsdGeom.XformCache()
     strands = []
@@ -85,14 +103,37 @@ def write_hair(path, strands, force=False):
         raise HarnessError(f"groom: {path} is a symbolic link or not a regular file; refusing to replace it")
     if path.exists() and not force:
         raise HarnessError(f"groom: {path} exists (give --force to replace it)")
-    data = hair_bytes(strands)
-    tmp = path.with_name(f"{path.name}.tmp.{os.getpid()}")
-    try:
-        tmp.write_bytes(data)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return path
+    return files.write_bytes(path, hair_bytes(strands))
+
+
+@contextlib.contextmanager
+def hair_for(scene):
+    """The scene as the binaries take it, and a function that names things as the user did: a
+    USD groom converted to a HAIR file in a temporary folder (removed after the block), whose path
+    the function turns back into the user's USD path in a record or message; an error raised in the
+    block names the user's file too. Other scenes pass through unchanged."""
+    src = scene.groom_file
+    if not (src and is_usd(src)):
+        yield scene, lambda x: x
+        return
+    with tempfile.TemporaryDirectory(prefix="hairbench-groom-") as folder:
+        hair = os.path.join(folder, "groom.hair")
+        convert(src, hair)
+
+        def named(x):
+            if isinstance(x, str):
+                return x.replace(hair, str(src))
+            if isinstance(x, dict):
+                return {k: named(v) for k, v in x.items()}
+            if isinstance(x, list):
+                return [named(v) for v in x]
+            return x
+
+        try:
+            yield dataclasses.replace(scene, groom=hair), named
+        except HarnessError as e:
+            e.args = (named(str(e)), *e.args[1:])
+            raise
 
 
 def convert(src, dst, force=False):

@@ -9,6 +9,7 @@ import re
 
 import numpy as np
 
+from harness import HarnessError
 from harness.io.states import StateError
 
 # The "SI" unit system of the units module: SI base and derived unit symbols, SI prefixes.
@@ -151,12 +152,12 @@ def _check_strands(f, out):
 def problems(path):
     """Every departure of the state at `path` from H5MD 1.1 and its units module, and from
     the documented strand structure; an empty list when the file conforms."""
-    import h5py
+    from harness.core import inputs
 
     try:
-        f = h5py.File(path, "r")
-    except (OSError, ValueError) as e:
-        raise StateError(f"{path}: cannot open as HDF5 ({e})") from None
+        f = inputs.open_h5(path, "state")
+    except HarnessError as e:
+        raise StateError(str(e)) from None
     out = []
     with f:
         if "h5md" not in f:

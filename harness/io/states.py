@@ -133,16 +133,13 @@ def _string_list(group: Any, name: str, n_frames: int, default: str | None, path
 
 def open_state(path: str | Path) -> State:
     """Open and check a state file; raise StateError with one clear line if it is not one."""
-    import h5py  # imported here so `--help` works without h5py
+    from harness.core import inputs
 
     path = str(path)
     try:
-        f = h5py.File(path, "r")
-    except FileNotFoundError:
-        raise StateError(f"{path}: no such file") from None
-    except OSError as e:
-        reason = "not an HDF5 file" if "signature" in str(e) else str(e).split("(")[0].strip()
-        raise StateError(f"{path}: cannot read: {reason}") from None
+        f = inputs.open_h5(path, "state")
+    except HarnessError as e:
+        raise StateError(str(e)) from None
     try:
         return _checked_state(f, path)
     except Exception:
@@ -261,11 +258,11 @@ def h5md_layout(path: str | Path) -> dict[str, Any]:
     """The H5MD metadata of a state file (docs/interfaces.md), for checking the writer:
     h5md version, author and creator attributes, box dimension, the position dataset's
     shape, dtype and chunks, its step list, and the /parameters attributes and datasets."""
-    import h5py
+    from harness.core import inputs
 
     with open_state(path):  # the layout of the positions and parameters first
         pass
-    with h5py.File(str(path), "r") as f:
+    with inputs.open_h5(path, "state") as f:
         value = f[POSITION]
         group = f[PARAMETERS]
         return {

@@ -6,13 +6,19 @@ errors differ in that place then swap order, and the same table renders a report
 another mode on another machine. The round-trip converter is exact; pandas 3.1 parses
 exactly by default and deprecates the argument, so it is passed only before 3.1."""
 
+import os
 import re
 
 
-def read_csv(path, **kwargs):
-    """pandas.read_csv(path, **kwargs), floats parsed exactly on every pandas version."""
+def read_csv(path, what="csv", **kwargs):
+    """pandas.read_csv(path, **kwargs), floats parsed exactly on every pandas version; a path is
+    checked first (harness.core.inputs: a regular file; `what` names it in the refusal)."""
     import pandas as pd  # lazily: runlog imports this module, and its writers need no pandas
 
+    from harness.core import inputs
+
+    if isinstance(path, (str, os.PathLike)):
+        inputs.regular(path, what, empty_ok=True)
     major, minor = (int(x) for x in re.match(r"(\d+)\.(\d+)", pd.__version__).groups())
     if (major, minor) < (3, 1):
         kwargs.setdefault("float_precision", "round_trip")

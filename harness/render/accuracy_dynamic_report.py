@@ -11,7 +11,6 @@ each other.
 
 import json
 import math
-import os
 from dataclasses import astuple, dataclass
 from pathlib import Path
 
@@ -20,7 +19,7 @@ import numpy as np
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, RESULTS, display
-from harness.io import tables
+from harness.io import files, tables
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     CSV_NAME,
@@ -681,10 +680,7 @@ def _plt():
 
 
 def _save(fig, path):
-    tmp = path.with_name(f"{path.stem}.tmp.{os.getpid()}{path.suffix}")
-    fig.savefig(tmp, dpi=110)
-    os.replace(tmp, path)
-    return path
+    return files.save_figure(fig, path, dpi=110)
 
 
 def pareto_plot(summ, study, path):
@@ -1046,9 +1042,7 @@ def write(results_dir=None, report_dir=None, csv_path=None, title=None):
         steps_plot(pairs, report_dir / names.steps),
     ]
     page = report_dir / names.page
-    tmp = page.with_name(f"{names.page}.tmp.{os.getpid()}")
-    tmp.write_text("\n".join(lines) + "\n")
-    os.replace(tmp, page)
+    files.write_text(page, "\n".join(lines) + "\n")
     return [page, *pics]
 
 

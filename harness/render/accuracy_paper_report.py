@@ -9,6 +9,7 @@ import numpy as np
 
 from harness import HarnessError
 from harness.core.paths import REPORT, display
+from harness.io import files
 from harness.studies.accuracy import PAPER_REFERENCE, paper_uses
 
 
@@ -114,7 +115,7 @@ def pareto_plot(rows, path, strands, points):
     ax.set_title("Speed against accuracy (reference: cpu fp64)")
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    files.save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
 
@@ -199,5 +200,5 @@ def write_markdown(rows, path, strands, points, res_strands, gpu_ok, why):
         + recommend(rows)
         + ["", "![speed against accuracy](accuracy_pareto.png)", ""]
     )
-    path.write_text("\n".join(out))
+    files.write_text(path, "\n".join(out))
     return path

@@ -14,7 +14,7 @@ from pathlib import Path
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, RESULTS, display
-from harness.io import tables
+from harness.io import files, tables
 
 PEER = "pypbd"
 OURS = "hairsim-cpu"
@@ -183,11 +183,10 @@ def plot(tim, out_dir):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     path = Path(out_dir) / "peer_time.png"
-    tmp = path.with_name(f"peer_time.tmp.{os.getpid()}.png")
-    fig.savefig(tmp, dpi=100, bbox_inches="tight")
-    plt.close(fig)
-    os.replace(tmp, path)
-    return path
+    try:
+        return files.save_figure(fig, path, dpi=100, bbox_inches="tight")
+    finally:
+        plt.close(fig)
 
 
 def section(results_dir, out_dir, missing_ok=False):
@@ -270,7 +269,4 @@ def write(results_dir=None, report_dir=None):
     out_dir = Path(report_dir) if report_dir else REPORT
     lines = section(results_dir, out_dir)
     path = out_dir / "peer.md"
-    tmp = path.with_name(f"peer.md.tmp.{os.getpid()}")
-    tmp.write_text("\n".join(lines) + "\n")
-    os.replace(tmp, path)
-    return path
+    return files.write_text(path, "\n".join(lines) + "\n")

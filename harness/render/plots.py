@@ -12,7 +12,6 @@
 Without GPU rows the GPU panels say so instead of staying blank.
 """
 
-import os
 from pathlib import Path
 
 import matplotlib
@@ -22,18 +21,20 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from harness.core.paths import REPORT, output_dir  # noqa: E402
-from harness.io import results_data  # noqa: E402
+from harness.io import (
+    files,
+    results_data,  # noqa: E402
+)
 
 FIGURE_DRAWN = 160  # strands drawn of them
 
 
 def _save(fig, path):
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.stem + f".tmp.{os.getpid()}.png")
-    fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    os.replace(tmp, path)
-    return path
+    try:
+        return files.save_figure(fig, path, dpi=110, bbox_inches="tight")
+    finally:
+        plt.close(fig)
 
 
 def _note(ax, text):

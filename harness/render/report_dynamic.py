@@ -15,7 +15,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from harness.core.paths import REPORT, display  # noqa: E402
-from harness.io import results_data  # noqa: E402
+from harness.io import (
+    files,
+    results_data,  # noqa: E402
+)
 from harness.render import (  # noqa: E402
     accuracy_dynamic_report,
     budget_report,
@@ -35,11 +38,10 @@ CURLY_SWEEP = "dynamic-curly"  # configs/sweeps/dynamic-curly.toml, in <root>/dy
 
 
 def _save(fig, path):
-    tmp = path.with_name(f"{path.stem}.tmp.{os.getpid()}{path.suffix}")
-    fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    os.replace(tmp, path)
-    return path
+    try:
+        return files.save_figure(fig, path, dpi=110, bbox_inches="tight")
+    finally:
+        plt.close(fig)
 
 
 def sim_rows(results_dir):
@@ -325,7 +327,4 @@ def build(root, report_dir=None):
     else:
         lines += ["No animation here: `python -m harness animate`.", ""]
     path = out_dir / "dynamic.md"
-    tmp = path.with_name(f"dynamic.md.tmp.{os.getpid()}")
-    tmp.write_text("\n".join(lines) + "\n")
-    os.replace(tmp, path)
-    return path
+    return files.write_text(path, "\n".join(lines) + "\n")

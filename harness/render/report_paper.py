@@ -14,7 +14,7 @@ import os
 from pathlib import Path
 
 from harness.core.paths import REPORT, display, output_dir
-from harness.io import results_data
+from harness.io import files, results_data
 from harness.io.results_data import curve_of, interp_time, strands_at_time
 from harness.render import budget_report, hair_report
 from harness.render.accuracy_paper_report import report_from_csv
@@ -334,7 +334,4 @@ def build(results_dir="results/default", report_dir=None):
     ]
     lines += environment_section(env)
     path = out_dir / "report.md"
-    tmp = path.with_name(f"report.md.tmp.{os.getpid()}")
-    tmp.write_text("\n".join(lines) + "\n")
-    os.replace(tmp, path)
-    return path
+    return files.write_text(path, "\n".join(lines) + "\n")

@@ -11,7 +11,7 @@ import pandas as pd
 from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, display
-from harness.io import tables
+from harness.io import files, tables
 from harness.studies.stability_slices import BLOWN_UP, LEGACY, OTHER, SLICES, VERDICTS, axis
 
 ORDER = VERDICTS + LEGACY + OTHER
@@ -191,11 +191,10 @@ def heatmap(rows, slice_name, path):
     )
     fig.tight_layout(rect=(0, 0.05, 1, 0.96))
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.stem + ".tmp.png")
-    fig.savefig(tmp, dpi=100)
-    plt.close(fig)
-    tmp.replace(path)
-    return path
+    try:
+        return files.save_figure(fig, path, dpi=100)
+    finally:
+        plt.close(fig)
 
 
 def backend_agreement(rows):
@@ -296,10 +295,7 @@ def write_markdown(rows, path, info, pngs):
             lines.append(f"- {r.label} {r.slice} {r.solver} {r.precision} {r.row}, {r.col}: {r.message}")
     lines.append("")
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text("\n".join(lines))
-    tmp.replace(path)
-    return path
+    return files.write_text(path, "\n".join(lines))
 
 
 def report_from_csv(csv_path, report_dir=None, log=print):

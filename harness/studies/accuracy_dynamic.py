@@ -40,7 +40,6 @@ report/dynamic_accuracy_curly.md.
 """
 
 import itertools
-import json
 import multiprocessing
 import os
 import shutil
@@ -669,7 +668,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
     elif long_path.exists():
         long_path.unlink()  # stale long runs must not be rendered with these rows
     if analytic_lines:
-        (out_dir / ANALYTIC_NAME).write_text("\n".join(analytic_lines) + "\n")
+        files.write_text(out_dir / ANALYTIC_NAME, "\n".join(analytic_lines) + "\n")
     elif (out_dir / ANALYTIC_NAME).exists():
         (out_dir / ANALYTIC_NAME).unlink()  # a stale table must not be rendered with these rows
     final_S = ref["steps"][-1]["S2"]
@@ -715,7 +714,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
             command=command,
         ),
     )
-    (out_dir / "env.json").write_text(json.dumps(meta, indent=1, default=str) + "\n")
+    files.write_json(out_dir / "env.json", meta)
     log(f"wrote {display(csv_path)}")
     if not ref["converged"]:
         log(

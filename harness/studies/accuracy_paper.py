@@ -20,15 +20,13 @@ Writes results/accuracy/accuracy.csv and env.json (render/accuracy_paper_report.
 report/accuracy_pareto.png and writes report/accuracy.md from them).
 """
 
-import json
-
 import numpy as np
 
 from harness.check import invariants
 from harness.core import env, runner, scenes, variants
 from harness.core.paths import RESULTS, binary_path, display, output_dir
 from harness.core.variants import Runner
-from harness.io import files
+from harness.io import files, runfolder
 from harness.io.states import open_state
 from harness.studies.accuracy import PAPER_MODES, PAPER_OTHER_CPU_USE, Mode, frame_errors
 
@@ -130,7 +128,7 @@ def run_study(
     """Measure every mode and the model resolution; write accuracy.csv and env.json into
     out_dir (render/accuracy_paper_report.py draws them) and return the rows."""
     scene = scenes.load_scene(scene_name).with_overrides(strands=strands, points=points)
-    out_dir = output_dir(out_dir or RESULTS / "accuracy")
+    out_dir = runfolder.claim(out_dir or RESULTS / "accuracy", "accuracy", force=True)
     scratch = output_dir(out_dir / "states")
     gpu_ok, why = env.gpu_status()
     L = scene.hair_length
@@ -228,7 +226,7 @@ def run_study(
     csv_path = out_dir / "accuracy.csv"
     files.write_csv(csv_path, COLUMNS, rows, extrasaction="ignore")
     meta = dict(env.collect(), resolution_strands=res_strands, gpu_absent=None if gpu_ok else why)
-    (out_dir / "env.json").write_text(json.dumps(meta, indent=1) + "\n")
+    files.write_json(out_dir / "env.json", meta)
     for p in scratch.glob("*.h5"):
         p.unlink()
     scratch.rmdir()

@@ -15,9 +15,11 @@ plays no part and the root need not lie on it.
 
 import math
 import os
-import subprocess
 
 import numpy as np
+
+from harness.core import runner
+from harness.io import files
 
 
 def write_paper_state(path, positions, hair_length, precision="fp64", hair_offset=0.1, head_radius=10.0):
@@ -27,8 +29,7 @@ def write_paper_state(path, positions, hair_length, precision="fp64", hair_offse
     positions = np.asarray(positions, dtype=np.float64)
     n, p, _ = positions.shape
     dtype = np.float64 if precision == "fp64" else np.float32
-    tmp = f"{path}.tmp.{os.getpid()}"
-    with h5py.File(tmp, "w") as f:
+    with files.writing(path) as tmp, h5py.File(tmp, "w") as f:
         h = f.create_group("h5md")
         h.attrs["version"] = np.array([1, 1], dtype=np.int32)
         h.create_group("author").attrs["name"] = "hairbench analytic tests"
@@ -54,7 +55,6 @@ def write_paper_state(path, positions, hair_length, precision="fp64", hair_offse
         ):
             g.attrs[key] = value
         g.create_dataset("stage", data=np.array(["init"], dtype=h5py.string_dtype()))
-    os.replace(tmp, path)
     return path
 
 
@@ -144,7 +144,7 @@ def simulate(
         "--quiet",
     ]
     cmd += [str(a) for a in extra]
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    r = runner.run_command(cmd, timeout=timeout)
     if r.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} exited {r.returncode}: {r.stderr.strip()}")
     return output_path

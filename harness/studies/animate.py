@@ -11,7 +11,6 @@ existing file is refused unless `force`. Without a state, the default dynamic sc
 """
 
 import math
-import os
 import shutil
 from pathlib import Path
 
@@ -21,6 +20,7 @@ from harness import HarnessError
 from harness.core import runner, scenes
 from harness.core.paths import REPORT, RESULTS, binary_path, display
 from harness.core.progress import Progress
+from harness.io import files
 from harness.io.trajectory import open_trajectory
 
 TARGET_FRAMES = 60  # drawn frames when `every` is not given
@@ -142,14 +142,9 @@ def render(traj, paths, max_strands=150, every=None, fps=None, log=print):
     try:
         for path in paths:
             path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = path.with_name(f"{path.stem}.tmp.{os.getpid()}{path.suffix}")
             writer = PillowWriter(fps=fps) if path.suffix.lower() == ".gif" else FFMpegWriter(fps=fps, bitrate=800)
-            try:
+            with files.writing(path) as tmp:
                 anim.save(tmp, writer=writer)
-                os.replace(tmp, path)
-            finally:
-                if tmp.exists():
-                    tmp.unlink()
             written.append(path)
             log(f"animate: {display(path)}: {len(drawn)} frames at {fps} fps, {path.stat().st_size / 1e6:.2f} MB")
     finally:

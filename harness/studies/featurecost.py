@@ -175,7 +175,6 @@ def instructions_per_point_substep(binary, flags, rec, st, timeout=None):
     point-substeps, counted by valgrind's callgrind: deterministic, whatever else the machine
     is doing, where wall times on a shared machine are not."""
     import re
-    import subprocess
     import tempfile
 
     if rec["backend"] != "cpu" or rec.get("variant") not in (None, "ref"):
@@ -189,7 +188,7 @@ def instructions_per_point_substep(binary, flags, rec, st, timeout=None):
     args = [a for i, a in enumerate(args) if a not in timing and args[i - 1] not in timing]
     with tempfile.TemporaryDirectory() as d:
         cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={d}/cg", f"--toggle-collect={fn}", str(binary)]
-        p = subprocess.run(cmd + args + ["--threads", "1", "--quiet"], capture_output=True, text=True, timeout=timeout)
+        p = runner.run_command(cmd + args + ["--threads", "1", "--quiet"], timeout=timeout)
     m = re.search(r"Collected\s*:\s*([0-9]+)", p.stderr)
     if p.returncode != 0 or not m:
         raise HarnessError(f"callgrind failed on {binary.name}: {runner.last_line(p.stderr)}")

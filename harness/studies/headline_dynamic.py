@@ -29,7 +29,6 @@ frame loop (host clock over the loop).
 import csv
 import io
 import shutil
-import subprocess
 from pathlib import Path
 
 from harness import HarnessError
@@ -169,8 +168,8 @@ def _ncu(binary, args, log):
         "--quiet",
     ]
     try:
-        p = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
-    except (OSError, subprocess.TimeoutExpired) as e:
+        p = runner.run_command(cmd, timeout=600)
+    except (OSError, runner.TimedOut) as e:
         return {"skipped": f"ncu failed: {e}"}
     rows = [ln for ln in p.stdout.splitlines() if ln.startswith('"')]
     if p.returncode != 0 or len(rows) < 2:

@@ -16,7 +16,8 @@ runs after a warm-up, per-stage compute only (docs/interfaces.md).
 """
 
 from harness.core import env, runner, variants
-from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display, output_dir
+from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
+from harness.io import runfolder
 from harness.io.files import write_json
 from harness.studies import roofline
 
@@ -60,7 +61,7 @@ def _row(label, rec, copy_gbps):
 def run(
     strands=4 * 1024 * 1024, points=32, repeat=9, cpu_repeat=3, cpu_rounds=5, block_size=256, out_dir=None, log=print
 ):
-    out_dir = output_dir(out_dir or RESULTS / "headline")
+    out_dir = runfolder.claim(out_dir or RESULTS / "headline", "headline", force=True)
     base = ["--strands", strands, "--points", points, "--stages", STAGES]
     result = {"strands": strands, "points": points, "env": env.collect(), "rows": []}
     cpu = binary_path("cpu")

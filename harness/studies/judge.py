@@ -28,9 +28,9 @@ from pathlib import Path
 from harness import HarnessError
 from harness.check import diff, diff_dynamic
 from harness.core import env, runner, scenes, tolerances, variants
-from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, build_dir, display, output_dir
+from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, build_dir, display
 from harness.core.progress import Progress
-from harness.io import files
+from harness.io import files, runfolder
 from harness.io.files import write_json
 from harness.io.trajectory import open_trajectory
 
@@ -312,7 +312,7 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
             f"judge: planted build(s) {', '.join(map(str, missing))} missing under {display(build_dir() / 'planted')} "
             "(run make planted)"
         )
-    out_dir = output_dir(out_dir or RESULTS / RESULTS_NAME)
+    out_dir = runfolder.claim(out_dir or RESULTS / RESULTS_NAME, "judge", force=True)
     honest, gpu_note = honest_runners(plan.gpu, log)
     if gpu_note:
         log(f"judge: GPU builds not run: {gpu_note}")

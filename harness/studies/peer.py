@@ -20,7 +20,6 @@ settings, machine, versions).
 """
 
 import datetime
-import json
 import math
 import os
 import platform
@@ -401,7 +400,5 @@ def run_study(args, log=print):
             "load_average": list(os.getloadavg()),
         },
     }
-    tmp = out / f"peer.json.tmp.{os.getpid()}"
-    tmp.write_text(json.dumps(meta, indent=1) + "\n")
-    os.replace(tmp, out / "peer.json")
+    files.write_json(out / "peer.json", meta)
     return out

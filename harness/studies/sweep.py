@@ -17,11 +17,11 @@ import numpy as np
 
 from harness import HarnessError
 from harness.core import budget, env, gpus, scenes
-from harness.core.paths import RESULTS, binary_path, display, output_dir
+from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.core.runner import BATCH_MAX, BackendError, DoesNotFit, batches, run_batch, run_binary, run_flags
 from harness.core.scenes import SceneError
-from harness.io import results_data, runlog
+from harness.io import results_data, runfolder, runlog
 from harness.io.files import write_json
 from harness.io.sweepfile import load_sweep
 from harness.studies import roofline
@@ -182,12 +182,12 @@ def check_same_machine(before, now, out_dir):
         )
 
 
-def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, shard=None, gate=None):
+def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, shard=None, gate=None, force=False):
     """Run (or resume) a sweep; return (results dir, number of failed cases). `shard` (a
     core.shards.Shard): only its share of the cases; `gate` (a core.budget.TierGate): the
     cases run smallest size first and a tier that does not fit is left out with every larger one."""
     sweep = load_sweep(sweep_ref)
-    out_dir = output_dir(out if out else RESULTS / sweep.name)
+    out_dir = runfolder.claim(out if out else RESULTS / sweep.name, f"sweep {sweep.name}", force=force)
     csv_path = out_dir / "runs.csv"
     env_path = out_dir / "env.json"
     say = log or (lambda m: print(m, flush=True))
@@ -277,6 +277,8 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
             )
             if gate is not None:
                 gate.measured(size, len(tier), time.monotonic() - t0)
+        session["finished_at"] = env.now()
+        write_json(env_path, record)
     finally:
         progress.close()
     say(
@@ -339,7 +341,7 @@ def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, 
                 {k: rec.get(k) for k in ("version", "git_revision", "compiler", "flags", "device", "driver")},
             )
         progress.update()
-        session["finished_at"] = env.now()
+        session["last_case_at"] = env.now()  # finished_at only when the whole session ends
         write_json(env_path, record)
 
     one = gpu_list[0] if gpu_list else None
@@ -382,7 +384,5 @@ def figure_state(results_dir):
         return None
     path.parent.mkdir(parents=True, exist_ok=True)
     scene = scenes.load_scene("paper").with_overrides(strands=FIGURE_STRANDS)
-    tmp = path.with_name(path.stem + f".part{os.getpid()}.h5")
-    run_binary(binary, run_flags(scene, "cpu", output=tmp, force=True))
-    os.replace(tmp, path)
+    run_binary(binary, run_flags(scene, "cpu", output=path, force=True))  # the binary writes it whole or not at all
     return path

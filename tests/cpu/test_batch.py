@@ -85,7 +85,7 @@ def test_a_bad_batch_is_one_line_and_exit_2(cpu_bin, tmp_path, lines, message):
 
 def test_an_unreadable_batch_file_is_refused(cpu_bin, tmp_path):
     p = subprocess.run([str(cpu_bin), "--batch", str(tmp_path / "none")], capture_output=True, text=True, timeout=60)
-    assert p.returncode == 2 and p.stderr.strip().endswith("cannot read it")
+    assert p.returncode == 2 and p.stderr.strip().endswith("none: no such file")
 
 
 def test_flags_holding_a_tab_are_refused_before_any_run(cpu_bin, tmp_path):

@@ -136,7 +136,7 @@ BAD_FILES = {
     "no_points_array": lambda s: hair_bytes(s)[:12] + struct.pack("<I", SEGMENTS) + hair_bytes(s)[16:],
 }
 BAD_WORDS = {
-    "empty": "truncated HAIR header",
+    "empty": "is empty",
     "short_header": "truncated HAIR header",
     "not_hair": "not a HAIR file",
     "no_strands": "holds no strands",

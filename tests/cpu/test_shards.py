@@ -173,3 +173,69 @@ def test_a_folder_of_one_share_is_not_resumed_as_another(runs):
         p = harness("sweep", d / "shard-t.toml", "--out", folder, "--shard", shard)
         assert p.returncode == 2 and "give another --out" in p.stderr and p.stderr.count("\n") == 1
     assert json.loads((p1 / "shard.json").read_text())["shard"] == "1/3"  # its record kept
+
+
+def damaged(src, dst, damage):
+    """A copy of the shard folder src, damaged by damage(folder)."""
+    import shutil
+
+    shutil.copytree(src, dst)
+    damage(dst)
+    return dst
+
+
+def record_with(**changes):
+    def damage(folder):
+        rec = json.loads((folder / "shard.json").read_text())
+        rec.update(changes)
+        for k, v in changes.items():
+            if v is None:
+                rec.pop(k)
+        (folder / "shard.json").write_text(json.dumps(rec))
+
+    return damage
+
+
+def csv_edit(edit):
+    def damage(folder):
+        lines = (folder / "runs.csv").read_text().splitlines(keepends=True)
+        (folder / "runs.csv").write_text("".join(edit(lines)))
+
+    return damage
+
+
+def session_abc(lines):
+    header = lines[0].rstrip("\n").split(",")
+    row = lines[1].rstrip("\n").split(",")
+    row[header.index("session")] = "abc"
+    return [lines[0], ",".join(row) + "\n", *lines[2:]]
+
+
+DAMAGE = {  # #46 D13, D14, M8: what a merge met, and the words of its one line
+    "record a list": (lambda f: (f / "shard.json").write_text("[1, 2]"), "not a shard record"),
+    "record without k": (record_with(k=None), "'k' is missing"),
+    "n a string": (record_with(n="3"), "'n' is missing or not a int"),
+    "k out of range": (record_with(k=7), "k = 7 is not a shard of n = 3"),
+    "record binary": (lambda f: (f / "shard.json").write_bytes(bytes(range(256))), "not UTF-8"),
+    "torn last line": (csv_edit(lambda ls: [*ls[:-1], ls[-1][: len(ls[-1]) // 2]]), "runs.csv line"),
+    "short row": (csv_edit(lambda ls: [*ls[:2], "a,b\n", *ls[2:]]), "runs.csv line 3"),
+    "session abc": (csv_edit(session_abc), "session 'abc'"),
+    "env.json binary": (lambda f: (f / "env.json").write_bytes(b"\xff\xfe{"), "env.json"),
+    "env.json a list": (lambda f: (f / "env.json").write_text("[]"), "env.json: not a JSON object"),
+    "not finished": (record_with(finished=False), "did not finish"),
+    "no runs.csv": (lambda f: (f / "runs.csv").unlink(), "runs.csv is missing"),
+    "cases lost": (csv_edit(lambda ls: ls[:-4]), "holds 1 case(s); the shard finished with 2"),
+}
+
+
+@needs_cpu
+@pytest.mark.parametrize("case", list(DAMAGE))
+def test_merge_refuses_a_damaged_or_incomplete_shard_naming_it(runs, tmp_path, case):
+    d, whole, (p1, p2, p3) = runs
+    damage, words = DAMAGE[case]
+    bad = damaged(p3, tmp_path / "bad", damage)
+    out = tmp_path / "merged"
+    p = harness("merge", out, p1, p2, bad)
+    assert p.returncode == 2 and "Traceback" not in p.stderr and p.stderr.count("\n") == 1, p.stderr
+    assert words in p.stderr and ("bad" in p.stderr or case in ("k out of range",)), p.stderr
+    assert not out.exists()

@@ -130,7 +130,10 @@ def test_layers_import_downwards_only():
 
 
 def test_renderers_never_reach_the_runner():
+    """No renderer measures: none reaches the runner, except through harness.core.variants, which
+    asks a binary for its declarations (--list-variants), through the runner like every child."""
     graph = import_graph()
+    graph = {m: ({} if m == "harness.core.variants" else t) for m, t in graph.items()}
     render = [m for m in graph if m.startswith("harness.render")]
     assert render, "no module under harness/render"
     chains = [" -> ".join(c) for m in render if (c := reaches(graph, m, RUNNER))]
@@ -157,3 +160,79 @@ def test_rendering_commands_live_in_render(command):
     used = {n.module for n in ast.walk(func) if isinstance(n, ast.ImportFrom)}
     assert used and all(m in ("harness.render", "harness.core.paths") for m in used), used
     assert graph["harness.cli.main"]
+
+
+def calls_and_imports(path):
+    """(imported module names, dotted names called) of a file, read with ast."""
+    tree = ast.parse(path.read_text(), str(path))
+    imported, called = set(), set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            imported |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            imported.add(node.module)
+        elif isinstance(node, ast.Call):
+            called.add(ast.unparse(node.func))
+    return imported, called
+
+
+def test_every_child_starts_through_the_runner():
+    """#47: harness/core/runner.py is the one module that starts a program (subprocess); no
+    os.system, os.popen, os.fork or os.exec* anywhere; a forked multiprocessing.Process is watched by
+    runner.supervised in the same module, so that a signal reaching the harness reaches it."""
+    bad = []
+    for path in PACKAGE.rglob("*.py"):
+        name = module_name(path)
+        imported, called = calls_and_imports(path)
+        if "subprocess" in imported and name != RUNNER:
+            bad.append(f"{name} imports subprocess (use harness.core.runner.run_command or run_binary)")
+        bad += [
+            f"{name} calls {c}" for c in called if c in ("os.system", "os.popen", "os.fork") or c.startswith("os.exec")
+        ]
+        if any(c.endswith(".Process") for c in called) and "runner.supervised" not in called:
+            bad.append(f"{name} forks a process without runner.supervised")
+    assert not bad, "\n".join(bad)
+
+
+WRITERS = ("harness.io.files", "harness.io.runlog", RUNNER)  # the one writer; the append-only log; the runner's scratch
+WRITE_CALLS = ("os.replace", "os.rename", "shutil.copy", "shutil.copy2", "shutil.copyfile", "shutil.move")
+WRITE_METHODS = (".write_text", ".write_bytes", ".savefig", ".rename", ".to_csv", ".to_json")
+
+
+def file_writes(path):
+    """The calls in a file that write a file around harness/io/files.py."""
+    tree = ast.parse(path.read_text(), str(path))
+    uses_writing = any(
+        isinstance(n, ast.Call) and ast.unparse(n.func).endswith("files.writing") for n in ast.walk(tree)
+    )
+    found = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call):
+            continue
+        func = ast.unparse(node.func)
+        modes = [a.value for a in [*node.args[1:2], *(k.value for k in node.keywords if k.arg == "mode")]
+                 if isinstance(a, ast.Constant) and isinstance(a.value, str)]  # fmt: skip
+        writes_mode = any(set(m) & set("wax+") for m in modes)
+        into_temporary = uses_writing and func.split(".")[0].startswith("tmp")  # a name files.writing gave
+        if func.startswith("files.") or into_temporary:
+            continue
+        if func in WRITE_CALLS or func.endswith(WRITE_METHODS) or (func == "open" and writes_mode):
+            found.append(f"line {node.lineno}: {func}")
+        elif func.endswith("h5py.File") and writes_mode and not uses_writing:
+            found.append(f"line {node.lineno}: {func} for writing outside files.writing")
+    return found
+
+
+def test_every_file_write_goes_through_files():
+    """#47: every file the harness writes goes through harness/io/files.py (whole or not at all,
+    its temporary removed in `finally`); an h5py file written inside files.writing."""
+    bad = [
+        f"{module_name(p)} {w}" for p in PACKAGE.rglob("*.py") if module_name(p) not in WRITERS for w in file_writes(p)
+    ]
+    assert not bad, "writes around harness/io/files.py:\n" + "\n".join(bad)
+
+
+def test_the_write_check_sees_a_hidden_write(tmp_path):
+    path = tmp_path / "m.py"
+    path.write_text("def f(p, t):\n    with open(p, 'w') as x:\n        x.write(t)\n    t.replace('a', 'b')\n")
+    assert file_writes(path) == ["line 2: open"]

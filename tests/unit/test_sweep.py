@@ -146,8 +146,11 @@ def test_a_foreign_csv_is_never_truncated(fake, tmp_path):
     out = tmp_path / "res"
     out.mkdir()
     (out / "runs.csv").write_text("a,b,c\n1,2,3\n")
-    with pytest.raises(Exception) as e:
+    with pytest.raises(Exception) as e:  # a folder that is not a run's: refused before anything
         run_sweep(fake, out=out, gpu="no")
+    assert "not a hairbench run folder" in str(e.value)
+    with pytest.raises(Exception) as e:  # and with --force, its foreign runs.csv is still not touched
+        run_sweep(fake, out=out, gpu="no", force=True)
     assert "other columns" in str(e.value)
     assert (out / "runs.csv").read_text() == "a,b,c\n1,2,3\n"
 
@@ -192,3 +195,32 @@ def test_a_sweep_does_not_resume_rows_of_another_machine(tmp_path):
     check_same_machine(h200, dict(h200), tmp_path)  # same machine: fine
     with pytest.raises(HarnessError, match="another machine .*NVIDIA H200.*this one is AMD EPYC, 2 cores, no GPU"):
         check_same_machine(h200, laptop, tmp_path)
+
+
+def test_a_killed_session_is_not_marked_finished(fake, tmp_path):
+    """#46 M9: env.json's session of a sweep killed mid-way has no finished_at; the one that
+    resumes it to the end has."""
+    import json
+
+    out = tmp_path / "res"
+    env = dict(os.environ, FAKE_SLEEP="0.25", PYTHONPATH=str(ROOT))
+    cmd = [sys.executable, "-m", "harness", "sweep", str(fake), "--out", str(out), "--gpu", "no"]
+    p = subprocess.Popen(
+        cmd, cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+    )
+
+    def cases_run():
+        try:
+            return json.loads((out / "env.json").read_text())["sessions"][-1]["cases_run"]
+        except (OSError, ValueError, KeyError, IndexError):
+            return 0
+
+    deadline = time.time() + 60
+    while time.time() < deadline and cases_run() < 1:
+        time.sleep(0.05)
+    os.killpg(p.pid, signal.SIGKILL)
+    p.wait()
+    killed = json.loads((out / "env.json").read_text())["sessions"][-1]
+    assert killed["cases_run"] >= 1 and "finished_at" not in killed, killed
+    assert subprocess.run(cmd, cwd=ROOT, env=dict(env, FAKE_SLEEP="0"), capture_output=True).returncode == 0
+    assert "finished_at" in json.loads((out / "env.json").read_text())["sessions"][-1]
