@@ -68,7 +68,7 @@ static const dyn_flag dyn_flags[] = {
     {"--gust-amplitude", DF_REAL, DYN(gust_amplitude), 0, "relative gust amplitude A_g (default 0: none)"},
     {"--gust-frequency", DF_REAL, DYN(gust_frequency), 0, "gust frequency f_g, Hz (default 1)"},
     {"--gust-wavelength", DF_REAL, DYN(gust_wavelength), 0, "gust wavelength λ_g, cm (default 100)"},
-    {"--head-motion", DF_MOTION, DYN(motion), 0, "still | nod | shake | tilt (default still)"},
+    {"--head-motion", DF_MOTION, DYN(motion), 0, "still | nod | shake | tilt | track (--motion-track; default still)"},
     {"--motion-amplitude", DF_REAL, DYN(motion_amplitude), 0, "head motion amplitude A, radians (default 0.25)"},
     {"--motion-frequency", DF_REAL, DYN(motion_frequency), 0, "head motion frequency f, Hz (default 1)"},
     {"--guides", DF_REAL, DYN(guides), DYN(guided),
@@ -169,7 +169,9 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
                "  --output-every K     write every K-th simulated frame; the last always (default 1)\n"
                "  --velocities W       last | all: write the velocities of the last or of every written frame\n"
                "  --frame-loop         after the run, time F more frames back to back as an application's frame\n"
-               "                       loop would (launches and the frame's tables included; cuda only)\n");
+               "                       loop would (launches and the frame's tables included; cuda only)\n"
+               "  --motion-track FILE  with --head-motion track: the head's transform track, a CSV file\n"
+               "                       (docs/interfaces.md, \"Motion tracks\"; translation must be zero)\n");
     for (size_t i = 0; i < N_DYN_FLAGS; i++) {
         char name[64];
         snprintf(name, sizeof name, "%s%s", dyn_flags[i].flag,
@@ -320,7 +322,8 @@ static int parse_dyn(const dyn_flag *df, const char *v, hb_options *o, char *err
         else if (strcmp(v, "nod") == 0) o->scene.dyn.motion = HB_MOTION_NOD;
         else if (strcmp(v, "shake") == 0) o->scene.dyn.motion = HB_MOTION_SHAKE;
         else if (strcmp(v, "tilt") == 0) o->scene.dyn.motion = HB_MOTION_TILT;
-        else FAIL("--head-motion must be still, nod, shake or tilt (got '%s')", v);
+        else if (strcmp(v, "track") == 0) o->scene.dyn.motion = HB_MOTION_TRACK;
+        else FAIL("--head-motion must be still, nod, shake, tilt or track (got '%s')", v);
         break;
     case DF_SWITCH: *(int *)(base + df->offset) = 0; break;
     case DF_FOLLOW:
@@ -513,6 +516,9 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
             if (v[0] == '\0') FAIL("--groom needs 'curly' or a HAIR file name");
             o->groom = v;
             s->groom = strcmp(v, "curly") == 0 ? HB_GROOM_CURLY : HB_GROOM_FILE;
+        } else if (strcmp(name, "--motion-track") == 0) {
+            if (v[0] == '\0') FAIL("--motion-track needs a CSV file name");
+            o->motion_track = v;
         } else if (strcmp(name, "--curl-radius") == 0) {
             if (parse_f64(name, v, &s->curl_radius, err, errlen)) return -1;
             if (!(s->curl_radius >= 0.0)) FAIL("--curl-radius must be >= 0 (got %s)", v);
@@ -547,6 +553,11 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
             if (sim || i != o->n_stages - 1) FAIL("--stages: simulate may appear once, as the last stage");
             sim = 1;
         }
+    if (!sim && o->motion_track) FAIL("--motion-track belongs to the simulate stage, which --stages does not list");
+    if (o->motion_track && o->scene.dyn.motion != HB_MOTION_TRACK) FAIL("--motion-track needs --head-motion track");
+    if (o->scene.dyn.motion == HB_MOTION_TRACK && (o->dyn_given & (1ull << hb_dyn_flag_index("--motion-amplitude") |
+                                                                   1ull << hb_dyn_flag_index("--motion-frequency"))))
+        FAIL("--motion-amplitude and --motion-frequency shape nod, shake and tilt, not --head-motion track");
     if (!sim && o->dyn_given) {
         for (size_t i = 0; i < N_DYN_FLAGS; i++)
             if (o->dyn_given & (1ull << i))

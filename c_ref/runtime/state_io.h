@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "dynamic/dynamics.h"
+#include "dynamic/head_track.h"
 #include "runtime/params.h"
 
 #ifdef __cplusplus
@@ -78,6 +79,7 @@ typedef struct {
     hb_observables *obs;
     int64_t *obs_step;
     double *obs_time;
+    hb_head_track track; /* head_motion = track: /parameters/motion_track (scene.dyn.track points here) */
 } hb_input;
 
 /* Opens and checks the layout and the scene; one line in err on failure. */

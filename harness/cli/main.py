@@ -1,8 +1,8 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
 Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, accuracy, headline,
-export, groom, calibrate, featurecost, reduced, peer, animate, stability, judge, docs (`--help` on each; docs/harness.md
-lists them). User errors print one line
+export, groom, motion, calibrate, featurecost, reduced, peer, animate, stability, judge, docs (`--help` on
+each; docs/harness.md lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
 
 import argparse
@@ -451,6 +451,21 @@ def cmd_groom(args):
 
     n = grooms.convert(args.src, args.dst, force=args.force)
     print(f"wrote {args.dst}: {n} strands")
+    return 0
+
+
+def cmd_motion(args):
+    from harness.io import motion_tracks
+
+    n = motion_tracks.convert(
+        args.src,
+        args.dst,
+        prim_path=args.prim,
+        relative=args.relative,
+        rotation_only=args.rotation_only,
+        force=args.force,
+    )
+    print(f"wrote {args.dst}: {n} samples")
     return 0
 
 
@@ -936,6 +951,23 @@ def parser():
     gc.add_argument("src", help="a USD file (.usd, .usda, .usdc, .usdz)")
     gc.add_argument("dst", help="the HAIR file to write")
     gc.add_argument("--force", action="store_true", help="replace dst if it exists")
+    mo = sub.add_parser(
+        "motion",
+        help="convert a USD xform's time samples to the CSV head track the binaries read",
+        description="motion convert IN.usd OUT.csv: the world transform of a prim (--prim, else the first xformable "
+        "prim with time samples) at each of its time samples, as the CSV of --head-motion track --motion-track "
+        '(docs/interfaces.md, "Motion tracks"): seconds from the stage\'s timeCodesPerSecond, unit quaternions '
+        "turned Y-up, translations in cm. The binaries refuse a non-zero translation (head translation is not "
+        "modelled yet): --rotation-only drops it. Needs usd-core; refused in one line without it.",
+    )
+    msub = mo.add_subparsers(dest="motion_command", required=True)
+    mc = command(msub, cmd_motion, help="USD xform time samples → CSV track", name="convert")
+    mc.add_argument("src", help="a USD file (.usd, .usda, .usdc, .usdz)")
+    mc.add_argument("dst", help="the CSV track to write")
+    mc.add_argument("--prim", default=None, help="the animated prim's path (default: the first with time samples)")
+    mc.add_argument("--relative", action="store_true", help="each rotation relative to the first sample's")
+    mc.add_argument("--rotation-only", action="store_true", help="write zero translation (the rotation alone)")
+    mc.add_argument("--force", action="store_true", help="replace dst if it exists")
     c = command(sub, cmd_calibrate, help="measure fp32-vs-fp64 errors behind tolerances.py")
     c.add_argument("--strands", type=whole(1), default=20000)
     c.add_argument("--points", type=whole(2), nargs="+", default=[8, 32, 128])

@@ -574,3 +574,23 @@ OBS_REST_MOVE_ABS_L = 1e-14  # of L = 30 cm: 3e-13 cm (measured 4.6e-14 cm; marg
 # linearised discrete chain's ω1/2π: −1.33e-4 relative (the scheme's 4e-5, tolerances above,
 # plus the spectral estimate's floor over 5.5 periods).
 OBS_CHAIN_SWING_FREQUENCY_REL = 5e-4  # measured 1.33e-4; margin 3.8×
+
+
+# ---------------------------------------------------------------------------------------
+# MOTION TRACKS (--head-motion track, docs/model.md §3.2). A sinusoid θ(t) = A·sin(2πft)
+# sampled every δ seconds and played as a track: slerp between two rotations about one axis
+# moves the angle linearly in time, so its angle is off by at most δ²/8·max|θ''| =
+# δ²/8·A·(2πf)² (linear interpolation's error bound), and a point at distance r from the head
+# centre by at most r times that; plus the rounding of the samples' and the sinusoid's
+# cosines and sines, TRACK_ROUND_K·ε·r. A derived bound, not a fit: measured on the C
+# reference (fp64, 40 strands × 16 points, 30 frames, rigid: every point carried with the
+# head) at δ = 1e-3 s, the worst point 4.09e-5 cm against its bound 4.95e-5 cm (r = 40.1 cm);
+# at δ = 2e-3 s four times that, as a second-order interpolation gives.
+TRACK_ROUND_K = 64.0
+
+
+def track_sampling_bound(delta: float, amplitude: float, frequency: float, radius: object, kind: str) -> np.ndarray:
+    """The most a point at distance `radius` from the head centre may differ between a sinusoidal
+    motion and the same sinusoid sampled every `delta` seconds and played as a track."""
+    angle = delta * delta / 8.0 * amplitude * (2.0 * math.pi * frequency) ** 2
+    return np.asarray(radius, dtype=np.float64) * (angle + TRACK_ROUND_K * EPS[kind])

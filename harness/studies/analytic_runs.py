@@ -19,6 +19,8 @@ import subprocess
 
 import numpy as np
 
+from harness.core.runner import COMPLETED
+
 
 def write_paper_state(path, positions, hair_length, precision="fp64", hair_offset=0.1, head_radius=10.0):
     """Write positions [N][P][3] as a one-frame paper-model state (stage "init")."""
@@ -145,7 +147,7 @@ def simulate(
     ]
     cmd += [str(a) for a in extra]
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    if r.returncode != 0:
+    if r.returncode not in COMPLETED:
         raise RuntimeError(f"{' '.join(cmd)} exited {r.returncode}: {r.stderr.strip()}")
     return output_path
 

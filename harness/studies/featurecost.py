@@ -162,7 +162,7 @@ def instructions_per_point_substep(binary, flags, rec, st, timeout=None):
         cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={d}/cg", f"--toggle-collect={fn}", str(binary)]
         p = subprocess.run(cmd + args + ["--threads", "1", "--quiet"], capture_output=True, text=True, timeout=timeout)
     m = re.search(r"Collected\s*:\s*([0-9]+)", p.stderr)
-    if p.returncode != 0 or not m:
+    if p.returncode not in runner.COMPLETED or not m:
         raise HarnessError(f"callgrind failed on {binary.name}: {runner.last_line(p.stderr)}")
     point_substeps = rec["strands"] * rec["points"] * st["substeps"] * st["frames"]
     return int(m.group(1)) / point_substeps
