@@ -10,7 +10,16 @@ SHELL := /bin/bash
 CC      ?= gcc
 NVCC    ?= nvcc
 PYTHON  ?= python3
-CUDA_ARCH ?= sm_90
+# CUDA_ARCH: the GPU architectures the CUDA binaries are built for (docs/cuda.md, "Building for
+# your GPU"). Given (CUDA_ARCH=sm_86 or a list, CUDA_ARCH="sm_80 sm_90": one fat binary), else
+# those of the GPUs nvidia-smi finds here, else sm_90 (no GPU: CI's compile stays one
+# architecture). Worked out once, only when a CUDA rule needs it.
+NVIDIA_SMI ?= nvidia-smi
+GPU_ARCHS = $(addprefix sm_,$(shell $(NVIDIA_SMI) --query-gpu=compute_cap --format=csv,noheader 2>/dev/null | \
+              tr -d ' .' | grep -E '^[0-9]+$$' | sort -un))
+ifeq ($(origin CUDA_ARCH),undefined)
+  CUDA_ARCH = $(eval CUDA_ARCH := $(or $(strip $(GPU_ARCHS)),sm_90))$(CUDA_ARCH)
+endif
 BUILD   := build
 OBJ     := $(BUILD)/obj
 
@@ -69,7 +78,12 @@ C_HEADERS  := $(wildcard c_ref/*/*.h)
 HAVE_NVCC := $(shell command -v $(NVCC) >/dev/null 2>&1 && echo yes)
 CUDA_SRC  := $(wildcard cuda/*.cu)
 CUDA_HDR  := $(wildcard cuda/*.cuh)
-NVCC_BASE := -arch=$(CUDA_ARCH) -O3 -std=c++17 -Ic_ref -lineinfo -Xcompiler -Wall
+# one architecture: -arch=sm_XX (its code and PTX); several: each one's code, and the newest's
+# PTX, which a later GPU compiles when it loads the binary
+comma := ,
+NVCC_ARCH = $(if $(word 2,$(CUDA_ARCH)),$(foreach a,$(CUDA_ARCH),-gencode arch=compute_$(a:sm_%=%)$(comma)code=$(a)) \
+              -gencode arch=compute_$(lastword $(CUDA_ARCH:sm_%=%))$(comma)code=compute_$(lastword $(CUDA_ARCH:sm_%=%)),-arch=$(CUDA_ARCH))
+NVCC_BASE = $(NVCC_ARCH) -O3 -std=c++17 -Ic_ref -lineinfo -Xcompiler -Wall
 NVCC_MODE_normal   :=
 NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DHB_REFERENCE_ARITHMETIC=1
 NVCC_MODE_fastmath := --use_fast_math
@@ -190,7 +204,7 @@ $(BUILD)/hairsim-cuda-strict: $(CUDA_OBJ_strict) $(SHARED_OBJ)
 $(BUILD)/hairsim-cuda-fastmath: $(CUDA_OBJ_fastmath) $(SHARED_OBJ)
 $(CUDA_BINS):
 	@mkdir -p $(BUILD)
-	$(NVCC) -arch=$(CUDA_ARCH) $^ -o $@ $(HDF5_LIBS)
+	$(NVCC) $(NVCC_ARCH) $^ -o $@ $(HDF5_LIBS)
 
 # The host checks (tests/native): the CUDA port's model templates compiled for the host and
 # run against the reference's objects; host code only, with the host compiler told the
