@@ -65,6 +65,7 @@ nonneg_seconds = real(
 )
 unit_interval = real("unit_interval", "a number in [0, 1]", lambda v: 0.0 <= v <= 1.0, "must lie in [0, 1]")
 number = real("number", "a number", math.isfinite, "needs a finite number")
+positive = real("positive", "a number", lambda v: 0 < v < math.inf, "must be a finite number > 0")
 
 
 def options(args, names):
@@ -451,6 +452,28 @@ def cmd_groom(args):
 
     n = grooms.convert(args.src, args.dst, force=args.force)
     print(f"wrote {args.dst}: {n} strands")
+    return 0
+
+
+def cmd_hair(args):
+    """Map a hair fibre (a preset, or radius, Young's modulus and density) to the dynamic model's point mass,
+    stiffnesses and per-unit-mass compliances on a strand of --length cm and --points points (docs/hair_physics.md),
+    and print the [fibre] table that puts it in a scene."""
+    from harness.core import hair_physics, scenes
+    from harness.render import hair_report
+
+    try:
+        fibre = hair_physics.fibre(
+            args.preset, args.radius_um, args.youngs_gpa, args.density, "given on the command line"
+        )
+    except ValueError as e:
+        raise HarnessError(f"hair: {e}") from None
+    curvature = args.curvature or 1.0 / (scenes.Scene.head_radius + scenes.Scene.hair_offset)
+    try:
+        m = hair_physics.mapped(fibre, args.length, args.points, curvature)
+    except ValueError as e:
+        raise HarnessError(f"hair: {e}") from None
+    print(hair_report.text(args.preset, fibre, m))
     return 0
 
 
@@ -951,6 +974,22 @@ def parser():
     gc.add_argument("src", help="a USD file (.usd, .usda, .usdc, .usdz)")
     gc.add_argument("dst", help="the HAIR file to write")
     gc.add_argument("--force", action="store_true", help="replace dst if it exists")
+    from harness.core.hair_physics import PRESETS
+
+    hp = command(sub, cmd_hair, help="physical hair: a fibre's point mass, stiffness and compliances")
+    hp.add_argument("--preset", choices=tuple(PRESETS), default=None, help="a measured hair type")
+    hp.add_argument("--radius-um", type=positive, default=None, help="fibre radius r, µm (replaces the preset's)")
+    hp.add_argument("--youngs-gpa", type=positive, default=None, help="Young's modulus E, GPa (replaces the preset's)")
+    hp.add_argument("--density", type=positive, default=None, help="density ρ, g/cm³ (replaces the preset's)")
+    hp.add_argument("--length", type=positive, default=30.0, help="strand length L, cm (default 30)")
+    hp.add_argument("--points", type=whole(3), default=32, help="points per strand (default 32)")
+    hp.add_argument(
+        "--curvature",
+        type=positive,
+        default=None,
+        help="the strand's rest curvature κ where it bends, 1/cm (default 1/(R + h) of the default head: 1/10.1)",
+    )
+
     mo = sub.add_parser(
         "motion",
         help="convert a USD xform's time samples to the CSV head track the binaries read",
