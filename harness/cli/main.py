@@ -195,10 +195,13 @@ def cmd_bench(args):
     from harness.bench import dynamic as bench_dynamic
     from harness.bench import merge
     from harness.bench import paper as bench_paper
-    from harness.core import budget, shards
-    from harness.core.paths import LOCAL_RUN
+    from harness.core import budget, shards, timing
+    from harness.core.paths import LOCAL_RUN, binary_path, output_dir
     from harness.core.progress import StepTimes
+    from harness.core.runner import require_binary
+    from harness.io.files import write_json
     from harness.io.sweepfile import load_sweep
+    from harness.render import host_report
 
     # one run folder (docs/decisions/bench-runs.md): the paper sweep in ROOT/sweep, the dynamic
     # bench's folders beside it, the report in ROOT/report; nothing tracked is written
@@ -212,6 +215,9 @@ def cmd_bench(args):
     if args.model in ("all", "dynamic"):
         sweeps["dynamic"] = load_sweep(bench_dynamic.SWEEP).path
         sweeps["dynamic-curly"] = load_sweep(bench_dynamic.CURLY_SWEEP).path
+    require_binary(binary_path("cpu"))  # before the run's folder is made
+    # the host's load before anything runs: the top of the run's reports says whether it was quiet
+    write_json(output_dir(root) / host_report.HOST_JSON, timing.host_load())
     if plan:
         print(
             f"harness: budget {plan.seconds:.0f} s: the sweeps' largest sizes and the studies are left out "

@@ -149,6 +149,16 @@ class LoadProbe:
         return {"other_cores": others, "loadavg": self.loadavg, "gpu_busy_pct": self.gpu_pct, "wall_s": wall}
 
 
+def host_load(seconds=2.0):
+    """The host's load now, this process idle for `seconds`: others' CPU use (cores), the load
+    average, the host's cores and (where nvidia-smi answers) the GPU's utilisation."""
+    probe = LoadProbe(gpu=True)
+    time.sleep(seconds)
+    out = probe.stop()
+    out["cpu_cores"] = os.cpu_count()
+    return out
+
+
 def worst_load(loads):
     """The worst of several rounds' loads (each a LoadProbe.stop() dict)."""
 

@@ -20,6 +20,7 @@ from harness.render import (  # noqa: E402
     accuracy_dynamic_report,
     budget_report,
     featurecost_report,
+    host_report,
     judge_report,
     peer_report,
     reduced_report,
@@ -97,7 +98,8 @@ def best_table(rows):
         def cell(r):
             if r is None:
                 return "—"
-            return f"{r['label']}: {float(r['median_ms']):.3g} ms ({float(r['point_substeps_per_s']):.3g}/s)"
+            noise = " (noise)" if isinstance(r.get("noisy"), str) and r.get("noisy") else ""
+            return f"{r['label']}: {float(r['median_ms']):.3g} ms ({float(r['point_substeps_per_s']):.3g}/s){noise}"
 
         sp = "—"
         if best["gpu"] is not None and best["all"] is not None:
@@ -266,6 +268,7 @@ def build(root, report_dir=None):
         f"by `python -m harness bench` from `{display(root)}`; rendering only.",
         "",
     ]
+    lines += host_report.section(root)
     lines += budget_report.section(root)
     lines += ["## Validation", ""]
     lines += validation_lines(sweep_dir) + [""]
@@ -277,7 +280,8 @@ def build(root, report_dir=None):
         lines += [
             "Time per frame of the default scene (S = 8, I = 2, every feature), kernel or loop time "
             "only (docs/interfaces.md), the median of the sweep's repeats; point-substeps per "
-            "second = N·P·S over it. The best of each family per strand count:",
+            'second = N·P·S over it. The best of each family per strand count ("(noise)": its time\'s spread '
+            "or the host's load marks it as noise, core/timing.py):",
             "",
         ]
         lines += best_table(rows) + [""]

@@ -16,7 +16,7 @@ from pathlib import Path
 from harness.core.paths import REPORT, display, output_dir
 from harness.io import results_data
 from harness.io.results_data import curve_of, interp_time, strands_at_time
-from harness.render import budget_report
+from harness.render import budget_report, host_report
 from harness.render.accuracy_paper_report import report_from_csv
 from harness.render.headline_report import table
 from harness.render.plots import make_all
@@ -286,6 +286,7 @@ def build(results_dir="results/default", report_dir=None):
     ]
     if env.get("provenance"):
         lines += ["## Provenance", "", env["provenance"], ""]
+    lines += host_report.section(Path(results_dir).parent)
     lines += budget_report.section(Path(results_dir).parent)
     lines += headline_section(Path(results_dir).parent / "headline" / "headline.json")
     lines += gpu_section(cases, env)

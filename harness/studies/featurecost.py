@@ -15,7 +15,7 @@ compiles it out), never by setting it to zero:
 import shutil
 
 from harness import HarnessError
-from harness.core import runner, scenes
+from harness.core import runner, scenes, timing
 from harness.core.paths import binary_path
 from harness.core.progress import Progress
 from harness.core.scenes_dynamic import DECLARING, FEATURES, NEEDS
@@ -40,6 +40,7 @@ FIELDS = (
     "point_substeps_per_s",
     "device",
     "instructions_per_point_substep",
+    *timing.Figure().columns(),  # the frame times' spread and the host's load (core/timing.py)
 )
 
 
@@ -112,9 +113,13 @@ def measure(
 
 
 def _row(binary, name, flags, timeout, instructions, progress):
-    """One row of the study: the binary's record of one feature set."""
+    """One row of the study: the binary's record of one feature set, its frame times' spread and
+    the load they ran under (its own --repeat; core/timing.py flags a noisy row)."""
+    probe = timing.LoadProbe(gpu=rec_backend(binary) == "cuda")
     rec = runner.run_binary(binary, flags, timeout=timeout)
+    load = probe.stop()
     st = declared(rec)
+    fig = timing.Figure(st.get("times_ms") or [], stop="fixed repeats", rounds=1, load=load, backend=rec["backend"])
     ips = instructions_per_point_substep(binary, flags, rec, st, timeout) if instructions else None
     row = {
         "row": name,
@@ -135,6 +140,7 @@ def _row(binary, name, flags, timeout, instructions, progress):
         "point_substeps_per_s": st["point_substeps_per_s"],
         "device": rec["device"],
         "instructions_per_point_substep": ips,
+        **fig.columns(),
     }
     progress(f"featurecost: {name:28s} {st['features']:44s} {st['median_ms']:10.3f} ms/frame")
     return row
@@ -166,6 +172,10 @@ def instructions_per_point_substep(binary, flags, rec, st, timeout=None):
         raise HarnessError(f"callgrind failed on {binary.name}: {runner.last_line(p.stderr)}")
     point_substeps = rec["strands"] * rec["points"] * st["substeps"] * st["frames"]
     return int(m.group(1)) / point_substeps
+
+
+def rec_backend(binary):
+    return "cuda" if "cuda" in binary.name else "cpu"
 
 
 def _set(flags, flag, value):
