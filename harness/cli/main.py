@@ -461,6 +461,23 @@ def cmd_groom(args):
     return 0
 
 
+def cmd_budget(args):
+    """For a scene, a strand count and a frame budget: on each device a run measured (or the GPU --gpu names),
+    the most accurate mode whose time a frame at --strands, predicted from its own measured throughput curve,
+    fits --frame-ms; its predicted time (said where it is extrapolated beyond the measured sizes, or within timing
+    noise of the budget) and its RMS error over the accuracy study's horizon (docs/harness.md, "A frame budget").
+    Reads RUN/dynamic-accuracy[-SCENE]/ and RUN/budget-curves[-SCENE]/ (make bench, or make bench SCENE=...)."""
+    from harness.core.paths import LOCAL_RUN
+    from harness.render import frame_budget
+
+    data = frame_budget.load(args.run or LOCAL_RUN, args.scene)
+    if args.json:
+        print(json.dumps(frame_budget.answer(data, args.strands, args.frame_ms, args.gpu), indent=1, default=float))
+        return 0
+    print("\n".join(frame_budget.lines(data, args.strands, args.frame_ms, args.gpu, scene=args.scene)))
+    return 0
+
+
 def cmd_hair(args):
     """Map a hair fibre (a preset, or radius, Young's modulus and density) to the dynamic model's point mass,
     stiffnesses and per-unit-mass compliances on a strand of --length cm and --points points (docs/hair_physics.md),
@@ -980,6 +997,14 @@ def parser():
     gc.add_argument("src", help="a USD file (.usd, .usda, .usdc, .usdz)")
     gc.add_argument("dst", help="the HAIR file to write")
     gc.add_argument("--force", action="store_true", help="replace dst if it exists")
+    bu = command(sub, cmd_budget, help="a frame budget's answer: the most accurate mode that fits, from measured data")
+    bu.add_argument("--strands", type=whole(1), required=True, help="strands simulated a frame")
+    bu.add_argument("--frame-ms", type=positive, required=True, help="the simulation's budget, ms a frame")
+    bu.add_argument("--scene", default="dynamic", help="the scene whose data to use (default dynamic)")
+    bu.add_argument("--gpu", default=None, help="only the GPU whose name holds this (e.g. H200); default: every device")
+    bu.add_argument("--run", default=None, help="the run folder (default results/local, make bench's)")
+    bu.add_argument("--json", action="store_true", help="print the answer as JSON")
+
     from harness.core.hair_physics import PRESETS
 
     hp = command(sub, cmd_hair, help="physical hair: a fibre's point mass, stiffness and compliances")

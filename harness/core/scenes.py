@@ -123,6 +123,8 @@ class Scene:
     # in the file's cm, () = fitted; head.radius is passed with it only when the scene gives it
     head_center: tuple = ()
     head_radius_given: bool = False
+    # a groom file decides its strands unless the scene or an override gives a count (the first N)
+    strands_given: bool = False
     # [fibre] (docs/hair_physics.md): a preset and the values that replace its own (0: the preset's)
     fibre_preset: str = ""
     fibre_radius_um: float = 0.0
@@ -161,6 +163,8 @@ class Scene:
                     changes[k] = converted
         if "head_radius" in changes:
             changes["head_radius_given"] = True
+        if "strands" in changes:
+            changes["strands_given"] = True
         scene = replace(self, **changes)
         _check_values(scene, f"scene {self.name}")
         return with_fibre(scene, f"scene {self.name}")
@@ -191,7 +195,8 @@ class Scene:
             if self.head_center:  # unless the scene gives the head
                 head = ["--head-center", ",".join(repr(c) for c in self.head_center)]
                 head += ["--head-radius", repr(self.head_radius)] if self.head_radius_given else []
-            return ["--points", str(self.points), "--groom", self.groom_file, *head, *tail]
+            count = ["--strands", str(self.strands)] if self.strands_given else []
+            return [*count, "--points", str(self.points), "--groom", self.groom_file, *head, *tail]
         curl = ["--groom", "curly", "--curl-radius", repr(self.curl_radius), "--curl-pitch", repr(self.curl_pitch)]
         return [
             *(curl if self.groom == "curly" else []),
@@ -359,6 +364,7 @@ def scene_from_dict(data, name, where):
     if "stages" not in values:
         raise SceneError(f"{where}: missing key 'stages' (the ordered list of stages to run)")
     values["head_radius_given"] = "head_radius" in values
+    values["strands_given"] = "strands" in values
     scene = Scene(name=name, source=where, **values)
     _check_values(scene, where)
     if "fibre" in data:
