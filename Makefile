@@ -3,7 +3,8 @@
 #   make          build build/hairsim-cpu and, where nvcc is present, the CUDA binaries
 #   make test     build (with build/planted/, the judge's planted defects), then run the pytest suite
 #                 (GPU tests skip with a reason without a GPU)
-#   make bench    build, validate the GPU variants against the CPU, sweep, studies, report (results/local/)
+#   make bench    build, validate the GPU variants against the CPU, sweep, studies, report (results/local/);
+#                 SCENE=my.toml: the same on your own scene or groom (results/scene-my/)
 #   make report   re-render a run folder's report (the committed one: REPORT_FROM=results/reference-h200 REPORT_TO=report)
 
 SHELL := /bin/bash
@@ -107,6 +108,7 @@ help:
 	@echo "make test     build and run the pytest suite (GPU tests skip with a reason without a GPU;"
 	@echo "             one pytest-xdist worker a core where xdist is installed, TEST_JOBS=N for N)"
 	@echo "make bench    validate GPU variants against the CPU, sweep, studies, report into results/local/ (OUT=results/NAME; BUDGET=10m fits the sizes to a time; SHARD=K/N runs a share)"
+	@echo "make bench SCENE=my.toml  the throughput sweep, speed/accuracy study, frame budget and stability map on your own scene or groom (results/scene-my/; docs/user_scene.md)"
 	@echo "make report   re-render a run folder's report, or one sweep folder's (REPORT_FROM=results/local, REPORT_TO=REPORT_FROM/report;"
 	@echo "             the committed one: REPORT_FROM=results/reference-h200 REPORT_TO=report)"
 	@echo "make report-dynamic  only the dynamic report of REPORT_FROM into REPORT_TO"
@@ -260,11 +262,13 @@ test: setup
 	fi; \
 	echo "pytest tests -q -ra $$workers"; $(RUN_PY) -m pytest tests -q -ra $$workers
 
-# make bench's run folder (untracked): results, then the report in $(OUT)/report
+# make bench's run folder (untracked): results, then the report in $(OUT)/report. SCENE=my.toml:
+# the dynamic studies on that scene or groom (docs/user_scene.md), into results/scene-<name>
+# unless OUT is given
 OUT ?= results/local
 bench: setup
 	@$(call BUILD_LOGGED,all)
-	$(RUN_PY) -m harness bench --out $(OUT)$(if $(BUDGET), --budget $(BUDGET))$(if $(SHARD), --shard $(SHARD))
+	$(RUN_PY) -m harness bench$(if $(SCENE), --scene $(SCENE))$(if $(and $(SCENE),$(filter file,$(origin OUT))),, --out $(OUT))$(if $(BUDGET), --budget $(BUDGET))$(if $(SHARD), --shard $(SHARD))
 
 # REPORT_FROM: the run folder to render (default results/local, make bench's), or one sweep's
 # folder (its runs.csv: the paper report alone); REPORT_TO: where

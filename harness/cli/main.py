@@ -205,10 +205,19 @@ def cmd_bench(args):
 
     # one run folder (docs/decisions/bench-runs.md): the paper sweep in ROOT/sweep, the dynamic
     # bench's folders beside it, the report in ROOT/report; nothing tracked is written
+    plan = budget.Budget(budget.parse_duration(args.budget), reserve=budget.REPORT_RESERVE_S) if args.budget else None
+    if args.scene:  # the dynamic studies on the user's own scene, in its own folder (bench/scene.py)
+        from harness.bench import scene as bench_scene
+
+        given = [f for f, v in (("--model", args.model != "all"), ("--sweep", args.sweep != "default"),
+                                ("--shard", args.shard)) if v]  # fmt: skip
+        if given:
+            raise HarnessError(f"bench --scene runs the dynamic studies on that scene alone: drop {', '.join(given)}")
+        quick = not args.full_studies
+        return bench_scene.run(args.scene, args.out, args.gpu, args.report_dir, quick_studies=quick, budget=plan)
     root = Path(args.out) if args.out else LOCAL_RUN
     report_dir = Path(args.report_dir) if args.report_dir else root / "report"
     shard = shards.parse(args.shard) if args.shard else None
-    plan = budget.Budget(budget.parse_duration(args.budget), reserve=budget.REPORT_RESERVE_S) if args.budget else None
     sweeps = {}
     if args.model in ("all", "paper"):
         sweeps["paper"] = load_sweep(args.sweep).path
@@ -854,6 +863,13 @@ def parser():
         help="K/N: run the K-th of N deterministic shares of the sweeps' cases and the stability map's cells "
         "(the studies measured once dealt out round robin), record OUT/shard.json and write no report; "
         "harness merge joins them",
+    )
+    b.add_argument(
+        "--scene",
+        default=None,
+        help="a dynamic scene or groom of your own (a .toml path or a name in configs/scenes/): validation, the "
+        "throughput sweep, the speed/accuracy study, the frame budget's curves and the stability map on it, into "
+        "its own folder (default results/scene-<name>) and report (OUT/report/scene.md); docs/user_scene.md",
     )
     b.add_argument(
         "--full-studies",

@@ -96,6 +96,15 @@ class Sweep:
     description: str = ""
     rule: StopRule = RULE  # the stopping rule of its timed repeats ([timing]; else `repeat` once)
 
+    def at_most(self, strands):
+        """This sweep with every strands axis cut at `strands` (a groom file's count), kept there
+        when nothing was below it."""
+        axes = []
+        for backend, a in self.axes:
+            keep = [n for n in a["strands"] if n <= strands] or [strands]
+            axes.append((backend, {**a, "strands": keep}))
+        return replace(self, axes=axes)
+
     def cases(self):
         out, seen = [], set()
         for backend, axes in self.axes:

@@ -20,6 +20,7 @@ from harness.render import (  # noqa: E402
     accuracy_dynamic_report,
     budget_report,
     featurecost_report,
+    frame_budget,
     host_report,
     judge_report,
     peer_report,
@@ -27,7 +28,7 @@ from harness.render import (  # noqa: E402
     stability_report,
 )
 from harness.render.headline_report import rounds_note  # noqa: E402
-from harness.studies.accuracy import results_name  # noqa: E402
+from harness.studies.accuracy import curves_name, results_name  # noqa: E402
 
 CURLY_SCENE = "curly"  # configs/scenes/curly.toml: the accuracy study's second scene
 CURLY_TITLE = "curly hair"
@@ -133,7 +134,7 @@ def _num(x):
     return f"{x:.3g}" if isinstance(x, (int, float)) and x == x else ""
 
 
-def validation_lines(results_dir):
+def validation_lines(results_dir, what="the default scene"):
     path = Path(results_dir) / "validation.json"
     if not path.exists():
         return [f"Not validated with these results (no `{display(path)}`)."]
@@ -141,7 +142,7 @@ def validation_lines(results_dir):
     checks = v.get("checks", [])
     bad = [c for c in checks if not c.get("equivalent")]
     lines = [
-        f"Before any timing, at {v.get('strands')} strands × {v.get('points')} points of the default scene: "
+        f"Before any timing, at {v.get('strands')} strands × {v.get('points')} points of {what}: "
         f"{len(checks)} comparisons, {len(checks) - len(bad)} equivalent"
         + (f" ({len(bad)} NOT)" if bad else "")
         + ". One frame from the same input state, judged by `harness.check.diff_dynamic` (the rule of "
@@ -306,6 +307,7 @@ def build(root, report_dir=None):
         "harness accuracy --model dynamic",
         out_dir,
     )
+    lines += frame_budget.section(root) if (root / curves_name("dynamic")).exists() else []
     curly = results_name(CURLY_SCENE)
     lines += _study(
         root,

@@ -23,7 +23,7 @@ from harness.core.runner import BATCH_MAX, BackendError, DoesNotFit, batches, ru
 from harness.core.scenes import SceneError
 from harness.io import results_data, runlog
 from harness.io.files import write_json
-from harness.io.sweepfile import load_sweep
+from harness.io.sweepfile import Sweep, load_sweep
 from harness.studies import roofline
 
 
@@ -187,10 +187,11 @@ def check_same_machine(before, now, out_dir):
 
 
 def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, shard=None, gate=None):
-    """Run (or resume) a sweep; return (results dir, number of failed cases). `shard` (a
+    """Run (or resume) a sweep (`sweep_ref`: a sweep file, or a loaded io.sweepfile.Sweep); return
+    (results dir, number of failed cases). `shard` (a
     core.shards.Shard): only its share of the cases; `gate` (a core.budget.TierGate): the
     cases run smallest size first and a tier that does not fit is left out with every larger one."""
-    sweep = load_sweep(sweep_ref)
+    sweep = sweep_ref if isinstance(sweep_ref, Sweep) else load_sweep(sweep_ref)
     out_dir = output_dir(out if out else RESULTS / sweep.name)
     csv_path = out_dir / "runs.csv"
     env_path = out_dir / "env.json"
