@@ -128,7 +128,7 @@ def summary(rows, horizon_frames):
     # before them has neither (its times then decide as before, without a noise flag)
     first = g.first()
     out["time_rsd"] = first["time_rsd"].astype(float) if "time_rsd" in first else np.nan
-    out["time_noisy"] = first["time_noisy"].fillna("").astype(str) if "time_noisy" in first else ""
+    out["time_noisy"] = [x if isinstance(x, str) else "" for x in first["time_noisy"]] if "time_noisy" in first else ""
     out["scheme"] = [scheme_name(s, d) for s, d in zip(out["solver"], out["ftl_damping"])]
     out["rms"] = g["rms_err_L"].apply(lambda s: s.max(skipna=False))
     out["max"] = g["max_err_L"].apply(lambda s: s.max(skipna=False))

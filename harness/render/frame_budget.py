@@ -57,7 +57,8 @@ def load(root, scene="dynamic"):
     rows, study, _, _ = accuracy.load(acc_dir)
     summ = accuracy.summary(rows, study["horizon_frames"])
     curves = tables.read_csv(curves_path)
-    curves = curves[curves["error"].fillna("").astype(str) == ""].copy()
+    err = curves["error"]
+    curves = curves[err.isna() | (err.astype(str) == "")].copy()  # the rows that ran
     ref = study.get("reference") or {}
     return Data(summ, curves, float(study["horizon"]), float(ref.get("converged_until_s", math.nan)), str(root))
 
@@ -105,7 +106,7 @@ def answer(data, strands, frame_ms, gpu=None):
             if mode not in usable.index:
                 continue
             ms, rsd, how = predict(curve, strands)
-            noise = curve.sort_values("strands")["noisy"].fillna("").astype(str)
+            noise = [x if isinstance(x, str) else "" for x in curve.sort_values("strands")["noisy"]]
             options.append(dict(mode=mode, rms=float(usable.loc[mode, "rms"]), ms=ms, rsd=rsd, how=how,
                                 noise=next((x for x in noise if x), "")))  # fmt: skip
         fits = [o for o in options if o["ms"] <= frame_ms]

@@ -32,7 +32,7 @@ def _figures(root):
         else:
             continue
         total += len(df)
-        noisy += int(flags.fillna("").astype(str).str.len().gt(0).sum())
+        noisy += sum(1 for x in flags if isinstance(x, str) and x)
         others += [float(x) for x in load.dropna()]
     return total, noisy, others
 

@@ -66,8 +66,10 @@ def sizes(mode, most=None):
     return out or [most]
 
 
-def measure(root, scene_ref, modes, rule=timing.RULE, gate=None, log=print, most=None):
-    """Time every mode at its ladder's sizes; write and return the rows (one per mode and size)."""
+def measure(root, scene_ref, modes, rule=None, gate=None, log=print, most=None):
+    """Time every mode at its ladder's sizes by `rule` (default timing.RULE); write and return the
+    rows (one per mode and size)."""
+    rule = rule or timing.RULE
     scene = scenes.load_scene(scene_ref)
     out = output_dir(Path(root) / curves_name(scene_ref))
     cases = [(m, n) for m in modes for n in sizes(m, most)]
@@ -96,7 +98,8 @@ def measure(root, scene_ref, modes, rule=timing.RULE, gate=None, log=print, most
                 rows.append(_row(m, n, scene, t))
                 bar.update()
             if gate is not None:
-                gate.measured(n, len(tier), time.monotonic() - t0)
+                sampled = sum(f.stats["total_s"] for t in timed for f in t.figures.values())
+                gate.measured(n, len(tier), time.monotonic() - t0, sampled)
     write_csv(out / CURVES_CSV, COLUMNS, rows)
     write_json(out / "env.json", {"scene": scene_ref, "rule": rule.as_dict(), "host": env.collect()})
     log(f"harness: budget curves: {len(rows)} rows in {display(out / CURVES_CSV)}")

@@ -280,11 +280,13 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
                     progress.update(len(tier))
                     continue
             t0 = time.monotonic()
+            sampled = []  # each case's timed samples, seconds (the gate scales these with the size)
             failed += _run_cases(
-                tier, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list, rule
-            )
+                tier, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list, rule,
+                sampled,
+            )  # fmt: skip
             if gate is not None:
-                gate.measured(size, len(tier), time.monotonic() - t0)
+                gate.measured(size, len(tier), time.monotonic() - t0, sum(sampled))
     finally:
         progress.close()
     say(
@@ -299,7 +301,9 @@ def case_size(case):
     return case.strands * case.points
 
 
-def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list, rule):
+def _run_cases(
+    todo, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list, rule, sampled
+):
     """Run the cases by the stopping rule (core.rounds.measure: rounds of timed repeats until
     each stage's samples meet `rule`), appending their rows; the number that failed. The CPU
     cases run one to a process, alone; the GPU cases of one binary several to a process (one
@@ -346,6 +350,7 @@ def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, 
         elif error is not None:
             raise error
         else:
+            sampled.append(sum(f.stats["total_s"] for f in t.figures.values()))
             rows = rows_of_record(case, rec, bandwidth.get(key(case)), session_index, binary, t.figures)
             for r in rows:
                 r["gpu"] = gpu.index if gpu is not None else ""
