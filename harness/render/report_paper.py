@@ -218,7 +218,12 @@ def paper_section(cases):
 
 
 def timing_table(cases):
-    lines = ["## wind + collide median times (ms)", ""]
+    lines = [
+        "## wind + collide median times (ms)",
+        "",
+        '"(noise)": a stage\'s spread above 0.5 % or a host loaded by others while it ran (core/timing.py).',
+        "",
+    ]
     c = cases.dropna(subset=["pair_ms"])
     if c.empty:
         return lines + ["No case ran a wind stage.", ""]
@@ -238,8 +243,9 @@ def timing_table(cases):
         for n in counts:
             row = []
             for lab in labels:
-                v = g[(g["strands"] == n) & (g["label"] == lab)]["pair_ms"]
-                row.append(fmt_ms(float(v.iloc[0])) if len(v) else "—")
+                hit = g[(g["strands"] == n) & (g["label"] == lab)]
+                noise = " (noise)" if len(hit) and hit["noisy"].iloc[0] else ""
+                row.append(fmt_ms(float(hit["pair_ms"].iloc[0])) + noise if len(hit) else "—")
             lines.append(f"| {n:,} | " + " | ".join(row) + " |")
         lines.append("")
     return lines
