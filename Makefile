@@ -3,14 +3,24 @@
 #   make          build build/hairsim-cpu and, where nvcc is present, the CUDA binaries
 #   make test     build (with build/planted/, the judge's planted defects), then run the pytest suite
 #                 (GPU tests skip with a reason without a GPU)
-#   make bench    build, validate the GPU variants against the CPU, sweep, studies, report (results/local/)
+#   make bench    build, validate the GPU variants against the CPU, sweep, studies, report (results/local/);
+#                 SCENE=my.toml: the same on your own scene or groom (results/scene-my/)
 #   make report   re-render a run folder's report (the committed one: REPORT_FROM=results/reference-h200 REPORT_TO=report)
 
 SHELL := /bin/bash
 CC      ?= gcc
 NVCC    ?= nvcc
 PYTHON  ?= python3
-CUDA_ARCH ?= sm_90
+# CUDA_ARCH: the GPU architectures the CUDA binaries are built for (docs/cuda.md, "Building for
+# your GPU"). Given (CUDA_ARCH=sm_86 or a list, CUDA_ARCH="sm_80 sm_90": one fat binary), else
+# those of the GPUs nvidia-smi finds here, else sm_90 (no GPU: CI's compile stays one
+# architecture). Worked out once, only when a CUDA rule needs it.
+NVIDIA_SMI ?= nvidia-smi
+GPU_ARCHS = $(addprefix sm_,$(shell $(NVIDIA_SMI) --query-gpu=compute_cap --format=csv,noheader 2>/dev/null | \
+              tr -d ' .' | grep -E '^[0-9]+$$' | sort -un))
+ifeq ($(origin CUDA_ARCH),undefined)
+  CUDA_ARCH = $(eval CUDA_ARCH := $(or $(strip $(GPU_ARCHS)),sm_90))$(CUDA_ARCH)
+endif
 BUILD   := build
 OBJ     := $(BUILD)/obj
 
@@ -70,7 +80,12 @@ C_HEADERS  := $(wildcard c_ref/*/*.h)
 HAVE_NVCC := $(shell command -v $(NVCC) >/dev/null 2>&1 && echo yes)
 CUDA_SRC  := $(wildcard cuda/*.cu)
 CUDA_HDR  := $(wildcard cuda/*.cuh)
-NVCC_BASE := -arch=$(CUDA_ARCH) -O3 -std=c++17 -Ic_ref -lineinfo -Xcompiler -Wall
+# one architecture: -arch=sm_XX (its code and PTX); several: each one's code, and the newest's
+# PTX, which a later GPU compiles when it loads the binary
+comma := ,
+NVCC_ARCH = $(if $(word 2,$(CUDA_ARCH)),$(foreach a,$(CUDA_ARCH),-gencode arch=compute_$(a:sm_%=%)$(comma)code=$(a)) \
+              -gencode arch=compute_$(lastword $(CUDA_ARCH:sm_%=%))$(comma)code=compute_$(lastword $(CUDA_ARCH:sm_%=%)),-arch=$(CUDA_ARCH))
+NVCC_BASE = $(NVCC_ARCH) -O3 -std=c++17 -Ic_ref -lineinfo -Xcompiler -Wall
 NVCC_MODE_normal   :=
 NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DHB_REFERENCE_ARITHMETIC=1
 NVCC_MODE_fastmath := --use_fast_math
@@ -95,6 +110,7 @@ help:
 	@echo "make test     build and run the pytest suite (GPU tests skip with a reason without a GPU;"
 	@echo "             one pytest-xdist worker a core where xdist is installed, TEST_JOBS=N for N)"
 	@echo "make bench    validate GPU variants against the CPU, sweep, studies, report into results/local/ (OUT=results/NAME; BUDGET=10m fits the sizes to a time; SHARD=K/N runs a share)"
+	@echo "make bench SCENE=my.toml  the throughput sweep, speed/accuracy study, frame budget and stability map on your own scene or groom (results/scene-my/; docs/user_scene.md)"
 	@echo "make report   re-render a run folder's report, or one sweep folder's (REPORT_FROM=results/local, REPORT_TO=REPORT_FROM/report;"
 	@echo "             the committed one: REPORT_FROM=results/reference-h200 REPORT_TO=report)"
 	@echo "make report-dynamic  only the dynamic report of REPORT_FROM into REPORT_TO"
@@ -193,7 +209,7 @@ $(BUILD)/hairsim-cuda-strict: $(CUDA_OBJ_strict) $(SHARED_OBJ)
 $(BUILD)/hairsim-cuda-fastmath: $(CUDA_OBJ_fastmath) $(SHARED_OBJ)
 $(CUDA_BINS):
 	@mkdir -p $(BUILD)
-	$(NVCC) -arch=$(CUDA_ARCH) $^ -o $@ $(HDF5_LIBS) -ldl
+	$(NVCC) $(NVCC_ARCH) $^ -o $@ $(HDF5_LIBS) -ldl
 
 # The host checks (tests/native): the CUDA port's model templates compiled for the host and
 # run against the reference's objects; host code only, with the host compiler told the
@@ -256,11 +272,13 @@ test: setup
 	fi; \
 	echo "pytest tests -q -ra $$workers"; $(RUN_PY) -m pytest tests -q -ra $$workers
 
-# make bench's run folder (untracked): results, then the report in $(OUT)/report
+# make bench's run folder (untracked): results, then the report in $(OUT)/report. SCENE=my.toml:
+# the dynamic studies on that scene or groom (docs/user_scene.md), into results/scene-<name>
+# unless OUT is given
 OUT ?= results/local
 bench: setup
 	@$(call BUILD_LOGGED,all)
-	$(RUN_PY) -m harness bench --out $(OUT)$(if $(BUDGET), --budget=$(BUDGET))$(if $(SHARD), --shard=$(SHARD))
+	$(RUN_PY) -m harness bench$(if $(SCENE), --scene $(SCENE))$(if $(and $(SCENE),$(filter file,$(origin OUT))),, --out $(OUT))$(if $(BUDGET), --budget=$(BUDGET))$(if $(SHARD), --shard=$(SHARD))
 
 # REPORT_FROM: the run folder to render (default results/local, make bench's), or one sweep's
 # folder (its runs.csv: the paper report alone); REPORT_TO: where

@@ -434,6 +434,13 @@ void cuda_describe(hb_backend *b, char *device, size_t dlen, char *driver, size_
         else snprintf(device, dlen, "unknown CUDA device");
     }
     driver_version(driver, vlen);
+    /* the compute capability the binary runs on (docs/cuda.md, "Building for your GPU") */
+    int dev = 0, major = 0, minor = 0;
+    if (vlen && cudaGetDevice(&dev) == cudaSuccess &&
+        cudaDeviceGetAttribute(&major, cudaDevAttrComputeCapabilityMajor, dev) == cudaSuccess &&
+        cudaDeviceGetAttribute(&minor, cudaDevAttrComputeCapabilityMinor, dev) == cudaSuccess && major > 0)
+        snprintf(driver + strlen(driver), vlen - strlen(driver), "%scompute capability %d.%d", driver[0] ? "; " : "",
+                 major, minor);
 }
 
 void cuda_teardown(hb_backend *b)

@@ -2,6 +2,7 @@
  * (docs/model.md §3.10): the features of a run, its constants rounded once, and each
  * frame's table of head rotations and gust phases, computed in double. */
 #include "dynamic/dynamics.h"
+#include "dynamic/head_track.h"
 #include "runtime/checked.h"
 
 #include <math.h>
@@ -128,9 +129,14 @@ void hb_dyn_frame_free(hb_dyn_frame *f)
     memset(f, 0, sizeof *f);
 }
 
-/* §3.2: the rotation about the motion's axis by θ(t) = A·sin(2πft), right-handed. */
+/* §3.2: the rotation about the motion's axis by θ(t) = A·sin(2πft), right-handed; or the
+ * recorded track's rotation at t (head_track.h). */
 void hb_head_rotation(const hb_dynamics *d, double t, double q[9])
 {
+    if (d->motion == HB_MOTION_TRACK) {
+        hb_track_rotation(d->track, t, q);
+        return;
+    }
     const double th = d->motion_amplitude * sin(2.0 * M_PI * d->motion_frequency * t);
     const double c = cos(th), sn = sin(th);
     static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -154,7 +160,8 @@ void hb_head_rotation(const hb_dynamics *d, double t, double q[9])
         q[3] = sn;
         q[4] = c;
         break;
-    case HB_MOTION_STILL: break;
+    case HB_MOTION_STILL:
+    case HB_MOTION_TRACK: break;
     }
 }
 

@@ -297,6 +297,12 @@ static const flag_spec flags[] = {
      .offset = OPT(frame_loop),
      .help = "after the run, time F more frames back to back as an application's frame\n"
              "loop would (launches and the frame's tables included; cuda only)"},
+    {.flag = "--motion-track",
+     .kind = F_PATH,
+     .offset = OPT(motion_track),
+     .arg = "FILE",
+     .help = "with --head-motion track: the head's transform track, a CSV file\n"
+             "(docs/interfaces.md, \"Motion tracks\"; translation must be zero)"},
     {.flag = "--draw",
      .kind = F_DRAW,
      .arg = "WxH",
@@ -330,7 +336,7 @@ static const flag_spec flags[] = {
     {"--gust-amplitude", DF_REAL, DYN(gust_amplitude), 0, "relative gust amplitude A_g (default 0: none)"},
     {"--gust-frequency", DF_REAL, DYN(gust_frequency), 0, "gust frequency f_g, Hz (default 1)"},
     {"--gust-wavelength", DF_REAL, DYN(gust_wavelength), 0, "gust wavelength λ_g, cm (default 100)"},
-    {"--head-motion", DF_MOTION, DYN(motion), 0, "still | nod | shake | tilt (default still)"},
+    {"--head-motion", DF_MOTION, DYN(motion), 0, "still | nod | shake | tilt | track (--motion-track; default still)"},
     {"--motion-amplitude", DF_REAL, DYN(motion_amplitude), 0, "head motion amplitude A, radians (default 0.25)"},
     {"--motion-frequency", DF_REAL, DYN(motion_frequency), 0, "head motion frequency f, Hz (default 1)"},
     {"--guides", DF_REAL, DYN(guides), DYN(guided),
@@ -656,7 +662,8 @@ static int parse_dyn(const flag_spec *df, const char *v, hb_options *o, char *er
         else if (strcmp(v, "nod") == 0) o->scene.dyn.motion = HB_MOTION_NOD;
         else if (strcmp(v, "shake") == 0) o->scene.dyn.motion = HB_MOTION_SHAKE;
         else if (strcmp(v, "tilt") == 0) o->scene.dyn.motion = HB_MOTION_TILT;
-        else FAIL("--head-motion must be still, nod, shake or tilt (got '%s')", v);
+        else if (strcmp(v, "track") == 0) o->scene.dyn.motion = HB_MOTION_TRACK;
+        else FAIL("--head-motion must be still, nod, shake, tilt or track (got '%s')", v);
         break;
     case DF_SWITCH: *(int *)(base + df->offset) = 0; break;
     case DF_FOLLOW:
@@ -811,6 +818,11 @@ static int check_combinations(hb_options *o, char *err, size_t errlen)
             if (sim || i != o->n_stages - 1) FAIL("--stages: simulate may appear once, as the last stage");
             sim = 1;
         }
+    if (!sim && o->motion_track) FAIL("--motion-track belongs to the simulate stage, which --stages does not list");
+    if (o->motion_track && o->scene.dyn.motion != HB_MOTION_TRACK) FAIL("--motion-track needs --head-motion track");
+    if (o->scene.dyn.motion == HB_MOTION_TRACK && (o->dyn_given & (1ull << hb_dyn_flag_index("--motion-amplitude") |
+                                                                   1ull << hb_dyn_flag_index("--motion-frequency"))))
+        FAIL("--motion-amplitude and --motion-frequency shape nod, shake and tilt, not --head-motion track");
     if (!sim && o->dyn_given) {
         for (int i = 0; hb_dyn_flag_name(i); i++)
             if (o->dyn_given & (1ull << i))

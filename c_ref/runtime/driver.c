@@ -17,6 +17,7 @@
 #include "dynamic/world.h"
 #include "runtime/host.h"
 #include "runtime/input.h"
+#include "runtime/motion_track.h"
 #include "runtime/philox.h"
 #include "runtime/record.h"
 #include "runtime/safe_write.h"
@@ -233,10 +234,11 @@ typedef struct {
     void *render, *vrender, *vhost; /* --render-points: a rendered frame and its velocities; simulated velocities */
     hb_input in;
     int have_input;
-    hb_groom groom;    /* --groom: what init places (docs/model.md §3.15) */
-    hb_colliders cols; /* --colliders (docs/model.md §3.17) */
-    double *times;     /* all stages' timed runs */
-    struct {           /* the simulation, for the file's /parameters */
+    hb_groom groom;      /* --groom: what init places (docs/model.md §3.15) */
+    hb_colliders cols;   /* --colliders (docs/model.md §3.17) */
+    hb_head_track track; /* --motion-track: the head's transform track (motion_track.h) */
+    double *times;       /* all stages' timed runs */
+    struct {             /* the simulation, for the file's /parameters */
         int dynamic;
         int64_t paper_frames, last_frame;
         char features[192];
@@ -249,6 +251,7 @@ static void run_free(hb_run *r)
     if (r->have_input) hb_input_close(&r->in);
     hb_groom_free(&r->groom);
     hb_colliders_free(&r->cols);
+    hb_track_free(&r->track);
     if (r->b->teardown) r->b->teardown(r->b);
     free(r->host);
     free(r->input);
@@ -541,6 +544,38 @@ static int place_groom(hb_run *r, hb_stage_record *sr, double *times, char *err,
     return rc;
 }
 
+/* --head-motion track (docs/model.md §3.2): the samples of --motion-track, or those a resumed
+ * dynamic file holds (then a --motion-track given must hold the same). */
+static int adopt_track(hb_options *o, hb_run *r, char *err, size_t errlen)
+{
+    hb_dynamics *d = &o->scene.dyn;
+    const int from_input = r->have_input && r->in.dynamic && r->in.scene.dyn.motion == HB_MOTION_TRACK;
+    if (o->motion_track) {
+        if (hb_track_load_csv(o->motion_track, &r->track, err, errlen)) return -1;
+        if (from_input && !hb_track_same(&r->track, &r->in.track))
+            return snprintf(err, errlen,
+                            "--motion-track %s does not match the input file's track (a resumed run "
+                            "keeps its physics)",
+                            o->motion_track),
+                   -1;
+        if (!from_input) d->track = &r->track;
+    }
+    if (d->motion == HB_MOTION_TRACK && !d->track)
+        return snprintf(err, errlen, "--head-motion track needs --motion-track FILE (a CSV head transform track)"), -1;
+    return 0;
+}
+
+/* One line on stderr when simulate runs a new simulation on the bare defaults: no physics
+ * flag at all (docs/interfaces.md, "Defaults"). */
+static void note_untuned(const hb_options *o, const hb_run *r)
+{
+    if (o->quiet || (r->have_input && r->in.dynamic) || (o->dyn_given & ~HB_DYN_GIVEN_RUN)) return;
+    fprintf(stderr,
+            "%s: note: no physics flag given: simulate runs the bare defaults (S = 1, I = 1, no bend, shape, drag or "
+            "wind), not a tuned setting; configs/scenes/dynamic.toml is one (python3 -m harness run dynamic)\n",
+            g_prog);
+}
+
 #define CHECK(call, status)                                                                                            \
     do {                                                                                                               \
         if ((call) != 0) {                                                                                             \
@@ -554,7 +589,8 @@ static int run_one(int argc, char **argv, hb_backend *b);
 /* --batch FILE: one run a line, its flags separated by tabs, all in this process, so that a
  * GPU's context is made once for all of them (docs/interfaces.md, "Batches"). The runs go in
  * order; the first that fails ends the batch with its exit status, after the records of the
- * runs before it. The backend starts every run as it started the first. */
+ * runs before it; a run that blew up (status 5) does not end it, and the batch then exits 5
+ * when none failed. The backend starts every run as it started the first. */
 #define HB_BATCH_MAX_ARGS 256
 
 /* A batch line is a run: the words that print something else on stdout are not. */
@@ -574,7 +610,7 @@ static int run_batch(char *prog, const char *path, hb_backend *b)
     char *line = NULL;
     size_t cap = 0;
     ssize_t n;
-    int status = HB_EXIT_OK;
+    int status = HB_EXIT_OK, blown = 0;
     for (long lineno = 1; status == HB_EXIT_OK && (n = getline(&line, &cap, f)) >= 0; lineno++) {
         while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r')) line[--n] = '\0';
         if (n == 0) continue;
@@ -610,6 +646,10 @@ static int run_batch(char *prog, const char *path, hb_backend *b)
         }
         argv[argc] = NULL;
         if (status == HB_EXIT_OK) status = run_one(argc, argv, b);
+        if (status == HB_EXIT_BLOWN_UP) { /* a run that blew up ended well: its record says so */
+            blown = 1;
+            status = HB_EXIT_OK;
+        }
         *b = pristine;
         fflush(stdout);
         fflush(stderr);
@@ -620,7 +660,7 @@ static int run_batch(char *prog, const char *path, hb_backend *b)
     }
     free(line);
     fclose(f);
-    return status;
+    return status == HB_EXIT_OK && blown ? HB_EXIT_BLOWN_UP : status;
 }
 
 int hb_main(int argc, char **argv, hb_backend *b)
@@ -729,6 +769,7 @@ static int run_one(int argc, char **argv, hb_backend *b)
     CHECK(hb_scene_validate(&o.scene, err, sizeof err), HB_EXIT_USAGE);
     const int simulate = o.stages[o.n_stages - 1] == HB_STAGE_SIMULATE;
     if (simulate) {
+        CHECK(adopt_track(&o, &run, err, sizeof err), HB_EXIT_USAGE);
         CHECK(hb_dynamics_validate(&o.scene.dyn, err, sizeof err), HB_EXIT_USAGE);
         CHECK(hb_dynamics_validate_scene(&o.scene, err, sizeof err), HB_EXIT_USAGE);
         if (o.end_to_end) {
@@ -811,6 +852,8 @@ static int run_one(int argc, char **argv, hb_backend *b)
         snprintf(err, sizeof err, "--output %s is the --input file; write to another name", o.output);
         CHECK(1, HB_EXIT_USAGE);
     }
+
+    if (simulate) note_untuned(&o, &run);
 
     const uint64_t bytes = hb_state_bytes(&o.scene);
     const int need_host = o.output != NULL || o.end_to_end || simulate;
@@ -1020,5 +1063,5 @@ static int run_one(int argc, char **argv, hb_backend *b)
     if (o.json) hb_record_json(stdout, &rec);
     if (!o.quiet) hb_record_summary(stderr, &rec);
     run_free(&run);
-    return HB_EXIT_OK;
+    return hb_record_blown_frames(&rec) ? HB_EXIT_BLOWN_UP : HB_EXIT_OK;
 }

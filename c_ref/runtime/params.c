@@ -125,6 +125,7 @@ const char *hb_motion_name(hb_motion m)
     case HB_MOTION_NOD: return "nod";
     case HB_MOTION_SHAKE: return "shake";
     case HB_MOTION_TILT: return "tilt";
+    case HB_MOTION_TRACK: return "track";
     }
     return "?";
 }

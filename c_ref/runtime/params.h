@@ -15,13 +15,21 @@ extern "C" {
 #define HB_ERRLEN 512
 
 /* Exit statuses (docs/interfaces.md). */
-enum { HB_EXIT_OK = 0, HB_EXIT_USAGE = 2, HB_EXIT_MEMORY = 3, HB_EXIT_RUNTIME = 4 };
+/* HB_EXIT_BLOWN_UP: the run ended and wrote everything, but a simulated frame blew up (§3.8) */
+enum { HB_EXIT_OK = 0, HB_EXIT_USAGE = 2, HB_EXIT_MEMORY = 3, HB_EXIT_RUNTIME = 4, HB_EXIT_BLOWN_UP = 5 };
 
 typedef enum { HB_FP32 = 0, HB_FP64 = 1 } hb_precision;
 typedef enum { HB_STAGE_INIT = 0, HB_STAGE_WIND = 1, HB_STAGE_COLLIDE = 2, HB_STAGE_SIMULATE = 3 } hb_stage;
 /* rigid: no dynamics, every point carried with the head (docs/model.md §3.13) */
 typedef enum { HB_SOLVER_XPBD = 0, HB_SOLVER_FTL = 1, HB_SOLVER_RIGID = 2, HB_SOLVER_COUNT = 3 } hb_solver;
-typedef enum { HB_MOTION_STILL = 0, HB_MOTION_NOD = 1, HB_MOTION_SHAKE = 2, HB_MOTION_TILT = 3 } hb_motion;
+/* track: a recorded transform track (--motion-track FILE, dynamic/head_track.h) */
+typedef enum {
+    HB_MOTION_STILL = 0,
+    HB_MOTION_NOD = 1,
+    HB_MOTION_SHAKE = 2,
+    HB_MOTION_TILT = 3,
+    HB_MOTION_TRACK = 4
+} hb_motion;
 typedef enum { HB_FOLLOW_BLEND3 = 0, HB_FOLLOW_ONE = 1 } hb_follow;
 
 /* The dynamic model's physics (docs/model.md §3): everything that decides the bits of a
@@ -47,8 +55,9 @@ typedef struct {
     double wind_speed;                                      /* U, cm/s; direction ψ is hb_scene.wind_angle */
     double gust_amplitude, gust_frequency, gust_wavelength; /* A_g, f_g (Hz), λ_g (cm) */
     hb_motion motion;
-    double motion_amplitude; /* A, radians */
-    double motion_frequency; /* f, Hz */
+    double motion_amplitude;           /* A, radians */
+    double motion_frequency;           /* f, Hz */
+    const struct hb_head_track *track; /* HB_MOTION_TRACK: the samples (owned by the run or its --input) */
     /* docs/model.md §3.13: guides and followers, long-range attachments */
     int guided;            /* --guides given: only the guides are simulated */
     double guides;         /* a fraction in (0, 1] of the strands, or a count > 1 */
@@ -108,12 +117,13 @@ typedef struct {
     hb_scene scene;
     hb_stage stages[HB_MAX_STAGES];
     int n_stages;
-    const char *variant; /* NULL: the backend's default */
-    int threads;         /* cpu: 0 = all cores */
-    int block_size;      /* cuda */
-    const char *input;   /* NULL: start with init */
-    const char *groom;   /* --groom: "curly" or a HAIR file; NULL: the drape */
-    const char *output;  /* NULL: no file */
+    const char *variant;      /* NULL: the backend's default */
+    int threads;              /* cpu: 0 = all cores */
+    int block_size;           /* cuda */
+    const char *input;        /* NULL: start with init */
+    const char *groom;        /* --groom: "curly" or a HAIR file; NULL: the drape */
+    const char *motion_track; /* --motion-track: a CSV head transform track; NULL: none */
+    const char *output;       /* NULL: no file */
     int force;
     int repeat;
     int warmup; /* -1: default (1 if repeat > 1, else 0) */

@@ -220,6 +220,8 @@ void hb_record_json(FILE *f, const hb_record *r)
         fputc('}', f);
     }
     fputs("]", f);
+    /* a blown-up simulation is flagged here and by the exit status (docs/interfaces.md) */
+    fprintf(f, ", \"blown_up\": %s", hb_record_blown_frames(r) ? "true" : "false");
     json_key_num(f, "end_to_end_ms", r->end_to_end_ms);
     json_key_num(f, "h2d_ms", r->h2d_ms);
     json_key_num(f, "d2h_ms", r->d2h_ms);
@@ -232,6 +234,14 @@ void hb_record_json(FILE *f, const hb_record *r)
     json_key_str(f, "driver", r->driver[0] ? r->driver : NULL);
     json_key_str(f, "version", HB_VERSION);
     fputs("}\n", f);
+}
+
+int64_t hb_record_blown_frames(const hb_record *r)
+{
+    int64_t n = 0;
+    for (int i = 0; i < r->n_stages; i++)
+        if (r->stages[i].stage == HB_STAGE_SIMULATE) n += r->stages[i].blown_frames;
+    return n;
 }
 
 void hb_record_summary(FILE *f, const hb_record *r)
@@ -257,7 +267,8 @@ void hb_record_summary(FILE *f, const hb_record *r)
                     st->features);
             fprintf(f, "\n    last frame: stretch_max %.3g, penetration_max %.3g cm, kinetic energy %.6g cm2/s2",
                     st->last.stretch_max, st->last.penetration_max, st->last.kinetic_energy);
-            if (st->blown_frames) fprintf(f, "; BLOWN UP in %lld frames", (long long)st->blown_frames);
+            if (st->blown_frames)
+                fprintf(f, "; BLOWN UP in %lld frames (exit status %d)", (long long)st->blown_frames, HB_EXIT_BLOWN_UP);
         }
         fputc('\n', f);
     }

@@ -45,6 +45,8 @@ typedef struct {
 } hb_record;
 
 void hb_record_json(FILE *f, const hb_record *r);
+/* Frames of the run's simulation that blew up (docs/model.md §3.8); 0 without one. */
+int64_t hb_record_blown_frames(const hb_record *r);
 void hb_record_summary(FILE *f, const hb_record *r);
 
 /* Statistics of n times: median (mean of the middle two for even n), min, max. */

@@ -4,6 +4,7 @@
 #include "runtime/checked.h"
 #include "runtime/h5md_meta.h"
 #include "runtime/input.h"
+#include "runtime/motion_track.h"
 
 #include <errno.h>
 #include <stddef.h>
@@ -568,6 +569,7 @@ static int write_dynamic(hb_writer *w, hid_t p, const hb_run_meta *rm)
     bad |= attr_i64(p, "sag_free", d->sag_free) < 0;
     bad |= attr_i64(p, "per_segment", d->per_segment) < 0; /* §3.15 */
     if (d->render_points) bad |= write_lod(w, p) < 0;
+    if (d->motion == HB_MOTION_TRACK && d->track) bad |= hb_track_write_h5(p, d->track) < 0;
     if (d->guided) bad |= attr_str(p, "follow", hb_follow_name(d->follow)) < 0;
     bad |= write_world(p, d) < 0; /* §3.16, §3.17 */
     const struct {
@@ -853,6 +855,7 @@ void hb_input_close(hb_input *in)
     in->vel_step = in->obs_step = NULL;
     in->vel_time = in->obs_time = NULL;
     in->obs = NULL;
+    hb_track_free(&in->track);
 }
 
 /* Reads a 1-D dataset at `path` of any length into a new array; its length in *n. */
@@ -1089,7 +1092,12 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
     else if (strcmp(motion, "nod") == 0) d->motion = HB_MOTION_NOD;
     else if (strcmp(motion, "shake") == 0) d->motion = HB_MOTION_SHAKE;
     else if (strcmp(motion, "tilt") == 0) d->motion = HB_MOTION_TILT;
+    else if (strcmp(motion, "track") == 0) d->motion = HB_MOTION_TRACK;
     else return snprintf(err, errlen, "--input %s: unknown head motion '%s'", path, motion), -1;
+    if (d->motion == HB_MOTION_TRACK) {
+        if (hb_track_read_h5(f, path, &in->track, err, errlen)) return -1;
+        d->track = &in->track;
+    }
     char why[HB_ERRLEN];
     if (hb_dynamics_validate(d, why, sizeof why) != 0)
         return snprintf(err, errlen, "--input %s holds invalid dynamic parameters: %s", path, why), -1;

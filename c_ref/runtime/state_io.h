@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "dynamic/dynamics.h"
+#include "dynamic/head_track.h"
 #include "runtime/params.h"
 
 #ifdef __cplusplus
@@ -82,6 +83,7 @@ typedef struct {
     /* §3.17 a dynamic file's colliders (scene.dyn.cols points here) and their file's name */
     hb_colliders cols;
     char colliders_file[1024];
+    hb_head_track track; /* head_motion = track: /parameters/motion_track (scene.dyn.track points here) */
 } hb_input;
 
 /* Opens and checks the layout and the scene; one line in err on failure. */

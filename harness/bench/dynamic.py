@@ -37,8 +37,8 @@ from harness.core.scenes import with_frames
 from harness.io import results_data
 from harness.io.files import write_json
 from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
-from harness.studies import accuracy_dynamic, animate, featurecost, peer, reduced, stability
-from harness.studies.accuracy import DEFAULT_SCENE, results_name
+from harness.studies import accuracy_dynamic, animate, budget_curves, featurecost, peer, reduced, stability
+from harness.studies.accuracy import DEFAULT_SCENE, curves_name, results_name
 from harness.studies.sweep import run_sweep
 
 VALIDATION_STRANDS = 2000
@@ -48,8 +48,9 @@ CURLY_SWEEP = report_dynamic.CURLY_SWEEP
 
 
 class DynValidator:
-    def __init__(self, scratch, say):
-        base = scenes.load_scene("dynamic").with_overrides(strands=VALIDATION_STRANDS)
+    def __init__(self, scratch, say, scene="dynamic", strands=VALIDATION_STRANDS):
+        """`scene`: the dynamic scene validated (a user's, bench --scene), at `strands` strands."""
+        base = scenes.load_scene(scene).with_overrides(strands=strands)
         self.scene = with_frames(base, 2)
         self.scratch = Path(scratch)
         self.say = say
@@ -60,14 +61,27 @@ class DynValidator:
     def cpu_others(self):
         """The CPU variants other than the oracle that simulate: each is stepped one frame."""
         cpu = variants.declared("cpu")
-        return [v for v in cpu.variants if v != cpu.default_variant and cpu.runs(v)]
+        feats = variants.features_of(self.scene.dynamic)
+        return [
+            v
+            for v in cpu.variants
+            if v != cpu.default_variant
+            and cpu.runs(v)
+            and cpu.runs_features(v, feats)
+            and (not self.scene.groom or v in cpu.per_segment)
+        ]
 
     def gpu_cases(self, builds):
         """(build, variant, block) of every GPU comparison of one precision and solver."""
         out = []
+        feats = variants.features_of(self.scene.dynamic)
         for build in builds:
             decl = variants.declared("cuda", build)
-            for v in (n for n in decl.variants if decl.runs(n, points=self.scene.points)):
+            for v in decl.variants:
+                if not decl.runs(v, points=self.scene.points) or not decl.runs_features(v, feats):
+                    continue
+                if self.scene.groom and v not in decl.per_segment:  # a groom's rest lengths: not every variant
+                    continue
                 out += [(build, v, b) for b in BLOCK_SIZES if decl.runs(v, points=self.scene.points, block=b)]
         return out
 
@@ -186,11 +200,14 @@ class DynValidator:
                     )
 
 
-def validate(out_dir, builds, gpu_note, say):
+def validate(out_dir, builds, gpu_note, say, scene="dynamic", strands=VALIDATION_STRANDS):
     def header(v):
-        return {"model": "dynamic", "strands": VALIDATION_STRANDS, "points": v.scene.points, "scene": v.scene.name}
+        return {"model": "dynamic", "strands": v.scene.strands, "points": v.scene.points, "scene": v.scene.name}
 
-    validation.validate(DynValidator, "dynamic validation", out_dir, builds, gpu_note, say, header)
+    def make(scratch, say_):
+        return DynValidator(scratch, say_, scene, strands)
+
+    validation.validate(make, "dynamic validation", out_dir, builds, gpu_note, say, header)
 
 
 def fastest_gpu_variants(sweep_dir):
@@ -237,6 +254,24 @@ def featurecost_size(sweep_dir, allowance_s):
         return cases * FEATURECOST_FRAMES_A_CASE * n * work / rate
 
     return largest_that_fits(FEATURECOST_STRANDS, seconds, allowance_s)
+
+
+def budget_modes(acc_dir):
+    """The modes the frame budget's curves time (studies/budget_curves.py): each backend's Pareto
+    front of the accuracy study in `acc_dir` (render/accuracy_dynamic_report.front_of: the usable
+    modes no other is both faster and more accurate than, the no-simulation mode among them), as
+    dicts of the study's columns."""
+    rows, study, _, _ = accuracy_dynamic_report.load(acc_dir)
+    summ = accuracy_dynamic_report.summary(rows, study["horizon_frames"])
+    modes = []
+    for backend, part in summ.groupby("backend"):
+        for _, r in accuracy_dynamic_report.front_of(part).iterrows():
+            s = r["ftl_damping"]
+            modes.append(dict(mode=r["mode"], backend=backend, build=r["build"], variant=r["variant"],
+                              solver=r["solver"], ftl_damping=None if s != s else float(s),
+                              substeps=int(r["substeps"]), iterations=int(r["iterations"]),
+                              precision=r["precision"]))  # fmt: skip
+    return modes
 
 
 # (scene, the study's name in the log and the budget): the straight default scene, then curly hair
@@ -331,12 +366,21 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
         within("reduced", measure_reduced, root / "reduced")
     for scene, study in ACCURACY_STUDIES:
         if mine(study) and fits(study):
-            within(
+            ran = within(
                 study,
                 lambda s=scene: accuracy(root, s, gpu, quick, say, report_dir),
                 root / results_name(scene),
                 *reports,
             )
+            if ran and scene == DEFAULT_SCENE and fits("budget curves"):  # the frame budget's answer needs them
+                gate = TierGate(budget.allowance("budget curves")) if budget else None
+                within(
+                    "budget curves",
+                    lambda s=scene, g=gate: budget_curves.measure(
+                        root, s, budget_modes(root / results_name(s)), gate=g, log=say
+                    ),
+                    root / curves_name(scene),
+                )
     if fits("stability"):
 
         def measure_stability():

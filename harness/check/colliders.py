@@ -53,7 +53,9 @@ def depths(traj, points, t):
     q = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
     turns = traj.head_motion != "still"
     if turns:
-        q = head_rotation(traj.head_motion, float(params["motion_amplitude"]), float(params["motion_frequency"]), t)
+        q = head_rotation(
+            traj.head_motion, float(params["motion_amplitude"]), float(params["motion_frequency"]), t, traj.motion_track
+        )
     b = body_translation(params, t)
     cm = float(params.get("collision_margin", 0.0))
     x = np.asarray(points, float).reshape(-1, 3)

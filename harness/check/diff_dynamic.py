@@ -49,6 +49,7 @@ from harness import HarnessError
 from harness.check import diff, invariants_dynamic
 from harness.core import runner, tolerances
 from harness.core.paths import build_dir, display
+from harness.core.runner import COMPLETED
 from harness.core.ulp import coarser, ulp_distance
 from harness.io.states import StateError, as_text
 from harness.io.trajectory import open_trajectory
@@ -160,7 +161,7 @@ def _step_once(binary, reference, k, out, timeout):
         p = runner.run_command(cmd, timeout=timeout)
     except runner.TimedOut:
         raise HarnessError(f"{display(binary)} did not finish within {timeout} s", code=2) from None
-    if p.returncode != 0:
+    if p.returncode not in COMPLETED:
         msg = (p.stderr.strip().splitlines() or [f"status {p.returncode}"])[-1]
         raise HarnessError(
             f"cannot measure the spread: {display(binary)} failed on frame {k} of {reference}: {msg}",
@@ -546,7 +547,7 @@ def stepdiff(reference, binary, flags=(), frames="all", exact=False, keep=None, 
                 p = runner.run_command(cmd, timeout=timeout)
             except runner.TimedOut:
                 raise HarnessError(f"{binary.name} did not finish within {timeout} s", code=2) from None
-            if p.returncode != 0:
+            if p.returncode not in COMPLETED:
                 msg = (p.stderr.strip().splitlines() or ["no message"])[-1]
                 raise HarnessError(
                     f"cannot compare: {binary.name} exited with status {p.returncode} on frame {k}: {msg}",

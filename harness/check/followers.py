@@ -99,6 +99,7 @@ def place_followers(traj, f, velocity=None):
                 float(p["motion_amplitude"]),
                 float(p["motion_frequency"]),
                 frame_end_time(traj, f),
+                traj.motion_track,
             )
         ]
     with np.errstate(all="ignore"):

@@ -90,5 +90,6 @@ def frame_volume(trajectory, f):
             float(params["motion_amplitude"]),
             float(params["motion_frequency"]),
             float(trajectory.time[f]),
+            trajectory.motion_track,
         )
     return {"hair_volume": hair_volume(x, q), "envelope_radius": envelope_radius(x), "close_pairs": close_pairs(x)}

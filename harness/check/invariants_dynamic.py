@@ -35,7 +35,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from harness.check import invariants
-from harness.check.head_motion import head_rotation  # noqa: F401 (read from here by other modules)
+from harness.check.head_motion import head_rotation, track_rotation  # noqa: F401 (read from here by other modules)
 from harness.check.invariants import Violation
 from harness.core import tolerances
 from harness.core.guides import guide_count, guide_strands
@@ -103,6 +103,7 @@ def expected_roots(traj, f, rest_roots):
             float(traj.dynamic_params["motion_amplitude"]),
             float(traj.dynamic_params["motion_frequency"]),
             frame_end_time(traj, f),
+            traj.motion_track,
         )
     ]
     a0, a1, a2 = rest_roots[:, 0], rest_roots[:, 1], rest_roots[:, 2]

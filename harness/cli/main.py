@@ -1,8 +1,8 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
 Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, accuracy, headline,
-export, groom, calibrate, featurecost, reduced, peer, animate, render, stability, judge, docs (`--help`
-on each; docs/harness.md lists them). User errors print one line
+export, groom, motion, calibrate, featurecost, reduced, peer, animate, render, stability, judge, budget, hair,
+docs (`--help` on each; docs/harness.md lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
 
 import argparse
@@ -65,6 +65,7 @@ nonneg_seconds = real(
 )
 unit_interval = real("unit_interval", "a number in [0, 1]", lambda v: 0.0 <= v <= 1.0, "must lie in [0, 1]")
 number = real("number", "a number", math.isfinite, "needs a finite number")
+positive = real("positive", "a number", lambda v: 0 < v < math.inf, "must be a finite number > 0")
 
 
 def options(args, names):
@@ -195,19 +196,30 @@ def cmd_bench(args):
     from harness.bench import dynamic as bench_dynamic
     from harness.bench import merge
     from harness.bench import paper as bench_paper
-    from harness.core import budget, shards
-    from harness.core.paths import LOCAL_RUN
+    from harness.core import budget, shards, timing
+    from harness.core.paths import LOCAL_RUN, binary_path, output_dir
     from harness.core.progress import StepTimes
+    from harness.core.runner import require_binary
+    from harness.io import runfolder
+    from harness.io.files import write_json
+    from harness.io.sweepfile import load_sweep
+    from harness.render import host_report
 
     # one run folder (docs/decisions/bench-runs.md): the paper sweep in ROOT/sweep, the dynamic
     # bench's folders beside it, the report in ROOT/report; nothing tracked is written
-    from harness.io import runfolder
-    from harness.io.sweepfile import load_sweep
+    plan = budget.Budget(budget.parse_duration(args.budget), reserve=budget.REPORT_RESERVE_S) if args.budget else None
+    if args.scene:  # the dynamic studies on the user's own scene, in its own folder (bench/scene.py)
+        from harness.bench import scene as bench_scene
 
+        given = [f for f, v in (("--model", args.model != "all"), ("--sweep", args.sweep != "default"),
+                                ("--shard", args.shard)) if v]  # fmt: skip
+        if given:
+            raise HarnessError(f"bench --scene runs the dynamic studies on that scene alone: drop {', '.join(given)}")
+        quick = not args.full_studies
+        return bench_scene.run(args.scene, args.out, args.gpu, args.report_dir, quick_studies=quick, budget=plan)
     root = Path(args.out) if args.out else LOCAL_RUN
     report_dir = Path(args.report_dir) if args.report_dir else root / "report"
     shard = shards.parse(args.shard) if args.shard else None
-    plan = budget.Budget(budget.parse_duration(args.budget), reserve=budget.REPORT_RESERVE_S) if args.budget else None
     runfolder.claim(root, "bench", force=getattr(args, "force", False))  # before anything is measured or written
     sweeps = {}
     if args.model in ("all", "paper"):
@@ -215,6 +227,9 @@ def cmd_bench(args):
     if args.model in ("all", "dynamic"):
         sweeps["dynamic"] = load_sweep(bench_dynamic.SWEEP).path
         sweeps["dynamic-curly"] = load_sweep(bench_dynamic.CURLY_SWEEP).path
+    require_binary(binary_path("cpu"))  # before the run's folder is made
+    # the host's load before anything runs: the top of the run's reports says whether it was quiet
+    write_json(output_dir(root) / host_report.HOST_JSON, timing.host_load())
     if plan:
         print(
             f"harness: budget {plan.seconds:.0f} s: the sweeps' largest sizes and the studies are left out "
@@ -459,6 +474,60 @@ def cmd_groom(args):
 
     n = grooms.convert(args.src, args.dst, force=args.force)
     print(f"wrote {args.dst}: {n} strands")
+    return 0
+
+
+def cmd_budget(args):
+    """For a scene, a strand count and a frame budget: on each device a run measured (or the GPU --gpu names),
+    the most accurate mode whose time a frame at --strands, predicted from its own measured throughput curve,
+    fits --frame-ms; its predicted time (said where it is extrapolated beyond the measured sizes, or within timing
+    noise of the budget) and its RMS error over the accuracy study's horizon (docs/harness.md, "A frame budget").
+    Reads RUN/dynamic-accuracy[-SCENE]/ and RUN/budget-curves[-SCENE]/ (make bench, or make bench SCENE=...)."""
+    from harness.core.paths import LOCAL_RUN
+    from harness.render import frame_budget
+
+    data = frame_budget.load(args.run or LOCAL_RUN, args.scene)
+    if args.json:
+        print(json.dumps(frame_budget.answer(data, args.strands, args.frame_ms, args.gpu), indent=1, default=float))
+        return 0
+    print("\n".join(frame_budget.lines(data, args.strands, args.frame_ms, args.gpu, scene=args.scene)))
+    return 0
+
+
+def cmd_hair(args):
+    """Map a hair fibre (a preset, or radius, Young's modulus and density) to the dynamic model's point mass,
+    stiffnesses and per-unit-mass compliances on a strand of --length cm and --points points (docs/hair_physics.md),
+    and print the [fibre] table that puts it in a scene."""
+    from harness.core import hair_physics, scenes
+    from harness.render import fibre_report
+
+    try:
+        fibre = hair_physics.fibre(
+            args.preset, args.radius_um, args.youngs_gpa, args.density, "given on the command line"
+        )
+    except ValueError as e:
+        raise HarnessError(f"hair: {e}") from None
+    curvature = args.curvature or 1.0 / (scenes.Scene.head_radius + scenes.Scene.hair_offset)
+    try:
+        m = hair_physics.mapped(fibre, args.length, args.points, curvature)
+    except ValueError as e:
+        raise HarnessError(f"hair: {e}") from None
+    print(fibre_report.text(args.preset, fibre, m))
+    return 0
+
+
+def cmd_motion(args):
+    from harness.io import motion_tracks
+
+    n = motion_tracks.convert(
+        args.src,
+        args.dst,
+        prim_path=args.prim,
+        relative=args.relative,
+        rotation_only=args.rotation_only,
+        force=args.force,
+    )
+    print(f"wrote {args.dst}: {n} samples")
     return 0
 
 
@@ -846,6 +915,13 @@ def parser():
         "harness merge joins them",
     )
     b.add_argument(
+        "--scene",
+        default=None,
+        help="a dynamic scene or groom of your own (a .toml path or a name in configs/scenes/): validation, the "
+        "throughput sweep, the speed/accuracy study, the frame budget's curves and the stability map on it, into "
+        "its own folder (default results/scene-<name>) and report (OUT/report/scene.md); docs/user_scene.md",
+    )
+    b.add_argument(
         "--full-studies",
         action="store_true",
         help="dynamic: the full accuracy study and stability map (tens of minutes) instead of the "
@@ -992,6 +1068,47 @@ def parser():
     gc.add_argument("src", help="a USD file (.usd, .usda, .usdc, .usdz)")
     gc.add_argument("dst", help="the HAIR file to write")
     gc.add_argument("--force", action="store_true", help="replace dst if it exists")
+    bu = command(sub, cmd_budget, help="a frame budget's answer: the most accurate mode that fits, from measured data")
+    bu.add_argument("--strands", type=whole(1), required=True, help="strands simulated a frame")
+    bu.add_argument("--frame-ms", type=positive, required=True, help="the simulation's budget, ms a frame")
+    bu.add_argument("--scene", default="dynamic", help="the scene whose data to use (default dynamic)")
+    bu.add_argument("--gpu", default=None, help="only the GPU whose name holds this (e.g. H200); default: every device")
+    bu.add_argument("--run", default=None, help="the run folder (default results/local, make bench's)")
+    bu.add_argument("--json", action="store_true", help="print the answer as JSON")
+
+    from harness.core.hair_physics import PRESETS
+
+    hp = command(sub, cmd_hair, help="physical hair: a fibre's point mass, stiffness and compliances")
+    hp.add_argument("--preset", choices=tuple(PRESETS), default=None, help="a measured hair type")
+    hp.add_argument("--radius-um", type=positive, default=None, help="fibre radius r, µm (replaces the preset's)")
+    hp.add_argument("--youngs-gpa", type=positive, default=None, help="Young's modulus E, GPa (replaces the preset's)")
+    hp.add_argument("--density", type=positive, default=None, help="density ρ, g/cm³ (replaces the preset's)")
+    hp.add_argument("--length", type=positive, default=30.0, help="strand length L, cm (default 30)")
+    hp.add_argument("--points", type=whole(3), default=32, help="points per strand (default 32)")
+    hp.add_argument(
+        "--curvature",
+        type=positive,
+        default=None,
+        help="the strand's rest curvature κ where it bends, 1/cm (default 1/(R + h) of the default head: 1/10.1)",
+    )
+
+    mo = sub.add_parser(
+        "motion",
+        help="convert a USD xform's time samples to the CSV head track the binaries read",
+        description="motion convert IN.usd OUT.csv: the world transform of a prim (--prim, else the first xformable "
+        "prim with time samples) at each of its time samples, as the CSV of --head-motion track --motion-track "
+        '(docs/interfaces.md, "Motion tracks"): seconds from the stage\'s timeCodesPerSecond, unit quaternions '
+        "turned Y-up, translations in cm. The binaries refuse a non-zero translation (head translation is not "
+        "modelled yet): --rotation-only drops it. Needs usd-core; refused in one line without it.",
+    )
+    msub = mo.add_subparsers(dest="motion_command", required=True)
+    mc = command(msub, cmd_motion, help="USD xform time samples → CSV track", name="convert")
+    mc.add_argument("src", help="a USD file (.usd, .usda, .usdc, .usdz)")
+    mc.add_argument("dst", help="the CSV track to write")
+    mc.add_argument("--prim", default=None, help="the animated prim's path (default: the first with time samples)")
+    mc.add_argument("--relative", action="store_true", help="each rotation relative to the first sample's")
+    mc.add_argument("--rotation-only", action="store_true", help="write zero translation (the rotation alone)")
+    mc.add_argument("--force", action="store_true", help="replace dst if it exists")
     c = command(sub, cmd_calibrate, help="measure fp32-vs-fp64 errors behind tolerances.py")
     c.add_argument("--strands", type=whole(1), default=20000)
     c.add_argument("--points", type=whole(2), nargs="+", default=[8, 32, 128])

@@ -21,8 +21,9 @@ from harness import HarnessError
 from harness.core import runner
 
 # of the time left when the step starts: the paper sweep, then the dynamic sweep; the
-# dynamic studies get what is left after that (each runs while any is left)
-SHARES = {"paper sweep": 0.45, "dynamic sweep": 0.5, "curly sweep": 0.15}
+# dynamic studies get what is left after that (each runs while any is left); the frame
+# budget's curves a share of what is left after the accuracy study (docs/decisions/honest-timings.md)
+SHARES = {"paper sweep": 0.45, "dynamic sweep": 0.5, "curly sweep": 0.15, "budget curves": 0.3}
 # kept back from the measuring steps for the reports rendered after the last study: at
 # de894b7f904c a BUDGET=10m run on the H200 node spent 14.6 s rendering after its last study
 # was stopped, so it took 615 s of its 600
@@ -171,12 +172,13 @@ def tiers(cases, size):
     return [(s, out[s]) for s in sorted(out)]
 
 
-def estimate(last, nxt):
+def estimate(last, nxt, work=1.0):
     """Seconds the tier `nxt` = (size, n_cases) should take, from the measured tier
-    `last` = (size, n_cases, seconds)."""
+    `last` = (size, n_cases, seconds) of which the share `work` was the timed samples: they
+    grow with the size, the rest (process starts, set-up, the stopping rule's rounds) stays."""
     size, n, seconds = last
     per_case = seconds / max(n, 1)
-    return per_case * (nxt[0] / size) * nxt[1]
+    return per_case * ((1.0 - work) + work * nxt[0] / size) * nxt[1]
 
 
 class TierGate:
@@ -187,6 +189,7 @@ class TierGate:
         self.allowance, self.clock = allowance_s, clock
         self.start = clock()
         self.last = None
+        self.work = 1.0  # the share of the last tier's time that was timed samples
         self.closed = None  # the reason, once a tier was refused (all larger ones are too)
         self.refused = []  # (size, cases) of every tier left out
 
@@ -196,7 +199,7 @@ class TierGate:
             return False, self.closed
         if self.last is None:
             return True, None  # the first tier is the measurement the rest is judged by
-        need = estimate(self.last, (size, n))
+        need = estimate(self.last, (size, n), self.work)
         left = self.allowance - (self.clock() - self.start)
         if need > left:
             self.closed = (
@@ -215,9 +218,11 @@ class TierGate:
         sizes = ", ".join(str(sz) for sz, _ in self.refused)
         return f"{n} case(s) at sizes {sizes} (strands × points)"
 
-    def measured(self, size, n, seconds):
+    def measured(self, size, n, seconds, sampled=None):
+        """A tier ran: `sampled` of its `seconds` were timed samples (None: all of them)."""
         if n:
             self.last = (size, n, seconds)
+            self.work = 1.0 if sampled is None or seconds <= 0 else min(1.0, max(sampled / seconds, 0.0))
 
 
 def largest_that_fits(ladder, seconds_at, allowance_s):

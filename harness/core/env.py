@@ -45,19 +45,28 @@ def cpu_model():
     return platform.processor() or None
 
 
+GPU_QUERY = ("name", "driver_version", "memory.total", "compute_cap")
+
+
 def gpu_info():
-    out = (
-        _cmd(["nvidia-smi", "--query-gpu=name,driver_version,memory.total", "--format=csv,noheader"])
-        if shutil.which("nvidia-smi")
-        else None
-    )
-    if not out:
+    """Each GPU's name, driver, memory and compute capability (an older driver without
+    compute_cap: the other three)."""
+    if not shutil.which("nvidia-smi"):
+        return None
+    for fields in (GPU_QUERY, GPU_QUERY[:3]):
+        out = _cmd(["nvidia-smi", f"--query-gpu={','.join(fields)}", "--format=csv,noheader"])
+        if out:
+            break
+    else:
         return None
     gpus = []
     for line in out.splitlines():
         parts = [p.strip() for p in line.split(",")]
-        if len(parts) == 3:
-            gpus.append({"name": parts[0], "driver": parts[1], "memory": parts[2]})
+        if len(parts) == len(fields):
+            gpu = {"name": parts[0], "driver": parts[1], "memory": parts[2]}
+            if len(parts) == 4:
+                gpu["compute_capability"] = parts[3]
+            gpus.append(gpu)
     return gpus or None
 
 

@@ -11,6 +11,7 @@ ROOT = Path(__file__).resolve().parents[2]
 CONFIGS = ROOT / "configs"
 SCENES = CONFIGS / "scenes"  # scene files (docs/model.md §2.6)
 SWEEPS = CONFIGS / "sweeps"  # sweep files
+MOTIONS = CONFIGS / "motions"  # head transform tracks (docs/interfaces.md, "Motion tracks")
 RESULTS = ROOT / "results"
 LOCAL_RUN = RESULTS / "local"  # make bench's run folder (untracked; docs/decisions/bench-runs.md)
 REPORT = LOCAL_RUN / "report"  # where reports are rendered unless --report-dir says otherwise

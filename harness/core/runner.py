@@ -31,6 +31,10 @@ from harness.core import tempfiles
 from harness.core.paths import display
 
 RECORD_KEYS = ("backend", "precision", "strands", "points", "stages")
+# exit statuses of a run that ended with its record printed and its file written: 0, and 5 when
+# a simulated frame blew up (the record's "blown_up" says so; docs/interfaces.md, "Exit status")
+EXIT_BLOWN_UP = 5
+COMPLETED = (0, EXIT_BLOWN_UP)
 
 
 class BackendError(HarnessError):
@@ -230,7 +234,7 @@ def run_binary(
         raise BackendError(f"cannot run {display(binary)}: {e.strerror}") from None
     if proc.returncode == -signal.SIGINT:
         raise KeyboardInterrupt
-    if proc.returncode != 0:
+    if proc.returncode not in COMPLETED:
         why = last_line(proc.stderr) or last_line(proc.stdout) or "no message"
         cls = DoesNotFit if proc.returncode == 3 else BackendError
         raise cls(f"{binary.name} exited with status {proc.returncode}: {why}", code=proc.returncode)
@@ -345,7 +349,7 @@ def _one_batch(
                 raise
             finally:
                 reader.join(timeout=5)
-            if i == len(runs) and rc == 0:
+            if i == len(runs) and rc in COMPLETED:
                 return i
             if rc < 0:
                 _check_not_stopping()

@@ -19,12 +19,21 @@ A scene file:
     [wind]
     strength = 0.5               # w in [0, 1]
     angle = 3.141592653589793    # ψ in radians from +z toward +y
+    [fibre]                      # model = "dynamic": physical hair (docs/hair_physics.md)
+    preset = "thick-straight"    # fine | thick-straight | coarse-curly (harness/core/hair_physics.py)
+    radius_um = 42.95            # r > 0, µm        each replaces the preset's value
+    youngs_modulus_gpa = 3.89    # E > 0, GPa
+    density = 1.32               # ρ > 0, g/cm³
+    reference_curvature = 0.099  # κ > 0, 1/cm (default: the curl's helix, else 1/(R + h))
 
 Every key is optional except `stages`; missing ones take the backends' defaults (the
-values above). Anything else is refused before any work, naming the key: unknown keys,
-counts that are not whole numbers ≥ 1 (≥ 2 for points), NaN or infinite numbers, stages
-that do not exist or a list not starting with init, ℓ < h, and a state whose frame (times
-the copies a backend holds) would not fit in this machine's memory.
+values above). A [fibre] sets the bend and stretch compliances (per unit mass, for the
+scene's L and P; again after an override of points or length) and is refused beside
+constraints.bend_compliance or constraints.stretch_compliance, the low-level interface.
+Anything else is refused before any work, naming the key: unknown keys, counts that are not
+whole numbers ≥ 1 (≥ 2 for points), NaN or infinite numbers, stages that do not exist or a
+list not starting with init, ℓ < h, and a state whose frame (times the copies a backend
+holds) would not fit in this machine's memory.
 """
 
 import math
@@ -32,7 +41,7 @@ import os
 from dataclasses import dataclass, field, replace
 
 from harness import HarnessError
-from harness.core import scenes_dynamic
+from harness.core import hair_physics, scenes_dynamic
 from harness.core.paths import SCENES, config_file, display, read_toml
 
 STAGES = ("init", "collide", "wind", "simulate")
@@ -51,6 +60,7 @@ SCHEMA = {
         "head": None,
         "hair": None,
         "wind": None,
+        "fibre": None,
     },
     "head": {
         "radius": ("head_radius", "pos"),
@@ -66,6 +76,13 @@ SCHEMA = {
         "curl_pitch": ("curl_pitch", "nonneg"),
     },
     "wind": {"strength": ("wind_strength", "unit"), "angle": ("wind_angle", "real")},
+    "fibre": {
+        "preset": ("fibre_preset", "text"),
+        "radius_um": ("fibre_radius_um", "pos"),
+        "youngs_modulus_gpa": ("fibre_youngs_gpa", "pos"),
+        "density": ("fibre_density", "pos"),
+        "reference_curvature": ("fibre_curvature", "pos"),
+    },
 }
 
 # field name → kind, for overrides given on the command line
@@ -105,6 +122,14 @@ class Scene:
     # in the file's cm, () = fitted; head.radius is passed with it only when the scene gives it
     head_center: tuple = ()
     head_radius_given: bool = False
+    # a groom file decides its strands unless the scene or an override gives a count (the first N)
+    strands_given: bool = False
+    # [fibre] (docs/hair_physics.md): a preset and the values that replace its own (0: the preset's)
+    fibre_preset: str = ""
+    fibre_radius_um: float = 0.0
+    fibre_youngs_gpa: float = 0.0
+    fibre_density: float = 0.0
+    fibre_curvature: float = 0.0
     # model = "dynamic": the binary flags of [dynamics], [constraints], [wind] and [head]
     # (harness/core/scenes_dynamic.py), flag → value text, in the order they were declared
     dynamic: dict = field(default_factory=dict)
@@ -137,9 +162,11 @@ class Scene:
                     changes[k] = converted
         if "head_radius" in changes:
             changes["head_radius_given"] = True
+        if "strands" in changes:
+            changes["strands_given"] = True
         scene = replace(self, **changes)
         _check_values(scene, f"scene {self.name}")
-        return scene
+        return with_fibre(scene, f"scene {self.name}")
 
     @property
     def groom_file(self):
@@ -167,7 +194,8 @@ class Scene:
             if self.head_center:  # unless the scene gives the head
                 head = ["--head-center", ",".join(repr(c) for c in self.head_center)]
                 head += ["--head-radius", repr(self.head_radius)] if self.head_radius_given else []
-            return ["--points", str(self.points), "--groom", self.groom_file, *head, *tail]
+            count = ["--strands", str(self.strands)] if self.strands_given else []
+            return [*count, "--points", str(self.points), "--groom", self.groom_file, *head, *tail]
         curl = ["--groom", "curly", "--curl-radius", repr(self.curl_radius), "--curl-pitch", repr(self.curl_pitch)]
         return [
             *(curl if self.groom == "curly" else []),
@@ -335,9 +363,52 @@ def scene_from_dict(data, name, where):
     if "stages" not in values:
         raise SceneError(f"{where}: missing key 'stages' (the ordered list of stages to run)")
     values["head_radius_given"] = "head_radius" in values
+    values["strands_given"] = "strands" in values
     scene = Scene(name=name, source=where, **values)
     _check_values(scene, where)
-    return scene
+    if "fibre" in data:
+        given = [f"constraints.{k[2:].replace('-', '_')}" for k in COMPLIANCES if k in scene.dynamic]
+        if given:
+            raise SceneError(f"{where}: [fibre] sets {' and '.join(given)}: give one or the other")
+    return with_fibre(scene, where)
+
+
+COMPLIANCES = ("--bend-compliance", "--stretch-compliance")  # what a [fibre] sets
+
+
+def fibre_of(scene, where="scene"):
+    """The scene's [fibre] as a hair_physics.Fibre (its preset with the values given), or None."""
+    own = [v or None for v in (scene.fibre_radius_um, scene.fibre_youngs_gpa, scene.fibre_density)]
+    if not scene.fibre_preset and not any(own):
+        return None
+    try:
+        return hair_physics.fibre(scene.fibre_preset or None, *own, where=f"given in {where}")
+    except ValueError as e:
+        raise SceneError(f"{where}: [fibre]: {e}") from None
+
+
+def fibre_curvature(scene):
+    """κ of the fibre mapping: given, else the curly groom's helix, else the scalp's 1/(R + h)."""
+    if scene.fibre_curvature:
+        return scene.fibre_curvature
+    if scene.groom == "curly":
+        return hair_physics.helix_curvature(scene.curl_radius, scene.curl_pitch)
+    return 1.0 / (scene.head_radius + scene.hair_offset)
+
+
+def with_fibre(scene, where):
+    """The scene with the bend and stretch compliances its [fibre] gives (unchanged without one)."""
+    fibre = fibre_of(scene, where)
+    if fibre is None:
+        return scene
+    if scene.model != "dynamic":
+        raise SceneError(f'{where}: [fibre] needs model = "dynamic"')
+    try:
+        m = hair_physics.mapped(fibre, scene.hair_length, scene.points, fibre_curvature(scene))
+    except ValueError as e:
+        raise SceneError(f"{where}: [fibre]: {e}") from None
+    dyn = {**scene.dynamic, COMPLIANCES[1]: m.stretch_compliance, COMPLIANCES[0]: m.bend_compliance}
+    return replace(scene, dynamic=dyn)
 
 
 def find_scene_file(ref):

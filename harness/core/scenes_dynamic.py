@@ -28,9 +28,11 @@ A scene with `model = "dynamic"` may hold, besides the paper keys:
     gust_frequency = 1.0       # f_g ≥ 0 (Hz)   --gust-frequency
     gust_wavelength = 60.0     # λ_g > 0 (cm)   --gust-wavelength
     [head]
-    motion = "nod"             # still | nod | shake | tilt   --head-motion
+    motion = "nod"             # still | nod | shake | tilt | track   --head-motion
     motion_amplitude = 0.25    # A ≥ 0 (rad)    --motion-amplitude
     motion_frequency = 1.0     # f ≥ 0 (Hz)     --motion-frequency
+    motion_track = "turn.csv"  # with motion = "track": a CSV track, relative to the scene file
+                               #                --motion-track (docs/interfaces.md, "Motion tracks")
     [grid]                     # the hair–hair grid (§3.16); a table declares it
     nodes = 32                 # n_g in 2 … 512 --grid
     rebuild = "frame"          # frame | substep  --grid-rebuild
@@ -56,7 +58,7 @@ import os
 
 DEFAULT_STAGES = ("init", "collide", "simulate")
 SOLVERS = ("xpbd", "ftl", "rigid")  # rigid: no dynamics (docs/model.md §3.13)
-MOTIONS = ("still", "nod", "shake", "tilt")
+MOTIONS = ("still", "nod", "shake", "tilt", "track")  # track: --motion-track FILE
 
 # table → key → (flag, kind)
 TABLES = {
@@ -109,6 +111,7 @@ SHARED = {
         "motion": ("--head-motion", MOTIONS),
         "motion_amplitude": ("--motion-amplitude", "nonneg"),
         "motion_frequency": ("--motion-frequency", "nonneg"),
+        "motion_track": ("--motion-track", "path"),
     },
 }
 MAX_COUNT = 10**6  # the binaries' bound on S and I (docs/model.md §3)
@@ -140,6 +143,15 @@ def _value(where, key, kind, value, error):
     if isinstance(kind, tuple):
         if not isinstance(value, str) or value not in kind:
             raise error(f"{where}: {key} must be one of {', '.join(kind)}, got {value!r}")
+        return value
+    if kind == "path":
+        if not isinstance(value, str) or not value:
+            raise error(f"{where}: {key} must be a file name, got {value!r}")
+        if value.lower().endswith((".usd", ".usda", ".usdc", ".usdz")):
+            raise error(
+                f"{where}: {key} is a USD file: convert it first (python3 -m harness motion convert {value} "
+                "TRACK.csv) and name the CSV"
+            )
         return value
     if kind == "bool":
         if not isinstance(value, bool):
@@ -204,6 +216,11 @@ def split(data, where, error):
         raise error(f"{where}: grid.nodes must be from 2 to 512, got {flags['--grid']!r}")
     if any(f.startswith("--grid-") for f in flags) and "--grid" not in flags:
         raise error(f"{where}: the [grid] table needs grid.nodes (the grid is off without it)")
+    track = flags.get("--head-motion") == "track"
+    if track != ("--motion-track" in flags):
+        raise error(f'{where}: head.motion = "track" and head.motion_track go together')
+    if track and ("--motion-amplitude" in flags or "--motion-frequency" in flags):
+        raise error(f'{where}: head.motion_amplitude and head.motion_frequency shape nod, shake and tilt, not "track"')
     if "--shape-range" in flags and "--shape-compliance" not in flags:
         raise error(f"{where}: constraints.shape_range needs constraints.shape_compliance (shape is off without it)")
     if "--frame-dt" in flags or "--substeps" in flags:
@@ -214,7 +231,10 @@ def split(data, where, error):
 
 
 def check(scene, where, error):
-    """The stage list rules of the dynamic model (called for every scene)."""
+    """The stage list rules of the dynamic model and its track file (called for every scene)."""
+    track = track_file(scene)
+    if track is not None and not os.path.isfile(track):
+        raise error(f"{where}: head.motion_track {track}: no such file")
     if scene.model == "dynamic":
         if scene.stages[-1] != "simulate" or "simulate" in scene.stages[:-1]:
             raise error(
@@ -222,6 +242,15 @@ def check(scene, where, error):
             )
     elif "simulate" in scene.stages:
         raise error(f"{where}: stage 'simulate' needs model = \"dynamic\"")
+
+
+def track_file(scene):
+    """The scene's motion track file (relative to the scene file's folder), or None."""
+    name = scene.dynamic.get("--motion-track")
+    if name is None:
+        return None
+    src = scene.source.removeprefix("scene ")
+    return os.path.join(os.path.dirname(src), name) if src else name
 
 
 def flags(scene):
@@ -233,6 +262,8 @@ def flags(scene):
             if value is False:
                 out.append(flag)
             continue
+        if flag == "--motion-track":
+            value = track_file(scene)
         if flag == "--colliders":
             src = scene.source.removeprefix("scene ")
             value = str(os.path.join(os.path.dirname(src), value)) if src and not os.path.isabs(value) else value
@@ -254,7 +285,7 @@ DECLARING = {
     "shape": ("--shape-compliance", "--shape-range"),
     "wind": ("--wind-speed", "--gust-amplitude", "--gust-frequency", "--gust-wavelength"),
     "gust": ("--gust-amplitude",),
-    "motion": ("--head-motion", "--motion-amplitude", "--motion-frequency"),
+    "motion": ("--head-motion", "--motion-amplitude", "--motion-frequency", "--motion-track"),
     "drag": ("--drag", "--damping"),
 }
 FEATURES = ("bend", "shape", "wind", "gust", "motion", "collide", "drag")

@@ -85,6 +85,18 @@ def _curves(Usd, UsdGeom, path):  # noqa: N803 (pxr's module names)
     return strands
 
 
+def hair_strand_count(path):
+    """The strand count a HAIR file's header gives (docs/model.md §3.15), or None where it is not one."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(8)
+    except OSError:
+        return None
+    if len(head) < 8 or head[:4] != b"HAIR":
+        return None
+    return struct.unpack("<I", head[4:8])[0]
+
+
 def hair_bytes(strands):
     """A HAIR file (docs/model.md §3.15's layout) holding the strands: segments and points arrays."""
     counts = [len(s) for s in strands]

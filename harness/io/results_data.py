@@ -63,7 +63,9 @@ def per_case(rows):
                 pair_iqr += iqr[i + 1]
         first = g.iloc[0]
         rec = {k: first[k] for k in CASE_KEYS}
+        noisy = [x for x in g["noisy"] if isinstance(x, str) and x] if "noisy" in g else []  # core/timing.py
         rec.update(
+            noisy=noisy[0] if noisy else "",
             pair_ms=pair,
             pair_iqr_ms=pair_iqr,
             total_ms=float(np.sum(med)),

@@ -55,6 +55,19 @@ COLUMNS = [
     "point_substeps_per_s",
     # the GPU (nvidia-smi -L's index) that measured a cuda row
     "gpu",
+    # honest timings (harness/core/timing.py Figure.columns): the samples' count, relative and
+    # absolute standard deviation, why the rule stopped, its rounds, the load they ran under
+    # (others' CPU cores, the 1-minute load average, the GPU's busy % before), and why the
+    # figure is noise ("" when it is not)
+    "n_samples",
+    "rsd",
+    "std_ms",
+    "stop",
+    "rounds",
+    "other_cores",
+    "loadavg",
+    "gpu_busy_pct",
+    "noisy",
 ]
 HEADER = ",".join(COLUMNS) + "\n"
 

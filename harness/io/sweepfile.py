@@ -4,9 +4,15 @@
     description = "…"
     scene = "paper"           # a scene name in configs/scenes/ or a path
     frames = 3                # dynamic scenes: simulated frames per case (else the scene's)
-    repeat = 9                # timed repetitions per stage (≥ 9: median and IQR)
+    repeat = 9                # the first round's timed repetitions per stage (≥ 9: median and IQR)
     warmup = 1                # untimed runs per stage before them
     timeout_s = 600           # per case
+    [timing]                  # the stopping rule (harness/core/timing.py; each key optional,
+    min_samples = 10          # nvbench's defaults as shown): samples ≥ min_samples (and ≥ repeat)
+    min_seconds = 0.5         # and their total ≥ min_seconds, then stop once the relative
+    max_rsd = 0.005           # standard deviation ≤ max_rsd, or after timeout_s per case, or at
+    timeout_s = 3.0           # max_samples per stage. Without [timing]: `repeat` samples, once
+    max_samples = 2000
     [axes]                    # shared by every backend
     strands = [1000, 10000]
     points = [32]
@@ -29,13 +35,14 @@ each group; a case that two groups both produce runs once.
 
 import itertools
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from harness import HarnessError
 from harness.core.paths import CUDA_BUILDS, SWEEPS, config_file, read_toml
 from harness.core.scenes import PRECISIONS, is_scene_file, load_scene, with_frames
 from harness.core.scenes_dynamic import SOLVERS
+from harness.core.timing import RULE, StopRule, fixed
 from harness.core.variants import declared
 from harness.core.variants import names as declared_variants
 
@@ -46,7 +53,7 @@ DEFAULTS = {
     "cpu": {"variant": ["ref"], "threads": ["all"]},
     "cuda": {"build": ["default"], "variant": ["fused"], "block_size": [256]},
 }
-TOP_KEYS = ("name", "description", "scene", "frames", "repeat", "warmup", "timeout_s", "axes", "cpu", "cuda")
+TOP_KEYS = ("name", "description", "scene", "frames", "repeat", "warmup", "timeout_s", "timing", "axes", "cpu", "cuda")
 
 
 class SweepError(HarnessError):
@@ -87,6 +94,16 @@ class Sweep:
     timeout_s: int
     axes: list  # (backend, {axis: values}) per group; the cases are each group's product
     description: str = ""
+    rule: StopRule = RULE  # the stopping rule of its timed repeats ([timing]; else `repeat` once)
+
+    def at_most(self, strands):
+        """This sweep with every strands axis cut at `strands` (a groom file's count), kept there
+        when nothing was below it."""
+        axes = []
+        for backend, a in self.axes:
+            keep = [n for n in a["strands"] if n <= strands] or [strands]
+            axes.append((backend, {**a, "strands": keep}))
+        return replace(self, axes=axes)
 
     def cases(self):
         out, seen = [], set()
@@ -180,16 +197,39 @@ def find_sweep_file(ref):
     raise SweepError(f"no sweep file '{ref}'")
 
 
-def load_sweep(ref):
+def _rule(where, table, repeat):
+    """The [timing] table as a StopRule (its keys those of StopRule, each optional); the first
+    round takes at least `repeat` samples. No table (None): `repeat` samples in one round."""
+    if table is None:
+        return fixed(repeat)
+    if not isinstance(table, dict):
+        raise SweepError(f"{where}: 'timing' must be a table [timing]")
+    known = tuple(StopRule.__dataclass_fields__)
+    given = {}
+    for key, value in table.items():
+        if key not in known:
+            raise SweepError(f"{where}: unknown key 'timing.{key}' (known: {', '.join(known)})")
+        whole = key in ("min_samples", "max_samples")
+        ok = not isinstance(value, bool) and isinstance(value, int if whole else (int, float))
+        if not ok or not (value >= 1 if whole else 0 <= value < float("inf")):
+            raise SweepError(f"{where}: timing.{key} must be a {'whole number ≥ 1' if whole else 'number ≥ 0'}")
+        given[key] = value
+    rule = replace(RULE, **given)
+    return replace(rule, min_samples=max(rule.min_samples, repeat), max_samples=max(rule.max_samples, repeat))
+
+
+def load_sweep(ref, scene=None):
+    """The sweep file `ref` (a name in configs/sweeps/ or a path); `scene` (a scene name or
+    path) in place of the file's own: the same axes on another scene (bench --scene)."""
     path = find_sweep_file(ref)
     where = f"sweep {path}"
     data = read_toml(path, where, SweepError)
     for key in data:
         if key not in TOP_KEYS:
             raise SweepError(f"{where}: unknown key '{key}' (known: {', '.join(TOP_KEYS)})")
-    if "scene" not in data:
+    if "scene" not in data and scene is None:
         raise SweepError(f"{where}: missing key 'scene'")
-    scene = load_scene(data["scene"])
+    scene = load_scene(scene if scene is not None else data["scene"])
     repeat = data.get("repeat", MIN_REPEAT)
     if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < MIN_REPEAT:
         raise SweepError(f"{where}: repeat must be a whole number ≥ {MIN_REPEAT} (median and IQR), got {repeat!r}")
@@ -263,4 +303,5 @@ def load_sweep(ref):
         timeout_s=int(timeout),
         axes=axes,
         description=data.get("description", ""),
+        rule=_rule(where, data.get("timing"), repeat),
     )

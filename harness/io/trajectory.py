@@ -31,6 +31,7 @@ from harness.io.states import POSITION, State, StateError, as_text, open_state
 HAIR = "particles/hair"
 REST = f"{HAIR}/rest_position"
 VELOCITY = f"{HAIR}/velocity"
+TRACK = "parameters/motion_track"  # --head-motion track (docs/interfaces.md, "Motion tracks")
 OBSERVABLES = ("stretch_max", "penetration_max", "kinetic_energy", "blown_up", "blown_up_strands")
 DYNAMIC_ATTRS = (
     "paper_frames",
@@ -121,6 +122,8 @@ class Trajectory(State):
     _vel: object = field(repr=False, default=None)
     simulated_rows: np.ndarray = None  # --render-points: which rows of a strand are simulated points (§3.14)
     colliders: list = field(default_factory=list)  # §3.17
+    # --head-motion track: /parameters/motion_track [K][8] (time, qw, qx, qy, qz, tx, ty, tz), else None
+    motion_track: np.ndarray = None
 
     @property
     def rest(self):
@@ -301,6 +304,11 @@ def _check_dynamic(t, f):
     if stray:
         raise StateError(f"{path}: velocities stored for step(s) {stray[:3]} that have no position frame")
     t.observables = _observables(f, path)
+    if t.head_motion == "track":
+        track = f.get(TRACK)
+        if track is None or track.ndim != 2 or track.shape[1] != 8 or track.shape[0] < 1:
+            raise StateError(f"{path}: head_motion is 'track' but /{TRACK} [K][8] is missing")
+        t.motion_track = track[()]
     if t.render_points:
         _check_lod(t, f)
     if int(params.get("colliders", 0)) > 0:

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.core import tolerances
+from harness.core import timing, tolerances
 from harness.core.paths import REPORT, RESULTS, display
 from harness.io import files, tables
 from harness.studies.accuracy import (
@@ -123,6 +123,11 @@ def summary(rows, horizon_frames):
     inside = m[m["frame"] <= horizon_frames]
     g = inside.groupby("mode", sort=False)
     out = g[list(KEYS) + ["time_per_frame_ms", "time_strands", "device"]].first()
+    # honest timings (core/timing.py): the time's spread and why it is noise; a table measured
+    # before them has neither (its times then decide as before, without a noise flag)
+    first = g.first()
+    out["time_rsd"] = first["time_rsd"].astype(float) if "time_rsd" in first else np.nan
+    out["time_noisy"] = [x if isinstance(x, str) else "" for x in first["time_noisy"]] if "time_noisy" in first else ""
     out["scheme"] = [scheme_name(s, d) for s, d in zip(out["solver"], out["ftl_damping"])]
     out["rms"] = g["rms_err_L"].apply(lambda s: s.max(skipna=False))
     out["max"] = g["max_err_L"].apply(lambda s: s.max(skipna=False))
@@ -448,6 +453,10 @@ def recommend(summ, long=None):
     lines = []
     longm, _ = long_metrics(long)
     base = baseline(summ)
+    summ = summ.assign(  # a summary without the timing columns (measured before them): no spread, no noise
+        time_rsd=summ["time_rsd"] if "time_rsd" in summ else np.nan,
+        time_noisy=summ["time_noisy"] if "time_noisy" in summ else "",
+    )
     for use, (rms_budget, stretch_budget, why) in tolerances.DYN_ACC_USES.items():
         verdicts, passes = _passing(summ, use, longm)
         picks = []
@@ -471,7 +480,7 @@ def recommend(summ, long=None):
                     )
                 )
                 continue
-            best = f.loc[f["time_per_frame_ms"].idxmin()]
+            best, tied = _fastest_or_tie(f)
             faster = mine[mine["time_per_frame_ms"] < best["time_per_frame_ms"]]
             failed = {}
             for m in faster["mode"]:
@@ -492,6 +501,7 @@ def recommend(summ, long=None):
                     else "the fastest mode of all"
                 )
                 + ")"
+                + tie_note(best, tied)
             )
         base_note = ""
         if base is not None and np.isfinite(base["rms"]):
@@ -522,6 +532,33 @@ def recommend(summ, long=None):
             f"{long_txt}, never blown up; {why}{base_note}): " + "; ".join(picks) + "." + jit_note
         )
     return lines
+
+
+def _fastest_or_tie(f):
+    """The pick among passing modes `f` by time, and the modes tied with the fastest within their
+    noise (core/timing.tie: bands of ±2 standard deviations, at least ±0.5 %): a tie goes to the
+    most accurate of them (its RMS error, a number the timing noise does not touch)."""
+    figs = [(float(t), float(r)) for t, r in zip(f["time_per_frame_ms"], f["time_rsd"])]
+    tied = f.iloc[timing.tie(figs)]
+    if len(tied) <= 1:
+        return f.loc[f["time_per_frame_ms"].idxmin()], tied.iloc[0:0]
+    best = tied.loc[tied["rms"].idxmin()]
+    return best, tied[tied["mode"] != best["mode"]]
+
+
+def tie_note(best, tied):
+    """Words for a pick that tied with others within noise, or whose own time is noise."""
+    note = ""
+    if len(tied):
+        others = ", ".join(f"{r['mode']} ({r['time_per_frame_ms']:.3g} ms)" for _, r in tied.iterrows())
+        note += (
+            f"; **a tie within timing noise** with {others}: named the most accurate, not the one whose median "
+            "happened to be lowest"
+        )
+    noisy = [r["time_noisy"] for r in [best, *(r for _, r in tied.iterrows())] if r["time_noisy"]]
+    if noisy:
+        note += f"; timings flagged as noise ({noisy[0]}): re-measure on a quiet host before trusting the order"
+    return note
 
 
 def _jit(use):
@@ -911,14 +948,39 @@ def _mode_table(df, numbered=False, base=None):
     for k, (_, r) in enumerate(df.iterrows(), 1):
         ok = r["blown"] == 0
         out.append(
-            (f"| {k} " if numbered else "")
-            + f"| {r['mode']} | {r['time_per_frame_ms']:.3g} | {_e(r['rms']) if ok else '—'} | "
+            (f"| {k} " if numbered else "") + f"| {r['mode']} | {_time(r)} | {_e(r['rms']) if ok else '—'} | "
             f"{f'{r.rms / b:.3g}' if ok and b else '—'} | {_e(r['p99']) if ok else '—'} | "
             f"{_e(r['max']) if ok else '—'} | {r['stretch']:.3g} | {r['stretch_p99']:.3g} | "
             f"{f'{r.iou:.3f}' if ok and np.isfinite(r['iou']) else '—'} | {r['penetration']:.2g} | "
             f"{r['verdict']} ({int(r['blown'])}) |"
         )
     return out
+
+
+def _time(r):
+    """A mode's time per frame, with its spread where measured and a mark where it is noise."""
+    rsd = r.get("time_rsd", np.nan)
+    spread = f" ± {100 * rsd:.2g} %" if rsd == rsd else ""
+    return f"{r['time_per_frame_ms']:.3g}{spread}" + (" (noise)" if r.get("time_noisy") else "")
+
+
+def noise_lines(summ):
+    """How many timed modes are noise, and why (nothing for a table measured before the rule)."""
+    if "time_noisy" not in summ or summ["time_rsd"].isna().all():
+        return []
+    noisy = summ[summ["time_noisy"].astype(bool)]
+    if noisy.empty:
+        return [
+            f"Every mode's time met the stopping rule on a quiet host (spread ≤ {100 * timing.RULE.max_rsd:g} %).",
+            "",
+        ]
+    why = noisy["time_noisy"].value_counts().index[0]
+    return [
+        f"**{len(noisy)} of {len(summ)} modes' times are flagged as noise** (the commonest reason: {why}); they "
+        'are marked "(noise)" below, and a pick that rests on them says so: modes whose times overlap within '
+        "their spread are reported as a tie.",
+        "",
+    ]
 
 
 def _all_modes_lines(summ):
@@ -943,7 +1005,7 @@ def markdown(rows, study, env, analytic, long=None, names=Names(), title=DEFAULT
     front = front_of(summ)
     pairs = small_steps(summ, study)
     base = baseline(summ)
-    out = [f"## Speed against accuracy: {title}", "", *_header(study, env)]
+    out = [f"## Speed against accuracy: {title}", "", *_header(study, env), *noise_lines(summ)]
     out += convergence_lines(rows, study)
     out += [reference_error_line(study), ""]
     out += baseline_lines(summ, study)

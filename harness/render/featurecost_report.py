@@ -27,18 +27,25 @@ def markdown(rows):
         f"{int(first['strands']):,} strands × {first['points']} points, {first['precision']}, {first['solver']} "
         f"S = {first['substeps']}, I = {first['iterations']}; {where}; {first['device']}",
         "",
-        "| case | features compiled in | ms / frame (median) | min … max | point-substeps/s | vs full |"
+        "| case | features compiled in | ms / frame (median) | min … max | spread | point-substeps/s | vs full |"
         + (" instructions / point-substep |" if counted(rows) else ""),
-        "| --- | --- | ---: | ---: | ---: | ---: |" + (" ---: |" if counted(rows) else ""),
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: |" + (" ---: |" if counted(rows) else ""),
     ]
     for r in rows:
         rel = f"{float(r['median_ms']) / float(full['median_ms']):.2f}" if full else "—"
         ips = f" {float(r['instructions_per_point_substep']):.1f} |" if counted(rows) else ""
         lines.append(
             f"| {r['row']} | {r['features']} | {float(r['median_ms']):.3f} | {float(r['min_ms']):.3f} … "
-            f"{float(r['max_ms']):.3f} | {float(r['point_substeps_per_s']):.3g} | {rel} |{ips}"
+            f"{float(r['max_ms']):.3f} | {_spread(r)} | {float(r['point_substeps_per_s']):.3g} | {rel} |{ips}"
         )
     return "\n".join(lines) + "\n"
+
+
+def _spread(r):
+    """The row's relative standard deviation, "(noise: why)" where core/timing.py flags it."""
+    rsd = r.get("rsd")
+    text = f"{100 * float(rsd):.2g} %" if rsd not in (None, "") else "—"
+    return text + (f" (noise: {r['noisy']})" if r.get("noisy") else "")
 
 
 def counted(rows):
@@ -71,10 +78,15 @@ def costs(rows):
         alone, minus = by.get(_only_row(feat)), by.get(f"full − {feat}")
         a = float(alone["median_ms"]) - float(none["median_ms"]) if alone and none else None
         b = float(full["median_ms"]) - float(minus["median_ms"]) if full and minus else None
-        noisy_a = bool(alone and none and _overlap(alone, none))
-        noisy_b = bool(full and minus and _overlap(full, minus))
+        noisy_a = bool(alone and none and (_overlap(alone, none) or _noise(alone, none)))
+        noisy_b = bool(full and minus and (_overlap(full, minus) or _noise(full, minus)))
         out.append((feat, a, noisy_a, b, noisy_b))
     return out
+
+
+def _noise(*rows):
+    """Whether any row's time is flagged as noise (core/timing.py; rows measured before it: no)."""
+    return any(r.get("noisy") for r in rows)
 
 
 def _overlap(r, s):
@@ -93,7 +105,7 @@ def cost_table(rows):
     def cell(v, base, noisy):
         if v is None or base is None:
             return "—", "—"
-        mark = " (within spread)" if noisy else ""
+        mark = " (within spread or noise)" if noisy else ""
         return f"{v:+.3f}{mark}", f"{100 * v / float(base['median_ms']):+.0f} %"
 
     by = {r["row"]: r for r in rows}
@@ -130,7 +142,8 @@ def section(paths):
         "out (docs/model.md §3.9): an undeclared feature should cost nothing, so `none` should be "
         "the fastest row. Each feature's cost is given alone (its row less `none`, or less the row "
         "of what it needs) and inside the full scene (`full` less `full − it`); differences inside "
-        "the two runs' min … max spread are marked.",
+        "the two runs' min … max spread, or flagged as noise (core/timing.py: a relative standard deviation "
+        "above 0.5 % or a host loaded by others), are marked and decide nothing.",
         "",
     ]
     if not paths:

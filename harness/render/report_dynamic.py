@@ -23,6 +23,8 @@ from harness.render import (  # noqa: E402
     accuracy_dynamic_report,
     budget_report,
     featurecost_report,
+    frame_budget,
+    host_report,
     hair_report,
     judge_report,
     peer_report,
@@ -30,7 +32,7 @@ from harness.render import (  # noqa: E402
     stability_report,
 )
 from harness.render.headline_report import rounds_note  # noqa: E402
-from harness.studies.accuracy import results_name  # noqa: E402
+from harness.studies.accuracy import curves_name, results_name  # noqa: E402
 
 CURLY_SCENE = "curly"  # configs/scenes/curly.toml: the accuracy study's second scene
 CURLY_TITLE = "curly hair"
@@ -100,7 +102,8 @@ def best_table(rows):
         def cell(r):
             if r is None:
                 return "—"
-            return f"{r['label']}: {float(r['median_ms']):.3g} ms ({float(r['point_substeps_per_s']):.3g}/s)"
+            noise = " (noise)" if isinstance(r.get("noisy"), str) and r.get("noisy") else ""
+            return f"{r['label']}: {float(r['median_ms']):.3g} ms ({float(r['point_substeps_per_s']):.3g}/s){noise}"
 
         sp = "—"
         if best["gpu"] is not None and best["all"] is not None:
@@ -134,7 +137,7 @@ def _num(x):
     return f"{x:.3g}" if isinstance(x, (int, float)) and x == x else ""
 
 
-def validation_lines(results_dir):
+def validation_lines(results_dir, what="the default scene"):
     path = Path(results_dir) / "validation.json"
     if not path.exists():
         return [f"Not validated with these results (no `{display(path)}`)."]
@@ -142,7 +145,7 @@ def validation_lines(results_dir):
     checks = v.get("checks", [])
     bad = [c for c in checks if not c.get("equivalent")]
     lines = [
-        f"Before any timing, at {v.get('strands')} strands × {v.get('points')} points of the default scene: "
+        f"Before any timing, at {v.get('strands')} strands × {v.get('points')} points of {what}: "
         f"{len(checks)} comparisons, {len(checks) - len(bad)} equivalent"
         + (f" ({len(bad)} NOT)" if bad else "")
         + ". One frame from the same input state, judged by `harness.check.diff_dynamic` (the rule of "
@@ -269,6 +272,7 @@ def build(root, report_dir=None):
         f"by `python -m harness bench` from `{display(root)}`; rendering only.",
         "",
     ]
+    lines += host_report.section(root)
     lines += budget_report.section(root)
     lines += ["## Validation", ""]
     lines += validation_lines(sweep_dir) + [""]
@@ -280,7 +284,8 @@ def build(root, report_dir=None):
         lines += [
             "Time per frame of the default scene (S = 8, I = 2, every feature), kernel or loop time "
             "only (docs/interfaces.md), the median of the sweep's repeats; point-substeps per "
-            "second = N·P·S over it. The best of each family per strand count:",
+            'second = N·P·S over it. The best of each family per strand count ("(noise)": its time\'s spread '
+            "or the host's load marks it as noise, core/timing.py):",
             "",
         ]
         lines += best_table(rows) + [""]
@@ -305,6 +310,7 @@ def build(root, report_dir=None):
         "harness accuracy --model dynamic",
         out_dir,
     )
+    lines += frame_budget.section(root) if (root / curves_name("dynamic")).exists() else []
     curly = results_name(CURLY_SCENE)
     lines += _study(
         root,

@@ -16,7 +16,7 @@ from pathlib import Path
 from harness.core.paths import REPORT, display, output_dir
 from harness.io import files, results_data
 from harness.io.results_data import curve_of, interp_time, strands_at_time
-from harness.render import budget_report, hair_report
+from harness.render import budget_report, hair_report, host_report
 from harness.render.accuracy_paper_report import report_from_csv
 from harness.render.headline_report import table
 from harness.render.plots import make_all
@@ -218,7 +218,12 @@ def paper_section(cases):
 
 
 def timing_table(cases):
-    lines = ["## wind + collide median times (ms)", ""]
+    lines = [
+        "## wind + collide median times (ms)",
+        "",
+        '"(noise)": a stage\'s spread above 0.5 % or a host loaded by others while it ran (core/timing.py).',
+        "",
+    ]
     c = cases.dropna(subset=["pair_ms"])
     if c.empty:
         return lines + ["No case ran a wind stage.", ""]
@@ -238,8 +243,9 @@ def timing_table(cases):
         for n in counts:
             row = []
             for lab in labels:
-                v = g[(g["strands"] == n) & (g["label"] == lab)]["pair_ms"]
-                row.append(fmt_ms(float(v.iloc[0])) if len(v) else "—")
+                hit = g[(g["strands"] == n) & (g["label"] == lab)]
+                noise = " (noise)" if len(hit) and hit["noisy"].iloc[0] else ""
+                row.append(fmt_ms(float(hit["pair_ms"].iloc[0])) + noise if len(hit) else "—")
             lines.append(f"| {n:,} | " + " | ".join(row) + " |")
         lines.append("")
     return lines
@@ -286,6 +292,7 @@ def build(results_dir="results/default", report_dir=None):
     ]
     if env.get("provenance"):
         lines += ["## Provenance", "", env["provenance"], ""]
+    lines += host_report.section(Path(results_dir).parent)
     lines += budget_report.section(Path(results_dir).parent)
     lines += headline_section(Path(results_dir).parent / "headline" / "headline.json")
     lines += gpu_section(cases, env)

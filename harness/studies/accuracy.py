@@ -130,6 +130,17 @@ def results_name(scene):
 
 
 CSV_NAME = "dynamic_accuracy.csv"
+# the frame budget's throughput curves of the study's modes (studies/budget_curves.py)
+CURVES_NAME = "budget-curves"
+CURVES_CSV = "curves.csv"
+
+
+def curves_name(scene):
+    """The budget curves' folder for a scene: budget-curves, or budget-curves-<scene>."""
+    tag = scene_tag(scene)
+    return f"{CURVES_NAME}-{tag}" if tag else CURVES_NAME
+
+
 ANALYTIC_NAME = "analytic.md"
 # the reference family of the contract (docs/model.md §3.6), in its working precision fp64
 REF_SOLVER, REF_PRECISION, REF_ITERATIONS = "xpbd", "fp64", 1

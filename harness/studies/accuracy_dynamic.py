@@ -53,7 +53,7 @@ import numpy as np
 
 from harness import HarnessError
 from harness.check import observables
-from harness.core import env, runner, scenes, scenes_dynamic, tolerances, variants
+from harness.core import env, rounds, runner, scenes, scenes_dynamic, timing, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
@@ -102,6 +102,7 @@ class Plan:
     long_seconds: float = 10.0  # the long runs' simulated time (0: no long runs)
     long_strands: int = 8
     long_ref_max: int = 512  # the long runs' reference S at most (its change to 2S is reported)
+    stop_rule: timing.StopRule = timing.RULE  # the timed runs' stopping rule (core/timing.py)
 
     @classmethod
     def quick(cls, **changes):
@@ -371,25 +372,29 @@ class Study:
         return flags, out
 
     def timed_all(self, modes):
-        """name → (median ms, min ms, record) of each mode's timed run, one run at a time, nothing
-        else running. ftl's damping s is one factor of the velocity update (no branch on it), so
-        modes that differ only in s share a run (Mode.timing_key); the runs of one binary go in
-        batches (runner.run_batch: one process and GPU context for several)."""
+        """name → (median ms, min ms, record, timing.Figure) of each mode's timed run, by the
+        stopping rule (core.rounds.measure, the plan's `timing`), one binary's runs in batches
+        and nothing else running. ftl's damping s is one factor of the velocity update (no
+        branch on it), so modes that differ only in s share a run (Mode.timing_key)."""
         first = {}
         for m in modes:
             first.setdefault(m.timing_key, m)
+        cases = list(first.values())
         runs = {}
-        with Progress(len(first), "dynamic accuracy: timed") as bar:
-            for chunk in runner.batches(first.values(), lambda m: m.runner.binary, runner.BATCH_MAX):
-                flags = [self.timed_flags(m) for m in chunk]
-                for i, rec, error in runner.run_batch(chunk[0].runner.binary, flags):
-                    if error is not None:
-                        raise error
-                    runs[chunk[i].timing_key] = self.timed_result(chunk[i], rec)
-                    bar.update()
+        with Progress(len(cases), "dynamic accuracy: timed") as bar:
+
+            def ended(i, t):
+                if t.error is not None:
+                    raise t.error
+                runs[cases[i].timing_key] = self.timed_result(cases[i], t)
+                bar.update()
+
+            rule = self.plan.stop_rule
+            rule = replace(rule, min_samples=max(rule.min_samples, self.plan.repeat))  # --repeat: the first round
+            rounds.measure(cases, self.timed_flags, lambda m: m.runner.binary, rule=rule, on_done=ended)
         return {m.name: runs[m.timing_key] for m in modes}
 
-    def timed_flags(self, mode):
+    def timed_flags(self, mode, repeat=None):
         sc = configured(
             self.scene,
             solver=mode.solver,
@@ -400,13 +405,18 @@ class Study:
             strands=self.plan.time_strands,
             ftl_damping=mode.ftl_damping,
         )
-        return runner.run_flags(sc, mode.runner.backend, variant=mode.runner.variant, repeat=self.plan.repeat)
+        repeat = repeat or self.plan.repeat
+        return runner.run_flags(sc, mode.runner.backend, variant=mode.runner.variant, repeat=repeat)
 
-    def timed_result(self, mode, rec):
-        sim = [s for s in rec["stages"] if s.get("stage") == SIMULATE]
+    def timed_result(self, mode, t):
+        """(median ms, min ms, record, figure) of a mode's simulate stage (a rounds.Timed)."""
+        rec = t.record
+        sim = [i for i, s in enumerate(rec["stages"]) if s.get("stage") == SIMULATE]
         if not sim:
             raise HarnessError(f"{mode.runner.binary.name}: its record has no simulate stage")
-        return float(sim[0]["median_ms"]), float(sim[0]["min_ms"]), rec
+        st = rec["stages"][sim[0]]
+        fig = t.figures.get(sim[0]) or timing.Figure(st.get("times_ms") or [], backend=mode.runner.backend)
+        return float(st["median_ms"]), float(st["min_ms"]), rec, fig
 
     # the reference ladder ------------------------------------------------------------
 
@@ -652,9 +662,9 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
             long_rows = long.measure(oracle_modes, jobs)
 
         # 3. timing, one run at a time, nothing else running
-        timing = study.timed_all(modes)
+        timed = study.timed_all(modes)
 
-        rows = _rows(study, modes, mode_paths, ref, timing) + _ladder_rows(study, ref) + check_rows
+        rows = _rows(study, modes, mode_paths, ref, timed) + _ladder_rows(study, ref) + check_rows
         rows += _ref_error_rows(study, ref, ref_err)
     finally:
         study.close()
@@ -725,14 +735,14 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
     return 0
 
 
-def _rows(study, modes, mode_paths, ref, timing):
+def _rows(study, modes, mode_paths, ref, timed):
     rows = []
     final_S = ref["steps"][-1]["S2"]
     measured = study.readers.starmap(
         _mode_metrics, [(mode_paths[m.name], ref["final"], study.L, study.gravity) for m in modes], chunksize=8
     )
     for m, (r, rms, mx, extra) in zip(modes, measured):
-        ms, ms_min, rec = timing[m.name]
+        ms, ms_min, rec, fig = timed[m.name]
         rows += _frame_rows(
             r,
             rms,
@@ -744,6 +754,7 @@ def _rows(study, modes, mode_paths, ref, timing):
             points=study.scene.points,
             time_per_frame_ms=ms,
             time_per_frame_min_ms=ms_min,
+            **fig.columns("time_"),
             time_strands=study.plan.time_strands,
             threads=rec.get("threads") if m.runner.backend == "cpu" else None,
             block_size=rec.get("block_size") if m.runner.backend == "cuda" else None,

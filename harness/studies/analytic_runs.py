@@ -19,6 +19,7 @@ import os
 import numpy as np
 
 from harness.core import runner
+from harness.core.runner import COMPLETED
 from harness.io import files
 
 
@@ -145,7 +146,7 @@ def simulate(
     ]
     cmd += [str(a) for a in extra]
     r = runner.run_command(cmd, timeout=timeout)
-    if r.returncode != 0:
+    if r.returncode not in COMPLETED:
         raise RuntimeError(f"{' '.join(cmd)} exited {r.returncode}: {r.stderr.strip()}")
     return output_path
 

@@ -16,7 +16,7 @@ compiles it out), never by setting it to zero:
 import shutil
 
 from harness import HarnessError
-from harness.core import runner, scenes, variants
+from harness.core import runner, scenes, timing, variants
 from harness.core.paths import binary_path
 from harness.core.progress import Progress
 from harness.core.scenes_dynamic import DECLARING, FEATURES, NEEDS
@@ -41,6 +41,7 @@ FIELDS = (
     "point_substeps_per_s",
     "device",
     "instructions_per_point_substep",
+    *timing.Figure().columns(),  # the frame times' spread and the host's load (core/timing.py)
 )
 
 
@@ -141,9 +142,13 @@ def measure(
 
 
 def _row(binary, name, flags, timeout, instructions, progress):
-    """One row of the study: the binary's record of one feature set."""
+    """One row of the study: the binary's record of one feature set, its frame times' spread and
+    the load they ran under (its own --repeat; core/timing.py flags a noisy row)."""
+    probe = timing.LoadProbe(gpu=rec_backend(binary) == "cuda")
     rec = runner.run_binary(binary, flags, timeout=timeout)
+    load = probe.stop()
     st = declared(rec)
+    fig = timing.Figure(st.get("times_ms") or [], stop="fixed repeats", rounds=1, load=load, backend=rec["backend"])
     ips = instructions_per_point_substep(binary, flags, rec, st, timeout) if instructions else None
     row = {
         "row": name,
@@ -164,6 +169,7 @@ def _row(binary, name, flags, timeout, instructions, progress):
         "point_substeps_per_s": st["point_substeps_per_s"],
         "device": rec["device"],
         "instructions_per_point_substep": ips,
+        **fig.columns(),
     }
     progress(f"featurecost: {name:28s} {st['features']:44s} {st['median_ms']:10.3f} ms/frame")
     return row
@@ -190,10 +196,14 @@ def instructions_per_point_substep(binary, flags, rec, st, timeout=None):
         cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={d}/cg", f"--toggle-collect={fn}", str(binary)]
         p = runner.run_command(cmd + args + ["--threads", "1", "--quiet"], timeout=timeout)
     m = re.search(r"Collected\s*:\s*([0-9]+)", p.stderr)
-    if p.returncode != 0 or not m:
+    if p.returncode not in runner.COMPLETED or not m:
         raise HarnessError(f"callgrind failed on {binary.name}: {runner.last_line(p.stderr)}")
     point_substeps = rec["strands"] * rec["points"] * st["substeps"] * st["frames"]
     return int(m.group(1)) / point_substeps
+
+
+def rec_backend(binary):
+    return "cuda" if "cuda" in binary.name else "cpu"
 
 
 def _set(flags, flag, value):

@@ -4,6 +4,9 @@ slices (two axes over a base scene each) and the verdicts of a cell. Runs nothin
 from dataclasses import dataclass
 from pathlib import Path
 
+from harness.core.paths import MOTIONS
+from harness.io.motion_tracks import FAST_TURN_FILE
+
 # mildest first; a blown-up cell (docs/model.md §3.8) is split by cause: escaped (a point
 # farther than 2L from its root, every number finite) or diverged (a NaN or Inf)
 VERDICTS = ("ok", "over-stretched", "penetrating", "escaped", "diverged")
@@ -114,6 +117,20 @@ SLICES += (
         (("--drag", 0.5), ("--gust-amplitude", 0.5), ("--gust-wavelength", 60.0), ("--iterations", 1)),
         LRA,
         Axis("--wind-speed", "U", (0, 1000, 2000, 4000, 8000, 16000), (2000, 16000), "cm/s"),
+    ),
+)
+# A recorded fast motion (docs/model.md §3.2, --head-motion track): the shipped head turn of
+# configs/motions/fast-turn.csv (80° and back at a measured peak head speed, 780 °/s), on the
+# still scene, substeps against iterations.
+SLICES += (
+    Slice(
+        "fast-turn",
+        "a recorded fast head turn (configs/motions/fast-turn.csv: 80° about y and back, peak 780 °/s): "
+        "substeps against iterations",
+        "still-dynamic",
+        (("--head-motion", "track"), ("--motion-track", str(MOTIONS / FAST_TURN_FILE))),
+        SUBSTEPS,
+        ITERATIONS,
     ),
 )
 SLICE_NAMES = tuple(s.name for s in SLICES)

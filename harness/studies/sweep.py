@@ -16,14 +16,14 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.core import budget, env, gpus, scenes
+from harness.core import budget, env, gpus, rounds, scenes, timing
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
-from harness.core.runner import BATCH_MAX, BackendError, DoesNotFit, batches, run_batch, run_binary, run_flags
+from harness.core.runner import BATCH_MAX, BackendError, DoesNotFit, batches, run_binary, run_flags
 from harness.core.scenes import SceneError
 from harness.io import results_data, runfolder, runlog
 from harness.io.files import write_json
-from harness.io.sweepfile import load_sweep
+from harness.io.sweepfile import Sweep, load_sweep
 from harness.studies import roofline
 
 
@@ -35,7 +35,9 @@ def quartiles(times):
     return float(q1), float(q3)
 
 
-def rows_of_record(case, record, copy_gbps, session, binary):
+def rows_of_record(case, record, copy_gbps, session, binary, figures=None):
+    """One row per stage of a case's record; `figures` (timing.Figure by stage index): each timed
+    stage's spread, stopping rule and the load it ran under, as columns (timing.Figure.columns)."""
     rows = []
     stages = record.get("stages", [])
     for i, st in enumerate(stages):
@@ -101,12 +103,14 @@ def rows_of_record(case, record, copy_gbps, session, binary):
                 "binary": binary.name,
                 "session": session,
                 "finished_at": env.now(),
+                **(figures[i].columns() if figures and i in figures else timing.Figure().columns()),
             }
         )
     return rows
 
 
-def case_flags(sweep, case):
+def case_flags(sweep, case, repeat=None):
+    """The binary flags of a case; `repeat`: this round's timed repeats (default the case's)."""
     scene = sweep.scene.with_overrides(strands=case.strands, points=case.points, precision=case.precision)
     if case.solver:
         from dataclasses import replace
@@ -119,7 +123,7 @@ def case_flags(sweep, case):
         variant=case.variant,
         block_size=case.block_size,
         threads=threads,
-        repeat=case.repeat,
+        repeat=repeat or case.repeat,
         warmup=case.warmup,
     )
     if scene.model == "dynamic":  # simulate times each frame on its own (--end-to-end is refused)
@@ -183,10 +187,11 @@ def check_same_machine(before, now, out_dir):
 
 
 def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, shard=None, gate=None, force=False):
-    """Run (or resume) a sweep; return (results dir, number of failed cases). `shard` (a
-    core.shards.Shard): only its share of the cases; `gate` (a core.budget.TierGate): the
-    cases run smallest size first and a tier that does not fit is left out with every larger one."""
-    sweep = load_sweep(sweep_ref)
+    """Run (or resume) a sweep (`sweep_ref`: a sweep file, or a loaded io.sweepfile.Sweep); return
+    (results dir, number of failed cases). `shard` (a core.shards.Shard): only its share of the
+    cases; `gate` (a core.budget.TierGate): the cases run smallest size first and a tier that does
+    not fit is left out with every larger one."""
+    sweep = sweep_ref if isinstance(sweep_ref, Sweep) else load_sweep(sweep_ref)
     out_dir = runfolder.claim(out if out else RESULTS / sweep.name, f"sweep {sweep.name}", force=force)
     csv_path = out_dir / "runs.csv"
     env_path = out_dir / "env.json"
@@ -259,6 +264,9 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
             f"harness: sweep {sweep.name}: GPU cases spread over {len(gpu_list)} GPUs "
             f"({', '.join(str(g.index) for g in gpu_list)}); the CPU cases run before them, alone"
         )
+    # the stopping rule, its minimum time and timeout within the budget's share for the cases
+    rule = sweep.rule.within(gate.allowance, len(todo)) if gate is not None else sweep.rule
+    session["timing"] = rule.as_dict()
     groups = budget.tiers(todo, case_size) if gate is not None else [(None, todo)]
     progress = Progress(len(todo), f"sweep {sweep.name}")
     failed = 0
@@ -272,11 +280,13 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
                     progress.update(len(tier))
                     continue
             t0 = time.monotonic()
+            sampled = []  # each case's timed samples, seconds (the gate scales these with the size)
             failed += _run_cases(
-                tier, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list
-            )
+                tier, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list, rule,
+                sampled,
+            )  # fmt: skip
             if gate is not None:
-                gate.measured(size, len(tier), time.monotonic() - t0)
+                gate.measured(size, len(tier), time.monotonic() - t0, sum(sampled))
         session["finished_at"] = env.now()
         write_json(env_path, record)
     finally:
@@ -293,34 +303,45 @@ def case_size(case):
     return case.strands * case.points
 
 
-def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list):
-    """Run the cases, appending their rows; the number that failed. Every case runs through
-    runner.run_batch: a CPU case alone, the GPU cases of one binary several to a process (one
-    context for them). With
-    several GPUs the CPU cases run first, alone, then the GPU batches on one worker per GPU
-    (core/gpus.py)."""
+def _run_cases(
+    todo, sweep, csv_path, env_path, record, session, session_index, bandwidth, progress, gpu_list, rule, sampled
+):
+    """Run the cases by the stopping rule (core.rounds.measure: rounds of timed repeats until
+    each stage's samples meet `rule`), appending their rows; the number that failed. The CPU
+    cases run one to a process, alone; the GPU cases of one binary several to a process (one
+    context for them), with several GPUs on one worker per GPU (core/gpus.py)."""
     failed = 0
     pin = len(gpu_list) > 1 or bool(os.environ.get("HB_GPUS"))  # else the one GPU as the binary finds it
 
     def key(case):
         return case.backend, case.build or "default"
 
-    def run_cases(cases, gpu):
-        """(case, record, error) of each case, in order, as each ends."""
+    def run_cases(cases, gpu, batch):
+        """(case, timed) of each case, in order, after all have ended (rounds.Timed)."""
         env_add = {"CUDA_VISIBLE_DEVICES": gpu.select} if gpu is not None and pin else None
-        binary = binary_path(*key(cases[0]))
-        ready = []  # (case, its flags)
+        ready, out = [], []
         for case in cases:
             try:
-                ready.append((case, case_flags(sweep, case)))
+                case_flags(sweep, case)
+                ready.append(case)
             except SceneError as e:
-                yield case, None, e
-        for i, rec, error in run_batch(binary, [f for _, f in ready], sweep.timeout_s, env=env_add):
-            yield ready[i][0], rec, error
+                out.append((case, rounds.Timed(error=e)))
+        timed = rounds.measure(
+            ready,
+            lambda c, n: case_flags(sweep, c, n),
+            lambda c: binary_path(*key(c)),
+            rule=rule,
+            timeout=sweep.timeout_s,
+            env=env_add,
+            gpu_index=gpu.index if gpu is not None else None,
+            batch=batch,
+        )
+        return out + list(zip(ready, timed))
 
-    def done(case, gpu, rec, error):
+    def done(case, gpu, t):
         nonlocal failed
         binary = binary_path(*key(case))
+        error, rec = t.error, t.record
         if isinstance(error, (DoesNotFit, SceneError)):
             session["skipped"].append({"case": case.case_id, "reason": str(error)})
             progress.write(f"harness: skipping {case.case_id}: {error}")
@@ -331,7 +352,8 @@ def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, 
         elif error is not None:
             raise error
         else:
-            rows = rows_of_record(case, rec, bandwidth.get(key(case)), session_index, binary)
+            sampled.append(sum(f.stats["total_s"] for f in t.figures.values()))
+            rows = rows_of_record(case, rec, bandwidth.get(key(case)), session_index, binary, t.figures)
             for r in rows:
                 r["gpu"] = gpu.index if gpu is not None else ""
             runlog.append_case(csv_path, rows)
@@ -348,24 +370,24 @@ def _run_cases(todo, sweep, csv_path, env_path, record, session, session_index, 
     on_cpu = [c for c in todo if c.backend != "cuda"]
     on_gpu = [c for c in todo if c.backend == "cuda"]
     for case in on_cpu:  # the CPU baselines, one process each, no GPU worker running
-        for c, rec, error in run_cases([case], None):
-            done(c, None, rec, error)
+        for c, t in run_cases([case], None, 1):
+            done(c, None, t)
     if len(gpu_list) <= 1:
         for chunk in batches(on_gpu, key, BATCH_MAX):
-            for c, rec, error in run_cases(chunk, one):
-                done(c, one, rec, error)
+            for c, t in run_cases(chunk, one, BATCH_MAX):
+                done(c, one, t)
         return failed
     # several GPUs: smaller batches, so that the workers end together
     size = max(1, min(BATCH_MAX, -(-len(on_gpu) // (4 * len(gpu_list)))))
 
     def run_chunk(chunk, gpu):
-        return list(run_cases(chunk, gpu))
+        return run_cases(chunk, gpu, size)
 
     def chunk_done(chunk, gpu, results, error):
         if error is not None:
             raise error
-        for c, rec, err in results:
-            done(c, gpu, rec, err)
+        for c, t in results:
+            done(c, gpu, t)
 
     gpus.spread(batches(on_gpu, key, size), gpu_list, run_chunk, chunk_done)
     return failed

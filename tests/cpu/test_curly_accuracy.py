@@ -10,7 +10,7 @@ from harness.core import variants
 from harness.core.budget import Budget
 from harness.core.shards import Shard
 from harness.render import accuracy_dynamic_report, report_dynamic
-from harness.studies import accuracy_dynamic, animate, featurecost, peer, reduced, stability
+from harness.studies import accuracy_dynamic, animate, budget_curves, featurecost, peer, reduced, stability
 from harness.studies.accuracy import results_name
 from support.accuracy_plans import TINY
 
@@ -58,6 +58,8 @@ def stubbed(monkeypatch):
     monkeypatch.setattr(featurecost, "measure", lambda **k: None)
     monkeypatch.setattr(reduced, "measure", lambda *a, **k: None)
     monkeypatch.setattr(stability, "run_study", lambda **k: None)
+    monkeypatch.setattr(bench_dynamic, "budget_modes", lambda acc_dir: [])  # the frame budget's curves
+    monkeypatch.setattr(budget_curves, "measure", lambda *a, **k: None)
     monkeypatch.setattr(peer, "run_study", lambda *a, **k: None)
     monkeypatch.setattr(bench_dynamic.peer_report, "write", lambda *a, **k: None)
     monkeypatch.setattr(animate, "run", lambda **k: None)

@@ -4,12 +4,14 @@ features at zero strength, determinism (threads, resume, frame split), fp32 agai
 harness (harness/io/trajectory.py, invariants_dynamic.py, diff_dynamic.py); every tolerance comes from
 harness/core/tolerances.py. Small sizes: 64 strands × 16 points, ≤ 20 frames."""
 
+import json
+
 import numpy as np
 import pytest
 
 from harness.check import diff_dynamic, invariants_dynamic
 from harness.cli.main import main as harness_main
-from harness.core import tolerances
+from harness.core import runner, tolerances
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run
 
@@ -172,10 +174,14 @@ def test_penetration_is_reported(cpu_bin, tmp_path):
 
 def test_blown_up_run_is_detected_and_matches_the_observables(cpu_bin, tmp_path):
     """xpbd with S = I = 1 and no damping at 32 points blows up (measured: every strand by
-    frame 60); the harness's own count from positions and velocities equals the file's."""
+    frame 60); the run still writes its file and record, flags the blow-up in its exit status
+    (5) and its record's "blown_up", and the harness's own count from positions and velocities
+    equals the file's."""
     out = tmp_path / "b.h5"
     size = ("--strands", 64, "--points", 32, "--frames", 30)
-    run(cpu_bin, *SIM, *size, "--velocities", "all", "--output", out, "--quiet")
+    p = run(cpu_bin, *SIM, *size, "--velocities", "all", "--output", out, "--json", "--quiet", check=False)
+    assert p.returncode == runner.EXIT_BLOWN_UP, p.stderr
+    assert json.loads(p.stdout)["blown_up"] is True
     with open_trajectory(out) as t:
         assert t.observables["blown_up"].any()
         rep = invariants_dynamic.check(t)

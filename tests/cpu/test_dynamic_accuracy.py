@@ -168,9 +168,9 @@ def test_modes_that_differ_only_in_ftl_damping_share_one_timed_run(cpu_bin, tmp_
     monkeypatch.setenv("HAIRBENCH_NO_GPU", "1")
     timed, real = [], accuracy_dynamic.Study.timed_flags
 
-    def counting(self, mode):  # the flags of each timed run
+    def counting(self, mode, repeat=None):  # the flags of each timed run (TINY: one round)
         timed.append(mode)
-        return real(self, mode)
+        return real(self, mode, repeat)
 
     monkeypatch.setattr(accuracy_dynamic.Study, "timed_flags", counting)
     out = tmp_path / "out"

@@ -39,7 +39,7 @@ FLAG_CASES = [
     ("gust_amplitude_negative", ["--gust-amplitude", "-1"], "--gust-amplitude must be a finite number >= 0"),
     ("gust_frequency_negative", ["--gust-frequency", "-2"], "--gust-frequency must be a finite number >= 0"),
     ("gust_wavelength_zero", ["--gust-wavelength", "0"], "--gust-wavelength must be a finite number > 0"),
-    ("unknown_motion", ["--head-motion", "spin"], "--head-motion must be still, nod, shake or tilt"),
+    ("unknown_motion", ["--head-motion", "spin"], "--head-motion must be still, nod, shake, tilt or track"),
     ("motion_amplitude_nan", ["--motion-amplitude", "nan"], "--motion-amplitude must be finite"),
     ("motion_frequency_negative", ["--motion-frequency", "-1"], "--motion-frequency must be a finite number >= 0"),
     ("output_every_zero", ["--output-every", "0"], "--output-every must be at least 1"),

@@ -118,3 +118,24 @@ def test_each_jitter_budget_is_checked_against_the_reference():
     shaky.loc[0, "value"] = 2 * tolerances.jitter_budget_cm("offline")  # the reference itself moves more
     offline = next(ln for ln in rep.jitter_budget_lines(shaky) if ln.startswith("| offline"))
     assert offline.endswith("| **no** |")
+
+
+def test_modes_within_timing_noise_are_a_tie_named_by_accuracy():
+    """The issue's case: two passing modes 0.07 % apart in time. Their bands (±2 spreads, at
+    least ±0.5 %) overlap, so the page reports a tie and names the more accurate one, whichever
+    median happened to be lower; a figure flagged as noise says so."""
+    tied = pd.DataFrame(
+        [
+            mode("cpu ref ftl s=1 S16 I1 fp32", "ftl", 1.0, 16, 1, 8.000, 0.5 * RMS_GAMES, damping=1.0),
+            mode("cpu ref ftl s=1 S16 I2 fp32", "ftl", 1.0, 16, 2, 8.0056, 0.4 * RMS_GAMES, damping=1.0),
+            mode("cpu ref xpbd S1 I1 fp32", "xpbd", None, 1, 1, 0.1, 5 * RMS_GAMES),
+        ]
+    ).assign(time_rsd=[0.002, 0.002, 0.002], time_noisy=["", "", ""])
+    line = next(ln for ln in rep.recommend(tied) if ln.startswith("- **games**"))
+    assert "**cpu ref ftl s=1 S16 I2 fp32**" in line and "a tie within timing noise" in line
+    apart = tied.assign(time_per_frame_ms=[8.0, 8.2, 0.1])  # 2.5 % apart with 0.2 % spreads: no tie
+    line = next(ln for ln in rep.recommend(apart) if ln.startswith("- **games**"))
+    assert "**cpu ref ftl s=1 S16 I1 fp32**" in line and "tie" not in line
+    noisy = apart.assign(time_rsd=[0.05, 0.05, 0.05], time_noisy=["spread 5 % > 0.5 %"] * 3)
+    line = next(ln for ln in rep.recommend(noisy) if ln.startswith("- **games**"))
+    assert "a tie within timing noise" in line and "flagged as noise (spread 5 % > 0.5 %)" in line

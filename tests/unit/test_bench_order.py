@@ -21,6 +21,7 @@ def bench_args(model, tmp_path):
         budget=None,
         gpu="no",
         full_studies=False,
+        scene=None,
     )
 
 

@@ -38,6 +38,15 @@ def test_estimate_scales_the_last_tier_by_size_and_count():
     assert budget.estimate((1000, 4, 8.0), (3000, 5)) == pytest.approx(30.0)
 
 
+def test_only_the_timed_samples_scale_with_the_size():
+    """Half of the last tier's 2 s a case was samples (the rest process starts and the stopping
+    rule's rounds): at 3× the size a case takes 1 + 3 = 4 s, 5 cases 20 s."""
+    assert budget.estimate((1000, 4, 8.0), (3000, 5), work=0.5) == pytest.approx(20.0)
+    gate = budget.TierGate(100.0, clock=Clock())
+    gate.measured(1000, 4, 8.0, sampled=4.0)
+    assert gate.work == 0.5 and gate.admit(3000, 5) == (True, None)
+
+
 def run_ladder(gate, clock, ladder, seconds_per_unit):
     """Drive the gate over (size, cases) like the sweep, a case costing size × seconds_per_unit."""
     ran = []

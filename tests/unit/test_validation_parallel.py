@@ -61,6 +61,7 @@ def paper_scene():
 @pytest.fixture
 def fake(monkeypatch):
     decl = SimpleNamespace(variants=VARIANTS, precisions=PRECISIONS, runs=lambda *a, **k: True, default_variant="alpha")
+    decl.runs_features, decl.per_segment = (lambda *a: True), VARIANTS
     decl.solvers, decl.dynamic_solvers = ("xpbd", "ftl", "rigid"), ("xpbd", "ftl")  # rigid: no simulation
     monkeypatch.setattr(variants, "names", lambda backend, build="default": VARIANTS)
     monkeypatch.setattr(variants, "declared", lambda backend, build="default": decl)

@@ -91,6 +91,7 @@ def head_rotation_at(traj, frame):
         float(params["motion_amplitude"]),
         float(params["motion_frequency"]),
         frame_end_time(traj, frame),
+        getattr(traj, "motion_track", None),
     )
     return np.asarray(q).reshape(3, 3)
 
