@@ -58,7 +58,9 @@ HB_DHD void carry(const At<T> &x, const At<const T> &rest, int64_t g, int64_t f,
     for (int c = 0; c < 3; c++) y[c] = x(g, k, c) + r[c];
 }
 
-/* Follower f placed from its W guides g[] with weights w[] (hb_follower_place). */
+/* Follower f placed from its W guides g[] with weights w[] (hb_follower_place): each point the
+ * blend of its guides' carried offsets, then pulled onto the segment of rest length ℓ_k from the
+ * follower's placed predecessor (ℓ_k from m.seg_rest in its layout, else m.seg_len). */
 template <typename T>
 HB_DHD void place_follower(const DModel<T> &m, const T *q, const At<T> &x, const At<T> &v, const At<const T> &rest,
                            int64_t f, const int64_t *g, const T *w, int W)
@@ -82,8 +84,23 @@ HB_DHD void place_follower(const DModel<T> &m, const T *q, const At<T> &x, const
             carry(x, rest, g[i], f, k, q, y);
             for (int c = 0; c < 3; c++) acc[c] = i == 0 ? w[0] * y[c] : acc[c] + w[i] * y[c];
         }
-        if (m.features & HB_F_COLLIDE) collide_sphere(acc[0], acc[1], acc[2], m.collide_r);
-        for (int c = 0; c < 3; c++) x(f, k, c) = acc[c];
+        /* the segment toward the blended point, at the follower's own rest length ℓ_k */
+        const T ell = m.seg_rest ? m.seg_rest[f * m.seg_is + (k - 1) * m.seg_s] : m.seg_len;
+        const T px = x(f, k - 1, 0), py = x(f, k - 1, 1), pz = x(f, k - 1, 2);
+        const T ex = acc[0] - px, ey = acc[1] - py, ez = acc[2] - pz;
+        const T rho = m_sqrt(ex * ex + ey * ey + ez * ez);
+        T p[3];
+        if (rho > (T)0) {
+            p[0] = px + ell * (ex / rho);
+            p[1] = py + ell * (ey / rho);
+            p[2] = pz + ell * (ez / rho);
+        } else {
+            p[0] = px;
+            p[1] = py - ell;
+            p[2] = pz;
+        }
+        if (m.features & HB_F_COLLIDE) collide_sphere(p[0], p[1], p[2], m.collide_r);
+        for (int c = 0; c < 3; c++) x(f, k, c) = p[c];
     }
 }
 

@@ -1,6 +1,6 @@
-/* dyn_followers_impl.h — the placement of one follower (docs/model.md §3.13), written once for
+/* dyn_followers_impl.h — the placement of one follower (docs/model.md §3.14), written once for
  * a floating type REAL; dyn_followers.c includes it for float and for double (SFX, DMODEL,
- * SQRT, WEIGHTS). Every expression is evaluated in the order written; §3.13 states it. */
+ * SQRT, WEIGHTS). Every expression is evaluated in the order written; §3.14 states it. */
 
 /* r = Q·a, row-major Q, each row summed left to right (as the root step). */
 static inline void SFX(fl_rotate)(const REAL *q, const REAL *a, REAL *r)
@@ -52,7 +52,7 @@ static inline void SFX(fl_carry)(const REAL *xg, const REAL *rg, const REAL *fk,
 }
 
 void SFX(hb_follower_place)(const DMODEL *m, const hb_followers *fl, int64_t j, const REAL *q, REAL *x, REAL *v,
-                            const REAL *rest)
+                            const REAL *rest, const REAL *seg_rest)
 {
     const int64_t P = m->points;
     const size_t st = (size_t)P * 3u;
@@ -62,6 +62,7 @@ void SFX(hb_follower_place)(const DMODEL *m, const hb_followers *fl, int64_t j, 
     const int64_t f = fl->follower[j];
     REAL *xf = x + (size_t)f * st, *vf = v + (size_t)f * st;
     const REAL *rf = rest + (size_t)f * st;
+    const REAL *sf = seg_rest ? seg_rest + (size_t)f * (size_t)(P - 1) : NULL;
     /* the root on the head */
     if (q) SFX(fl_rotate)(q, rf, xf);
     else
@@ -79,8 +80,21 @@ void SFX(hb_follower_place)(const DMODEL *m, const hb_followers *fl, int64_t j, 
             SFX(fl_carry)(x + (size_t)src[i] * st, rest + (size_t)src[i] * st, rf + 3 * k, k, q, y);
             for (int c = 0; c < 3; c++) acc[c] = i == 0 ? w[0] * y[c] : acc[c] + w[i] * y[c];
         }
+        /* the segment toward the blended point, at the follower's own rest length ℓ_k */
+        const REAL *pp = xf + 3 * (k - 1);
         REAL *p = xf + 3 * k;
-        for (int c = 0; c < 3; c++) p[c] = acc[c];
+        const REAL ell = sf ? sf[k - 1] : m->seg_len;
+        const REAL ex = acc[0] - pp[0], ey = acc[1] - pp[1], ez = acc[2] - pp[2];
+        const REAL rho = SQRT(ex * ex + ey * ey + ez * ez);
+        if (rho > (REAL)0) {
+            p[0] = pp[0] + ell * (ex / rho);
+            p[1] = pp[1] + ell * (ey / rho);
+            p[2] = pp[2] + ell * (ez / rho);
+        } else {
+            p[0] = pp[0];
+            p[1] = pp[1] - ell;
+            p[2] = pp[2];
+        }
         if (m->features & HB_F_COLLIDE) { /* the head collision of §3.5 */
             const REAL rc = m->collide_r;
             const REAL len = SQRT(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);

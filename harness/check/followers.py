@@ -79,6 +79,40 @@ def _carry(xg, rg, rf, q, one):
     return xg[:, 1:] + r
 
 
+def _follower_rest(traj, followers, dtype):
+    """ℓ_k of each follower in the working precision: [F][P−1] from a groom's rest shape, else ℓ
+    (as the backends round them: once, from double)."""
+    ell = traj.segment_rest()
+    if np.ndim(ell) == 0:
+        return np.full((followers.size, traj.points - 1), dtype.type(ell), dtype=dtype)
+    return ell[followers].astype(dtype)
+
+
+def _collide(p, rc, one):
+    """§3.5's head collision of points p [F][3] (rc falsy: the collider is off)."""
+    if not rc:
+        return p
+    n = np.sqrt(_dot(p, p))[..., None]
+    scaled = p * (rc / np.where(n == 0, one, n))
+    centre = np.broadcast_to(np.array([0, rc, 0], dtype=p.dtype), p.shape)
+    return np.where(n < rc, np.where(n == 0, centre, scaled), p)
+
+
+def _follow_blend(root, acc, ell, rc, one):
+    """Points 1 … P−1 of every follower (§3.14 step 2): each the blended point acc[:, k−1] pulled
+    onto the segment of length ℓ_k from the placed predecessor, then the head collision."""
+    out = np.empty_like(acc)
+    prev = root
+    for k in range(acc.shape[1]):
+        e = acc[:, k] - prev
+        rho = np.sqrt((e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1]) + e[:, 2] * e[:, 2])[:, None]
+        lk = ell[:, k][:, None]
+        down = prev - lk * np.array([0, 1, 0], dtype=acc.dtype)
+        p = np.where(rho > 0, prev + lk * (e / np.where(rho > 0, rho, one)), down)
+        prev = out[:, k] = _collide(p, rc, one)
+    return out
+
+
 def place_followers(traj, f, velocity=None):
     """(x, v) of written frame f with every follower placed from the frame's guides (§3.14).
     `velocity` is the frame's stored velocities (None: v is None)."""
@@ -109,15 +143,10 @@ def place_followers(traj, f, velocity=None):
             y = _carry(x[src[:, i]], rest[src[:, i]], rf, q, one)
             wi = w[:, i][:, None, None]
             acc = wi * y if acc is None else acc + wi * y
-        if traj.collider:
-            rc = dt(traj.collide_radius)
-            n = np.sqrt(_dot(acc, acc))[..., None]
-            inside = n < rc
-            scaled = acc * (rc / np.where(n == 0, one, n))
-            centre = np.broadcast_to(np.array([0, rc, 0], dtype=x.dtype), acc.shape)
-            acc = np.where(inside, np.where(n == 0, centre, scaled), acc)
+        ell = _follower_rest(traj, followers, x.dtype)
+        placed = _follow_blend(root, acc, ell, traj.collider and dt(traj.collide_radius), one)
         x[followers, 0] = root
-        x[followers, 1:] = acc
+        x[followers, 1:] = placed
         v = None
         if velocity is not None:
             v = velocity.reshape(traj.n_strands, traj.points, 3).copy()
