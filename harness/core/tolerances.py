@@ -405,6 +405,30 @@ DYN_ACC_USES_LONG = {
 DYN_ACC_VIEW_CM = 40.0  # scene height across the picture (L = 30 cm of hair below a head)
 
 
+# PREDICTABILITY (harness/check/predictability.py, harness/studies/predictability.py). A twin
+# run's one frame is perturbed by DYN_LYAPUNOV_PERTURBATION_L (RMS over the points, ·L): far
+# above fp64's rounding of a coordinate (2.2e-16 × 40 cm ≈ 9e-15 cm, 3e-16·L) and far below any
+# error a study ranks, so its growth is the model's own. The rate λ is fitted to ln(separation)
+# where the separation lies between DYN_LYAPUNOV_FLOOR × the perturbation (a random
+# perturbation first aligns with the growing direction: its first e-fold or two are not the
+# rate) and DYN_LYAPUNOV_CEILING_L (eight decades below the motion's size, 1e-4·L = 3 µm: the
+# growth is still linear there). These are choices of the method, not measurements; the tests
+# (tests/unit/test_predictability.py) recover known rates with them: the tent map's ln 2 per
+# step exactly, an unstable linear oscillator's k to 0.5 %.
+DYN_LYAPUNOV_PERTURBATION_L = 1e-12
+DYN_LYAPUNOV_FLOOR = 10.0
+DYN_LYAPUNOV_CEILING_L = 1e-4
+DYN_LYAPUNOV_TWINS = 3  # perturbed twins a scene (their log separations averaged); the ensemble's members
+# The predictability time: how long a difference of fp32's rounding of a coordinate
+# (2⁻²⁴·L, the smallest difference two modes of a study have: fp32 against fp64 of one mode)
+# takes to grow to the games budget of the dynamic accuracy study (DYN_ACC_USES, 1e-2·L) at the
+# rate λ: ln(1e-2/2⁻²⁴)/λ = 12.0/λ. Beyond it two runs that differ in rounding alone differ by
+# more than a game tolerates, so a pointwise error no longer ranks modes: the studies judge
+# pointwise errors only up to it and compare statistics (harness/check/ensemble.py) beyond.
+DYN_PREDICT_SEED_L = 2.0**-24
+DYN_PREDICT_TOLERANCE_L = DYN_ACC_USES["games"][0]
+
+
 def jitter_budget_cm(use: str) -> float:
     """The use's rest-jitter budget (largest frame-to-frame move) in cm."""
     lb = DYN_ACC_USES_LONG[use]
@@ -574,3 +598,9 @@ OBS_REST_MOVE_ABS_L = 1e-14  # of L = 30 cm: 3e-13 cm (measured 4.6e-14 cm; marg
 # linearised discrete chain's ω1/2π: −1.33e-4 relative (the scheme's 4e-5, tolerances above,
 # plus the spectral estimate's floor over 5.5 periods).
 OBS_CHAIN_SWING_FREQUENCY_REL = 5e-4  # measured 1.33e-4; margin 3.8×
+# A tip swings (observables.swings) when its dominant frequency fits OBS_SWING_MIN_PERIODS
+# whole periods into the signal and it crosses its mean 2·2 − 1 = 3 times: the damping fit
+# needs two periods (four half-period windows), and a drift's spectral peak sits at its lowest
+# bins (the long runs printed 6.5e-5 Hz for modes that do not swing), never a frequency of the
+# hair. A choice of the method, not a measurement.
+OBS_SWING_MIN_PERIODS = 2
