@@ -219,12 +219,12 @@ def test_release_damping_noise_is_the_larger_of_halves_and_fit():
         return pos
 
     pos = strands([0.02, 0.02, 0.04, 0.04])
-    values, noise, verdict = observables_long.metrics("release", pos, np.zeros_like(pos), None, L, 981.0, dt)
+    values, noise, verdict = observables_long.metrics("release", pos, np.zeros_like(pos), L, 981.0, dt)
     assert verdict == ob.OK and set(values) == {"tip_frequency_hz", "tip_damping_ratio"}
     assert values["tip_damping_ratio"] == pytest.approx(0.03, rel=0.03)  # the median of two 0.02s and two 0.04s
     assert noise["tip_damping_ratio"] == ob.swing(pos, dt)[2] > 0
     pos = strands([0.02, 0.03, 0.04, 0.05])
-    _, noise, _ = observables_long.metrics("release", pos, np.zeros_like(pos), None, L, 981.0, dt)
+    _, noise, _ = observables_long.metrics("release", pos, np.zeros_like(pos), L, 981.0, dt)
     assert noise["tip_damping_ratio"] == pytest.approx(0.005, rel=0.05)
 
 
