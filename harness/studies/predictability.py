@@ -5,8 +5,8 @@ ensemble (harness/check/ensemble.py).
 A twin resumes a run from its first simulated frame with that frame's positions perturbed by
 tolerances.DYN_LYAPUNOV_PERTURBATION_L (RMS over the non-root points, ·L; each twin its own
 direction), on the same binary and variant, so the run and its twins differ by the perturbation
-alone. The run must be written with every frame and `--velocities all` (a resumed run needs the
-frame's velocities); the twins are written with every frame too.
+alone. The run must store the velocities of its first written simulated frame (`--velocities
+all`: a resumed run needs them); the twins are written at the run's steps.
 """
 
 import shutil
@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from harness import HarnessError
 from harness.check import predictability as pr
 from harness.core import runner, tolerances
 from harness.io.trajectory import open_trajectory
@@ -22,31 +23,35 @@ from harness.io.trajectory import open_trajectory
 @dataclass
 class Twins:
     rate: pr.Rate
-    times: np.ndarray  # the simulated frames' times, the first (the perturbed one) included
-    positions: list  # each twin's positions [F][N][P][3] in double, frame 1 the perturbed one
+    times: np.ndarray  # the written simulated frames' times, the first (the perturbed one) included
+    positions: list  # each twin's positions [F][N][P][3] in double (or what `reduce` kept of them)
 
 
 def _positions(path):
     with open_trajectory(path) as t:
         sim = t.simulated
-        return t.time[sim].copy(), np.stack([t.frame(f) for f in sim]).astype(np.float64), t.hair_length
+        return t.step[sim].copy(), t.time[sim].copy(), np.stack([t.frame(f) for f in sim]).astype(np.float64)
 
 
-def run_twins(build, base, scratch, n=None, threads=None, timeout=3600):
+def run_twins(build, base, scratch, n=None, threads=None, timeout=3600, reduce=None):
     """n (default DYN_LYAPUNOV_TWINS) twins of the run in file `base` on `build`
-    (variants.Runner); Twins with their rate against the run."""
+    (variants.Runner), perturbed at its first written simulated frame and written at its steps
+    (its --output-every); Twins with their rate against the run. `reduce(x)`: what to keep of each
+    twin's positions (default: the positions)."""
     n = tolerances.DYN_LYAPUNOV_TWINS if n is None else n
     d0 = tolerances.DYN_LYAPUNOV_PERTURBATION_L
-    times, x_base, L = _positions(base)
+    steps, times, x_base = _positions(base)
     with open_trajectory(base) as t:
-        k, frames, shape = t.paper_frames, len(t.simulated), (t.n_strands, t.points, 3)
+        k, L, shape = t.paper_frames, t.hair_length, (t.n_strands, t.points, 3)
+        first, last = t.simulated_index(k), t.simulated_index(t.n_frames - 1)
+        every = int(t.dynamic_params.get("output_every", 1))
     twins, seps = [], []
     for j in range(n):
         src, out = scratch / f"{base.stem}_twin{j}_in.h5", scratch / f"{base.stem}_twin{j}.h5"
         shutil.copyfile(base, src)
         _perturb(src, k, shape, d0, L, seed=j)
-        flags = ["--input", src, "--input-frame", k, "--stages", "simulate", "--frames", frames - 1]
-        flags += ["--output", out, "--force"]
+        flags = ["--input", src, "--input-frame", k, "--stages", "simulate", "--frames", last - first]
+        flags += ["--output-every", every, "--output", out, "--force"]
         if build.variant:
             flags += ["--variant", build.variant]
         if build.backend == "cpu" and threads:
@@ -55,10 +60,12 @@ def run_twins(build, base, scratch, n=None, threads=None, timeout=3600):
             runner.run_binary(build.binary, flags, timeout=timeout)
         finally:
             src.unlink(missing_ok=True)
-        _, x, _ = _positions(out)
+        s, _, x = _positions(out)
         out.unlink()
-        twins.append(x)
+        if not np.array_equal(s, steps):
+            raise HarnessError(f"a twin of {base.name} was written at other steps than the run")
         seps.append(pr.separation(x[1:], x_base[1:], L))
+        twins.append(x if reduce is None else reduce(x))
     return Twins(pr.rate(times[1:], np.array(seps), d0), times, twins)
 
 
