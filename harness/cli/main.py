@@ -538,7 +538,7 @@ def cmd_stability(args):
     """Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend compliance, points and
     iterations, iterations on curly hair; head-motion frequency against amplitude; long-range attachments on and
     off under fast nods and gales) for both solvers and precisions, on the CPU and every built CUDA build where
-    a GPU answers; judge each cell ok, over-stretched, penetrating, escaped (a point past 2L) or diverged
+    a GPU answers; judge each cell ok, over-stretched, penetrating, escaped (a point past twice its hanging length) or diverged
     (NaN/Inf); write results/stability/, results/local/report/stability_*.png and
     results/local/report/dynamic_stability.md."""
     from harness.render import stability_report
