@@ -32,7 +32,7 @@ frame f (at step s, simulated frame number g = s − paper_frames + 1) is checke
 """
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -41,6 +41,7 @@ from harness.check.invariants import Violation
 from harness.core import tolerances
 from harness.core.guides import guide_count, guide_strands
 from harness.io.states import State, as_text
+from harness.io.trajectory import SimulatedView
 
 
 @dataclass
@@ -151,14 +152,15 @@ def observe(traj, x, v=None):
 
 def _paper_view(traj):
     """The paper frames of a dynamic file as a plain State (for invariants.check)."""
-    kw = {f.name: getattr(traj, f.name) for f in fields(State)}
-    kw.update(
+    cut = dict(
         n_frames=traj.paper_frames,
         stages=traj.stages[: traj.paper_frames],
         skipped=traj.skipped[: traj.paper_frames],
         fused=traj.fused[: traj.paper_frames],
     )
-    return State(**kw)
+    if isinstance(traj, SimulatedView):  # a LOD file's simulated rows (its frames read through them)
+        return replace(traj, **cut)
+    return State(**{**{f.name: getattr(traj, f.name) for f in fields(State)}, **cut})
 
 
 def _strands_holding_rest(traj):

@@ -563,7 +563,9 @@ def cmd_judge(args):
     """Step every planted defect (build/planted/, make planted) from the C reference's frames on the standard
     scenes, and every honest build × variant × precision on the extreme scenes, judging each frame as stepdiff
     does (the rule and the scene's spread); the paper model's planted defects and variants likewise by whole
-    runs judged as harness diff does; print caught / planted and false alarms / honest runs, write
+    runs judged as harness diff does; simulated-point LOD runs (not resumable) by stepdiff of the same run without
+    LOD, their simulated rows against it and their rendered rows recomputed; print caught / planted and false
+    alarms / honest runs, write
     results/judge/judge.csv and judge.json (docs/judge.md). Exit 0 when every defect is caught and no honest run
     fails, else 1."""
     from harness.studies import judge
@@ -572,14 +574,15 @@ def cmd_judge(args):
     if args.strands:
         plan = judge.replace(plan, strands=args.strands)
     if args.extreme:
-        unknown = [n for n in args.extreme if n not in judge.EXTREME and n not in judge.PAPER_EXTREME]
+        known = [*judge.EXTREME, *judge.PAPER_EXTREME, *judge.LOD_SCENES]
+        unknown = [n for n in args.extreme if n not in known]
         if unknown:
-            known = ", ".join([*judge.EXTREME, *judge.PAPER_EXTREME])
-            raise HarnessError(f"judge: unknown extreme scene(s) {', '.join(unknown)} (known: {known})")
+            raise HarnessError(f"judge: unknown extreme scene(s) {', '.join(unknown)} (known: {', '.join(known)})")
         plan = judge.replace(
             plan,
             extreme=tuple(n for n in args.extreme if n in judge.EXTREME),
             paper_extreme=tuple(n for n in args.extreme if n in judge.PAPER_EXTREME),
+            lod=tuple(n for n in args.extreme if n in judge.LOD_SCENES),
         )
     if args.plant:
         plan = judge.replace(plan, plants=tuple(args.plant))
