@@ -393,8 +393,13 @@ def check_same_rendering(a, b):
     """Raise StateError (exit 2) unless both files or neither were written with --render-points,
     with the same P_r and P_s: a rendered point has no simulated counterpart to compare with."""
     if (a.render_points, a.simulated_points) != (b.render_points, b.simulated_points):
+
         def what(t):
-            return f"{t.simulated_points} points rendered as {t.render_points}" if t.render_points else f"{t.points} points"
+            return (
+                f"{t.simulated_points} points rendered as {t.render_points}"
+                if t.render_points
+                else f"{t.points} points"
+            )
 
         raise StateError(f"A has {what(a)} a strand, B {what(b)}: compare files rendered alike")
 

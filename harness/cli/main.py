@@ -16,7 +16,7 @@ from pathlib import Path
 from harness import HarnessError, __version__
 from harness.core import interrupts
 from harness.core.paths import CUDA_BUILDS
-from harness.studies import peer
+from harness.studies import peer, reduced
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -479,12 +479,13 @@ def cmd_reduced(args):
     and without sag-free rest at two shape ranges: how far it sags, and the tip's swing under a wind step.
     Prints Markdown; --out writes the rows as CSV and references.csv beside it."""
     from harness.render import reduced_report
-    from harness.studies import reduced
 
     base = reduced.Plan.quick if args.quick else reduced.Plan
     changes = {k: v for k, v in (("scene", args.scene), ("seconds", args.seconds)) if v}
     if args.strands:
         changes["strands"] = tuple(args.strands)
+    if args.parts:
+        changes["parts"] = tuple(args.parts)
     rows = reduced.measure(base(gpu=args.gpu, **changes), out=args.out)
     print(reduced_report.markdown(rows), end="")
     return 0
@@ -538,8 +539,8 @@ def cmd_stability(args):
     """Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend compliance, points and
     iterations, iterations on curly hair; head-motion frequency against amplitude; long-range attachments on and
     off under fast nods and gales) for both solvers and precisions, on the CPU and every built CUDA build where
-    a GPU answers; judge each cell ok, over-stretched, penetrating, escaped (a point past twice its hanging length) or diverged
-    (NaN/Inf); write results/stability/, results/local/report/stability_*.png and
+    a GPU answers; judge each cell ok, over-stretched, penetrating, escaped (a point past twice its hanging
+    length) or diverged (NaN/Inf); write results/stability/, results/local/report/stability_*.png and
     results/local/report/dynamic_stability.md."""
     from harness.render import stability_report
     from harness.studies import stability
@@ -985,6 +986,13 @@ def parser():
         "--strands", type=whole(1), nargs="+", default=None, help="strand counts of the checked runs (1000 10000)"
     )
     rd.add_argument("--seconds", type=seconds, default=None, help="simulated time of each run")
+    rd.add_argument(
+        "--parts",
+        nargs="+",
+        choices=reduced.PARTS,
+        default=None,
+        help="which rows to measure (default all: guides lra sagfree sagfreq lod)",
+    )
     rd.add_argument("--quick", action="store_true", help="the small version (CI, a first look)")
     case_options(rd, gpu="the cuda variants too, where a GPU is usable", gpu_choices=("auto", "no"))
     rd.add_argument("--out", default=None, help="CSV file to write")

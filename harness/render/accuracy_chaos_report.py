@@ -269,9 +269,7 @@ def long_lines(long, worst_verdict):
             cells.append("—")
             continue
         r = r.iloc[0]
-        band = (
-            f"{_fmt(r['ref_lo'])} … {_fmt(r['ref_hi'])}" if np.isfinite(r["ref_lo"]) else _fmt(r["ref_uncertainty"])
-        )
+        band = f"{_fmt(r['ref_lo'])} … {_fmt(r['ref_hi'])}" if np.isfinite(r["ref_lo"]) else _fmt(r["ref_uncertainty"])
         cells.append(f"{_fmt(r['reference'])} / {band}")
     out.append(f"| reference: {ref['mode'].iloc[0] if len(ref) else '?'} | " + " | ".join(cells) + " | ok |")
     for mode, g in long[long["study"] == "mode"].groupby("mode", sort=False):

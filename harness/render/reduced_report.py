@@ -123,11 +123,29 @@ def markdown(rows, refs=()):
             cases,
             cols,
             "guides",
-            ("solver", "strands", "guides", "spacing (cm)", "scheme", "rms err / L", "max err / L",
-             "stretch of followers", "tip W1 / L", "curvature W1", "area"),  # fmt: skip
-            lambda r: (r["solver"], f"{int(r['strands']):,}", f"{_f(r, 'guides'):.0%} ({r['guide_count']})",
-                       _g(_f(r, "guide_spacing_cm")), r["follow"] or "all simulated", *_errs(r),
-                       _g(_f(r, "stretch_followers")), *_stats(r)),  # fmt: skip
+            (
+                "solver",
+                "strands",
+                "guides",
+                "spacing (cm)",
+                "scheme",
+                "rms err / L",
+                "max err / L",
+                "stretch of followers",
+                "tip W1 / L",
+                "curvature W1",
+                "area",
+            ),  # fmt: skip
+            lambda r: (
+                r["solver"],
+                f"{int(r['strands']):,}",
+                f"{_f(r, 'guides'):.0%} ({r['guide_count']})",
+                _g(_f(r, "guide_spacing_cm")),
+                r["follow"] or "all simulated",
+                *_errs(r),
+                _g(_f(r, "stretch_followers")),
+                *_stats(r),
+            ),  # fmt: skip
         ),
         "",
         "Long-range attachments under a fast nod, few iterations (LRA bound excess: the largest |x_k − x_0| over "
@@ -138,8 +156,15 @@ def markdown(rows, refs=()):
             cols,
             "lra",
             ("solver", "I", "LRA", "rms err / L", "max err / L", "stretch max (ℓ_k)", "bound excess", "moved (cm)"),
-            lambda r: (r["solver"], r["iterations"], "on" if int(r["lra"]) else "off", *_errs(r),
-                       _g(_f(r, "stretch_max_k")), _g(_f(r, "lra_excess")), _g(_f(r, "lra_moved_cm"))),  # fmt: skip
+            lambda r: (
+                r["solver"],
+                r["iterations"],
+                "on" if int(r["lra"]) else "off",
+                *_errs(r),
+                _g(_f(r, "stretch_max_k")),
+                _g(_f(r, "lra_excess")),
+                _g(_f(r, "lra_moved_cm")),
+            ),  # fmt: skip
         ),
     ]
     lines += _sag_lines(cases, cols)
@@ -155,8 +180,16 @@ def markdown(rows, refs=()):
                 cases,
                 cols,
                 "lod",
-                ("solver", "P_s", "rms err / L", "max err / L", "stretch max (rendered)", "tip W1 / L",
-                 "curvature W1", "area"),  # fmt: skip
+                (
+                    "solver",
+                    "P_s",
+                    "rms err / L",
+                    "max err / L",
+                    "stretch max (rendered)",
+                    "tip W1 / L",
+                    "curvature W1",
+                    "area",
+                ),  # fmt: skip
                 lambda r: (r["solver"], _points(r), *_errs(r), _g(_f(r, "stretch_max_k")), *_stats(r)),
             ),
         ]
@@ -182,8 +215,13 @@ def _sag_lines(cases, cols):
                 cols,
                 "sagfree",
                 ("solver", "shape range", "sag-free", "rest rms / L", "rest max / L"),
-                lambda r: (r["solver"], r["shape_range"], "on" if r["sag_free"] == "1" else "off",
-                           _g(_f(r, "rest_rms_L")), _g(_f(r, "rest_max_L"))),  # fmt: skip
+                lambda r: (
+                    r["solver"],
+                    r["shape_range"],
+                    "on" if r["sag_free"] == "1" else "off",
+                    _g(_f(r, "rest_rms_L")),
+                    _g(_f(r, "rest_max_L")),
+                ),  # fmt: skip
             ),
         ]
     if any(k[0] == "sagfreq" for k in cases):
@@ -197,8 +235,12 @@ def _sag_lines(cases, cols):
                 cols,
                 "sagfreq",
                 ("solver", "sag-free", "tip Hz", "tip damping ratio"),
-                lambda r: (r["solver"], "on" if r["sag_free"] == "1" else "off", _g(_f(r, "tip_hz"), 4),
-                           _g(_f(r, "tip_damping"))),  # fmt: skip
+                lambda r: (
+                    r["solver"],
+                    "on" if r["sag_free"] == "1" else "off",
+                    _g(_f(r, "tip_hz"), 4),
+                    _g(_f(r, "tip_damping")),
+                ),  # fmt: skip
             ),
         ]
     return out
@@ -243,10 +285,11 @@ def recommend(rows, refs=()):
                 parts.append(f"at {n:,} strands no guide fraction (not even all simulated) passes")
                 continue
             r = min(ok, key=lambda r: (_f(r, "guides"), _f(r, "rms_err_L")))
+            stretch = _f(r, "stretch_followers") if r["follow"] else _f(r, "stretch_max_k")
             parts.append(
-                f"at {n:,} strands {_f(r, 'guides'):.0%} guides ({r['guide_count']}, {_g(_f(r, 'guide_spacing_cm'))} cm "
-                f"apart), {r['follow'] or 'every strand simulated'} (rms {_g(_f(r, 'rms_err_L'))}·L up to {_g(h)} s, "
-                f"stretch {_g(_f(r, 'stretch_followers') if r['follow'] else _f(r, 'stretch_max_k'))})"
+                f"at {n:,} strands {_f(r, 'guides'):.0%} guides ({r['guide_count']}, "
+                f"{_g(_f(r, 'guide_spacing_cm'))} cm apart), {r['follow'] or 'every strand simulated'} "
+                f"(rms {_g(_f(r, 'rms_err_L'))}·L up to {_g(h)} s, stretch {_g(stretch)})"
             )
         lod = [r for r in cpu if r["study"] == "lod" and r["solver"] == "xpbd" and passes(r, use, spreads)]
         if lod:
@@ -259,8 +302,11 @@ def recommend(rows, refs=()):
         elif any(r["study"] == "lod" for r in cpu):
             parts.append("no P_s passes")
         budget = tolerances.DYN_ACC_USES[use]
-        out.append(f"- **{use}** (rms ≤ {budget[0]:g}·L, stretch ≤ {budget[1]:.1%}, statistics within the "
-                   f"ensemble's spread plus the use's allowance; the default scene, xpbd): " + "; ".join(parts) + ".")  # fmt: skip
+        head = (
+            f"- **{use}** (rms ≤ {budget[0]:g}·L, stretch ≤ {budget[1]:.1%}, statistics within the ensemble's spread "
+            "plus the use's allowance; the default scene, xpbd): "
+        )
+        out.append(head + "; ".join(parts) + ".")
     out += _lra_lines(cpu) + _sag_recommendation(cpu)
     return out
 
@@ -291,7 +337,9 @@ def _sag_recommendation(rows):
     for (solver, rng, on), v in sorted(sag.items()):
         plain = sag.get((solver, rng, "0"))
         if on == "1" and solver == "xpbd" and plain:
-            parts.append(f"shape range {rng}: it removes {1 - v / plain:.0%} of the sag (rest rms {_g(plain)} → {_g(v)}·L)")
+            parts.append(
+                f"shape range {rng}: it removes {1 - v / plain:.0%} of the sag (rest rms {_g(plain)} → {_g(v)}·L)"
+            )
     if not parts:
         return []
     line = "- Sag-free rest (xpbd, the scene held still): " + "; ".join(parts)

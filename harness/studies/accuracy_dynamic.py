@@ -532,7 +532,6 @@ class Study:
             finer=finer[:1],  # the 2S rung: a member of the reference ensemble (accuracy_ensemble)
         )
 
-
     def predictability(self, ref, ref_err):
         """The reference ensemble (accuracy_ensemble.build): λ and T_p from the final rung's twins;
         from here on pointwise errors are judged up to min(horizon, T_p) (horizon_frames), and
@@ -549,6 +548,7 @@ class Study:
         self.horizon_frames = ens.pointwise_frames
         ref["converged"] = bool(ref["ok"][: self.horizon_frames].all())
         return ens
+
 
 def _gpu_reference_build(gpu_ok, scene):
     """The default cuda build's fastest variant that runs `scene` with the reference's

@@ -280,7 +280,9 @@ class Judge:
             view = simulated_view(b)
             same = all(np.array_equal(a.frame(f), view.frame(f)) for f in range(a.n_frames))
             unit = tolerances.EPS[tolerances.kind_of(b.precision, b.fast_math)] * (b.collide_radius + 2 * b.hair_length)
-        failures = [v.message for v in bad[:2]] + ([] if same else ["the simulated rows differ from the run without LOD"])
+        failures = [v.message for v in bad[:2]] + (
+            [] if same else ["the simulated rows differ from the run without LOD"]
+        )
         return [
             {
                 "frame": "all",

@@ -223,8 +223,18 @@ class LongRuns:
         """(the S run, {metric: value}, {metric: (lo, hi) or spread}, the members' Signatures, rate)."""
         st = self.study
         runs = [
-            self.run(scene, self.ref_build, REF_SOLVER, S, REF_ITERATIONS, REF_PRECISION, None, f"ref_S{S}", threads,
-                     keep=S == self.ref_S)  # fmt: skip
+            self.run(
+                scene,
+                self.ref_build,
+                REF_SOLVER,
+                S,
+                REF_ITERATIONS,
+                REF_PRECISION,
+                None,
+                f"ref_S{S}",
+                threads,
+                keep=S == self.ref_S,
+            )  # fmt: skip
             for S in (self.ref_S, 2 * self.ref_S)
         ]
         base, base_path = runs[0]
@@ -235,8 +245,17 @@ class LongRuns:
         dt = st.frame_dt
         members = [Signatures(x, self.ctx, base.ell) for x in positions] if scene == "motion" else []
         values = [
-            metrics(scene, x, base.vel if k == 0 else None, st.L, gravity, dt, self.ctx, base.ell,
-                    members[:k] + members[k + 1 :])[0]  # fmt: skip
+            metrics(
+                scene,
+                x,
+                base.vel if k == 0 else None,
+                st.L,
+                gravity,
+                dt,
+                self.ctx,
+                base.ell,
+                members[:k] + members[k + 1 :],
+            )[0]  # fmt: skip
             for k, x in enumerate(positions)
         ]
         own = values[0]

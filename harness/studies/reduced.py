@@ -116,6 +116,7 @@ REF_FIELDS = (
     "envelope_rel_spread",
 )
 SCHEMES = ("one", "blend3")
+PARTS = ("guides", "lra", "sagfree", "sagfreq", "lod")
 STUDIED = ("guides", "lra", "sagfree", "lod")  # the §3.14 features the rows declare
 
 
@@ -140,6 +141,7 @@ class Plan:
     repeat: int = 3
     gpu: str = "auto"  # auto | no
     threads: int | None = None  # the CPU's checked runs and references (None: every core)
+    parts: tuple = PARTS  # which rows to measure
 
     @classmethod
     def quick(cls, **changes):
@@ -207,8 +209,10 @@ def cases(plan, scene):
     pr = plan.lod_render_points
     for solver in ("xpbd", "ftl"):
         for ps in plan.lod_points:
-            out.append(Case("lod", solver, s, it, big, points=ps, extra=("--render-points", str(pr)) if ps < pr else ()))
-    return out
+            out.append(
+                Case("lod", solver, s, it, big, points=ps, extra=("--render-points", str(pr)) if ps < pr else ())
+            )
+    return [c for c in out if c.study in plan.parts]
 
 
 def _fast(plan):
@@ -377,7 +381,14 @@ def _timings(plan, scene, case, timers):
         n = plan.time_gpu_strands if backend == "cuda" else plan.time_strands
         tf = _flags(scene, solver=case.solver, substeps=case.substeps, iterations=case.iterations, precision="fp32",
                     strands=n, frames=2, extra=case.extra, variant=(backend, variant), points=case.points)  # fmt: skip
-        out.append((backend, variant, n, runner.run_binary(binary_path(backend, "default"), tf + ["--repeat", str(plan.repeat)])))
+        out.append(
+            (
+                backend,
+                variant,
+                n,
+                runner.run_binary(binary_path(backend, "default"), tf + ["--repeat", str(plan.repeat)]),
+            )
+        )
     return out
 
 
@@ -451,4 +462,3 @@ def _ref_row(st, r):
         horizon_s=r.horizon_frames * st.dt * st.every,
         **{f"{m}_spread": r.spread.get(m) for m in en.DISTANCES},
     )
-

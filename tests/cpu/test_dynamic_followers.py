@@ -85,7 +85,9 @@ def test_guides_move_as_in_a_fully_simulated_run(cpu_bin, tmp_path, solver):
 
 @pytest.mark.parametrize("solver", ["xpbd", "ftl"])
 @pytest.mark.parametrize("follow", ["one", "blend3"])
-def test_a_follower_whose_guides_are_identical_to_it_is_their_shape_at_its_rest_lengths(cpu_bin, tmp_path, follow, solver):
+def test_a_follower_whose_guides_are_identical_to_it_is_their_shape_at_its_rest_lengths(
+    cpu_bin, tmp_path, follow, solver
+):
     """Every strand a copy of strand 0: each follower's guides sit at distance 0, so its blended
     points are its nearest guide's, and §3.14 pulls them onto its own rest lengths ℓ from its
     placed root. Segment by segment that moves point k by at most |x_k − x_{k−1}| − ℓ more than

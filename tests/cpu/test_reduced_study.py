@@ -27,8 +27,8 @@ def rows(tmp_path_factory):
 
 def test_every_case_is_measured_and_written(rows):
     got, out = rows
-    # per N: solvers × (all + fraction × schemes); solvers × I × LRA; solvers × (ranges × sag-free + wind step × sag-free);
-    # solvers × P_s
+    # per N: solvers × (all + fraction × schemes); solvers × I × LRA; solvers × (ranges × sag-free
+    # + wind step × sag-free); solvers × P_s
     want = 2 * 2 * (1 + 2) + 2 * 2 + 2 * (2 * 2 + 2) + 2 * 2
     assert len(got) == want and all(r["backend"] == "cpu" for r in got)
     assert len(reduced_report.read(out)) == want
@@ -64,7 +64,8 @@ def _row(guides, follow, rms, stretch=0.0, strands=1000, spacing=1.0):
     return {"study": "guides", "solver": "xpbd", "backend": "cpu", "guides": str(guides), "follow": follow,
             "rms_err_L": str(rms), "strands": str(strands), "guide_count": str(int(guides * strands)),
             "guide_spacing_cm": str(spacing), "stretch_followers": str(stretch) if follow else "",
-            "stretch_max_k": "0.001", "blown_up": "0", "tip_L": "", "curvature_rel": "", "envelope_rel": ""}  # fmt: skip
+            "stretch_max_k": "0.001", "blown_up": "0", "tip_L": "", "curvature_rel": "",
+            "envelope_rel": ""}  # fmt: skip
 
 
 def _use_line(lines, use):

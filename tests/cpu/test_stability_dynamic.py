@@ -400,13 +400,13 @@ def test_boundaries_are_named_from_the_data():
     b, o, k = "escaped", "over-stretched", "ok"
     words = stability_report.boundaries(_panel([[b, b], [o, b], [k, o], [k, k]]), "substeps-wind")
     assert words == (
-        "escapes (a point past twice its hanging length, finite) at S = 1 (U = 0 cm/s); S ≤ 2 (U = 1000 cm/s); over-stretches at "
-        "S = 2 (U = 0 cm/s); S = 4 (U = 1000 cm/s)"
+        "escapes (a point past twice its hanging length, finite) at S = 1 (U = 0 cm/s); S ≤ 2 (U = 1000 cm/s); "
+        "over-stretches at S = 2 (U = 0 cm/s); S = 4 (U = 1000 cm/s)"
     )
     d = "diverged"
     assert stability_report.boundaries(_panel([[d, b]] * 4), "substeps-wind") == (
-        "diverges (NaN/Inf) at every S (U = 0 cm/s); escapes (a point past twice its hanging length, finite) at every S (U = 1000 cm/s); "
-        "ok in no cell"
+        "diverges (NaN/Inf) at every S (U = 0 cm/s); escapes (a point past twice its hanging length, finite) at "
+        "every S (U = 1000 cm/s); ok in no cell"
     )
     assert stability_report.boundaries(_panel([[k, k]] * 4), "substeps-wind") == "ok in every cell"
     assert stability_report.boundaries(_panel([[b, b]] * 4), "substeps-wind") == (

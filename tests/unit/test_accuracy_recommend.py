@@ -52,8 +52,18 @@ def long_rows(metric, scene, values, lo, hi, noise=0.0):
     rows += [dict(study="mode", solver="ftl", ftl_damping=s, substeps=4, iterations=1) for s in (0.9, 1.0)]
     return pd.DataFrame(
         [
-            dict(r, precision="fp32", scene=scene, metric=metric, value=v, noise=noise, reference=values[0],
-                 ref_uncertainty=(hi - lo) / 2, ref_lo=lo, ref_hi=hi)  # fmt: skip
+            dict(
+                r,
+                precision="fp32",
+                scene=scene,
+                metric=metric,
+                value=v,
+                noise=noise,
+                reference=values[0],
+                ref_uncertainty=(hi - lo) / 2,
+                ref_lo=lo,
+                ref_hi=hi,
+            )  # fmt: skip
             for r, v in zip(rows, values)
         ]
     )
