@@ -51,6 +51,43 @@ static inline void SFX(fl_carry)(const REAL *xg, const REAL *rg, const REAL *fk,
     for (int c = 0; c < 3; c++) y[c] = x1[c] + r[c];
 }
 
+/* The head collision of a follower point q placed at distance ell from its predecessor a:
+ * inside the sphere rc it goes to the nearest point of the circle where the sphere of radius ell
+ * about a meets the collider sphere (so the segment keeps its length), or, where they do not
+ * meet, radially onto the collider as §3.5. The factored forms are §2.5's. */
+static inline void SFX(fl_collide)(const REAL *a, REAL ell, REAL rc, REAL *q)
+{
+    const REAL len = SQRT(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+    if (!(len < rc)) return;
+    const REAL d = SQRT(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (d > (REAL)0) {
+        const REAL tau = ((d - rc) * (d + rc) + ell * ell) / (d + d);
+        const REAL cp = d - tau;
+        const REAL h2 = ((rc - d) + tau) * (rc + cp);
+        if (h2 > (REAL)0) {
+            const REAL n[3] = {a[0] / d, a[1] / d, a[2] / d};
+            const REAL m[3] = {cp * n[0], cp * n[1], cp * n[2]};
+            const REAL v[3] = {q[0] - m[0], q[1] - m[1], q[2] - m[2]};
+            const REAL s = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+            const REAL u[3] = {v[0] - s * n[0], v[1] - s * n[1], v[2] - s * n[2]};
+            const REAL lam = SQRT(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            if (lam > (REAL)0) {
+                const REAL r = SQRT(h2);
+                for (int c = 0; c < 3; c++) q[c] = m[c] + r * (u[c] / lam);
+                return;
+            }
+        }
+    }
+    if (len == (REAL)0) {
+        q[0] = (REAL)0;
+        q[1] = rc;
+        q[2] = (REAL)0;
+    } else {
+        const REAL sc = rc / len;
+        for (int c = 0; c < 3; c++) q[c] = q[c] * sc;
+    }
+}
+
 void SFX(hb_follower_place)(const DMODEL *m, const hb_followers *fl, int64_t j, const REAL *q, REAL *x, REAL *v,
                             const REAL *rest, const REAL *seg_rest)
 {
@@ -95,19 +132,6 @@ void SFX(hb_follower_place)(const DMODEL *m, const hb_followers *fl, int64_t j, 
             p[1] = pp[1] - ell;
             p[2] = pp[2];
         }
-        if (m->features & HB_F_COLLIDE) { /* the head collision of §3.5 */
-            const REAL rc = m->collide_r;
-            const REAL len = SQRT(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-            if (len < rc) {
-                if (len == (REAL)0) {
-                    p[0] = (REAL)0;
-                    p[1] = rc;
-                    p[2] = (REAL)0;
-                } else {
-                    const REAL sc = rc / len;
-                    for (int c = 0; c < 3; c++) p[c] = p[c] * sc;
-                }
-            }
-        }
+        if (m->features & HB_F_COLLIDE) SFX(fl_collide)(pp, ell, m->collide_r, p);
     }
 }

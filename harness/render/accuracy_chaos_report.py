@@ -160,8 +160,8 @@ def predictability_lines(study, long):
     out = ["### Predictability", ""]
     if not p:
         return out + [
-            "Not measured with these results (a study from before the perturbed twins): pointwise errors are "
-            f"judged over the whole {study['horizon']:g} s horizon, which may exceed the scene's predictability.",
+            "Measured before the study ran perturbed twins (env.json has no rate): pointwise errors are judged over "
+            f"the whole {study['horizon']:g} s horizon, which may exceed the scene's predictability time.",
             "",
         ]
     tp = p["predictability_s"]
@@ -202,7 +202,7 @@ def chaos_lines(summ, ens, shown):
     out = ["### What survives chaos: statistics against the reference ensemble", ""]
     cells = ensemble_cells(ens)
     if not cells:
-        return out + ["Not measured with these results (no ensemble.csv: a study from before the ensemble).", ""]
+        return out + ["Measured before the study had a reference ensemble (no ensemble.csv beside its table).", ""]
     members = ens[ens["study"] == "member"]
     first = next(iter(cells.values()))
     spread = " · ".join(
