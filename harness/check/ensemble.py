@@ -1,4 +1,4 @@
-"""Metrics that survive chaos (docs/model.md §5.2): what a run looks like, compared with a
+"""Metrics that survive chaos (docs/model.md §5.4): what a run looks like, compared with a
 reference ensemble rather than with one trajectory. Numpy only; nothing here runs a binary.
 
 Beyond the predictability time (harness/check/predictability.py) two runs that differ in

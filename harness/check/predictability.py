@@ -1,4 +1,4 @@
-"""How long a trajectory can be predicted pointwise (docs/model.md §5.2): the largest Lyapunov
+"""How long a trajectory can be predicted pointwise (docs/model.md §5.4): the largest Lyapunov
 rate λ from perturbed twin runs, and the predictability time it gives. Numpy only; nothing
 here runs a binary (harness/studies/predictability.py runs the twins).
 

@@ -1,5 +1,5 @@
-"""The parts of the dynamic accuracy page that go beyond one reference trajectory (accuracy_dynamic_
-report.py writes the page): the predictability of the scenes, the metrics that survive chaos
+"""The parts of the dynamic accuracy page that go beyond one reference trajectory (the page is
+accuracy_dynamic_report.py's): the predictability of the scenes, the metrics that survive chaos
 against the reference ensemble (ensemble.csv), the long runs (observables.csv), and the gates a
 mode must pass on them for a use (`checks`). Every number comes from those files; a table written
 before they existed reads as "not measured"."""

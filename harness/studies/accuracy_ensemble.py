@@ -1,4 +1,4 @@
-"""The dynamic accuracy study's reference ensemble and predictability (docs/model.md §5.2): what
+"""The dynamic accuracy study's reference ensemble and predictability (docs/model.md §5.4): what
 `python -m harness accuracy --model dynamic` measures beyond one reference trajectory.
 
 After the reference ladder, the converged rung S gets tolerances.DYN_LYAPUNOV_TWINS perturbed twins

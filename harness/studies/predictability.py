@@ -1,6 +1,6 @@
-"""Perturbed twin runs: the Lyapunov rate λ and the predictability time of a scene (harness/check/
-predictability.py fits them), and the twins themselves, which are members of a study's reference
-ensemble (harness/check/ensemble.py).
+"""Perturbed twin runs: the Lyapunov rate λ and the predictability time of a scene
+(harness/check/predictability.py fits them), and the twins themselves, which are members of a
+study's reference ensemble (harness/check/ensemble.py).
 
 A twin resumes a run from its first simulated frame with that frame's positions perturbed by
 tolerances.DYN_LYAPUNOV_PERTURBATION_L (RMS over the non-root points, ·L; each twin its own
