@@ -25,8 +25,11 @@ where one is usable, once the GPU's rung S0 agrees with the CPU's within a share
 margin (tolerances.DYN_ACC_GPU_REF_SHARE); otherwise the CPU ladder is used.
 
 After the ladder, `ref_extra` more doublings measure the reference's own error
-(Study.reference_error), and the long runs (studies/observables_long.py, observables.csv)
-measure what a user sees over `long_seconds`.
+(Study.reference_error); perturbed twins of the converged rung give the scene's Lyapunov rate
+and predictability time T_p, and pointwise errors are judged only up to min(horizon, T_p)
+(Study.predictability, studies/accuracy_ensemble.py); every mode's statistics over the whole run
+go against the reference ensemble (ensemble.csv); and the long runs (studies/observables_long.py,
+observables.csv) measure what a user sees over `long_seconds`.
 
 Time per frame is measured apart from the checked run: the same mode at `time_strands`
 strands, `time_frames` frames, `--repeat`, no output file (never a run that also checks);
