@@ -10,7 +10,10 @@ tolerances.DYN_LYAPUNOV_FLOOR·d0 (past the alignment of the perturbation with t
 direction) and tolerances.DYN_LYAPUNOV_CEILING_L (below saturation), the log averaged over the
 twins first. A separation that never leaves the floor gives the slope over the frames below
 the ceiling and `grew` False: the run is not chaotic over its length, and its predictability
-time is beyond the run (infinite here).
+time is beyond the run (infinite here). One that passes the ceiling before three frames lie in
+the linear range (frames written too far apart for the rate) gives the secant from the
+perturbation to the first frame past the ceiling, a lower bound of λ (`bound`), so the
+predictability time is an upper bound.
 
 `predictability_time(λ)`: the time in which a difference of DYN_PREDICT_SEED_L (fp32's
 rounding of a coordinate, the smallest difference two modes of a study have) grows to
@@ -32,8 +35,9 @@ class Rate:
     grew: bool  # the separation passed the floor: the fit is over the linear range
     t_lo: float  # the fitted range
     t_hi: float
-    samples: int  # frames fitted
+    samples: int  # frames fitted (0: a secant, see `bound`)
     d_end: float  # the separation (log-averaged over the twins) at the last frame, over L
+    bound: bool = False  # λ is only a lower bound: the separation passed the ceiling within two frames
 
     @property
     def predictability(self):
@@ -64,8 +68,13 @@ def rate(times, separations, d0, floor=None, ceiling=None):
             below[past[0] :] = False
     linear = below & (mean_log >= math.log(floor * d0))
     grew = int(linear.sum()) >= 3
-    use = linear if grew else below
     d_end = float(np.exp(mean_log[good][-1])) if good.any() else math.nan
+    past = np.flatnonzero(good & (mean_log > math.log(ceiling)))
+    if not grew and past.size:  # past the ceiling before three frames of growth: sampled too coarsely
+        k = past[0]  # the secant from the perturbation (at t[0] less a frame) is a lower bound of λ
+        t0 = t[0] - (t[1] - t[0]) if len(t) > 1 else t[0] - 1.0
+        return Rate((mean_log[k] - math.log(d0)) / (t[k] - t0), True, float(t0), float(t[k]), 0, d_end, True)
+    use = linear if grew else below
     if int(use.sum()) < 2:
         return Rate(math.nan, grew, math.nan, math.nan, int(use.sum()), d_end)
     slope = float(np.polyfit(t[use], mean_log[use], 1)[0])

@@ -486,8 +486,9 @@ def cmd_reduced(args):
         changes["strands"] = tuple(args.strands)
     if args.parts:
         changes["parts"] = tuple(args.parts)
-    rows = reduced.measure(base(gpu=args.gpu, **changes), out=args.out)
-    print(reduced_report.markdown(rows), end="")
+    refs = []
+    rows = reduced.measure(base(gpu=args.gpu, **changes), out=args.out, refs_into=refs)
+    print(reduced_report.markdown(rows, refs), end="")
     return 0
 
 

@@ -170,7 +170,11 @@ def predictability_lines(study, long):
         f"{p['twins']} twins of the reference run (its first frame's positions perturbed by "
         f"{p['perturbation_L']:g}·L, RMS) separate from it at the largest Lyapunov rate "
         + (
-            f"**λ = {p['lyapunov_per_s']:.3g} /s** (e-folding {1e3 / p['lyapunov_per_s']:.3g} ms; ln of the "
+            f"**λ ≥ {p['lyapunov_per_s']:.3g} /s** (the separation passed {tolerances.DYN_LYAPUNOV_CEILING_L:g}·L "
+            f"by {p['fit_to_s']:.3g} s, faster than the frames resolve: the secant from the perturbation is a lower "
+            f"bound, and T_p below an upper bound). The **predictability time** T_p ≤ **{tp:.3g} s**. "
+            if p.get("lower_bound")
+            else f"**λ = {p['lyapunov_per_s']:.3g} /s** (e-folding {1e3 / p['lyapunov_per_s']:.3g} ms; ln of the "
             f"separation fitted from {p['fit_from_s']:.3g} to {p['fit_to_s']:.3g} s, {p['fit_frames']} frames). "
             f"The **predictability time** T_p = ln({tolerances.DYN_PREDICT_TOLERANCE_L:g}/2⁻²⁴)/λ = "
             f"**{tp:.3g} s**: the time a difference of fp32's rounding takes to grow to the games budget. "

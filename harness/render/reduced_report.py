@@ -77,6 +77,13 @@ def _stats(r):
     return tuple(_g(_f(r, m)) for m in DISTANCES)
 
 
+def _rate(r, tp):
+    """λ as the references table writes it: 'no growth', '≥ x' (a lower bound) or x."""
+    if math.isinf(tp):
+        return "no growth"
+    return ("≥ " if str(r.get("lyapunov_lower_bound")) == "True" else "") + _g(_f(r, "lyapunov_per_s"))
+
+
 def references_lines(refs):
     if not refs:
         return []
@@ -95,8 +102,8 @@ def references_lines(refs):
         tp = _f(r, "predictability_s")
         out.append(
             f"| {r['scene']} | {int(r['strands']):,} | {r.get('build', '')} | {r['substeps']} | "
-            f"{'yes' if r['converged'] == 'True' else '**no**'} | {r['ladder']} | "
-            f"{'no growth' if math.isinf(tp) else _g(_f(r, 'lyapunov_per_s'))} | "
+            f"{'yes' if str(r['converged']) == 'True' else '**no**'} | {r['ladder']} | "
+            f"{_rate(r, tp)} | "
             f"{'beyond the run' if math.isinf(tp) else _g(tp)} | {_g(_f(r, 'horizon_s'))} | "
             + " / ".join(_g(_f(r, f"{m}_spread")) for m in DISTANCES)
             + " |"
@@ -218,7 +225,7 @@ def _sag_lines(cases, cols):
                 lambda r: (
                     r["solver"],
                     r["shape_range"],
-                    "on" if r["sag_free"] == "1" else "off",
+                    "on" if str(r["sag_free"]) == "1" else "off",
                     _g(_f(r, "rest_rms_L")),
                     _g(_f(r, "rest_max_L")),
                 ),  # fmt: skip
@@ -237,7 +244,7 @@ def _sag_lines(cases, cols):
                 ("solver", "sag-free", "tip Hz", "tip damping ratio"),
                 lambda r: (
                     r["solver"],
-                    "on" if r["sag_free"] == "1" else "off",
+                    "on" if str(r["sag_free"]) == "1" else "off",
                     _g(_f(r, "tip_hz"), 4),
                     _g(_f(r, "tip_damping")),
                 ),  # fmt: skip
@@ -312,7 +319,7 @@ def recommend(rows, refs=()):
 
 
 def _lra_lines(rows):
-    by = {(r["solver"], r["iterations"], r["lra"]): r for r in rows if r["study"] == "lra"}
+    by = {(r["solver"], str(r["iterations"]), str(r["lra"])): r for r in rows if r["study"] == "lra"}
     out = []
     for (solver, i, lra), r in sorted(by.items()):
         off = by.get((solver, i, "0"))
@@ -331,8 +338,9 @@ def _lra_lines(rows):
 
 
 def _sag_recommendation(rows):
-    sag = {(r["solver"], r["shape_range"], r["sag_free"]): _f(r, "rest_rms_L") for r in rows if r["study"] == "sagfree"}
-    hz = {r["sag_free"]: _f(r, "tip_hz") for r in rows if r["study"] == "sagfreq" and r["solver"] == "xpbd"}
+    sag = {(r["solver"], str(r["shape_range"]), str(r["sag_free"])): _f(r, "rest_rms_L")
+           for r in rows if r["study"] == "sagfree"}  # fmt: skip
+    hz = {str(r["sag_free"]): _f(r, "tip_hz") for r in rows if r["study"] == "sagfreq" and r["solver"] == "xpbd"}
     parts = []
     for (solver, rng, on), v in sorted(sag.items()):
         plain = sag.get((solver, rng, "0"))

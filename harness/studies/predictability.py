@@ -83,6 +83,7 @@ def rate_columns(rate):
     """The rate as a flat dict (an env.json entry, a CSV row's columns)."""
     return dict(
         lyapunov_per_s=rate.lam,
+        lower_bound=rate.bound,
         grew=rate.grew,
         fit_from_s=rate.t_lo,
         fit_to_s=rate.t_hi,

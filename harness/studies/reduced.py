@@ -109,6 +109,7 @@ REF_FIELDS = (
     "worst_ratio",
     "ladder",
     "lyapunov_per_s",
+    "lyapunov_lower_bound",
     "predictability_s",
     "horizon_s",
     "tip_L_spread",
@@ -392,8 +393,9 @@ def _timings(plan, scene, case, timers):
     return out
 
 
-def measure(plan=Plan(), out=None, work=None, progress=print):
-    """Every row (module docstring); with `out`, the CSV and references.csv beside it."""
+def measure(plan=Plan(), out=None, work=None, progress=print, refs_into=None):
+    """Every row (module docstring); with `out`, the CSV and references.csv beside it; the
+    references' rows are appended to the list `refs_into` when given."""
     with tempfile.TemporaryDirectory(dir=work) as tmp:
         st = Study(plan, tmp, progress)
         all_cases = cases(plan, st.scene)
@@ -418,6 +420,8 @@ def measure(plan=Plan(), out=None, work=None, progress=print):
                     f"{sim['median_ms']:.3f} ms/frame"
                 )
         refs = [_ref_row(st, r) for r in st.refs.cache.values()]
+        if refs_into is not None:
+            refs_into.extend(refs)
     if out:
         write_csv(out, FIELDS, rows)
         write_csv(Path(out).with_name("references.csv"), REF_FIELDS, refs)
@@ -458,6 +462,7 @@ def _ref_row(st, r):
         worst_ratio=r.ladder[-1][3],
         ladder="; ".join(f"S{S}/{S2}: {d:.2e}·L ({q:.3g}×)" for S, S2, d, q in r.ladder),
         lyapunov_per_s=r.rate.lam,
+        lyapunov_lower_bound=r.rate.bound,
         predictability_s=r.rate.predictability,
         horizon_s=r.horizon_frames * st.dt * st.every,
         **{f"{m}_spread": r.spread.get(m) for m in en.DISTANCES},

@@ -74,3 +74,13 @@ def test_perturbation_has_the_asked_rms_and_leaves_roots():
 def test_predictability_time_is_infinite_without_growth():
     assert math.isinf(pr.predictability_time(0.0)) and math.isinf(pr.predictability_time(float("nan")))
     assert pr.predictability_time(120.0) == pytest.approx(math.log(1e-2 * 2**24) / 120.0)
+
+
+def test_a_growth_faster_than_the_frames_gives_a_lower_bound():
+    """At 400 /s sampled every 0.05 s the separation passes 1e-4·L by the second frame: the rate is
+    the secant's lower bound, and the predictability time an upper bound, not 'predictable'."""
+    t = 0.05 * np.arange(1, 21)
+    sep = np.minimum(1e-12 * np.exp(400 * (t - 0.0)), 1e-2)
+    r = pr.rate(t, sep, 1e-12)
+    assert r.grew and r.bound and r.samples == 0
+    assert 0 < r.lam <= 400 and r.predictability < 0.2
