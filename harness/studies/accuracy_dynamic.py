@@ -712,8 +712,24 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         (out_dir / ANALYTIC_NAME).write_text("\n".join(analytic_lines) + "\n")
     elif (out_dir / ANALYTIC_NAME).exists():
         (out_dir / ANALYTIC_NAME).unlink()  # a stale table must not be rendered with these rows
+    meta = _env(study, plan, builds, (gpu_ok, gpu_why, gpu_note), ref, ref_err, ens, started, command)
     final_S = ref["steps"][-1]["S2"]
-    meta = dict(
+    (out_dir / "env.json").write_text(json.dumps(meta, indent=1, default=str) + "\n")
+    log(f"wrote {display(csv_path)}")
+    if not ref["converged"]:
+        log(
+            f"dynamic accuracy: the reference did NOT converge over the horizon by S = {final_S} "
+            f"(--ref-max {plan.ref_max}); the report says so"
+        )
+        return 1
+    return 0
+
+
+def _env(study, plan, builds, gpu, ref, ref_err, ens, started, command):
+    """env.json's record: the machine, the plan and what the study decided (gpu: (usable, why, note))."""
+    gpu_ok, gpu_why, gpu_note = gpu
+    final_S = ref["steps"][-1]["S2"]
+    return dict(
         env.collect(),
         study=dict(
             asdict(plan),
@@ -759,15 +775,6 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
             command=command,
         ),
     )
-    (out_dir / "env.json").write_text(json.dumps(meta, indent=1, default=str) + "\n")
-    log(f"wrote {display(csv_path)}")
-    if not ref["converged"]:
-        log(
-            f"dynamic accuracy: the reference did NOT converge over the horizon by S = {final_S} "
-            f"(--ref-max {plan.ref_max}); the report says so"
-        )
-        return 1
-    return 0
 
 
 def _rows(study, modes, mode_paths, ref, timing, ens):
