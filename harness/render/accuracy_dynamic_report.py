@@ -421,8 +421,9 @@ def recommend(summ, long=None, ens=None, horizon=None):
         over = f" up to {horizon:.3g} s" if horizon is not None else " over the horizon"
         chaos_txt = (
             f"; over the whole run, within the reference ensemble's spread plus {allow['tip_L']:g}·L (tip "
-            f"distribution) and {100 * allow['curvature_rel']:g} % (curvature, silhouette area), kinetic energy of "
-            f"the motion within ×{allow['kinetic_factor']:g} of the members' range"
+            f"distribution), {100 * allow['curvature_rel']:g} % (curvature) and {100 * allow['envelope_rel']:g} % "
+            f"(silhouette area), kinetic energy of the motion within ×{allow['kinetic_factor']:g} of the members' "
+            "range, stretch against ℓ_k within the use's budget"
             if ensm
             else ""
         )

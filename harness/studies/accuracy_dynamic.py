@@ -496,10 +496,8 @@ class Study:
 
     def reference_error(self, ref):
         """The reference's own error, measured: its final rung against plan.ref_extra more
-        doublings. Per frame the RMS and max difference from the finest rung, and (with two or
-        more) a Richardson-style estimate: that difference plus the tail the last two
-        differences predict if each doubling keeps shrinking the change by their ratio q
-        (q = worst over the horizon of the last over the one before; no estimate if q ≥ 1)."""
+        doublings: per frame the RMS and max difference from the finest rung; reference_tail adds
+        the Richardson-style estimate once the pointwise horizon is known."""
         if self.plan.ref_extra < 1:
             return None
         S = ref["steps"][-1]["S2"]
@@ -512,28 +510,26 @@ class Study:
             finer.append(cur)
             prev, prev_S = cur, 2 * prev_S
         rms, mx = frame_errors(ref["final"].pos, prev.pos, self.L)
-        H = self.horizon_frames
+        self.log(
+            f"dynamic accuracy: the reference S = {S} against S = {prev_S}: RMS {np.nanmax(rms):.2e}·L, max "
+            f"{np.nanmax(mx):.2e}·L over the run"
+        )
+        return dict(S=S, finest=prev_S, rms=rms, max=mx, diffs=diffs, finer=finer[:1])  # finer: an ensemble member
+
+    def reference_tail(self, err):
+        """With two or more extra doublings, the tail they predict over the (pointwise) horizon: each
+        doubling shrinks the change by q, the worst of the last change over the one before (no
+        estimate if q ≥ 1); adds est_rms, est_max and ratio to `err`."""
+        H, diffs = self.horizon_frames, err["diffs"]
         q = float("nan")
-        tail_rms = tail_max = np.full_like(rms, np.nan)
+        tail_rms = tail_max = np.full_like(err["rms"], np.nan)
         if len(diffs) >= 2:
             with np.errstate(invalid="ignore", divide="ignore"):
                 q = float(np.nanmax(diffs[-1][2][:H]) / np.nanmax(diffs[-2][2][:H]))
             if q < 1:
                 tail_rms, tail_max = diffs[-1][2] * q / (1 - q), diffs[-1][3] * q / (1 - q)
-        self.log(
-            f"dynamic accuracy: the reference S = {S} against S = {prev_S}: RMS {np.nanmax(rms[:H]):.2e}·L, max "
-            f"{np.nanmax(mx[:H]):.2e}·L over the horizon; change ratio per doubling {q:.3g}"
-        )
-        return dict(
-            S=S,
-            finest=prev_S,
-            rms=rms,
-            max=mx,
-            est_rms=rms + tail_rms,
-            est_max=mx + tail_max,
-            ratio=q,
-            finer=finer[:1],  # the 2S rung: a member of the reference ensemble (accuracy_ensemble)
-        )
+        err.update(est_rms=err["rms"] + tail_rms, est_max=err["max"] + tail_max, ratio=q)
+        self.log(f"dynamic accuracy: change ratio per doubling {q:.3g} over the horizon")
 
     def predictability(self, ref, ref_err):
         """The reference ensemble (accuracy_ensemble.build): λ and T_p from the final rung's twins;
@@ -550,6 +546,8 @@ class Study:
         )
         self.horizon_frames = ens.pointwise_frames
         ref["converged"] = bool(ref["ok"][: self.horizon_frames].all())
+        if ref_err:
+            self.reference_tail(ref_err)
         return ens
 
 
