@@ -168,18 +168,18 @@ def predictability_lines(study, long):
     asked = study.get("asked_horizon", study["horizon"])
     out += [
         f"{p['twins']} twins of the reference run (its first frame's positions perturbed by "
-        f"{p['perturbation_L']:g}·L, RMS) separate from it at the largest Lyapunov rate "
+        f"{p['perturbation_L']:g}·L, RMS) "
         + (
-            f"**λ ≥ {p['lyapunov_per_s']:.3g} /s** (the separation passed {tolerances.DYN_LYAPUNOV_CEILING_L:g}·L "
+            f"separate from it at the largest Lyapunov rate **λ ≥ {p['lyapunov_per_s']:.3g} /s** (the separation passed {tolerances.DYN_LYAPUNOV_CEILING_L:g}·L "
             f"by {p['fit_to_s']:.3g} s, faster than the frames resolve: the secant from the perturbation is a lower "
             f"bound, and T_p below an upper bound). The **predictability time** T_p ≤ **{tp:.3g} s**. "
             if p.get("lower_bound")
-            else f"**λ = {p['lyapunov_per_s']:.3g} /s** (e-folding {1e3 / p['lyapunov_per_s']:.3g} ms; ln of the "
+            else f"separate from it at the largest Lyapunov rate **λ = {p['lyapunov_per_s']:.3g} /s** (e-folding {1e3 / p['lyapunov_per_s']:.3g} ms; ln of the "
             f"separation fitted from {p['fit_from_s']:.3g} to {p['fit_to_s']:.3g} s, {p['fit_frames']} frames). "
             f"The **predictability time** T_p = ln({tolerances.DYN_PREDICT_TOLERANCE_L:g}/2⁻²⁴)/λ = "
             f"**{tp:.3g} s**: the time a difference of fp32's rounding takes to grow to the games budget. "
             if p["grew"]
-            else f"no growth: the separation never grew past {tolerances.DYN_LYAPUNOV_FLOOR:g}× the perturbation "
+            else f"do not separate: the separation never grew past {tolerances.DYN_LYAPUNOV_FLOOR:g}× the perturbation "
             f"over the run (its slope {_fmt(p['lyapunov_per_s'])} /s; it ended at {p['separation_end_L']:.3g}·L), "
             "so the scene is predictable beyond the run. "
         )
