@@ -154,6 +154,30 @@ def _tp(v):
     return "beyond the run" if v is not None and math.isinf(v) else _fmt(v)
 
 
+def _rate_sentence(p, tp):
+    """How the twins separate (env.json's `predictability` p, T_p tp), as the page says it."""
+    lam = p["lyapunov_per_s"]
+    if p.get("lower_bound"):
+        return (
+            f"separate from it at the largest Lyapunov rate **λ ≥ {lam:.3g} /s** (the separation passed "
+            f"{tolerances.DYN_LYAPUNOV_CEILING_L:g}·L by {p['fit_to_s']:.3g} s, faster than the frames resolve: the "
+            "secant from the perturbation is a lower bound, and T_p below an upper bound). The **predictability "
+            f"time** T_p ≤ **{tp:.3g} s**. "
+        )
+    if p["grew"]:
+        return (
+            f"separate from it at the largest Lyapunov rate **λ = {lam:.3g} /s** (e-folding {1e3 / lam:.3g} ms; ln "
+            f"of the separation fitted from {p['fit_from_s']:.3g} to {p['fit_to_s']:.3g} s, {p['fit_frames']} "
+            f"frames). The **predictability time** T_p = ln({tolerances.DYN_PREDICT_TOLERANCE_L:g}/2⁻²⁴)/λ = "
+            f"**{tp:.3g} s**: the time a difference of fp32's rounding takes to grow to the games budget. "
+        )
+    return (
+        f"do not separate: the separation never grew past {tolerances.DYN_LYAPUNOV_FLOOR:g}× the perturbation over "
+        f"the run (its slope {_fmt(lam)} /s; it ended at {p['separation_end_L']:.3g}·L), so the scene is "
+        "predictable beyond the run. "
+    )
+
+
 def predictability_lines(study, long):
     """The scenes' Lyapunov rates and predictability times, and what they mean for the page."""
     p = study.get("predictability")
@@ -169,20 +193,7 @@ def predictability_lines(study, long):
     out += [
         f"{p['twins']} twins of the reference run (its first frame's positions perturbed by "
         f"{p['perturbation_L']:g}·L, RMS) "
-        + (
-            f"separate from it at the largest Lyapunov rate **λ ≥ {p['lyapunov_per_s']:.3g} /s** (the separation passed {tolerances.DYN_LYAPUNOV_CEILING_L:g}·L "
-            f"by {p['fit_to_s']:.3g} s, faster than the frames resolve: the secant from the perturbation is a lower "
-            f"bound, and T_p below an upper bound). The **predictability time** T_p ≤ **{tp:.3g} s**. "
-            if p.get("lower_bound")
-            else f"separate from it at the largest Lyapunov rate **λ = {p['lyapunov_per_s']:.3g} /s** (e-folding {1e3 / p['lyapunov_per_s']:.3g} ms; ln of the "
-            f"separation fitted from {p['fit_from_s']:.3g} to {p['fit_to_s']:.3g} s, {p['fit_frames']} frames). "
-            f"The **predictability time** T_p = ln({tolerances.DYN_PREDICT_TOLERANCE_L:g}/2⁻²⁴)/λ = "
-            f"**{tp:.3g} s**: the time a difference of fp32's rounding takes to grow to the games budget. "
-            if p["grew"]
-            else f"do not separate: the separation never grew past {tolerances.DYN_LYAPUNOV_FLOOR:g}× the perturbation "
-            f"over the run (its slope {_fmt(p['lyapunov_per_s'])} /s; it ended at {p['separation_end_L']:.3g}·L), "
-            "so the scene is predictable beyond the run. "
-        )
+        + _rate_sentence(p, tp)
         + f"Pointwise errors (RMS, p99, max, the Pareto front, the reference's convergence) are judged over "
         f"**{study['horizon']:.3g} s** = min(the asked {asked:g} s, T_p) ({study['horizon_frames']} frames); beyond "
         "it the page compares statistics against the reference ensemble "
