@@ -169,12 +169,13 @@ $(BUILD)/hairsim-cpu-contract: $(CONTRACT_OBJ) $(filter-out $(CONTRACT_SRC:c_ref
 # Planted defects (docs/judge.md), test-only: build/planted/hairsim-cpu-plant<n> is the C
 # reference with `#if HB_PLANT == n` hunk n compiled in. Not part of `make`; `make planted`.
 PLANTS := $(shell grep -ho 'HB_PLANT == [0-9]*' c_ref/*/*.c c_ref/*/*.h | awk '{print $$3}' | sort -un)
-PLANT_SRC := c_ref/dynamic/dynamics_f32.c c_ref/dynamic/dynamics_f64.c c_ref/dynamic/dynamics_host.c c_ref/paper/model.c
+PLANT_SRC := c_ref/dynamic/dynamics_f32.c c_ref/dynamic/dynamics_f64.c c_ref/dynamic/dynamics_host.c c_ref/paper/model.c \
+             c_ref/dynamic/dyn_lod.c
 PLANT_BINS := $(PLANTS:%=$(BUILD)/planted/hairsim-cpu-plant%)
 planted: $(PLANT_BINS)
 .SECONDARY: $(foreach n,$(PLANTS),$(PLANT_SRC:c_ref/%.c=$(BUILD)/planted/obj$(n)/%.o))
 $(BUILD)/planted/obj%/dynamics_f32.o $(BUILD)/planted/obj%/dynamics_f64.o $(BUILD)/planted/obj%/dynamics_host.o \
-  $(BUILD)/planted/obj%/model.o: $(PLANT_SRC) $(C_HEADERS) | check-hdf5
+  $(BUILD)/planted/obj%/model.o $(BUILD)/planted/obj%/dyn_lod.o: $(PLANT_SRC) $(C_HEADERS) | check-hdf5
 	@mkdir -p $(BUILD)/planted/obj$*
 	for f in $(PLANT_SRC); do $(CC) $(CFLAGS_REF) -Ic_ref -O0 -g0 -fopenmp $(HDF5_CFLAGS) -DHB_PLANT=$* -c $$f \
 	  -o $(BUILD)/planted/obj$*/$$(basename $${f%.c}).o || exit 1; done

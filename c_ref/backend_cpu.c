@@ -755,11 +755,13 @@ static void cpu_place_followers(cpu_impl *c, const hb_dyn_frame *f)
     if (c->scene.precision == HB_FP32) {
 #pragma omp parallel for schedule(static)
         for (int64_t j = 0; j < c->fl.n_followers; j++)
-            hb_follower_place_f32(&c->d32, &c->fl, j, still ? NULL : f->q32 + last, c->state, c->vel, c->rest);
+            hb_follower_place_f32(&c->d32, &c->fl, j, still ? NULL : f->q32 + last, c->state, c->vel, c->rest,
+                                  (const float *)c->seg_rest);
     } else {
 #pragma omp parallel for schedule(static)
         for (int64_t j = 0; j < c->fl.n_followers; j++)
-            hb_follower_place_f64(&c->d64, &c->fl, j, still ? NULL : f->q64 + last, c->state, c->vel, c->rest);
+            hb_follower_place_f64(&c->d64, &c->fl, j, still ? NULL : f->q64 + last, c->state, c->vel, c->rest,
+                                  (const double *)c->seg_rest);
     }
 }
 

@@ -58,7 +58,38 @@ HB_DHD void carry(const At<T> &x, const At<const T> &rest, int64_t g, int64_t f,
     for (int c = 0; c < 3; c++) y[c] = x(g, k, c) + r[c];
 }
 
-/* Follower f placed from its W guides g[] with weights w[] (hb_follower_place). */
+/* The head collision of follower point q at distance ell from its predecessor a (fl_collide):
+ * inside the collider, the nearest point of the circle where the sphere of radius ell about a meets
+ * it, else (no such circle) §3.5's radial projection. */
+template <typename T> HB_DHD void follower_collide(const T *a, T ell, T rc, T *q)
+{
+    const T len = m_sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+    if (!(len < rc)) return;
+    const T d = m_sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (d > (T)0) {
+        const T tau = ((d - rc) * (d + rc) + ell * ell) / (d + d);
+        const T cp = d - tau;
+        const T h2 = ((rc - d) + tau) * (rc + cp);
+        if (h2 > (T)0) {
+            const T n[3] = {a[0] / d, a[1] / d, a[2] / d};
+            const T m[3] = {cp * n[0], cp * n[1], cp * n[2]};
+            const T v[3] = {q[0] - m[0], q[1] - m[1], q[2] - m[2]};
+            const T s = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+            const T u[3] = {v[0] - s * n[0], v[1] - s * n[1], v[2] - s * n[2]};
+            const T lam = m_sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            if (lam > (T)0) {
+                const T r = m_sqrt(h2);
+                for (int c = 0; c < 3; c++) q[c] = m[c] + r * (u[c] / lam);
+                return;
+            }
+        }
+    }
+    collide_sphere(q[0], q[1], q[2], rc);
+}
+
+/* Follower f placed from its W guides g[] with weights w[] (hb_follower_place): each point the
+ * blend of its guides' carried offsets, then pulled onto the segment of rest length ℓ_k from the
+ * follower's placed predecessor (ℓ_k from m.seg_rest in its layout, else m.seg_len). */
 template <typename T>
 HB_DHD void place_follower(const DModel<T> &m, const T *q, const At<T> &x, const At<T> &v, const At<const T> &rest,
                            int64_t f, const int64_t *g, const T *w, int W)
@@ -82,8 +113,26 @@ HB_DHD void place_follower(const DModel<T> &m, const T *q, const At<T> &x, const
             carry(x, rest, g[i], f, k, q, y);
             for (int c = 0; c < 3; c++) acc[c] = i == 0 ? w[0] * y[c] : acc[c] + w[i] * y[c];
         }
-        if (m.features & HB_F_COLLIDE) collide_sphere(acc[0], acc[1], acc[2], m.collide_r);
-        for (int c = 0; c < 3; c++) x(f, k, c) = acc[c];
+        /* the segment toward the blended point, at the follower's own rest length ℓ_k */
+        const T ell = m.seg_rest ? m.seg_rest[f * m.seg_is + (k - 1) * m.seg_s] : m.seg_len;
+        const T px = x(f, k - 1, 0), py = x(f, k - 1, 1), pz = x(f, k - 1, 2);
+        const T ex = acc[0] - px, ey = acc[1] - py, ez = acc[2] - pz;
+        const T rho = m_sqrt(ex * ex + ey * ey + ez * ez);
+        T p[3];
+        if (rho > (T)0) {
+            p[0] = px + ell * (ex / rho);
+            p[1] = py + ell * (ey / rho);
+            p[2] = pz + ell * (ez / rho);
+        } else {
+            p[0] = px;
+            p[1] = py - ell;
+            p[2] = pz;
+        }
+        if (m.features & HB_F_COLLIDE) {
+            const T prev[3] = {px, py, pz};
+            follower_collide(prev, ell, m.collide_r, p);
+        }
+        for (int c = 0; c < 3; c++) x(f, k, c) = p[c];
     }
 }
 

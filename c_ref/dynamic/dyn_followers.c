@@ -1,4 +1,4 @@
-/* dyn_followers.c — guides and followers (docs/model.md §3.13): the host-side plan shared by
+/* dyn_followers.c — guides and followers (docs/model.md §3.14): the host-side plan shared by
  * every backend and the reference placement of a follower in fp32 and fp64. */
 #include "dynamic/dyn_followers.h"
 #include "runtime/checked.h"

@@ -1,4 +1,4 @@
-/* dyn_followers.h — guides and followers (docs/model.md §3.13): which strands are simulated,
+/* dyn_followers.h — guides and followers (docs/model.md §3.14): which strands are simulated,
  * which guides each follower takes and with what weights (host side, once per run, shared by
  * every backend), and the placement of one follower in the working precision (the C
  * reference; the CUDA backend has its own kernel with the same arithmetic). */
@@ -25,7 +25,7 @@ typedef struct {
     double *w64;
 } hb_followers;
 
-/* G of §3.13 for a scene that declares --guides (N otherwise). */
+/* G of §3.14 for a scene that declares --guides (N otherwise). */
 int64_t hb_guide_count(const hb_scene *s);
 /* The plan from the rest shape (canonical [N·P][3] in the scene's precision); 0 on success,
  * else one line in err (out of memory). */
@@ -34,12 +34,13 @@ void hb_followers_free(hb_followers *fl);
 /* The features of a run as a name ("bend+shape+…+guides+lra"). */
 void hb_dyn_scene_feature_names(const hb_scene *s, char *out, size_t n);
 
-/* Places follower j (§3.13) in the canonical arrays x, v (all strands) from its guides, with
- * the head rotation q at the frame's end (NULL: still head). */
+/* Places follower j (§3.14) in the canonical arrays x, v (all strands) from its guides, with
+ * the head rotation q at the frame's end (NULL: still head); seg_rest: a groom's ℓ_k as
+ * [N][P−1] (§3.15), NULL for ℓ = L/(P−1). */
 void hb_follower_place_f32(const hb_dyn_model_f32 *m, const hb_followers *fl, int64_t j, const float *q, float *x,
-                           float *v, const float *rest);
+                           float *v, const float *rest, const float *seg_rest);
 void hb_follower_place_f64(const hb_dyn_model_f64 *m, const hb_followers *fl, int64_t j, const double *q, double *x,
-                           double *v, const double *rest);
+                           double *v, const double *rest, const double *seg_rest);
 
 #ifdef __cplusplus
 }

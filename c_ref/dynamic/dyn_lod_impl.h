@@ -6,7 +6,11 @@
  * reflections x_{−1} = x_0 + (x_0 − x_1) and x_ps = x_{ps−1} + (x_{ps−1} − x_{ps−2}). */
 static inline REAL SFX(lod_at)(const REAL *x, int64_t ps, int64_t j, int c)
 {
+#if HB_PLANT == 14 /* judge test: the root's phantom end copied, not reflected */
+    if (j < 0) return x[c];
+#else
     if (j < 0) return x[c] + (x[c] - x[3 + c]);
+#endif
     if (j >= ps) return x[3 * (ps - 1) + c] + (x[3 * (ps - 1) + c] - x[3 * (ps - 2) + c]);
     return x[3 * j + c];
 }

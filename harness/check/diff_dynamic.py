@@ -15,7 +15,11 @@ files stored the velocities of a compared step, they are judged by the same rule
 h·|Δv| (the position change a velocity makes in one substep). The observables of every
 compared frame are printed side by side (A, B, B − A) and judged by what the two states'
 difference allows (observables_ok). Each file's invariants (invariants_dynamic.py) are
-checked on its compared frames. The GPU tests (tests/gpu/test_gpu_dynamic.py) judge with this
+checked on its compared frames. Two files written with --render-points (the same P_r and P_s)
+are compared on their simulated rows (trajectory.simulated_view), to which every check above
+applies, and each file's rendered rows are recomputed from its simulated ones
+(lod.check_rendered: bit for bit for the reference build); a rendered file against a plain one
+cannot be compared (exit 2). The GPU tests (tests/gpu/test_gpu_dynamic.py) judge with this
 same function.
 
 stepdiff: for each chosen simulated frame k of a reference A written with --velocities
@@ -46,13 +50,13 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.check import diff, invariants_dynamic
+from harness.check import diff, invariants_dynamic, lod
 from harness.core import runner, tolerances
 from harness.core.paths import build_dir, display
 from harness.core.runner import COMPLETED
 from harness.core.ulp import coarser, ulp_distance
 from harness.io.states import StateError, as_text
-from harness.io.trajectory import open_trajectory
+from harness.io.trajectory import open_trajectory, simulated_view
 
 OBS_SHOWN = ("stretch_max", "penetration_max", "kinetic_energy", "blown_up_strands")
 
@@ -317,7 +321,9 @@ def compare(path_a, path_b, frames="all", exact=False, check_paper=True, spread=
     """Compare two files (either may be dynamic) at their common steps; DynDiffResult.
     spread=True: B's simulated frames were each advanced by one frame from A's previous
     frame, and are judged against A's spread there too (module docstring)."""
-    with open_trajectory(path_a) as a, open_trajectory(path_b) as b:
+    with open_trajectory(path_a) as a_file, open_trajectory(path_b) as b_file:
+        check_same_rendering(a_file, b_file)
+        a, b = simulated_view(a_file), simulated_view(b_file)  # a LOD file: its simulated rows
         diff.check_comparable(a, b)
         check_same_run(a, b, frames)
         steps = _pick_steps(a, b, frames)
@@ -378,7 +384,25 @@ def compare(path_a, path_b, frames="all", exact=False, check_paper=True, spread=
         res.invariants_b = invariants_dynamic.check(
             b, exact=invariants_dynamic.is_reference_build(b), frames=used_b, paper=check_paper
         )
+        for t, used, rep in ((a_file, used_a, res.invariants_a), (b_file, used_b, res.invariants_b)):
+            if t.render_points:  # the rendered rows: recomputed from the simulated ones (§3.14)
+                rep.violations += lod.check_rendered(t, invariants_dynamic.is_reference_build(t), used)[0]
     return res
+
+
+def check_same_rendering(a, b):
+    """Raise StateError (exit 2) unless both files or neither were written with --render-points,
+    with the same P_r and P_s: a rendered point has no simulated counterpart to compare with."""
+    if (a.render_points, a.simulated_points) != (b.render_points, b.simulated_points):
+
+        def what(t):
+            return (
+                f"{t.simulated_points} points rendered as {t.render_points}"
+                if t.render_points
+                else f"{t.points} points"
+            )
+
+        raise StateError(f"A has {what(a)} a strand, B {what(b)}: compare files rendered alike")
 
 
 def _g(x):

@@ -79,6 +79,62 @@ def _carry(xg, rg, rf, q, one):
     return xg[:, 1:] + r
 
 
+def _follower_rest(traj, followers, dtype):
+    """ℓ_k of each follower in the working precision: [F][P−1] from a groom's rest shape, else ℓ
+    (as the backends round them: once, from double)."""
+    ell = traj.segment_rest()
+    if np.ndim(ell) == 0:
+        return np.full((followers.size, traj.points - 1), dtype.type(ell), dtype=dtype)
+    return ell[followers].astype(dtype)
+
+
+def _radial(p, rc, one):
+    """§3.5's head collision of points p [F][3]: radially onto the sphere rc where inside."""
+    n = np.sqrt(_dot(p, p))[..., None]
+    scaled = p * (rc / np.where(n == 0, one, n))
+    centre = np.broadcast_to(np.array([0, rc, 0], dtype=p.dtype), p.shape)
+    return np.where(n < rc, np.where(n == 0, centre, scaled), p)
+
+
+def _collide(a, q, ell, rc, one):
+    """§3.14's head collision of follower points q [F][3] placed ell [F][1] from their predecessors
+    a: inside the sphere rc, the nearest point of the circle where the sphere of radius ell about a
+    meets it; where there is none, radially (_radial); rc falsy: the collider is off."""
+    if not rc:
+        return q
+    zero = one - one
+    d = np.sqrt(_dot(a, a))[..., None]
+    dd = np.where(d > zero, d, one)
+    tau = ((d - rc) * (d + rc) + ell * ell) / (dd + dd)
+    cp = d - tau
+    h2 = ((rc - d) + tau) * (rc + cp)
+    n = a / dd
+    m = cp * n
+    v = q - m
+    s = _dot(v, n)[..., None]
+    u = v - s * n
+    lam = np.sqrt(_dot(u, u))[..., None]
+    on_circle = m + np.sqrt(np.where(h2 > zero, h2, zero)) * (u / np.where(lam > zero, lam, one))
+    inside = np.sqrt(_dot(q, q))[..., None] < rc
+    use = inside & (d > zero) & (h2 > zero) & (lam > zero)
+    return np.where(use, on_circle, _radial(q, rc, one))
+
+
+def _follow_blend(root, acc, ell, rc, one):
+    """Points 1 … P−1 of every follower (§3.14 step 2): each the blended point acc[:, k−1] pulled
+    onto the segment of length ℓ_k from the placed predecessor, then the follower's head collision."""
+    out = np.empty_like(acc)
+    prev = root
+    for k in range(acc.shape[1]):
+        e = acc[:, k] - prev
+        rho = np.sqrt((e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1]) + e[:, 2] * e[:, 2])[:, None]
+        lk = ell[:, k][:, None]
+        down = prev - lk * np.array([0, 1, 0], dtype=acc.dtype)
+        p = np.where(rho > 0, prev + lk * (e / np.where(rho > 0, rho, one)), down)
+        prev = out[:, k] = _collide(prev, p, lk, rc, one)
+    return out
+
+
 def place_followers(traj, f, velocity=None):
     """(x, v) of written frame f with every follower placed from the frame's guides (§3.14).
     `velocity` is the frame's stored velocities (None: v is None)."""
@@ -110,15 +166,10 @@ def place_followers(traj, f, velocity=None):
             y = _carry(x[src[:, i]], rest[src[:, i]], rf, q, one)
             wi = w[:, i][:, None, None]
             acc = wi * y if acc is None else acc + wi * y
-        if traj.collider:
-            rc = dt(traj.collide_radius)
-            n = np.sqrt(_dot(acc, acc))[..., None]
-            inside = n < rc
-            scaled = acc * (rc / np.where(n == 0, one, n))
-            centre = np.broadcast_to(np.array([0, rc, 0], dtype=x.dtype), acc.shape)
-            acc = np.where(inside, np.where(n == 0, centre, scaled), acc)
+        ell = _follower_rest(traj, followers, x.dtype)
+        placed = _follow_blend(root, acc, ell, traj.collider and dt(traj.collide_radius), one)
         x[followers, 0] = root
-        x[followers, 1:] = acc
+        x[followers, 1:] = placed
         v = None
         if velocity is not None:
             v = velocity.reshape(traj.n_strands, traj.points, 3).copy()

@@ -82,8 +82,7 @@ def is_collide_frame(state, f):
 
 def read_strands(state, f, i0, i1):
     """Strands [i0, i1) of frame f as [n][P][3] in the file's dtype."""
-    rows = state._dset[f, i0 * state.points : i1 * state.points]
-    return rows.reshape(i1 - i0, state.points, 3)
+    return state.strands(f, i0, i1)
 
 
 class _Tally:

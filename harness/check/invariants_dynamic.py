@@ -15,8 +15,10 @@ frame f (at step s, simulated frame number g = s − paper_frames + 1) is checke
                DYN_PENETRATION_K·ε·R_c
   ftl_segments (solver ftl) every segment (k−1, k) whose end k the collider did not move
                (|x_k| above R_c by more than that tolerance, or the collider off) has length
-               ℓ (a groom: its ℓ_k, §3.15) within DYN_FTL_SEGMENT_K·ε·E, E = R + h + L; in a guided file (§3.14) the
-               guides' segments only (followers are placed from them, not followed)
+               ℓ (a groom: its ℓ_k, §3.15) within DYN_FTL_SEGMENT_K·ε·E, E = R + h + L
+  follower_segments  (a guided xpbd file, §3.14) the same of every follower's segments: a
+               follower is placed segment by segment at its own ℓ_k (ftl files check their
+               followers under ftl_segments)
   observables  the frame's observables (§3.8) agree with its positions: stretch_max and
                penetration_max recomputed in double from the stored positions (bit for bit
                with `exact`, the reference: a maximum does not depend on order; otherwise
@@ -30,7 +32,7 @@ frame f (at step s, simulated frame number g = s − paper_frames + 1) is checke
 """
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -40,6 +42,7 @@ from harness.check.invariants import Violation
 from harness.core import tolerances
 from harness.core.guides import guide_count, guide_strands
 from harness.io.states import State, as_text
+from harness.io.trajectory import SimulatedView
 
 
 def collider_depths(traj, points, t):
@@ -148,14 +151,26 @@ def observe(traj, x, v=None, t=None):
 
 def _paper_view(traj):
     """The paper frames of a dynamic file as a plain State (for invariants.check)."""
-    kw = {f.name: getattr(traj, f.name) for f in fields(State)}
-    kw.update(
+    cut = dict(
         n_frames=traj.paper_frames,
         stages=traj.stages[: traj.paper_frames],
         skipped=traj.skipped[: traj.paper_frames],
         fused=traj.fused[: traj.paper_frames],
     )
-    return State(**kw)
+    if isinstance(traj, SimulatedView):  # a LOD file's simulated rows (its frames read through them)
+        return replace(traj, **cut)
+    return State(**{**{f.name: getattr(traj, f.name) for f in fields(State)}, **cut})
+
+
+def _strands_holding_rest(traj):
+    """The strands whose every segment the model puts at ℓ (ℓ_k) before the collider: all of an
+    ftl run, the followers of a guided xpbd run (§3.14, placed segment by segment), else None."""
+    if traj.solver == "ftl":
+        return np.arange(traj.n_strands)
+    if traj.guided:
+        g = guide_count(traj.n_strands, float(traj.dynamic_params["guides"]))
+        return np.setdiff1d(np.arange(traj.n_strands), guide_strands(traj.n_strands, g))
+    return None
 
 
 def is_reference_build(traj):
@@ -270,7 +285,8 @@ def check(traj, exact=True, frames=None, paper=True):
                     "(worst {worst:.3g}·ε·R_c)",
                     nan_over=False,
                 )
-            if traj.solver == "ftl":
+            held = _strands_holding_rest(traj)
+            if held is not None:
                 seg = np.sqrt(np.sum(np.diff(xd, axis=1) ** 2, axis=2))
                 err = np.abs(seg - ell) / (eps * E)
                 free = np.ones_like(err, dtype=bool)
@@ -284,13 +300,10 @@ def check(traj, exact=True, frames=None, paper=True):
                 if traj.colliders:  # nor any other collider
                     d = collider_depths(traj, xd[:, 1:, :], frame_end_time(traj, f))
                     free &= ~np.any(np.nan_to_num(d, nan=-np.inf) > -near, axis=0).reshape(free.shape)
-                err = np.where(free, err, 0.0)
-                if traj.guided:  # §3.14: followers are placed, not followed; only guides hold ℓ
-                    g = guide_count(traj.n_strands, float(traj.dynamic_params["guides"]))
-                    err = err[guide_strands(traj.n_strands, g)]
+                err = np.where(free, err, 0.0)[held]
                 bound(
                     f,
-                    "ftl_segments",
+                    "ftl_segments" if traj.solver == "ftl" else "follower_segments",
                     err,
                     tolerances.DYN_FTL_SEGMENT_K,
                     "worst_ftl_segment_k",

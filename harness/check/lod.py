@@ -5,11 +5,15 @@ simulated ones.
 y, e.g. velocities, interpolated with x's knots and weights), in x's precision and in
 §3.14's order of operations (c_ref/dynamic/dyn_lod_impl.h), so that a file from the same build
 matches bit for bit; `recompute(traj, f)` frame f of a --render-points file recomputed from
-the simulated rows it holds; `straightness(x)` how far each point of a strand lies from the
-line through its ends, relative to the strand's length.
+the simulated rows it holds; `check_rendered(traj)` every written frame's rendered rows (and
+stored velocities) against their recomputation, as invariant violations; `straightness(x)` how
+far each point of a strand lies from the line through its ends, relative to the strand's length.
 """
 
 import numpy as np
+
+from harness.check.invariants import Violation
+from harness.core import tolerances
 
 
 def _knot(a, b):
@@ -74,3 +78,30 @@ def straightness(x):
     r = x - a
     off = r - (r * u).sum(-1, keepdims=True) * u
     return np.sqrt((off * off).sum(-1)).max(axis=1) / length[:, 0, 0]
+
+
+def check_rendered(traj, exact, frames=None):
+    """Violations of a --render-points file's rendered rows: each written frame's positions (and
+    its stored velocities) recomputed from its simulated rows; bit for bit with `exact` (the
+    reference build), else within DYN_LOD_KERNEL_K·ε·E (E = R + c_m + 2L, the kernel's
+    contraction). Returns (violations, the worst difference over ε·E)."""
+    kind = tolerances.kind_of(traj.precision, traj.fast_math)
+    unit = tolerances.EPS[kind] * (traj.collide_radius + 2.0 * traj.hair_length)
+    out, worst = [], 0.0
+    for f in range(traj.n_frames) if frames is None else frames:
+        step = int(traj.step[f])
+        v = traj.velocity_at_step(step)
+        x_want, v_want = recompute(traj, f, v)
+        pairs = [("positions", traj.frame(f), x_want)] + ([("velocities", v, v_want)] if v is not None else [])
+        for what, got, want in pairs:
+            with np.errstate(invalid="ignore"):
+                d = np.abs(got.astype(np.float64) - want.astype(np.float64)) / unit
+            bad = ~(d == 0) if exact else ~(d <= tolerances.DYN_LOD_KERNEL_K)
+            worst = max(worst, float(np.nanmax(d)) if d.size else 0.0)
+            n = int(np.count_nonzero(bad))
+            if n:
+                rule = "bit for bit" if exact else f"within {tolerances.DYN_LOD_KERNEL_K:g}·ε·E"
+                out.append(Violation(f, traj.stages[f], "rendered", n, float(np.nanmax(d)),
+                                     f"frame {f}: {n} rendered {what} coordinate(s) differ from their recomputation "
+                                     f"from the simulated rows ({rule}; worst {np.nanmax(d):.3g}·ε·E)"))  # fmt: skip
+    return out, worst

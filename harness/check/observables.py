@@ -8,6 +8,8 @@ cm/s; L is the hair length. Point 0 of a strand is its root. Nothing here runs a
 
 import numpy as np
 
+from harness.core import tolerances
+
 OK, DIVERGED, ESCAPED = "ok", "diverged", "escaped"
 
 
@@ -34,11 +36,25 @@ def verdict(pos, L, vel=None):
 
 def energy(pos, vel, gravity):
     """Per frame, per non-root particle (unit masses): kinetic ½|v|², gravitational potential
-    g0·y, and their sum. Returns three arrays [F]."""
+    g0·y, and their sum, from the stored velocities. Returns three arrays [F]. ftl's stored
+    velocities include its correction −s·d/h (docs/model.md §3.7), which no position shows: use
+    kinetic_from_positions for the motion."""
     x, v = _f64(pos)[..., 1:, :], _f64(vel)[..., 1:, :]
     kinetic = 0.5 * np.mean(np.sum(v * v, axis=-1), axis=(-2, -1))
     potential = float(gravity) * np.mean(x[..., 1], axis=(-2, -1))
     return kinetic, potential, kinetic + potential
+
+
+def kinetic_from_positions(pos, dt):
+    """Per frame, ½·mean |v|² over the non-root points (unit masses) of the motion the positions
+    show: v the central difference (x_{f+1} − x_{f−1})/(2·dt) inside the run, one-sided at its
+    two ends ([F], frames dt apart; 0 for a single frame). Zero for positions that do not move,
+    whatever velocities a solver stores."""
+    x = _f64(pos)[..., 1:, :]
+    if len(x) < 2:
+        return np.zeros(len(x))
+    v = np.gradient(x, dt, axis=0)
+    return 0.5 * np.mean(np.sum(v * v, axis=-1), axis=(-2, -1))
 
 
 def drift(series, times):
@@ -73,13 +89,28 @@ def tip_swing(pos):
     return np.einsum("fnc,nc->fn", rel, h0)
 
 
+def swings(signal, dt, periods=None):
+    """Whether a signal swings: its dominant frequency fits at least `periods` (default
+    tolerances.OBS_SWING_MIN_PERIODS) whole periods into it and it crosses its mean at least
+    2·periods − 1 times. A drift, a settling or a still strand does not: its spectrum's peak is
+    its lowest bin, which is no frequency of the hair."""
+    periods = tolerances.OBS_SWING_MIN_PERIODS if periods is None else periods
+    y = _f64(signal)
+    if len(y) < 4 or not np.isfinite(y).all() or not np.ptp(y) > 0:
+        return False
+    f = dominant_frequency(y, dt)
+    c = y - y.mean()
+    crossings = int(np.count_nonzero(np.signbit(c[1:]) != np.signbit(c[:-1])))
+    return f * len(y) * dt >= periods and crossings >= 2 * periods - 1
+
+
 def swing(pos, dt):
-    """The median over strands of the dominant frequency (Hz) and of the damping ratio of each
-    strand's tip swing (tip_swing) that moves, and the median of the damping fits' standard
+    """The median over the strands whose tip swings (tip_swing, `swings`) of the dominant
+    frequency (Hz) and of the damping ratio, and the median of the damping fits' standard
     errors: the strands' own motion, not their average (strands that swing in opposite phase
-    would cancel in a mean). NaN where no strand gives a value."""
+    would cancel in a mean). NaN where no strand swings: a frequency is never read off a drift."""
     s = tip_swing(pos)
-    moving = [s[:, n] for n in range(s.shape[1]) if np.ptp(s[:, n]) > 0]  # a strand at rest has no swing
+    moving = [s[:, n] for n in range(s.shape[1]) if swings(s[:, n], dt)]
     f = [dominant_frequency(y, dt) for y in moving]
     fits = [damping_fit(y, dt) for y in moving]
     fits = [v for v in fits if np.isfinite(v[0])]
@@ -163,15 +194,22 @@ def jitter(pos, dt):
     return float(np.sqrt(np.mean(step * step)) / dt), float(step.max())
 
 
-def stretch_stats(pos, L):
-    """Max and 99th percentile of |len/ℓ − 1| over every segment of every frame (ℓ = L/(P−1))."""
+def stretch_stats(pos, L, ell=None):
+    """Max and 99th percentile of |len/ℓ_k − 1| over every segment of every frame: ℓ_k each
+    segment's own rest length where given ([P−1] or [N][P−1], e.g. Trajectory.segment_rest()
+    or rest_lengths(rest), docs/model.md §3.15), else ℓ = L/(P−1)."""
     x = _f64(pos)
-    ell = L / (x.shape[-2] - 1)
+    ell = L / (x.shape[-2] - 1) if ell is None else _f64(ell)
     s = np.abs(np.linalg.norm(np.diff(x, axis=-2), axis=-1) / ell - 1.0).ravel()
     s = s[np.isfinite(s)]
     if s.size == 0:
         return float("nan"), float("nan")
     return float(s.max()), float(np.percentile(s, 99))
+
+
+def rest_lengths(rest):
+    """ℓ_k = |X̄_k − X̄_{k−1}| in double from a rest shape [..., P, 3]: [..., P − 1]."""
+    return np.linalg.norm(np.diff(_f64(rest), axis=-2), axis=-1)
 
 
 def error_percentiles(pos, ref, L):

@@ -16,7 +16,7 @@ from pathlib import Path
 from harness import HarnessError, __version__
 from harness.core import interrupts
 from harness.core.paths import CUDA_BUILDS
-from harness.studies import peer
+from harness.studies import peer, reduced
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -547,19 +547,25 @@ def cmd_featurecost(args):
 
 
 def cmd_reduced(args):
-    """Run a dynamic scene with guide fractions 100/50/25/10/5% x scheme (one, blend3), LRA off/on at few
-    iterations, and P_s simulated points written as P_r = 33 (--render-points); compare each with every strand
-    and point simulated (xpbd, fp64, finer S) and time it on the cpu oracle and, with a usable GPU, the cuda
-    variants that run it (docs/model.md §3.14); and the still scene with and without sag-free rest: how far it
-    sags, and the tip's swing frequency under a wind step. Prints a Markdown table; --out writes the rows as
-    CSV."""
+    """Run a dynamic scene at 1,000 and 10,000 strands (--quick: 200 and 1,000) with guide fractions 100 … 1%
+    x scheme (one, blend3), LRA off/on at few iterations under a fast nod, and P_s simulated points written as
+    P_r = 33 (--render-points); compare each with a converged reference in which every strand and point is
+    simulated (xpbd, fp64, S doubled until it is ten times closer than the rows it ranks) up to the scene's
+    predictability time, and with the reference ensemble's statistics over the whole run; time it on the cpu
+    oracle and, with a usable GPU, the cuda variants that run it (docs/model.md §3.14); and the still scene with
+    and without sag-free rest at two shape ranges: how far it sags, and the tip's swing under a wind step.
+    Prints Markdown; --out writes the rows as CSV and references.csv beside it."""
     from harness.render import reduced_report
-    from harness.studies import reduced
 
     base = reduced.Plan.quick if args.quick else reduced.Plan
-    changes = {k: v for k, v in (("scene", args.scene), ("strands", args.strands), ("seconds", args.seconds)) if v}
-    rows = reduced.measure(base(gpu=args.gpu, **changes), out=args.out)
-    print(reduced_report.markdown(rows), end="")
+    changes = {k: v for k, v in (("scene", args.scene), ("seconds", args.seconds)) if v}
+    if args.strands:
+        changes["strands"] = tuple(args.strands)
+    if args.parts:
+        changes["parts"] = tuple(args.parts)
+    refs = []
+    rows = reduced.measure(base(gpu=args.gpu, **changes), out=args.out, refs_into=refs)
+    print(reduced_report.markdown(rows, refs), end="")
     return 0
 
 
@@ -648,8 +654,8 @@ def cmd_stability(args):
     """Run 2-D slices of the dynamic scene space (substeps against wind, stretch and bend compliance, points and
     iterations, iterations on curly hair; head-motion frequency against amplitude; long-range attachments on and
     off under fast nods and gales) for both solvers and precisions, on the CPU and every built CUDA build where
-    a GPU answers; judge each cell ok, over-stretched, penetrating, escaped (a point past 2L) or diverged
-    (NaN/Inf); write results/stability/, results/local/report/stability_*.png and
+    a GPU answers; judge each cell ok, over-stretched, penetrating, escaped (a point past twice its hanging
+    length) or diverged (NaN/Inf); write results/stability/, results/local/report/stability_*.png and
     results/local/report/dynamic_stability.md."""
     from harness.render import stability_report
     from harness.studies import stability
@@ -673,7 +679,9 @@ def cmd_judge(args):
     """Step every planted defect (build/planted/, make planted) from the C reference's frames on the standard
     scenes, and every honest build × variant × precision on the extreme scenes, judging each frame as stepdiff
     does (the rule and the scene's spread); the paper model's planted defects and variants likewise by whole
-    runs judged as harness diff does; print caught / planted and false alarms / honest runs, write
+    runs judged as harness diff does; simulated-point LOD runs (not resumable) by stepdiff of the same run without
+    LOD, their simulated rows against it and their rendered rows recomputed; print caught / planted and false
+    alarms / honest runs, write
     results/judge/judge.csv and judge.json (docs/judge.md). Exit 0 when every defect is caught and no honest run
     fails, else 1."""
     from harness.studies import judge
@@ -682,14 +690,15 @@ def cmd_judge(args):
     if args.strands:
         plan = judge.replace(plan, strands=args.strands)
     if args.extreme:
-        unknown = [n for n in args.extreme if n not in judge.EXTREME and n not in judge.PAPER_EXTREME]
+        known = [*judge.EXTREME, *judge.PAPER_EXTREME, *judge.LOD_SCENES]
+        unknown = [n for n in args.extreme if n not in known]
         if unknown:
-            known = ", ".join([*judge.EXTREME, *judge.PAPER_EXTREME])
-            raise HarnessError(f"judge: unknown extreme scene(s) {', '.join(unknown)} (known: {known})")
+            raise HarnessError(f"judge: unknown extreme scene(s) {', '.join(unknown)} (known: {', '.join(known)})")
         plan = judge.replace(
             plan,
             extreme=tuple(n for n in args.extreme if n in judge.EXTREME),
             paper_extreme=tuple(n for n in args.extreme if n in judge.PAPER_EXTREME),
+            lod=tuple(n for n in args.extreme if n in judge.LOD_SCENES),
         )
     if args.plant:
         plan = judge.replace(plan, plants=tuple(args.plant))
@@ -1147,8 +1156,17 @@ def parser():
         "simulated-point LOD: error and time",
     )
     rd.add_argument("--scene", default=None, help="a dynamic scene (default dynamic)")
-    rd.add_argument("--strands", type=whole(1), default=None, help="strands of the checked runs")
+    rd.add_argument(
+        "--strands", type=whole(1), nargs="+", default=None, help="strand counts of the checked runs (1000 10000)"
+    )
     rd.add_argument("--seconds", type=seconds, default=None, help="simulated time of each run")
+    rd.add_argument(
+        "--parts",
+        nargs="+",
+        choices=reduced.PARTS,
+        default=None,
+        help="which rows to measure (default all: guides lra sagfree sagfreq lod)",
+    )
     rd.add_argument("--quick", action="store_true", help="the small version (CI, a first look)")
     case_options(rd, gpu="the cuda variants too, where a GPU is usable", gpu_choices=("auto", "no"))
     rd.add_argument("--out", default=None, help="CSV file to write")

@@ -102,6 +102,11 @@ class State:
             raise StateError(f"{self.path}: cannot read frame {f}: {e}") from None
         return flat.reshape(self.n_strands, self.points, 3)
 
+    def strands(self, f: int, i0: int, i1: int) -> np.ndarray:
+        """Strands [i0, i1) of frame f as [n][P][3] in the file's dtype (f ≥ 0)."""
+        rows = self._dset[f, i0 * self.points : i1 * self.points]
+        return rows.reshape(i1 - i0, self.points, 3)
+
     def frames(self) -> np.ndarray:
         """Every frame as one [F][N][P][3] array of the file's dtype (small states only)."""
         try:

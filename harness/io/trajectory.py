@@ -22,7 +22,7 @@ observables), so callers can take either. Any departure from the layout (a missi
 dataset, a shape or dtype that does not fit, steps that do not match) is a StateError.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -334,6 +334,57 @@ def _check_lod(t, f):
     t.simulated_rows = want
 
 
+@dataclass
+class SimulatedView(Trajectory):
+    """A --render-points file seen through its simulated rows only (docs/model.md §3.14): P_s
+    points a strand, as the run simulated them, its rest shape and velocities likewise, no
+    render_points. What the paper model's and the dynamic model's checks apply to; the rendered
+    rows are checked by recomputation (harness/check/lod.py)."""
+
+    rows_of: np.ndarray = None
+    rendered_points: int = 0
+
+    def _sim(self, flat):
+        return flat.reshape(self.n_strands, self.rendered_points, 3)[:, self.rows_of]
+
+    def frame(self, f):
+        if not -self.n_frames <= f < self.n_frames:
+            raise StateError(f"{self.path}: has no frame {f} (it has {self.n_frames})")
+        try:
+            return self._sim(self._dset[f % self.n_frames])
+        except StateError:
+            raise
+        except Exception as e:
+            raise StateError(f"{self.path}: cannot read frame {f}: {e}") from None
+
+    def frames(self):
+        return np.stack([self.frame(f) for f in range(self.n_frames)])
+
+    def strands(self, f, i0, i1):
+        rows = self._dset[f, i0 * self.rendered_points : i1 * self.rendered_points]
+        return rows.reshape(i1 - i0, self.rendered_points, 3)[:, self.rows_of]
+
+    @property
+    def rest(self):
+        return None if self._rest is None else self._sim(self._rest[()])
+
+    def velocity(self, i):
+        n = 0 if self._vel is None else self._vel.shape[0]
+        if not -n <= i < n:
+            raise StateError(f"{self.path}: has no velocity frame {i} (it has {n})")
+        return self._sim(self._vel[i % n])
+
+
+def simulated_view(t):
+    """The SimulatedView of a --render-points Trajectory (t itself otherwise); it shares t's file."""
+    if not t.render_points:
+        return t
+    kw = {f.name: getattr(t, f.name) for f in fields(Trajectory)}
+    params = {k: v for k, v in t.dynamic_params.items() if k not in ("render_points", "simulated_points")}
+    kw.update(points=t.simulated_points, dynamic_params=params, simulated_rows=None)
+    return SimulatedView(**kw, rows_of=t.simulated_rows, rendered_points=t.points)
+
+
 def open_trajectory(path):
     """Open and check a state file (paper or dynamic); StateError with one line if it is not one."""
     import pandas as pd
@@ -366,4 +417,4 @@ def open_trajectory(path):
         raise
 
 
-__all__ = ["Trajectory", "open_trajectory", "StateError", "POSITION"]
+__all__ = ["Trajectory", "SimulatedView", "open_trajectory", "simulated_view", "StateError", "POSITION"]

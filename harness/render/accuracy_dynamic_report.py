@@ -20,6 +20,8 @@ from harness import HarnessError
 from harness.core import timing, tolerances
 from harness.core.paths import REPORT, RESULTS, display
 from harness.io import files, tables
+from harness.render import accuracy_chaos_report as chaos
+from harness.render.accuracy_chaos_report import jitter_budget_lines, load_ensemble, load_long
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     CSV_NAME,
@@ -41,7 +43,6 @@ GROWTH_PNG = "dynamic_accuracy_growth.png"
 STEPS_PNG = "dynamic_accuracy_steps.png"
 DEFAULT_TITLE = "the dynamic model"
 KEYS = ("backend", "build", "variant", "solver", "ftl_damping", "substeps", "iterations", "precision")
-LONG_CSV = "observables.csv"  # studies/observables_long.py's table
 
 
 @dataclass(frozen=True)
@@ -100,17 +101,6 @@ def load(results_dir, csv_path=None):
     analytic = results_dir / ANALYTIC_NAME
     lines = analytic.read_text().splitlines() if analytic.exists() else []
     return rows, study, env, lines
-
-
-def load_long(results_dir):
-    """The long runs' table (observables.csv) as a DataFrame, or None where the study ran none."""
-    path = Path(results_dir) / LONG_CSV
-    if not path.exists():
-        return None
-    try:
-        return tables.read_csv(path)
-    except (OSError, ValueError) as e:
-        raise HarnessError(f"{display(path)}: cannot read ({e})") from None
 
 
 # ---- what the rows say ----------------------------------------------------------------
@@ -347,75 +337,23 @@ def _better(a, b):
     return bool(a["usable"] and b["usable"] and a["rms"] < b["rms"])
 
 
-def long_metrics(long):
-    """{(scheme, S, I, precision): {metric: (value, noise, reference, ref_uncertainty)}} of the
-    long runs' modes (one build ran them; the same settings of another build are the same model),
-    and the reference's {metric: (value, noise, reference, ref_uncertainty)}."""
-    out, ref = {}, {}
-    if long is None or long.empty:
-        return out, ref
-    for _, r in long.iterrows():
-        cell = (r["value"], r["noise"], r["reference"], r["ref_uncertainty"])
-        if r["study"] == "reference":
-            ref[r["metric"]] = cell
-            continue
-        key = (scheme_name(r["solver"], r["ftl_damping"]), int(r["substeps"]), int(r["iterations"]), r["precision"])
-        out.setdefault(key, {})[r["metric"]] = cell
-    return out, ref
-
-
-def _setting(r):
-    return (r["scheme"], int(r["substeps"]), int(r["iterations"]), r["precision"])
-
-
-def _within(cell, budget_rel):
-    """A relative error within budget once the mode's noise, the reference's and its
-    uncertainty are allowed for; None where not measured."""
-    if cell is None:
-        return None
-    v, noise, ref, unc = cell
-    if not (np.isfinite(v) and np.isfinite(ref)) or ref == 0:
-        return False if not np.isfinite(v) else None
-    slack = sum(x for x in (noise, unc) if np.isfinite(x)) / abs(ref)
-    return abs(v / ref - 1) <= budget_rel + slack
-
-
-def _within_factor(cell, factor):
-    """value/reference within [1/factor, factor], the bounds widened by the noise and the
-    reference's uncertainty; None where not measured."""
-    if cell is None:
-        return None
-    v, noise, ref, unc = cell
-    if not np.isfinite(v):
-        return False
-    if not np.isfinite(ref) or ref <= 0:
-        return None
-    slack = sum(x for x in (noise, unc) if np.isfinite(x))
-    return bool(ref / factor - slack <= v <= ref * factor + slack)
-
-
-def checks(r, use, longm):
-    """{metric: passes} of mode row r against the use's budgets (None: not measured)."""
-    rms_budget, stretch_budget, _ = tolerances.DYN_ACC_USES[use]
-    out = {"RMS error": bool(r["usable"] and r["rms"] <= rms_budget), "stretch": bool(r["stretch"] <= stretch_budget)}
-    lb = tolerances.DYN_ACC_USES_LONG.get(use)
-    m = longm.get(_setting(r))
-    if lb and m is not None:
-        out["tip frequency"] = _within(m.get("tip_frequency_hz"), lb["freq_rel"])
-        out["kinetic energy"] = _within_factor(m.get("kinetic_mean"), lb["kinetic_factor"])
-        j = m.get("jitter_max_move")
-        if j is not None:
-            v, noise, _, _ = j
-            lim = tolerances.jitter_budget_cm(use) + (noise if np.isfinite(noise) else 0)
-            out["rest jitter"] = bool(np.isfinite(v) and v <= lim)
-    return out
-
-
-def _passing(summ, use, longm):
-    """({mode: its checks against the use's budgets}, the usable rows that pass them all)."""
-    verdicts = {r["mode"]: checks(r, use, longm) for _, r in summ.iterrows()}
+def _passing(summ, use, longm, ensm):
+    """({mode: {gate: passes}}, the usable modes that pass every gate measured for them)."""
+    verdicts = {r["mode"]: chaos.checks(r, use, longm, ensm) for _, r in summ.iterrows()}
     passes = summ[[all(v is not False for v in verdicts[m].values()) for m in summ["mode"]]]
     return verdicts, passes[passes["usable"]]
+
+
+def recommended(summ, long=None, ens=None):
+    """The modes recommend() picks (each use, each backend), in order, once each."""
+    longm, _ = chaos.long_metrics(long)
+    ensm = chaos.ensemble_cells(ens)
+    out = []
+    for use in tolerances.DYN_ACC_USES:
+        _, passes = _passing(summ, use, longm, ensm)
+        for _, f in passes.groupby("backend", sort=False):
+            out.append(f.loc[f["time_per_frame_ms"].idxmin(), "mode"])
+    return list(dict.fromkeys(out))
 
 
 def recommended_modes(results_dir):
@@ -425,10 +363,11 @@ def recommended_modes(results_dir):
     the study's record (env.json's "study": its scene, horizon and reference)."""
     rows, study, _, _ = load(results_dir)
     summ = summary(rows, study["horizon_frames"])
-    longm, _ = long_metrics(load_long(results_dir))
+    longm, _ = chaos.long_metrics(load_long(results_dir))
+    ensm = chaos.ensemble_cells(load_ensemble(results_dir))
     out = []
     for use in tolerances.DYN_ACC_USES:
-        _, passes = _passing(summ, use, longm)
+        _, passes = _passing(summ, use, longm, ensm)
         for backend in ("cpu", "cuda"):
             f = passes[passes["backend"] == backend]
             usable = summ[(summ["backend"] == backend) & summ["usable"]]
@@ -445,20 +384,22 @@ def recommended_modes(results_dir):
     return out, study
 
 
-def recommend(summ, long=None):
-    """Per use (tolerances.DYN_ACC_USES and DYN_ACC_USES_LONG) and per backend: the cheapest
-    mode that meets every budget measured for it, naming its solver, s, S, I, precision and
-    build, and the metric that decided it (the one that rejected most of the faster modes).
-    Lines of Markdown."""
+def recommend(summ, long=None, ens=None, horizon=None):
+    """Per use (tolerances.DYN_ACC_USES, DYN_ACC_USES_LONG, DYN_ACC_USES_CHAOS) and per backend:
+    the cheapest mode that meets every budget measured for it (accuracy_chaos_report.checks),
+    naming its solver, s, S, I, precision and build, and the metric that decided it (the one that
+    rejected most of the faster modes); `horizon`: the pointwise horizon (s) the RMS budget is
+    judged over. Lines of Markdown."""
     lines = []
-    longm, _ = long_metrics(long)
+    longm, _ = chaos.long_metrics(long)
+    ensm = chaos.ensemble_cells(ens)
     base = baseline(summ)
     summ = summ.assign(  # a summary without the timing columns (measured before them): no spread, no noise
         time_rsd=summ["time_rsd"] if "time_rsd" in summ else np.nan,
         time_noisy=summ["time_noisy"] if "time_noisy" in summ else "",
     )
     for use, (rms_budget, stretch_budget, why) in tolerances.DYN_ACC_USES.items():
-        verdicts, passes = _passing(summ, use, longm)
+        verdicts, passes = _passing(summ, use, longm, ensm)
         picks = []
         for backend, what in (("cpu", "CPU"), ("cuda", "GPU")):
             if not (summ["backend"] == backend).any():
@@ -488,7 +429,7 @@ def recommend(summ, long=None):
                     if v is False:
                         failed[k] = failed.get(k, 0) + 1
             decided = max(failed, key=failed.get) if failed else None
-            long_note = "" if _setting(best) in longm else "; no long runs at these settings"
+            long_note = "" if chaos.setting(best) in longm else "; no long runs at these settings"
             picks.append(
                 f"{what}: **{best['mode']}** (solver {best['solver']}"
                 + (f", s = {best['ftl_damping']:g}" if best["solver"] == "ftl" else "")
@@ -512,23 +453,34 @@ def recommend(summ, long=None):
                 if tighter
                 else f"; **the RMS budget is not tighter than not simulating at all** ({_e(base['rms'])})"
             )
-        lb = tolerances.DYN_ACC_USES_LONG.get(use)
+        lb = tolerances.DYN_ACC_USES_LONG[use]
+        allow = tolerances.DYN_ACC_USES_CHAOS[use]
+        over = f" up to {horizon:.3g} s" if horizon is not None else " over the horizon"
+        chaos_txt = (
+            f"; over the whole run, within the reference ensemble's spread plus {allow['tip_L']:g}·L (tip "
+            f"distribution), {100 * allow['curvature_rel']:g} % (curvature) and {100 * allow['envelope_rel']:g} % "
+            f"(silhouette area), kinetic energy of the motion within ×{allow['kinetic_factor']:g} of the members' "
+            "range, stretch against ℓ_k within the use's budget"
+            if ensm
+            else ""
+        )
         long_txt = (
-            f", tip frequency within {100 * lb['freq_rel']:g} %, mean kinetic energy within ×{lb['kinetic_factor']:g}"
-            " of the reference's, and no point of a still head moving more than "
-            f"{lb['jitter_px']:g} px from frame to frame at {lb['lines']} lines ({_jit(use)}; long runs, noise allowed)"
-            if lb and longm
+            f"; in the long runs tip frequency within {100 * lb['freq_rel']:g} % and damping ratio within "
+            f"{100 * lb['damping_rel']:g} % of the reference ensemble's range, kinetic energy from positions within "
+            f"×{lb['kinetic_factor']:g}, and no point of a still head moving more than {lb['jitter_px']:g} px from "
+            f"frame to frame at {lb['lines']} lines ({_jit(use)}; noise allowed)"
+            if longm
             else ""
         )
         jit = [c for c in verdicts.values() if c.get("rest jitter") is False]
         alone = [c for c in jit if all(v is not False for k, v in c.items() if k != "rest jitter")]
         jit_note = (
             f" Rest jitter rejects {len(jit)} of the {len(verdicts)} modes, {len(alone)} of them on that alone."
-            if lb and longm
+            if longm
             else ""
         )
         lines.append(
-            f"- **{use}** (RMS error ≤ {rms_budget:g}·L and stretch ≤ {_pct(stretch_budget)} over the horizon"
+            f"- **{use}** (RMS error ≤ {rms_budget:g}·L and stretch ≤ {_pct(stretch_budget)}{over}{chaos_txt}"
             f"{long_txt}, never blown up; {why}{base_note}): " + "; ".join(picks) + "." + jit_note
         )
     return lines
@@ -565,32 +517,6 @@ def _jit(use):
     return f"{tolerances.jitter_budget_cm(use):.2g} cm"
 
 
-def jitter_budget_lines(long):
-    """Each use's rest-jitter budget in pixels and cm, against the reference's own largest
-    move and the no-simulation mode's (nothing moves)."""
-    if long is None or long.empty:
-        return []
-    _, ref = long_metrics(long)
-    ref_move = ref.get("jitter_max_move", (np.nan,) * 4)[0]
-    out = [
-        "Rest jitter budgets: the largest frame-to-frame move of any point of the settled **rest** scene, in "
-        f"pixels of a picture {tolerances.DYN_ACC_VIEW_CM:g} cm high (a head-and-shoulders shot; "
-        "harness/core/tolerances.py, DYN_ACC_USES_LONG). Not simulating moves nothing (0 px), so every move is "
-        "flicker the simulation adds; the reference's own largest move is its settling, and each budget must be "
-        "looser than it.",
-        "",
-        "| use | lines | budget (px) | budget (cm) | reference's largest move (px) | looser than the reference |",
-        "| --- | ---: | ---: | ---: | ---: | --- |",
-    ]
-    for use, lb in tolerances.DYN_ACC_USES_LONG.items():
-        cm = tolerances.jitter_budget_cm(use)
-        px = ref_move * lb["lines"] / tolerances.DYN_ACC_VIEW_CM
-        looser = "yes" if np.isfinite(ref_move) and cm > ref_move else "**no**"
-        out.append(f"| {use} | {lb['lines']} | {lb['jitter_px']:g} | {cm:.3g} | {px:.2g} | {looser} |")
-    out.append("")
-    return out
-
-
 def baseline_lines(summ, study):
     """The no-simulation baseline: its errors, and each use's budget against it."""
     base = baseline(summ)
@@ -615,79 +541,6 @@ def baseline_lines(summ, study):
     for use, (rms_budget, _, _) in tolerances.DYN_ACC_USES.items():
         ratio = rms_budget / base["rms"] if base["rms"] > 0 else float("nan")
         out.append(f"| {use} | {rms_budget:g} | {ratio:.3g} | {'yes' if ratio < 1 else '**no**'} |")
-    out.append("")
-    return out
-
-
-LONG_COLUMNS = (
-    ("kinetic_mean", "KE mean (cm²/s²)", "motion"),
-    ("energy_drift", "energy drift (cm²/s³)", "motion"),
-    ("stretch_p99", "stretch p99", "motion"),
-    ("err_p99_L", "p99 err / L (whole run)", "motion"),
-    ("tip_distribution_L", "tip distribution W1 / L", "motion"),
-    ("tip_spectrum", "tip spectrum TV", "motion"),
-    ("iou_front", "IoU front", "motion"),
-    ("iou_side", "IoU side", "motion"),
-    ("tip_frequency_hz", "tip frequency (Hz)", "release"),
-    ("tip_damping_ratio", "damping ratio ζ", "release"),
-    ("jitter_rms_velocity", "rest jitter RMS v (cm/s)", "rest"),
-    ("jitter_max_move", "largest rest move (cm)", "rest"),
-)
-
-
-def _pm(v, n):
-    if v is None or not np.isfinite(v):
-        return "—"
-    return f"{v:.3g} ± {n:.2g}" if n is not None and np.isfinite(n) else f"{v:.3g}"
-
-
-def long_lines(long, study):
-    """The long runs' section: one table, the reference first (± its S-against-2S change),
-    then every mode (± its noise)."""
-    if long is None or long.empty:
-        return [
-            "### What a user sees over seconds",
-            "",
-            "Not measured with these results (`--long-seconds 0`).",
-            "",
-        ]
-    longm, ref = long_metrics(long)
-    first = long.iloc[0]
-    rest = long[long["scene"] == "rest"]
-    rest_s = f"{rest['seconds'].iloc[0]:g} s" if len(rest) else "its time"
-    head = "| mode | " + " | ".join(c[1] for c in LONG_COLUMNS) + " | verdict |"
-    out = [
-        "### What a user sees over seconds",
-        "",
-        f"Long runs ({first['seconds']:g} s, {int(first['strands'])} strands × {int(first['points'])} points, "
-        "harness/studies/observables_long.py): **motion** is the study's scene; **release** the still-dynamic "
-        "scene without its collider let go from its rest shape (the median over the strands that swing of each "
-        "strand's swing frequency over the first half and of its damping ratio over the whole run, from the decay "
-        "of the swing's envelope; ζ's noise is the larger of the strand halves' difference and the fit's "
-        "standard error); **rest** the still-dynamic scene with a strong damping "
-        f"for {rest_s} (RMS frame-to-frame velocity and the largest move over its last fifth, settled: what "
-        "flickers). Distances (W1 of the tip's distribution, total variation of its "
-        "spectrum, IoU of the silhouettes) compare statistics, not phases: pointwise error means little after "
-        "about half a second (the horizon's table). Each value ± its noise (half the difference between the "
-        "even and the odd strands); the reference row gives ± the change from S to 2S (its own uncertainty) "
-        "and, after a /, its noise.",
-        "",
-        head,
-        "|" + " --- |" * (len(LONG_COLUMNS) + 2),
-    ]
-    cells = []
-    for metric, _, _ in LONG_COLUMNS:
-        v, noise, _, unc = ref.get(metric, (np.nan, np.nan, np.nan, np.nan))
-        cells.append("—" if not np.isfinite(v) else f"{v:.3g} ± {unc:.2g} / {noise:.2g}")
-    rr = long[long["study"] == "reference"]
-    out.append(f"| reference: {rr['mode'].iloc[0] if len(rr) else '?'} | " + " | ".join(cells) + " | ok |")
-    modes = long[long["study"] == "mode"]
-    for mode, g in modes.groupby("mode", sort=False):
-        cell = {r["metric"]: (r["value"], r["noise"]) for _, r in g.iterrows()}
-        verdict = _worst_verdict(g["verdict"])
-        out.append(
-            f"| {mode} | " + " | ".join(_pm(*cell.get(m, (None, None))) for m, _, _ in LONG_COLUMNS) + f" | {verdict} |"
-        )
     out.append("")
     return out
 
@@ -854,9 +707,15 @@ def _header(study, env):
         f"Scene `{study['scene_file']}` ({study.get('scene_description') or 'no description'}) at "
         f"{study['strands']:,} strands × "
         f"{study['points']} points (strands are independent and keep their roots at any count: same seed), "
-        f"{study['frames']} frames of Δt = {study['frame_dt']:.4g} s ({study['seconds']:g} s). Errors are "
-        f"compared over the **horizon of {study['horizon']:g} s** ({study['horizon_frames']} frames): the "
-        f"worst frame of RMS and of max |x − x_ref| over all points, over L = {study['hair_length']:g} cm. "
+        f"{study['frames']} frames of Δt = {study['frame_dt']:.4g} s ({study['seconds']:g} s). Pointwise errors "
+        f"are compared over the **horizon of {study['horizon']:.3g} s** ({study['horizon_frames']} frames"
+        + (
+            f"; the asked {study['asked_horizon']:g} s cut to the scene's predictability time, below"
+            if study.get("asked_horizon", study["horizon"]) > study["horizon"] + 1e-9
+            else ""
+        )
+        + f"): the worst frame of RMS and of max |x − x_ref| over all points, over L = {study['hair_length']:g} cm; "
+        "statistics that survive chaos are compared over the whole run against a reference ensemble. "
         f"Time per frame: a separate run of the same mode at {study['time_strands']:,} strands, "
         f"{study['time_frames']} frame(s) × `--repeat {study['repeat']}`, no output file, the simulate stage's "
         f"median (never a run that also checks). Reference: {ref['label']} {ref['solver']} {ref['precision']}, "
@@ -1000,12 +859,13 @@ def _all_modes_lines(summ):
     ]
 
 
-def markdown(rows, study, env, analytic, long=None, names=Names(), title=DEFAULT_TITLE):
+def markdown(rows, study, env, analytic, long=None, names=Names(), title=DEFAULT_TITLE, ens=None):
     summ = summary(rows, study["horizon_frames"])
     front = front_of(summ)
     pairs = small_steps(summ, study)
     base = baseline(summ)
     out = [f"## Speed against accuracy: {title}", "", *_header(study, env), *noise_lines(summ)]
+    out += chaos.predictability_lines(study, long)
     out += convergence_lines(rows, study)
     out += [reference_error_line(study), ""]
     out += baseline_lines(summ, study)
@@ -1056,19 +916,23 @@ def markdown(rows, study, env, analytic, long=None, names=Names(), title=DEFAULT
         ladder = o[(o["scheme"] == solver) & (o["iterations"] == 1)].sort_values("substeps")
         out += small_steps_verdict(solver, ps, ladder)
     out += ["", reference_error_line(study), "", f"![small steps against iterations]({names.steps})", ""]
-    out += long_lines(long, study)
+    shown = list(dict.fromkeys([*front["mode"], *recommended(summ, long, ens)]))
+    out += chaos.chaos_lines(summ, ens, shown)
+    out += chaos.long_lines(long, _worst_verdict)
     out += [
         "### Which settings for which use",
         "",
         "Rule: for each use, the mode with the least time per frame among those never blown up whose RMS error "
-        "and stretch_max over the horizon are within the use's budget (harness/core/tolerances.py, DYN_ACC_USES) "
-        "and, where the long runs measured its settings, whose tip frequency and mean kinetic energy are within "
-        "the use's allowance of the reference's and whose rest jitter is within the use's pixel budget "
+        f"and stretch_max up to the pointwise horizon ({study['horizon']:.3g} s) are within the use's budget "
+        "(harness/core/tolerances.py, DYN_ACC_USES); whose statistics over the whole run are within the reference "
+        "ensemble's spread plus the use's allowance (DYN_ACC_USES_CHAOS); and, where the long runs measured its "
+        "settings, whose kinetic energy from positions, tip frequency and damping ratio are within the use's "
+        "allowance of the ensemble's range and whose rest jitter is within the use's pixel budget "
         "(DYN_ACC_USES_LONG, each widened by the measured noise), on the CPU and on the GPU apart. ftl's s is "
         "part of the setting: s < 1 converges to another motion and adds energy (docs/model.md §3.7).",
         "",
         *jitter_budget_lines(long),
-        *recommend(summ, long),
+        *recommend(summ, long, ens, study["horizon"]),
         "",
     ]
     if analytic:
@@ -1093,11 +957,12 @@ def write(results_dir=None, report_dir=None, csv_path=None, title=None):
     results_dir = Path(results_dir or RESULTS / RESULTS_NAME)
     report_dir = Path(report_dir or REPORT)
     rows, study, env, analytic = load(results_dir, csv_path)
-    long = load_long(Path(csv_path).parent if csv_path else results_dir)
+    where = Path(csv_path).parent if csv_path else results_dir
+    long, ens = load_long(where), load_ensemble(where)
     scene = study.get("scene", DEFAULT_SCENE)
     names = Names.of(scene)
     report_dir.mkdir(parents=True, exist_ok=True)
-    lines, summ, _, pairs = markdown(rows, study, env, analytic, long, names, title or title_of(scene))
+    lines, summ, _, pairs = markdown(rows, study, env, analytic, long, names, title or title_of(scene), ens)
     pics = [
         pareto_plot(summ, study, report_dir / names.pareto),
         growth_plot(rows, summ, study, report_dir / names.growth),
@@ -1156,7 +1021,7 @@ def section(results_dir=None, report_dir=None, write_page=True, scene=DEFAULT_SC
         reference_error_line(study),
         "",
         *baseline_lines(summ, study)[2:3],
-        *recommend(summ, load_long(results_dir)),
+        *recommend(summ, load_long(results_dir), load_ensemble(results_dir), study["horizon"]),
         "",
         f"![error against time per frame]({names.pareto})",
         "",

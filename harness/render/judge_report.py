@@ -21,7 +21,7 @@ def _by_model(s, num, den):
     bm = s.get("by_model")
     if not bm:
         return ""
-    return " (" + ", ".join(f"{m} {bm[m][num]} / {bm[m][den]}" for m in ("dynamic", "paper") if m in bm) + ")"
+    return " (" + ", ".join(f"{m} {bm[m][num]} / {bm[m][den]}" for m in ("dynamic", "paper", "lod") if m in bm) + ")"
 
 
 def section(results_dir, out_dir=None):
@@ -35,7 +35,9 @@ def section(results_dir, out_dir=None):
         f"Each frame of a comparison is judged as `harness stepdiff` judges it: a point is over when farther "
         f"than max({s['rule_k']:g}·ε·E·S·I, {s['spread_k']:g} × the scene's spread), the spread being how far "
         "the C reference built with FMA contraction lands from the same input; the paper model's defects and "
-        "variants are judged by whole runs as `harness diff` judges them (docs/judge.md).",
+        "variants are judged by whole runs as `harness diff` judges them; simulated-point LOD runs (not "
+        "resumable) by stepdiff of the same run without LOD, their simulated rows against it bit for bit and "
+        "their rendered rows recomputed from them (docs/judge.md).",
         "",
         f"- planted defects caught on the standard scenes: **{s['caught']} / {s['planted']}**"
         + _by_model(s, "caught", "planted"),

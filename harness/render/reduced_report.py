@@ -1,27 +1,25 @@
-"""The reduced-model trades (harness/studies/reduced.py's CSV) as Markdown: guide fraction ×
-scheme, LRA on/off, simulated points P_s against rendered points P_r (LOD), and sag-free rest
-(the still groom's displacement, the tip's swing frequency), each row's error against the fully
-simulated finer reference and its time per frame on every binary that timed it;
-`section(path)` for report/dynamic.md.
+"""The reduced-model trades (harness/studies/reduced.py's CSV and references.csv beside it) as
+Markdown: guide fraction × scheme at each strand count with the guide spacing, LRA on/off, simulated
+points P_s against rendered points P_r (LOD), and sag-free rest (the still groom's displacement at
+each shape range, the tip's swing), each row's error against a converged, fully simulated reference
+up to the pointwise horizon, its statistics against the reference ensemble over the whole run, its
+stretch against each segment's own rest length, and its time per frame on every binary that timed
+it; `section(path)` for report/dynamic.md.
 
-Recommendations are read off the measured rows with fixed error budgets on the RMS error
-over the hair length L (docs/decisions/reduced-models.md): a preview takes the fewest guides
-and the fewest simulated points within PREVIEW_BUDGET, a game within GAME_BUDGET, an offline
-render simulates every strand and every point.
+Recommendations are read off the measured rows with the dynamic accuracy study's budgets
+(tolerances.DYN_ACC_USES: RMS error and stretch per use; DYN_ACC_USES_CHAOS: the statistics'
+allowance beyond the ensemble's spread): per use and strand count the fewest guides, and the fewest
+simulated points, whose every measure is within it; each names its scene, horizon and strand count.
 """
 
 import csv
+import math
 from pathlib import Path
 
+from harness.core import tolerances
 from harness.core.paths import display
 
-PREVIEW_BUDGET = 0.05
-GAME_BUDGET = 0.02
-
-
-def _table_head(intro, header, rule):
-    """A paragraph, then a Markdown table's header and rule."""
-    return ["", intro, "", header, rule]
+DISTANCES = ("tip_L", "curvature_rel", "envelope_rel")
 
 
 def read(path):
@@ -29,24 +27,181 @@ def read(path):
         return list(csv.DictReader(f))
 
 
+def _f(r, k):
+    try:
+        return float(r.get(k, ""))
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def _g(v, digits=3):
+    return "—" if not math.isfinite(v) else f"{v:.{digits}g}"
+
+
+def _key(r):
+    return (r["study"], r["solver"], r["strands"], r["iterations"], r["guides"], r["follow"], r["lra"],
+            str(r.get("sag_free", 0)), str(r.get("shape_range", "")), str(r.get("points", "")))  # fmt: skip
+
+
 def _times(rows):
-    """{(case key): {backend/variant: ms}} and the timing columns in order."""
+    """{case key: (row, {backend/variant: ms})} and the timing columns in order."""
     cols, out = [], {}
     for r in rows:
         col = f"{r['backend']}/{r['variant']}"
         if col not in cols:
             cols.append(col)
-        key = (r["study"], r["solver"], r["iterations"], r["guides"], r["follow"], r["lra"], str(r.get("sag_free", 0)),
-               str(r.get("points", "")))  # fmt: skip
-        ms = float(r["median_ms"])
+        ms = _f(r, "median_ms")
         if r.get("render_ms") not in (None, ""):
-            ms += float(r["render_ms"])  # LOD: the frame and its rendering
-        out.setdefault(key, (r, {}))[1][col] = ms
+            ms += _f(r, "render_ms")  # LOD: the frame and its rendering
+        out.setdefault(_key(r), (r, {}))[1][col] = ms
     return cols, out
 
 
-def _fmt_ms(d, col):
-    return f"{d[col]:.3f}" if col in d else "—"
+def _table(cases, cols, study, head, cells):
+    lines = [
+        "| " + " | ".join(head) + " | " + " | ".join(f"{c} ms" for c in cols) + " |",
+        "|" + " --- |" * (len(head) + len(cols)),
+    ]
+    for key, (r, t) in cases.items():
+        if key[0] == study:
+            ms = " | ".join(f"{t[c]:.3f}" if c in t else "—" for c in cols)
+            lines.append("| " + " | ".join(map(str, cells(r))) + " | " + ms + " |")
+    return lines
+
+
+def _errs(r):
+    return _g(_f(r, "rms_err_L")), _g(_f(r, "max_err_L"))
+
+
+def _stats(r):
+    return tuple(_g(_f(r, m)) for m in DISTANCES)
+
+
+def _rate(r, tp):
+    """λ as the references table writes it: 'no growth', '≥ x' (a lower bound) or x."""
+    if math.isinf(tp):
+        return "no growth"
+    return ("≥ " if str(r.get("lyapunov_lower_bound")) == "True" else "") + _g(_f(r, "lyapunov_per_s"))
+
+
+def references_lines(refs):
+    if not refs:
+        return []
+    out = [
+        "References (every strand and point simulated, xpbd, fp64, I = 1): S doubled until S and 2S differ by "
+        f"less than {tolerances.DYN_ACC_REF_FACTOR:g} × the smallest error of the rows each ranks, at every written "
+        "frame up to the pointwise horizon; three perturbed twins of the converged run give the scene's Lyapunov "
+        "rate λ and predictability time T_p (the pointwise horizon is min(run, T_p)) and, with it, the ensemble "
+        "whose spread the statistics are judged against:",
+        "",
+        "| scene | strands | ran on | S | converged | ladder (worst RMS of S − 2S, ÷ smallest row error) | λ (1/s) | "
+        "T_p (s) | pointwise horizon (s) | spread: tip / curvature / area |",
+        "| --- | ---: | --- | ---: | --- | --- | ---: | ---: | ---: | --- |",
+    ]
+    for r in refs:
+        tp = _f(r, "predictability_s")
+        out.append(
+            f"| {r['scene']} | {int(r['strands']):,} | {r.get('build', '')} | {r['substeps']} | "
+            f"{'yes' if str(r['converged']) == 'True' else '**no**'} | {r['ladder']} | "
+            f"{_rate(r, tp)} | "
+            f"{'beyond the run' if math.isinf(tp) else _g(tp)} | {_g(_f(r, 'horizon_s'))} | "
+            + " / ".join(_g(_f(r, f"{m}_spread")) for m in DISTANCES)
+            + " |"
+        )
+    return out + [""]
+
+
+def markdown(rows, refs=()):
+    if not rows:
+        return "No rows.\n"
+    cols, cases = _times(rows)
+    first = rows[0]
+    sizes = ", ".join(sorted({f"{r['backend']} at {int(r['time_strands']):,} strands" for r in rows}))
+    lines = [
+        f"Checked runs: fp32, S = {first['substeps']}, {_g(_f(first, 'seconds'))} s; errors are the worst written "
+        "frame up to the pointwise horizon, statistics (W1 of the tip's and the curvature's distributions, the "
+        "silhouette's area; harness/check/ensemble.py) over the whole run, stretch against each segment's own "
+        f"rest length. Times per frame ({sizes}, median).",
+        "",
+        *references_lines(refs),
+        "Guides and followers (guide spacing: the mean distance from a follower's root to its nearest guide's):",
+        "",
+        *_table(
+            cases,
+            cols,
+            "guides",
+            (
+                "solver",
+                "strands",
+                "guides",
+                "spacing (cm)",
+                "scheme",
+                "rms err / L",
+                "max err / L",
+                "stretch of followers",
+                "tip W1 / L",
+                "curvature W1",
+                "area",
+            ),  # fmt: skip
+            lambda r: (
+                r["solver"],
+                f"{int(r['strands']):,}",
+                f"{_f(r, 'guides'):.0%} ({r['guide_count']})",
+                _g(_f(r, "guide_spacing_cm")),
+                r["follow"] or "all simulated",
+                *_errs(r),
+                _g(_f(r, "stretch_followers")),
+                *_stats(r),
+            ),  # fmt: skip
+        ),
+        "",
+        "Long-range attachments under a fast nod, few iterations (LRA bound excess: the largest |x_k − x_0| over "
+        "its bound k·ℓ, less 1, in the output; moved: how far LRA moved the output from the same row without it):",
+        "",
+        *_table(
+            cases,
+            cols,
+            "lra",
+            ("solver", "I", "LRA", "rms err / L", "max err / L", "stretch max (ℓ_k)", "bound excess", "moved (cm)"),
+            lambda r: (
+                r["solver"],
+                r["iterations"],
+                "on" if int(r["lra"]) else "off",
+                *_errs(r),
+                _g(_f(r, "stretch_max_k")),
+                _g(_f(r, "lra_excess")),
+                _g(_f(r, "lra_moved_cm")),
+            ),  # fmt: skip
+        ),
+    ]
+    lines += _sag_lines(cases, cols)
+    if any(k[0] == "lod" for k in cases):
+        pr = next(r["render_points"] for k, (r, _t) in cases.items() if k[0] == "lod")
+        lines += [
+            "",
+            f"Simulated-point LOD: P_s points simulated, {pr} written (a centripetal Catmull–Rom spline through the "
+            f"simulated ones, --render-points); errors against {pr} points simulated; stretch of the rendered points "
+            "against the rendered rest shape; times are the frame's plus its rendering:",
+            "",
+            *_table(
+                cases,
+                cols,
+                "lod",
+                (
+                    "solver",
+                    "P_s",
+                    "rms err / L",
+                    "max err / L",
+                    "stretch max (rendered)",
+                    "tip W1 / L",
+                    "curvature W1",
+                    "area",
+                ),  # fmt: skip
+                lambda r: (r["solver"], _points(r), *_errs(r), _g(_f(r, "stretch_max_k")), *_stats(r)),
+            ),
+        ]
+    lines += ["", *recommend(rows, refs)]
+    return "\n".join(lines) + "\n"
 
 
 def _points(r):
@@ -54,157 +209,152 @@ def _points(r):
     return f"{r['points']}" + (" (all)" if int(r["points"]) == int(r["render_points"]) else "")
 
 
-def _errs(r):
-    return f"{float(r['rms_err_L']):.3g}", f"{float(r['max_err_L']):.3g}"
-
-
-def _table(cases, cols, study, head, align, cells):
-    """A Markdown table of one study's cases: `head` and `cells(key, row)` first, then a time
-    column per backend."""
-    lines = [
-        "| " + " | ".join(head) + " | " + " | ".join(f"{c} ms" for c in cols) + " |",
-        align + " ---: |" * len(cols),
-    ]
-    for key, (r, t) in cases.items():
-        if key[0] == study:
-            lines.append(
-                "| " + " | ".join(map(str, cells(key, r))) + " | " + " | ".join(_fmt_ms(t, c) for c in cols) + " |"
-            )
-    return lines
-
-
-def markdown(rows):
-    if not rows:
-        return "No rows.\n"
-    cols, cases = _times(rows)
-    first = rows[0]
-    sizes = ", ".join(sorted({f"{r['backend']} at {int(r['time_strands']):,} strands" for r in rows}))
-    lines = [
-        f"Checked runs: {int(first['strands']):,} strands, fp32, S = {first['substeps']}; errors against every "
-        f"strand simulated (xpbd, fp64, finer S). Times per frame ({sizes}, median):",
-        "",
-        *_table(
-            cases,
-            cols,
-            "guides",
-            ("solver", "guides", "scheme", "rms err / L", "max err / L"),
-            "| --- | ---: | --- | ---: | ---: |",
-            lambda k, r: (k[1], f"{float(k[3]):.0%}", k[4] or "all simulated", *_errs(r)),
-        ),
-        "",
-        "Long-range attachments under a fast nod, few iterations (xpbd):",
-        "",
-        *_table(
-            cases,
-            cols,
-            "lra",
-            ("I", "LRA", "rms err / L", "max err / L", "stretch_max"),
-            "| ---: | --- | ---: | ---: | ---: |",
-            lambda k, r: (k[2], "on" if int(k[5]) else "off", *_errs(r), f"{float(r['stretch_max']):.3g}"),
-        ),
-    ]
-    sag = [(k, v) for k, v in cases.items() if k[0] == "sagfree"]
-    if sag:
-        lines += _table_head(
-            "Sag-free rest: the scene held still (no head motion, no wind, every point in shape); how far the "
-            "groom moves from its rest shape:",
-            "| solver | sag-free | rest rms / L | rest max / L | " + " | ".join(f"{c} ms" for c in cols) + " |",
-            "| --- | --- | ---: | ---: |" + " ---: |" * len(cols),
-        )
-        for (_st, solver, _i, _g, _f, _l, on, _p), (r, t) in sag:
-            lines.append(
-                f"| {solver} | {'on' if on == '1' else 'off'} | {float(r['rest_rms_L']):.3g} | "
-                f"{float(r['rest_max_L']):.3g} | " + " | ".join(_fmt_ms(t, c) for c in cols) + " |"
-            )
-    freq = [(k, v) for k, v in cases.items() if k[0] == "sagfreq"]
-    if freq:
-        lines += _table_head(
-            "Sag-free rest leaves the dynamics alone: the same still scene hit at t = 0 by a steady wind (a step "
-            "load); the median over strands of the tip's swing frequency and damping ratio:",
-            "| solver | sag-free | tip Hz | tip damping ratio |",
-            "| --- | --- | ---: | ---: |",
-        )
-        for (_st, solver, *_rest, on, _p), (r, _t) in freq:
-            lines.append(
-                f"| {solver} | {'on' if on == '1' else 'off'} | {float(r['tip_hz']):.4g} | "
-                f"{float(r['tip_damping']):.3g} |"
-            )
-    if any(k[0] == "lod" for k in cases):
-        pr = next(r["render_points"] for k, (r, _t) in cases.items() if k[0] == "lod")
-        lines += [
+def _sag_lines(cases, cols):
+    out = []
+    if any(k[0] == "sagfree" for k in cases):
+        out += [
             "",
-            f"Simulated-point LOD: P_s points simulated, {pr} written (a centripetal Catmull–Rom spline through "
-            f"the simulated ones, --render-points); errors against {pr} points simulated; times are the frame's "
-            "plus its rendering:",
+            "Sag-free rest: the scene held still (no head motion, no wind); how far the groom moves from its rest "
+            "shape, at the shipped shape range and with every point in shape:",
             "",
             *_table(
                 cases,
                 cols,
-                "lod",
-                ("solver", "P_s", "rms err / L", "max err / L"),
-                "| --- | ---: | ---: | ---: |",
-                lambda k, r: (k[1], _points(r), *_errs(r)),
+                "sagfree",
+                ("solver", "shape range", "sag-free", "rest rms / L", "rest max / L"),
+                lambda r: (
+                    r["solver"],
+                    r["shape_range"],
+                    "on" if str(r["sag_free"]) == "1" else "off",
+                    _g(_f(r, "rest_rms_L")),
+                    _g(_f(r, "rest_max_L")),
+                ),  # fmt: skip
             ),
         ]
-    lines += ["", *recommend(rows)]
-    return "\n".join(lines) + "\n"
-
-
-def recommend(rows):
-    """One line each for a preview, a game and an offline render, from the xpbd guide rows."""
-    guide = [r for r in rows if r["study"] == "guides" and r["solver"] == "xpbd" and r["backend"] == "cpu"]
-
-    def fewest(budget):
-        ok = [r for r in guide if float(r["rms_err_L"]) <= budget]
-        if not ok:
-            return None
-        return min(ok, key=lambda r: (float(r["guides"]), float(r["rms_err_L"])))
-
-    lod = [r for r in rows if r["study"] == "lod" and r["solver"] == "xpbd" and r["backend"] == "cpu"]
-
-    def fewest_points(budget):
-        ok = [r for r in lod if float(r["rms_err_L"]) <= budget]
-        return min(ok, key=lambda r: (int(r["points"]), float(r["rms_err_L"]))) if ok else None
-
-    out = []
-    for who, budget in (("a preview", PREVIEW_BUDGET), ("a game", GAME_BUDGET)):
-        r = fewest(budget)
-        if r is None:
-            line = f"- For {who} (rms error ≤ {budget:g} L): no measured guide fraction is within it here"
-        else:
-            scheme = r["follow"] or "every strand simulated"
-            line = (
-                f"- For {who} (rms error ≤ {budget:g} L): {float(r['guides']):.0%} guides, {scheme} "
-                f"(measured {float(r['rms_err_L']):.3g} L)"
-            )
-        p = fewest_points(budget)
-        if lod and p is None:
-            line += "; no measured P_s is within it"
-        elif p is not None and int(p["points"]) != int(p["render_points"]):
-            line += (
-                f"; {p['points']} simulated points rendered as {p['render_points']} "
-                f"(measured {float(p['rms_err_L']):.3g} L)"
-            )
-        elif p is not None:
-            line += "; every point simulated (fewer points were not within it)"
-        out.append(line + ".")
-    lra = {(r["iterations"], r["lra"]): float(r["rms_err_L"]) for r in rows if r["study"] == "lra"}
-    helps = [i for (i, on) in lra if on == "1" and lra[(i, "1")] < lra.get((i, "0"), float("inf"))]
-    note = f"LRA lowered the error at I = {', '.join(sorted(helps))}" if helps else "LRA did not lower the error here"
-    out.append(
-        f"- For an offline render: every strand and every point simulated, and LRA only where it helps ({note})."
-    )
-    sag = {(r["solver"], str(r.get("sag_free"))): float(r["rest_max_L"]) for r in rows if r["study"] == "sagfree"}
-    hz = {str(r.get("sag_free")): float(r["tip_hz"]) for r in rows if r["study"] == "sagfreq" and r["solver"] == "xpbd"}
-    if ("xpbd", "0") in sag and ("xpbd", "1") in sag:
-        line = (
-            f"- Sag-free rest for every scene with shape (preview, game and offline alike): the still groom moved at "
-            f"most {sag[('xpbd', '1')]:.3g} L with it and {sag[('xpbd', '0')]:.3g} L without (xpbd)"
-        )
-        if "0" in hz and "1" in hz:
-            line += f"; the tip swings at {hz['1']:.4g} Hz with it and {hz['0']:.4g} Hz without"
-        out.append(line + ".")
+    if any(k[0] == "sagfreq" for k in cases):
+        out += [
+            "",
+            "Sag-free rest leaves the dynamics alone: the same still scene (shape range 1) hit at t = 0 by a steady "
+            "wind (a step load); the median over the strands that swing of the tip's frequency and damping ratio:",
+            "",
+            *_table(
+                cases,
+                cols,
+                "sagfreq",
+                ("solver", "sag-free", "tip Hz", "tip damping ratio"),
+                lambda r: (
+                    r["solver"],
+                    "on" if str(r["sag_free"]) == "1" else "off",
+                    _g(_f(r, "tip_hz"), 4),
+                    _g(_f(r, "tip_damping")),
+                ),  # fmt: skip
+            ),
+        ]
     return out
+
+
+def _spreads(refs):
+    """{(scene, strands): {distance: spread}} of references.csv."""
+    return {(r["scene"], str(r["strands"])): {m: _f(r, f"{m}_spread") for m in DISTANCES} for r in refs}
+
+
+def passes(r, use, spreads):
+    """Whether a row meets a use: RMS error (up to the horizon) and stretch (the followers', a LOD
+    row's rendered points, else every point's, against ℓ_k) within the use's budgets, and each
+    statistic within the ensemble's spread plus the use's allowance."""
+    rms_budget, stretch_budget, _ = tolerances.DYN_ACC_USES[use]
+    if not _f(r, "rms_err_L") <= rms_budget or int(_f(r, "blown_up") or 0) > 0:
+        return False
+    stretch = _f(r, "stretch_followers") if math.isfinite(_f(r, "stretch_followers")) else _f(r, "stretch_max_k")
+    if not stretch <= stretch_budget:
+        return False
+    scene = {"guides": "scene", "lod": "lod", "lra": "nod"}.get(r["study"], "scene")
+    sp = spreads.get((scene, str(r["strands"])), {})
+    allow = tolerances.DYN_ACC_USES_CHAOS[use]
+    return all(not math.isfinite(_f(r, m)) or _f(r, m) <= sp.get(m, 0.0) + allow[m] for m in DISTANCES)
+
+
+def recommend(rows, refs=()):
+    """Per use: at each strand count the fewest guides (xpbd, the CPU's rows) and at the LOD's
+    strand count the fewest simulated points that pass it; LRA where it lowers the error without
+    raising the stretch; sag-free by how much of the sag it removes at each shape range."""
+    spreads = _spreads(refs)
+    horizon = {(r["scene"], str(r["strands"])): _f(r, "horizon_s") for r in refs}
+    cpu = [r for r in rows if r["backend"] == "cpu"]
+    out = []
+    for use in tolerances.DYN_ACC_USES:
+        parts = []
+        for n in sorted({int(r["strands"]) for r in cpu if r["study"] == "guides"}):
+            ok = [r for r in cpu if r["study"] == "guides" and r["solver"] == "xpbd" and int(r["strands"]) == n
+                  and passes(r, use, spreads)]  # fmt: skip
+            h = horizon.get(("scene", str(n)), math.nan)
+            if not ok:
+                parts.append(f"at {n:,} strands no guide fraction (not even all simulated) passes")
+                continue
+            r = min(ok, key=lambda r: (_f(r, "guides"), _f(r, "rms_err_L")))
+            stretch = _f(r, "stretch_followers") if r["follow"] else _f(r, "stretch_max_k")
+            parts.append(
+                f"at {n:,} strands {_f(r, 'guides'):.0%} guides ({r['guide_count']}, "
+                f"{_g(_f(r, 'guide_spacing_cm'))} cm apart), {r['follow'] or 'every strand simulated'} "
+                f"(rms {_g(_f(r, 'rms_err_L'))}·L up to {_g(h)} s, stretch {_g(stretch)})"
+            )
+        lod = [r for r in cpu if r["study"] == "lod" and r["solver"] == "xpbd" and passes(r, use, spreads)]
+        if lod:
+            p = min(lod, key=lambda r: (int(r["points"]), _f(r, "rms_err_L")))
+            parts.append(
+                f"{p['points']} simulated points rendered as {p['render_points']}"
+                if int(p["points"]) != int(p["render_points"])
+                else "every point simulated (fewer were not within it)"
+            )
+        elif any(r["study"] == "lod" for r in cpu):
+            parts.append("no P_s passes")
+        budget = tolerances.DYN_ACC_USES[use]
+        head = (
+            f"- **{use}** (rms ≤ {budget[0]:g}·L, stretch ≤ {budget[1]:.1%}, statistics within the ensemble's spread "
+            "plus the use's allowance; the default scene, xpbd): "
+        )
+        out.append(head + "; ".join(parts) + ".")
+    out += _lra_lines(cpu) + _sag_recommendation(cpu)
+    return out
+
+
+def _lra_lines(rows):
+    by = {(r["solver"], str(r["iterations"]), str(r["lra"])): r for r in rows if r["study"] == "lra"}
+    out = []
+    for (solver, i, lra), r in sorted(by.items()):
+        off = by.get((solver, i, "0"))
+        if lra != "1" or off is None:
+            continue
+        better = _f(r, "rms_err_L") < _f(off, "rms_err_L")
+        stretch = _f(r, "stretch_max_k") <= _f(off, "stretch_max_k")
+        out.append(
+            f"- LRA, {solver}, I = {i}, fast nod: RMS error {_g(_f(off, 'rms_err_L'))} → {_g(_f(r, 'rms_err_L'))}·L "
+            f"({'lower' if better else 'not lower'}), largest stretch {_g(_f(off, 'stretch_max_k'))} → "
+            f"{_g(_f(r, 'stretch_max_k'))} ({'not raised' if stretch else 'raised'}), bound excess in the output "
+            f"{_g(_f(off, 'lra_excess'))} → {_g(_f(r, 'lra_excess'))}, output moved up to {_g(_f(r, 'lra_moved_cm'))} "
+            f"cm: {'use it here' if better and stretch else 'not worth it here'}."
+        )
+    return out
+
+
+def _sag_recommendation(rows):
+    sag = {(r["solver"], str(r["shape_range"]), str(r["sag_free"])): _f(r, "rest_rms_L")
+           for r in rows if r["study"] == "sagfree"}  # fmt: skip
+    hz = {str(r["sag_free"]): _f(r, "tip_hz") for r in rows if r["study"] == "sagfreq" and r["solver"] == "xpbd"}
+    parts = []
+    for (solver, rng, on), v in sorted(sag.items()):
+        plain = sag.get((solver, rng, "0"))
+        if on == "1" and solver == "xpbd" and plain:
+            parts.append(
+                f"shape range {rng}: it removes {1 - v / plain:.0%} of the sag (rest rms {_g(plain)} → {_g(v)}·L)"
+            )
+    if not parts:
+        return []
+    line = "- Sag-free rest (xpbd, the scene held still): " + "; ".join(parts)
+    if "0" in hz and "1" in hz:
+        line += f"; the tip swings at {_g(hz['1'], 4)} Hz with it and {_g(hz['0'], 4)} Hz without"
+    return [line + ". It holds only the points a shape constraint holds: use it with the shape range that covers "
+            "the groom it should keep."]  # fmt: skip
 
 
 def section(path):
@@ -216,9 +366,13 @@ def section(path):
             f"Not measured here: this results directory has no `{display(p)}` (the study is newer than the run); "
             f"`python -m harness reduced --out {display(p)}` or `make bench` measures it."
         ]
-    lines += [
-        "docs/model.md §3.14.",
-        "",
-        markdown(read(p)).rstrip(),
-    ]
-    return lines
+    refs_path = p.with_name("references.csv")
+    rows = read(p)
+    if "guide_spacing_cm" not in (rows[0] if rows else {}):
+        return lines + [
+            f"`{display(p)}` was measured before the study compared rows with a converged reference at scale "
+            "(no guide spacing, horizon or stretch columns): its verdicts are not shown. `python -m harness reduced` "
+            "or `make bench` measures it again."
+        ]
+    refs = read(refs_path) if refs_path.exists() else []
+    return lines + ["docs/model.md §3.14.", "", markdown(rows, refs).rstrip()]

@@ -28,7 +28,7 @@ COLOURS = {
 }
 # how the words name a verdict ("xpbd fp32 blows up at …")
 VERBS = {
-    "escaped": "escapes (a point past 2L, finite)",
+    "escaped": "escapes (a point past twice its hanging length, finite)",
     "diverged": "diverges (NaN/Inf)",
     "penetrating": "penetrates the head",
     "over-stretched": "over-stretches",
@@ -228,9 +228,11 @@ def write_markdown(rows, path, info, pngs):
         f"Each cell is one run of {info.get('strands', '?')} strands over {info.get('frames', '?')} frames "
         "(Δt = 1/60 s) of the base scene with one or two parameters changed; its verdict is the first of: "
         "**diverged** (a strand blown up in some frame, docs/model.md §3.8, and a NaN or Inf in the last "
-        "frame), **escaped** (a strand blown up in some frame by a point farther than 2L from its root, every "
-        "number finite: large but bounded, as an iteration-starved run is; the substeps-iterations slice shows "
-        "where more iterations bring it back), "
+        "frame), **escaped** (a point farther from its root than twice the length the strand hangs at under "
+        "its own weight in some frame — 2L, or for a soft xpbd chain 2(L + α_s·g0·P(P − 1)/2) — every number "
+        "finite: large but bounded, as an iteration-starved run is; the substeps-iterations slice shows where "
+        "more iterations bring it back; a soft chain that settles at its static length is judged by its "
+        "stretch), "
         f"**penetrating** (penetration_max > {bound_p:g}·R_c), **over-stretched** "
         f"(stretch_max > {bound_s:g}, i.e. {100 * bound_s:.0f} %), else **ok** (bounds and their reasons: "
         "harness/core/tolerances.py STABILITY_*).",

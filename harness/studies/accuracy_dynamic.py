@@ -25,8 +25,11 @@ where one is usable, once the GPU's rung S0 agrees with the CPU's within a share
 margin (tolerances.DYN_ACC_GPU_REF_SHARE); otherwise the CPU ladder is used.
 
 After the ladder, `ref_extra` more doublings measure the reference's own error
-(Study.reference_error), and the long runs (studies/observables_long.py, observables.csv)
-measure what a user sees over `long_seconds`.
+(Study.reference_error); perturbed twins of the converged rung give the scene's Lyapunov rate
+and predictability time T_p, and pointwise errors are judged only up to min(horizon, T_p)
+(Study.predictability, studies/accuracy_ensemble.py); every mode's statistics over the whole run
+go against the reference ensemble (ensemble.csv); and the long runs (studies/observables_long.py,
+observables.csv) measure what a user sees over `long_seconds`.
 
 Time per frame is measured apart from the checked run: the same mode at `time_strands`
 strands, `time_frames` frames, `--repeat`, no output file (never a run that also checks);
@@ -58,7 +61,7 @@ from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
 from harness.io.trajectory import open_trajectory
-from harness.studies import observables_long
+from harness.studies import accuracy_ensemble, observables_long, predictability
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     COLUMNS,
@@ -246,6 +249,7 @@ class Run:
     penetration: np.ndarray
     blown: np.ndarray
     vel: np.ndarray | None = None
+    ell: object = None  # the stretch rest lengths in double: ℓ, or a groom's [N][P−1] (§3.15)
 
 
 def read_run(path):
@@ -261,6 +265,7 @@ def read_run(path):
             penetration=obs["penetration_max"].to_numpy(np.float64),
             blown=obs["blown_up_strands"].to_numpy(np.int64),
             vel=np.stack(vel).astype(np.float64) if all(v is not None for v in vel) else None,
+            ell=t.segment_rest(),
         )
 
 
@@ -271,11 +276,13 @@ def _mode_rms(path, ref_pos, L):
     return np.full_like(rms, np.nan) if (r.blown > 0).any() else rms
 
 
-def _mode_metrics(path, ref, L, gravity):
-    """A mode's run (its positions dropped), RMS and max error against `ref`, frame_metrics."""
+def _mode_metrics(path, ref, gravity, ctx):
+    """A mode's run (its positions dropped), RMS and max error against `ref`, frame_metrics and
+    its signature over the whole run (accuracy_ensemble.Context `ctx`)."""
     r = read_run(path)
-    rms, mx = frame_errors(r.pos, ref.pos, L)
-    return replace(r, pos=None, vel=None), rms, mx, frame_metrics(r, ref, L, gravity)
+    rms, mx = frame_errors(r.pos, ref.pos, ctx.L)
+    sig = ctx.signature(r.pos, r.ell)
+    return replace(r, pos=None, vel=None), rms, mx, frame_metrics(r, ref, ctx.L, gravity, ctx.dt), sig
 
 
 def reader_pool(jobs):
@@ -285,13 +292,16 @@ def reader_pool(jobs):
     return multiprocessing.get_context("fork").Pool(jobs, signal.signal, (signal.SIGINT, signal.SIG_IGN))
 
 
-def frame_metrics(run, ref, L, gravity):
+def frame_metrics(run, ref, L, gravity, dt):
     """Per frame of `run`: the verdict, error percentiles and silhouette overlaps against
-    `ref` (a Run, or None), stretch p99, kinetic and potential energy per particle."""
+    `ref` (a Run, or None), stretch p99 against each segment's ℓ_k, kinetic energy per
+    particle from the stored velocities and from the positions (frames dt apart), potential."""
     F = len(run.times)
     out = {k: [np.nan] * F for k in ("err_p50_L", "err_p95_L", "err_p99_L", "iou_front", "iou_side")}
     out["verdict"] = [observables.verdict(run.pos[f], L, None if run.vel is None else run.vel[f]) for f in range(F)]
-    out["stretch_p99"] = [observables.stretch_stats(run.pos[f], L)[1] for f in range(F)]
+    out["stretch_p99"] = [observables.stretch_stats(run.pos[f], L, run.ell)[1] for f in range(F)]
+    with np.errstate(invalid="ignore", over="ignore"):
+        out["kinetic_pos"] = list(observables.kinetic_from_positions(run.pos, dt))
     if run.vel is not None:
         k, p, _ = observables.energy(run.pos, run.vel, gravity)
         out["kinetic"], out["potential"] = list(k), list(p)
@@ -461,7 +471,7 @@ class Study:
             cur_path = self.rung(build, 2 * S)
             prev, cur = read_run(prev_path), read_run(cur_path)
             d_rms, d_max = frame_errors(prev.pos, cur.pos, self.L)
-            extra = frame_metrics(prev, cur, self.L, self.gravity)
+            extra = frame_metrics(prev, cur, self.L, self.gravity, self.frame_dt)
             steps.append(dict(S=S, S2=2 * S, rms=d_rms, max=d_max, run=replace(prev, pos=None, vel=None), extra=extra))
             if then is None:
                 then, moved = self.mode_rms(mode_paths, cur), np.zeros_like(d_rms)
@@ -495,34 +505,59 @@ class Study:
 
     def reference_error(self, ref):
         """The reference's own error, measured: its final rung against plan.ref_extra more
-        doublings. Per frame the RMS and max difference from the finest rung, and (with two or
-        more) a Richardson-style estimate: that difference plus the tail the last two
-        differences predict if each doubling keeps shrinking the change by their ratio q
-        (q = worst over the horizon of the last over the one before; no estimate if q ≥ 1)."""
+        doublings: per frame the RMS and max difference from the finest rung; reference_tail adds
+        the Richardson-style estimate once the pointwise horizon is known."""
         if self.plan.ref_extra < 1:
             return None
         S = ref["steps"][-1]["S2"]
-        prev, prev_S, diffs = ref["final"], S, []
+        prev, prev_S, diffs, finer = ref["final"], S, [], []
         for _ in range(self.plan.ref_extra):
             path = self.rung(ref["build"], 2 * prev_S)
             cur = read_run(path)
             os.unlink(path)
             diffs.append((prev_S, 2 * prev_S, *frame_errors(prev.pos, cur.pos, self.L)))
+            finer.append(cur)
             prev, prev_S = cur, 2 * prev_S
         rms, mx = frame_errors(ref["final"].pos, prev.pos, self.L)
-        H = self.horizon_frames
+        self.log(
+            f"dynamic accuracy: the reference S = {S} against S = {prev_S}: RMS {np.nanmax(rms):.2e}·L, max "
+            f"{np.nanmax(mx):.2e}·L over the run"
+        )
+        return dict(S=S, finest=prev_S, rms=rms, max=mx, diffs=diffs, finer=finer[:1])  # finer: an ensemble member
+
+    def reference_tail(self, err):
+        """With two or more extra doublings, the tail they predict over the (pointwise) horizon: each
+        doubling shrinks the change by q, the worst of the last change over the one before (no
+        estimate if q ≥ 1); adds est_rms, est_max and ratio to `err`."""
+        H, diffs = self.horizon_frames, err["diffs"]
         q = float("nan")
-        tail_rms = tail_max = np.full_like(rms, np.nan)
+        tail_rms = tail_max = np.full_like(err["rms"], np.nan)
         if len(diffs) >= 2:
             with np.errstate(invalid="ignore", divide="ignore"):
                 q = float(np.nanmax(diffs[-1][2][:H]) / np.nanmax(diffs[-2][2][:H]))
             if q < 1:
                 tail_rms, tail_max = diffs[-1][2] * q / (1 - q), diffs[-1][3] * q / (1 - q)
+        err.update(est_rms=err["rms"] + tail_rms, est_max=err["max"] + tail_max, ratio=q)
+        self.log(f"dynamic accuracy: change ratio per doubling {q:.3g} over the horizon")
+
+    def predictability(self, ref, ref_err):
+        """The reference ensemble (accuracy_ensemble.build): λ and T_p from the final rung's twins;
+        from here on pointwise errors are judged up to min(horizon, T_p) (horizon_frames), and
+        whether the ladder converged is read again over that horizon."""
+        threads = self.cpu_threads if ref["build"].backend == "cpu" else None
+        finer = ref_err["finer"] if ref_err else []
+        ens = accuracy_ensemble.build(self, ref, finer, accuracy_ensemble.context(self), threads)
+        r = ens.twins.rate
         self.log(
-            f"dynamic accuracy: the reference S = {S} against S = {prev_S}: RMS {np.nanmax(rms[:H]):.2e}·L, max "
-            f"{np.nanmax(mx[:H]):.2e}·L over the horizon; change ratio per doubling {q:.3g}"
+            f"dynamic accuracy: Lyapunov rate {r.lam:.3g} /s ({'fitted from' if r.grew else 'no growth past'} "
+            f"{tolerances.DYN_LYAPUNOV_FLOOR:g}× the perturbation), predictability time {r.predictability:.3g} s; "
+            f"pointwise errors judged over {ens.pointwise_frames} of {self.horizon_frames} frames"
         )
-        return dict(S=S, finest=prev_S, rms=rms, max=mx, est_rms=rms + tail_rms, est_max=mx + tail_max, ratio=q)
+        self.horizon_frames = ens.pointwise_frames
+        ref["converged"] = bool(ref["ok"][: self.horizon_frames].all())
+        if ref_err:
+            self.reference_tail(ref_err)
+        return ens
 
 
 def _gpu_reference_build(gpu_ok, scene):
@@ -638,7 +673,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                 gpu_run,
                 g_rms,
                 g_max,
-                frame_metrics(gpu_run, cpu_run, study.L, study.gravity),
+                frame_metrics(gpu_run, cpu_run, study.L, study.gravity, study.frame_dt),
                 study="gpu_check",
                 mode=f"{gpu_ref.label} vs {cpu_oracle.label} S{S0}",
                 **_ref_columns(study, gpu_ref, S0),
@@ -653,6 +688,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         else:
             ref = study.ladder(cpu_oracle, mode_paths)
         ref_err = study.reference_error(ref)
+        ens = study.predictability(ref, ref_err)
 
         # the long runs: what a user sees over seconds (studies/observables_long.py)
         long_rows = []
@@ -664,7 +700,8 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         # 3. timing, one run at a time, nothing else running
         timed = study.timed_all(modes)
 
-        rows = _rows(study, modes, mode_paths, ref, timed) + _ladder_rows(study, ref) + check_rows
+        mode_rows, ens_rows = _rows(study, modes, mode_paths, ref, timed, ens)
+        rows = mode_rows + _ladder_rows(study, ref) + check_rows
         rows += _ref_error_rows(study, ref, ref_err)
     finally:
         study.close()
@@ -672,6 +709,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
 
     out_dir.mkdir(parents=True, exist_ok=True)
     files.write_csv(csv_path, COLUMNS, rows)
+    files.write_csv(out_dir / accuracy_ensemble.CSV_NAME, accuracy_ensemble.COLUMNS, ens_rows)
     long_path = out_dir / observables_long.CSV_NAME
     if long_rows:
         files.write_csv(long_path, observables_long.COLUMNS, long_rows)
@@ -681,8 +719,24 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         files.write_text(out_dir / ANALYTIC_NAME, "\n".join(analytic_lines) + "\n")
     elif (out_dir / ANALYTIC_NAME).exists():
         (out_dir / ANALYTIC_NAME).unlink()  # a stale table must not be rendered with these rows
+    meta = _env(study, plan, builds, (gpu_ok, gpu_why, gpu_note), ref, ref_err, ens, started, command)
     final_S = ref["steps"][-1]["S2"]
-    meta = dict(
+    files.write_json(out_dir / "env.json", meta)
+    log(f"wrote {display(csv_path)}")
+    if not ref["converged"]:
+        log(
+            f"dynamic accuracy: the reference did NOT converge over the horizon by S = {final_S} "
+            f"(--ref-max {plan.ref_max}); the report says so"
+        )
+        return 1
+    return 0
+
+
+def _env(study, plan, builds, gpu, ref, ref_err, ens, started, command):
+    """env.json's record: the machine, the plan and what the study decided (gpu: (usable, why, note))."""
+    gpu_ok, gpu_why, gpu_note = gpu
+    final_S = ref["steps"][-1]["S2"]
+    return dict(
         env.collect(),
         study=dict(
             asdict(plan),
@@ -691,6 +745,10 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
             frame_dt=study.frame_dt,
             frames=study.frames,
             horizon_frames=study.horizon_frames,
+            horizon=study.horizon_frames * study.frame_dt,  # judged pointwise: min(asked, T_p)
+            asked_horizon=plan.horizon,
+            predictability=predictability.rate_columns(ens.twins.rate),
+            ensemble=ens.labels,
             points=study.scene.points,
             hair_length=study.L,
             builds=[b.label for b in builds],
@@ -724,24 +782,18 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
             command=command,
         ),
     )
-    files.write_json(out_dir / "env.json", meta)
-    log(f"wrote {display(csv_path)}")
-    if not ref["converged"]:
-        log(
-            f"dynamic accuracy: the reference did NOT converge over the horizon by S = {final_S} "
-            f"(--ref-max {plan.ref_max}); the report says so"
-        )
-        return 1
-    return 0
 
 
-def _rows(study, modes, mode_paths, ref, timed):
-    rows = []
+def _rows(study, modes, mode_paths, ref, timed, ens):
+    """(the modes' rows, one per frame; ensemble.csv's rows: the members', then every mode's)."""
+    rows, ens_rows = [], accuracy_ensemble.member_rows(ens)
     final_S = ref["steps"][-1]["S2"]
+    ctx = accuracy_ensemble.context(study)
     measured = study.readers.starmap(
-        _mode_metrics, [(mode_paths[m.name], ref["final"], study.L, study.gravity) for m in modes], chunksize=8
+        _mode_metrics, [(mode_paths[m.name], ref["final"], study.gravity, ctx) for m in modes], chunksize=8
     )
-    for m, (r, rms, mx, extra) in zip(modes, measured):
+    for m, (r, rms, mx, extra, sig) in zip(modes, measured):
+        ens_rows += accuracy_ensemble.mode_rows(m.name, sig, ens)
         ms, ms_min, rec, fig = timed[m.name]
         rows += _frame_rows(
             r,
@@ -761,7 +813,7 @@ def _rows(study, modes, mode_paths, ref, timed):
             device=rec.get("device"),
             ref_substeps=final_S,
         )
-    return rows
+    return rows, ens_rows
 
 
 def _ladder_rows(study, ref):

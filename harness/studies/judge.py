@@ -13,6 +13,13 @@ Two counts, each over one-frame comparisons judged exactly as `harness stepdiff`
       the extreme scenes (EXTREME); an honest run is a false alarm when any of its frames is
       not equivalent.
 
+Simulated-point LOD files (--render-points) are not resumable, so stepdiff cannot step them; each
+LOD scene (LOD_SCENES) is judged by (a) stepdiff of the same run without LOD (the simulation), (b)
+the LOD run's simulated rows against that run, bit for bit (rendering changes nothing the
+simulation does), and (c) its rendered rows recomputed from its simulated rows
+(harness/check/lod.py: bit for bit for the reference build, within DYN_LOD_KERNEL_K·ε·E for the
+others); the LOD plant (PLANTS, model "lod") must fail (c).
+
 Writes <out>/judge.csv (one row per compared frame) and <out>/judge.json (the counts, what
 each defect is and which scenes caught it); report/dynamic.md renders them.
 """
@@ -25,14 +32,16 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+import numpy as np
+
 from harness import HarnessError
-from harness.check import diff, diff_dynamic
+from harness.check import diff, diff_dynamic, invariants_dynamic, lod
 from harness.core import env, runner, scenes, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, build_dir, display
 from harness.core.progress import Progress
 from harness.io import files, runfolder
 from harness.io.files import write_json
-from harness.io.trajectory import open_trajectory
+from harness.io.trajectory import open_trajectory, simulated_view
 
 RESULTS_NAME = "judge"
 
@@ -60,7 +69,10 @@ PLANTS = {
     11: Plant("the wind's blend of segment k taken at k − 1", "wind", "paper"),
     12: Plant("collide without the follow-the-leader pull after a move", "a point collide moves", "paper"),
     13: Plant("every drape step from the head circle, not the shell", "a draped strand of ≥ 3 points", "paper"),
+    14: Plant("the rendered spline's root end copied, not reflected", "--render-points", "lod"),
 }
+# LOD scenes (configs/scenes/dynamic with P_s simulated points rendered as P_r): name → (P_s, P_r, solver)
+LOD_SCENES = {"lod-dynamic": (9, 33, "xpbd"), "lod-dynamic-ftl": (5, 33, "ftl")}
 
 # The standard scenes the planted defects are run on: configs/scenes/<name> × solver.
 STANDARD = (("dynamic", "xpbd"), ("dynamic", "ftl"), ("still-dynamic", "xpbd"), ("still-dynamic", "ftl"))
@@ -127,6 +139,7 @@ class Plan:
     plants: tuple = tuple(PLANTS)
     paper_standard: tuple = PAPER_STANDARD
     paper_extreme: tuple = tuple(PAPER_EXTREME)
+    lod: tuple = tuple(LOD_SCENES)
     gpu: str = "auto"  # auto | yes | no: the CUDA builds' honest runs
 
     @classmethod
@@ -155,6 +168,14 @@ def extreme_scene(name, plan):
             dyn[flag] = value
     scene = base.with_overrides(**{"strands": plan.strands, **fields})
     return replace(scene, name=name, dynamic=dyn)
+
+
+def lod_scene(name, plan):
+    """A LOD scene without its --render-points (lod_flags adds them)."""
+    ps, _, solver = LOD_SCENES[name]
+    base = scenes.load_scene("dynamic")
+    return replace(base.with_overrides(strands=plan.strands, points=ps), name=name,
+                   dynamic={**base.dynamic, "--solver": solver})  # fmt: skip
 
 
 def paper_scene(name, plan):
@@ -239,6 +260,41 @@ class Judge:
             )
             out.unlink()
         return rows
+
+    def lod_rows(self, scene, precision, binary, flags):
+        """One row for a LOD run of `binary`: its simulated rows against the same run without LOD (bit
+        for bit) and its rendered rows recomputed (lod.check_rendered). A refusal gives no row."""
+        self.count += 1
+        plain, rendered = self.work / f"plain{self.count}.h5", self.work / f"lod{self.count}.h5"
+        s = scenes.with_frames(scene.with_overrides(precision=precision), self.plan.frames)
+        base = runner.run_flags(s, "cpu") + ["--velocities", "all", *flags]
+        try:
+            runner.run_binary(binary, base + ["--output", plain], timeout=600)
+            runner.run_binary(binary, base + ["--render-points", LOD_SCENES[scene.name][1], "--output", rendered],
+                              timeout=600)  # fmt: skip
+        except runner.BackendError as e:
+            return [] if e.code == 2 else [{"frame": "all", "equivalent": False, "failures": str(e)}]
+        with open_trajectory(plain) as a, open_trajectory(rendered) as b:
+            exact = invariants_dynamic.is_reference_build(b)
+            bad, worst = lod.check_rendered(b, exact)
+            view = simulated_view(b)
+            same = all(np.array_equal(a.frame(f), view.frame(f)) for f in range(a.n_frames))
+            unit = tolerances.EPS[tolerances.kind_of(b.precision, b.fast_math)] * (b.collide_radius + 2 * b.hair_length)
+        failures = [v.message for v in bad[:2]] + (
+            [] if same else ["the simulated rows differ from the run without LOD"]
+        )
+        return [
+            {
+                "frame": "all",
+                "max_abs": worst * unit,
+                "rule": (0.0 if exact else tolerances.DYN_LOD_KERNEL_K) * unit,
+                "spread": float("nan"),
+                "limit": (0.0 if exact else tolerances.DYN_LOD_KERNEL_K) * unit,
+                "over": sum(v.count for v in bad),
+                "equivalent": same and not bad,
+                "failures": "; ".join(failures),
+            }
+        ]
 
     def paper_run(self, scene, precision, binary=None, flags=()):
         """A whole paper-model run of `scene`; its file."""
@@ -330,6 +386,9 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
     if paper_plants:
         units += [("planted", paper_scene(n, plan), p) for n in plan.paper_standard for p in plan.precisions]
     units += [("honest", paper_scene(n, plan), p) for n in plan.paper_extreme for p in plan.precisions]
+    lod_plants = [n for n in plan.plants if PLANTS[n].model == "lod"]
+    units += [(kind, lod_scene(n, plan), p) for kind in ("planted",) * bool(lod_plants) + ("honest",)
+              for n in plan.lod for p in plan.precisions]  # fmt: skip
     cpu_honest = [(f"cpu {v}", binary_path("cpu"), ["--variant", v]) for v in variants.declared("cpu").running("init")]
 
     def one(i, kind, scene, precision):
@@ -351,6 +410,8 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
                     flagged += [label] if rows and j.add(kind, label, scene, precision, rows) else []
             shutil.rmtree(j.work, ignore_errors=True)
             return j.rows, flagged, runs
+        if scene.name in LOD_SCENES:
+            return lod_unit(j, kind, scene, precision)
         ref, frames = j.reference(scene, precision)
         if kind == "planted":
             for n in dynamic_plants:
@@ -364,8 +425,26 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
         shutil.rmtree(j.work, ignore_errors=True)
         return j.rows, flagged, runs
 
+    def lod_unit(j, kind, scene, precision):
+        """A LOD scene: each plant's LOD run, or each honest run's stepdiff and LOD run."""
+        flagged, runs = [], 0
+        if kind == "planted":
+            for n in lod_plants:
+                rows = j.lod_rows(scene, precision, planted_binary(n), ["--variant", oracle])
+                flagged += [n] if j.add(kind, f"plant {n}", scene, precision, rows) else []
+        else:
+            ref, frames = j.reference(scene, precision)
+            for label, binary, flags in honest:
+                rows = j.lod_rows(scene, precision, binary, flags)
+                if rows:
+                    rows += j.step(ref, frames, binary, flags, scene.points)
+                runs += bool(rows)
+                flagged += [label] if rows and j.add(kind, label, scene, precision, rows) else []
+        shutil.rmtree(j.work, ignore_errors=True)
+        return j.rows, flagged, runs
+
     caught_by = {n: [] for n in plan.plants}
-    false_alarms, honest_runs, rows = [], {"dynamic": 0, "paper": 0}, []
+    false_alarms, honest_runs, rows = [], {"dynamic": 0, "paper": 0, "lod": 0}, []
     bar = Progress(len(units), "judge")
     try:
         with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
@@ -373,7 +452,7 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
             for (kind, scene, precision), fut in zip(units, futures):
                 unit_rows, flagged, runs = fut.result()
                 rows += unit_rows
-                honest_runs[scene.model] += runs
+                honest_runs[_model(scene)] += runs
                 for who in flagged:
                     if kind == "planted":
                         caught_by[who].append(f"{scene.name} {precision}")
@@ -393,12 +472,10 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
             m: {
                 "caught": sum(1 for n in caught if PLANTS[n].model == m),
                 "planted": sum(1 for n in plan.plants if PLANTS[n].model == m),
-                "false_alarms": sum(
-                    1 for r in false_alarms if r.split(" ", 2)[2].startswith("paper-") == (m == "paper")
-                ),
+                "false_alarms": sum(1 for r in false_alarms if _alarm_model(r) == m),
                 "honest_runs": honest_runs[m],
             }
-            for m in ("dynamic", "paper")
+            for m in ("dynamic", "paper", "lod")
         },
         "spread_k": tolerances.DYN_SPREAD_K,
         "rule_k": tolerances.DYN_STEP_K[("fp64", "fp64")],
@@ -423,15 +500,35 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
     return summary
 
 
+def _model(scene):
+    """The judged model of a unit's scene: paper, lod (a LOD scene) or dynamic."""
+    return "lod" if scene.name in LOD_SCENES else scene.model
+
+
+def _alarm_model(alarm):
+    """The model of a false alarm's 'who scene precision' line."""
+    scene = alarm.rsplit(" ", 1)[0]
+    if any(scene.endswith(name) for name in LOD_SCENES):
+        return "lod"
+    return "paper" if any(scene.endswith(name) for name in PAPER_EXTREME) else "dynamic"
+
+
+def _lod(by_model):
+    """The LOD counts of a summary (zeros in one written before LOD was judged)."""
+    return by_model.get("lod", {"caught": 0, "planted": 0, "false_alarms": 0, "honest_runs": 0})
+
+
 def format_summary(s):
     bm = s["by_model"]
     lines = [
         f"judge: caught {s['caught']} / {s['planted']} planted defects on the standard scenes "
         f"(dynamic {bm['dynamic']['caught']} / {bm['dynamic']['planted']} by stepdiff's judge, "
-        f"paper {bm['paper']['caught']} / {bm['paper']['planted']} by diff's)",
+        f"paper {bm['paper']['caught']} / {bm['paper']['planted']} by diff's, "
+        f"LOD {_lod(bm)['caught']} / {_lod(bm)['planted']} by the rendered rows' recomputation)",
         f"judge: false alarms {s['false_alarms']} / {s['honest_runs']} honest runs on the extreme scenes "
         f"({', '.join(s['honest'])}; dynamic {bm['dynamic']['false_alarms']} / {bm['dynamic']['honest_runs']}, "
-        f"paper {bm['paper']['false_alarms']} / {bm['paper']['honest_runs']})",
+        f"paper {bm['paper']['false_alarms']} / {bm['paper']['honest_runs']}, "
+        f"LOD {_lod(bm)['false_alarms']} / {_lod(bm)['honest_runs']})",
         f"judge: limit max({s['rule_k']:g}·ε·E·S·I, {s['spread_k']:g} × spread); {s['seconds']} s",
     ]
     for n, p in s["plants"].items():

@@ -1,29 +1,33 @@
 """The long runs of `python -m harness accuracy --model dynamic`: what a hair user sees over
-seconds rather than how far each point is from the reference's after a fraction of one
-(docs/harness.md, "The dynamic accuracy study"). Measured with harness/check/observables.py.
+seconds rather than how far each point is from one reference trajectory (docs/harness.md, "The
+dynamic accuracy study"). Measured with harness/check/observables.py and harness/check/ensemble.py.
 
-Three scenes, `long_strands` strands (the study's points), `long_seconds` of simulated time
-(rest: REST_SECONDS at most):
+Three scenes, all made from the study's own scene (curly hair stays curly), `long_strands`
+strands (the study's points), `long_seconds` of simulated time (rest: REST_SECONDS at most):
 
-  motion   the study's own scene (a nodding head in gusty wind): energy per particle
-           (kinetic mean, drift of kinetic + potential), stretch max and p99, pointwise error
-           percentiles over the whole run, the distance between the distributions of the tip
-           (relative to its root) and between the tip's spectra, silhouette IoU front/side
-  release  still-dynamic (a still head, gravity and damping) without its collider: strands let
-           go from their rest shape swing freely below their roots and settle; the median over
-           strands of each tip's swing frequency over the first half and damping ratio
-           over the whole run (ob.damping_fit: the envelope's decay; its noise is the larger
-           of the strand halves' difference and the fit's standard error)
-  rest     still-dynamic as shipped (the collider on: hair draped on the head) with damping
+  motion   the study's scene as it is: the metrics that survive chaos against the reference
+           ensemble (the distribution of the tip and of the curvature over time, the silhouette's
+           area, the tip's spectrum), the kinetic energy of the motion from positions (the stored
+           velocities' beside it: ftl's include its correction), the drift of the energy, stretch
+           against each segment's own rest length ℓ_k
+  release  the study's scene with the head still, no wind and no collider, let go from its rest
+           shape: strands sag and swing below their roots and settle; the median over the strands
+           whose tip swings (observables.swings) of its swing frequency over the first half and of
+           its damping ratio over the whole run (the envelope's decay; its noise is the larger of
+           the strand halves' difference and the fit's standard error); no swing, no value
+  rest     the study's scene with the head still and no wind (the collider on) and damping
            REST_DAMPING, so that it settles within the run: rest jitter (RMS frame-to-frame
            velocity, largest frame-to-frame move) over the last fifth, what flickers on screen
 
-Every mode of the oracle build (the cpu default variant: solver × s × S × I × precision, and
-the no-simulation baseline) runs all three; the reference is xpbd fp64 I = 1 at the short study's
-converged S (at most `long_ref_max`: statistics converge long before pointwise positions),
-and once more at 2S: |metric(S) − metric(2S)| is the reference's own
-uncertainty. Each metric's noise is half the difference between its values on the even and
-the odd strands. Written to observables.csv (COLUMNS), one row per scene × mode × metric.
+Every mode of the oracle build (the cpu default variant: solver × s × S × I × precision, and the
+no-simulation baseline) runs all three. The reference ensemble of each scene: xpbd fp64 I = 1 at
+the short study's converged S (at most `long_ref_max`: statistics converge long before pointwise
+positions), the same at 2S, and DYN_LYAPUNOV_TWINS perturbed twins of the S run
+(studies/predictability.py; their separation also gives the scene's Lyapunov rate and
+predictability time, rows of the reference). A distance is the mean over the members beside the
+ensemble's spread (the largest distance between two members); a scalar beside the members'
+range. Each metric's noise is half the difference between its values on the even and the odd
+strands. Written to observables.csv (COLUMNS), one row per scene × mode × metric.
 """
 
 import os
@@ -32,12 +36,13 @@ from dataclasses import replace
 
 import numpy as np
 
+from harness.check import ensemble as en
 from harness.check import observables as ob
-from harness.core import runner, scenes
+from harness.core import runner
+from harness.studies import predictability
 from harness.studies.accuracy import REF_ITERATIONS, REF_PRECISION, REF_SOLVER
 
 CSV_NAME = "observables.csv"
-RELEASE_SCENE = "still-dynamic"
 SCENES = ("motion", "release", "rest")
 REST_DAMPING = 5.0  # 1/s: motion decays as e^(−β·t/2), to e^(−10) of its start in 4 s
 REST_SECONDS = 5.0  # the rest scene's time (at most the long time): what the hair takes to settle on the head
@@ -59,71 +64,115 @@ COLUMNS = (
     "metric",
     "value",
     "noise",  # half the even-strands against odd-strands difference
-    "reference",  # the reference's value
-    "ref_uncertainty",  # |reference at S − at 2S|
+    "reference",  # the reference's value (its S run)
+    "ref_uncertainty",  # a distance: the ensemble's spread; a scalar: half the members' range
     "verdict",  # ok | diverged | escaped (the worst frame)
+    "ref_lo",  # a scalar: the members' range
+    "ref_hi",
 )
-# metric -> (scene, compared with the reference as: "rel" relative error, "abs" the value is
-# itself a distance or overlap, "" reported beside the reference)
+# metric -> (scene, how it is compared: "distance" to the ensemble, "range" of the members' values,
+# "" reported beside the reference)
 METRICS = {
-    "kinetic_mean": ("motion", "rel"),
+    "kinetic_pos": ("motion", "range"),
+    "kinetic_stored": ("motion", ""),
     "energy_drift": ("motion", ""),
     "stretch_max": ("motion", ""),
     "stretch_p99": ("motion", ""),
-    "err_rms_L": ("motion", "abs"),
-    "err_p50_L": ("motion", "abs"),
-    "err_p95_L": ("motion", "abs"),
-    "err_p99_L": ("motion", "abs"),
-    "err_max_L": ("motion", "abs"),
-    "tip_distribution_L": ("motion", "abs"),
-    "tip_spectrum": ("motion", "abs"),
-    "iou_front": ("motion", "abs"),
-    "iou_side": ("motion", "abs"),
-    "tip_frequency_hz": ("release", "rel"),
-    "tip_damping_ratio": ("release", "rel"),
-    "jitter_rms_velocity": ("rest", "rel"),
-    "jitter_max_move": ("rest", "rel"),
+    "tip_L": ("motion", "distance"),
+    "curvature_rel": ("motion", "distance"),
+    "envelope_rel": ("motion", "distance"),
+    "tip_spectrum": ("motion", "distance"),
+    "tip_frequency_hz": ("release", "range"),
+    "tip_damping_ratio": ("release", "range"),
+    "jitter_rms_velocity": ("rest", ""),
+    "jitter_max_move": ("rest", ""),
 }
+REFERENCE_ONLY = ("lyapunov_per_s", "predictability_s")  # rows of the reference, per scene
 DAMPING_FIT_SE = "tip_damping_fit_se"  # not a row: it widens tip_damping_ratio's noise
-IOU_EVERY = 10  # silhouettes every 10th frame: they change slowly and cost the most
 
 
-def _scene_metrics(scene, pos, vel, ref, L, gravity, dt):
-    """{metric: value} of one run (arrays [F][N][P][3]) against the reference's positions."""
+def scene_variants(scene, motion_flags=("--head-motion", "--motion-amplitude", "--motion-frequency")):
+    """{motion, release, rest}: the study's scene, and its still, windless variants (module
+    docstring)."""
+    calm = {k: v for k, v in scene.dynamic.items() if k not in motion_flags and not k.startswith(("--wind", "--gust"))}
+    calm["--head-motion"] = "still"
+    release = replace(scene, dynamic={**calm, "--no-collider": False})
+    rest = replace(scene, dynamic={**calm, "--damping": REST_DAMPING})
+    return {"motion": scene, "release": release, "rest": rest}
+
+
+class Signatures:
+    """A scene's run as the motion metrics see it: its ensemble signature and tip signal, for the
+    whole run and for its even and odd strands."""
+
+    def __init__(self, pos, ctx, ell):
+        self.pos = pos
+        ell = np.asarray(ell) if np.ndim(ell) else ell
+        self.parts = {}
+        for part, sl in (("all", slice(None)), ("even", slice(0, None, 2)), ("odd", slice(1, None, 2))):
+            e = ell[sl] if np.ndim(ell) == 2 else ell
+            x = pos[:, sl]
+            self.parts[part] = (ctx.signature(x, e), ob.tip_displacement(x) if np.isfinite(x).all() else None)
+
+
+def _motion(sig, members, dt, part, vel, gravity):
+    """{metric: value} of one part (all, even, odd strands) of a motion run against the members."""
+    s, tip = sig.parts[part]
     out = {}
-    if scene == "motion":
-        k, _, e = ob.energy(pos, vel, gravity)
-        t = np.arange(len(k)) * dt
-        out["kinetic_mean"] = float(np.mean(k))
-        out["energy_drift"] = ob.drift(e, t)
-        out["stretch_max"], out["stretch_p99"] = ob.stretch_stats(pos, L)
-        if ref is not None:
-            e = ob.error_percentiles(pos, ref, L)
-            out.update({f"err_{k}_L": v for k, v in e.items()})
-            out["tip_distribution_L"] = ob.tip_distribution_distance(pos, ref, L)
-            out["tip_spectrum"] = ob.spectrum_distance(ob.tip_displacement(pos), ob.tip_displacement(ref), dt)
-            ious = [ob.silhouette_iou(pos[f], ref[f]) for f in range(0, len(pos), IOU_EVERY)]
-            out["iou_front"] = float(np.mean([i["front"] for i in ious]))
-            out["iou_side"] = float(np.mean([i["side"] for i in ious]))
-    elif scene == "release":
-        half = max(4, len(pos) // 2)
-        out["tip_frequency_hz"], _, _ = ob.swing(pos[:half], dt)
-        _, out["tip_damping_ratio"], out[DAMPING_FIT_SE] = ob.swing(pos, dt)
+    if s is None:
+        return out
+    m_sigs = [m.parts[part][0] for m in members if m.parts[part][0] is not None]
+    if m_sigs:
+        for metric, (v, _) in en.compare(s, m_sigs).items():
+            if metric in METRICS:
+                out[metric] = v
+        out["tip_spectrum"] = float(
+            np.mean([ob.spectrum_distance(tip, m.parts[part][1], dt) for m in members if m.parts[part][1] is not None])
+        )
     else:
-        out["jitter_rms_velocity"], out["jitter_max_move"] = ob.jitter(pos[-max(2, len(pos) // 5) :], dt)
+        out.update({m: s[m] for m in en.SCALARS})
+    x = sig.pos if part == "all" else sig.pos[:, 0::2] if part == "even" else sig.pos[:, 1::2]
+    if vel is not None:
+        v = vel if part == "all" else vel[:, 0::2] if part == "even" else vel[:, 1::2]
+        k, _, e = ob.energy(x, v, gravity)
+        out["kinetic_stored"] = float(np.mean(k))
+        out["energy_drift"] = ob.drift(ob.kinetic_from_positions(x, dt) + (e - k), np.arange(len(k)) * dt)
     return out
 
 
-def metrics(scene, pos, vel, ref, L, gravity, dt):
-    """({metric: value}, {metric: noise}, verdict) of one run; noise from the strand halves."""
+def _motion_spread(members, dt):
+    """The ensemble's spread of the motion distances: the largest between two members."""
+    sigs = [m.parts["all"][0] for m in members if m.parts["all"][0] is not None]
+    out = {k: v for k, v in en.spread(sigs).items() if k in en.DISTANCES} if sigs else {}
+    tips = [m.parts["all"][1] for m in members if m.parts["all"][1] is not None]
+    out["tip_spectrum"] = max((ob.spectrum_distance(a, b, dt) for a in tips for b in tips if a is not b), default=0.0)
+    return out
+
+
+def _scalar(scene, pos, dt):
+    """{metric: value} of a release or rest run (positions of some strands)."""
+    if scene == "release":
+        half = max(4, len(pos) // 2)
+        out = {"tip_frequency_hz": ob.swing(pos[:half], dt)[0]}
+        _, out["tip_damping_ratio"], out[DAMPING_FIT_SE] = ob.swing(pos, dt)
+        return out
+    rms, most = ob.jitter(pos[-max(2, len(pos) // 5) :], dt)
+    return {"jitter_rms_velocity": rms, "jitter_max_move": most}
+
+
+def metrics(scene, pos, vel, L, gravity, dt, ctx=None, ell=None, members=()):
+    """({metric: value}, {metric: noise}, verdict) of one run; noise from the strand halves.
+    Motion runs need ctx (accuracy_ensemble.Context), ell and the members (Signatures)."""
     verdict = ob.verdict(pos, L, vel)
     if verdict == ob.DIVERGED:
         return {}, {}, verdict
-    whole = _scene_metrics(scene, pos, vel, ref, L, gravity, dt)
-    halves = [
-        _scene_metrics(scene, pos[:, h::2], vel[:, h::2], None if ref is None else ref[:, h::2], L, gravity, dt)
-        for h in (0, 1)
-    ]
+    if scene == "motion":
+        sig = Signatures(pos, ctx, ell)
+        whole = _motion(sig, members, dt, "all", vel, gravity)
+        halves = [_motion(sig, members, dt, part, vel, gravity) for part in ("even", "odd")]
+    else:
+        whole = _scalar(scene, pos, dt)
+        halves = [_scalar(scene, pos[:, h::2], dt) for h in (0, 1)]
     noise = {k: abs(halves[0][k] - halves[1][k]) / 2 for k in whole if k in halves[0] and k in halves[1]}
     if DAMPING_FIT_SE in whole:  # the envelope fit's own scatter, where it is the larger
         noise.pop(DAMPING_FIT_SE, None)
@@ -136,16 +185,14 @@ class LongRuns:
     def __init__(self, study, ref_build, ref_S, log, configure, read_run):
         """study: accuracy_dynamic.Study; configure and read_run: its scene-with-a-mode and
         its reader (passed in, so that this module does not import the study back)."""
+        from harness.studies import accuracy_ensemble
+
         self.study, self.plan, self.log = study, study.plan, log
         self.configure, self.read_run = configure, read_run
         self.ref_build = ref_build
+        self.ctx = accuracy_ensemble.context(study)
         self.frames = max(4, round(self.plan.long_seconds / study.frame_dt))
-        release = scenes.load_scene(RELEASE_SCENE).with_overrides(points=study.scene.points)
-        # no collider: the strands swing freely below their roots instead of draping on the head
-        release = replace(release, dynamic={**release.dynamic, "--no-collider": False})
-        still = scenes.load_scene(RELEASE_SCENE).with_overrides(points=study.scene.points)
-        rest = replace(still, dynamic={**still.dynamic, "--damping": REST_DAMPING})
-        self.scenes = {"motion": study.scene, "release": release, "rest": rest}
+        self.scenes = scene_variants(study.scene)
         self.ref_S = min(ref_S, self.plan.long_ref_max)
 
     def frames_of(self, scene):
@@ -153,7 +200,7 @@ class LongRuns:
             return max(4, min(self.frames, round(REST_SECONDS / self.study.frame_dt)))
         return self.frames
 
-    def run(self, scene, build, solver, substeps, iterations, precision, ftl_damping, tag, threads):
+    def run(self, scene, build, solver, substeps, iterations, precision, ftl_damping, tag, threads, keep=False):
         sc = self.configure(
             self.scenes[scene],
             solver=solver,
@@ -168,8 +215,56 @@ class LongRuns:
         flags = runner.run_flags(sc, build.backend, variant=build.variant, threads=threads, output=out, force=True)
         runner.run_binary(build.binary, flags + ["--velocities", "all"], timeout=3600)
         r = self.read_run(out)
-        os.unlink(out)
-        return r
+        if not keep:
+            os.unlink(out)
+        return r, out
+
+    def reference(self, scene, threads):
+        """(the S run, {metric: value}, {metric: (lo, hi) or spread}, the members' Signatures, rate)."""
+        st = self.study
+        runs = [
+            self.run(
+                scene,
+                self.ref_build,
+                REF_SOLVER,
+                S,
+                REF_ITERATIONS,
+                REF_PRECISION,
+                None,
+                f"ref_S{S}",
+                threads,
+                keep=S == self.ref_S,
+            )  # fmt: skip
+            for S in (self.ref_S, 2 * self.ref_S)
+        ]
+        base, base_path = runs[0]
+        twins = predictability.run_twins(self.ref_build, base_path, st.scratch, threads=threads)
+        os.unlink(base_path)
+        positions = [base.pos, runs[1][0].pos, *twins.positions]
+        gravity = float(self.scenes[scene].dynamic.get("--gravity", 981.0))
+        dt = st.frame_dt
+        members = [Signatures(x, self.ctx, base.ell) for x in positions] if scene == "motion" else []
+        values = [
+            metrics(
+                scene,
+                x,
+                base.vel if k == 0 else None,
+                st.L,
+                gravity,
+                dt,
+                self.ctx,
+                base.ell,
+                members[:k] + members[k + 1 :],
+            )[0]  # fmt: skip
+            for k, x in enumerate(positions)
+        ]
+        own = values[0]
+        band = _motion_spread(members, dt) if scene == "motion" else {}
+        for metric, (where, how) in METRICS.items():
+            vals = [v[metric] for v in values if np.isfinite(v.get(metric, np.nan))]
+            if where == scene and how == "range" and vals:
+                band[metric] = (min(vals), max(vals))
+        return base, own, band, members, twins.rate
 
     def measure(self, modes, jobs):
         """Rows of observables.csv for the reference and every mode."""
@@ -177,63 +272,43 @@ class LongRuns:
         threads = st.cpu_threads if self.ref_build.backend == "cpu" else None
         rows, refs = [], {}
         for scene in SCENES:
-            runs = [
-                self.run(
-                    scene, self.ref_build, REF_SOLVER, S, REF_ITERATIONS, REF_PRECISION, None, f"ref_S{S}", threads
-                )
-                for S in (self.ref_S, 2 * self.ref_S)
-            ]
-            dt = st.frame_dt
+            base, own, band, members, rate = self.reference(scene, threads)
             gravity = float(self.scenes[scene].dynamic.get("--gravity", 981.0))
-            fine = metrics(scene, runs[0].pos, runs[0].vel, runs[0].pos, st.L, gravity, dt)
-            finer = metrics(scene, runs[1].pos, runs[1].vel, runs[0].pos, st.L, gravity, dt)
-            unc = {k: abs(v - finer[0].get(k, np.nan)) for k, v in fine[0].items()}
-            refs[scene] = (runs[0], fine[0], unc, gravity)
+            refs[scene] = (base, own, band, members, gravity)
             self.log(
-                f"dynamic accuracy: long runs, {scene}: reference S = {self.ref_S} and {2 * self.ref_S} "
-                f"({self.frames_of(scene)} frames × {self.plan.long_strands} strands)"
+                f"dynamic accuracy: long runs, {scene}: reference S = {self.ref_S}, {2 * self.ref_S} and "
+                f"{len(members) or 'its'} twins ({self.frames_of(scene)} frames × {self.plan.long_strands} strands); "
+                f"Lyapunov rate {rate.lam:.3g} /s, predictability {rate.predictability:.3g} s"
             )
-            rows += self._rows(
-                "reference",
-                scene,
-                dict(
-                    mode=f"{self.ref_build.label} {REF_SOLVER} S{self.ref_S} I{REF_ITERATIONS} {REF_PRECISION}",
-                    backend=self.ref_build.backend,
-                    build=self.ref_build.build,
-                    variant=self.ref_build.variant,
-                    solver=REF_SOLVER,
-                    substeps=self.ref_S,
-                    iterations=REF_ITERATIONS,
-                    precision=REF_PRECISION,
-                ),
-                fine,
-                fine[0],
-                unc,
+            keys = dict(
+                mode=f"{self.ref_build.label} {REF_SOLVER} S{self.ref_S} I{REF_ITERATIONS} {REF_PRECISION}",
+                backend=self.ref_build.backend,
+                build=self.ref_build.build,
+                variant=self.ref_build.variant,
+                solver=REF_SOLVER,
+                substeps=self.ref_S,
+                iterations=REF_ITERATIONS,
+                precision=REF_PRECISION,
             )
+            own_rate = {"lyapunov_per_s": rate.lam, "predictability_s": rate.predictability}
+            rows += self._rows("reference", scene, keys, (own, {}, ob.OK), own, band, extra=own_rate)
 
         def one(m, scene):
-            r = self.run(scene, m.runner, m.solver, m.substeps, m.iterations, m.precision, m.ftl_damping, m.tag, 1)
-            ref_run, ref_vals, unc, gravity = refs[scene]
-            return m, scene, metrics(scene, r.pos, r.vel, ref_run.pos, st.L, gravity, st.frame_dt)
+            r, _ = self.run(scene, m.runner, m.solver, m.substeps, m.iterations, m.precision, m.ftl_damping, m.tag, 1)
+            base, _, _, members, gravity = refs[scene]
+            return m, scene, metrics(scene, r.pos, r.vel, st.L, gravity, st.frame_dt, self.ctx, r.ell, members)
 
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             futures = [pool.submit(one, m, scene) for m in modes for scene in SCENES]
             for k, f in enumerate(futures, 1):
                 m, scene, got = f.result()
-                _, ref_vals, unc, _ = refs[scene]
-                rows += self._rows(
-                    "mode",
-                    scene,
-                    m.columns(),
-                    got,
-                    ref_vals,
-                    unc,
-                )
+                _, own, band, _, _ = refs[scene]
+                rows += self._rows("mode", scene, m.columns(), got, own, band)
                 if k % 40 == 0 or k == len(futures):
                     self.log(f"dynamic accuracy: long runs {k}/{len(futures)}")
         return rows
 
-    def _rows(self, study, scene, keys, got, ref_vals, unc):
+    def _rows(self, study, scene, keys, got, own, band, extra=None):
         values, noise, verdict = got
         shared = dict(
             study=study,
@@ -245,18 +320,23 @@ class LongRuns:
             **keys,
         )
         out = []
-        for metric, (where, _) in METRICS.items():
-            if where != scene:
-                continue
+        cells = [(m, values.get(m, np.nan)) for m, (where, _) in METRICS.items() if where == scene]
+        cells += list((extra or {}).items())
+        for metric, value in cells:
+            b = band.get(metric, np.nan)
+            lo, hi = b if isinstance(b, tuple) else (np.nan, np.nan)
+            unc = (hi - lo) / 2 if isinstance(b, tuple) else b
             out.append(
                 {
                     **{c: None for c in COLUMNS},
                     **shared,
                     "metric": metric,
-                    "value": values.get(metric, np.nan),
+                    "value": value,
                     "noise": noise.get(metric, np.nan),
-                    "reference": ref_vals.get(metric, np.nan),
-                    "ref_uncertainty": unc.get(metric, np.nan),
+                    "reference": own.get(metric, np.nan),
+                    "ref_uncertainty": unc,
+                    "ref_lo": lo,
+                    "ref_hi": hi,
                 }
             )
         return out

@@ -123,15 +123,22 @@ def test_a_tiny_study_writes_its_table_report_and_refuses_to_overwrite(cpu_bin, 
     with open(out / "observables.csv", newline="") as fh:
         long = list(csv.DictReader(fh))
     assert {r["study"] for r in long} == {"mode", "reference"}
-    assert {r["metric"] for r in long} == set(observables_long.METRICS)
+    assert {r["metric"] for r in long} == set(observables_long.METRICS) | set(observables_long.REFERENCE_ONLY)
+    with open(out / "ensemble.csv", newline="") as fh:
+        ens = list(csv.DictReader(fh))
+    assert {r["study"] for r in ens} == {"mode", "member"}
+    assert {r["mode"] for r in ens if r["study"] == "mode"} == {r["mode"] for r in mode_rows}
     ladder = [r for r in rows if r["study"] == "reference"]
     assert ladder and all(int(r["ref_substeps"]) == 2 * int(r["substeps"]) for r in ladder)
     meta = json.loads((out / "env.json").read_text())["study"]
+    assert meta["predictability"]["twins"] == tolerances.DYN_LYAPUNOV_TWINS and len(meta["ensemble"]) >= 2
     assert meta["reference"]["converged"] and meta["reference"]["substeps"] == max(
         int(r["ref_substeps"]) for r in ladder
     )
     page = (rep / accuracy_dynamic_report.PAGE).read_text()
     for heading in (
+        "Predictability",
+        "What survives chaos: statistics against the reference ensemble",
         "The converged reference",
         "The no-simulation baseline",
         "Small steps against iterations",

@@ -113,3 +113,31 @@ def test_render_points_needs_simulate_and_a_rendered_file_is_no_input(cpu_bin, t
 def test_help_and_list_variants_declare_lod(cpu_bin):
     assert "--render-points" in run(cpu_bin, "--help").stdout
     assert '"lod"' in run(cpu_bin, "--list-variants").stdout
+
+
+def test_diff_of_two_rendered_files_judges_their_simulated_rows_and_recomputes_the_rendered(cpu_bin, tmp_path):
+    """`harness diff` of two --render-points files (ref and simd, fp32, sag-free: the issue's kind of
+    pair) applies the paper and dynamic checks to the simulated rows only (no 'left their slice
+    plane' for a rendered point) and recomputes each file's rendered rows: equivalent; a rendered row
+    moved by a hair is a 'rendered' violation; a rendered file against a plain one is refused (exit 2)."""
+    import h5py
+
+    from harness.check import diff_dynamic
+
+    common = [*SIM, *TINY, *MOVING, "--shape-compliance", "1e-4", "--sag-free", "--quiet"]
+    a, b, plain = tmp_path / "a.h5", tmp_path / "b.h5", tmp_path / "plain.h5"
+    run(cpu_bin, *common, "--render-points", "22", "--variant", "ref", "--output", a)
+    run(cpu_bin, *common, "--render-points", "22", "--variant", "simd", "--output", b)
+    run(cpu_bin, *common, "--output", plain)
+    r = diff_dynamic.compare(a, b)
+    assert r.equivalent, r.failures()[:3]
+    assert r.invariants_a.ok and not r.invariants_a.paper.violations
+    with h5py.File(b, "r+") as f:
+        pos = f["particles/hair/position/value"]
+        x = pos[-1]
+        x[1] += np.float32(1e-3)  # strand 0, rendered row 1 (between simulated rows 0 and 3)
+        pos[-1] = x
+    r = diff_dynamic.compare(a, b)
+    assert not r.equivalent and any(v.invariant == "rendered" for v in r.invariants_b.violations)
+    with pytest.raises(diff_dynamic.StateError, match="compare files rendered alike"):
+        diff_dynamic.compare(a, plain)

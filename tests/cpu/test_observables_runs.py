@@ -106,6 +106,23 @@ def test_zero_jitter_for_a_strand_resting_on_nothing(cpu_bin, tmp_path, solver):
     assert most <= tol.OBS_REST_MOVE_ABS_L * LENGTH and rms_v * DT <= tol.OBS_REST_MOVE_ABS_L * LENGTH, (rms_v, most)
 
 
+def test_energy_from_positions_of_a_still_ftl_chain_is_zero(cpu_bin, tmp_path):
+    """A chain hanging straight down under gravity, ftl, collider off: its positions stay put (to
+    rounding), so the kinetic energy of its motion, from positions, is zero, while the velocities
+    ftl stores (its correction −s·d/h, docs/model.md §3.7) read g·h·Σ s^j along the chain."""
+    from harness.studies.analytic_runs import straight_chain_positions
+
+    inp = write_paper_state(tmp_path / "in.h5", straight_chain_positions(32, LENGTH, 0.0), LENGTH)
+    out = simulate(cpu_bin, inp, tmp_path / "still.h5", 60, 8, "ftl", extra=["--velocities", "all"])
+    _, x, v = read(out)
+    stored, _, _ = ob.energy(x, v, G0)
+    moved = ob.kinetic_from_positions(x, DT)
+    h, s, P = DT / 8, 0.9, 32
+    carried = [G0 * h * sum(s**j for j in range(1, P - k)) for k in range(1, P)]  # docs/analytic.md
+    assert stored[-1] == pytest.approx(0.5 * np.mean(np.square(carried)), rel=1e-9)
+    assert moved.max() <= (tol.OBS_REST_MOVE_ABS_L * LENGTH / DT) ** 2, moved.max()
+
+
 @pytest.mark.parametrize("motion,axis", [("nod", 0), ("shake", 1), ("tilt", 2)])
 def test_rigid_solver_is_the_rest_shape_rotated_by_the_head(cpu_bin, tmp_path, motion, axis):
     amp, freq = 0.4, 1.5

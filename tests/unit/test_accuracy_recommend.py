@@ -1,7 +1,8 @@
 """The dynamic accuracy page's recommendation (harness/render/accuracy_dynamic_report.py) on a
 hand-made summary: the pick names solver, s, S, I, precision and build and the metric that
-decided it; a long-run measurement can veto a mode; the budgets are compared with the
-no-simulation baseline."""
+decided it; a long-run measurement (the kinetic energy of the motion, the damping ratio, rest
+jitter) or a statistic against the reference ensemble can veto a mode; the budgets are compared
+with the no-simulation baseline."""
 
 import math
 
@@ -44,15 +45,33 @@ SUMM = pd.DataFrame(
 )
 
 
-def long_table(kinetic_s09):
-    """observables.csv rows: the reference and the two ftl settings' mean kinetic energy."""
+def long_rows(metric, scene, values, lo, hi, noise=0.0):
+    """observables.csv rows: the reference and the two ftl settings' `values` of one metric, the
+    reference ensemble's range lo … hi."""
     rows = [dict(study="reference", solver="xpbd", ftl_damping=math.nan, substeps=1024, iterations=1)]
     rows += [dict(study="mode", solver="ftl", ftl_damping=s, substeps=4, iterations=1) for s in (0.9, 1.0)]
-    out = []
-    for r, ke in zip(rows, (100.0, kinetic_s09, 110.0)):
-        out.append(dict(r, precision="fp32", metric="kinetic_mean", value=ke, noise=1.0, reference=100.0,
-                        ref_uncertainty=0.5))  # fmt: skip
-    return pd.DataFrame(out)
+    return pd.DataFrame(
+        [
+            dict(
+                r,
+                precision="fp32",
+                scene=scene,
+                metric=metric,
+                value=v,
+                noise=noise,
+                reference=values[0],
+                ref_uncertainty=(hi - lo) / 2,
+                ref_lo=lo,
+                ref_hi=hi,
+            )  # fmt: skip
+            for r, v in zip(rows, values)
+        ]
+    )
+
+
+def long_table(kinetic_s09):
+    """The kinetic energy of the motion (from positions): the ensemble 95 … 105 cm²/s²."""
+    return long_rows("kinetic_pos", "motion", (100.0, kinetic_s09, 110.0), 95.0, 105.0, noise=1.0)
 
 
 def games_line(long=None):
@@ -85,14 +104,34 @@ def games_line_of(summ):
 
 def jitter_table(move_s09):
     """observables.csv rows: the largest rest move (cm) of the reference and the two ftl settings."""
-    rows = [dict(study="reference", solver="xpbd", ftl_damping=math.nan, substeps=1024, iterations=1)]
-    rows += [dict(study="mode", solver="ftl", ftl_damping=s, substeps=4, iterations=1) for s in (0.9, 1.0)]
-    return pd.DataFrame(
+    return long_rows("jitter_max_move", "rest", (1e-4, move_s09, 1e-4), math.nan, math.nan)
+
+
+def test_a_damping_ratio_far_from_the_ensemble_vetoes_a_mode():
+    """ζ = 0.197 against an ensemble at 0.030 … 0.036 (6×): no use takes it, and the ftl s = 1
+    mode, within 25 % of the range, is the games pick."""
+    long = long_rows("tip_damping_ratio", "release", (0.033, 0.197, 0.034), 0.030, 0.036, noise=0.002)
+    line = games_line(long)
+    assert "**cpu ref ftl s=1 S4 I1 fp32**" in line
+    assert "**cpu ref ftl s=0.9 S4 I1 fp32**" in games_line(
+        long_rows("tip_damping_ratio", "release", (0.033, 0.035, 0.034), 0.030, 0.036)
+    )
+
+
+def test_a_statistic_outside_the_ensembles_spread_vetoes_a_mode():
+    """ensemble.csv: the s = 0.9 mode's tip distribution 0.05·L from the members, whose spread is
+    0.001·L: beyond the games allowance (0.01·L), within the previews' (0.05·L)."""
+    ens = pd.DataFrame(
         [
-            dict(r, precision="fp32", metric="jitter_max_move", value=v, noise=0.0, reference=1e-4, ref_uncertainty=0)
-            for r, v in zip(rows, (1e-4, move_s09, 1e-4))
+            dict(study="mode", mode=name, metric="tip_L", value=v, spread=0.001, lo=math.nan, hi=math.nan)
+            for name, v in (("cpu ref ftl s=0.9 S4 I1 fp32", 0.05), ("cpu ref ftl s=1 S4 I1 fp32", 0.004))
         ]
     )
+    assert "**cpu ref ftl s=1 S4 I1 fp32**" in next(
+        ln for ln in rep.recommend(SUMM, None, ens) if ln.startswith("- **games**")
+    )
+    previews = next(ln for ln in rep.recommend(SUMM, None, ens) if ln.startswith("- **previews**"))
+    assert "**cpu ref ftl s=0.9 S4 I1 fp32**" in previews or "**cpu ref xpbd S1 I1 fp32**" in previews
 
 
 def test_the_rest_jitter_budget_is_a_fraction_of_a_pixel():

@@ -219,10 +219,46 @@ def test_release_damping_noise_is_the_larger_of_halves_and_fit():
         return pos
 
     pos = strands([0.02, 0.02, 0.04, 0.04])
-    values, noise, verdict = observables_long.metrics("release", pos, np.zeros_like(pos), None, L, 981.0, dt)
+    values, noise, verdict = observables_long.metrics("release", pos, np.zeros_like(pos), L, 981.0, dt)
     assert verdict == ob.OK and set(values) == {"tip_frequency_hz", "tip_damping_ratio"}
     assert values["tip_damping_ratio"] == pytest.approx(0.03, rel=0.03)  # the median of two 0.02s and two 0.04s
     assert noise["tip_damping_ratio"] == ob.swing(pos, dt)[2] > 0
     pos = strands([0.02, 0.03, 0.04, 0.05])
-    _, noise, _ = observables_long.metrics("release", pos, np.zeros_like(pos), None, L, 981.0, dt)
+    _, noise, _ = observables_long.metrics("release", pos, np.zeros_like(pos), L, 981.0, dt)
     assert noise["tip_damping_ratio"] == pytest.approx(0.005, rel=0.05)
+
+
+def test_stretch_stats_with_each_segments_own_rest_length():
+    """A curl's chords are shorter than L/(P−1): against ℓ = L/(P−1) an unstretched curl reads
+    its chord deficit as stretch; against its own ℓ_k it reads 0."""
+    t = np.linspace(0.0, 4 * np.pi, 9)
+    rest = np.stack([np.cos(t), np.sin(t), 0.3 * t], axis=-1)[None]  # one helix strand, 9 points
+    L = float(np.sum(np.linalg.norm(np.diff(rest[0], axis=0), axis=1))) * 1.05
+    deficit = ob.stretch_stats(rest[None], L)
+    assert deficit[0] == pytest.approx(1 - 1 / 1.05, rel=1e-12)
+    assert ob.stretch_stats(rest[None], L, ob.rest_lengths(rest)) == (0.0, 0.0)
+    moved = rest.copy()
+    moved[0, 5:] += [0.0, 0.0, 0.1]  # segment 5 lengthened
+    smax, _ = ob.stretch_stats(moved[None], L, ob.rest_lengths(rest))
+    assert smax == pytest.approx(np.linalg.norm(np.diff(moved[0], axis=0)[4]) / ob.rest_lengths(rest)[0, 4] - 1)
+
+
+def test_kinetic_from_positions_of_still_and_moving_points():
+    x = np.zeros((5, 2, 3, 3))
+    assert np.array_equal(ob.kinetic_from_positions(x, 0.1), np.zeros(5))
+    x[:, :, 1:, 0] = (0.1 * np.arange(5) * 2.0)[:, None, None]  # every non-root point at 2 cm/s along x
+    assert ob.kinetic_from_positions(x, 0.1) == pytest.approx(np.full(5, 2.0))
+
+
+def test_swing_detector_tells_a_swing_from_a_drift():
+    dt = 1 / 60
+    t = np.arange(300) * dt
+    assert ob.swings(np.exp(-0.2 * t) * np.sin(2 * np.pi * 1.3 * t), dt)
+    assert not ob.swings(1 - np.exp(-0.5 * t), dt)  # settling: no period fits
+    assert not ob.swings(np.sin(2 * np.pi * 0.3 * t), dt)  # 1.5 periods in the run: too few to call a frequency
+    assert not ob.swings(np.zeros(300), dt)
+    # a released strand that only sinks: no frequency, no damping ratio
+    pos = np.zeros((300, 2, 4, 3))
+    pos[:, :, 1:, 2] = 1.0 + 0.01 * t[:, None, None]
+    f, zeta, _ = ob.swing(pos, dt)
+    assert np.isnan(f) and np.isnan(zeta)

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The GPU node's runs behind the dynamic studies of results/reference-h200/ (issue #45), one part a
+# call, each under 9 minutes on one H100, each writing under $OUT (a run folder laid out as
+# results/reference-h200/). Run from the repository root:
+#
+#   OUT=$OUT bash results/gpu_rerun.sh build        # first: the binaries (make -j; minutes)
+#   OUT=$OUT bash results/gpu_rerun.sh accuracy     # dynamic-accuracy/: the quick study, every build
+#   OUT=$OUT bash results/gpu_rerun.sh curly        # dynamic-accuracy-curly/: the same on curly hair
+#   OUT=$OUT bash results/gpu_rerun.sh reduced      # reduced/: 1,000 and 10,000 strands, 1 s
+#   OUT=$OUT bash results/gpu_rerun.sh stability    # stability/: the quick map, CPU and every CUDA build
+#   OUT=$OUT bash results/gpu_rerun.sh judge        # judge/: planted defects, honest runs, LOD scenes
+#   OUT=$OUT bash results/gpu_rerun.sh gputests     # the GPU tests of the followers and LOD (no results)
+#
+# Copy each part's folder into results/reference-h200/ (replacing the old one), then re-render the
+# committed report:  make report REPORT_FROM=results/reference-h200 REPORT_TO=report
+# The other folders (sweep/, headline/, dynamic/, featurecost/, peer/, accuracy/, dynamic-curly/) are
+# measured by `make bench` and the headline commands of results/README.md; none of them changed here.
+set -euo pipefail
+part=${1:?"usage: OUT=DIR bash results/gpu_rerun.sh build|accuracy|curly|reduced|stability|judge|gputests"}
+out=${OUT:?"set OUT to the folder the runs write into"}
+py="$(cat build/python 2>/dev/null || echo python3)"
+mkdir -p "$out"
+case "$part" in
+build) make -j"$(nproc)" all planted ;;
+accuracy) "$py" -m harness accuracy --model dynamic --quick --gpu auto --force \
+	--out "$out/dynamic-accuracy" --report-dir "$out/report" ;;
+curly) "$py" -m harness accuracy --model dynamic --scene curly --quick --analytic none --ref-max 4096 --gpu auto --force \
+	--out "$out/dynamic-accuracy-curly" --report-dir "$out/report" ;;
+reduced) mkdir -p "$out/reduced" && "$py" -m harness reduced --gpu auto --out "$out/reduced/reduced.csv" >"$out/reduced/reduced.md" ;;
+stability) "$py" -m harness stability --quick --gpu auto --out "$out/stability" --report-dir "$out/report" ;;
+judge) "$py" -m harness judge --gpu auto --out "$out/judge" ;;
+gputests) "$py" -m pytest tests/gpu/test_gpu_features.py tests/gpu/test_gpu_lod.py tests/native -q -ra ;;
+*)
+	echo "error: unknown part '$part' (build, accuracy, curly, reduced, stability, judge, gputests)" >&2
+	exit 2
+	;;
+esac
