@@ -217,7 +217,7 @@ $(CUDA_BINS):
 # reference's rules (no FMA contraction, no fast math). The dynamic one at -O1: its many
 # instantiations compile faster, and without contraction the level changes no IEEE result.
 # dynamics_host.o plans the colliders' poses (docs/model.md §3.17): their objects link beside it
-HOSTCHECK_WORLD_OBJ := $(OBJ)/dynamic/colliders.o $(OBJ)/dynamic/sdf_mesh.o $(OBJ)/runtime/cli.o $(OBJ)/runtime/input.o
+HOSTCHECK_WORLD_OBJ := $(OBJ)/dynamic/colliders.o $(OBJ)/dynamic/sdf_mesh.o $(OBJ)/runtime/cli.o $(OBJ)/runtime/input.o $(OBJ)/runtime/safe_write.o
 HOSTCHECK_NVCC := $(NVCC) -std=c++17 -Ic_ref -Icuda -Xcompiler -ffp-contract=off,-fno-fast-math
 hostcheck: $(HOSTCHECK_BINS)
 $(BUILD)/hostcheck/model_hostcheck_reference: HOSTCHECK_MODE := -O2 -DHB_REFERENCE_ARITHMETIC=1

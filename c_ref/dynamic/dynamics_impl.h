@@ -158,6 +158,8 @@ HB_ALWAYS_INLINE void SFX(lra_all)(const DMODEL *m, REAL *p)
 HB_ALWAYS_INLINE void SFX(collide_point)(const DMODEL *m, const WORLD *w, const REAL *pose, const REAL *back, REAL *p,
                                          const REAL *x, int64_t k, const unsigned F)
 {
+    const int64_t P = m->points; /* PLANT_SKIPPED's */
+    (void)P;
     if ((F & HB_F_COLLIDE) && !PLANT_SKIPPED(k)) {
         if (w && (w->head_friction || w->bounded)) SFX(hb_collide_head)(w, m->collide_r, back, p, x);
         else SFX(collide_sphere)(p, m->collide_r);
