@@ -1,6 +1,6 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
-Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, accuracy, headline,
+Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, compare, accuracy, headline,
 export, groom, motion, calibrate, featurecost, reduced, peer, animate, render, stability, judge, budget, hair,
 docs (`--help` on each; docs/harness.md lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
@@ -295,6 +295,44 @@ def cmd_merge(args):
 
     merge.merge(args.out, args.shards)
     return 0
+
+
+def cmd_compare(args):
+    """Compare two runs' timings case by case: two run folders (every runs.csv, headline/*.json and the bench's
+    steps.json in each) or two files of one kind. Each figure's ratio B/A, and a verdict by the noise rule of
+    harness/core/timing.py: within noise when the two figures' bands overlap, else slower or faster. Prints the
+    table; --out writes compare.md, .csv, .json and .png. Exit 0, or 1 when a figure is slower beyond
+    --fail-above; 2 when nothing could be compared."""
+    from harness.check import compare_runs
+    from harness.core.paths import display
+    from harness.render import compare_report
+
+    comp = compare_runs.compare(args.a, args.b, fail_above=args.fail_above)
+    if args.out:
+        from harness.io import runfolder
+
+        out = runfolder.claim(args.out, "compare", force=args.force)
+        for path in compare_report.write(comp, out):
+            print(f"wrote {display(path)}", file=sys.stderr)
+    print(json.dumps(comp.record(), indent=1) if args.json else compare_report.markdown(comp), end="")
+    return 1 if comp.failed else 0
+
+
+def compare_parser(sub):
+    cp = command(
+        sub, cmd_compare, help="is B faster than A, and by more than the noise? (exit 1: slower beyond a ratio)"
+    )
+    cp.add_argument("a", help="the run before: a run folder (make bench's), a runs.csv or a headline JSON")
+    cp.add_argument("b", help="the run after, of the same kind as A")
+    cp.add_argument(
+        "--fail-above",
+        type=real("ratio", "a ratio", lambda v: 1.0 <= v < math.inf, "must be a finite ratio ≥ 1"),
+        default=1.05,
+        help="exit 1 when a figure slower beyond its noise has B/A above this (default 1.05)",
+    )
+    cp.add_argument("--out", default=None, help="write compare.md, compare.csv, compare.json, compare.png here")
+    cp.add_argument("--json", action="store_true", help="print the comparison as JSON instead of the table")
+    cp.add_argument("--force", action="store_true", help=FORCE_FOLDER_HELP)
 
 
 PAPER_ACCURACY = dict(
@@ -945,6 +983,7 @@ def parser():
     mg = command(sub, cmd_merge, help="join shard folders (bench --shard K/N) into one results folder")
     mg.add_argument("out", help="the merged folder to write (must not exist, or be empty)")
     mg.add_argument("shards", nargs="+", help="the shard folders")
+    compare_parser(sub)
 
     a = command(
         sub,
