@@ -9,6 +9,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 from harness.core import tolerances  # noqa: E402
 from harness.io import files  # noqa: E402
@@ -80,12 +81,19 @@ def plot(comp, path):
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.vlines(t["median_ms_a"], t["within_lo"], t["within_hi"], color="0.85", lw=2, zorder=1)
+    top = max(float(t["ratio"].max()), comp.fail_above) * 2  # an unbounded interval drawn to here
+    ax.vlines(t["median_ms_a"], t["within_lo"], t["within_hi"].clip(upper=top), color="0.85", lw=2, zorder=1)
     for what, colour in COLOURS.items():
         s = t[t["verdict"] == what]
         ax.scatter(s["median_ms_a"], s["ratio"], s=12, color=colour, label=f"{what} ({len(s)})", zorder=2)
     ax.axhline(1.0, color="0.3", lw=0.8)
     ax.axhline(comp.fail_above, color="tab:red", lw=0.8, ls="--", label=f"fails above {comp.fail_above:g}")
+    ax.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    lo, hi = ax.get_ylim()
+    narrow = hi / lo < 10  # within a decade the minor ticks carry the labels
+    ax.yaxis.set_minor_formatter(
+        matplotlib.ticker.FormatStrFormatter("%g") if narrow else matplotlib.ticker.NullFormatter()
+    )
     ax.set_xlabel("A's median time (ms)")
     ax.set_ylabel("B / A (above 1: B slower)")
     ax.set_title("B against A, each figure with its within-noise interval (grey)", fontsize=10)
