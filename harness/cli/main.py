@@ -196,6 +196,7 @@ def cmd_bench(args):
     from harness.bench import dynamic as bench_dynamic
     from harness.bench import merge
     from harness.bench import paper as bench_paper
+    from harness.bench import steps as bench_steps
     from harness.core import budget, shards, timing
     from harness.core.paths import LOCAL_RUN, binary_path, output_dir
     from harness.core.progress import StepTimes
@@ -241,7 +242,8 @@ def cmd_bench(args):
         merge.write_record(root, shard, sweeps, command)
     # both models are validated before anything is timed; under a budget the validations are
     # its fixed cost and the sweeps and studies share what they leave
-    times = StepTimes()  # the log's last line: where the run's time went
+    gpu_list = bench_steps.node_gpus(args.gpu)
+    times = StepTimes(on_step=lambda t: bench_steps.write(root, t, gpu_list))  # the log's last line, steps.json
     if args.model in ("all", "paper"):
         times.step("validation", bench_paper.validate_first, args.sweep, out=root / "sweep", gpu=args.gpu)
     if args.model in ("all", "dynamic"):
@@ -282,7 +284,7 @@ def cmd_bench(args):
         report_paper.build(root / "sweep", report_dir)  # again: its time-budget section now lists the dynamic part too
     if shard:
         merge.finish_record(root)  # the shard finished: merge takes it, with the cases it holds
-    print(times.summary("bench"), flush=True)
+    print("\n".join([*bench_steps.gpu_lines(times, gpu_list), times.summary("bench")]), flush=True)
     return code
 
 

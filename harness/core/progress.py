@@ -8,6 +8,8 @@ import sys
 import threading
 import time
 
+from harness.core import gpus
+
 try:
     from tqdm import tqdm as _tqdm
 except ImportError:  # the harness works without it
@@ -97,21 +99,32 @@ class Progress:
 
 
 class StepTimes:
-    """How long each step of a run took, in the order they ran; summary() is the log's last
-    line, so a CI log says where a run's time went (each step's own lines say how far it got)."""
+    """How long each step of a run took, in the order they ran, and the work each step sent to
+    each named GPU (core/gpus.py `working`); summary() is the log's last line, so a CI log says
+    where a run's time went (each step's own lines say how far it got). `on_step(self)` is
+    called as each step ends (the bench writes OUT/steps.json then)."""
 
-    def __init__(self, clock=time.monotonic):
+    def __init__(self, clock=time.monotonic, on_step=None):
         self.clock = clock
         self.start = clock()
         self.steps = []  # (name, seconds)
+        self.gpu_work = []  # per step: {GPU index: seconds of work sent to it}
+        self.on_step = on_step
 
     def step(self, name, fn, *args, **kwargs):
         """fn(*args, **kwargs), timed as `name`; its result."""
-        t = self.clock()
+        t, before = self.clock(), gpus.work_seconds()
         try:
             return fn(*args, **kwargs)
         finally:
             self.steps.append((name, self.clock() - t))
+            after = gpus.work_seconds()
+            self.gpu_work.append({i: s - before.get(i, 0.0) for i, s in after.items() if s > before.get(i, 0.0)})
+            if self.on_step is not None:
+                self.on_step(self)
+
+    def elapsed(self):
+        return self.clock() - self.start
 
     def summary(self, what):
         parts = ", ".join(f"{name} {s:.0f} s" for name, s in self.steps)

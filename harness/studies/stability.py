@@ -321,6 +321,13 @@ def measure(
 
     if len(spread) > 1:
         log(f"stability: GPU cells spread over {len(spread)} GPUs")
+
+    def counted(cells, strands, frames, timeout, gpu):
+        """run_cells, its time counted as work of the GPU it ran on (the first where not spread)."""
+        on = gpu or (spread[0] if spread and cells[0][-1].backend == "cuda" else None)
+        with gpus.working(on):
+            return run_cells(cells, strands, frames, timeout, gpu)
+
     t0 = time.perf_counter()
     bar = Progress(len(todo), "stability")
     # the heaviest cells (most substep iterations a frame, GPU before CPU) start first, so that
@@ -335,7 +342,7 @@ def measure(
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         futures = {}
         for u in units:
-            f = pool.submit(run_cells, [todo[i] for i in u], strands, frames, timeout, gpu_for(u[0], todo[u[0]]))
+            f = pool.submit(counted, [todo[i] for i in u], strands, frames, timeout, gpu_for(u[0], todo[u[0]]))
             futures[f] = u
         for f in as_completed(futures):
             u = futures[f]

@@ -326,16 +326,17 @@ def _run_cases(
                 ready.append(case)
             except SceneError as e:
                 out.append((case, rounds.Timed(error=e)))
-        timed = rounds.measure(
-            ready,
-            lambda c, n: case_flags(sweep, c, n),
-            lambda c: binary_path(*key(c)),
-            rule=rule,
-            timeout=sweep.timeout_s,
-            env=env_add,
-            gpu_index=gpu.index if gpu is not None else None,
-            batch=batch,
-        )
+        with gpus.working(gpu):  # this GPU's work, for the bench's steps.json
+            timed = rounds.measure(
+                ready,
+                lambda c, n: case_flags(sweep, c, n),
+                lambda c: binary_path(*key(c)),
+                rule=rule,
+                timeout=sweep.timeout_s,
+                env=env_add,
+                gpu_index=gpu.index if gpu is not None else None,
+                batch=batch,
+            )
         return out + list(zip(ready, timed))
 
     def done(case, gpu, t):
