@@ -625,7 +625,7 @@ def cmd_peer(args):
     """Run chains released from rest in hairsim-cpu and in pypbd (XPBD distance constraints, the parameters
     mapped as docs/decisions.md says), against our converged fp64 reference: error, stretch and time per frame
     at several strand counts. Writes results/peer/ and results/local/report/peer.md. Needs pypbd (optional):
-    without it, one line says so and the exit status is 2."""
+    without it, one line says it is skipped, nothing is written, and the exit status is 0."""
     from harness.render import peer_report
 
     if not args.report_only:

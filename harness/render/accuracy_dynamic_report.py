@@ -722,8 +722,9 @@ def _header(study, env):
         f"I = {ref['iterations']}, S = {ref['substeps']}.",
         "",
         f"Machine: {env.get('cpu_model')} ({env.get('cpu_cores')} cores), GPU: {dev}; revision "
-        f"{env.get('git_revision')}; {env.get('date')}. Command: `{command}` "
-        f"(the whole study took {study.get('wall_s', float('nan')):.0f} s).",
+        f"{env.get('git_revision')}; {env.get('date')}. Measured by `{command}` "
+        f"(the whole study took {study.get('wall_s', float('nan')):.0f} s); this page is rendered from the "
+        "results that command wrote.",
         "",
     ]
 

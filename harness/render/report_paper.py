@@ -199,8 +199,9 @@ def paper_section(cases):
             )
     lines.append("")
     notes = [
-        f"Ours: fp32, {points} points per strand, `{paper_variant or 'no'}` GPU variant; "
-        "the CPU is our optimised C reference (-O2), so the paper's debug-mode times map to "
+        f"Ours: fp32, {points} points per strand, "
+        + (f"the `{paper_variant}` GPU variant; " if paper_variant else "no GPU rows; ")
+        + "the CPU is our optimised C reference (-O2), so the paper's debug-mode times map to "
         "larger N than its release-mode ones only because its debug CPU was slow."
     ]
     if g32:
