@@ -228,8 +228,8 @@ def hair_figures(state_path, out_dir):
 
 def make_all(results_dir, report_dir=None):
     """Every plot of a results directory; returns the paths written."""
+    rows, env = results_data.load(results_dir)  # refused before a folder is made
     out_dir = output_dir(report_dir if report_dir else REPORT, "--report-dir")
-    rows, env = results_data.load(results_dir)
     cases = results_data.per_case(rows)
     gpu_note = results_data.gpu_absent_reason(env)
     written = []

@@ -192,6 +192,8 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
     cases; `gate` (a core.budget.TierGate): the cases run smallest size first and a tier that does
     not fit is left out with every larger one."""
     sweep = sweep_ref if isinstance(sweep_ref, Sweep) else load_sweep(sweep_ref)
+    cases = shard.share(sweep.cases()) if shard is not None else sweep.cases()
+    reasons = backend_reasons(cases, gpu)  # a refusal (--gpu yes without a GPU) before anything is written
     out_dir = runfolder.claim(out if out else RESULTS / sweep.name, f"sweep {sweep.name}", force=force)
     csv_path = out_dir / "runs.csv"
     env_path = out_dir / "env.json"
@@ -206,7 +208,6 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
     done, dropped = runlog.resume(csv_path)
     if done and record.get("sessions"):
         check_same_machine(record["sessions"][-1].get("host") or {}, env.collect(), out_dir)
-    cases = sweep.cases()
     if done and record.get("shard") != (str(shard) if shard else None):
         was = f"shard {record['shard']}" if record.get("shard") else "the whole sweep"
         raise HarnessError(
@@ -215,9 +216,7 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
             + ": give another --out"
         )
     if shard is not None:
-        cases = shard.share(cases)
         record["shard"] = str(shard)
-    reasons = backend_reasons(cases, gpu)
     skipped = []
     for why in sorted(set(reasons.values())):
         keys = [k for k, r in reasons.items() if r == why]
