@@ -498,13 +498,23 @@ def cmd_headline(args):
 
 
 def cmd_export(args):
-    """Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions referenced in STATE) and, with --usd,
-    STATE.usdc (BasisCurves, one time sample per frame; needs usd-core). A dynamic state's times are in seconds.
+    """Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions referenced in STATE); with --usd,
+    STATE.usdc (BasisCurves, one time sample per frame; needs usd-core); with --hair, STATE.hair (one frame, the
+    last or --frame K, as a groom that --groom reads). A dynamic state's times are in seconds.
     Existing sidecars are replaced only with --force; every refusal comes before anything is written."""
     from harness.io import export
 
     usd = args.usd or args.usd_only
-    for path in export.run(args.state, xdmf=not args.usd_only, usd=usd, out=args.out, force=args.force):
+    only = args.usd_only or args.hair_only
+    for path in export.run(
+        args.state,
+        xdmf=not only,
+        usd=usd,
+        out=args.out,
+        force=args.force,
+        hair=args.hair or args.hair_only,
+        frame=args.frame,
+    ):
         print(f"wrote {path}")
     return 0
 
@@ -1102,6 +1112,9 @@ def parser():
     e.add_argument("state", help="an HDF5 state written by a hairsim binary")
     e.add_argument("--usd", action="store_true", help="also write the USD file")
     e.add_argument("--usd-only", action="store_true", help="write only the USD file")
+    e.add_argument("--hair", action="store_true", help="also write STATE.hair: one frame as a groom (--groom reads it)")
+    e.add_argument("--hair-only", action="store_true", help="write only the HAIR file")
+    e.add_argument("--frame", type=int, default=-1, help="the HAIR file's frame (default -1, the last; 0 the first)")
     e.add_argument("--out", help="output prefix (default: the state's path)")
     e.add_argument("--force", action="store_true", help="replace sidecars that exist (else refused, nothing written)")
 
