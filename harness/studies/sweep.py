@@ -267,7 +267,7 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
     rule = sweep.rule.within(gate.allowance, len(todo)) if gate is not None else sweep.rule
     session["timing"] = rule.as_dict()
     groups = budget.tiers(todo, case_size) if gate is not None else [(None, todo)]
-    progress = Progress(len(todo), f"sweep {sweep.name}")
+    progress = Progress(len(todo), f"sweep {sweep.name}", work=sum(case_size(c) for c in todo))
     failed = 0
     try:
         for size, tier in groups:
@@ -276,7 +276,7 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
                 if not fits:
                     session["skipped"].append({"cases": len(tier), "size": size, "reason": why, "budget": True})
                     progress.write(f"harness: sweep {sweep.name}: {len(tier)} case(s) of size {size} {why}")
-                    progress.update(len(tier))
+                    progress.update(len(tier), work=sum(case_size(c) for c in tier), skip=True)
                     continue
             t0 = time.monotonic()
             sampled = []  # each case's timed samples, seconds (the gate scales these with the size)
@@ -298,7 +298,8 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
 
 
 def case_size(case):
-    """A case's rung on the budget's size ladder: strands × points."""
+    """A case's rung on the budget's size ladder, and its weight in the progress estimate:
+    strands × points (one sweep's cases share the scene's substeps and iterations)."""
     return case.strands * case.points
 
 
@@ -362,7 +363,7 @@ def _run_cases(
                 binary.name,
                 {k: rec.get(k) for k in ("version", "git_revision", "compiler", "flags", "device", "driver")},
             )
-        progress.update()
+        progress.update(work=case_size(case))
         session["last_case_at"] = env.now()  # finished_at only when the whole session ends
         write_json(env_path, record)
 
