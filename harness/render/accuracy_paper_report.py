@@ -108,7 +108,7 @@ def pareto_plot(rows, path, strands, points):
                 fontsize=7,
                 color="0.3",
             )
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)  # beside the data
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(f"time of the scene's stages, median (ms), {strands:,} strands x {points} points")
@@ -116,7 +116,7 @@ def pareto_plot(rows, path, strands, points):
     ax.set_title("Speed against accuracy (reference: cpu fp64)")
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    files.save_figure(fig, path, dpi=110)
+    files.save_figure(fig, path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return path
 
