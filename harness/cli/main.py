@@ -197,7 +197,7 @@ def cmd_bench(args):
     from harness.bench import merge
     from harness.bench import paper as bench_paper
     from harness.bench import steps as bench_steps
-    from harness.core import budget, shards, timing
+    from harness.core import budget, load, shards
     from harness.core.paths import LOCAL_RUN, binary_path, output_dir
     from harness.core.progress import StepTimes
     from harness.core.runner import require_binary
@@ -230,7 +230,7 @@ def cmd_bench(args):
         sweeps["dynamic-curly"] = load_sweep(bench_dynamic.CURLY_SWEEP).path
     require_binary(binary_path("cpu"))  # before the run's folder is made
     # the host's load before anything runs: the top of the run's reports says whether it was quiet
-    write_json(output_dir(root) / host_report.HOST_JSON, timing.host_load())
+    write_json(output_dir(root) / host_report.HOST_JSON, load.host_load())
     if plan:
         print(
             f"harness: budget {plan.seconds:.0f} s: the sweeps' largest sizes and the studies are left out "
