@@ -120,7 +120,7 @@ help:
 	@echo "make lint     ruff check, ruff format --check, mypy (lint-py) and clang-format --dry-run (lint-c)"
 	@echo "make fmt      ruff format the Python and clang-format -i the C and CUDA sources"
 	@echo "make docs     remake docs/harness.md's command and module reference (python3 -m harness docs)"
-	@echo "make setup    install what is missing (apt as root/sudo, pip into .venv under PEP 668); nothing when all is there"
+	@echo "make setup    install what is missing (apt as root/sudo, pip into the project environment .venv); nothing when all is there"
 	@echo "make hostcheck  build the CUDA port's host checks (cuda/hostcheck/, run by tests/native)"
 	@echo "make planted  build/planted/: the C reference with each planted defect (python -m harness judge)"
 	@echo "make clean    remove build/"
@@ -129,8 +129,9 @@ check-hdf5:
 	@echo '#include <hdf5.h>' | $(CC) $(HDF5_CFLAGS) -E -x c - >/dev/null 2>&1 || { \
 	  echo "error: the HDF5 C library is missing (hdf5.h not found): install it, e.g. 'sudo apt-get install libhdf5-dev hdf5-tools'"; exit 1; }
 
-# Set-up: system packages (apt, as root or with sudo) and the Python packages (pip, into
-# .venv under PEP 668) when missing; nothing is installed when all are there.
+# Set-up: system packages (apt, as root or with sudo) and the Python packages (pip, into the
+# project environment .venv, never a system interpreter's) when missing; nothing is installed
+# when all are there.
 setup:
 	@PYTHON="$(PYTHON)" CC="$(CC)" harness/setup.sh $(PY_FILE)
 

@@ -6,7 +6,9 @@
 #    sudo; otherwise one line says what to run.
 # 2. Python >= 3.11 with the packages of requirements.lock. If $PYTHON already imports them,
 #    nothing is installed (machines without a network work from what is there). Else pip
-#    installs the lock into $PYTHON, or into ./.venv when $PYTHON refuses (PEP 668).
+#    installs the lock into the project environment ./.venv, or into $PYTHON's own virtual
+#    environment when $PYTHON runs inside one (the user's choice); never into a system
+#    interpreter's packages (a shared interpreter's versions are not ours to change).
 #    The renderer (moderngl) is tried on its own when it is the one thing missing, and not
 #    required: without it `harness render` and the report's renders say why and skip.
 # The interpreter to use is written to OUT (make reads it). Environment: PYTHON (default
@@ -86,20 +88,18 @@ done_with() {
 imports "$PY" && done_with "$(command -v "$PY")"
 [ -x "$VENV/bin/python" ] && imports "$VENV/bin/python" && done_with "$PWD/$VENV/bin/python"
 
-managed=$("$PY" -c 'import os, sys, sysconfig
-inside_venv = sys.prefix != sys.base_prefix
-print(int(not inside_venv and os.path.exists(os.path.join(sysconfig.get_path("stdlib"), "EXTERNALLY-MANAGED"))))')
+inside_venv=$("$PY" -c 'import sys; print(int(sys.prefix != sys.base_prefix))')
 pip_install() {
   "$1" -m pip install -q --disable-pip-version-check --retries 1 --timeout 30 -r requirements.lock >>"$LOG" 2>&1
 }
-if [ "$managed" = 0 ] && "$PY" -m pip --version >/dev/null 2>&1; then
-  say "installing requirements.lock into $PY with pip"
+if [ "$inside_venv" = 1 ] && "$PY" -m pip --version >/dev/null 2>&1; then
+  say "installing requirements.lock into $PY (its virtual environment) with pip"
   pip_install "$PY" || die "pip could not install requirements.lock into $PY (see $LOG; no network?): run '$PY -m pip install -r requirements.lock' where PyPI is reachable"
   imports "$PY" || die "requirements.lock installed but '$MODULES' still do not import in $PY (see $LOG)"
   done_with "$(command -v "$PY")"
 fi
 
-say "$PY refuses pip installs (PEP 668) or has no pip: installing requirements.lock into $VENV"
+say "installing requirements.lock into the project environment $VENV ($PY's own packages are left as they are)"
 if [ ! -x "$VENV/bin/python" ]; then
   if ! "$PY" -m venv "$VENV" >>"$LOG" 2>&1; then
     rm -rf "$VENV"

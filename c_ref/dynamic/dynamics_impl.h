@@ -20,7 +20,7 @@
 #define ROOT_MOVES(k) ((k)-1 != 0)
 #endif
 #if HB_PLANT == 6 /* judge test: the collider skips point P/2 */
-#define PLANT_SKIPPED(k) ((k) == P / 2)
+#define PLANT_SKIPPED(k) ((k) == m->points / 2)
 #else
 #define PLANT_SKIPPED(k) 0
 #endif

@@ -22,7 +22,7 @@ from harness import HarnessError
 from harness.bench import dynamic as bench_dynamic
 from harness.bench.validation import gpu_plan
 from harness.core import budget as budgets
-from harness.core import runner, scenes, timing
+from harness.core import load, runner, scenes
 from harness.core.budget import TierGate, run_study
 from harness.core.paths import binary_path, display, output_dir
 from harness.core.progress import StepTimes
@@ -69,7 +69,7 @@ def run(scene_ref, out=None, gpu="auto", report_dir=None, quick_studies=True, bu
     root = Path(out) if out else default_out(scene_ref)
     report_dir = Path(report_dir) if report_dir else root / "report"
     runner.require_binary(binary_path("cpu"))
-    write_json(output_dir(root) / host_report.HOST_JSON, timing.host_load())  # the report's first line
+    write_json(output_dir(root) / host_report.HOST_JSON, load.host_load())  # the report's first line
     builds, gpu_note = gpu_plan(gpu)
     if gpu_note:
         say(f"harness: GPU rows skipped: {gpu_note}")

@@ -1,1 +1,2 @@
-"""Layer 3: checking states — invariants, diff (paper and dynamic), stepdiff."""
+"""Layer 3: checking — states (invariants, diff of the paper and dynamic models, stepdiff) and
+timings (compare: two runs' figures against their noise)."""

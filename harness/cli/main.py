@@ -1,6 +1,6 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
-Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, accuracy, headline,
+Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, compare, accuracy, headline,
 export, groom, motion, calibrate, featurecost, reduced, peer, animate, render, stability, judge, budget, hair,
 docs (`--help` on each; docs/harness.md lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
@@ -196,7 +196,8 @@ def cmd_bench(args):
     from harness.bench import dynamic as bench_dynamic
     from harness.bench import merge
     from harness.bench import paper as bench_paper
-    from harness.core import budget, shards, timing
+    from harness.bench import steps as bench_steps
+    from harness.core import budget, load, shards
     from harness.core.paths import LOCAL_RUN, binary_path, output_dir
     from harness.core.progress import StepTimes
     from harness.core.runner import require_binary
@@ -229,7 +230,7 @@ def cmd_bench(args):
         sweeps["dynamic-curly"] = load_sweep(bench_dynamic.CURLY_SWEEP).path
     require_binary(binary_path("cpu"))  # before the run's folder is made
     # the host's load before anything runs: the top of the run's reports says whether it was quiet
-    write_json(output_dir(root) / host_report.HOST_JSON, timing.host_load())
+    write_json(output_dir(root) / host_report.HOST_JSON, load.host_load())
     if plan:
         print(
             f"harness: budget {plan.seconds:.0f} s: the sweeps' largest sizes and the studies are left out "
@@ -241,7 +242,8 @@ def cmd_bench(args):
         merge.write_record(root, shard, sweeps, command)
     # both models are validated before anything is timed; under a budget the validations are
     # its fixed cost and the sweeps and studies share what they leave
-    times = StepTimes()  # the log's last line: where the run's time went
+    gpu_list = bench_steps.node_gpus(args.gpu)
+    times = StepTimes(on_step=lambda t: bench_steps.write(root, t, gpu_list))  # the log's last line, steps.json
     if args.model in ("all", "paper"):
         times.step("validation", bench_paper.validate_first, args.sweep, out=root / "sweep", gpu=args.gpu)
     if args.model in ("all", "dynamic"):
@@ -282,7 +284,7 @@ def cmd_bench(args):
         report_paper.build(root / "sweep", report_dir)  # again: its time-budget section now lists the dynamic part too
     if shard:
         merge.finish_record(root)  # the shard finished: merge takes it, with the cases it holds
-    print(times.summary("bench"), flush=True)
+    print("\n".join([*bench_steps.gpu_lines(times, gpu_list), times.summary("bench")]), flush=True)
     return code
 
 
@@ -295,6 +297,44 @@ def cmd_merge(args):
 
     merge.merge(args.out, args.shards)
     return 0
+
+
+def cmd_compare(args):
+    """Compare two runs' timings case by case: two run folders (every runs.csv, headline/*.json and the bench's
+    steps.json in each) or two files of one kind. Each figure's ratio B/A, and a verdict by the noise rule of
+    harness/core/timing.py: within noise when the two figures' bands overlap, else slower or faster. Prints the
+    table; --out writes compare.md, .csv, .json and .png. Exit 0, or 1 when a figure is slower beyond
+    --fail-above; 2 when nothing could be compared."""
+    from harness.check import compare_runs
+    from harness.core.paths import display
+    from harness.render import compare_report
+
+    comp = compare_runs.compare(args.a, args.b, fail_above=args.fail_above)
+    if args.out:
+        from harness.io import runfolder
+
+        out = runfolder.claim(args.out, "compare", force=args.force)
+        for path in compare_report.write(comp, out):
+            print(f"wrote {display(path)}", file=sys.stderr)
+    print(json.dumps(comp.record(), indent=1) if args.json else compare_report.markdown(comp), end="")
+    return 1 if comp.failed else 0
+
+
+def compare_parser(sub):
+    cp = command(
+        sub, cmd_compare, help="is B faster than A, and by more than the noise? (exit 1: slower beyond a ratio)"
+    )
+    cp.add_argument("a", help="the run before: a run folder (make bench's), a runs.csv or a headline JSON")
+    cp.add_argument("b", help="the run after, of the same kind as A")
+    cp.add_argument(
+        "--fail-above",
+        type=real("ratio", "a ratio", lambda v: 1.0 <= v < math.inf, "must be a finite ratio ≥ 1"),
+        default=1.05,
+        help="exit 1 when a figure slower beyond its noise has B/A above this (default 1.05)",
+    )
+    cp.add_argument("--out", default=None, help="write compare.md, compare.csv, compare.json, compare.png here")
+    cp.add_argument("--json", action="store_true", help="print the comparison as JSON instead of the table")
+    cp.add_argument("--force", action="store_true", help=FORCE_FOLDER_HELP)
 
 
 PAPER_ACCURACY = dict(
@@ -458,13 +498,23 @@ def cmd_headline(args):
 
 
 def cmd_export(args):
-    """Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions referenced in STATE) and, with --usd,
-    STATE.usdc (BasisCurves, one time sample per frame; needs usd-core). A dynamic state's times are in seconds.
+    """Write STATE.xdmf + STATE.topo.h5 (polylines over time, positions referenced in STATE); with --usd,
+    STATE.usdc (BasisCurves, one time sample per frame; needs usd-core); with --hair, STATE.hair (one frame, the
+    last or --frame K, as a groom that --groom reads). A dynamic state's times are in seconds.
     Existing sidecars are replaced only with --force; every refusal comes before anything is written."""
     from harness.io import export
 
     usd = args.usd or args.usd_only
-    for path in export.run(args.state, xdmf=not args.usd_only, usd=usd, out=args.out, force=args.force):
+    only = args.usd_only or args.hair_only
+    for path in export.run(
+        args.state,
+        xdmf=not only,
+        usd=usd,
+        out=args.out,
+        force=args.force,
+        hair=args.hair or args.hair_only,
+        frame=args.frame,
+    ):
         print(f"wrote {path}")
     return 0
 
@@ -585,7 +635,7 @@ def cmd_peer(args):
     """Run chains released from rest in hairsim-cpu and in pypbd (XPBD distance constraints, the parameters
     mapped as docs/decisions.md says), against our converged fp64 reference: error, stretch and time per frame
     at several strand counts. Writes results/peer/ and results/local/report/peer.md. Needs pypbd (optional):
-    without it, one line says so and the exit status is 2."""
+    without it, one line says it is skipped, nothing is written, and the exit status is 0."""
     from harness.render import peer_report
 
     if not args.report_only:
@@ -945,6 +995,7 @@ def parser():
     mg = command(sub, cmd_merge, help="join shard folders (bench --shard K/N) into one results folder")
     mg.add_argument("out", help="the merged folder to write (must not exist, or be empty)")
     mg.add_argument("shards", nargs="+", help="the shard folders")
+    compare_parser(sub)
 
     a = command(
         sub,
@@ -1061,6 +1112,9 @@ def parser():
     e.add_argument("state", help="an HDF5 state written by a hairsim binary")
     e.add_argument("--usd", action="store_true", help="also write the USD file")
     e.add_argument("--usd-only", action="store_true", help="write only the USD file")
+    e.add_argument("--hair", action="store_true", help="also write STATE.hair: one frame as a groom (--groom reads it)")
+    e.add_argument("--hair-only", action="store_true", help="write only the HAIR file")
+    e.add_argument("--frame", type=int, default=-1, help="the HAIR file's frame (default -1, the last; 0 the first)")
     e.add_argument("--out", help="output prefix (default: the state's path)")
     e.add_argument("--force", action="store_true", help="replace sidecars that exist (else refused, nothing written)")
 

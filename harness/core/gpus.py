@@ -5,13 +5,20 @@ scheduler set it (indices or UUIDs) and to HB_GPUS when given (indices as nvidia
 numbers them, e.g. HB_GPUS=0,1; HB_GPUS=0 keeps one GPU). `spread()` runs cases on one
 worker per GPU, each worker's child seeing only its GPU (CUDA_VISIBLE_DEVICES), a worker
 taking the next case when its last one ends; the caller runs the CPU cases before or after,
-never while GPU workers load the host."""
+never while GPU workers load the host.
 
+`working(gpu)` counts the wall time of a run sent to a named GPU as that GPU's work (the
+sweeps' GPU cases, the stability map's GPU cells; runs that overlap on one GPU add up), so a
+bench step can say how its GPU work was shared (core/progress.py StepTimes). Runs left to the
+first GPU without naming it (the validations, the other studies) are not counted."""
+
+import contextlib
 import os
 import queue
 import re
 import shutil
 import threading
+import time
 from dataclasses import dataclass
 
 from harness import HarnessError
@@ -86,6 +93,28 @@ def visible(listed=None, environ=None):
             )
         gpus = [by_index[i] for i in dict.fromkeys(indices)]
     return gpus
+
+
+_work: dict[int, float] = {}  # GPU index → seconds of runs sent to it, in this process
+_work_lock = threading.Lock()
+
+
+@contextlib.contextmanager
+def working(gpu):
+    """The block's wall time counted as work of `gpu` (a Gpu; None counts nothing)."""
+    t = time.monotonic()
+    try:
+        yield
+    finally:
+        if gpu is not None:
+            with _work_lock:
+                _work[gpu.index] = _work.get(gpu.index, 0.0) + time.monotonic() - t
+
+
+def work_seconds():
+    """Each GPU's work so far (index → seconds), a copy."""
+    with _work_lock:
+        return dict(_work)
 
 
 def spread(cases, gpus, run_case, on_done):

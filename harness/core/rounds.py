@@ -7,8 +7,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from harness.core.load import LoadProbe, worst_load
 from harness.core.runner import BATCH_MAX, batches, run_batch
-from harness.core.timing import RULE, Figure, LoadProbe, StopRule, stats, worst_load
+from harness.core.timing import RULE, Figure, StopRule, stats
 
 
 def _timed_stages(record):

@@ -9,20 +9,13 @@ case meets the rule, the case has run `timeout_s` since its first round, or it h
 `max_samples`. The binaries time each repeat from the same state, so rounds add samples of one
 distribution (each round one more process start; a GPU round a batch, one context).
 
-The load a round ran under: the CPU time other processes used meanwhile, in cores (/proc/stat's
-busy time less this process's and its children's own), the 1-minute load average when it
-started, and for a GPU round the GPU's utilisation just before it (nvidia-smi, when there).
-`noisy()` says when a figure is noise (harness/core/tolerances.py TIMING_*): its spread is above
+The load a round ran under is measured by core/load.py (others' CPU use, the load average, the
+GPU's utilisation). `noisy()` says when a figure is noise (harness/core/tolerances.py TIMING_*): its spread is above
 the rule's, or other processes took more than TIMING_OTHER_CORES of the host while it ran.
 Noise never decides a recommendation: figures that overlap within their noise are ties
 (`tie()`, `overlaps()`)."""
 
 import math
-import os
-import resource
-import shutil
-import subprocess
-import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -95,78 +88,6 @@ def stats(samples_ms):
         min_ms=float(a.min()),
         max_ms=float(a.max()),
     )
-
-
-# ---- the host's load ------------------------------------------------------------------------
-
-
-def _cpu_busy_seconds():
-    """CPU seconds the whole host has been busy (all cores), from /proc/stat; None where absent."""
-    try:
-        with open("/proc/stat") as f:
-            v = [int(x) for x in f.readline().split()[1:9]]
-    except (OSError, ValueError):
-        return None
-    return (sum(v) - v[3] - v[4]) / os.sysconf("SC_CLK_TCK")  # all but idle and iowait
-
-
-def _own_cpu_seconds():
-    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
-
-
-def gpu_busy_pct(gpu=None):
-    """The GPU's utilisation (%) as nvidia-smi reports it now (`gpu`: its index), or None."""
-    smi = shutil.which("nvidia-smi")
-    if smi is None:
-        return None
-    cmd = [smi, "--query-gpu=utilization.gpu", "--format=csv,noheader,nounits"]
-    if gpu is not None:
-        cmd += ["-i", str(gpu)]
-    try:
-        out = subprocess.run(cmd, capture_output=True, text=True, timeout=10)
-        return float(out.stdout.split()[0]) if out.returncode == 0 and out.stdout.split() else None
-    except (OSError, subprocess.TimeoutExpired, ValueError):
-        return None
-
-
-class LoadProbe:
-    """Around a piece of work: others' CPU use (cores) over its wall time, the load average when
-    it started and (`gpu`: a GPU round) the GPU's utilisation just before it."""
-
-    def __init__(self, gpu=False, gpu_index=None):
-        self.loadavg = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-        self.gpu_pct = gpu_busy_pct(gpu_index) if gpu else None
-        self.t0, self.busy0, self.own0 = time.monotonic(), _cpu_busy_seconds(), _own_cpu_seconds()
-
-    def stop(self):
-        wall = time.monotonic() - self.t0
-        busy = _cpu_busy_seconds()
-        if busy is None or self.busy0 is None or wall <= 0:
-            others = float("nan")
-        else:
-            others = max(0.0, ((busy - self.busy0) - (_own_cpu_seconds() - self.own0)) / wall)
-        return {"other_cores": others, "loadavg": self.loadavg, "gpu_busy_pct": self.gpu_pct, "wall_s": wall}
-
-
-def host_load(seconds=2.0):
-    """The host's load now, this process idle for `seconds`: others' CPU use (cores), the load
-    average, the host's cores and (where nvidia-smi answers) the GPU's utilisation."""
-    probe = LoadProbe(gpu=True)
-    time.sleep(seconds)
-    out = probe.stop()
-    out["cpu_cores"] = os.cpu_count()
-    return out
-
-
-def worst_load(loads):
-    """The worst of several rounds' loads (each a LoadProbe.stop() dict)."""
-
-    def top(key):
-        vals = [x[key] for x in loads if x.get(key) is not None and x[key] == x[key]]
-        return max(vals) if vals else None
-
-    return {"other_cores": top("other_cores"), "loadavg": top("loadavg"), "gpu_busy_pct": top("gpu_busy_pct")}
 
 
 # ---- a figure and its noise -------------------------------------------------------------------

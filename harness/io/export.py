@@ -7,6 +7,8 @@
   few kilobytes at any strand count.
 - USD (`STATE.usdc`, needs PyPI `usd-core`): one `BasisCurves` prim, linear, with one time
   sample per frame, for Blender, Houdini and usdview.
+- HAIR (`STATE.hair`): one frame's strands (the last, or `frame`) as a groom, the format of
+  Cem Yuksel's hair models that `--groom` reads (docs/model.md §3.15), in cm, float32.
 
 A dynamic state's velocities go with the frames whose step has one (XDMF attribute
 `velocity`, USD `velocities`), and its rest shape with every frame (XDMF `rest_position`,
@@ -295,14 +297,40 @@ def _pxr():
     return Sdf, Usd, UsdGeom, Vt
 
 
-def targets(state, out_prefix=None, xdmf=False, usd=False):
-    """The files an export writes: OUT.xdmf and OUT.topo.h5, OUT.usdc (OUT: out_prefix, else the state)."""
+def _frame_index(state, frame):
+    """`frame` (negative from the end) as an index of the state's frames, or refused in one line."""
+    f, _, _ = _open_state(state)
+    with f:
+        count = f[f"{POSITION}/value"].shape[0]
+    k = frame if frame >= 0 else count + frame
+    if not 0 <= k < count:
+        raise HarnessError(f"export: --frame {frame}: {state} holds frames 0 … {count - 1}")
+    return k
+
+
+def export_hair(state, out_prefix=None, frame=-1):
+    """Write OUT.hair: frame `frame` (negative from the end) of the state, a strand a polyline."""
+    from harness.io import grooms
+
+    state = Path(state)
+    (hair_path,) = targets(state, out_prefix, hair=True)
+    k = _frame_index(state, frame)
+    f, n, p = _open_state(state)
+    with f:
+        strands = np.asarray(f[f"{POSITION}/value"][k], dtype=np.float64).reshape(n, p, 3)
+    files.write_bytes(_writable(hair_path), grooms.hair_bytes(list(strands)))
+    return hair_path
+
+
+def targets(state, out_prefix=None, xdmf=False, usd=False, hair=False):
+    """The files an export writes: OUT.xdmf and OUT.topo.h5, OUT.usdc, OUT.hair (OUT: out_prefix,
+    else the state)."""
     prefix = Path(out_prefix) if out_prefix else Path(state)
-    names = ([".xdmf", ".topo.h5"] if xdmf else []) + ([".usdc"] if usd else [])
+    names = ([".xdmf", ".topo.h5"] if xdmf else []) + ([".usdc"] if usd else []) + ([".hair"] if hair else [])
     return [prefix.with_name(prefix.name + suffix) for suffix in names]
 
 
-def run(state, xdmf=True, usd=False, out=None, force=False):
+def run(state, xdmf=True, usd=False, out=None, force=False, hair=False, frame=-1):
     """Write the sidecars; return their paths. Everything that can refuse does so before
     anything is written: no such state, USD asked for without usd-core, a target that is a
     symbolic link or not a regular file, or one that exists without `force`."""
@@ -311,7 +339,9 @@ def run(state, xdmf=True, usd=False, out=None, force=False):
     inputs.regular(state, "export:")
     if usd:
         _pxr()
-    paths = targets(state, out, xdmf, usd)
+    if hair:
+        _frame_index(state, frame)
+    paths = targets(state, out, xdmf, usd, hair)
     for path in paths:
         _writable(path)
     if not force:
@@ -323,4 +353,6 @@ def run(state, xdmf=True, usd=False, out=None, force=False):
         written += export_xdmf(state, out)
     if usd:
         written.append(export_usd(state, out))
+    if hair:
+        written.append(export_hair(state, out, frame))
     return written

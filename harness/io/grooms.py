@@ -2,7 +2,9 @@
 binaries read (`python -m harness groom convert IN.usda OUT.hair`).
 
 The binaries are C and cannot link usd-core (Python); so a USD groom passes through here: every
-BasisCurves prim of the stage's default time, its points taken to world space, scaled by the
+BasisCurves prim at the stage's earliest time (its default value, else the first time sample:
+the first frame of an animation, such as `harness export --usd` writes), its points taken to
+world space, scaled by the
 stage's metersPerUnit to cm, turned Y-up when the stage is Z-up, and written as a HAIR file
 (segments and points arrays). usd-core is optional: without it a USD groom is refused in one line.
 """
@@ -59,19 +61,19 @@ def _curves(Usd, UsdGeom, path):  # noqa: N803 (pxr's module names)
         raise HarnessError(f"groom {path}: metersPerUnit is {meters}; it must be a finite number > 0")
     to_cm = meters / 0.01
     z_up = UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.z
-    cache = UsdGeom.XformCache()
     strands = []
     for prim in stage.Traverse():
         if not prim.IsA(UsdGeom.BasisCurves):
             continue
         curves = UsdGeom.BasisCurves(prim)
-        pts = np.asarray(curves.GetPointsAttr().Get() or [], dtype=np.float64).reshape(-1, 3)
-        counts = list(curves.GetCurveVertexCountsAttr().Get() or [])
+        at = Usd.TimeCode.EarliestTime()  # the default value, else the first time sample (an animation)
+        pts = np.asarray(curves.GetPointsAttr().Get(at) or [], dtype=np.float64).reshape(-1, 3)
+        counts = list(curves.GetCurveVertexCountsAttr().Get(at) or [])
         if sum(counts) != len(pts):
             raise HarnessError(
                 f"groom {path}: {prim.GetPath()} has {len(pts)} points but its counts sum to {sum(counts)}"
             )
-        m = np.asarray(cache.GetLocalToWorldTransform(prim), dtype=np.float64)  # row vectors: p·M
+        m = np.asarray(UsdGeom.XformCache(at).GetLocalToWorldTransform(prim), dtype=np.float64)  # p·M
         world = np.hstack([pts, np.ones((len(pts), 1))]) @ m
         world = world[:, :3] * to_cm
         if z_up:
@@ -95,6 +97,26 @@ def hair_strand_count(path):
     if len(head) < 8 or head[:4] != b"HAIR":
         return None
     return struct.unpack("<I", head[4:8])[0]
+
+
+def read_hair(path):
+    """The strands of a HAIR file (docs/model.md §3.15's layout) as float64 [n][3] arrays in the
+    file's units: its segments (or the header's count) and points arrays; the rest is skipped.
+    A file that is not one, or is shorter than its header says, is refused in one line."""
+    data = inputs.read_bytes(path, "groom")
+    if len(data) < 128 or data[:4] != b"HAIR":
+        raise HarnessError(f"groom {path}: not a HAIR file (no 'HAIR' header)")
+    strands, points, arrays, default_segments = struct.unpack("<IIII", data[4:20])
+    at = 128
+    if arrays & HAIR_SEGMENTS:
+        counts = np.frombuffer(data, "<u2", strands, at).astype(np.int64) + 1 if len(data) >= at + 2 * strands else None
+        at += 2 * strands
+    else:
+        counts = np.full(strands, default_segments + 1, dtype=np.int64)
+    if counts is None or not arrays & HAIR_POINTS or len(data) < at + 12 * points or int(counts.sum()) != points:
+        raise HarnessError(f"groom {path}: shorter than its header says, or its counts disagree with its points")
+    xyz = np.frombuffer(data, "<f4", 3 * points, at).reshape(points, 3).astype(np.float64)
+    return np.split(xyz, np.cumsum(counts)[:-1])
 
 
 def hair_bytes(strands):

@@ -9,13 +9,13 @@ the head centre, y up; translations in cm (read and stored, not yet modelled: th
 refuse a non-zero one)."""
 
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from harness import HarnessError
+from harness.io import files
 
 HEADER = "time,qw,qx,qy,qz,tx,ty,tz"
 AXIS_HEADER = "time,axis_x,axis_y,axis_z,angle,tx,ty,tz"
@@ -49,13 +49,7 @@ def write_csv(path, track, comment="", force=False):
         raise HarnessError(f"motion track {path} exists (give --force to replace it)")
     lines = [f"# {c}" for c in comment.splitlines()] + [HEADER]
     lines += [",".join(repr(float(v)) for v in (t[i], *q[i], *tr[i])) for i in range(len(t))]
-    tmp = path.with_name(f"{path.name}.tmp.{os.getpid()}")
-    try:
-        tmp.write_text("\n".join(lines) + "\n")
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return path
+    return files.write_text(path, "\n".join(lines) + "\n")
 
 
 def read_csv(path):

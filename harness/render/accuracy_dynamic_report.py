@@ -570,7 +570,7 @@ def _plt():
 
 
 def _save(fig, path):
-    return files.save_figure(fig, path, dpi=110)
+    return files.save_figure(fig, path, dpi=110, bbox_inches="tight")
 
 
 def pareto_plot(summ, study, path):
@@ -625,11 +625,14 @@ def pareto_plot(summ, study, path):
         + (f"; {blown} blown up, not shown)" if blown else ")")
     )
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)  # beside the data, not on it
     fig.tight_layout()
     out = _save(fig, path)
     plt.close(fig)
     return out
+
+
+GROWTH_COLUMNS = 2  # panels a row: readable at a page's width
 
 
 def growth_plot(rows, summ, study, path):
@@ -640,7 +643,12 @@ def growth_plot(rows, summ, study, path):
     base = o[o["solver"] == NO_SIMULATION]
     o = o[(o["iterations"] == 1) & (o["solver"] != NO_SIMULATION)]
     solvers = list(dict.fromkeys(o["scheme"])) or ["none"]
-    fig, axes = plt.subplots(1, len(solvers), figsize=(5.2 * len(solvers), 4.2), sharey=True, squeeze=False)
+    ncols = min(GROWTH_COLUMNS, len(solvers))
+    nrows = -(-len(solvers) // ncols)
+    fig, grid = plt.subplots(nrows, ncols, figsize=(5.2 * ncols, 3.8 * nrows), sharey=True, squeeze=False)
+    axes = [list(grid.flat)]
+    for spare in axes[0][len(solvers) :]:
+        spare.set_visible(False)
     ref = rows[rows["study"] == "reference"]
     finest = ref[ref["substeps"] == ref["substeps"].max()] if len(ref) else ref
     m = rows[rows["study"] == "mode"]
@@ -662,10 +670,11 @@ def growth_plot(rows, summ, study, path):
         ax.set_xlabel("simulated time (s)")
         ax.set_title(f"{solver}, fp64, I = 1 ({study['builds'][0] if study.get('builds') else ''})", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
-    axes[0][0].set_ylabel("RMS position error / L against the reference")
-    handles, names = axes[0][-1].get_legend_handles_labels()
-    fig.legend(handles, names, loc="lower center", ncol=min(len(names), 8), fontsize=7, frameon=False)
-    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    for row in grid:
+        row[0].set_ylabel("RMS error / L vs the reference")
+    handles, names = axes[0][len(solvers) - 1].get_legend_handles_labels()
+    fig.legend(handles, names, loc="lower center", ncol=min(len(names), 5), fontsize=7, frameon=False)
+    fig.tight_layout(rect=(0, 0.1 / nrows, 1, 1))
     out = _save(fig, path)
     plt.close(fig)
     return out
@@ -722,8 +731,9 @@ def _header(study, env):
         f"I = {ref['iterations']}, S = {ref['substeps']}.",
         "",
         f"Machine: {env.get('cpu_model')} ({env.get('cpu_cores')} cores), GPU: {dev}; revision "
-        f"{env.get('git_revision')}; {env.get('date')}. Command: `{command}` "
-        f"(the whole study took {study.get('wall_s', float('nan')):.0f} s).",
+        f"{env.get('git_revision')}; {env.get('date')}. Measured by `{command}` "
+        f"(the whole study took {study.get('wall_s', float('nan')):.0f} s); this page is rendered from the "
+        "results that command wrote.",
         "",
     ]
 

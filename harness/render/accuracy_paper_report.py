@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
+from harness.core import timing
 from harness.core.paths import REPORT, display
 from harness.io import files
 from harness.studies.accuracy import PAPER_REFERENCE, paper_uses
@@ -107,7 +108,7 @@ def pareto_plot(rows, path, strands, points):
                 fontsize=7,
                 color="0.3",
             )
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)  # beside the data
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(f"time of the scene's stages, median (ms), {strands:,} strands x {points} points")
@@ -115,29 +116,45 @@ def pareto_plot(rows, path, strands, points):
     ax.set_title("Speed against accuracy (reference: cpu fp64)")
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    files.save_figure(fig, path, dpi=110)
+    files.save_figure(fig, path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return path
 
 
+def _pick(modes):
+    """The mode to recommend among `modes` (rows that meet a use's bound): the fastest, unless
+    others tie with it within timing noise (core/timing.py `tie`: these tables keep no spread,
+    so within its floor): then the most accurate of the tie. (mode, the others it tied with)."""
+    modes = sorted(modes, key=lambda r: r["time_ms"])
+    tied = [modes[i] for i in timing.tie([(r["time_ms"], float("nan")) for r in modes])]
+    best = min(tied, key=lambda r: r["max_err_L"])
+    return best, [r["mode"] for r in tied if r is not best]
+
+
+def _tie_note(others):
+    return f"; a tie within timing noise with {', '.join(others)}" if others else ""
+
+
 def recommend(rows):
-    """Which mode for which use, from the measured end-to-end errors and times."""
+    """Which mode for which use, from the measured end-to-end errors and times; modes whose times
+    tie within noise are a tie, decided by their errors (noise never decides)."""
     e2e = [r for r in _end_to_end(rows) if r["mode"] != PAPER_REFERENCE and np.isfinite(r["max_err_L"])]
     if not e2e:
         return ["No mode other than the reference ran."]
     lines = []
     fastest = min(e2e, key=lambda r: r["time_ms"])
+    tied = [e2e[i]["mode"] for i in timing.tie([(r["time_ms"], float("nan")) for r in e2e])]
     lines.append(
         f"- Fastest overall: **{fastest['mode']}** ({fastest['time_ms']:.2f} ms, end-to-end error "
-        f"{fastest['max_err_L']:.1e}·L)."
+        f"{fastest['max_err_L']:.1e}·L{_tie_note([m for m in tied if m != fastest['mode']])})."
     )
     for limit, use in ((1e-5, "production runs and benchmarks"), (1e-12, "references and validation")):
         ok = [r for r in e2e if r["max_err_L"] <= limit]
         if ok:
-            best = min(ok, key=lambda r: r["time_ms"])
+            best, others = _pick(ok)
             lines.append(
                 f"- For {use} (error ≤ {limit:.0e}·L): **{best['mode']}** ({best['time_ms']:.2f} ms, "
-                f"{best['max_err_L']:.1e}·L)."
+                f"{best['max_err_L']:.1e}·L{_tie_note(others)})."
             )
         else:
             lines.append(f"- For {use} (error ≤ {limit:.0e}·L): no mode measured here meets it.")

@@ -203,7 +203,7 @@ def hair_figures(state_path, out_dir):
             ("fig1_initialized.png", after_init, "Fig. 1: hair initialized"),
             ("fig2_after_wind.png", after_wind, "Fig. 2: hair after wind"),
         ):
-            fig, ax = plt.subplots(figsize=(5.5, 6))
+            fig, ax = plt.subplots(figsize=(5.5, 6.2))
             if frame is None:
                 _note(ax, "this state has no wind stage")
             else:
@@ -214,7 +214,8 @@ def hair_figures(state_path, out_dir):
                 ax.annotate("face →", (R * 0.55, -R * 0.1), fontsize=8, color="0.3")
                 ax.set_title(
                     f"{title} (frame {frame}: after {' + '.join(stages[: frame + 1])})\n"
-                    f"{len(pick)} of {s.n_strands} strands, side view",
+                    f"{len(pick)} of {s.n_strands} strands, side view: projected along x, so a strand\n"
+                    "drawn inside the head's outline lies beside the head, at another x",
                     fontsize=9,
                 )
             ax.set_aspect("equal")
@@ -227,8 +228,8 @@ def hair_figures(state_path, out_dir):
 
 def make_all(results_dir, report_dir=None):
     """Every plot of a results directory; returns the paths written."""
+    rows, env = results_data.load(results_dir)  # refused before a folder is made
     out_dir = output_dir(report_dir if report_dir else REPORT, "--report-dir")
-    rows, env = results_data.load(results_dir)
     cases = results_data.per_case(rows)
     gpu_note = results_data.gpu_absent_reason(env)
     written = []

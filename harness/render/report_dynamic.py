@@ -30,6 +30,7 @@ from harness.render import (  # noqa: E402
     peer_report,
     reduced_report,
     stability_report,
+    steps_report,
 )
 from harness.render.headline_report import rounds_note  # noqa: E402
 from harness.studies.accuracy import curves_name, results_name  # noqa: E402
@@ -135,6 +136,18 @@ def curly_throughput_lines(sweep_dir):
 
 def _num(x):
     return f"{x:.3g}" if isinstance(x, (int, float)) and x == x else ""
+
+
+def validation_summary(results_dir):
+    """One line for the page's top: how many comparisons were equivalent (the table is at the end)."""
+    path = Path(results_dir) / "validation.json"
+    if not path.exists():
+        return []
+    checks = json.loads(path.read_text()).get("checks", [])
+    bad = sum(1 for c in checks if not c.get("equivalent"))
+    verdict = f"**{bad} NOT equivalent**" if bad else "all equivalent"
+    return [f"Every backend was validated against the C reference before any timing: {len(checks)} comparisons, "
+            f"{verdict} (the table: \"Validation\", at the end).", ""]  # fmt: skip
 
 
 def validation_lines(results_dir, what="the default scene"):
@@ -273,9 +286,8 @@ def build(root, report_dir=None):
         "",
     ]
     lines += host_report.section(root)
+    lines += validation_summary(sweep_dir)
     lines += budget_report.section(root)
-    lines += ["## Validation", ""]
-    lines += validation_lines(sweep_dir) + [""]
     lines += ["## Headline targets", ""] + headline_lines(root / "headline" / "headline_dynamic.json") + [""]
     lines += ["## Throughput over strand counts", ""]
     if (sweep_dir / "runs.csv").exists():
@@ -332,5 +344,8 @@ def build(root, report_dir=None):
         lines += [f"![the default dynamic scene, side and front]({os.path.relpath(gif, out_dir)})", ""]
     else:
         lines += ["No animation here: `python -m harness animate`.", ""]
+    # how the results were checked and made, after the results themselves
+    lines += ["## Validation", ""] + validation_lines(sweep_dir) + [""]
+    lines += steps_report.section(root)
     path = out_dir / "dynamic.md"
     return files.write_text(path, "\n".join(lines) + "\n")

@@ -199,8 +199,9 @@ def paper_section(cases):
             )
     lines.append("")
     notes = [
-        f"Ours: fp32, {points} points per strand, `{paper_variant or 'no'}` GPU variant; "
-        "the CPU is our optimised C reference (-O2), so the paper's debug-mode times map to "
+        f"Ours: fp32, {points} points per strand, "
+        + (f"the `{paper_variant}` GPU variant; " if paper_variant else "no GPU rows; ")
+        + "the CPU is our optimised C reference (-O2), so the paper's debug-mode times map to "
         "larger N than its release-mode ones only because its debug CPU was slow."
     ]
     if g32:
@@ -277,8 +278,8 @@ def headline_section(path):
 
 
 def build(results_dir="results/default", report_dir=None):
+    rows, env = results_data.load(results_dir)  # a run without results is refused before a folder is made
     out_dir = output_dir(report_dir if report_dir else REPORT, "--report-dir")
-    rows, env = results_data.load(results_dir)
     cases = results_data.per_case(rows)
     pictures = make_all(results_dir, out_dir)
     lines = [
@@ -297,7 +298,6 @@ def build(results_dir="results/default", report_dir=None):
     lines += headline_section(Path(results_dir).parent / "headline" / "headline.json")
     lines += gpu_section(cases, env)
     lines += scenes_section(env, cases)
-    lines += validation_section(results_dir)
     lines += hair_report.paper_lines(Path(results_dir) / results_data.FIGURE_STATE, out_dir)
     lines += paper_section(cases) if not cases.empty else []
     lines += ["## Plots", ""]
@@ -339,6 +339,7 @@ def build(results_dir="results/default", report_dir=None):
         "accuracy, stability, the peer, the animation) is reported in [dynamic.md](dynamic.md).",
         "",
     ]
+    lines += validation_section(results_dir)  # how the results were checked, after them
     lines += environment_section(env)
     path = out_dir / "report.md"
     return files.write_text(path, "\n".join(lines) + "\n")

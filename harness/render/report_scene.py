@@ -9,6 +9,7 @@ from pathlib import Path
 
 from harness.core import scenes
 from harness.core.paths import display
+from harness.io import files
 from harness.render import (
     accuracy_dynamic_report,
     budget_report,
@@ -72,5 +73,4 @@ def build(root, scene_ref, report_dir):
     else:
         lines += ["## Stability", "", f"Not measured (no `{display(root / 'stability' / 'stability.csv')}`).", ""]
     path = out_dir / PAGE
-    path.write_text("\n".join(lines).rstrip("\n") + "\n")
-    return path
+    return files.write_text(path, "\n".join(lines).rstrip("\n") + "\n")

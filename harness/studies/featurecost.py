@@ -16,7 +16,7 @@ compiles it out), never by setting it to zero:
 import shutil
 
 from harness import HarnessError
-from harness.core import runner, scenes, timing, variants
+from harness.core import load, runner, scenes, timing, variants
 from harness.core.paths import binary_path
 from harness.core.progress import Progress
 from harness.core.scenes_dynamic import DECLARING, FEATURES, NEEDS
@@ -144,11 +144,13 @@ def measure(
 def _row(binary, name, flags, timeout, instructions, progress):
     """One row of the study: the binary's record of one feature set, its frame times' spread and
     the load they ran under (its own --repeat; core/timing.py flags a noisy row)."""
-    probe = timing.LoadProbe(gpu=rec_backend(binary) == "cuda")
+    probe = load.LoadProbe(gpu=rec_backend(binary) == "cuda")
     rec = runner.run_binary(binary, flags, timeout=timeout)
-    load = probe.stop()
+    ran_under = probe.stop()
     st = declared(rec)
-    fig = timing.Figure(st.get("times_ms") or [], stop="fixed repeats", rounds=1, load=load, backend=rec["backend"])
+    fig = timing.Figure(
+        st.get("times_ms") or [], stop="fixed repeats", rounds=1, load=ran_under, backend=rec["backend"]
+    )
     ips = instructions_per_point_substep(binary, flags, rec, st, timeout) if instructions else None
     row = {
         "row": name,

@@ -368,8 +368,8 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
             f"judge: planted build(s) {', '.join(map(str, missing))} missing under {display(build_dir() / 'planted')} "
             "(run make planted)"
         )
+    honest, gpu_note = honest_runners(plan.gpu, log)  # --gpu yes without a GPU: refused before a folder is made
     out_dir = runfolder.claim(out_dir or RESULTS / RESULTS_NAME, "judge", force=True)
-    honest, gpu_note = honest_runners(plan.gpu, log)
     if gpu_note:
         log(f"judge: GPU builds not run: {gpu_note}")
     oracle = variants.declared("cpu").default_variant

@@ -9,7 +9,6 @@ alone. The run must store the velocities of its first written simulated frame (`
 all`: a resumed run needs them); the twins are written at the run's steps.
 """
 
-import shutil
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,6 +16,7 @@ import numpy as np
 from harness import HarnessError
 from harness.check import predictability as pr
 from harness.core import runner, tolerances
+from harness.io import files
 from harness.io.trajectory import open_trajectory
 
 
@@ -48,8 +48,7 @@ def run_twins(build, base, scratch, n=None, threads=None, timeout=3600, reduce=N
     twins, seps = [], []
     for j in range(n):
         src, out = scratch / f"{base.stem}_twin{j}_in.h5", scratch / f"{base.stem}_twin{j}.h5"
-        shutil.copyfile(base, src)
-        _perturb(src, k, shape, d0, L, seed=j)
+        _perturbed_copy(base, src, k, shape, d0, L, seed=j)
         flags = ["--input", src, "--input-frame", k, "--stages", "simulate", "--frames", last - first]
         flags += ["--output-every", every, "--output", out, "--force"]
         if build.variant:
@@ -69,14 +68,17 @@ def run_twins(build, base, scratch, n=None, threads=None, timeout=3600, reduce=N
     return Twins(pr.rate(times[1:], np.array(seps), d0), times, twins)
 
 
-def _perturb(path, frame, shape, d0, L, seed):
-    """Add predictability.perturbation to the positions of file frame `frame`, in place."""
+def _perturbed_copy(base, path, frame, shape, d0, L, seed):
+    """`base` copied to `path` with predictability.perturbation added to the positions of file
+    frame `frame` (harness/io/files.py: whole or not at all)."""
     import h5py
 
-    with h5py.File(path, "r+") as f:
-        ds = f["particles/hair/position/value"]
-        x = ds[frame].astype(np.float64).reshape(shape)
-        ds[frame] = (x + pr.perturbation(shape, d0, L, seed)).reshape(-1, 3).astype(ds.dtype)
+    with files.writing(path) as tmp:
+        files.copy(base, tmp)
+        with h5py.File(tmp, "r+") as f:
+            ds = f["particles/hair/position/value"]
+            x = ds[frame].astype(np.float64).reshape(shape)
+            ds[frame] = (x + pr.perturbation(shape, d0, L, seed)).reshape(-1, 3).astype(ds.dtype)
 
 
 def rate_columns(rate):

@@ -321,27 +321,35 @@ def measure(
 
     if len(spread) > 1:
         log(f"stability: GPU cells spread over {len(spread)} GPUs")
+
+    def counted(cells, strands, frames, timeout, gpu):
+        """run_cells, its time counted as work of the GPU it ran on (the first where not spread)."""
+        on = gpu or (spread[0] if spread and cells[0][-1].backend == "cuda" else None)
+        with gpus.working(on):
+            return run_cells(cells, strands, frames, timeout, gpu)
+
     t0 = time.perf_counter()
-    bar = Progress(len(todo), "stability")
+    weight = [cell_weight(job, strands, frames) for job in todo]
+    bar = Progress(len(todo), "stability", work=sum(weight))  # the estimate by the cells' weights
     # the heaviest cells (most substep iterations a frame, GPU before CPU) start first, so that
     # none is left running alone at the end; the rows keep the order of `todo`. A GPU cell runs
     # with others of its binary and GPU in one process (a context made once a batch).
-    order = sorted(range(len(todo)), key=lambda i: -cell_weight(todo[i], strands, frames))
+    order = sorted(range(len(todo)), key=lambda i: -weight[i])
     units = [[i] for i in order if todo[i][-1].backend != "cuda"]
     gpu_cells = [i for i in order if todo[i][-1].backend == "cuda"]
     units += runner.batches(gpu_cells, lambda i: (todo[i][-1], gpu_for(i, todo[i])), GPU_CELLS_A_BATCH)
-    units.sort(key=lambda u: -cell_weight(todo[u[0]], strands, frames))
+    units.sort(key=lambda u: -weight[u[0]])
     rows = [None] * len(todo)
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         futures = {}
         for u in units:
-            f = pool.submit(run_cells, [todo[i] for i in u], strands, frames, timeout, gpu_for(u[0], todo[u[0]]))
+            f = pool.submit(counted, [todo[i] for i in u], strands, frames, timeout, gpu_for(u[0], todo[u[0]]))
             futures[f] = u
         for f in as_completed(futures):
             u = futures[f]
             for i, row in zip(u, f.result()):
                 rows[i] = row
-            bar.update(len(u))
+            bar.update(len(u), work=sum(weight[i] for i in u))
     bar.close()
     return rows, bes, time.perf_counter() - t0
 

@@ -192,6 +192,8 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
     cases; `gate` (a core.budget.TierGate): the cases run smallest size first and a tier that does
     not fit is left out with every larger one."""
     sweep = sweep_ref if isinstance(sweep_ref, Sweep) else load_sweep(sweep_ref)
+    cases = shard.share(sweep.cases()) if shard is not None else sweep.cases()
+    reasons = backend_reasons(cases, gpu)  # a refusal (--gpu yes without a GPU) before anything is written
     out_dir = runfolder.claim(out if out else RESULTS / sweep.name, f"sweep {sweep.name}", force=force)
     csv_path = out_dir / "runs.csv"
     env_path = out_dir / "env.json"
@@ -206,7 +208,6 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
     done, dropped = runlog.resume(csv_path)
     if done and record.get("sessions"):
         check_same_machine(record["sessions"][-1].get("host") or {}, env.collect(), out_dir)
-    cases = sweep.cases()
     if done and record.get("shard") != (str(shard) if shard else None):
         was = f"shard {record['shard']}" if record.get("shard") else "the whole sweep"
         raise HarnessError(
@@ -215,9 +216,7 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
             + ": give another --out"
         )
     if shard is not None:
-        cases = shard.share(cases)
         record["shard"] = str(shard)
-    reasons = backend_reasons(cases, gpu)
     skipped = []
     for why in sorted(set(reasons.values())):
         keys = [k for k, r in reasons.items() if r == why]
@@ -268,7 +267,7 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
     rule = sweep.rule.within(gate.allowance, len(todo)) if gate is not None else sweep.rule
     session["timing"] = rule.as_dict()
     groups = budget.tiers(todo, case_size) if gate is not None else [(None, todo)]
-    progress = Progress(len(todo), f"sweep {sweep.name}")
+    progress = Progress(len(todo), f"sweep {sweep.name}", work=sum(case_size(c) for c in todo))
     failed = 0
     try:
         for size, tier in groups:
@@ -277,7 +276,7 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
                 if not fits:
                     session["skipped"].append({"cases": len(tier), "size": size, "reason": why, "budget": True})
                     progress.write(f"harness: sweep {sweep.name}: {len(tier)} case(s) of size {size} {why}")
-                    progress.update(len(tier))
+                    progress.update(len(tier), work=sum(case_size(c) for c in tier), skip=True)
                     continue
             t0 = time.monotonic()
             sampled = []  # each case's timed samples, seconds (the gate scales these with the size)
@@ -299,7 +298,8 @@ def run_sweep(sweep_ref, out=None, gpu="auto", log=None, announce_skips=True, sh
 
 
 def case_size(case):
-    """A case's rung on the budget's size ladder: strands × points."""
+    """A case's rung on the budget's size ladder, and its weight in the progress estimate:
+    strands × points (one sweep's cases share the scene's substeps and iterations)."""
     return case.strands * case.points
 
 
@@ -326,16 +326,17 @@ def _run_cases(
                 ready.append(case)
             except SceneError as e:
                 out.append((case, rounds.Timed(error=e)))
-        timed = rounds.measure(
-            ready,
-            lambda c, n: case_flags(sweep, c, n),
-            lambda c: binary_path(*key(c)),
-            rule=rule,
-            timeout=sweep.timeout_s,
-            env=env_add,
-            gpu_index=gpu.index if gpu is not None else None,
-            batch=batch,
-        )
+        with gpus.working(gpu):  # this GPU's work, for the bench's steps.json
+            timed = rounds.measure(
+                ready,
+                lambda c, n: case_flags(sweep, c, n),
+                lambda c: binary_path(*key(c)),
+                rule=rule,
+                timeout=sweep.timeout_s,
+                env=env_add,
+                gpu_index=gpu.index if gpu is not None else None,
+                batch=batch,
+            )
         return out + list(zip(ready, timed))
 
     def done(case, gpu, t):
@@ -362,7 +363,7 @@ def _run_cases(
                 binary.name,
                 {k: rec.get(k) for k in ("version", "git_revision", "compiler", "flags", "device", "driver")},
             )
-        progress.update()
+        progress.update(work=case_size(case))
         session["last_case_at"] = env.now()  # finished_at only when the whole session ends
         write_json(env_path, record)
 

@@ -74,6 +74,12 @@ def test_bench_end_to_end_on_cpu(tmp_path):
     assert all(int(r["n_times"]) >= 9 and r["copy_gbps"] for r in rows)
     env = json.loads((results / "env.json").read_text())
     assert env["sessions"][0]["skipped"][0]["reason"] == "HAIRBENCH_NO_GPU is set"
+    # where the time went: steps.json holds the steps the log's last line names, no GPU work
+    steps = json.loads((tmp_path / "run" / "steps.json").read_text())
+    last = p.stdout.strip().splitlines()[-1]
+    assert [s["name"] for s in steps["steps"]] == ["validation", "sweep quick and its report"]
+    assert all(f"{s['name']} {s['seconds']:.0f} s" in last for s in steps["steps"]) and steps["gpus"] == []
+    assert not any("gpu_work_s" in s for s in steps["steps"])
     md = (tmp_path / "run" / "report" / "report.md").read_text()  # the report inside the run's folder
     assert "GPU rows are absent**: HAIRBENCH_NO_GPU is set" in md
     n = len(validation["checks"])

@@ -4,6 +4,7 @@ run on one worker per GPU, each child seeing only its GPU (CUDA_VISIBLE_DEVICES)
 row names the GPU that measured it; HB_GPUS keeps one GPU."""
 
 import csv
+import json
 import os
 import subprocess
 import sys
@@ -106,3 +107,63 @@ def test_hb_gpus_keeps_one_gpu_and_the_sweep_order(node):
     for e in log:
         in_flight += 1 if e[0] == "start" else -1
         assert in_flight <= 1  # one case at a time, as on any one-GPU machine
+
+
+STEPS = """
+import sys
+from harness.bench import steps
+from harness.core import gpus
+from harness.core.progress import StepTimes
+from harness.studies import sweep
+
+out, path = sys.argv[1], sys.argv[2]
+node = gpus.visible()
+times = StepTimes(on_step=lambda t: steps.write(out, t, node))
+times.step("sweep", sweep.run_sweep, path, out=out + "/sweep", gpu="yes", log=lambda m: None)
+times.step("no GPU", lambda: None)
+print("\\n".join(steps.gpu_lines(times, node)))
+"""
+
+
+def bench_steps(node, name, **extra):
+    """The bench's step record (bench/steps.py) around the two-GPU sweep: steps.json and the log's lines."""
+    tmp_path, path, env = node
+    out = tmp_path / name
+    p = subprocess.run(
+        [sys.executable, "-c", STEPS, str(out), str(path)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=dict(env, PYTHONPATH=str(ROOT), **extra),
+    )
+    assert p.returncode == 0, p.stdout + p.stderr
+    return json.loads((out / "steps.json").read_text()), p.stdout
+
+
+def test_each_step_records_the_work_each_gpu_got(node):
+    """Twelve GPU cases of FAKE_SLEEP = 0.2 s each: both GPUs get work, at least the sleeps' 2.4 s
+    between them; a step that sent nothing to a GPU records none; the log says it per GPU."""
+    record, log = bench_steps(node, "two")
+    assert [g["index"] for g in record["gpus"]] == [0, 1]
+    sweep_step, idle = record["steps"]
+    assert sweep_step["name"] == "sweep" and set(sweep_step["gpu_work_s"]) == {"0", "1"}
+    work = list(sweep_step["gpu_work_s"].values())
+    assert min(work) > 0 and sum(work) >= 12 * 0.2
+    assert sweep_step["balance"] == pytest.approx(min(work) / max(work))
+    assert sweep_step["gpu_work_per_s"] == pytest.approx(sum(work) / sweep_step["seconds"])
+    assert "gpu_work_s" not in idle and record["total_s"] >= sweep_step["seconds"]
+    assert log.startswith("harness: GPU work of sweep (") and "GPU 0 " in log and "GPU 1 " in log
+
+
+def test_one_gpu_records_all_the_work_on_it_and_compare_sets_two_runs_side_by_side(node, capsys):
+    one, log = bench_steps(node, "one", HB_GPUS="0")
+    two, _ = bench_steps(node, "two")
+    assert [g["index"] for g in one["gpus"]] == [0] and log == "\n"  # no per-GPU lines with one GPU
+    assert set(one["steps"][0]["gpu_work_s"]) == {"0"} and one["steps"][0]["balance"] == 1.0
+    from harness.check import compare_runs
+
+    tmp_path = node[0]
+    comp = compare_runs.compare(tmp_path / "one" / "steps.json", tmp_path / "two" / "steps.json")
+    assert set(comp.table.key) == {"step sweep", "step no GPU"}  # each step's B/A: the scaling, step by step
+    assert set(comp.table.noise_from_a) == {""}  # a step is timed once: no spread of its own

@@ -105,3 +105,23 @@ def test_step_times_say_each_step_in_order_and_the_total():
     assert [s for _, s in times.steps] == pytest.approx([72.4, 337.0])
     assert times.summary("bench") == "harness: bench took 414 s (validation 72 s, sweep default 337 s)"
     assert StepTimes(clock=clock).summary("bench") == "harness: bench took 0 s"
+
+
+def test_the_estimate_is_by_the_cases_sizes_where_given():
+    """Nine small cases (1 unit, 1 s each) then one of 90 units (90 s): by count the line after
+    the ninth promises 11 s more; by size it promises the 90 s it takes. A case left out of the
+    run leaves the total."""
+    out, clock = io.StringIO(), Clock()
+    p = Progress(11, "sweep", stream=out, clock=clock, every=1.0, timer=False, work=9 + 90 + 50)
+    p.update(1, work=50, skip=True)  # left out by a budget: never run
+    for _ in range(9):
+        clock.t += 1.0
+        p.update(work=1)
+    assert out.getvalue().splitlines()[-1] == "sweep: 10/11 done, 9 s elapsed, about 90 s left"
+    clock.t += 90.0
+    p.update(work=90)
+    assert out.getvalue().splitlines()[-1] == "sweep: 11/11 done, 99 s elapsed, about 0 s left"
+    by_count = Progress(10, "sweep", stream=io.StringIO(), clock=Clock(), every=1.0, timer=False)
+    by_count.clock.t += 9.0
+    by_count.update(9)
+    assert by_count.stream.getvalue().splitlines()[-1].endswith("about 1 s left")

@@ -67,3 +67,22 @@ def test_missing_packages_without_network_stop_in_one_line(tmp_path):
     errors = [ln for ln in p.stderr.splitlines() if ln.startswith("error: ")]
     assert len(errors) == 1 and "pip install -r requirements.lock" in errors[0], p.stderr
     assert "installing requirements.lock" in p.stderr  # it did try: the packages were missing
+
+
+def test_a_system_interpreter_is_never_installed_into(tmp_path):
+    """An interpreter outside any virtual environment that lacks the packages (here the real
+    one with its site-packages hidden, -S) gets the project environment .venv instead: pip is
+    pointed at .venv, never at that interpreter (here it fails for want of a network)."""
+    base = Path(getattr(sys, "_base_executable", sys.executable))
+    system = tmp_path / "system-python"
+    system.write_text(f'#!/bin/sh\nexec "{base}" -S "$@"\n')
+    system.chmod(0o755)
+    probe = subprocess.run([str(system), "-c", "import sys; print(sys.prefix != sys.base_prefix)"], capture_output=True)
+    if probe.stdout.strip() != b"False":
+        pytest.skip("no interpreter outside a virtual environment here")
+    root = copy_of_repo(tmp_path)
+    p = setup(root, system)
+    assert p.returncode != 0
+    assert "installing requirements.lock into the project environment .venv" in p.stderr, p.stderr
+    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("error: ")]
+    assert len(errors) == 1 and ".venv" in errors[0] and "-S" not in errors[0], p.stderr

@@ -1,17 +1,17 @@
 """Images out: PNG frames (Pillow) and animations, a GIF always and an MP4 beside it where
-ffmpeg is on PATH. Each file is written under a temporary name in its directory and renamed,
+ffmpeg is on PATH (harness/core/encode.py). Each file is written through harness/io/files.py,
 so an error leaves nothing behind; `refuse_existing` is called before any drawing, so a run
 that would replace a file without --force writes nothing at all."""
 
-import os
 import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
 
 from harness import HarnessError
+from harness.core import encode
 from harness.core.paths import display
+from harness.io import files
 
 MAX_GIF_FPS = 50  # GIF delays are whole hundredths of a second
 
@@ -32,15 +32,11 @@ def refuse_existing(paths, force):
 
 
 def _atomic(path, write):
+    """write(tmp) fills a temporary beside `path` (harness/io/files.py), moved over it after."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.tmp.{os.getpid()}{path.suffix}")
-    try:
+    with files.writing(path) as tmp:
         write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
     return path
 
 
@@ -94,22 +90,8 @@ def write_gif(frames, path, fps):
 
 
 def write_mp4(frames, path, fps):
-    """H.264 through ffmpeg, the frames piped as raw RGB (even sizes, as yuv420p needs)."""
-    h, w = np.shape(frames[0])[:2]
-    h2, w2 = h - h % 2, w - w % 2
-
-    def encode(tmp):
-        cmd = ["ffmpeg", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{w2}x{h2}"]
-        cmd += ["-r", str(fps), "-i", "-", "-pix_fmt", "yuv420p", "-c:v", "libx264", "-f", "mp4", str(tmp)]
-        data = b"".join(np.ascontiguousarray(np.asarray(f, np.uint8)[:h2, :w2]).tobytes() for f in frames)
-        done = subprocess.run(cmd, input=data, capture_output=True)
-        if done.returncode:
-            why = done.stderr.decode(errors="replace").strip().splitlines()
-            raise HarnessError(
-                f"render: ffmpeg could not write {display(path)} ({why[-1] if why else done.returncode})"
-            )
-
-    return _atomic(path, encode)
+    """H.264 through ffmpeg (harness/core/encode.py), whole or not at all."""
+    return _atomic(path, lambda tmp: encode.mp4(frames, tmp, fps, name=display(path)))
 
 
 def write_animation(frames, gif, fps):
