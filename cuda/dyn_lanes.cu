@@ -193,18 +193,20 @@ __device__ __forceinline__ void predict(const DModel<T> &m, Feat has, T phase, c
 /* §3.16 the hair–hair correction of point k at x (velocity v): the strict build runs the
  * reference (contact_impl.h) itself; the free builds the same sums from registers, the eight
  * corners' nodes read as vectors through the read-only cache. */
-template <typename T> struct Node4;
-template <> struct Node4<float> {
-    __device__ static float4 load(const float *p) { return __ldg(reinterpret_cast<const float4 *>(p)); }
+template <typename T> struct Node4 {
+    T x, y, z, w;
 };
-template <> struct Node4<double> {
-    __device__ static double4 load(const double *p)
-    {
+template <typename T> __device__ __forceinline__ Node4<T> load_node4(const T *p)
+{
+    if constexpr (sizeof(T) == sizeof(float)) {
+        const float4 a = __ldg(reinterpret_cast<const float4 *>(p));
+        return Node4<T>{a.x, a.y, a.z, a.w};
+    } else {
         const double2 a = __ldg(reinterpret_cast<const double2 *>(p)),
                       b = __ldg(reinterpret_cast<const double2 *>(p) + 1);
-        return double4{a.x, a.y, b.x, b.y};
+        return Node4<T>{a.x, a.y, b.x, b.y};
     }
-};
+}
 template <typename T>
 __device__ __forceinline__ void grid_fix(const DModel<T> &m, const T *qg, int k, const V3<T> &x, V3<T> &v)
 {
@@ -232,7 +234,7 @@ __device__ __forceinline__ void grid_fix(const DModel<T> &m, const T *qg, int k,
             const T wt = (wx * wy) * wz;
             const int64_t j = b + ((c & 1) ? 1 : 0) + ((c & 2) ? n : 0) + ((c & 4) ? n * n : 0);
             if (w.grid_friction) {
-                const auto nv = Node4<T>::load(w.node_v + 4 * j);
+                const auto nv = load_node4<T>(w.node_v + 4 * j);
                 const T wo = wt * nv.w; /* o ∈ {0, 1}; V is 0 where o is */
                 sw += wo;
                 svx += wt * nv.x;
@@ -240,7 +242,7 @@ __device__ __forceinline__ void grid_fix(const DModel<T> &m, const T *qg, int k,
                 svz += wt * nv.z;
             }
             if (w.grid_volume) {
-                const auto na = Node4<T>::load(w.node_a + 4 * j);
+                const auto na = load_node4<T>(w.node_a + 4 * j);
                 ax += wt * na.x;
                 ay += wt * na.y;
                 az += wt * na.z;

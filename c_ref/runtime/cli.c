@@ -357,7 +357,7 @@ static const flag_spec flags[] = {
     {"--grid-volume", DF_REAL, DYN(grid_volume), DYN(grid_volume_declared),
      "K, cm²/s²: push down the excess-density gradient; declares the volume term"},
     {"--colliders", DF_PATH, DYN(colliders_path), 0,
-     "FILE: spheres, capsules, planes and meshes with friction, one a line (docs/model.md §3.17)"},
+     "spheres, capsules, planes and meshes with friction, one a line (docs/model.md §3.17)"},
     {"--friction", DF_PAIR, DYN(friction), DYN(friction_declared),
      "MU_S[,MU_K]: the head sphere's Coulomb friction (default: frictionless)"},
     {"--depenetration-speed", DF_REAL, DYN(depen_speed), DYN(depen_declared),
@@ -454,6 +454,7 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend)
         char name[64];
         const char *arg = is_dyn(fl) ? (fl->kind == DF_SWITCH || fl->kind == DF_FLAG ? ""
                                         : fl->kind == DF_OPTREAL                     ? "[S]"
+                                        : fl->kind == DF_PATH                        ? "FILE"
                                                                                      : "V")
                           : fl->arg  ? fl->arg
                                      : "";

@@ -1,6 +1,7 @@
 /* motion_track.c — the head transform track of --head-motion track: its CSV file and its copy
  * in the HDF5 state (docs/interfaces.md, "Motion tracks"). */
 #include "runtime/motion_track.h"
+#include "runtime/input.h"
 
 #include <hdf5.h>
 #include <math.h>
@@ -89,8 +90,8 @@ static int row_quaternion(const double *v, int axis_angle, double q[4])
 int hb_track_load_csv(const char *path, hb_head_track *k, char *err, size_t errlen)
 {
     memset(k, 0, sizeof *k);
-    FILE *f = fopen(path, "r");
-    if (!f) return snprintf(err, errlen, "--motion-track %s: cannot read it", path), -1;
+    FILE *f = hb_input_fopen("--motion-track", path, "a motion track: a CSV file", 1, NULL, err, errlen);
+    if (!f) return -1;
     char *line = NULL, *field[TRACK_COLUMNS + 1];
     size_t cap = 0;
     int64_t lineno = 0, have = 0;

@@ -26,7 +26,7 @@ from harness.core import load, runner, scenes
 from harness.core.budget import TierGate, run_study
 from harness.core.paths import binary_path, display, output_dir
 from harness.core.progress import StepTimes
-from harness.io import grooms
+from harness.io import grooms, runfolder
 from harness.io.files import write_json
 from harness.io.sweepfile import load_sweep
 from harness.render import accuracy_dynamic_report, host_report, report_scene, stability_report
@@ -66,7 +66,7 @@ def run(scene_ref, out=None, gpu="auto", report_dir=None, quick_studies=True, bu
     say = log or (lambda m: print(m, flush=True))
     times = StepTimes()
     scene, most = check(scene_ref)
-    root = Path(out) if out else default_out(scene_ref)
+    root = runfolder.claim(Path(out) if out else default_out(scene_ref), f"bench --scene {scene_ref}")
     report_dir = Path(report_dir) if report_dir else root / "report"
     runner.require_binary(binary_path("cpu"))
     write_json(output_dir(root) / host_report.HOST_JSON, load.host_load())  # the report's first line

@@ -118,10 +118,6 @@ MAX_COUNT = 10**6  # the binaries' bound on S and I (docs/model.md §3)
 
 
 def _value(where, key, kind, value, error):
-    if kind == "path":
-        if not isinstance(value, str) or not value:
-            raise error(f"{where}: {key} must be a file name, got {value!r}")
-        return value
     if kind in ("box", "pair", "pair_unit"):
         items = value if isinstance(value, list) else [value]
         n = (6, 6) if kind == "box" else (1, 2)

@@ -124,6 +124,7 @@ def _observed(x, length):
         hair_length=length,
         collider=False,
         collide_radius=0.0,
+        colliders=None,  # §3.17: the peer's chains meet no collider
         segment_rest=lambda: length / (p - 1),  # a chain's links are equal (no groom)
     )
     obs = [invariants_dynamic.observe(view, xf) for xf in x[1:]]

@@ -40,6 +40,15 @@ FILE_FLAGS = [f for f, v in FLAGS if v in ("FILE", "G") and f != "--output"]
 VALUE_FLAGS = [f for f, v in FLAGS if v and v not in ("FILE", "G", "rng", "[S]") and f != "--output"]
 
 
+# the flags a file flag needs beside it to be read at all
+FILE_FLAG_CONTEXT = {
+    "--batch": [],
+    "--groom": ["--stages", "init,simulate"],
+    "--motion-track": ["--head-motion", "track", "--stages", "init,simulate"],
+    "--colliders": ["--stages", "init,simulate"],
+}
+
+
 def make_fault(tmp_path, kind):
     path = tmp_path / f"input-{kind}"
     if kind == "fifo":
@@ -65,18 +74,15 @@ def test_the_matrix_sees_the_binarys_flags():
     """--help lists every flag the parser takes (cli.c's one table), so the rows below are all of them."""
     names = {f for f, _ in FLAGS}
     assert {"--groom", "--input", "--batch", "--output", "--seed", "--frames", "--lra"} <= names, names
-    assert len(VALUE_FLAGS) >= 40 and len(FILE_FLAGS) == 3, (VALUE_FLAGS, FILE_FLAGS)
+    assert len(VALUE_FLAGS) >= 40, VALUE_FLAGS
+    assert {"--groom", "--input", "--batch", "--motion-track", "--colliders"} <= set(FILE_FLAGS), FILE_FLAGS
 
 
 @pytest.mark.parametrize("kind", FILE_FAULTS)
 @pytest.mark.parametrize("flag", FILE_FLAGS)
 def test_binary_file_input(cpu_bin, tmp_path, flag, kind):
     path = make_fault(tmp_path, kind)
-    args = (
-        [flag, path]
-        if flag == "--batch"
-        else [flag, path, "--stages", "init,simulate" if flag == "--groom" else "simulate"]
-    )
+    args = [flag, path, *FILE_FLAG_CONTEXT.get(flag, ["--stages", "simulate"])]
     p = subprocess.run([str(cpu_bin), *map(str, args)], capture_output=True, text=True, timeout=30)
     refused_in_one_line(p, flag, str(path))
 
