@@ -305,7 +305,7 @@ docs: setup
 sanitize: setup check-hdf5
 	$(MAKE) BUILD=build/asan COPT="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" \
 	  CC="$(CC) -fsanitize=address,undefined" build/asan/hairsim-cpu
-	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(RUN_PY) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume or fault_probe or fault_matrix or binary_inputs"
+	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/support/lsan-hdf5.supp:print_suppressions=0 $(RUN_PY) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume or fault_probe or fault_matrix or binary_inputs"
 	@for f in tests/fuzz/corpus/hair/*; do ASAN_OPTIONS=detect_leaks=1 build/asan/hairsim-cpu --groom $$f --stages init,simulate \
 	  --quiet >/dev/null 2>&1; rc=$$?; if [ $$rc -ne 0 ] && [ $$rc -ne 2 ] && [ $$rc -ne 3 ]; then \
 	  echo "error: build/asan/hairsim-cpu --groom $$f exited $$rc"; exit 1; fi; done; echo "sanitize: the HAIR seed corpus ran clean"
