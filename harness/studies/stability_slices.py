@@ -183,7 +183,7 @@ SLICES += (
     ),
     Slice(
         "body-inside",
-        "a groom started inside the body (still from the start): depenetration speed (off = unbounded) against substeps",
+        "a groom started inside the body (still from the start): depenetration speed (off: unbounded) × substeps",
         "body",
         (("--grid", OFF), ("--body-motion", OFF), ("--body-amplitude", OFF), ("--body-frequency", OFF)),
         Axis("--depenetration-speed", "V", (OFF, 50, 200, 1000), (OFF, 200), "cm/s"),
