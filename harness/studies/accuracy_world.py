@@ -291,6 +291,9 @@ def measure(plan, log=print):
 def run_study(plan, out_dir=None, log=print):
     """Measure; write world.csv and env.json into out_dir (results/accuracy-world); the CSV's path."""
     out_dir = Path(out_dir or RESULTS / RESULTS_NAME)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise HarnessError(f"accuracy-world: --out {out_dir} is not a directory", code=2)
+    check_plan(plan)
     rows = measure(plan, log)
     path = files.write_csv(out_dir / CSV_NAME, COLUMNS, rows)
     files.write_json(out_dir / "env.json", dict(env.collect(), plan={k: getattr(plan, k) for k in COLUMNS_PLAN}))
