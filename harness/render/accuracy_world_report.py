@@ -76,12 +76,27 @@ def verdict(rows, group):
         )
     cost, n = paired_ratio(on, "ms_frame", "friction", "off", "on", ("sdf",))
     err, _ = paired_ratio(on, "rms_err_L", "friction", "off", "on", ("sdf",))
+    text = f"For the body, {cheapest}."
+    if n:
+        text = (
+            f"On the body, friction costs {cost:.2f}× the frictionless colliders and moves the error against the "
+            f"converged reference by {err:.2f}× (medians over {n} SDF sizes); {cheapest}."
+        )
+    return text + sdf_clause(on)
+
+
+def sdf_clause(rows):
+    """What the mesh's SDF size did to the error: the finest against the coarsest, per friction."""
+    sizes = sorted({int(r["sdf"]) for r in rows if str(r["sdf"]).isdigit()})
+    if len(sizes) < 2:
+        return ""
+    lo, hi = str(sizes[0]), str(sizes[-1])
+    ratio, n = paired_ratio(rows, "rms_err_L", "sdf", lo, hi, ("friction",))
     if n == 0:
-        return f"For the body, {cheapest}."
-    return (
-        f"On the body, friction costs {cost:.2f}× the frictionless colliders and moves the error against the "
-        f"converged reference by {err:.2f}× (medians over {n} SDF sizes); {cheapest}."
-    )
+        return ""
+    if ratio == 1.0:
+        return f" The SDF's size ({lo}³ to {hi}³) changed no error: the hair did not reach the mesh in this run."
+    return f" The {hi}³ SDF moves the error by {ratio:.2f}× over the {lo}³ (median over {n} pairs)."
 
 
 def _pair(r, key, fmt):
@@ -91,15 +106,16 @@ def _pair(r, key, fmt):
 def table(rows, group):
     """The group's rows as a Markdown table (the reference's value in brackets)."""
     lines = [
-        "| variant | ms / frame | × off | RMS err / L | max err / L | hair volume cm³ | envelope cm | close pairs "
-        "| penetration cm | stretch max |",
+        "| variant | ms / frame (rounds' range) | × off | RMS err / L | max err / L | hair volume cm³ | envelope cm "
+        "| close pairs | penetration cm | stretch max |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     for r in (r for r in rows if r["group"] == group):
         pen = f"{_f(r, 'penetration_max'):.2g} ({_f(r, 'penetration_ref'):.2g})"
         stretch = f"{_f(r, 'stretch_max'):.3f} ({_f(r, 'stretch_ref'):.3f})"
         lines.append(
-            f"| {r['variant']} | {_f(r, 'ms_frame'):.3g} | {_f(r, 'cost_ratio'):.2f} | {_f(r, 'rms_err_L'):.2e} "
+            f"| {r['variant']} | {_f(r, 'ms_frame'):.3g} ({_f(r, 'ms_min'):.3g} … {_f(r, 'ms_max'):.3g}) "
+            f"| {_f(r, 'cost_ratio'):.2f} | {_f(r, 'rms_err_L'):.2e} "
             f"| {_f(r, 'max_err_L'):.2e} | {_pair(r, 'hair_volume', '.0f')} | {_pair(r, 'envelope', '.2f')} "
             f"| {_pair(r, 'close_pairs', '.0f')} | {pen} | {stretch} |"
         )
@@ -119,8 +135,9 @@ def section(results_dir, report_dir=None):
     lines += [
         f"Each variant at {first['strands']} strands, {first['frames']} frames, S = {first['substeps']}, "
         f"I = {first['iterations']}, fp32 on the CPU oracle, against the same features at S = {first['ref_substeps']} "
-        f"in fp64 (in brackets: the reference's value); cost: the median time per frame at {first['time_strands']} "
-        "strands, and over the same scene without the feature (× off). Hair volume, envelope and close pairs of "
+        f"in fp64 (in brackets: the reference's value); cost: the time per frame at {first['time_strands']} "
+        "strands on one thread, the median of rounds that time every variant in turn, and over the same scene "
+        "without the feature (× off). Hair volume, envelope and close pairs of "
         "the last frame (docs/model.md §3.16), penetration and stretch of the worst (§3.8). From "
         f"`{display(path)}`.",
         "",

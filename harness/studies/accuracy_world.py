@@ -9,8 +9,10 @@ then the step's, not the feature's). Against it: the RMS and max error over all 
 frames (studies.accuracy.frame_errors, over L), and the observables the features change, the
 variant's beside its reference's: the last frame's hair volume, envelope radius and close pairs
 (check/hair_volume.py), and the worst frame's penetration and stretch (§3.8). The cost is the
-simulate stage's median time per frame apart from the checked runs (`time_strands` strands,
-`time_frames` frames, `repeat`), over the same scene without the feature (the group's `off` row).
+simulate stage's time per frame apart from the checked runs (`time_strands` strands, one thread,
+`time_frames` frames), the median of `repeat` rounds that each time every variant in turn (a
+shared machine's load then falls on all alike; the rounds' spread is kept), over the same scene
+without the feature (the group's `off` row).
 """
 
 import os
@@ -50,7 +52,9 @@ COLUMNS = (
     "iterations",
     "ref_substeps",
     "time_strands",
-    "ms_frame",
+    "ms_frame",  # the median over the timing rounds of each round's median frame time
+    "ms_min",  # the fastest and slowest round: the spread a shared machine put on it
+    "ms_max",
     "cost_ratio",  # ms_frame over the group's off row
     "rms_err_L",
     "max_err_L",
@@ -77,14 +81,14 @@ class Plan:
     sdf_sizes: tuple = (32, 64, 128)
     time_strands: int = 1000
     time_frames: int = 3
-    repeat: int = 3
+    repeat: int = 5  # timing rounds, every variant once a round (in turn, so that a load hits them alike)
     jobs: int | None = None
 
     @classmethod
     def quick(cls, **changes):
         """Every axis still present, fewer strands and a shorter run (a minute or two on 2 cores)."""
         base = dict(strands=32, seconds=0.75, ref_substeps=32, grid_sizes=(16, 32), sdf_sizes=(32, 64),
-                    time_strands=300)  # fmt: skip
+                    time_strands=300, repeat=3)  # fmt: skip
         return cls(**{**base, **changes})
 
 
@@ -99,8 +103,8 @@ class Variant:
 def check_plan(plan):
     """Refuse a plan that cannot measure anything (HarnessError, exit 2)."""
     bad = []
-    if plan.strands < 2 or plan.time_strands < 1:
-        bad.append("--strands must be at least 2 and the timed strands at least 1")
+    if plan.strands < 2 or plan.time_strands < 1 or plan.repeat < 1:
+        bad.append("--strands must be at least 2, the timed strands and rounds at least 1")
     if not 0 < plan.seconds <= 10:
         bad.append(f"--seconds must be in (0, 10] (got {plan.seconds:g})")
     if plan.ref_substeps <= 8:
@@ -204,11 +208,21 @@ def _run(scene, path, plan, precision, substeps):
 
 
 def _time(scene, plan):
-    """The simulate stage's median ms a frame at time_strands strands (no output file)."""
+    """The simulate stage's median ms a frame at time_strands strands, one thread (no output file)."""
     s = scene.with_overrides(strands=plan.time_strands)
     s = replace(s, dynamic={**s.dynamic, "--frames": plan.time_frames})
-    rec = runner.run_binary(binary_path("cpu"), runner.run_flags(s, "cpu", repeat=plan.repeat), timeout=600)
+    rec = runner.run_binary(binary_path("cpu"), runner.run_flags(s, "cpu", threads=1, repeat=1), timeout=600)
     return float(next(st for st in rec["stages"] if st["stage"] == "simulate")["median_ms"])
+
+
+def timed(todo, plan, tick=lambda: None):
+    """[variant][round] ms a frame: `plan.repeat` rounds, each timing every variant once in turn."""
+    times = [[] for _ in todo]
+    for _ in range(plan.repeat):
+        for k, v in enumerate(todo):
+            times[k].append(_time(v.scene, plan))
+            tick()
+    return times
 
 
 def _observed(path):
@@ -274,14 +288,13 @@ def measure(plan, log=print):
                 shutil.rmtree(d, ignore_errors=True)
 
         rows = []
-        with Progress(2 * len(todo), "accuracy-world") as bar:
+        with Progress((1 + plan.repeat) * len(todo), "accuracy-world") as bar:
             with ThreadPoolExecutor(plan.jobs or os.cpu_count() or 1) as pool:
                 for row in pool.map(one, range(len(todo))):
                     rows.append(row)
                     bar.update()
-            for v, row in zip(todo, rows):
-                row["ms_frame"] = _time(v.scene, plan)
-                bar.update()
+            for row, ms in zip(rows, timed(todo, plan, bar.update)):
+                row.update(ms_frame=float(np.median(ms)), ms_min=min(ms), ms_max=max(ms))
     for r in rows:  # the cost over the same scene without the feature
         off = next(o for o in rows if o["group"] == r["group"] and o["variant"] == "off")
         r["cost_ratio"] = r["ms_frame"] / off["ms_frame"] if off["ms_frame"] > 0 else float("nan")

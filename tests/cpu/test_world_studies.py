@@ -209,3 +209,13 @@ def test_the_default_body_holds_no_root_of_the_default_scene(cpu_bin, tmp_path):
         # the body in place (its rise over): t large enough that b(t) = 0
         d = colliders.depths(t, roots, 10.0)[body]
     assert (d < 0).all(), float(d.max())
+
+
+def test_the_sdf_clause_says_when_the_size_changed_nothing():
+    rows = [
+        _row("body", "a", 2.0, 0.02, sdf="32", friction="on"),
+        _row("body", "b", 3.0, 0.02, sdf="64", friction="on"),
+    ]
+    assert "changed no error" in accuracy_world_report.sdf_clause(rows)
+    rows[1]["rms_err_L"] = "0.01"
+    assert "moves the error by 0.50× over the 32³" in accuracy_world_report.sdf_clause(rows)
