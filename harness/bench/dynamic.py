@@ -418,7 +418,7 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
 
         def measure_world():
             say(f"harness: world{' --quick' if quick else ''}")
-            plan = accuracy_world.Plan.quick() if quick else accuracy_world.Plan()
+            plan = accuracy_world.Plan.quick(gpu=gpu) if quick else accuracy_world.Plan(gpu=gpu)
             accuracy_world.run_study(plan, out_dir=root / accuracy_world.RESULTS_NAME, log=say)
 
         within("world", measure_world, root / accuracy_world.RESULTS_NAME)

@@ -602,7 +602,7 @@ def cmd_world(args):
     from harness.render import accuracy_world_report
     from harness.studies import accuracy_world
 
-    plan = accuracy_world.Plan.quick() if args.quick else accuracy_world.Plan()
+    plan = accuracy_world.Plan.quick(gpu=args.gpu) if args.quick else accuracy_world.Plan(gpu=args.gpu)
     path = accuracy_world.run_study(plan, out_dir=args.out)
     print("\n".join(accuracy_world_report.section(path.parent)))
     return 0
@@ -1219,6 +1219,7 @@ def parser():
                  "converged reference")  # fmt: skip
     wd.add_argument("--quick", action="store_true", help="fewer strands, sizes and seconds (a minute on 2 cores)")
     wd.add_argument("--out", default=None, help="results folder (default results/accuracy-world)")
+    wd.add_argument("--gpu", choices=("auto", "no"), default="auto", help="time each variant on the GPU too (auto)")
 
     rd = command(
         sub,

@@ -104,13 +104,31 @@ def _pair(r, key, fmt):
 
 
 def table(rows, group):
-    """The group's rows as a Markdown table (the reference's value in brackets)."""
+    """The group's rows as a Markdown table (the reference's value in brackets; the GPU's time where
+    measured)."""
+    part = [r for r in rows if r["group"] == group]
+    if any(r.get("gpu_ms_frame") not in (None, "") for r in part):
+        return _with_gpu(_cpu_table(part), part)
+    return _cpu_table(part)
+
+
+def _with_gpu(lines, rows):
+    """The table with the GPU's time and its ratio to the off row added."""
+    head = f" GPU ms / frame ({rows[0].get('gpu_strands') or '—'} strands) | GPU × off |"
+    out = [lines[0] + head, lines[1] + " ---: | ---: |"]
+    for line, r in zip(lines[2:], rows):
+        gpu = f" {_f(r, 'gpu_ms_frame'):.3g} ({r.get('gpu_variant') or '—'}) | {_f(r, 'gpu_cost_ratio'):.2f} |"
+        out.append(line + gpu)
+    return out
+
+
+def _cpu_table(rows):
     lines = [
         "| variant | ms / frame (rounds' range) | × off | RMS err / L | max err / L | hair volume cm³ | envelope cm "
         "| close pairs | penetration cm | stretch max |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
-    for r in (r for r in rows if r["group"] == group):
+    for r in rows:
         pen = f"{_f(r, 'penetration_max'):.2g} ({_f(r, 'penetration_ref'):.2g})"
         stretch = f"{_f(r, 'stretch_max'):.3f} ({_f(r, 'stretch_ref'):.3f})"
         lines.append(

@@ -26,7 +26,7 @@ import numpy as np
 
 from harness import HarnessError
 from harness.check import hair_volume
-from harness.core import env, runner, scenes
+from harness.core import env, runner, scenes, variants
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
@@ -56,6 +56,10 @@ COLUMNS = (
     "ms_min",  # the fastest and slowest round: the spread a shared machine put on it
     "ms_max",
     "cost_ratio",  # ms_frame over the group's off row
+    "gpu_variant",  # where a GPU answers: the default cuda build's fastest variant that runs the row
+    "gpu_strands",
+    "gpu_ms_frame",  # its median frame time over the rounds (empty: no GPU, or no variant runs it)
+    "gpu_cost_ratio",
     "rms_err_L",
     "max_err_L",
     "hair_volume",
@@ -83,6 +87,8 @@ class Plan:
     time_frames: int = 3
     repeat: int = 5  # timing rounds, every variant once a round (in turn, so that a load hits them alike)
     jobs: int | None = None
+    gpu: str = "auto"  # auto: the GPU's times too where one answers and hairsim-cuda is built; no
+    gpu_strands: int = 1_000_000
 
     @classmethod
     def quick(cls, **changes):
@@ -215,14 +221,38 @@ def _time(scene, plan):
     return float(next(st for st in rec["stages"] if st["stage"] == "simulate")["median_ms"])
 
 
-def timed(todo, plan, tick=lambda: None):
-    """[variant][round] ms a frame: `plan.repeat` rounds, each timing every variant once in turn."""
-    times = [[] for _ in todo]
+def _gpu_time(scene, plan, variant):
+    """The simulate stage's median ms a frame on the default cuda build's `variant`, gpu_strands strands."""
+    s = scene.with_overrides(strands=plan.gpu_strands)
+    s = replace(s, dynamic={**s.dynamic, "--frames": plan.time_frames})
+    rec = runner.run_binary(binary_path("cuda"), runner.run_flags(s, "cuda", variant=variant, repeat=1), timeout=600)
+    return float(next(st for st in rec["stages"] if st["stage"] == "simulate")["median_ms"])
+
+
+def gpu_variants(todo, plan, log=print):
+    """Per variant, the default cuda build's fastest variant that runs it (None: not timed on a GPU)."""
+    if plan.gpu == "no":
+        return [None] * len(todo)
+    usable, why = env.gpu_status()
+    if not usable or not binary_path("cuda").exists():
+        log(f"accuracy-world: no GPU rows: {why if not usable else 'hairsim-cuda is not built'}")
+        return [None] * len(todo)
+    decl = variants.declared("cuda")
+    return [variants.fastest(decl, v.scene.points, variants.features_of(v.scene.dynamic)) for v in todo]
+
+
+def timed(todo, plan, tick=lambda: None, on_gpu=None):
+    """([variant][round] ms a frame on the CPU, the same on the GPU where `on_gpu` names a variant):
+    `plan.repeat` rounds, each timing every variant once in turn."""
+    on_gpu = on_gpu or [None] * len(todo)
+    times, gpu = [[] for _ in todo], [[] for _ in todo]
     for _ in range(plan.repeat):
         for k, v in enumerate(todo):
             times[k].append(_time(v.scene, plan))
+            if on_gpu[k]:
+                gpu[k].append(_gpu_time(v.scene, plan, on_gpu[k]))
             tick()
-    return times
+    return times, gpu
 
 
 def _observed(path):
@@ -293,11 +323,17 @@ def measure(plan, log=print):
                 for row in pool.map(one, range(len(todo))):
                     rows.append(row)
                     bar.update()
-            for row, ms in zip(rows, timed(todo, plan, bar.update)):
+            on_gpu = gpu_variants(todo, plan, log)
+            cpu_ms, gpu_ms = timed(todo, plan, bar.update, on_gpu)
+            for row, ms, g, v in zip(rows, cpu_ms, gpu_ms, on_gpu):
                 row.update(ms_frame=float(np.median(ms)), ms_min=min(ms), ms_max=max(ms))
+                if g:
+                    row.update(gpu_variant=v, gpu_strands=plan.gpu_strands, gpu_ms_frame=float(np.median(g)))
     for r in rows:  # the cost over the same scene without the feature
         off = next(o for o in rows if o["group"] == r["group"] and o["variant"] == "off")
         r["cost_ratio"] = r["ms_frame"] / off["ms_frame"] if off["ms_frame"] > 0 else float("nan")
+        if r.get("gpu_ms_frame") and off.get("gpu_ms_frame"):
+            r["gpu_cost_ratio"] = r["gpu_ms_frame"] / off["gpu_ms_frame"]
     return rows
 
 
@@ -315,4 +351,4 @@ def run_study(plan, out_dir=None, log=print):
 
 
 COLUMNS_PLAN = ("strands", "seconds", "ref_substeps", "grid_sizes", "rebuilds", "sdf_sizes", "time_strands",
-                "time_frames", "repeat")  # fmt: skip
+                "time_frames", "repeat", "gpu", "gpu_strands")  # fmt: skip

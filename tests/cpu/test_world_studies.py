@@ -4,6 +4,7 @@ verdict follows its numbers, the sweep's body groups and the refusals. Small: a 
 a few frames."""
 
 import math
+from dataclasses import replace
 
 import pytest
 
@@ -219,3 +220,24 @@ def test_the_sdf_clause_says_when_the_size_changed_nothing():
     assert "changed no error" in accuracy_world_report.sdf_clause(rows)
     rows[1]["rms_err_L"] = "0.01"
     assert "moves the error by 0.50× over the 32³" in accuracy_world_report.sdf_clause(rows)
+
+
+def test_without_a_gpu_the_world_study_says_so_and_times_the_cpu_alone(monkeypatch):
+    todo = accuracy_world.grid_variants(TINY)[:2]
+    assert accuracy_world.gpu_variants(todo, replace(TINY, gpu="no"), log=pytest.fail) == [None, None]
+    monkeypatch.setattr(accuracy_world.env, "gpu_status", lambda: (False, "no NVIDIA driver"))
+    said = []
+    assert accuracy_world.gpu_variants(todo, TINY, log=said.append) == [None, None]
+    assert said == ["accuracy-world: no GPU rows: no NVIDIA driver"]
+
+
+def test_gpu_times_get_their_own_columns():
+    rows = [
+        {**_row("grid", "off", 1.0, 0.01), "gpu_ms_frame": "0.5", "gpu_cost_ratio": "1.0", "gpu_variant": "lanes",
+         "gpu_strands": "1000000"},
+        {**_row("grid", "a", 2.0, 0.01), "gpu_ms_frame": "", "gpu_cost_ratio": "", "gpu_variant": ""},
+    ]  # fmt: skip
+    lines = accuracy_world_report.table(rows, "grid")
+    assert lines[0].endswith("GPU ms / frame (1000000 strands) | GPU × off |")
+    assert lines[2].endswith("| 0.5 (lanes) | 1.00 |") and lines[3].endswith("| nan (—) | nan |")
+    assert "GPU" not in accuracy_world_report.table([_row("grid", "off", 1.0, 0.01)], "grid")[0]
