@@ -8,7 +8,7 @@ import statistics
 from harness.core import tolerances
 from harness.core.paths import display
 from harness.io.tables import read_csv
-from harness.studies.accuracy_world import CSV_NAME
+from harness.studies.accuracy import WORLD_CSV_NAME as CSV_NAME
 
 TITLE = "The grid and the body: cost against effect against the converged reference"
 

@@ -34,8 +34,12 @@ from harness.render import (  # noqa: E402
     steps_report,
 )
 from harness.render.headline_report import rounds_note  # noqa: E402
-from harness.studies import accuracy_world  # noqa: E402
-from harness.studies.accuracy import curves_name, results_name  # noqa: E402
+from harness.studies.accuracy import (  # noqa: E402
+    BODY_SCENE,
+    WORLD_RESULTS_NAME,
+    curves_name,
+    results_name,
+)
 
 CURLY_SCENE = "curly"  # configs/scenes/curly.toml: the accuracy study's second scene
 CURLY_TITLE = "curly hair"
@@ -70,7 +74,7 @@ def sim_rows(results_dir):
 def split_world(rows):
     """(the sweep's rows of its own scene, those of the body scene's groups); every row stays its
     own scene's when the sweep itself ran the body scene."""
-    body = rows["scene"].astype(str) == accuracy_world.BODY_SCENE if "scene" in rows else None
+    body = rows["scene"].astype(str) == BODY_SCENE if "scene" in rows else None
     if body is None or body.all():
         return rows, rows.iloc[0:0]
     return rows[~body], rows[body]
@@ -315,7 +319,7 @@ def build(root, report_dir=None):
         lines += best_table(rows) + [""]
         if not world.empty:
             lines += [
-                f"The same on a body with the hair–hair grid (configs/scenes/{accuracy_world.BODY_SCENE}.toml: four "
+                f"The same on a body with the hair–hair grid (configs/scenes/{BODY_SCENE}.toml: four "
                 "capsules and a face-mesh SDF with friction, the 32³ grid with friction and volume), in the variants "
                 "that run them (the sweep's groups with its `scene`):",
                 "",
@@ -356,7 +360,7 @@ def build(root, report_dir=None):
         title=CURLY_TITLE,
     )
     lines += _study(
-        root, accuracy_world.RESULTS_NAME, accuracy_world_report, accuracy_world_report.TITLE, "harness world", out_dir
+        root, WORLD_RESULTS_NAME, accuracy_world_report, accuracy_world_report.TITLE, "harness world", out_dir
     )
     lines += _study(root, "stability", stability_report, "Stability at the extremes", "harness stability", out_dir)
     lines += _study(root, "judge", judge_report, "The judge's power", "harness judge", out_dir)

@@ -31,11 +31,11 @@ from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
 from harness.io.trajectory import open_trajectory
-from harness.studies.accuracy import frame_errors
+from harness.studies.accuracy import BODY_SCENE, WORLD_CSV_NAME, WORLD_RESULTS_NAME, frame_errors
 
-CSV_NAME = "world.csv"
-RESULTS_NAME = "accuracy-world"
-BODY_SCENE = "body"  # the grid's settings and the body come from its [grid] and [body]
+CSV_NAME = WORLD_CSV_NAME
+RESULTS_NAME = WORLD_RESULTS_NAME
+# the grid's settings and the body come from BODY_SCENE's [grid] and [body]
 GRID_SCENE = "dynamic"  # the grid's variants run on the default scene
 
 COLUMNS = (
