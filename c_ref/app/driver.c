@@ -8,7 +8,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "runtime/backend.h"
+#include "app/backend.h"
 #include "runtime/checked.h"
 #include "runtime/cli.h"
 #include "runtime/groom.h"
@@ -17,11 +17,12 @@
 #include "dynamic/world.h"
 #include "runtime/host.h"
 #include "runtime/input.h"
-#include "runtime/motion_track.h"
+#include "dynamic/motion_track.h"
 #include "runtime/philox.h"
-#include "runtime/record.h"
+#include "app/record.h"
 #include "runtime/safe_write.h"
-#include "runtime/state_io.h"
+#include "app/run.h"
+#include "app/state_io.h"
 
 static const char *g_prog = "hairsim";
 
@@ -31,18 +32,6 @@ static int die(int status, const char *msg)
     return status;
 }
 
-
-uint64_t hb_host_memory_available(void)
-{
-    FILE *f = fopen("/proc/meminfo", "r");
-    if (!f) return 0;
-    char line[256];
-    unsigned long long kb = 0;
-    while (fgets(line, sizeof line, f))
-        if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) break;
-    fclose(f);
-    return (uint64_t)kb * 1024u;
-}
 
 /* ---- --self-test rng: Random123's published known-answer vectors (kat_vectors) ------- */
 static int self_test_rng(void)
@@ -214,7 +203,7 @@ static int same_file(const char *a, const char *b)
     return strcmp(ra, rb) == 0;
 }
 
-static void frame_meta(hb_frame_meta *m, hb_stage st, const hb_scene *s, const char *backend, const char *variant)
+void hb_frame_meta_init(hb_frame_meta *m, hb_stage st, const hb_scene *s, const char *backend, const char *variant)
 {
     memset(m, 0, sizeof *m);
     snprintf(m->stage, sizeof m->stage, "%s", hb_stage_name(st));
@@ -223,27 +212,6 @@ static void frame_meta(hb_frame_meta *m, hb_stage st, const hb_scene *s, const c
     m->wind_strength = st == HB_STAGE_WIND ? s->wind_strength : NAN;
     m->wind_angle = st == HB_STAGE_WIND ? s->wind_angle : NAN;
 }
-
-typedef struct {
-    hb_backend *b;
-    hb_options *o;
-    hb_record *rec;
-    hb_writer *w;
-    void *host;                     /* canonical host frame (output, end-to-end) */
-    void *input;                    /* the input's last frame */
-    void *render, *vrender, *vhost; /* --render-points: a rendered frame and its velocities; simulated velocities */
-    hb_input in;
-    int have_input;
-    hb_groom groom;      /* --groom: what init places (docs/model.md §3.15) */
-    hb_colliders cols;   /* --colliders (docs/model.md §3.17) */
-    hb_head_track track; /* --motion-track: the head's transform track (motion_track.h) */
-    double *times;       /* all stages' timed runs */
-    struct {             /* the simulation, for the file's /parameters */
-        int dynamic;
-        int64_t paper_frames, last_frame;
-        char features[192];
-    } sim;
-} hb_run;
 
 static void run_free(hb_run *r)
 {
@@ -262,243 +230,12 @@ static void run_free(hb_run *r)
 }
 
 
-/* The frame as the file holds it: the state itself, or with --render-points its rendered
- * points (docs/model.md §3.14, the C reference's spline on the host). */
-static const void *as_written(hb_run *r, const void *state)
+const void *hb_run_as_written(hb_run *r, const void *state)
 {
     const hb_scene *s = &r->o->scene;
     if (!s->dyn.render_points) return state;
     hb_lod_render(s->precision, state, NULL, s->n_strands, s->points, s->dyn.render_points, r->render, NULL);
     return r->render;
-}
-
-/* A simulated frame's rendered points (and velocities when `vel`) into r->render (r->vrender):
- * by the backend's own kernel where it has one, else fetched and rendered on the host; *ms
- * the rendering's time (the kernel, or the host spline; transfers not counted). */
-static int render_frame(hb_run *r, int vel, double *ms, char *err, size_t errlen)
-{
-    hb_backend *b = r->b;
-    const hb_scene *s = &r->o->scene;
-    if (b->dyn_render) return b->dyn_render(b, r->render, vel ? r->vrender : NULL, ms, err, errlen);
-    double fetch_ms;
-    if (b->fetch(b, r->host, &fetch_ms, err, errlen)) return -1;
-    if (vel && b->dyn_fetch_velocity(b, r->vhost, err, errlen)) return -1;
-    const double t0 = hb_now_ms();
-    hb_lod_render(s->precision, r->host, vel ? r->vhost : NULL, s->n_strands, s->points, s->dyn.render_points,
-                  r->render, r->vrender);
-    *ms = hb_now_ms() - t0;
-    return 0;
-}
-
-/* ---- the simulate stage (docs/model.md §3) ---------------------------------------------
- * Starts from the current state: a new simulation takes it as the rest shape with zero
- * velocities; a resumed one (--input of a dynamic file at a simulated frame) continues with
- * that file's rest shape, velocities and time. Each frame is timed on its own (--repeat
- * times from the same state); the observables and the file's frames are taken between the
- * timed frames, outside them. Memory does not grow with the frame count: one host frame. */
-static int frame_plans(const hb_scene *s, int64_t first, int64_t n, hb_dyn_frame **plans, int64_t *n_plans, char *err,
-                       size_t errlen);
-
-static int run_simulate(hb_run *r, hb_stage_record *sr, int frame, double *times, char *err, size_t errlen)
-{
-    hb_backend *b = r->b;
-    const hb_options *o = r->o;
-    const hb_scene *s = &o->scene;
-    const hb_dynamics *d = &s->dyn;
-    const uint64_t bytes = hb_state_bytes(s);
-    const int need_save = o->repeat > 1 || o->warmup > 0;
-    int64_t gf0 = 0, paper_frames = frame;
-    void *rest = malloc(bytes), *vel = NULL;
-    hb_dyn_frame plan, *plans = NULL;
-    int64_t n_plans = 0;
-    double *rt = NULL; /* --render-points: each written frame's rendering time */
-    int64_t n_rt = 0;
-    memset(&plan, 0, sizeof plan);
-    int status = HB_EXIT_OK;
-#define FAIL_IF(cond, st)                                                                                              \
-    do {                                                                                                               \
-        if (cond) {                                                                                                    \
-            status = (st);                                                                                             \
-            goto out;                                                                                                  \
-        }                                                                                                              \
-    } while (0)
-    if (d->render_points && !(rt = malloc((size_t)o->frames * sizeof *rt))) {
-        snprintf(err, errlen, "out of host memory for the rendering times");
-        FAIL_IF(1, HB_EXIT_MEMORY);
-    }
-    if (!rest || hb_dyn_frame_alloc(&plan, d->substeps) != 0 || hb_dyn_frame_alloc_world(&plan, s) != 0) {
-        snprintf(err, errlen, "out of host memory for the simulation's rest shape and substep tables");
-        FAIL_IF(1, HB_EXIT_MEMORY);
-    }
-    if (r->have_input && r->in.dynamic && o->input_frame >= r->in.paper_frames) {
-        /* resume: the frame's velocities, the rest shape and the global frame index */
-        const int64_t step = r->in.frames[o->input_frame].step;
-        int vi = -1;
-        for (int i = 0; i < r->in.n_vel; i++)
-            if (r->in.vel_step[i] == step) vi = i;
-        if (vi < 0) {
-            snprintf(err, errlen,
-                     "--input %s: frame %d has no stored velocities, so the simulation cannot resume "
-                     "from it (write the file with --velocities all, or resume from its last frame)",
-                     o->input, o->input_frame);
-            FAIL_IF(1, HB_EXIT_USAGE);
-        }
-        paper_frames = r->in.paper_frames;
-        gf0 = step - paper_frames + 1;
-        vel = malloc(bytes);
-        if (!vel) {
-            snprintf(err, errlen, "out of host memory for the input's velocities");
-            FAIL_IF(1, HB_EXIT_MEMORY);
-        }
-        FAIL_IF(hb_input_read_rest(&r->in, rest, err, errlen), HB_EXIT_USAGE);
-        FAIL_IF(hb_input_read_velocity(&r->in, vi, vel, err, errlen), HB_EXIT_USAGE);
-        if (r->w) {
-            char *hv = r->host;
-            for (int i = 0; i < r->in.n_vel; i++)
-                if (o->all_velocities && r->in.vel_step[i] <= step) {
-                    FAIL_IF(hb_input_read_velocity(&r->in, i, hv, err, errlen), HB_EXIT_USAGE);
-                    FAIL_IF(hb_writer_velocity(r->w, hv, r->in.vel_step[i], r->in.vel_time[i], err, errlen),
-                            HB_EXIT_RUNTIME);
-                }
-            for (int i = 0; i < r->in.n_obs; i++)
-                if (r->in.obs_step[i] <= step)
-                    FAIL_IF(
-                        hb_writer_observables(r->w, &r->in.obs[i], r->in.obs_step[i], r->in.obs_time[i], err, errlen),
-                        HB_EXIT_RUNTIME);
-        }
-    } else {
-        double ms;
-        FAIL_IF(b->fetch(b, rest, &ms, err, errlen), HB_EXIT_RUNTIME);
-    }
-    if (gf0 + o->frames > (INT64_C(1) << 53) / d->substeps) {
-        snprintf(err, errlen,
-                 "--frames %lld x --substeps %lld from frame %lld passes 2^53 substeps: times would "
-                 "no longer be exact",
-                 (long long)o->frames, (long long)d->substeps, (long long)gf0);
-        FAIL_IF(1, HB_EXIT_USAGE);
-    }
-    const int64_t after = (o->frame_loop ? 1 : 0) + (o->draw_w ? 1 : 0); /* F more frames each */
-    const double t_end = (double)(gf0 + (1 + after) * o->frames) * d->frame_dt;
-    FAIL_IF(hb_dynamics_validate_time(s, t_end, err, errlen), HB_EXIT_USAGE);
-    FAIL_IF(b->dyn_load(b, vel, rest, err, errlen), HB_EXIT_RUNTIME);
-    if (r->w) FAIL_IF(hb_writer_rest(r->w, as_written(r, rest), err, errlen), HB_EXIT_RUNTIME);
-
-    r->sim.dynamic = 1;
-    r->sim.paper_frames = paper_frames;
-    hb_dyn_scene_feature_names(s, r->sim.features, sizeof r->sim.features);
-    snprintf(sr->features, sizeof sr->features, "%s", r->sim.features);
-    sr->frames = o->frames;
-    sr->times_ms = times;
-    sr->n_times = (int)(o->frames * o->repeat);
-    double observe_ms = 0.0;
-    for (int64_t j = 1; j <= o->frames; j++) {
-        const int64_t gf = gf0 + j;
-        hb_dyn_frame_plan(s, (gf - 1) * d->substeps, &plan);
-        if (need_save) FAIL_IF(b->save(b, err, errlen), HB_EXIT_RUNTIME);
-        double *ft = times + (j - 1) * o->repeat;
-        for (int k = 0; k < o->warmup + o->repeat; k++) {
-            if (k > 0) FAIL_IF(b->restore(b, err, errlen), HB_EXIT_RUNTIME);
-            hb_stage_result res = {0, -1, 1};
-            FAIL_IF(b->dyn_frame(b, &plan, &res, err, errlen), HB_EXIT_RUNTIME);
-            if (k >= o->warmup) ft[k - o->warmup] = res.ms;
-        }
-        hb_observables obs;
-        const double t0 = hb_now_ms();
-        FAIL_IF(b->dyn_observe(b, &obs, err, errlen), HB_EXIT_RUNTIME);
-        observe_ms += hb_now_ms() - t0;
-        const int64_t step = paper_frames - 1 + gf;
-        const double time = (double)gf * d->frame_dt;
-        sr->last = obs;
-        sr->blown_frames += hb_obs_blown_up(&obs);
-        r->sim.last_frame = gf;
-        if (!r->w) {
-            if (d->render_points) { /* §3.14: no file: every frame is rendered (and dropped), so its cost shows */
-                double ms;
-                FAIL_IF(render_frame(r, 0, &ms, err, errlen), HB_EXIT_RUNTIME);
-                rt[n_rt++] = ms;
-            }
-            continue;
-        }
-        FAIL_IF(hb_writer_observables(r->w, &obs, step, time, err, errlen), HB_EXIT_RUNTIME);
-        if (j % o->output_every != 0 && j != o->frames) continue;
-        hb_frame_meta m;
-        frame_meta(&m, HB_STAGE_SIMULATE, s, b->name, o->variant);
-        hb_time_stats(ft, o->repeat, &m.median_ms, &m.min_ms, &m.max_ms);
-        m.step = step;
-        m.time = time;
-        double ms;
-        if (d->render_points) { /* §3.14: the rendered points, and their velocities */
-            const int vel = o->all_velocities || j == o->frames;
-            FAIL_IF(render_frame(r, vel, &ms, err, errlen), HB_EXIT_RUNTIME);
-            rt[n_rt++] = ms;
-            FAIL_IF(hb_writer_append(r->w, r->render, &m, err, errlen), HB_EXIT_RUNTIME);
-            if (vel) FAIL_IF(hb_writer_velocity(r->w, r->vrender, step, time, err, errlen), HB_EXIT_RUNTIME);
-            continue;
-        }
-        FAIL_IF(b->fetch(b, r->host, &ms, err, errlen), HB_EXIT_RUNTIME);
-        FAIL_IF(hb_writer_append(r->w, r->host, &m, err, errlen), HB_EXIT_RUNTIME);
-        if (o->all_velocities || j == o->frames) {
-            FAIL_IF(b->dyn_fetch_velocity(b, r->host, err, errlen), HB_EXIT_RUNTIME);
-            FAIL_IF(hb_writer_velocity(r->w, r->host, step, time, err, errlen), HB_EXIT_RUNTIME);
-        }
-    }
-    sr->observe_ms = observe_ms;
-    sr->render_ms = NAN;
-    if (n_rt > 0) {
-        double lo, hi;
-        hb_time_stats(rt, (int)n_rt, &sr->render_ms, &lo, &hi);
-    }
-    hb_time_stats(sr->times_ms, sr->n_times, &sr->meta.median_ms, &sr->meta.min_ms, &sr->meta.max_ms);
-    sr->loop_ms = sr->loop_graph_ms = NAN;
-    if (after > 0 && (o->frames > INT32_MAX || gf0 + (1 + after) * o->frames > (INT64_C(1) << 53) / d->substeps)) {
-        snprintf(err, errlen, "%s: --frames %lld is too many frames to run again",
-                 o->draw_w ? "--draw" : "--frame-loop", (long long)o->frames);
-        FAIL_IF(1, HB_EXIT_USAGE);
-    }
-    int64_t next = gf0 + o->frames; /* the global frame the next of these runs starts from */
-    if (o->frame_loop) {
-        /* F more frames from the final state, after everything above is written: the frames
-         * an application would run next, their tables made here as for any frame */
-        FAIL_IF(frame_plans(s, next, o->frames, &plans, &n_plans, err, errlen), HB_EXIT_MEMORY);
-        FAIL_IF(b->dyn_loop(b, plans, (int)o->frames, &sr->loop_ms, &sr->loop_graph_ms, err, errlen), HB_EXIT_RUNTIME);
-        next += o->frames;
-    }
-    if (o->draw_w) { /* F more frames, each simulated and drawn on the device (docs/interfaces.md) */
-        FAIL_IF(frame_plans(s, next, o->frames, &plans, &n_plans, err, errlen), HB_EXIT_MEMORY);
-        FAIL_IF(b->dyn_draw(b, plans, (int)o->frames, o->draw_w, o->draw_h, o->draw_image, &sr->draw, err, errlen),
-                HB_EXIT_RUNTIME);
-        sr->drawn = 1;
-    }
-out:
-#undef FAIL_IF
-    for (int64_t j = 0; j < n_plans; j++) hb_dyn_frame_free(&plans[j]);
-    free(plans);
-    hb_dyn_frame_free(&plan);
-    free(rest);
-    free(vel);
-    free(rt);
-    return status;
-}
-
-/* The tables of n frames from global frame `first` (its substeps first·S …) into *plans,
- * the ones there before freed; −1 with one line when the host memory runs out. */
-static int frame_plans(const hb_scene *s, int64_t first, int64_t n, hb_dyn_frame **plans, int64_t *n_plans, char *err,
-                       size_t errlen)
-{
-    for (int64_t j = 0; j < *n_plans; j++) hb_dyn_frame_free(&(*plans)[j]);
-    free(*plans);
-    *n_plans = 0;
-    *plans = calloc((size_t)n, sizeof **plans);
-    for (int64_t j = 0; *plans && j < n; j++) {
-        if (hb_dyn_frame_alloc(&(*plans)[j], s->dyn.substeps) != 0 || hb_dyn_frame_alloc_world(&(*plans)[j], s) != 0) {
-            hb_dyn_frame_free(&(*plans)[j]);
-            break;
-        }
-        *n_plans = j + 1;
-        hb_dyn_frame_plan(s, (first + j) * s->dyn.substeps, &(*plans)[j]);
-    }
-    if (*n_plans < n) return snprintf(err, errlen, "out of host memory for the frames' tables"), -1;
-    return 0;
 }
 
 /* --groom (docs/model.md §3.15): init places the groom; the paper stages, which keep each
@@ -576,13 +313,398 @@ static void note_untuned(const hb_options *o, const hb_run *r)
             g_prog);
 }
 
-#define CHECK(call, status)                                                                                            \
-    do {                                                                                                               \
-        if ((call) != 0) {                                                                                             \
-            run_free(&run);                                                                                            \
-            return die(status, err);                                                                                   \
-        }                                                                                                              \
-    } while (0)
+/* ---- refuse bad input before any work (docs/model.md §2.6) ---- */
+
+/* The variant --variant names (the backend's default if none); it must run every stage listed. */
+static int pick_variant(hb_options *o, const hb_backend *b, const hb_variant **var, char *err, size_t errlen)
+{
+    if (!o->variant) o->variant = b->default_variant;
+    *var = NULL;
+    for (const hb_variant *v = b->variants; v->name; v++)
+        if (strcmp(v->name, o->variant) == 0) *var = v;
+    if (!*var) {
+        char list[256] = "";
+        for (const hb_variant *v = b->variants; v->name; v++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? ", " : "", v->name);
+        snprintf(err, errlen, "--variant %s is not a %s variant (known: %s)", o->variant, b->name, list);
+        return -1;
+    }
+    for (int i = 0; i < o->n_stages; i++)
+        if (!((*var)->stages & (1u << o->stages[i]))) {
+            snprintf(err, errlen, "--stages: the %s variant %s does not run '%s' (see --list-variants)", b->name,
+                     (*var)->name, hb_stage_name(o->stages[i]));
+            return -1;
+        }
+    return 0;
+}
+
+/* Where the state comes from: --input (its scene adopted), --groom, the drape of init; and
+ * the --colliders file. */
+static int check_state_source(hb_run *r, char *err, size_t errlen)
+{
+    hb_options *o = r->o;
+    if (o->input) {
+        HB_TRY(hb_input_open(o->input, &r->in, err, errlen), HB_EXIT_USAGE);
+        r->have_input = 1;
+        HB_TRY(adopt_input_scene(o, &r->in.scene, r->in.dynamic, err, errlen), HB_EXIT_USAGE);
+        for (int i = 0; i < o->n_stages; i++)
+            if (o->stages[i] == HB_STAGE_INIT) {
+                snprintf(err, errlen, "--stages: init cannot run on an --input state (it would replace it)");
+                return HB_EXIT_USAGE;
+            }
+    }
+    if (o->groom) {
+        const int groom_status = check_groom(o, &r->groom, err, errlen);
+        if (groom_status) return groom_status < 0 ? HB_EXIT_USAGE : groom_status;
+    }
+    if (o->scene.dyn.colliders_path && !o->scene.dyn.cols) { /* docs/model.md §3.17 (a resumed run has the file's) */
+        HB_TRY(hb_colliders_load(o->scene.dyn.colliders_path, &r->cols, err, errlen), HB_EXIT_USAGE);
+        o->scene.dyn.cols = &r->cols;
+    }
+    if (!o->input && o->stages[0] != HB_STAGE_INIT) {
+        snprintf(err, errlen, "--stages: '%s' needs a state: list init first or give --input",
+                 hb_stage_name(o->stages[0]));
+        return HB_EXIT_USAGE;
+    }
+    HB_TRY(hb_scene_validate(&o->scene, err, errlen), HB_EXIT_USAGE);
+    return HB_EXIT_OK;
+}
+
+/* simulate's physics, and what the variant runs of them (--list-variants); --frame-loop and
+ * --draw only after simulate. */
+static int check_simulate(hb_run *r, const hb_variant *var, int simulate, char *err, size_t errlen)
+{
+    hb_options *o = r->o;
+    const hb_backend *b = r->b;
+    if (!simulate) {
+        if (o->frame_loop) return snprintf(err, errlen, "--frame-loop needs simulate in --stages"), HB_EXIT_USAGE;
+        if (o->draw_w) return snprintf(err, errlen, "--draw needs simulate in --stages"), HB_EXIT_USAGE;
+        return HB_EXIT_OK;
+    }
+    HB_TRY(adopt_track(o, r, err, errlen), HB_EXIT_USAGE);
+    HB_TRY(hb_dynamics_validate(&o->scene.dyn, err, errlen), HB_EXIT_USAGE);
+    HB_TRY(hb_dynamics_validate_scene(&o->scene, err, errlen), HB_EXIT_USAGE);
+    if (o->end_to_end)
+        return snprintf(err, errlen, "--end-to-end is not measured for simulate: its frames are timed one by one"),
+               HB_EXIT_USAGE;
+    if (var->max_points > 0 && o->scene.points > var->max_points)
+        return snprintf(err, errlen,
+                        "--points %lld: the %s variant %s simulates at most %lld points a strand (see --list-variants)",
+                        (long long)o->scene.points, b->name, var->name, (long long)var->max_points),
+               HB_EXIT_USAGE;
+    if (!(hb_variant_solvers(var) & (1u << o->scene.dyn.solver)))
+        return snprintf(err, errlen, "--solver %s: the %s variant %s does not run it (see --list-variants)",
+                        hb_solver_name(o->scene.dyn.solver), b->name, var->name),
+               HB_EXIT_USAGE;
+    if (o->scene.dyn.per_segment && !var->per_segment)
+        return snprintf(err, errlen,
+                        "%s: the %s variant %s does not simulate a groom's per-segment rest lengths yet (docs/model.md "
+                        "§3.15)",
+                        o->groom ? "--groom" : "--input", b->name, var->name),
+               HB_EXIT_USAGE;
+    const unsigned lacking = x_declared(&o->scene.dyn) & var->lacks;
+    for (int x = 0; x < HB_X_COUNT; x++)
+        if (lacking & (1u << x))
+            return snprintf(err, errlen, "--variant %s does not run %s (see --list-variants)", var->name,
+                            x_features[x].flag),
+                   HB_EXIT_USAGE;
+    if (var->max_block > 0 && o->block_size > var->max_block)
+        return snprintf(err, errlen,
+                        "--block-size %d: the %s variant %s simulates with at most %d threads a block (see "
+                        "--list-variants)",
+                        o->block_size, b->name, var->name, var->max_block),
+               HB_EXIT_USAGE;
+    if ((o->frame_loop || o->draw_w) && (o->scene.dyn.grid || hb_dyn_has_world(&o->scene)))
+        return snprintf(err, errlen, "%s does not yet run the grid and colliders (docs/model.md §3.16, §3.17)",
+                        o->frame_loop ? "--frame-loop" : "--draw"),
+               HB_EXIT_USAGE;
+    if (o->frame_loop && !b->dyn_loop)
+        return snprintf(err, errlen, "--frame-loop is measured by the cuda backend only"), HB_EXIT_USAGE;
+    if (o->draw_w && !b->dyn_draw)
+        return snprintf(err, errlen, "--draw draws on the GPU: the cuda backend only"), HB_EXIT_USAGE;
+    return HB_EXIT_OK;
+}
+
+/* --input-frame (the input's last frame by default) and --output against --input. */
+static int check_input_frame(hb_run *r, int simulate, char *err, size_t errlen)
+{
+    hb_options *o = r->o;
+    if (o->input) {
+        if (o->input_frame >= r->in.n_frames)
+            return snprintf(err, errlen, "--input-frame %d: %s has frames 0 to %d", o->input_frame, o->input,
+                            r->in.n_frames - 1),
+                   HB_EXIT_USAGE;
+        if (o->input_frame < 0) o->input_frame = r->in.n_frames - 1;
+        if (r->in.dynamic && o->input_frame >= r->in.paper_frames && !simulate)
+            return snprintf(err, errlen, "--stages: frame %d of %s is simulated; only simulate can follow it",
+                            o->input_frame, o->input),
+                   HB_EXIT_USAGE;
+    } else if (o->input_frame >= 0) {
+        return snprintf(err, errlen, "--input-frame needs --input"), HB_EXIT_USAGE;
+    }
+    if (o->output && o->input && same_file(o->output, o->input))
+        return snprintf(err, errlen, "--output %s is the --input file; write to another name", o->output),
+               HB_EXIT_USAGE;
+    return HB_EXIT_OK;
+}
+
+static int check_run(hb_run *r, const hb_variant *var, int simulate, char *err, size_t errlen)
+{
+    int status = check_state_source(r, err, errlen);
+    if (status == HB_EXIT_OK) status = check_simulate(r, var, simulate, err, errlen);
+    if (status == HB_EXIT_OK && r->o->draw_image && !r->o->draw_w)
+        status = (snprintf(err, errlen, "--draw-image needs --draw"), HB_EXIT_USAGE);
+    if (status == HB_EXIT_OK) status = check_input_frame(r, simulate, err, errlen);
+    return status;
+}
+
+/* --measure-bandwidth: the backend's copy (and triad) bandwidth, printed; no stage runs. */
+static int print_bandwidth(hb_run *r, char *err, size_t errlen)
+{
+    hb_backend *b = r->b;
+    hb_options *o = r->o;
+    hb_record *rec = r->rec;
+    double gbps = 0, bytes = 0, triad = NAN, triad_bytes = NAN;
+    HB_TRY(b->measure_bandwidth(b, o, &gbps, &bytes, err, errlen), HB_EXIT_RUNTIME);
+    if (b->measure_triad) HB_TRY(b->measure_triad(b, o, &triad, &triad_bytes, err, errlen), HB_EXIT_RUNTIME);
+    b->describe(b, rec->device, sizeof rec->device, rec->driver, sizeof rec->driver);
+    if (o->json) {
+        printf("{\"backend\": \"%s\", \"copy_gbps\": %.6g, \"bytes\": %.17g", b->name, gbps, bytes);
+        if (isfinite(triad)) printf(", \"triad_gbps\": %.6g, \"triad_bytes\": %.17g", triad, triad_bytes);
+        if (b->threads > 0) printf(", \"threads\": %d", b->threads);
+        printf(", \"device\": \"%s\"}\n", rec->device);
+    } else {
+        printf("%s copy bandwidth: %.1f GB/s (read + write, %.0f bytes per copy)", b->name, gbps, bytes);
+        if (isfinite(triad)) printf("; triad %.1f GB/s (%.0f bytes)", triad, triad_bytes);
+        printf(" on %s\n", rec->device);
+    }
+    return HB_EXIT_OK;
+}
+
+/* ---- the run's memory: the backend's state, the host frames, the times; the output opened ---- */
+static int prepare_run(hb_run *r, int simulate, char *err, size_t errlen)
+{
+    hb_backend *b = r->b;
+    hb_options *o = r->o;
+    hb_record *rec = r->rec;
+    const uint64_t bytes = hb_state_bytes(&o->scene);
+    const int need_host = o->output != NULL || o->end_to_end || simulate;
+    /* simulate: the rest shape and the velocities pass through the host once */
+    /* --render-points: a rendered frame, its velocities and the simulated velocities */
+    const int64_t pr = simulate ? o->scene.dyn.render_points : 0;
+    const uint64_t render_bytes =
+        pr ? hb_mul_sat(hb_mul_sat((uint64_t)o->scene.n_strands, (uint64_t)pr), 3u * hb_real_size(o->scene.precision))
+           : 0;
+    const uint64_t driver_bytes = hb_add_sat(
+        hb_add_sat(hb_add_sat(need_host ? bytes : 0, o->input ? bytes : 0), simulate ? hb_mul_sat(bytes, 2u) : 0),
+        hb_add_sat(hb_mul_sat(render_bytes, 2u), render_bytes ? bytes : 0));
+    const int need_save = o->repeat > 1 || o->warmup > 0;
+    const int status = b->setup(b, o, need_save, driver_bytes, err, errlen);
+    if (status != HB_EXIT_OK) return status;
+    b->describe(b, rec->device, sizeof rec->device, rec->driver, sizeof rec->driver);
+    rec->flags = b->flags; /* setup may name the build that runs (cpu simd: x86-64-v3 or -v4) */
+    rec->threads = b->threads;
+    rec->block_size = b->block_size;
+    if (need_host && !(r->host = malloc(bytes)))
+        return snprintf(err, errlen, "cannot allocate the %llu-byte host frame", (unsigned long long)bytes),
+               HB_EXIT_MEMORY;
+    if (render_bytes &&
+        (!(r->render = malloc(render_bytes)) || !(r->vrender = malloc(render_bytes)) || !(r->vhost = malloc(bytes))))
+        return snprintf(err, errlen, "cannot allocate the %llu-byte rendered frames (--render-points)",
+                        (unsigned long long)render_bytes),
+               HB_EXIT_MEMORY;
+    if (o->input && !(r->input = malloc(bytes)))
+        return snprintf(err, errlen, "cannot allocate the %llu-byte input frame", (unsigned long long)bytes),
+               HB_EXIT_MEMORY;
+    /* one time per stage (or simulated frame) and repeat, counted by an int */
+    uint64_t n_times, times_bytes;
+    if (hb_add_u64((uint64_t)o->n_stages, simulate ? (uint64_t)o->frames : 0, &n_times) ||
+        hb_mul_u64(n_times, (uint64_t)o->repeat, &n_times) || n_times > INT32_MAX ||
+        hb_mul_u64(n_times, sizeof *r->times, &times_bytes))
+        return snprintf(err, errlen, "--frames %lld x --repeat %lld is more timings than a run keeps (at most %d)",
+                        (long long)(simulate ? o->frames : 0), (long long)o->repeat, INT32_MAX),
+               HB_EXIT_USAGE;
+    r->times = calloc((size_t)n_times, sizeof *r->times);
+    if (!r->times) return snprintf(err, errlen, "out of host memory"), HB_EXIT_MEMORY;
+    if (o->output) {
+        int open_status;
+        r->w = hb_writer_open(o->output, o->force, &o->scene, &open_status, err, errlen);
+        if (!r->w) return open_status;
+    }
+    return HB_EXIT_OK;
+}
+
+/* ---- the input state: its frames go into the output first, its last loaded ---- */
+static int load_input(hb_run *r, int *frame, char *err, size_t errlen)
+{
+    const hb_options *o = r->o;
+    if (!o->input) return HB_EXIT_OK;
+    const int last = o->input_frame;
+    HB_TRY(hb_input_read_frame(&r->in, last, r->input, err, errlen), HB_EXIT_USAGE);
+    for (int f = 0; r->w && f <= last; f++) {
+        const void *src = r->input;
+        if (f != last) {
+            HB_TRY(hb_input_read_frame(&r->in, f, r->host, err, errlen), HB_EXIT_USAGE);
+            src = r->host;
+        }
+        HB_TRY(hb_writer_append(r->w, hb_run_as_written(r, src), &r->in.frames[f], err, errlen), HB_EXIT_RUNTIME);
+    }
+    *frame = last + 1;
+    double ms;
+    HB_TRY(r->b->load(r->b, r->input, &ms, err, errlen), HB_EXIT_RUNTIME);
+    return HB_EXIT_OK;
+}
+
+/* The backend's current state into the file (nothing without --output). */
+static int write_current(hb_run *r, const hb_frame_meta *m, char *err, size_t errlen)
+{
+    if (!r->w) return 0;
+    double ms;
+    if (r->b->fetch(r->b, r->host, &ms, err, errlen)) return -1;
+    return hb_writer_append(r->w, hb_run_as_written(r, r->host), m, err, errlen);
+}
+
+/* Paper stage i (frame `frame`), timed from the same input (docs/model.md §5.3), and what it
+ * made into the file: a fused wind+collide runs two stages in one time, two frames. */
+static int run_paper_stage(hb_run *r, int i, int frame, hb_stage_record *sr, double *times, int *consumed, char *err,
+                           size_t errlen)
+{
+    hb_backend *b = r->b;
+    hb_options *o = r->o;
+    hb_record *rec = r->rec;
+    if (o->repeat > 1 || o->warmup > 0) HB_TRY(b->save(b, err, errlen), HB_EXIT_RUNTIME);
+    hb_stage_result res = {0, -1, 1};
+    for (int j = 0; j < o->warmup + o->repeat; j++) {
+        if (j > 0) HB_TRY(b->restore(b, err, errlen), HB_EXIT_RUNTIME);
+        HB_TRY(b->run_stage(b, o->stages, i, o->n_stages, &res, err, errlen), HB_EXIT_RUNTIME);
+        if (j >= o->warmup) times[j - o->warmup] = res.ms;
+    }
+    sr->times_ms = times;
+    sr->n_times = o->repeat;
+    hb_time_stats(sr->times_ms, sr->n_times, &sr->meta.median_ms, &sr->meta.min_ms, &sr->meta.max_ms);
+    if (res.consumed == 2) {
+        /* a fused wind+collide: one time for the pair, two frames */
+        hb_stage_record *sc = &rec->stages[rec->n_stages++];
+        snprintf(sr->meta.fused, sizeof sr->meta.fused, "wind+collide");
+        sc->frame = frame + 1;
+        sc->stage = o->stages[i + 1];
+        hb_frame_meta_init(&sc->meta, sc->stage, &o->scene, b->name, o->variant);
+        sc->meta.step = frame + 1;
+        snprintf(sc->meta.fused, sizeof sc->meta.fused, "into-previous");
+        sc->meta.moved_points = res.moved_points;
+        if (r->w) {
+            HB_TRY(b->fetch_intermediate(b, r->host, err, errlen), HB_EXIT_RUNTIME);
+            HB_TRY(hb_writer_append(r->w, hb_run_as_written(r, r->host), &sr->meta, err, errlen), HB_EXIT_RUNTIME);
+        }
+        sr = sc;
+    } else {
+        sr->meta.moved_points = res.moved_points;
+    }
+    HB_TRY(write_current(r, &sr->meta, err, errlen), HB_EXIT_RUNTIME);
+    *consumed = res.consumed;
+    return HB_EXIT_OK;
+}
+
+/* ---- the stages in order from frame `frame`, simulate (the dynamic model's) last ---- */
+static int run_stages(hb_run *r, int frame, char *err, size_t errlen)
+{
+    hb_backend *b = r->b;
+    hb_options *o = r->o;
+    hb_record *rec = r->rec;
+    if (b->keep_intermediate) b->keep_intermediate(b, r->w != NULL);
+    double *times = r->times;
+    for (int i = 0; i < o->n_stages;) {
+        hb_stage st = o->stages[i];
+        hb_stage_record *sr = &rec->stages[rec->n_stages++];
+        sr->frame = frame;
+        sr->stage = st;
+        hb_frame_meta_init(&sr->meta, st, &o->scene, b->name, o->variant);
+        sr->meta.step = frame;
+        if (st == HB_STAGE_SIMULATE) return hb_run_simulate(r, sr, frame, times, err, errlen);
+        int consumed = 1;
+        if (st == HB_STAGE_INIT && o->groom) {
+            HB_TRY(place_groom(r, sr, times, err, errlen), HB_EXIT_RUNTIME);
+            times += o->repeat;
+        } else if (st == HB_STAGE_WIND && o->scene.wind_strength == 0.0) {
+            /* a stage whose effect is nil is not launched (docs/model.md §2.6) */
+            sr->meta.skipped = 1;
+            HB_TRY(write_current(r, &sr->meta, err, errlen), HB_EXIT_RUNTIME);
+        } else {
+            const int status = run_paper_stage(r, i, frame, sr, times, &consumed, err, errlen);
+            if (status != HB_EXIT_OK) return status;
+            times += o->repeat;
+        }
+        frame += consumed;
+        i += consumed;
+    }
+    return HB_EXIT_OK;
+}
+
+/* ---- one whole pass, transfers included, timed apart from the stages ---- */
+static int run_end_to_end(hb_run *r, char *err, size_t errlen)
+{
+    hb_backend *b = r->b;
+    hb_options *o = r->o;
+    hb_record *rec = r->rec;
+    if (b->keep_intermediate) b->keep_intermediate(b, 0);
+    double t0 = hb_now_ms(), h2d = 0, d2h = 0;
+    if (o->input) HB_TRY(b->load(b, r->input, &h2d, err, errlen), HB_EXIT_RUNTIME);
+    for (int i = 0; i < o->n_stages;) {
+        if (o->stages[i] == HB_STAGE_WIND && o->scene.wind_strength == 0.0) {
+            i++;
+            continue;
+        }
+        hb_stage_result res = {0, -1, 1};
+        HB_TRY(b->run_stage(b, o->stages, i, o->n_stages, &res, err, errlen), HB_EXIT_RUNTIME);
+        i += res.consumed;
+    }
+    HB_TRY(b->fetch(b, r->host, &d2h, err, errlen), HB_EXIT_RUNTIME);
+    rec->end_to_end_ms = hb_now_ms() - t0;
+    if (strcmp(b->name, "cpu") != 0) {
+        rec->h2d_ms = o->input ? h2d : NAN;
+        rec->d2h_ms = d2h;
+    }
+    return HB_EXIT_OK;
+}
+
+/* ---- the file's /parameters, then the file closed into place ---- */
+static int close_output(hb_run *r, char *err, size_t errlen)
+{
+    const hb_backend *b = r->b;
+    const hb_options *o = r->o;
+    hb_record *rec = r->rec;
+    hb_run_meta rm = {b->name,
+                      o->variant,
+                      rec->git_revision,
+                      rec->compiler,
+                      b->flags,
+                      rec->device,
+                      rec->driver,
+                      rec->threads,
+                      rec->block_size,
+                      o->repeat,
+                      o->warmup,
+                      rec->end_to_end_ms,
+                      0,
+                      r->sim.dynamic,
+                      r->sim.paper_frames,
+                      r->sim.last_frame,
+                      (int)o->output_every,
+                      r->sim.features,
+                      NULL,
+                      {0.0, 0.0, 0.0}};
+    if (o->scene.groom == HB_GROOM_FILE) {
+        rm.groom_head = r->groom.head_given ? "given" : "fitted";
+        memcpy(rm.groom_head_center, r->groom.head_center, sizeof rm.groom_head_center);
+    }
+    double t0 = hb_now_ms(), before = 1e3 * hb_writer_seconds(r->w);
+    hb_writer *w = r->w;
+    r->w = NULL;
+    const int rc_close = hb_writer_close(w, &rm, err, errlen);
+    if (rc_close) return rc_close == HB_SAFE_EXISTS ? HB_EXIT_USAGE : HB_EXIT_RUNTIME;
+    rec->hdf5_write_ms = before + (hb_now_ms() - t0);
+    return HB_EXIT_OK;
+}
 
 static int run_one(int argc, char **argv, hb_backend *b);
 
@@ -688,23 +810,8 @@ static int run_one(int argc, char **argv, hb_backend *b)
 
     if (o.list_variants) return list_variants(b);
 
-    if (!o.variant) o.variant = b->default_variant;
-    const hb_variant *var = NULL;
-    for (const hb_variant *v = b->variants; v->name; v++)
-        if (strcmp(v->name, o.variant) == 0) var = v;
-    if (!var) {
-        char list[256] = "";
-        for (const hb_variant *v = b->variants; v->name; v++)
-            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? ", " : "", v->name);
-        snprintf(err, sizeof err, "--variant %s is not a %s variant (known: %s)", o.variant, b->name, list);
-        return die(HB_EXIT_USAGE, err);
-    }
-    for (int i = 0; i < o.n_stages; i++)
-        if (!(var->stages & (1u << o.stages[i]))) {
-            snprintf(err, sizeof err, "--stages: the %s variant %s does not run '%s' (see --list-variants)", b->name,
-                     var->name, hb_stage_name(o.stages[i]));
-            return die(HB_EXIT_USAGE, err);
-        }
+    const hb_variant *var;
+    if (pick_variant(&o, b, &var, err, sizeof err)) return die(HB_EXIT_USAGE, err);
 
     hb_record rec;
     memset(&rec, 0, sizeof rec);
@@ -723,342 +830,26 @@ static int run_one(int argc, char **argv, hb_backend *b)
     run.rec = &rec;
     rec.groom = &run.groom;
 
+    int status;
     if (o.measure_bandwidth) {
-        double gbps = 0, bytes = 0, triad = NAN, triad_bytes = NAN;
-        CHECK(b->measure_bandwidth(b, &o, &gbps, &bytes, err, sizeof err), HB_EXIT_RUNTIME);
-        if (b->measure_triad) CHECK(b->measure_triad(b, &o, &triad, &triad_bytes, err, sizeof err), HB_EXIT_RUNTIME);
-        b->describe(b, rec.device, sizeof rec.device, rec.driver, sizeof rec.driver);
-        if (o.json) {
-            printf("{\"backend\": \"%s\", \"copy_gbps\": %.6g, \"bytes\": %.17g", b->name, gbps, bytes);
-            if (isfinite(triad)) printf(", \"triad_gbps\": %.6g, \"triad_bytes\": %.17g", triad, triad_bytes);
-            if (b->threads > 0) printf(", \"threads\": %d", b->threads);
-            printf(", \"device\": \"%s\"}\n", rec.device);
-        } else {
-            printf("%s copy bandwidth: %.1f GB/s (read + write, %.0f bytes per copy)", b->name, gbps, bytes);
-            if (isfinite(triad)) printf("; triad %.1f GB/s (%.0f bytes)", triad, triad_bytes);
-            printf(" on %s\n", rec.device);
-        }
+        status = print_bandwidth(&run, err, sizeof err);
         run_free(&run);
-        return HB_EXIT_OK;
+        return status == HB_EXIT_OK ? HB_EXIT_OK : die(status, err);
     }
-
-    /* ---- refuse bad input before any work (docs/model.md §2.6) ---- */
-    if (o.input) {
-        CHECK(hb_input_open(o.input, &run.in, err, sizeof err), HB_EXIT_USAGE);
-        run.have_input = 1;
-        CHECK(adopt_input_scene(&o, &run.in.scene, run.in.dynamic, err, sizeof err), HB_EXIT_USAGE);
-        for (int i = 0; i < o.n_stages; i++)
-            if (o.stages[i] == HB_STAGE_INIT) {
-                snprintf(err, sizeof err, "--stages: init cannot run on an --input state (it would replace it)");
-                CHECK(1, HB_EXIT_USAGE);
-            }
-    }
-    if (o.groom) {
-        const int groom_status = check_groom(&o, &run.groom, err, sizeof err);
-        CHECK(groom_status, groom_status < 0 ? HB_EXIT_USAGE : groom_status);
-    }
-    if (o.scene.dyn.colliders_path && !o.scene.dyn.cols) { /* docs/model.md §3.17 (a resumed run has the file's) */
-        CHECK(hb_colliders_load(o.scene.dyn.colliders_path, &run.cols, err, sizeof err), HB_EXIT_USAGE);
-        o.scene.dyn.cols = &run.cols;
-    }
-    if (!o.input && o.stages[0] != HB_STAGE_INIT) {
-        snprintf(err, sizeof err, "--stages: '%s' needs a state: list init first or give --input",
-                 hb_stage_name(o.stages[0]));
-        CHECK(1, HB_EXIT_USAGE);
-    }
-    CHECK(hb_scene_validate(&o.scene, err, sizeof err), HB_EXIT_USAGE);
     const int simulate = o.stages[o.n_stages - 1] == HB_STAGE_SIMULATE;
-    if (simulate) {
-        CHECK(adopt_track(&o, &run, err, sizeof err), HB_EXIT_USAGE);
-        CHECK(hb_dynamics_validate(&o.scene.dyn, err, sizeof err), HB_EXIT_USAGE);
-        CHECK(hb_dynamics_validate_scene(&o.scene, err, sizeof err), HB_EXIT_USAGE);
-        if (o.end_to_end) {
-            snprintf(err, sizeof err, "--end-to-end is not measured for simulate: its frames are timed one by one");
-            CHECK(1, HB_EXIT_USAGE);
-        }
-        if (var->max_points > 0 && o.scene.points > var->max_points) {
-            snprintf(err, sizeof err,
-                     "--points %lld: the %s variant %s simulates at most %lld points a strand (see --list-variants)",
-                     (long long)o.scene.points, b->name, var->name, (long long)var->max_points);
-            CHECK(1, HB_EXIT_USAGE);
-        }
-        if (!(hb_variant_solvers(var) & (1u << o.scene.dyn.solver))) {
-            snprintf(err, sizeof err, "--solver %s: the %s variant %s does not run it (see --list-variants)",
-                     hb_solver_name(o.scene.dyn.solver), b->name, var->name);
-            CHECK(1, HB_EXIT_USAGE);
-        }
-        if (o.scene.dyn.per_segment && !var->per_segment) {
-            snprintf(err, sizeof err,
-                     "%s: the %s variant %s does not simulate a groom's per-segment rest lengths yet (docs/model.md "
-                     "§3.15)",
-                     o.groom ? "--groom" : "--input", b->name, var->name);
-            CHECK(1, HB_EXIT_USAGE);
-        }
-        const unsigned lacking = x_declared(&o.scene.dyn) & var->lacks;
-        for (int x = 0; x < HB_X_COUNT; x++)
-            if (lacking & (1u << x)) {
-                snprintf(err, sizeof err, "--variant %s does not run %s (see --list-variants)", var->name,
-                         x_features[x].flag);
-                CHECK(1, HB_EXIT_USAGE);
-            }
-        if (var->max_block > 0 && o.block_size > var->max_block) {
-            snprintf(err, sizeof err,
-                     "--block-size %d: the %s variant %s simulates with at most %d threads a block (see "
-                     "--list-variants)",
-                     o.block_size, b->name, var->name, var->max_block);
-            CHECK(1, HB_EXIT_USAGE);
-        }
-        if ((o.frame_loop || o.draw_w) && (o.scene.dyn.grid || hb_dyn_has_world(&o.scene))) {
-            snprintf(err, sizeof err, "%s does not yet run the grid and colliders (docs/model.md §3.16, §3.17)",
-                     o.frame_loop ? "--frame-loop" : "--draw");
-            CHECK(1, HB_EXIT_USAGE);
-        }
-        if (o.frame_loop && !b->dyn_loop) {
-            snprintf(err, sizeof err, "--frame-loop is measured by the cuda backend only");
-            CHECK(1, HB_EXIT_USAGE);
-        }
-        if (o.draw_w && !b->dyn_draw) {
-            snprintf(err, sizeof err, "--draw draws on the GPU: the cuda backend only");
-            CHECK(1, HB_EXIT_USAGE);
-        }
-    } else if (o.frame_loop) {
-        snprintf(err, sizeof err, "--frame-loop needs simulate in --stages");
-        CHECK(1, HB_EXIT_USAGE);
-    } else if (o.draw_w) {
-        snprintf(err, sizeof err, "--draw needs simulate in --stages");
-        CHECK(1, HB_EXIT_USAGE);
+    int frame = 0;
+    status = check_run(&run, var, simulate, err, sizeof err);
+    if (status == HB_EXIT_OK) {
+        if (simulate) note_untuned(&o, &run);
+        status = prepare_run(&run, simulate, err, sizeof err);
     }
-    if (o.draw_image && !o.draw_w) {
-        snprintf(err, sizeof err, "--draw-image needs --draw");
-        CHECK(1, HB_EXIT_USAGE);
-    }
-    if (o.input) {
-        if (o.input_frame >= run.in.n_frames) {
-            snprintf(err, sizeof err, "--input-frame %d: %s has frames 0 to %d", o.input_frame, o.input,
-                     run.in.n_frames - 1);
-            CHECK(1, HB_EXIT_USAGE);
-        }
-        if (o.input_frame < 0) o.input_frame = run.in.n_frames - 1;
-        if (run.in.dynamic && o.input_frame >= run.in.paper_frames && !simulate) {
-            snprintf(err, sizeof err, "--stages: frame %d of %s is simulated; only simulate can follow it",
-                     o.input_frame, o.input);
-            CHECK(1, HB_EXIT_USAGE);
-        }
-    } else if (o.input_frame >= 0) {
-        snprintf(err, sizeof err, "--input-frame needs --input");
-        CHECK(1, HB_EXIT_USAGE);
-    }
-    if (o.output && o.input && same_file(o.output, o.input)) {
-        snprintf(err, sizeof err, "--output %s is the --input file; write to another name", o.output);
-        CHECK(1, HB_EXIT_USAGE);
-    }
-
-    if (simulate) note_untuned(&o, &run);
-
-    const uint64_t bytes = hb_state_bytes(&o.scene);
-    const int need_host = o.output != NULL || o.end_to_end || simulate;
-    /* simulate: the rest shape and the velocities pass through the host once */
-    /* --render-points: a rendered frame, its velocities and the simulated velocities */
-    const int64_t pr = simulate ? o.scene.dyn.render_points : 0;
-    const uint64_t render_bytes =
-        pr ? hb_mul_sat(hb_mul_sat((uint64_t)o.scene.n_strands, (uint64_t)pr), 3u * hb_real_size(o.scene.precision))
-           : 0;
-    const uint64_t driver_bytes = hb_add_sat(
-        hb_add_sat(hb_add_sat(need_host ? bytes : 0, o.input ? bytes : 0), simulate ? hb_mul_sat(bytes, 2u) : 0),
-        hb_add_sat(hb_mul_sat(render_bytes, 2u), render_bytes ? bytes : 0));
-    const int need_save = o.repeat > 1 || o.warmup > 0;
-    int status = b->setup(b, &o, need_save, driver_bytes, err, sizeof err);
+    if (status == HB_EXIT_OK) status = load_input(&run, &frame, err, sizeof err);
+    if (status == HB_EXIT_OK) status = run_stages(&run, frame, err, sizeof err);
+    if (status == HB_EXIT_OK && o.end_to_end) status = run_end_to_end(&run, err, sizeof err);
+    if (status == HB_EXIT_OK && run.w) status = close_output(&run, err, sizeof err);
     if (status != HB_EXIT_OK) {
         run_free(&run);
         return die(status, err);
-    }
-    b->describe(b, rec.device, sizeof rec.device, rec.driver, sizeof rec.driver);
-    rec.flags = b->flags; /* setup may name the build that runs (cpu simd: x86-64-v3 or -v4) */
-    rec.threads = b->threads;
-    rec.block_size = b->block_size;
-    if (need_host && !(run.host = malloc(bytes))) {
-        snprintf(err, sizeof err, "cannot allocate the %llu-byte host frame", (unsigned long long)bytes);
-        CHECK(1, HB_EXIT_MEMORY);
-    }
-    if (render_bytes && (!(run.render = malloc(render_bytes)) || !(run.vrender = malloc(render_bytes)) ||
-                         !(run.vhost = malloc(bytes)))) {
-        snprintf(err, sizeof err, "cannot allocate the %llu-byte rendered frames (--render-points)",
-                 (unsigned long long)render_bytes);
-        CHECK(1, HB_EXIT_MEMORY);
-    }
-    if (o.input && !(run.input = malloc(bytes))) {
-        snprintf(err, sizeof err, "cannot allocate the %llu-byte input frame", (unsigned long long)bytes);
-        CHECK(1, HB_EXIT_MEMORY);
-    }
-    /* one time per stage (or simulated frame) and repeat, counted by an int */
-    uint64_t n_times, times_bytes;
-    if (hb_add_u64((uint64_t)o.n_stages, simulate ? (uint64_t)o.frames : 0, &n_times) ||
-        hb_mul_u64(n_times, (uint64_t)o.repeat, &n_times) || n_times > INT32_MAX ||
-        hb_mul_u64(n_times, sizeof *run.times, &times_bytes)) {
-        snprintf(err, sizeof err, "--frames %lld x --repeat %lld is more timings than a run keeps (at most %d)",
-                 (long long)(simulate ? o.frames : 0), (long long)o.repeat, INT32_MAX);
-        CHECK(1, HB_EXIT_USAGE);
-    }
-    run.times = calloc((size_t)n_times, sizeof *run.times);
-    if (!run.times) {
-        snprintf(err, sizeof err, "out of host memory");
-        CHECK(1, HB_EXIT_MEMORY);
-    }
-    if (o.output) {
-        int open_status;
-        run.w = hb_writer_open(o.output, o.force, &o.scene, &open_status, err, sizeof err);
-        if (!run.w) CHECK(1, open_status);
-    }
-
-    /* ---- the input state: its frames go into the output first ---- */
-    int frame = 0;
-    if (o.input) {
-        const int last = o.input_frame;
-        CHECK(hb_input_read_frame(&run.in, last, run.input, err, sizeof err), HB_EXIT_USAGE);
-        if (run.w) {
-            for (int f = 0; f <= last; f++) {
-                const void *src = run.input;
-                if (f != last) {
-                    CHECK(hb_input_read_frame(&run.in, f, run.host, err, sizeof err), HB_EXIT_USAGE);
-                    src = run.host;
-                }
-                CHECK(hb_writer_append(run.w, as_written(&run, src), &run.in.frames[f], err, sizeof err),
-                      HB_EXIT_RUNTIME);
-            }
-        }
-        frame = last + 1;
-        double ms;
-        CHECK(b->load(b, run.input, &ms, err, sizeof err), HB_EXIT_RUNTIME);
-    }
-    if (b->keep_intermediate) b->keep_intermediate(b, run.w != NULL);
-
-    /* ---- the stages, each timed from the same input (docs/model.md §5.3) ---- */
-    double *times = run.times;
-    for (int i = 0; i < o.n_stages;) {
-        hb_stage st = o.stages[i];
-        hb_stage_record *sr = &rec.stages[rec.n_stages++];
-        sr->frame = frame;
-        sr->stage = st;
-        frame_meta(&sr->meta, st, &o.scene, b->name, o.variant);
-        sr->meta.step = frame;
-        if (st == HB_STAGE_INIT && o.groom) {
-            CHECK(place_groom(&run, sr, times, err, sizeof err), HB_EXIT_RUNTIME);
-            times += o.repeat;
-            frame++;
-            i++;
-            continue;
-        }
-        if (st == HB_STAGE_SIMULATE) {
-            status = run_simulate(&run, sr, frame, times, err, sizeof err);
-            if (status != HB_EXIT_OK) {
-                run_free(&run);
-                return die(status, err);
-            }
-            break; /* simulate is the last stage */
-        }
-        if (st == HB_STAGE_WIND && o.scene.wind_strength == 0.0) {
-            /* a stage whose effect is nil is not launched (docs/model.md §2.6) */
-            sr->meta.skipped = 1;
-            if (run.w) {
-                double ms;
-                CHECK(b->fetch(b, run.host, &ms, err, sizeof err), HB_EXIT_RUNTIME);
-                CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
-            }
-            frame++;
-            i++;
-            continue;
-        }
-        if (need_save) CHECK(b->save(b, err, sizeof err), HB_EXIT_RUNTIME);
-        hb_stage_result r = {0, -1, 1};
-        for (int j = 0; j < o.warmup + o.repeat; j++) {
-            if (j > 0) CHECK(b->restore(b, err, sizeof err), HB_EXIT_RUNTIME);
-            CHECK(b->run_stage(b, o.stages, i, o.n_stages, &r, err, sizeof err), HB_EXIT_RUNTIME);
-            if (j >= o.warmup) times[j - o.warmup] = r.ms;
-        }
-        sr->times_ms = times;
-        sr->n_times = o.repeat;
-        times += o.repeat;
-        hb_time_stats(sr->times_ms, sr->n_times, &sr->meta.median_ms, &sr->meta.min_ms, &sr->meta.max_ms);
-        if (r.consumed == 2) {
-            /* a fused wind+collide: one time for the pair, two frames */
-            hb_stage_record *sc = &rec.stages[rec.n_stages++];
-            snprintf(sr->meta.fused, sizeof sr->meta.fused, "wind+collide");
-            sc->frame = frame + 1;
-            sc->stage = o.stages[i + 1];
-            frame_meta(&sc->meta, sc->stage, &o.scene, b->name, o.variant);
-            sc->meta.step = frame + 1;
-            snprintf(sc->meta.fused, sizeof sc->meta.fused, "into-previous");
-            sc->meta.moved_points = r.moved_points;
-            if (run.w) {
-                CHECK(b->fetch_intermediate(b, run.host, err, sizeof err), HB_EXIT_RUNTIME);
-                CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
-            }
-            sr = sc;
-        } else {
-            sr->meta.moved_points = r.moved_points;
-        }
-        if (run.w) {
-            double ms;
-            CHECK(b->fetch(b, run.host, &ms, err, sizeof err), HB_EXIT_RUNTIME);
-            CHECK(hb_writer_append(run.w, as_written(&run, run.host), &sr->meta, err, sizeof err), HB_EXIT_RUNTIME);
-        }
-        frame += r.consumed;
-        i += r.consumed;
-    }
-
-    /* ---- one whole pass, transfers included, timed apart from the stages ---- */
-    if (o.end_to_end) {
-        if (b->keep_intermediate) b->keep_intermediate(b, 0);
-        double t0 = hb_now_ms(), h2d = 0, d2h = 0;
-        if (o.input) CHECK(b->load(b, run.input, &h2d, err, sizeof err), HB_EXIT_RUNTIME);
-        for (int i = 0; i < o.n_stages;) {
-            if (o.stages[i] == HB_STAGE_WIND && o.scene.wind_strength == 0.0) {
-                i++;
-                continue;
-            }
-            hb_stage_result r = {0, -1, 1};
-            CHECK(b->run_stage(b, o.stages, i, o.n_stages, &r, err, sizeof err), HB_EXIT_RUNTIME);
-            i += r.consumed;
-        }
-        CHECK(b->fetch(b, run.host, &d2h, err, sizeof err), HB_EXIT_RUNTIME);
-        rec.end_to_end_ms = hb_now_ms() - t0;
-        if (strcmp(b->name, "cpu") != 0) {
-            rec.h2d_ms = o.input ? h2d : NAN;
-            rec.d2h_ms = d2h;
-        }
-    }
-
-    if (run.w) {
-        hb_run_meta rm = {b->name,
-                          o.variant,
-                          rec.git_revision,
-                          rec.compiler,
-                          b->flags,
-                          rec.device,
-                          rec.driver,
-                          rec.threads,
-                          rec.block_size,
-                          o.repeat,
-                          o.warmup,
-                          rec.end_to_end_ms,
-                          0,
-                          run.sim.dynamic,
-                          run.sim.paper_frames,
-                          run.sim.last_frame,
-                          (int)o.output_every,
-                          run.sim.features,
-                          NULL,
-                          {0.0, 0.0, 0.0}};
-        if (o.scene.groom == HB_GROOM_FILE) {
-            rm.groom_head = run.groom.head_given ? "given" : "fitted";
-            memcpy(rm.groom_head_center, run.groom.head_center, sizeof rm.groom_head_center);
-        }
-        double t0 = hb_now_ms(), before = 1e3 * hb_writer_seconds(run.w);
-        hb_writer *w = run.w;
-        run.w = NULL;
-        const int rc_close = hb_writer_close(w, &rm, err, sizeof err);
-        CHECK(rc_close, rc_close == HB_SAFE_EXISTS ? HB_EXIT_USAGE : HB_EXIT_RUNTIME);
-        rec.hdf5_write_ms = before + (hb_now_ms() - t0);
     }
     if (o.json) hb_record_json(stdout, &rec);
     if (!o.quiet) hb_record_summary(stderr, &rec);

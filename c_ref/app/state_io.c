@@ -1,10 +1,10 @@
 /* state_io.c — HDF5 states, H5MD 1.1 shaped (layout in docs/interfaces.md). */
-#include "runtime/state_io.h"
+#include "app/state_io.h"
 #include "runtime/safe_write.h"
 #include "runtime/checked.h"
 #include "runtime/h5md_meta.h"
 #include "runtime/input.h"
-#include "runtime/motion_track.h"
+#include "dynamic/motion_track.h"
 
 #include <errno.h>
 #include <stddef.h>

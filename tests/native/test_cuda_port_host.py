@@ -1,5 +1,5 @@
-"""The CUDA port's model math (cuda/model.cuh) run on the HOST against the C reference
-(c_ref/paper/model.c). No GPU needed: model.cuh is `__host__ __device__`, so a host-only program
+"""The CUDA port's model math (cuda/paper/model.cuh) run on the HOST against the C reference
+(c_ref/paper/model.c). No GPU needed: cuda/paper/model.cuh is `__host__ __device__`, so a host-only program
 (cuda/hostcheck/model_hostcheck.cu, no kernel launches) runs the very templates the kernels
 run, on the CPU, with glibc's libm like model.c. Both layouts, fp32 and fp64, P = 2, 3, 16,
 64, four scenes, every stage, the fused wind+collide with and without the kept
