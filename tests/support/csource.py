@@ -9,8 +9,8 @@ from pathlib import Path
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 # a comment, or a string or character literal, each blanked (its newlines kept)
 _NOISE = re.compile(r'//[^\n]*|/\*.*?\*/|"(?:\\.|[^"\\\n])*"|\'(?:\\.|[^\'\\\n])*\'', re.S)
-# braces that open a scope whose body is itself at file scope
-_TRANSPARENT = re.compile(r'(\bnamespace\b[^;{}]*|\bextern\s*"C"\s*)$')
+# braces that open a scope whose body is itself at file scope (extern "C": its string blanked)
+_TRANSPARENT = re.compile(r"(\bnamespace\b[^;{}]*|\bextern\s*)$")
 _NOT_FUNCTION = re.compile(r"\b(struct|union|enum|class|typedef)\b|=\s*$")
 
 
