@@ -64,7 +64,7 @@ SIMD_V4_CFLAGS := -O3 -march=x86-64-v4 -mprefer-vector-width=512 -fopenmp-simd -
 CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (c_ref/simd/) adds: $(SIMD_CFLAGS)
 CPU_FLAGS_STR_V4 := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (c_ref/simd/, x86-64-v4 build) adds: $(SIMD_V4_CFLAGS)
 
-# c_ref/, from the top layer down (docs/decisions/source-layout.md): app/ (the program both binaries
+# c_ref/, from the top layer down (docs/decisions/code-layout.md): app/ (the program both binaries
 # link: the driver, the backend interface, HDF5 states and the JSON record; it knows both models),
 # paper/ and dynamic/ (the two models' reference), runtime/ (model-free: command line, input,
 # parameters, safe writes), simd/ (the CPU simd variant), and backend_cpu.c (the CPU backend that
@@ -94,7 +94,7 @@ NVCC_MODE_normal   :=
 NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DHB_REFERENCE_ARITHMETIC=1
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
-HOSTCHECK_BINS := $(BUILD)/hostcheck/model_hostcheck_reference $(BUILD)/hostcheck/model_hostcheck_free \
+HOSTCHECK_BINS := $(BUILD)/hostcheck/paper_hostcheck_reference $(BUILD)/hostcheck/paper_hostcheck_free \
                   $(BUILD)/hostcheck/dyn_hostcheck $(BUILD)/hostcheck/post_hostcheck $(BUILD)/hostcheck/lod_hostcheck \
                   $(BUILD)/hostcheck/draw_hostcheck
 
@@ -225,9 +225,9 @@ $(CUDA_BINS):
 HOSTCHECK_WORLD_OBJ := $(OBJ)/dynamic/colliders.o $(OBJ)/dynamic/sdf_mesh.o $(OBJ)/runtime/cli.o $(OBJ)/runtime/input.o $(OBJ)/runtime/safe_write.o
 HOSTCHECK_NVCC := $(NVCC) -std=c++17 -Ic_ref -Icuda -Xcompiler -ffp-contract=off,-fno-fast-math
 hostcheck: $(HOSTCHECK_BINS)
-$(BUILD)/hostcheck/model_hostcheck_reference: HOSTCHECK_MODE := -O2 -DHB_REFERENCE_ARITHMETIC=1
-$(BUILD)/hostcheck/model_hostcheck_free: HOSTCHECK_MODE := -O2
-$(BUILD)/hostcheck/model_hostcheck_%: cuda/hostcheck/model_hostcheck.cu cuda/paper/model.cuh cuda/tmath.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/paper_hostcheck_reference: HOSTCHECK_MODE := -O2 -DHB_REFERENCE_ARITHMETIC=1
+$(BUILD)/hostcheck/paper_hostcheck_free: HOSTCHECK_MODE := -O2
+$(BUILD)/hostcheck/paper_hostcheck_%: cuda/hostcheck/paper_hostcheck.cu cuda/paper/model.cuh cuda/tmath.cuh $(C_HEADERS) \
   $(OBJ)/paper/model.o $(OBJ)/runtime/params.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) $(HOSTCHECK_MODE) $< $(OBJ)/paper/model.o $(OBJ)/runtime/params.o -o $@ -lm

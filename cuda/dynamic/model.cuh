@@ -37,7 +37,7 @@
 #include "dynamic/obs_point.h" /* hb_obs_point: §3.8 per point, shared with the reference */
 #include "runtime/params.h"    /* HB_SOLVER_* */
 #include "tmath.cuh"           /* m_sqrt, m_sin: the float overloads for float */
-#include "dynamic/world.cuh"       /* §3.16 grid, §3.17 colliders: contact_impl.h for float and double */
+#include "dynamic/world.cuh"   /* §3.16 grid, §3.17 colliders: contact_impl.h for float and double */
 
 #if defined(__CUDACC__)
 #define HB_DHD __host__ __device__ __forceinline__

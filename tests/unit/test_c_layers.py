@@ -1,4 +1,4 @@
-"""c_ref/ and cuda/ in layers with one-way includes (docs/decisions/source-layout.md): the
+"""c_ref/ and cuda/ in layers with one-way includes (docs/decisions/code-layout.md): the
 model-free runtime includes only itself, each model only the runtime and itself, the program
 (app/) sits above both; in cuda/ the paper and dynamic kernels never include each other. Every
 quoted include names one file of the tree, found the way the build's -I folders find it. And no

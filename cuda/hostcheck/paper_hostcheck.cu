@@ -1,4 +1,4 @@
-/* model_hostcheck.cu — runs the CUDA port's model (cuda/paper/model.cuh, __host__ __device__) on
+/* paper_hostcheck.cu — runs the CUDA port's model (cuda/paper/model.cuh, __host__ __device__) on
  * the HOST against the C reference (c_ref/paper/model.c).
  *
  * Built twice (tests/test_cuda_port_host.py):
@@ -21,9 +21,9 @@
  * (without the intermediate) must not write x: X is poisoned with a NaN pattern first and
  * must come back untouched.
  *
- * Built by `make hostcheck` twice (build/hostcheck/model_hostcheck_{reference,free}, with and
+ * Built by `make hostcheck` twice (build/hostcheck/paper_hostcheck_{reference,free}, with and
  * without -DHB_REFERENCE_ARITHMETIC=1), run by tests/native/test_cuda_port_host.py.
- * Usage: model_hostcheck [N [k32 over32 k64 over64 moved]]   (default 2000 strands; the
+ * Usage: paper_hostcheck [N [k32 over32 k64 over64 moved]]   (default 2000 strands; the
  * tolerances only for the free arithmetic). Exit status 0 = all checks pass.
  */
 #include <math.h>
