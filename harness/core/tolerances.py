@@ -532,7 +532,7 @@ ANALYTIC_FP32_WIND_ANGLE_ABS = 5e-4  # rad at S ≤ 8 (worst 8.7e-5; below the 3
 #
 # The strict build (no FMA contraction, IEEE division and square root, no flush to zero)
 # evaluates the model with +, −, ×, ÷ and sqrt only, each correctly rounded, in the order of
-# c_ref/dynamic/dynamics_impl.h (cuda/dyn_model.cuh; the host check shows the port reproduces the
+# c_ref/dynamic/dynamics_impl.h (cuda/dynamic/model.cuh; the host check shows the port reproduces the
 # C reference bit for bit with glibc's libm). So without gusts it must equal the CPU bit for
 # bit, observables included (GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS; the observables' reduction
 # is the CPU's, chunk by chunk in strand order); with gusts CUDA's sinf/sin (≤ 2 ulp from

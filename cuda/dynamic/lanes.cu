@@ -1,4 +1,4 @@
-/* dyn_lanes.cu — the lanes variant of the dynamic model's frame (docs/cuda.md "The lanes
+/* cuda/dynamic/lanes.cu — the lanes variant of the dynamic model's frame (docs/cuda.md "The lanes
  * variant"): a half-warp of 16 lanes per strand (two strands a warp), lane l holding the G
  * consecutive points G·l … G·l + G − 1 in registers for the whole frame, G = 2, 4 or 8
  * (P ≤ 32, 64, 128). Every group of docs/model.md §3.6 keeps nearly every lane busy:
@@ -11,13 +11,13 @@
  * sends its new position back, so every point is written by one lane.
  *
  * Arithmetic (docs/cuda.md "Builds and arithmetic"): the strict build (HB_REFERENCE_ARITHMETIC)
- * calls dyn_model.cuh's reference helpers, the same operations as c_ref/dynamic/dynamics_impl.h, so
+ * calls cuda/dynamic/model.cuh's reference helpers, the same operations as c_ref/dynamic/dynamics_impl.h, so
  * it gives the CPU's bits; the normal and fast-math builds use reciprocal square roots and
  * the scene's precomputed reciprocals (DModel::inv_*), judged by the one-frame rule.
  */
 #include <utility>
 
-#include "dyn_kernels.cuh"
+#include "dynamic/kernels.cuh"
 #include "runtime/approx.h" /* hb_rsqrt_fast, HB_FAST_FLOOR */
 
 namespace hb {
@@ -342,7 +342,7 @@ __device__ __forceinline__ void update(const DModel<T> &m, bool corr, const V3<T
 }
 
 template <typename T> __device__ __forceinline__ V3<T> rotated(const T *q, const V3<T> &a)
-{ /* Q·a as dyn_model.cuh's rotate: each row summed left to right */
+{ /* Q·a as cuda/dynamic/model.cuh's rotate: each row summed left to right */
     return V3<T>{q[0] * a.x + q[1] * a.y + q[2] * a.z, q[3] * a.x + q[4] * a.y + q[5] * a.z,
                  q[6] * a.x + q[7] * a.y + q[8] * a.z};
 }
