@@ -5,6 +5,7 @@ quoted include names one file of the tree, found the way the build's -I folders 
 function outside the CUDA kernels is over 150 lines. Read statically: no compiler needed."""
 
 import pytest
+
 from conftest import ROOT
 from support.csource import functions, includes
 
