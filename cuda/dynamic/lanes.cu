@@ -276,6 +276,18 @@ __device__ __forceinline__ void collide_world(const DModel<T> &m, Feat has, cons
     p = V3<T>{pp[0], pp[1], pp[2]};
 }
 
+/* The free builds' follow-the-leader target of p: ell from a along a→p (straight down when p is on a). */
+template <typename T> __device__ __forceinline__ V3<T> follow_target(T ell, const V3<T> &a, const V3<T> &p)
+{
+    const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
+    const T q = ex * ex + ey * ey + ez * ez;
+    if (q > floor_of<T>()) {
+        const T f = ell * rsq(q);
+        return V3<T>{a.x + f * ex, a.y + f * ey, a.z + f * ez};
+    }
+    return V3<T>{a.x, a.y - ell, a.z};
+}
+
 /* §3.7 one follow-the-leader step of p after its corrected predecessor a, ell its segment's
  * rest length; d: the correction; wc: the colliders of §3.17 (pose, back, x) instead of the head sphere. */
 template <typename T, class Feat>
@@ -285,15 +297,7 @@ __device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, 
 {
     if (wc) {
         if constexpr (kFree) {
-            const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
-            const T q = ex * ex + ey * ey + ez * ez;
-            V3<T> n;
-            if (q > floor_of<T>()) {
-                const T f = ell * rsq(q);
-                n = V3<T>{a.x + f * ex, a.y + f * ey, a.z + f * ez};
-            } else {
-                n = V3<T>{a.x, a.y - ell, a.z};
-            }
+            const V3<T> n = follow_target(ell, a, p);
             d = V3<T>{n.x - p.x, n.y - p.y, n.z - p.z};
             p = n;
         } else {
@@ -303,15 +307,7 @@ __device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, 
         return;
     }
     if constexpr (kFree) {
-        const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
-        const T q = ex * ex + ey * ey + ez * ez;
-        V3<T> n;
-        if (q > floor_of<T>()) {
-            const T f = ell * rsq(q);
-            n = V3<T>{a.x + f * ex, a.y + f * ey, a.z + f * ez};
-        } else {
-            n = V3<T>{a.x, a.y - ell, a.z};
-        }
+        V3<T> n = follow_target(ell, a, p);
         d = V3<T>{n.x - p.x, n.y - p.y, n.z - p.z};
         if (has(HB_F_COLLIDE)) collide(m, n);
         p = n;
