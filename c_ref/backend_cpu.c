@@ -726,11 +726,11 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
     return hb_host_world_make(&c->world, &c->scene, c->rest, 1, err, errlen);
 }
 
-/* Strands over threads, substeps j0 … j1 − 1; each thread's scratch (9·P reals) is its own. */
+/* Strands over threads, substeps j0 … j1 − 1; each thread's scratch (17·P reals, dynamics.h) is its own. */
 #define DYN_FRAME(T, SFX, M, W)                                                                                        \
     _Pragma("omp parallel")                                                                                            \
     {                                                                                                                  \
-        T *scratch = malloc((size_t)hb_mul_sat((uint64_t)P, 9u * sizeof(T)));                                          \
+        T *scratch = malloc((size_t)hb_mul_sat((uint64_t)P, 17u * sizeof(T)));                                          \
         if (!scratch) {                                                                                                \
             _Pragma("omp atomic write") failed = 1;                                                                    \
         } else {                                                                                                       \

@@ -494,7 +494,8 @@ static int write_world(hid_t p, const hb_dynamics *d)
     int bad = attr_i64(p, "grid", d->grid) < 0;
     if (d->grid) {
         bad |= attr_i64(p, "grid_n", d->grid_n) < 0;
-        bad |= attr_str(p, "grid_rebuild", d->grid_rebuild == HB_GRID_SUBSTEP ? "substep" : "frame") < 0;
+        bad |= attr_str(p, "grid_rebuild",
+                        d->grid_rebuild == HB_GRID_SUBSTEP ? "substep" : d->grid_rebuild == HB_GRID_HELD ? "held" : "frame") < 0;
         bad |= attr_i64(p, "grid_box_given", d->grid_box_given) < 0;
         bad |= attr_f64v(p, "grid_box", d->grid_box, 6) < 0;
         bad |= attr_f64(p, "grid_padding", d->grid_padding) < 0;
@@ -921,9 +922,11 @@ static int input_world(hb_input *in, const char *path, hid_t p, char *err, size_
         int64_t given = 0, fr = 0, vol = 0;
         if (read_attr(p, "grid_n", H5T_NATIVE_INT64, &d->grid_n) < 0) BAD("grid_n");
         if (read_attr_str(p, "grid_rebuild", word, sizeof word) < 0 ||
-            (strcmp(word, "frame") != 0 && strcmp(word, "substep") != 0))
+            (strcmp(word, "frame") != 0 && strcmp(word, "substep") != 0 && strcmp(word, "held") != 0))
             BAD("grid_rebuild");
-        d->grid_rebuild = strcmp(word, "substep") == 0 ? HB_GRID_SUBSTEP : HB_GRID_FRAME;
+        d->grid_rebuild = strcmp(word, "substep") == 0 ? HB_GRID_SUBSTEP
+                          : strcmp(word, "held") == 0  ? HB_GRID_HELD
+                                                       : HB_GRID_FRAME;
         if (read_attr(p, "grid_box_given", H5T_NATIVE_INT64, &given) < 0 ||
             read_attr_f64v(p, "grid_box", d->grid_box, 6) < 0 ||
             read_attr(p, "grid_padding", H5T_NATIVE_DOUBLE, &d->grid_padding) < 0)

@@ -111,12 +111,17 @@ HB_HD void SFX(hb_grid_node)(int64_t j, int64_t gn, const int64_t *mass, const i
     }
 }
 
-/* §3.16 the hair–hair correction of point k (≥ 1) at x, velocity v, in step 2 of §3.4. */
-HB_HD void SFX(hb_grid_correct)(const WORLD *w, const REAL *qg, REAL h, int64_t k, const REAL *x, REAL *v)
+/* §3.16 the grid's sample at x (the correction's inputs): s[0..2] = v̄ and s[3] = 1 where
+ * friction applies (S_w > 0), else s[3] = 0; s[4..6] = ā (volume); s[7] = 1 when x is in the
+ * grid, else 0 (then nothing else is written). */
+HB_HD void SFX(hb_grid_sample)(const WORLD *w, const REAL *qg, const REAL *x, REAL *s)
 {
     int64_t base;
     REAL wt[8];
+    s[7] = (REAL)0;
     if (!SFX(hb_grid_locate)(qg, w->glo, w->gsc, w->gn, x, &base, wt)) return;
+    s[7] = (REAL)1;
+    s[3] = (REAL)0;
     if (w->grid_friction) {
         REAL sw = (REAL)0, sv[3] = {(REAL)0, (REAL)0, (REAL)0};
         for (int c8 = 0; c8 < 8; c8++) {
@@ -127,11 +132,8 @@ HB_HD void SFX(hb_grid_correct)(const WORLD *w, const REAL *qg, REAL h, int64_t 
             }
         }
         if (sw > (REAL)0) {
-            const REAL f = w->ftab[k];
-            for (int c = 0; c < 3; c++) {
-                const REAL vbar = sv[c] / sw;
-                v[c] = v[c] + f * (vbar - v[c]);
-            }
+            for (int c = 0; c < 3; c++) s[c] = sv[c] / sw;
+            s[3] = (REAL)1;
         }
     }
     if (w->grid_volume) {
@@ -140,8 +142,28 @@ HB_HD void SFX(hb_grid_correct)(const WORLD *w, const REAL *qg, REAL h, int64_t 
             const REAL *na = w->node_a + 4 * SFX(hb_grid_corner)(base, w->gn, c8);
             for (int c = 0; c < 3; c++) a[c] = a[c] + wt[c8] * na[c];
         }
-        for (int c = 0; c < 3; c++) v[c] = v[c] + h * a[c];
+        for (int c = 0; c < 3; c++) s[4 + c] = a[c];
     }
+}
+
+/* §3.16 the correction of point k (≥ 1), velocity v, from its sample s (hb_grid_sample). */
+HB_HD void SFX(hb_grid_apply)(const WORLD *w, REAL h, int64_t k, const REAL *s, REAL *v)
+{
+    if (s[7] == (REAL)0) return;
+    if (w->grid_friction && s[3] != (REAL)0) {
+        const REAL f = w->ftab[k];
+        for (int c = 0; c < 3; c++) v[c] = v[c] + f * (s[c] - v[c]);
+    }
+    if (w->grid_volume)
+        for (int c = 0; c < 3; c++) v[c] = v[c] + h * s[4 + c];
+}
+
+/* §3.16 the hair–hair correction of point k (≥ 1) at x, velocity v, in step 2 of §3.4. */
+HB_HD void SFX(hb_grid_correct)(const WORLD *w, const REAL *qg, REAL h, int64_t k, const REAL *x, REAL *v)
+{
+    REAL s[8];
+    SFX(hb_grid_sample)(w, qg, x, s);
+    SFX(hb_grid_apply)(w, h, k, s, v);
 }
 
 /* ---- §3.17 colliders ---- */

@@ -103,7 +103,7 @@ int hb_obs_blown_up(const hb_observables *o);
 void hb_dyn_reduce_into(hb_obs_partial *acc, const hb_obs_partial *o);
 
 /* ---- one strand (dynamics_impl.h via dynamics_f32.c, dynamics_f64.c) ----
- * `scratch` holds 9·P reals. `bend_rest` holds P − 2 rest lengths (hb_dyn_bend_rest). */
+ * `scratch` holds 17·P reals. `bend_rest` holds P − 2 rest lengths (hb_dyn_bend_rest). */
 void hb_dyn_bend_rest_f32(const hb_dyn_model_f32 *m, const float *rest, float *bend_rest);
 void hb_dyn_bend_rest_f64(const hb_dyn_model_f64 *m, const double *rest, double *bend_rest);
 /* `seg_rest` holds the P − 1 stretch rest lengths ℓ_k of a groom (§3.15), NULL for ℓ = L/(P−1). */

@@ -180,8 +180,11 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_
     REAL *lam = scratch + 3 * P; /* multipliers: stretch P−1 | bend P−2 | shape K */
     REAL *lam_s = lam, *lam_b = lam + P, *lam_g = lam + 2 * P;
     REAL *d = scratch + 6 * P; /* ftl corrections d_k, 3P */
+    REAL *hs = scratch + 9 * P; /* §3.16 `held`: the points' grid samples of the frame, 8P */
 
     const int wgrid = w && w->grid && (w->grid_friction || w->grid_volume);
+    const int held = wgrid && w->grid_rebuild == HB_GRID_HELD;
+    (void)hs;
     const int wcol = w && (w->ncol > 0 || w->head_friction || w->bounded);
     for (int64_t j = j0; j < j1; j++) {
         const REAL *q = QTABLE(fr) + 9 * j; /* Q(t + h) */
@@ -226,7 +229,12 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_
         for (int64_t k = 1; k < P; k++) {
             REAL *vk = v + 3 * k;
             const REAL *xk = x + 3 * k;
-            if (wgrid) SFX(hb_grid_correct)(w, qg, h, k, xk, vk); /* §3.16 friction, then volume */
+            if (held) { /* §3.16 the sample taken at the frame's first substep, applied at each */
+                if (j == 0) SFX(hb_grid_sample)(w, qg, xk, hs + 8 * k);
+                SFX(hb_grid_apply)(w, h, k, hs + 8 * k, vk);
+            } else if (wgrid) {
+                SFX(hb_grid_correct)(w, qg, h, k, xk, vk); /* §3.16 friction, then volume */
+            }
             REAL vx = vk[0], vy = vk[1], vz = vk[2];
             if (F & HB_F_WIND) {
                 REAL gam = (REAL)1;

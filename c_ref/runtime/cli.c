@@ -348,7 +348,7 @@ static const flag_spec flags[] = {
      "write P_r > P points a strand, a Catmull-Rom spline through the simulated ones; P_r - 1 a multiple of P - 1"},
     {"--grid", DF_COUNT, DYN(grid_n), DYN(grid),
      "hair-hair grid of N^3 nodes, 2..512 (docs/model.md §3.16); declares it"},
-    {"--grid-rebuild", DF_REBUILD, DYN(grid_rebuild), 0, "frame | substep: when the grid is built (default frame)"},
+    {"--grid-rebuild", DF_REBUILD, DYN(grid_rebuild), 0, "frame | substep | held: when the grid is built and sampled (default frame)"},
     {"--grid-box", DF_BOX, DYN(grid_box), DYN(grid_box_given),
      "the grid's box X0,Y0,Z0,X1,Y1,Z1 in the head frame, cm (default: the rest shape's bounds + padding)"},
     {"--grid-padding", DF_REAL, DYN(grid_padding), 0, "padding b of the derived grid box, cm (default 2)"},
@@ -685,7 +685,8 @@ static int parse_dyn(const flag_spec *df, const char *v, hb_options *o, char *er
     case DF_REBUILD:
         if (strcmp(v, "frame") == 0) o->scene.dyn.grid_rebuild = HB_GRID_FRAME;
         else if (strcmp(v, "substep") == 0) o->scene.dyn.grid_rebuild = HB_GRID_SUBSTEP;
-        else FAIL("--grid-rebuild must be frame or substep (got '%s')", v);
+        else if (strcmp(v, "held") == 0) o->scene.dyn.grid_rebuild = HB_GRID_HELD;
+        else FAIL("--grid-rebuild must be frame, substep or held (got '%s')", v);
         break;
     case DF_BODY:
         if (strcmp(v, "still") == 0) o->scene.dyn.body_motion = HB_BODY_STILL;

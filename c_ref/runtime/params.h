@@ -89,7 +89,7 @@ typedef struct {
     double body_amplitude, body_frequency; /* A_b (cm), f_b (Hz) */
 } hb_dynamics;
 
-typedef enum { HB_GRID_FRAME = 0, HB_GRID_SUBSTEP = 1 } hb_grid_rebuild;
+typedef enum { HB_GRID_FRAME = 0, HB_GRID_SUBSTEP = 1, HB_GRID_HELD = 2 } hb_grid_rebuild;
 typedef enum { HB_BODY_STILL = 0, HB_BODY_SWAY = 1, HB_BODY_RISE = 2 } hb_body_motion;
 
 /* The scene: everything that decides the bits of a state. */

@@ -73,7 +73,8 @@ struct DeviceMin {
     }
 };
 
-template <typename T> __global__ void k_segments(unsigned long long *fb, hb_draw::View v, Positions p)
+template <typename T>
+__global__ void k_segments(unsigned long long *fb, hb_draw::View v, Positions p, const uint32_t *smap)
 {
     const int64_t s = (int64_t)blockIdx.x * blockDim.x + threadIdx.x, per = p.P - 1;
     if (s >= p.N * per) return;
@@ -82,7 +83,32 @@ template <typename T> __global__ void k_segments(unsigned long long *fb, hb_draw
     float a[3], b[3];
     load_point<T>(p, i, k, a);
     load_point<T>(p, i, k + 1, b);
-    hb_draw::raster_segment(v, a, b, k, DeviceMin{fb});
+    hb_draw::raster_segment(v, a, b, k, DeviceMin{fb}, hb_draw::ShadowMap{smap});
+}
+
+/* the shadow map (view.cuh): the head first, then every segment's nearest depth */
+__global__ void k_shadow_head(uint32_t *smap, hb_draw::View v)
+{
+    const int c = blockIdx.x * blockDim.x + threadIdx.x, r = blockIdx.y;
+    if (c < v.S) smap[(int64_t)r * v.S + c] = hb_draw::head_shadow(v, c, r);
+}
+struct DeviceMin32 {
+    uint32_t *map;
+    __device__ void operator()(int64_t i, uint32_t value) const
+    {
+        if (value < *(volatile uint32_t *)(map + i)) atomicMin(map + i, value);
+    }
+};
+template <typename T> __global__ void k_shadow_segments(uint32_t *smap, hb_draw::View v, Positions p)
+{
+    const int64_t s = (int64_t)blockIdx.x * blockDim.x + threadIdx.x, per = p.P - 1;
+    if (s >= p.N * per) return;
+    const int64_t i = s / per;
+    const int k = (int)(s % per);
+    float a[3], b[3];
+    load_point<T>(p, i, k, a);
+    load_point<T>(p, i, k + 1, b);
+    hb_draw::shadow_segment(v, a, b, DeviceMin32{smap});
 }
 
 __global__ void k_resolve(const unsigned long long *fb, uint32_t *rgba, int64_t n)
@@ -117,7 +143,7 @@ unsigned blocks(int64_t n, int block)
 struct DrawRes {
     void *dq = nullptr, *dp = nullptr;
     unsigned long long *fb = nullptr;
-    uint32_t *rgba = nullptr;
+    uint32_t *rgba = nullptr, *smap = nullptr;
     cudaStream_t st = nullptr;
     std::vector<cudaEvent_t> ev;
     cudaGraphicsResource *res = nullptr;
@@ -133,6 +159,7 @@ struct DrawRes {
         cudaFree(dp);
         cudaFree(fb);
         cudaFree(rgba);
+        cudaFree(smap);
     }
 };
 
@@ -159,9 +186,11 @@ int write_ppm(const char *prefix, const char *path, const uint32_t *rgba, int W,
 template <typename T>
 cudaError_t enqueue_compute(const DrawRes &r, const hb_draw::View &v, const Positions &p, int block)
 {
-    k_head<<<dim3(blocks(v.W, 256), (unsigned)v.H), 256, 0, r.st>>>(r.fb, v);
     const int64_t segs = p.N * (p.P - 1), px = (int64_t)v.W * v.H;
-    if (segs > 0) k_segments<T><<<blocks(segs, block), block, 0, r.st>>>(r.fb, v, p);
+    k_shadow_head<<<dim3(blocks(v.S, 256), (unsigned)v.S), 256, 0, r.st>>>(r.smap, v);
+    if (segs > 0) k_shadow_segments<T><<<blocks(segs, block), block, 0, r.st>>>(r.smap, v, p);
+    k_head<<<dim3(blocks(v.W, 256), (unsigned)v.H), 256, 0, r.st>>>(r.fb, v);
+    if (segs > 0) k_segments<T><<<blocks(segs, block), block, 0, r.st>>>(r.fb, v, p, r.smap);
     k_resolve<<<blocks(px, 256), 256, 0, r.st>>>(r.fb, r.rgba, px);
     return cudaGetLastError();
 }
@@ -205,6 +234,7 @@ int cuda_dyn_draw(hb_backend *b, const hb_dyn_frame *plans, int n, int width, in
     const int64_t px = (int64_t)width * height;
     HB_CUDA_AS(cudaMalloc((void **)&r.fb, (size_t)px * 8u), "cudaMalloc (the compute path's depth and colour buffer)");
     HB_CUDA_AS(cudaMalloc((void **)&r.rgba, (size_t)px * 4u), "cudaMalloc (the compute path's image)");
+    HB_CUDA_AS(cudaMalloc((void **)&r.smap, (size_t)v.S * (size_t)v.S * 4u), "cudaMalloc (the compute path's shadow map)");
     HB_CUDA(cudaStreamCreateWithFlags(&r.st, cudaStreamNonBlocking));
     r.ev.resize((size_t)n * 3);
     for (cudaEvent_t &e : r.ev) HB_CUDA(cudaEventCreate(&e));

@@ -29,15 +29,28 @@ constexpr bool kFree = false;
 #else
 constexpr bool kFree = true;
 #endif
+/* the colliders of §3.17 in free arithmetic (contact_free.cuh) where the build is free;
+ * HB_LANES_REF_COLLIDE=1 keeps contact_impl.h's operations there (a measured alternative) */
+#ifndef HB_LANES_REF_COLLIDE
+#define HB_LANES_REF_COLLIDE 0
+#endif
+constexpr bool kFreeCollide = kFree && !HB_LANES_REF_COLLIDE;
 
 /* Blocks of kLanesMaxBlock an SM must hold (__launch_bounds__'s second argument, which caps
  * the registers a thread): fp32 at P ≤ 32 HB_LANES_MINB for xpbd and HB_LANES_FTL_MINB for
- * ftl (measured, docs/cuda.md), 1 (up to 255 registers) otherwise. */
+ * ftl, with the world's code HB_LANES_WORLD_MINB (all of it), HB_LANES_COL_MINB (colliders alone)
+ * or HB_LANES_MINB (the held grid alone) (measured, docs/cuda.md), 1 (up to 255 registers) otherwise. */
 #ifndef HB_LANES_MINB
 #define HB_LANES_MINB 4
 #endif
 #ifndef HB_LANES_FTL_MINB
 #define HB_LANES_FTL_MINB 3
+#endif
+#ifndef HB_LANES_WORLD_MINB
+#define HB_LANES_WORLD_MINB 2
+#endif
+#ifndef HB_LANES_COL_MINB
+#define HB_LANES_COL_MINB 3
 #endif
 #ifndef HB_LANES_FTL_G
 #define HB_LANES_FTL_G 4
@@ -70,10 +83,26 @@ template <typename T> __device__ __forceinline__ constexpr T floor_of()
 {
     return sin(x);
 }
-template <typename T, int G, int L, bool Ftl, bool W = false> constexpr int lanes_min_blocks()
+/* a / b in free arithmetic */
+[[maybe_unused]] __device__ __forceinline__ float fdiv(float a, float b)
+{
+    return __fdividef(a, b);
+}
+[[maybe_unused]] __device__ __forceinline__ double fdiv(double a, double b)
+{
+    return a / b;
+}
+#include "dynamic/contact_free.cuh" /* templates only: inside this file's namespace, after rsq, floor_of, fdiv */
+/* The world's code a kernel carries (its W, a set of these): the grid's gather every substep
+ * (`frame`, `substep`), the held sample (`held`), the colliders of §3.17 and the head sphere's
+ * friction or bounded depenetration. A run takes the smallest kernel that holds what it declares. */
+constexpr int kWGather = 1, kWHeld = 2, kWCol = 4, kWAll = kWGather | kWHeld | kWCol;
+template <typename T, int G, int L, bool Ftl, int W = 0> constexpr int lanes_min_blocks()
 {
     return sizeof(T) != 4                      ? 1
-           : W                                 ? 2 /* the grid and colliders' code: up to 128 registers */
+           : W == kWHeld && !Ftl && G == 2     ? HB_LANES_MINB /* the held grid alone: as the default kernel */
+           : W == kWCol                        ? HB_LANES_COL_MINB
+           : W                                 ? HB_LANES_WORLD_MINB /* everything: 2, up to 128 registers */
            : (!Ftl && G == 2)                  ? HB_LANES_MINB
            : (Ftl && G == kFtlG && L == kFtlL) ? HB_LANES_FTL_MINB
                                                : 1;
@@ -207,15 +236,21 @@ template <typename T> __device__ __forceinline__ Node4<T> load_node4(const T *p)
         return Node4<T>{a.x, a.y, b.x, b.y};
     }
 }
-template <typename T>
-__device__ __forceinline__ void grid_fix(const DModel<T> &m, const T *qg, int k, const V3<T> &x, V3<T> &v)
+/* §3.16 a point's grid sample as contact_impl.h's hb_grid_sample lays it out: a = (v̄, 1 where
+ * friction applies, else 0), b = (ā, 1 when x is in the grid, else 0). */
+template <typename T> struct Sample {
+    Node4<T> a, b;
+};
+template <typename T> __device__ __forceinline__ Sample<T> grid_sample_at(const DModel<T> &m, const T *qg, const V3<T> &x)
 {
     const World<T> &w = m.world;
+    Sample<T> s{{(T)0, (T)0, (T)0, (T)0}, {(T)0, (T)0, (T)0, (T)0}};
     if constexpr (!kFree) {
         const T xx[3] = {x.x, x.y, x.z};
-        T vv[3] = {v.x, v.y, v.z};
-        grid_correct(w, qg, m.h, k, xx, vv);
-        v = V3<T>{vv[0], vv[1], vv[2]};
+        T r[8] = {};
+        grid_sample(w, qg, xx, r);
+        s.a = Node4<T>{r[0], r[1], r[2], r[3]};
+        s.b = Node4<T>{r[4], r[5], r[6], r[7]};
     } else {
         V3<T> u = x;
         if (qg)
@@ -223,7 +258,7 @@ __device__ __forceinline__ void grid_fix(const DModel<T> &m, const T *qg, int k,
                       (qg[2] * x.x + qg[5] * x.y) + qg[8] * x.z};
         const T gx = (u.x - w.glo[0]) * w.gsc[0], gy = (u.y - w.glo[1]) * w.gsc[1], gz = (u.z - w.glo[2]) * w.gsc[2];
         const T top = (T)(w.gn - 1);
-        if (!(gx >= (T)0 && gx < top && gy >= (T)0 && gy < top && gz >= (T)0 && gz < top)) return;
+        if (!(gx >= (T)0 && gx < top && gy >= (T)0 && gy < top && gz >= (T)0 && gz < top)) return s;
         const int ix = (int)gx, iy = (int)gy, iz = (int)gz;
         const T fx = gx - (T)ix, fy = gy - (T)iy, fz = gz - (T)iz;
         const int64_t n = w.gn, b = ix + n * (iy + n * (int64_t)iz);
@@ -249,10 +284,51 @@ __device__ __forceinline__ void grid_fix(const DModel<T> &m, const T *qg, int k,
             }
         }
         if (w.grid_friction && sw > (T)0) {
-            const T f = w.ftab[k], inv = (T)1 / sw;
-            v = V3<T>{v.x + f * (svx * inv - v.x), v.y + f * (svy * inv - v.y), v.z + f * (svz * inv - v.z)};
+            const T inv = (T)1 / sw;
+            s.a = Node4<T>{svx * inv, svy * inv, svz * inv, (T)1};
         }
-        if (w.grid_volume) v = V3<T>{v.x + m.h * ax, v.y + m.h * ay, v.z + m.h * az};
+        s.b = Node4<T>{ax, ay, az, (T)1};
+    }
+    return s;
+}
+/* §3.16 the correction of point k from its sample (hb_grid_apply). */
+template <typename T>
+__device__ __forceinline__ void grid_apply_at(const DModel<T> &m, int k, const Sample<T> &s, V3<T> &v)
+{
+    const World<T> &w = m.world;
+    if constexpr (!kFree) {
+        const T r[8] = {s.a.x, s.a.y, s.a.z, s.a.w, s.b.x, s.b.y, s.b.z, s.b.w};
+        T vv[3] = {v.x, v.y, v.z};
+        grid_apply(w, m.h, k, r, vv);
+        v = V3<T>{vv[0], vv[1], vv[2]};
+    } else {
+        if (s.b.w == (T)0) return;
+        if (w.grid_friction && s.a.w != (T)0) {
+            const T f = w.ftab[k];
+            v = V3<T>{v.x + f * (s.a.x - v.x), v.y + f * (s.a.y - v.y), v.z + f * (s.a.z - v.z)};
+        }
+        if (w.grid_volume) v = V3<T>{v.x + m.h * s.b.x, v.y + m.h * s.b.y, v.z + m.h * s.b.z};
+    }
+}
+/* A held sample in shared memory (`held`): slot i of a lane at hs[(2i + 0|1)·32 + lane], as
+ * vectors, so that a warp's loads and stores are conflict-free. */
+template <typename T> __device__ __forceinline__ void store_node4(T *p, const Node4<T> &a)
+{
+    if constexpr (sizeof(T) == sizeof(float)) {
+        *reinterpret_cast<float4 *>(p) = make_float4(a.x, a.y, a.z, a.w);
+    } else {
+        reinterpret_cast<double2 *>(p)[0] = make_double2(a.x, a.y);
+        reinterpret_cast<double2 *>(p)[1] = make_double2(a.z, a.w);
+    }
+}
+template <typename T> __device__ __forceinline__ Node4<T> shared_node4(const T *p)
+{
+    if constexpr (sizeof(T) == sizeof(float)) {
+        const float4 a = *reinterpret_cast<const float4 *>(p);
+        return Node4<T>{a.x, a.y, a.z, a.w};
+    } else {
+        const double2 a = reinterpret_cast<const double2 *>(p)[0], b = reinterpret_cast<const double2 *>(p)[1];
+        return Node4<T>{a.x, a.y, b.x, b.y};
     }
 }
 
@@ -266,13 +342,18 @@ __device__ __forceinline__ void collide_world(const DModel<T> &m, Feat has, cons
     T pp[3] = {p.x, p.y, p.z};
     const T xx[3] = {x.x, x.y, x.z};
     if (has(HB_F_COLLIDE)) {
-        if (w.head_friction || w.bounded) collide_head(w, m.collide_r, back, pp, xx);
-        else {
+        if (w.head_friction || w.bounded) {
+            if constexpr (kFreeCollide) collide_head_free(w, m.collide_r, back, pp, xx);
+            else collide_head(w, m.collide_r, back, pp, xx);
+        } else {
             collide(m, p);
             pp[0] = p.x, pp[1] = p.y, pp[2] = p.z;
         }
     }
-    for (int i = 0; i < w.ncol; i++) collide_one(w, i, pose + i * HB_COL_POSE, back, pp, xx);
+    for (int i = 0; i < w.ncol; i++) {
+        if constexpr (kFreeCollide) collide_one_free(w, i, pose + i * HB_COL_POSE, back, pp, xx);
+        else collide_one(w, i, pose + i * HB_COL_POSE, back, pp, xx);
+    }
     p = V3<T>{pp[0], pp[1], pp[2]};
 }
 
@@ -349,6 +430,12 @@ template <typename T, int G, int L> __host__ __device__ constexpr int64_t lanes_
 {
     return 3 * (32 / L) * 3 * P + (32 / L) * (P - 2);
 }
+/* With the grid (W): a warp's held samples of §3.16 `held`, two vectors of 4 reals a point slot,
+ * before every warp's staging area (so that they stay 16-byte aligned). */
+template <typename T, int G> __host__ __device__ constexpr int64_t lanes_held_reals()
+{
+    return 2 * 4 * G * 32;
+}
 
 /* Slot i of a lane holds point k0 + i, or with two points a lane on an odd lane (sw) k0 + 1 − i:
  * then every lane of a bend pair finds its own point and the one its partner needs in the
@@ -387,7 +474,7 @@ __device__ __forceinline__ void pack(T *s, int k0, bool sw, int P, bool live, co
  * solver of §3.7, else §3.6; Seg: a groom's per-segment rest lengths (§3.15, m.seg_rest); W: the
  * grid and colliders of §3.16–3.17 (m.world), with the strands taken in the order m.perm (slot
  * s holds strand perm[s], nearby strands together, so a block's points share grid nodes). */
-template <typename T, class Feat, int G, int L, bool Ftl, bool Seg, bool W>
+template <typename T, class Feat, int G, int L, bool Ftl, bool Seg, int W>
 __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl, W>())
     k_lanes(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
             const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N)
@@ -401,7 +488,9 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
     const int P = (int)m.points, K = (int)m.shape_count, k0 = G * l;
     const bool sw = G == 2 && (l & 1); /* slots in reverse point order (point_of) */
     const int row = 3 * P;             /* reals of a strand */
-    T *xv = (T *)hb_lanes_smem + (int64_t)w * lanes_warp_reals<T, G, L>(P);
+    T *hs = (T *)hb_lanes_smem + (int64_t)w * ((W & kWHeld) ? lanes_held_reals<T, G>() : 0);
+    T *xv = (T *)hb_lanes_smem + (int64_t)wpb * ((W & kWHeld) ? lanes_held_reals<T, G>() : 0) +
+            (int64_t)w * lanes_warp_reals<T, G, L>(P);
     T *rs = xv + 2 * SPW * row; /* the rest shape of the warp's strands */
     const bool need_rest = has(HB_F_MOTION) || has(HB_F_SHAPE);
     const int stages = (P + G - 1) / G; /* lanes that hold points */
@@ -414,13 +503,13 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         const int n = ns * row;
         /* where element e (< n) of the warp's strands lies: base + e, or in strand perm[s0 + e/row] */
         auto at = [&](int e) -> int64_t {
-            if constexpr (W) {
+            if constexpr (W != 0) {
                 if (m.perm) return m.perm[s0 + e / row] * (int64_t)row + e % row;
             }
             return base + e;
         };
         auto bat = [&](int e) -> int64_t { /* the same for the bend rest lengths, P − 2 a strand */
-                                           if constexpr (W) {
+                                           if constexpr (W != 0) {
                                                if (m.perm)
                                                    return m.perm[s0 + e / (P - 2)] * (int64_t)(P - 2) + e % (P - 2);
                                            }
@@ -487,8 +576,9 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         }
 
         const int jend = m.j1 < 0 ? (int)m.substeps : m.j1;
-        const bool wgrid = W && m.world.grid && (m.world.grid_friction || m.world.grid_volume);
-        const bool wcol = W && (m.world.ncol > 0 || m.world.head_friction || m.world.bounded);
+        const bool wgrid = (W & (kWGather | kWHeld)) && m.world.grid && (m.world.grid_friction || m.world.grid_volume);
+        const bool held = (W & kWHeld) && wgrid && m.world.grid_rebuild == HB_GRID_HELD;
+        const bool wcol = (W & kWCol) && (m.world.ncol > 0 || m.world.head_friction || m.world.bounded);
         for (int j = m.j0; j < jend; j++) {
             const T *q = qtab + 9 * j;
             /* §3.16 the rotation of the grid in use (nullptr: still); §3.17 this substep's poses */
@@ -517,8 +607,18 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
             for (int i = 0; i < G; i++) {
                 const int k = point_of<G>(k0, sw, i);
                 if (k >= 1 && k < P) {
-                    if constexpr (W) {
-                        if (wgrid) grid_fix(m, qg, k, X[i], V[i]); /* §3.16 friction, then volume */
+                    if constexpr (W != 0) { /* §3.16 friction, then volume; `held`: sampled at the frame's first substep */
+                        if (held) {
+                            T *sa = hs + 4 * (2 * i * 32 + lane), *sb = hs + 4 * ((2 * i + 1) * 32 + lane);
+                            if (j == 0) {
+                                const Sample<T> sm = grid_sample_at(m, qg, X[i]);
+                                store_node4(sa, sm.a);
+                                store_node4(sb, sm.b);
+                            }
+                            grid_apply_at(m, k, Sample<T>{shared_node4(sa), shared_node4(sb)}, V[i]);
+                        } else if constexpr ((W & kWGather) != 0) {
+                            if (wgrid) grid_apply_at(m, k, grid_sample_at(m, qg, X[i]), V[i]);
+                        }
                     }
                     predict(m, has, phase, X[i], V[i], Q[i]);
                 }
@@ -620,7 +720,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                         bend(1);
                     }
                     if (has(HB_F_SHAPE)) shapes();
-                    if (W && wcol) {
+                    if ((W & kWCol) && wcol) {
 #pragma unroll
                         for (int i = 0; i < G; i++)
                             if (point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P)
@@ -647,7 +747,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                         for (int i = 0; i < G; i++) {
                             const int k = k0 + i;
                             if (k >= 1 && k < P)
-                                follow_one(m, has, ell(i), i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i], W && wcol,
+                                follow_one(m, has, ell(i), i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i], (W & kWCol) && wcol,
                                            pose, back, &X[i]);
                         }
                     }
@@ -690,8 +790,8 @@ template <typename T, int G, int L, bool Ftl, unsigned F> constexpr LanesFn<T> l
 {
     constexpr bool own = (!Ftl && G == 2 && L == 16) || (Ftl && G == kFtlG && L == kFtlL);
     if constexpr (!valid_mask(F)) return nullptr;
-    else if constexpr (own && specialised_mask(F)) return &k_lanes<T, StaticF<F>, G, L, Ftl, false, false>;
-    else return &k_lanes<T, DynF, G, L, Ftl, false, false>;
+    else if constexpr (own && specialised_mask(F)) return &k_lanes<T, StaticF<F>, G, L, Ftl, false, 0>;
+    else return &k_lanes<T, DynF, G, L, Ftl, false, 0>;
 }
 template <typename T, int G, int L, bool Ftl, unsigned... Fs> struct LanesTable {
     static constexpr LanesFn<T> fn[sizeof...(Fs)] = {lanes_entry<T, G, L, Ftl, Fs>()...};
@@ -708,15 +808,31 @@ template <typename T> struct LanesPick {
     int64_t warp_reals;
 };
 /* a groom (seg) runs the generic kernel of its layout with per-segment rest lengths; a run with
- * the grid or colliders (world) the generic kernel with them */
-template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int64_t P, bool seg, bool world)
+ * the grid or colliders (wk, a set of kW…) the generic kernel with the world's code it needs (a
+ * groom's: all of it) */
+template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int64_t P, bool seg, int wk)
 {
     LanesFn<T> fn = LanesTableT<T, G, L, Ftl>::fn[f];
-    if (world) fn = seg ? &k_lanes<T, DynF, G, L, Ftl, true, true> : &k_lanes<T, DynF, G, L, Ftl, false, true>;
-    else if (seg) fn = &k_lanes<T, DynF, G, L, Ftl, true, false>;
-    return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P)};
+    if (wk && seg) wk = kWAll;
+    if (wk == kWAll) fn = seg ? &k_lanes<T, DynF, G, L, Ftl, true, kWAll> : &k_lanes<T, DynF, G, L, Ftl, false, kWAll>;
+    else if (wk == kWHeld) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWHeld>;
+    else if (wk == kWCol) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWCol>;
+    else if (seg) fn = &k_lanes<T, DynF, G, L, Ftl, true, 0>;
+    return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P) + ((wk & kWHeld) ? lanes_held_reals<T, G>() : 0)};
 }
-template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P, bool seg, bool world)
+/* The world's code a run needs (docs/cuda.md "The hair–hair grid and the colliders"): none
+ * without a world; the held grid alone (or a grid that applies nothing); the colliders alone;
+ * else all of it. */
+template <typename T> int world_kind(const DModel<T> &m)
+{
+    if (!m.has_world) return 0;
+    const World<T> &w = m.world;
+    const bool col = w.ncol > 0 || w.head_friction || w.bounded;
+    const bool apply = w.grid && (w.grid_friction || w.grid_volume);
+    if (apply && (col || w.grid_rebuild != HB_GRID_HELD)) return kWAll;
+    return col ? kWCol : kWHeld;
+}
+template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P, bool seg, int world)
 {
     if (!valid_mask(f) || P < 2 || P > kLanesMaxPoints) return LanesPick<T>{nullptr, 0, 0};
     if (solver == HB_SOLVER_FTL) {
@@ -733,23 +849,27 @@ template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P,
 
 template <typename T> size_t lanes_smem_bytes(unsigned features, int solver, int64_t P, int block)
 {
-    return (size_t)(block / 32) * (size_t)lanes_pick<T>(features, solver, P, false, false).warp_reals * sizeof(T);
+    return (size_t)(block / 32) * (size_t)lanes_pick<T>(features, solver, P, false, 0).warp_reals * sizeof(T);
 }
 
 template <typename T>
 cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg, bool world)
 {
-    const LanesPick<T> k = lanes_pick<T>(features, solver, P, seg, world);
-    if (!k.fn) return cudaErrorInvalidValue;
-    return cudaFuncSetAttribute(k.fn, cudaFuncAttributeMaxDynamicSharedMemorySize,
-                                (int)lanes_smem_bytes<T>(features, solver, P, block));
+    for (int wk : {kWHeld, kWCol, kWAll}) { /* a world's run launches one of its three kernels */
+        const LanesPick<T> k = lanes_pick<T>(features, solver, P, seg, world ? wk : 0);
+        if (!k.fn) return cudaErrorInvalidValue;
+        const cudaError_t e = cudaFuncSetAttribute(k.fn, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                                   (int)((size_t)(block / 32) * (size_t)k.warp_reals * sizeof(T)));
+        if (e != cudaSuccess || !world) return e;
+    }
+    return cudaSuccess;
 }
 
 template <typename T>
 cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                                const T *bend_rest, int64_t N, int block, cudaStream_t stream)
 {
-    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, m.has_world != 0);
+    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, world_kind(m));
     if (!k.fn) return cudaErrorInvalidValue;
     const int64_t per_block = (int64_t)(block / 32) * (32 / k.lanes);
     const int64_t g = (N + per_block - 1) / per_block;

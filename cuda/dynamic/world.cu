@@ -11,11 +11,6 @@ namespace {
 
 template <typename T> struct Splat;
 template <> struct Splat<float> {
-    __device__ static int point(const World<float> &w, const float *qg, const float *x, const float *v, int64_t *base,
-                                int64_t *m, int64_t *p)
-    {
-        return hb_grid_splat_point_f32(qg, w.glo, w.gsc, w.gn, x, v, base, m, p);
-    }
     __device__ static void node(int64_t j, const World<float> &w, const int64_t *mass, const int64_t *mom,
                                 const float *target, float inv_rho0, float neg_kv, const float *qg, float *nv,
                                 float *na)
@@ -24,11 +19,6 @@ template <> struct Splat<float> {
     }
 };
 template <> struct Splat<double> {
-    __device__ static int point(const World<double> &w, const double *qg, const double *x, const double *v,
-                                int64_t *base, int64_t *m, int64_t *p)
-    {
-        return hb_grid_splat_point_f64(qg, w.glo, w.gsc, w.gn, x, v, base, m, p);
-    }
     __device__ static void node(int64_t j, const World<double> &w, const int64_t *mass, const int64_t *mom,
                                 const double *target, double inv_rho0, double neg_kv, const double *qg, double *nv,
                                 double *na)
@@ -37,23 +27,25 @@ template <> struct Splat<double> {
     }
 };
 
-/* The warp's sum of x over the lanes of `group` (lanes with the same cell), exact for any 64-bit
- * x within ±2^46: its low 16 bits and the rest summed apart by the warp's reduction unit. */
-__device__ __forceinline__ int64_t group_sum(unsigned group, int64_t x)
-{
-    const unsigned lo = __reduce_add_sync(group, (unsigned)(x & 0xffff));
-    const int hi = __reduce_add_sync(group, (int)(x >> 16));
-    return (int64_t)hi * 65536 + (int64_t)lo;
-}
-
-/* The splat (docs/cuda.md "The hair–hair grid"). A block takes 32 neighbouring strands (the
- * order perm; nullptr: as stored): lane l of every warp holds strand s0 + l, and warp w its
- * points k ≡ w (mod warps), so a warp's 32 lanes hold point k of 32 neighbours, mostly in one
- * cell. Pass 1 finds the block's box of cells; when its nodes fit the shared window, pass 2
- * adds each cell's lanes' shares there (one shared atomic a node and channel a cell), and the
- * window goes to the grid with one global atomic a touched node and channel; otherwise pass 2
- * adds to the grid directly. Integer sums: no order changes a bit. */
-constexpr int kSplatStrands = 32, kSplatWarps = 8, kWindow = 1024; /* nodes: 32 KB of int64 × 4 */
+/* The splat (docs/cuda.md "The hair–hair grid"). A block takes kSplatStrands neighbouring
+ * strands (the order perm; nullptr: as stored); each warp takes its strands one at a time, a lane
+ * a point, so that every load of x and v coalesces. Pass 1 finds the block's box of cells; when
+ * its nodes fit the shared window (and no node can receive more than 2^16 shares), pass 2 adds
+ * each point's fixed-point shares there, each 64-bit share split into its low 16 bits and the
+ * rest, both summed by native 32-bit shared atomics (exact: see kSplatWindowPoints), and the
+ * window goes to the grid with one 64-bit global atomic a touched node and channel; otherwise
+ * pass 2 adds to the grid directly. Integer sums: no order changes a bit. */
+#ifndef HB_SPLAT_STRANDS
+#define HB_SPLAT_STRANDS 64
+#endif
+#ifndef HB_SPLAT_WINDOW
+#define HB_SPLAT_WINDOW 2048
+#endif
+constexpr int kSplatStrands = HB_SPLAT_STRANDS, kSplatWarps = 8; /* strands a block, its warps */
+constexpr int kWindow = HB_SPLAT_WINDOW; /* nodes: 2 × 32 bits × 4 channels each (64 KB at 2048) */
+/* At most this many shares reach a window node (one a point): their low parts (< 2^16 each) sum
+ * below 2^32 and their high parts (|x| ≤ 2^30, so |x >> 16| ≤ 2^14) within ±2^31. */
+constexpr int64_t kSplatWindowPoints = 65536;
 
 template <typename T> struct Locate;
 template <> struct Locate<float> {
@@ -74,88 +66,107 @@ template <typename T> __device__ __forceinline__ bool finite3(const T *p)
     return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
 }
 
+/* one share x (|x| ≤ 2^30) into a window node's channel: low 16 bits, then the rest */
+__device__ __forceinline__ void window_add(unsigned *ch, int64_t x)
+{
+    if (x == 0) return;
+    atomicAdd(ch, (unsigned)(x & 0xffff));
+    atomicAdd(reinterpret_cast<int *>(ch) + 1, (int)(x >> 16));
+}
+
 template <typename T>
 __global__ void __launch_bounds__(kSplatWarps * 32)
     k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, const int64_t *perm, int64_t *mass,
                  int64_t *mom)
 {
-    __shared__ int64_t win[4 * kWindow];
+    extern __shared__ unsigned win[]; /* [node][channel: mass, p_x, p_y, p_z][low, high] */
     __shared__ int lo[3], hi[3];
     const int lane = (int)(threadIdx.x & 31u), warp = (int)(threadIdx.x >> 5);
-    const int64_t slot = (int64_t)blockIdx.x * kSplatStrands + lane;
-    const bool live = slot < N;
-    const int64_t strand = live ? (perm ? perm[slot] : slot) : 0;
+    const int64_t s0 = (int64_t)blockIdx.x * kSplatStrands;
+    const int ns = N - s0 < kSplatStrands ? (int)(N - s0) : kSplatStrands;
     const int64_t n = w.gn;
     if (threadIdx.x < 3) lo[threadIdx.x] = INT_MAX, hi[threadIdx.x] = -1;
     __syncthreads();
-    /* pass 1: the block's box of cells */
-    for (int k = warp; k < P; k += kSplatWarps) {
-        const T *xp = x + 3 * (strand * P + k);
-        int64_t b;
-        T wt[8];
-        const bool in = live && finite3(xp) && finite3(v + 3 * (strand * P + k)) && Locate<T>::at(w, qg, xp, &b, wt);
-        const int c[3] = {in ? (int)(b % n) : INT_MAX, in ? (int)((b / n) % n) : INT_MAX,
-                          in ? (int)(b / (n * n)) : INT_MAX};
-        for (int a = 0; a < 3; a++) { /* the warp's extremes first: one shared atomic a warp */
-            const int mn = __reduce_min_sync(0xffffffffu, c[a]);
-            const int mx = __reduce_max_sync(0xffffffffu, in ? c[a] + 1 : -1);
-            if (lane == 0 && mx >= 0) {
-                atomicMin(&lo[a], mn);
-                atomicMax(&hi[a], mx);
+    /* pass 1: the block's box of cells (points whose x is finite and in the grid) */
+    int cl[3] = {INT_MAX, INT_MAX, INT_MAX}, ch[3] = {-1, -1, -1};
+    for (int s = warp; s < ns; s += kSplatWarps) {
+        const int64_t st = perm ? perm[s0 + s] : s0 + s;
+        for (int k = lane; k < P; k += 32) {
+            const T *xp = x + 3 * (st * P + k);
+            int64_t b;
+            T wt[8];
+            if (finite3(xp) && Locate<T>::at(w, qg, xp, &b, wt)) {
+                const int c[3] = {(int)(b % n), (int)((b / n) % n), (int)(b / (n * n))};
+                for (int a = 0; a < 3; a++) {
+                    cl[a] = min(cl[a], c[a]);
+                    ch[a] = max(ch[a], c[a] + 1);
+                }
             }
         }
     }
+    for (int a = 0; a < 3; a++) { /* the warp's extremes first: one shared atomic a warp */
+        const int mn = __reduce_min_sync(0xffffffffu, cl[a]), mx = __reduce_max_sync(0xffffffffu, ch[a]);
+        if (lane == 0 && mx >= 0) {
+            atomicMin(&lo[a], mn);
+            atomicMax(&hi[a], mx);
+        }
+    }
     __syncthreads();
-    const int ex = hi[0] - lo[0] + 1, ey = hi[1] - lo[1] + 1, ez = hi[2] - lo[2] + 1;
-    const bool windowed = hi[0] >= 0 && (int64_t)ex * ey * ez <= kWindow;
     if (hi[0] < 0) return; /* no point of the block in the grid */
+    const int ex = hi[0] - lo[0] + 1, ey = hi[1] - lo[1] + 1, ez = hi[2] - lo[2] + 1;
+    const bool windowed = (int64_t)ex * ey * ez <= kWindow && (int64_t)ns * P <= kSplatWindowPoints;
     if (windowed) {
-        for (int i = threadIdx.x; i < 4 * ex * ey * ez; i += blockDim.x) win[i] = 0;
+        for (int i = threadIdx.x; i < 8 * ex * ey * ez; i += blockDim.x) win[i] = 0u;
         __syncthreads();
     }
-    /* pass 2: each cell's lanes sum their shares, one atomic a node and channel */
-    for (int k = warp; k < P; k += kSplatWarps) {
-        const int64_t r = strand * P + k;
-        const T *xp = x + 3 * r, *vp = v + 3 * r;
-        int64_t b = -1;
-        T wt[8];
-        const bool in = live && finite3(xp) && finite3(vp) && Locate<T>::at(w, qg, xp, &b, wt);
-        if (!in) b = -1;
-        T vc[3];
-        for (int c = 0; c < 3; c++) {
-            const T lim = (T)HB_GRID_VEL_CLAMP;
-            vc[c] = in ? (vp[c] < -lim ? -lim : vp[c] > lim ? lim : vp[c]) : (T)0;
-        }
-        const unsigned same = __match_any_sync(0xffffffffu, (unsigned long long)b);
-        const bool leader = lane == __ffs(same) - 1;
-        for (int c8 = 0; c8 < 8; c8++) {
-            /* the point's fixed-point shares at corner c8, as hb_grid_splat_point computes them */
-            const T wc = in ? wt[c8] : (T)0;
-            const int64_t sm = group_sum(same, HB_RINT64(wc * (T)HB_GRID_MASS_SCALE));
-            int64_t sp[3];
-            for (int c = 0; c < 3; c++) sp[c] = group_sum(same, HB_RINT64((wc * vc[c]) * (T)HB_GRID_MOM_SCALE));
-            if (!(in && leader)) continue;
-            const int64_t j = hb_grid_corner_f64(b, n, c8);
-            if (windowed) {
-                const int jx = (int)(j % n) - lo[0], jy = (int)((j / n) % n) - lo[1], jz = (int)(j / (n * n)) - lo[2];
-                int64_t *cell = win + 4 * (jx + ex * (jy + ey * jz));
-                atomicAdd((unsigned long long *)&cell[0], (unsigned long long)sm);
-                for (int c = 0; c < 3; c++) atomicAdd((unsigned long long *)&cell[1 + c], (unsigned long long)sp[c]);
-            } else {
-                atomicAdd((unsigned long long *)&mass[j], (unsigned long long)sm);
-                for (int c = 0; c < 3; c++) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sp[c]);
+    /* pass 2: each point's shares (hb_grid_splat_point: the reference's integers) */
+    for (int s = warp; s < ns; s += kSplatWarps) {
+        const int64_t st = perm ? perm[s0 + s] : s0 + s;
+        for (int k = lane; k < P; k += 32) {
+            const int64_t r = st * P + k;
+            const T *xp = x + 3 * r, *vp = v + 3 * r;
+            int64_t b;
+            T wt[8], vc[3];
+            /* hb_grid_splat_point's shares, a corner at a time (fewer registers, the same integers) */
+            if (!(finite3(xp) && finite3(vp)) || !Locate<T>::at(w, qg, xp, &b, wt)) continue;
+            for (int c = 0; c < 3; c++) {
+                const T lim = (T)HB_GRID_VEL_CLAMP;
+                vc[c] = vp[c] < -lim ? -lim : vp[c] > lim ? lim : vp[c];
+            }
+#pragma unroll
+            for (int c8 = 0; c8 < 8; c8++) {
+                int64_t sm[1], sp[3];
+                sm[0] = HB_RINT64(wt[c8] * (T)HB_GRID_MASS_SCALE);
+                for (int c = 0; c < 3; c++) sp[c] = HB_RINT64((wt[c8] * vc[c]) * (T)HB_GRID_MOM_SCALE);
+                const int64_t j = hb_grid_corner_f64(b, n, c8);
+                if (windowed) {
+                    const int jx = (int)(j % n) - lo[0], jy = (int)((j / n) % n) - lo[1], jz = (int)(j / (n * n)) - lo[2];
+                    unsigned *node = win + 8 * (jx + ex * (jy + ey * jz));
+                    window_add(node, sm[0]);
+                    for (int c = 0; c < 3; c++) window_add(node + 2 + 2 * c, sp[c]);
+                } else {
+                    atomicAdd((unsigned long long *)&mass[j], (unsigned long long)sm[0]);
+                    for (int c = 0; c < 3; c++) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sp[c]);
+                }
             }
         }
     }
     if (!windowed) return;
     __syncthreads();
     for (int i = threadIdx.x; i < ex * ey * ez; i += blockDim.x) {
-        const int64_t *cell = win + 4 * i;
-        if (cell[0] == 0 && cell[1] == 0 && cell[2] == 0 && cell[3] == 0) continue;
+        const unsigned *node = win + 8 * i;
+        int64_t sum[4];
+        bool any = false;
+        for (int c = 0; c < 4; c++) {
+            sum[c] = (int64_t)reinterpret_cast<const int *>(node)[2 * c + 1] * 65536 + (int64_t)node[2 * c];
+            any |= sum[c] != 0;
+        }
+        if (!any) continue;
         const int jx = i % ex + lo[0], jy = (i / ex) % ey + lo[1], jz = i / (ex * ey) + lo[2];
         const int64_t j = jx + n * (jy + n * (int64_t)jz);
-        atomicAdd((unsigned long long *)&mass[j], (unsigned long long)cell[0]);
-        for (int c = 0; c < 3; c++) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)cell[1 + c]);
+        if (sum[0]) atomicAdd((unsigned long long *)&mass[j], (unsigned long long)sum[0]);
+        for (int c = 0; c < 3; c++)
+            if (sum[1 + c]) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sum[1 + c]);
     }
 }
 
@@ -184,8 +195,11 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
     if (e == cudaSuccess) e = cudaMemsetAsync(mom, 0, (size_t)nodes * 3 * sizeof *mom, stream);
     if (e != cudaSuccess) return e;
     const int64_t blocks = (N + kSplatStrands - 1) / kSplatStrands;
+    const size_t smem = (size_t)kWindow * 8 * sizeof(unsigned);
+    e = cudaFuncSetAttribute(k_grid_splat<T>, cudaFuncAttributeMaxDynamicSharedMemorySize, (int)smem);
+    if (e != cudaSuccess) return e;
     k_grid_splat<T>
-        <<<(int)(blocks < 1 ? 1 : blocks), kSplatWarps * 32, 0, stream>>>(w, qg, x, v, N, (int)P, perm, mass, mom);
+        <<<(int)(blocks < 1 ? 1 : blocks), kSplatWarps * 32, smem, stream>>>(w, qg, x, v, N, (int)P, perm, mass, mom);
     return cudaGetLastError();
 }
 

@@ -42,6 +42,30 @@ HB_HD void grid_correct(const World<double> &w, const double *qg, double h, int6
 {
     hb_grid_correct_f64(&w, qg, h, k, x, v);
 }
+HB_HD void grid_sample(const World<float> &w, const float *qg, const float *x, float *s)
+{
+    hb_grid_sample_f32(&w, qg, x, s);
+}
+HB_HD void grid_sample(const World<double> &w, const double *qg, const double *x, double *s)
+{
+    hb_grid_sample_f64(&w, qg, x, s);
+}
+HB_HD void grid_apply(const World<float> &w, float h, int64_t k, const float *s, float *v)
+{
+    hb_grid_apply_f32(&w, h, k, s, v);
+}
+HB_HD void grid_apply(const World<double> &w, double h, int64_t k, const double *s, double *v)
+{
+    hb_grid_apply_f64(&w, h, k, s, v);
+}
+HB_HD int sdf_sample(const float *sdf, int64_t n, const float *geo, const float *u, float *phi, float *g)
+{
+    return hb_sdf_sample_f32(sdf, n, geo, u, phi, g);
+}
+HB_HD int sdf_sample(const double *sdf, int64_t n, const double *geo, const double *u, double *phi, double *g)
+{
+    return hb_sdf_sample_f64(sdf, n, geo, u, phi, g);
+}
 HB_HD void collide_one(const World<float> &w, int i, const float *pose, const float *back, float *p, const float *x)
 {
     hb_collide_one_f32(&w, i, pose, back, p, x);

@@ -9,7 +9,11 @@
  *   1. a strand along x at y = 4.1, z = 6 (in front of the head): exactly row 29 (the row of
  *      y = 4.1 is (1 − 4.1/10)/2·100 = 29.5), columns 50 to 149 (x from −10 to 10 cm);
  *   2. a strand along x at y = 0.1, z = −8 (behind the head): hidden where the head covers
- *      it (|x| < 5 cm), drawn outside; and the same strand at z = +8 drawn over the head.
+ *      it (|x| < 5 cm), drawn outside; and the same strand at z = +8 drawn over the head;
+ *   3. (compute, with its shadow map) a strand along x at y = −7.1, z = 4, alone, then with a
+ *      second strand 4 cm nearer the light along the light's direction (it shadows the first:
+ *      most of the first's pixels darken), then with the second moved 4 cm across the light
+ *      instead (no pixel of the first changes).
  * Exit status 0 when every check holds; the last line counts them. Where EGL gives no
  * context the gl checks are skipped with one line saying why (tests/native skips with it). */
 #include <math.h>
@@ -56,13 +60,35 @@ struct HostMin {
     }
 };
 
-std::vector<uint32_t> compute_image(const View &v, const std::vector<std::vector<float>> &strands)
+struct HostMin32 {
+    uint32_t *map;
+    HB_DV void operator()(int64_t i, uint32_t value) const
+    {
+        if (value < map[i]) map[i] = value;
+    }
+};
+
+/* the compute path's image, as its kernels draw it: the shadow map (the head, then every
+ * segment), then the head and the strands (shadows = false: every fragment lit) */
+std::vector<uint32_t> compute_image(const View &v, const std::vector<std::vector<float>> &strands,
+                                    bool shadows = true)
 {
+    std::vector<uint32_t> smap((size_t)v.S * v.S);
+    for (int r = 0; r < v.S; r++)
+        for (int c = 0; c < v.S; c++) smap[(size_t)r * v.S + c] = hb_draw::head_shadow(v, c, r);
+    for (const auto &s : strands)
+        for (int k = 0; k + 1 < P; k++) hb_draw::shadow_segment(v, &s[3 * k], &s[3 * k + 3], HostMin32{smap.data()});
     std::vector<uint64_t> fb((size_t)W * H);
     for (int r = 0; r < H; r++)
         for (int c = 0; c < W; c++) fb[(size_t)r * W + c] = hb_draw::head_pixel(v, c, r);
     for (const auto &s : strands)
-        for (int k = 0; k + 1 < P; k++) hb_draw::raster_segment(v, &s[3 * k], &s[3 * k + 3], k, HostMin{fb.data()});
+        for (int k = 0; k + 1 < P; k++) {
+            if (shadows)
+                hb_draw::raster_segment(v, &s[3 * k], &s[3 * k + 3], k, HostMin{fb.data()},
+                                        hb_draw::ShadowMap{smap.data()});
+            else
+                hb_draw::raster_segment(v, &s[3 * k], &s[3 * k + 3], k, HostMin{fb.data()});
+        }
     std::vector<uint32_t> out(fb.size());
     for (size_t i = 0; i < fb.size(); i++) out[i] = (uint32_t)fb[i];
     return out;
@@ -117,6 +143,33 @@ void scenes(const char *path, const std::vector<uint32_t> &one, const std::vecto
     check(over, path, "a strand in front of the head is drawn over it");
 }
 
+/* scene 3: the compute path's shadows */
+void shadow_scene(const View &v)
+{
+    const auto a = strand(-6, 6, -7.1f, 4);
+    auto moved = [&](const float *dir) {
+        std::vector<float> b = a;
+        for (size_t i = 0; i < b.size(); i++) b[i] += 4.0f * dir[i % 3];
+        return b;
+    };
+    const auto alone = compute_image(v, {a}), shaded = compute_image(v, {a, moved(v.light)}),
+               beside = compute_image(v, {a, moved(v.lw)}), unshadowed = compute_image(v, {a, moved(v.light)}, false);
+    const int row = 85; /* y = −7.1 → row 85.5 */
+    int lit = 0, darker = 0, changed = 0;
+    for (int c = 0; c < W; c++) {
+        const size_t i = (size_t)row * W + c;
+        if (is_background(alone[i])) continue;
+        lit++;
+        const uint32_t p = alone[i], q = shaded[i];
+        if (q != p && (q & 0xff) + (q >> 8 & 0xff) + (q >> 16 & 0xff) < (p & 0xff) + (p >> 8 & 0xff) + (p >> 16 & 0xff))
+            darker++;
+        if (beside[i] != p || unshadowed[i] != p) changed++;
+    }
+    check(lit >= 55, "compute", "a strand along x at y = -7.1 covers row 85");
+    check(darker * 10 >= lit * 6, "compute", "a strand 4 cm nearer the light darkens most of its pixels (shadow)");
+    check(changed == 0, "compute", "the same strand moved across the light, or no shadow map, changes none of them");
+}
+
 } // namespace
 
 int main()
@@ -125,6 +178,7 @@ int main()
     const auto one = strand(-10, 10, 4.1f, 6), behind = strand(-10, 10, 0.1f, -8), front = strand(-10, 10, 0.1f, 8);
     scenes("compute", compute_image(v, {one}), compute_image(v, {behind}), compute_image(v, {front}),
            compute_image(v, {}), 0);
+    shadow_scene(v);
     const int n_compute = checks, f_compute = failed;
     hb_gl::GlDraw g;
     char why[256] = "";

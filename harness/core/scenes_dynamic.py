@@ -35,7 +35,7 @@ A scene with `model = "dynamic"` may hold, besides the paper keys:
                                #                --motion-track (docs/interfaces.md, "Motion tracks")
     [grid]                     # the hair–hair grid (§3.16); a table declares it
     nodes = 32                 # n_g in 2 … 512 --grid
-    rebuild = "frame"          # frame | substep  --grid-rebuild
+    rebuild = "frame"          # frame | substep | held  --grid-rebuild
     box = [x0, y0, z0, x1, y1, z1]  # cm, head frame  --grid-box (default: the rest shape's bounds)
     padding = 2.0              # b ≥ 0 (cm)     --grid-padding
     friction = [0.05, 0.01]    # f_r[, f_t] in [0, 1]  --grid-friction
@@ -84,7 +84,7 @@ TABLES = {
     },
     "grid": {
         "nodes": ("--grid", "count"),
-        "rebuild": ("--grid-rebuild", ("frame", "substep")),
+        "rebuild": ("--grid-rebuild", ("frame", "substep", "held")),
         "box": ("--grid-box", "box"),
         "padding": ("--grid-padding", "nonneg"),
         "friction": ("--grid-friction", "pair_unit"),

@@ -81,7 +81,7 @@ class Plan:
     seconds: float = 1.0  # the body rises into place in 0.5 s (body.toml): the hair then lies on it
     ref_substeps: int = 64
     grid_sizes: tuple = (16, 32, 64)
-    rebuilds: tuple = ("frame", "substep")
+    rebuilds: tuple = ("frame", "substep", "held")
     sdf_sizes: tuple = (32, 64, 128)
     time_strands: int = 1000
     time_frames: int = 3
@@ -119,8 +119,8 @@ def check_plan(plan):
         bad.append("--grid-sizes needs values from 2 to 512")
     if not plan.sdf_sizes or any(not 8 <= n <= 512 for n in plan.sdf_sizes):
         bad.append("--sdf-sizes needs values from 8 to 512")
-    if not plan.rebuilds or any(r not in ("frame", "substep") for r in plan.rebuilds):
-        bad.append("the grid's rebuilds are frame and substep")
+    if not plan.rebuilds or any(r not in ("frame", "substep", "held") for r in plan.rebuilds):
+        bad.append("the grid's rebuilds are frame, substep and held")
     if bad:
         raise HarnessError("accuracy-world: " + "; ".join(bad), code=2)
 

@@ -67,7 +67,7 @@ def _bits(path):
         return np.concatenate([t.frame(f).ravel() for f in range(t.n_frames)]).view(np.uint8)
 
 
-@pytest.mark.parametrize("rebuild", ["frame", "substep"])
+@pytest.mark.parametrize("rebuild", ["frame", "substep", "held"])
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 def test_same_bits_on_any_thread_count_and_when_resumed(cpu_bin, tmp_path, rebuild, precision):
     args = ["--stages", "init,collide,simulate", *SCENE, *GRID, "--grid-rebuild", rebuild, "--precision", precision]
@@ -118,7 +118,7 @@ def test_volume_spreads_a_tight_bundle(cpu_bin, tmp_path):
         (["--grid", "16", "--grid-friction", "0.1,0.2,0.3"], "--grid-friction needs 1 to 2 numbers"),
         (["--grid", "16", "--grid-box", "0,0,0,1,1"], "--grid-box needs 6 numbers"),
         (["--grid", "16", "--grid-box", "0,0,0,1,-1,1"], "--grid-box needs X0 < X1"),
-        (["--grid", "16", "--grid-rebuild", "always"], "--grid-rebuild must be frame or substep"),
+        (["--grid", "16", "--grid-rebuild", "always"], "--grid-rebuild must be frame, substep or held"),
         (["--grid", "16", "--grid-volume", "-1"], "--grid-volume must be a finite number >= 0"),
         (["--grid", "16", "--strands", "70000000", "--points", "32"], "must be at most 2^31 points"),
     ],
@@ -128,3 +128,18 @@ def test_bad_grid_flags_are_refused_in_one_line(cpu_bin, tmp_path, flags, messag
     p = run(cpu_bin, "--stages", "init,collide,simulate", *flags, "--output", out, check=False)
     assert p.returncode == 2 and message in p.stderr and len(p.stderr.strip().splitlines()) == 1, p.stderr
     assert not out.exists()
+
+
+def test_held_equals_frame_with_one_substep_and_differs_with_more(cpu_bin, tmp_path):
+    """`held` samples the grid at the frame's first substep, where `frame` samples it too: with
+    one substep a frame the two are the same bits; with four, later substeps differ."""
+    bits = {}
+    for substeps in (1, 4):
+        for rebuild in ("frame", "held"):
+            out = tmp_path / f"{rebuild}{substeps}.h5"
+            scene = [str(substeps) if i and SCENE[i - 1] == "--substeps" else a for i, a in enumerate(SCENE)]
+            args = [*scene, *GRID, "--grid-rebuild", rebuild, "--frames", 3]
+            run(cpu_bin, "--stages", "init,collide,simulate", *args, "--velocities", "all", "--output", out, "--quiet")
+            bits[rebuild, substeps] = _bits(out)
+    assert np.array_equal(bits["frame", 1], bits["held", 1])
+    assert not np.array_equal(bits["frame", 4], bits["held", 4])

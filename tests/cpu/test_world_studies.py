@@ -83,7 +83,7 @@ def test_the_world_table_has_every_variant_of_both_axes(world_rows):
     grid = [r for r in world_rows if r["group"] == "grid"]
     body = [r for r in world_rows if r["group"] == "body"]
     assert {(r["grid"], r["rebuild"], r["friction"], r["volume"]) for r in grid if r["variant"] != "off"} == {
-        (8, rb, f, v) for rb in ("frame", "substep") for f in ("on", "off") for v in ("on", "off")
+        (8, rb, f, v) for rb in ("frame", "substep", "held") for f in ("on", "off") for v in ("on", "off")
     }
     assert {(r["sdf"], r["friction"]) for r in body if r["variant"] != "off"} == {(16, "on"), (16, "off")}
     for r in world_rows:
