@@ -57,7 +57,7 @@ from harness.check import observables
 from harness.core import env, rounds, runner, scenes, scenes_dynamic, timing, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
-from harness.io import files
+from harness.io import files, grooms
 from harness.io.trajectory import open_trajectory
 from harness.studies import accuracy_ensemble, observables_long, predictability
 from harness.studies.accuracy import (
@@ -315,13 +315,18 @@ def frame_metrics(run, ref, L, gravity, dt):
 
 class Study:
     def __init__(self, plan, out_dir, log):
-        self.plan = plan
         self.log = log
         base = scenes.load_scene(plan.scene)
         if base.model != "dynamic":
             raise HarnessError(
                 f"accuracy --model dynamic: scene {plan.scene} is a {base.model}-model scene (its model key)"
             )
+        most = grooms.hair_strand_count(base.groom_file) if base.groom_file else None
+        if most is not None and plan.time_strands > most:  # a groom file holds no more (docs/model.md §3.15)
+            log(f"dynamic accuracy: the groom holds {most} strands: each mode is timed at {most}, "
+                f"not {plan.time_strands}")  # fmt: skip
+            plan = replace(plan, time_strands=most)
+        self.plan = plan
         self.scene = base.with_overrides(strands=plan.strands, points=plan.points)
         self.frame_dt = float(self.scene.dynamic.get("--frame-dt", 1 / 60))
         check_plan(plan, self.frame_dt)

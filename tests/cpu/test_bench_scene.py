@@ -7,6 +7,7 @@ import json
 
 import pytest
 
+from conftest import ROOT
 from harness.bench import dynamic as bench_dynamic
 from harness.cli.main import main as harness_main
 from harness.core import timing
@@ -96,3 +97,19 @@ def test_options_of_the_default_bench_are_refused_with_a_scene(tiny, tmp_path, c
 def test_a_paper_scene_is_refused(tmp_path, capsys):
     assert harness_main(["bench", "--scene", "paper", "--out", str(tmp_path / "r")]) == 2
     assert "a paper-model scene" in capsys.readouterr().err and not (tmp_path / "r").exists()
+
+
+def test_a_groom_file_times_its_modes_at_its_own_strand_count(tmp_path):
+    """A HAIR groom holds its strands and no more (docs/model.md §3.15): the accuracy study asked
+    to time 1,000 strands of the 256-strand example groom times them at 256 and says so (found
+    by the GPU node's `bench --scene` on the example groom, which stopped with exit 2)."""
+    scene = tmp_path / "mine.toml"
+    example = ROOT / "configs" / "grooms" / "example.hair"
+    scene.write_text(SCENE.replace('groom = "curly"', f'groom = "{example}"').replace("points = 32", "points = 24"))
+    said = []
+    plan = accuracy_dynamic.Plan(**{**TINY, "time_strands": 1000, "scene": str(scene)})
+    study = accuracy_dynamic.Study(plan, tmp_path / "acc", said.append)
+    assert study.plan.time_strands == 256
+    assert any("the groom holds 256 strands" in s for s in said), said
+    small = accuracy_dynamic.Study(accuracy_dynamic.Plan(**{**TINY, "scene": str(scene)}), tmp_path / "b", said.append)
+    assert small.plan.time_strands == TINY["time_strands"]
