@@ -730,7 +730,7 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
 #define DYN_FRAME(T, SFX, M, W)                                                                                        \
     _Pragma("omp parallel")                                                                                            \
     {                                                                                                                  \
-        T *scratch = malloc((size_t)hb_mul_sat((uint64_t)P, 17u * sizeof(T)));                                          \
+        T *scratch = malloc((size_t)hb_mul_sat((uint64_t)P, 17u * sizeof(T)));                                         \
         if (!scratch) {                                                                                                \
             _Pragma("omp atomic write") failed = 1;                                                                    \
         } else {                                                                                                       \

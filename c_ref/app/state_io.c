@@ -495,7 +495,9 @@ static int write_world(hid_t p, const hb_dynamics *d)
     if (d->grid) {
         bad |= attr_i64(p, "grid_n", d->grid_n) < 0;
         bad |= attr_str(p, "grid_rebuild",
-                        d->grid_rebuild == HB_GRID_SUBSTEP ? "substep" : d->grid_rebuild == HB_GRID_HELD ? "held" : "frame") < 0;
+                        d->grid_rebuild == HB_GRID_SUBSTEP ? "substep"
+                        : d->grid_rebuild == HB_GRID_HELD  ? "held"
+                                                           : "frame") < 0;
         bad |= attr_i64(p, "grid_box_given", d->grid_box_given) < 0;
         bad |= attr_f64v(p, "grid_box", d->grid_box, 6) < 0;
         bad |= attr_f64(p, "grid_padding", d->grid_padding) < 0;

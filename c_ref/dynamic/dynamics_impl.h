@@ -179,7 +179,7 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_
     REAL *p = scratch;           /* predicted positions, 3P */
     REAL *lam = scratch + 3 * P; /* multipliers: stretch P−1 | bend P−2 | shape K */
     REAL *lam_s = lam, *lam_b = lam + P, *lam_g = lam + 2 * P;
-    REAL *d = scratch + 6 * P; /* ftl corrections d_k, 3P */
+    REAL *d = scratch + 6 * P;  /* ftl corrections d_k, 3P */
     REAL *hs = scratch + 9 * P; /* §3.16 `held`: the points' grid samples of the frame, 8P */
 
     const int wgrid = w && w->grid && (w->grid_friction || w->grid_volume);

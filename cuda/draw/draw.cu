@@ -234,7 +234,8 @@ int cuda_dyn_draw(hb_backend *b, const hb_dyn_frame *plans, int n, int width, in
     const int64_t px = (int64_t)width * height;
     HB_CUDA_AS(cudaMalloc((void **)&r.fb, (size_t)px * 8u), "cudaMalloc (the compute path's depth and colour buffer)");
     HB_CUDA_AS(cudaMalloc((void **)&r.rgba, (size_t)px * 4u), "cudaMalloc (the compute path's image)");
-    HB_CUDA_AS(cudaMalloc((void **)&r.smap, (size_t)v.S * (size_t)v.S * 4u), "cudaMalloc (the compute path's shadow map)");
+    HB_CUDA_AS(cudaMalloc((void **)&r.smap, (size_t)v.S * (size_t)v.S * 4u),
+               "cudaMalloc (the compute path's shadow map)");
     HB_CUDA(cudaStreamCreateWithFlags(&r.st, cudaStreamNonBlocking));
     r.ev.resize((size_t)n * 3);
     for (cudaEvent_t &e : r.ev) HB_CUDA(cudaEventCreate(&e));

@@ -42,10 +42,10 @@ struct View {
 };
 
 constexpr float kAmbient = 0.2f, kDiffuse = 0.8f, kSpecular = 0.25f, kShininess = 48.0f;
-constexpr int kMaxSteps = 8192;         /* the most pixels a segment walks */
-constexpr int kShadowMap = 1024;        /* S */
-constexpr float kShadowBias = 2.0f;     /* texels of depth (2E/S each) before a fragment counts as shadowed */
-constexpr float kShadowed = 0.35f;      /* the diffuse term's share left in shadow */
+constexpr int kMaxSteps = 8192;               /* the most pixels a segment walks */
+constexpr int kShadowMap = 1024;              /* S */
+constexpr float kShadowBias = 2.0f;           /* texels of depth (2E/S each) before a fragment counts as shadowed */
+constexpr float kShadowed = 0.35f;            /* the diffuse term's share left in shadow */
 constexpr uint32_t kBackground = 0xffebeeeeu; /* RGBA8 (0xAABBGGRR): a light grey */
 
 inline View make_view(int W, int H, double R, double extent, int P)

@@ -11,7 +11,7 @@
  * was outside) and the normal in n. */
 template <typename T>
 __device__ __forceinline__ T push_sphere_free(T (&p)[3], const T *c, T rc, const T *nperp, bool bounded, T depen,
-                                             T (&n)[3])
+                                              T (&n)[3])
 {
     const T e[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
     const T q = (e[0] * e[0] + e[1] * e[1]) + e[2] * e[2];

@@ -241,7 +241,8 @@ template <typename T> __device__ __forceinline__ Node4<T> load_node4(const T *p)
 template <typename T> struct Sample {
     Node4<T> a, b;
 };
-template <typename T> __device__ __forceinline__ Sample<T> grid_sample_at(const DModel<T> &m, const T *qg, const V3<T> &x)
+template <typename T>
+__device__ __forceinline__ Sample<T> grid_sample_at(const DModel<T> &m, const T *qg, const V3<T> &x)
 {
     const World<T> &w = m.world;
     Sample<T> s{{(T)0, (T)0, (T)0, (T)0}, {(T)0, (T)0, (T)0, (T)0}};
@@ -607,7 +608,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
             for (int i = 0; i < G; i++) {
                 const int k = point_of<G>(k0, sw, i);
                 if (k >= 1 && k < P) {
-                    if constexpr (W != 0) { /* §3.16 friction, then volume; `held`: sampled at the frame's first substep */
+                    /* §3.16 friction, then volume; `held`: sampled at the frame's first substep */
+                    if constexpr (W != 0) {
                         if (held) {
                             T *sa = hs + 4 * (2 * i * 32 + lane), *sb = hs + 4 * ((2 * i + 1) * 32 + lane);
                             if (j == 0) {
@@ -747,8 +749,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                         for (int i = 0; i < G; i++) {
                             const int k = k0 + i;
                             if (k >= 1 && k < P)
-                                follow_one(m, has, ell(i), i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i], (W & kWCol) && wcol,
-                                           pose, back, &X[i]);
+                                follow_one(m, has, ell(i), i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i],
+                                           (W & kWCol) && wcol, pose, back, &X[i]);
                         }
                     }
                 }

@@ -140,13 +140,15 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
                 for (int c = 0; c < 3; c++) sp[c] = HB_RINT64((wt[c8] * vc[c]) * (T)HB_GRID_MOM_SCALE);
                 const int64_t j = hb_grid_corner_f64(b, n, c8);
                 if (windowed) {
-                    const int jx = (int)(j % n) - lo[0], jy = (int)((j / n) % n) - lo[1], jz = (int)(j / (n * n)) - lo[2];
+                    const int jx = (int)(j % n) - lo[0], jy = (int)((j / n) % n) - lo[1],
+                              jz = (int)(j / (n * n)) - lo[2];
                     unsigned *node = win + 8 * (jx + ex * (jy + ey * jz));
                     window_add(node, sm[0]);
                     for (int c = 0; c < 3; c++) window_add(node + 2 + 2 * c, sp[c]);
                 } else {
                     atomicAdd((unsigned long long *)&mass[j], (unsigned long long)sm[0]);
-                    for (int c = 0; c < 3; c++) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sp[c]);
+                    for (int c = 0; c < 3; c++)
+                        atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sp[c]);
                 }
             }
         }
@@ -158,7 +160,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
         int64_t sum[4];
         bool any = false;
         for (int c = 0; c < 4; c++) {
-            sum[c] = (int64_t)reinterpret_cast<const int *>(node)[2 * c + 1] * 65536 + (int64_t)node[2 * c];
+            sum[c] = (int64_t) reinterpret_cast<const int *>(node)[2 * c + 1] * 65536 + (int64_t)node[2 * c];
             any |= sum[c] != 0;
         }
         if (!any) continue;

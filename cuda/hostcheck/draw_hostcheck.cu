@@ -70,8 +70,7 @@ struct HostMin32 {
 
 /* the compute path's image, as its kernels draw it: the shadow map (the head, then every
  * segment), then the head and the strands (shadows = false: every fragment lit) */
-std::vector<uint32_t> compute_image(const View &v, const std::vector<std::vector<float>> &strands,
-                                    bool shadows = true)
+std::vector<uint32_t> compute_image(const View &v, const std::vector<std::vector<float>> &strands, bool shadows = true)
 {
     std::vector<uint32_t> smap((size_t)v.S * v.S);
     for (int r = 0; r < v.S; r++)
@@ -86,8 +85,7 @@ std::vector<uint32_t> compute_image(const View &v, const std::vector<std::vector
             if (shadows)
                 hb_draw::raster_segment(v, &s[3 * k], &s[3 * k + 3], k, HostMin{fb.data()},
                                         hb_draw::ShadowMap{smap.data()});
-            else
-                hb_draw::raster_segment(v, &s[3 * k], &s[3 * k + 3], k, HostMin{fb.data()});
+            else hb_draw::raster_segment(v, &s[3 * k], &s[3 * k + 3], k, HostMin{fb.data()});
         }
     std::vector<uint32_t> out(fb.size());
     for (size_t i = 0; i < fb.size(); i++) out[i] = (uint32_t)fb[i];

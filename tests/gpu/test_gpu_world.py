@@ -37,8 +37,18 @@ SCENES = {
     "grid-frame": ["--head-motion", "nod", "--grid", "16", "--grid-friction", "0.1,0.02", "--grid-volume", "2000"],
     "grid-substep": ["--head-motion", "shake", "--grid", "20", "--grid-friction", "0.05", "--grid-rebuild", "substep"],
     "grid-still": ["--grid", "12", "--grid-volume", "5000"],
-    "grid-held": ["--head-motion", "nod", "--grid", "16", "--grid-friction", "0.1,0.02", "--grid-volume", "2000",
-                  "--grid-rebuild", "held"],  # fmt: skip
+    "grid-held": [
+        "--head-motion",
+        "nod",
+        "--grid",
+        "16",
+        "--grid-friction",
+        "0.1,0.02",
+        "--grid-volume",
+        "2000",
+        "--grid-rebuild",
+        "held",
+    ],
     "body": ["--head-motion", "nod", "--friction", "0.4,0.3", "--depenetration-speed", "150", "--colliders", "BODY"],
     "body-sway": ["--colliders", "BODY", "--body-motion", "sway", "--body-amplitude", "3"],
     "all": [

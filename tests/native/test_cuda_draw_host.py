@@ -3,8 +3,8 @@ compute rasteriser's functions (cuda/draw/view.cuh) with a host atomicMin, and t
 (cuda/draw/egl_gl.cuh) through EGL on whatever driver is here (Mesa's llvmpipe in CI): a strand at
 known coordinates covers its row and columns, a strand behind the head is hidden and one in
 front is not; and the compute path's shadow map: a strand 4 cm nearer the light along it darkens
-another's pixels, the same strand moved across the light changes none. Skipped, with the reason, where nvcc is missing; the GL half where EGL gives no
-context."""
+another's pixels, the same strand moved across the light changes none. Skipped, with the reason,
+where nvcc is missing; the GL half where EGL gives no context."""
 
 import pytest
 from test_cuda_port_host import build_hostcheck, check_hostcheck
