@@ -36,8 +36,16 @@ from harness.core.progress import StepTimes
 from harness.core.scenes import with_frames
 from harness.io import results_data
 from harness.io.files import write_json
-from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
-from harness.studies import accuracy_dynamic, animate, budget_curves, featurecost, peer, reduced, stability
+from harness.render import accuracy_dynamic_report, report_dynamic
+from harness.render import peer_dynamic_report as peer_report
+from harness.render import stability_dynamic_report as stability_report
+from harness.studies import accuracy_dynamic
+from harness.studies import animate_dynamic as animate
+from harness.studies import budget_curves_dynamic as budget_curves
+from harness.studies import featurecost_dynamic as featurecost
+from harness.studies import peer_dynamic as peer
+from harness.studies import reduced_dynamic as reduced
+from harness.studies import stability_dynamic as stability
 from harness.studies.accuracy import DEFAULT_SCENE, curves_name, results_name
 from harness.studies.sweep import run_sweep
 

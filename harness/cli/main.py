@@ -16,7 +16,8 @@ from pathlib import Path
 from harness import HarnessError, __version__
 from harness.core import interrupts
 from harness.core.paths import CUDA_BUILDS
-from harness.studies import peer, reduced
+from harness.studies import peer_dynamic as peer
+from harness.studies import reduced_dynamic as reduced
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -162,7 +163,7 @@ def cmd_sweep(args):
 
 
 def cmd_plot(args):
-    from harness.render import plots
+    from harness.render import plots_paper as plots
 
     for path in plots.make_all(args.results, args.report_dir):
         print(f"wrote {path}")
@@ -534,7 +535,7 @@ def cmd_budget(args):
     noise of the budget) and its RMS error over the accuracy study's horizon (docs/harness.md, "A frame budget").
     Reads RUN/dynamic-accuracy[-SCENE]/ and RUN/budget-curves[-SCENE]/ (make bench, or make bench SCENE=...)."""
     from harness.core.paths import LOCAL_RUN
-    from harness.render import frame_budget
+    from harness.render import frame_budget_dynamic as frame_budget
 
     data = frame_budget.load(args.run or LOCAL_RUN, args.scene)
     if args.json:
@@ -549,7 +550,7 @@ def cmd_hair(args):
     stiffnesses and per-unit-mass compliances on a strand of --length cm and --points points (docs/hair_physics.md),
     and print the [fibre] table that puts it in a scene."""
     from harness.core import hair_physics, scenes
-    from harness.render import fibre_report
+    from harness.render import fibre_dynamic_report as fibre_report
 
     try:
         fibre = hair_physics.fibre(
@@ -585,8 +586,8 @@ def cmd_featurecost(args):
     """Run a dynamic scene with every feature undeclared, each alone, the full scene less each, and the full
     scene (features are removed by their flags, so the binary compiles them out); print a Markdown table and,
     with --out, write the rows as CSV."""
-    from harness.render import featurecost_report
-    from harness.studies import featurecost
+    from harness.render import featurecost_dynamic_report as featurecost_report
+    from harness.studies import featurecost_dynamic as featurecost
 
     given = options(
         args, "backend build variant strands points frames repeat threads block_size out timeout instructions"
@@ -605,7 +606,7 @@ def cmd_reduced(args):
     oracle and, with a usable GPU, the cuda variants that run it (docs/model.md §3.14); and the still scene with
     and without sag-free rest at two shape ranges: how far it sags, and the tip's swing under a wind step.
     Prints Markdown; --out writes the rows as CSV and references.csv beside it."""
-    from harness.render import reduced_report
+    from harness.render import reduced_dynamic_report as reduced_report
 
     base = reduced.Plan.quick if args.quick else reduced.Plan
     changes = {k: v for k, v in (("scene", args.scene), ("seconds", args.seconds)) if v}
@@ -636,7 +637,7 @@ def cmd_peer(args):
     mapped as docs/decisions.md says), against our converged fp64 reference: error, stretch and time per frame
     at several strand counts. Writes results/peer/ and results/local/report/peer.md. Needs pypbd (optional):
     without it, one line says it is skipped, nothing is written, and the exit status is 0."""
-    from harness.render import peer_report
+    from harness.render import peer_dynamic_report as peer_report
 
     if not args.report_only:
         fields = peer.Plan.__dataclass_fields__
@@ -656,7 +657,7 @@ def cmd_animate(args):
     """Draw the frames of a dynamic HDF5 state (read through harness.io.trajectory) seen from the side and from
     the front, the head sphere drawn, as a GIF (and an MP4 beside it where ffmpeg is on PATH). Without STATE,
     runs configs/scenes/dynamic.toml on hairsim-cpu first."""
-    from harness.studies import animate
+    from harness.studies import animate_dynamic as animate
 
     for path in animate.run(args.state, **options(args, "out max_strands every fps force strands frames")):
         print(f"wrote {path}")
@@ -707,8 +708,8 @@ def cmd_stability(args):
     a GPU answers; judge each cell ok, over-stretched, penetrating, escaped (a point past twice its hanging
     length) or diverged (NaN/Inf); write results/stability/, results/local/report/stability_*.png and
     results/local/report/dynamic_stability.md."""
-    from harness.render import stability_report
-    from harness.studies import stability
+    from harness.render import stability_dynamic_report as stability_report
+    from harness.studies import stability_dynamic as stability
 
     if args.from_csv:
         stability_report.report_from_csv(args.from_csv, report_dir=args.report_dir)
@@ -760,7 +761,7 @@ def cmd_judge(args):
 def cmd_calibrate(args):
     """Run the cpu binary at fp32 and fp64 on the paper scene and print the errors and invariant residuals that
     tolerances.py is set from."""
-    from harness.studies import calibrate
+    from harness.studies import calibrate_paper as calibrate
 
     return calibrate.run(
         strands=args.strands, points=args.points, seeds=args.seeds, other=args.other, as_json=args.json
@@ -1292,7 +1293,7 @@ def parser():
     rd.add_argument("--no-shadows", action="store_true", help="no self-shadowing (the opacity shadow map)")
     rd.add_argument("--force", action="store_true", help="replace existing output files")
 
-    from harness.studies.stability import FRAMES, SLICE_NAMES, STRANDS
+    from harness.studies.stability_dynamic import FRAMES, SLICE_NAMES, STRANDS
 
     sb = command(
         sub,

@@ -382,7 +382,7 @@ DYN_ACC_USES = {
     "games": (1e-2, 0.02, "real-time, stretch must not show"),
     "offline": (2e-3, 0.005, "film quality, close to the converged motion"),
 }
-# What each use tolerates of the long runs' observables (harness/studies/observables_long.py),
+# What each use tolerates of the long runs' observables (harness/studies/observables_long_dynamic.py),
 # this project's statements like the budgets above: the swing's frequency off by at most this
 # share (a quarter is a visibly different hair length in a preview; 10 % players do not read
 # as wrong; 3 % an animator matching reference footage would not notice), the mean kinetic
@@ -427,7 +427,7 @@ DYN_ENSEMBLE_WINDOW_S = 0.25
 DYN_ACC_VIEW_CM = 40.0  # scene height across the picture (L = 30 cm of hair below a head)
 
 
-# PREDICTABILITY (harness/check/predictability.py, harness/studies/predictability.py). A twin
+# PREDICTABILITY (harness/check/predictability.py, harness/studies/predictability_dynamic.py). A twin
 # run's one frame is perturbed by DYN_LYAPUNOV_PERTURBATION_L (RMS over the points, ·L): far
 # above fp64's rounding of a coordinate (2.2e-16 × 40 cm ≈ 9e-15 cm, 3e-16·L) and far below any
 # error a study ranks, so its growth is the model's own. The rate λ is fitted to ln(separation)
@@ -459,7 +459,7 @@ def jitter_budget_cm(use: str) -> float:
 
 # ---------------------------------------------------------------------------------------
 # ANALYTIC CHECKS of the dynamic model (docs/model.md §4; tests/cpu/test_analytic.py; the full
-# S sweeps in docs/analytic.md, made by `python -m harness.studies.analytic_table`). Measured on the
+# S sweeps in docs/analytic.md, made by `python -m harness.studies.analytic_table_dynamic`). Measured on the
 # C reference, fp64, --threads 1, Δt = 1/60 s, g0 = 981 cm/s², --iterations 1, at commit
 # 87dab6c's model (dynamics_impl.h). Relative errors are |measured − expected|/expected.
 #
@@ -487,7 +487,7 @@ ANALYTIC_FTL_XPBD_P2_REL = 1e-11  # |T_ftl − T_xpbd|/T at P = 2 (measured ≤ 
 ANALYTIC_WIND_ANGLE_ABS = 2e-12  # rad (9× the worst measured at S ≤ 8)
 # Hanging chain (§4.3): L = 30 cm, rigid links, no bend, displaced by 0.3 cm × the continuum
 # first mode; ω from the zero crossings of the first-mode coordinate over 4 periods, against
-# the linearised discrete chain's ω1 (harness.studies.analytic.discrete_chain_omega1). ftl runs with
+# the linearised discrete chain's ω1 (harness.studies.analytic_dynamic.discrete_chain_omega1). ftl runs with
 # --ftl-damping 1: with the default s = 0.9 it converges (in S) to a different frequency,
 # 13% (P = 32) and 33% (P = 64) above the chain's (docs/analytic.md).
 #   xpbd      P = 32: S = 64, 256 → 6.0e-4, 4.2e-5;  P = 64: 2.4e-3, 1.6e-4
@@ -541,7 +541,7 @@ ANALYTIC_FP32_WIND_ANGLE_ABS = 5e-4  # rad at S ≤ 8 (worst 8.7e-5; below the 3
 # 1.3e-6 (normal fp32), 8.6e-7 (fast-math fp32), 3.4e-15 (normal fp64), h·|Δv|/L 7.3e-7
 # (fp32), 1.3e-15 (fp64): margins of 15 and 11, the smallest seen.
 GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS = True
-# ---- beside a peer: Bender's PositionBasedDynamics (pypbd) on chains (harness/studies/peer.py,
+# ---- beside a peer: Bender's PositionBasedDynamics (pypbd) on chains (harness/studies/peer_dynamic.py,
 # tests/cpu/test_peer.py; the mapping and the differences in docs/decisions.md, "The peer") ----
 # The converged reference of `harness peer`: S doubles until the largest change of a point
 # from S to 2S is below this fraction of the smallest error the comparison reports.
@@ -567,7 +567,7 @@ PEER_PERIOD_REL = 1e-11  # |T_peer − T_ours|/T (worst measured 1.3e-12; margin
 PEER_RIGID_STRETCH_S256 = 2e-3  # both solvers at S = 256 (measured 1.17e-3; margin 1.7×)
 
 
-# ---- verdicts of the dynamic stability map (harness/studies/stability.py, docs/decisions.md
+# ---- verdicts of the dynamic stability map (harness/studies/stability_dynamic.py, docs/decisions.md
 # "Stability map of the dynamic model") ------------------------------------------------------
 # These are not rounding tolerances but the lines a cell of the map is judged by; they live
 # here because every number that judges a result does. Each is taken over every frame of

@@ -16,8 +16,8 @@ from harness.core.paths import display
 from harness.io import tables
 from harness.studies.accuracy import scheme_name
 
-LONG_CSV = "observables.csv"  # studies/observables_long.py's table
-ENSEMBLE_CSV = "ensemble.csv"  # studies/accuracy_ensemble.py's table
+LONG_CSV = "observables.csv"  # studies/observables_long_dynamic.py's table
+ENSEMBLE_CSV = "ensemble.csv"  # studies/accuracy_ensemble_dynamic.py's table
 CHAOS_COLUMNS = (
     ("tip_L", "tip distribution W1 / L"),
     ("curvature_rel", "curvature distribution W1, relative"),
@@ -262,7 +262,8 @@ def long_lines(long, worst_verdict):
     rest_s = f"{rest['seconds'].iloc[0]:g} s" if len(rest) else "its time"
     out = head + [
         f"Long runs ({first['seconds']:g} s, {int(first['strands'])} strands × {int(first['points'])} points, "
-        "harness/studies/observables_long.py), each made from the study's own scene: **motion** the scene itself; "
+        "harness/studies/observables_long_dynamic.py), each made from the study's own scene: "
+        "**motion** the scene itself; "
         "**release** the scene with the head still, no wind and no collider, let go from its rest shape (the median "
         "over the strands whose tip swings, at least two periods, of each strand's swing frequency over the first "
         "half and of its damping ratio over the whole run; — where no strand swings); **rest** the scene still, "

@@ -20,8 +20,8 @@ from harness import HarnessError
 from harness.core import timing, tolerances
 from harness.core.paths import REPORT, RESULTS, display
 from harness.io import files, tables
-from harness.render import accuracy_chaos_report as chaos
-from harness.render.accuracy_chaos_report import jitter_budget_lines, load_ensemble, load_long
+from harness.render import accuracy_chaos_dynamic_report as chaos
+from harness.render.accuracy_chaos_dynamic_report import jitter_budget_lines, load_ensemble, load_long
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     CSV_NAME,
@@ -950,7 +950,7 @@ def markdown(rows, study, env, analytic, long=None, names=Names(), title=DEFAULT
             "### Analytic checks against S",
             "",
             "docs/model.md §4 against the C reference (fp64 unless a table says fp32, `--threads 1`, no collider; "
-            "`harness/studies/analytic_table.py`, run by this study):",
+            "`harness/studies/analytic_table_dynamic.py`, run by this study):",
             "",
             *[ln.replace("### ", "#### ", 1) if ln.startswith("### ") else ln for ln in analytic],
             "",

@@ -6,7 +6,7 @@ mode whose predicted time at N fits B, from measured data only:
              (<run>/dynamic-accuracy[-<scene>]/, render/accuracy_dynamic_report.summary);
   cost       the mode's own throughput curve, its time a frame measured at a ladder of strand
              counts by the stopping rule (<run>/budget-curves[-<scene>]/curves.csv,
-             studies/budget_curves.py).
+             studies/budget_curves_dynamic.py).
 
 The cost at N: measured at N; between two measured sizes, interpolated on the log-log line
 through them; beyond the largest measured size M, t(M)·N/M, said as an extrapolation (strands
@@ -164,7 +164,8 @@ def section(root, scene="dynamic", budgets=BUDGETS_MS, sizes=TABLE_STRANDS):
         return head + [f"Not measured: {e}.", ""]
     out = head + [
         "For a budget of B ms a frame and N strands, the most accurate mode whose time at N, predicted from its "
-        "own measured curve, fits B (`python -m harness budget --strands N --frame-ms B`; render/frame_budget.py). "
+        "own measured curve, fits B (`python -m harness budget --strands N --frame-ms B`; "
+        "render/frame_budget_dynamic.py). "
         f"Each cell: the mode, its predicted ms, its RMS error over the first {data.horizon_s:g} s; * where the "
         "time is extrapolated beyond the largest measured size, ~ where the budget is within the time's noise.",
         "",

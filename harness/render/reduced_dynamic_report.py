@@ -1,4 +1,4 @@
-"""The reduced-model trades (harness/studies/reduced.py's CSV and references.csv beside it) as
+"""The reduced-model trades (harness/studies/reduced_dynamic.py's CSV and references.csv beside it) as
 Markdown: guide fraction × scheme at each strand count with the guide spacing, LRA on/off, simulated
 points P_s against rendered points P_r (LOD), and sag-free rest (the still groom's displacement at
 each shape range, the tip's swing), each row's error against a converged, fully simulated reference

@@ -130,7 +130,7 @@ def results_name(scene):
 
 
 CSV_NAME = "dynamic_accuracy.csv"
-# the frame budget's throughput curves of the study's modes (studies/budget_curves.py)
+# the frame budget's throughput curves of the study's modes (studies/budget_curves_dynamic.py)
 CURVES_NAME = "budget-curves"
 CURVES_CSV = "curves.csv"
 

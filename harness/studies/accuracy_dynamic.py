@@ -61,7 +61,9 @@ from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
 from harness.io.trajectory import open_trajectory
-from harness.studies import accuracy_ensemble, observables_long, predictability
+from harness.studies import accuracy_ensemble_dynamic as accuracy_ensemble
+from harness.studies import observables_long_dynamic as observables_long
+from harness.studies import predictability_dynamic as predictability
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     COLUMNS,
@@ -632,7 +634,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             futures = {}
             if plan.analytic != "none":
-                from harness.studies import analytic_table
+                from harness.studies import analytic_table_dynamic as analytic_table
 
                 futures[pool.submit(analytic_table.tables, str(cpu_oracle.binary), plan.analytic == "quick")] = None
             units = [[m] for m in modes if m.runner.backend == "cpu"]  # a process each, the pool's jobs in parallel

@@ -1,6 +1,6 @@
 """Hand-made input states for the analytic checks (docs/model.md §4), and the runs on them.
 
-Self-contained on purpose (it needs only h5py, numpy, harness.studies.analytic and
+Self-contained on purpose (it needs only h5py, numpy, harness.studies.analytic_dynamic and
 harness.check.observables' dominant_frequency): it writes a
 paper-model state file (the layout of docs/interfaces.md: /h5md,
 /particles/hair/position/value [1][N·P][3], /parameters with the scene attributes and
@@ -35,7 +35,7 @@ def write_paper_state(path, positions, hair_length, precision="fp64", hair_offse
         h.attrs["version"] = np.array([1, 1], dtype=np.int32)
         h.create_group("author").attrs["name"] = "hairbench analytic tests"
         c = h.create_group("creator")
-        c.attrs["name"] = "harness/studies/analytic_runs.py"
+        c.attrs["name"] = "harness/studies/analytic_runs_dynamic.py"
         c.attrs["version"] = "1"
         pos = f.create_group("particles/hair/position")
         pos.create_dataset("value", data=positions.reshape(1, n * p, 3).astype(dtype))
@@ -153,14 +153,14 @@ def simulate(
 
 # ---------------------------------------------------------------- the checks' runs
 # Each returns a dict with the measured value, the expected value(s) and extras. They import
-# harness.studies.analytic for the analysis (the closed forms live there, once).
+# harness.studies.analytic_dynamic for the analysis (the closed forms live there, once).
 
 FRAME_DT = 1.0 / 60.0
 G0 = 981.0
 
 
 def _analytic():
-    from harness.studies import analytic
+    from harness.studies import analytic_dynamic as analytic
 
     return analytic
 

@@ -1,5 +1,5 @@
 """`python -m harness reduced`: what modelling less costs and saves (docs/model.md §3.14) — the
-measuring part; harness/render/reduced_report.py renders it.
+measuring part; harness/render/reduced_dynamic_report.py renders it.
 
 Rows of one dynamic scene (default `dynamic`), each run for `seconds` of simulated time, written
 every `write_every` s:
@@ -25,7 +25,7 @@ every `write_every` s:
            reference simulates P_r points
 
 Each row's checked run (fp32, the CPU oracle on every core) is compared with a converged
-reference of the same scene (studies/reduced_reference.py: xpbd fp64 I = 1, S doubled until it
+reference of the same scene (studies/reduced_reference_dynamic.py: xpbd fp64 I = 1, S doubled until it
 is ten times closer than the smallest row error, on the GPU in fp64 where one is usable): rms_err_L
 and max_err_L are the worst written frame up to the pointwise horizon (min(seconds, the scene's
 predictability time)); tip_L, curvature_rel and envelope_rel the statistics of the whole run
@@ -56,7 +56,7 @@ from harness.core.guides import guide_count, guide_strands
 from harness.core.paths import binary_path
 from harness.io.files import write_csv
 from harness.studies.accuracy import frame_errors
-from harness.studies.reduced_reference import References, read_positions
+from harness.studies.reduced_reference_dynamic import References, read_positions
 
 FIELDS = (
     "study",

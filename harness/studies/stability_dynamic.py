@@ -50,7 +50,7 @@ from harness.core.progress import Progress
 from harness.io import files
 from harness.io.files import write_json
 from harness.io.trajectory import open_trajectory
-from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES, scene_slice
+from harness.studies.stability_slices_dynamic import OFF, SLICE_NAMES, SLICES, scene_slice
 
 STRANDS = 16
 FRAMES = 60  # one second at the base scenes' Δt = 1/60 s

@@ -1,4 +1,4 @@
-"""`python -m harness animate` (harness/studies/animate.py): a tiny dynamic state becomes a GIF with
+"""`python -m harness animate` (harness/studies/animate_dynamic.py): a tiny dynamic state becomes a GIF with
 the frames the docs promise (the rest frame, then every K-th simulated frame); bad input is
 one line, exit status 2, and no file (nor a temporary one) left behind."""
 

@@ -17,7 +17,8 @@ from harness.cli import main as cli
 from harness.core import env, tolerances, variants
 from harness.core.paths import ROOT
 from harness.render import accuracy_dynamic_report
-from harness.studies import accuracy_dynamic, observables_long
+from harness.studies import accuracy_dynamic
+from harness.studies import observables_long_dynamic as observables_long
 from support.accuracy_plans import TINY
 from support.cuda_standin import install
 

@@ -205,7 +205,7 @@ def test_release_damping_noise_is_the_larger_of_halves_and_fit():
     (even strands 0.02 and 0.04, odd the same): the strand halves agree, so ζ's noise is
     the envelope fit's standard error; with 0.02, 0.04 on the even and 0.03, 0.05 on the odd
     strands it is half the halves' difference."""
-    from harness.studies import observables_long
+    from harness.studies import observables_long_dynamic as observables_long
 
     dt, f0 = 1 / 60, 1.1
     t = np.arange(600) * dt
