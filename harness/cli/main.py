@@ -15,6 +15,7 @@ from pathlib import Path
 
 from harness import HarnessError, __version__
 from harness.core import interrupts
+from harness.core.limits import limits
 from harness.core.paths import CUDA_BUILDS
 from harness.studies import peer_dynamic as peer
 from harness.studies import reduced_dynamic as reduced
@@ -41,6 +42,18 @@ def whole(low):
         return value
 
     return parse
+
+
+def block_size(text):
+    """An argparse type: cuda threads per block, as the binaries' --limits allow them."""
+    value = whole(1)(text)
+    try:
+        why = limits().block_size_error(value)
+    except HarnessError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+    if why:
+        raise argparse.ArgumentTypeError(why)
+    return value
 
 
 def real(name, needs, accept, must):
@@ -819,7 +832,7 @@ def binary_options(p):
         help="a variant the binary declares (`hairsim-* --list-variants`; default: the binary's default variant)",
     )
     p.add_argument("--threads", type=whole(1), help="cpu OpenMP threads (default: all cores)")
-    p.add_argument("--block-size", type=whole(32), help="cuda threads per block (32…1024)")
+    p.add_argument("--block-size", type=block_size, help="cuda threads per block, as the binaries' --limits allow")
 
 
 def command(sub, func, help, description=None, name=None):  # noqa: A002 (argparse's own name)
@@ -1098,7 +1111,7 @@ def parser():
         default=5,
         help="rounds of (CPU copy bandwidth, fast CPU variant) whose median round is reported (default 5)",
     )
-    h.add_argument("--block-size", type=whole(32), default=256)
+    h.add_argument("--block-size", type=block_size, default=256)
     h.add_argument(
         "--model",
         choices=("paper", "dynamic"),

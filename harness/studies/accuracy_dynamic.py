@@ -56,7 +56,8 @@ import numpy as np
 
 from harness import HarnessError
 from harness.check import observables
-from harness.core import env, rounds, runner, scenes, scenes_dynamic, timing, tolerances, variants
+from harness.core import env, rounds, runner, scenes, timing, tolerances, variants
+from harness.core.limits import limits
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
@@ -150,14 +151,13 @@ def check_plan(plan, frame_dt):
     if not plan.substeps or not plan.iterations:
         bad.append("--substeps and --iterations need at least one value each")
     for flag, vals in (("--substeps", plan.substeps), ("--iterations", plan.iterations)):
-        if any(v < 1 or v > scenes_dynamic.MAX_COUNT for v in vals):
-            bad.append(f"{flag} values must lie in 1 … {scenes_dynamic.MAX_COUNT}")
+        bad += sorted({f"{flag} values {why}" for v in vals if (why := limits().count_error(flag[2:], v))})
     if plan.substeps and plan.first_rung <= max(plan.substeps):
         bad.append(f"--ref-start {plan.first_rung} must exceed the largest --substeps ({max(plan.substeps)})")
     if plan.ref_max < 2 * plan.first_rung:
         bad.append(f"--ref-max {plan.ref_max} must be at least twice --ref-start ({plan.first_rung})")
-    elif not frame_dt / plan.ref_max >= 1e-12:
-        bad.append(f"--ref-max {plan.ref_max} makes the substep {frame_dt / plan.ref_max:g} s, below 1e-12 s")
+    elif why := limits().substep_error(frame_dt / plan.ref_max):
+        bad.append(f"--ref-max {plan.ref_max}: {why}")
     if plan.analytic not in ("full", "quick", "none"):
         bad.append(f"--analytic must be full, quick or none (got '{plan.analytic}')")
     if not plan.ftl_damping or any(not 0.0 <= s <= 1.0 for s in plan.ftl_damping):
