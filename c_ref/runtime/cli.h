@@ -18,11 +18,11 @@ void hb_print_usage(FILE *f, const char *prog, const char *backend);
 void hb_default_options(hb_options *o);
 
 /* Limits the binaries check that the harness reads through --limits (docs/interfaces.md,
- * "Limits"); the flag table's ranges (--block-size, --threads, ...) are printed from the table. */
-#define HB_COUNT_MAX 1000000                   /* --substeps and --iterations at most */
-#define HB_SUBSTEP_MIN_S 1e-12                 /* h = --frame-dt / --substeps, s */
+ * "Command line"); the flag table's ranges (--block-size, --threads, ...) are printed from the table. */
+#define HB_COUNT_MAX 1000000   /* --substeps and --iterations at most */
+#define HB_SUBSTEP_MIN_S 1e-12 /* h = --frame-dt / --substeps, s */
 #define HB_SUBSTEP_MAX_S 1e3
-#define HB_GRID_N_MIN 2                        /* --grid nodes per axis */
+#define HB_GRID_N_MIN 2 /* --grid nodes per axis */
 #define HB_GRID_N_MAX 512
 #define HB_GRID_POINTS_MAX (UINT64_C(1) << 31) /* --strands x --points with --grid */
 #define HB_BLOCK_MULTIPLE 32                   /* --block-size: a whole number of warps */
