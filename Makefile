@@ -64,11 +64,13 @@ SIMD_V4_CFLAGS := -O3 -march=x86-64-v4 -mprefer-vector-width=512 -fopenmp-simd -
 CPU_FLAGS_STR := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (c_ref/simd/) adds: $(SIMD_CFLAGS)
 CPU_FLAGS_STR_V4 := $(CC) $(CFLAGS_REF) -fopenmp; simd variant (c_ref/simd/, x86-64-v4 build) adds: $(SIMD_V4_CFLAGS)
 
-# c_ref/: runtime/ (the host runtime both binaries link: command line, driver, HDF5 and JSON
-# output), paper/ and dynamic/ (the two models' reference), simd/ (the CPU simd variant), and
-# backend_cpu.c (the CPU backend that puts them together). Included as "runtime/params.h".
-SHARED_SRC := $(wildcard c_ref/runtime/*.c) c_ref/paper/model_host.c c_ref/dynamic/dynamics_host.c \
-              c_ref/dynamic/dyn_followers.c c_ref/dynamic/dyn_sagfree.c c_ref/dynamic/dyn_lod.c \
+# c_ref/, from the top layer down (docs/decisions/code-layout.md): app/ (the program both binaries
+# link: the driver, the backend interface, HDF5 states and the JSON record; it knows both models),
+# paper/ and dynamic/ (the two models' reference), runtime/ (model-free: command line, input,
+# parameters, safe writes), simd/ (the CPU simd variant), and backend_cpu.c (the CPU backend that
+# puts them together). Included as "runtime/params.h".
+SHARED_SRC := $(wildcard c_ref/app/*.c c_ref/runtime/*.c) c_ref/paper/model_host.c c_ref/dynamic/dynamics_host.c \
+              c_ref/dynamic/motion_track.c c_ref/dynamic/dyn_followers.c c_ref/dynamic/dyn_sagfree.c c_ref/dynamic/dyn_lod.c \
               c_ref/dynamic/colliders.c c_ref/dynamic/sdf_mesh.c c_ref/dynamic/hair_grid.c c_ref/dynamic/world_host.c
 SHARED_OBJ := $(SHARED_SRC:c_ref/%.c=$(OBJ)/%.o)
 CPU_SRC    := c_ref/paper/model.c c_ref/dynamic/dynamics_f32.c c_ref/dynamic/dynamics_f64.c $(wildcard c_ref/simd/*.c) \
@@ -78,8 +80,10 @@ C_HEADERS  := $(wildcard c_ref/*/*.h)
 
 # ---- CUDA: three builds of one source; the flags are recorded in every output ----
 HAVE_NVCC := $(shell command -v $(NVCC) >/dev/null 2>&1 && echo yes)
-CUDA_SRC  := $(wildcard cuda/*.cu)
-CUDA_HDR  := $(wildcard cuda/*.cuh)
+# cuda/: the backend (backend_*.cu) and what both models share at the top, the models' kernels in
+# paper/ and dynamic/, --draw in draw/; included by their path from cuda/ ("dynamic/model.cuh")
+CUDA_SRC  := $(wildcard cuda/*.cu cuda/*/*.cu)
+CUDA_HDR  := $(wildcard cuda/*.cuh cuda/*/*.cuh)
 # one architecture: -arch=sm_XX (its code and PTX); several: each one's code, and the newest's
 # PTX, which a later GPU compiles when it loads the binary
 comma := ,
@@ -90,7 +94,7 @@ NVCC_MODE_normal   :=
 NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DHB_REFERENCE_ARITHMETIC=1
 NVCC_MODE_fastmath := --use_fast_math
 CUDA_BINS := $(BUILD)/hairsim-cuda $(BUILD)/hairsim-cuda-strict $(BUILD)/hairsim-cuda-fastmath
-HOSTCHECK_BINS := $(BUILD)/hostcheck/model_hostcheck_reference $(BUILD)/hostcheck/model_hostcheck_free \
+HOSTCHECK_BINS := $(BUILD)/hostcheck/paper_hostcheck_reference $(BUILD)/hostcheck/paper_hostcheck_free \
                   $(BUILD)/hostcheck/dyn_hostcheck $(BUILD)/hostcheck/post_hostcheck $(BUILD)/hostcheck/lod_hostcheck \
                   $(BUILD)/hostcheck/draw_hostcheck
 
@@ -147,7 +151,7 @@ $(OBJ)/simd/%.o: CFLAGS_REF += $(SIMD_CFLAGS)
 $(OBJ)/simd/%_v4.o: CFLAGS_REF += $(SIMD_V4_CFLAGS)
 $(OBJ)/simd/model_simd_v4.o: c_ref/simd/model_simd.c
 $(OBJ)/simd/dynamics_simd_v4.o: c_ref/simd/dynamics_simd.c
-$(OBJ)/runtime/record.o: $(REV_STAMP)
+$(OBJ)/app/record.o: $(REV_STAMP)
 
 $(BUILD)/hairsim-cpu: $(SHARED_OBJ) $(CPU_OBJ)
 	$(CC) -fopenmp $^ -o $@ $(HDF5_LIBS) -lm
@@ -157,13 +161,13 @@ $(BUILD)/hairsim-cpu: $(SHARED_OBJ) $(CPU_OBJ)
 # sensitive a scene is; the rest of its objects are the reference's.
 CONTRACT_FLAGS := $(filter-out -ffp-contract=off,$(CFLAGS_REF)) -ffp-contract=fast -march=x86-64-v3
 CONTRACT_SRC := c_ref/paper/model.c c_ref/dynamic/dynamics_f32.c c_ref/dynamic/dynamics_f64.c c_ref/dynamic/dynamics_host.c \
-                c_ref/runtime/record.c
+                c_ref/app/record.c
 CONTRACT_OBJ := $(CONTRACT_SRC:c_ref/%.c=$(OBJ)/contract/%.o)
 $(OBJ)/contract/%.o: c_ref/%.c $(C_HEADERS) | check-hdf5
 	@mkdir -p $(dir $@)
 	$(CC) $(CONTRACT_FLAGS) -fopenmp -Ic_ref $(HDF5_CFLAGS) -DHB_GIT_REV='"$(GIT_REV)"' \
 	  -DHB_FLAGS='"$(CC) $(CONTRACT_FLAGS) -fopenmp (spread build: $(notdir $(CONTRACT_SRC)); the rest as hairsim-cpu)"' -c $< -o $@
-$(OBJ)/contract/runtime/record.o: $(REV_STAMP)
+$(OBJ)/contract/app/record.o: $(REV_STAMP)
 $(BUILD)/hairsim-cpu-contract: $(CONTRACT_OBJ) $(filter-out $(CONTRACT_SRC:c_ref/%.c=$(OBJ)/%.o),$(SHARED_OBJ) $(CPU_OBJ))
 	$(CC) -fopenmp $^ -o $@ $(HDF5_LIBS) -lm
 
@@ -190,20 +194,20 @@ cuda: $(CUDA_BINS)
 # sources that hold the dynamic model's kernel tables once per precision (-DHB_DYN_REAL), which
 # halves the longest compile. Only backend_cuda.cu takes the build's flags string.
 CUDA_MODES := normal strict fastmath
-CUDA_SPLIT := dyn_kernels dyn_lanes
-CUDA_UNITS := $(filter-out $(CUDA_SPLIT),$(notdir $(CUDA_SRC:.cu=))) $(foreach s,$(CUDA_SPLIT),$(s)-f32 $(s)-f64)
+CUDA_SPLIT := dynamic/kernels dynamic/lanes
+CUDA_UNITS := $(filter-out $(CUDA_SPLIT) hostcheck/%,$(CUDA_SRC:cuda/%.cu=%)) $(foreach s,$(CUDA_SPLIT),$(s)-f32 $(s)-f64)
 define CUDA_MODE_RULES
 CUDA_OBJ_$(1) := $$(CUDA_UNITS:%=$$(OBJ)/cuda-$(1)/%.o)
 $$(OBJ)/cuda-$(1)/%.o: cuda/%.cu $$(CUDA_HDR) $$(C_HEADERS)
 	@mkdir -p $$(@D)
-	$$(NVCC) $$(NVCC_BASE) $$(NVCC_MODE_$(1)) $$(HDF5_CFLAGS) -DHB_FLAGS='"$$(NVCC) $$(NVCC_BASE) $$(NVCC_MODE_$(1))"' \
+	$$(NVCC) $$(NVCC_BASE) -Icuda $$(NVCC_MODE_$(1)) $$(HDF5_CFLAGS) -DHB_FLAGS='"$$(NVCC) $$(NVCC_BASE) $$(NVCC_MODE_$(1))"' \
 	  -DHB_MATH_MODE='"$(1)"' -c $$< -o $$@
 $$(OBJ)/cuda-$(1)/%-f32.o: cuda/%.cu $$(CUDA_HDR) $$(C_HEADERS)
 	@mkdir -p $$(@D)
-	$$(NVCC) $$(NVCC_BASE) $$(NVCC_MODE_$(1)) $$(HDF5_CFLAGS) -DHB_DYN_REAL=float -c $$< -o $$@
+	$$(NVCC) $$(NVCC_BASE) -Icuda $$(NVCC_MODE_$(1)) $$(HDF5_CFLAGS) -DHB_DYN_REAL=float -c $$< -o $$@
 $$(OBJ)/cuda-$(1)/%-f64.o: cuda/%.cu $$(CUDA_HDR) $$(C_HEADERS)
 	@mkdir -p $$(@D)
-	$$(NVCC) $$(NVCC_BASE) $$(NVCC_MODE_$(1)) $$(HDF5_CFLAGS) -DHB_DYN_REAL=double -c $$< -o $$@
+	$$(NVCC) $$(NVCC_BASE) -Icuda $$(NVCC_MODE_$(1)) $$(HDF5_CFLAGS) -DHB_DYN_REAL=double -c $$< -o $$@
 endef
 $(foreach m,$(CUDA_MODES),$(eval $(call CUDA_MODE_RULES,$(m))))
 $(BUILD)/hairsim-cuda: $(CUDA_OBJ_normal) $(SHARED_OBJ)
@@ -221,27 +225,27 @@ $(CUDA_BINS):
 HOSTCHECK_WORLD_OBJ := $(OBJ)/dynamic/colliders.o $(OBJ)/dynamic/sdf_mesh.o $(OBJ)/runtime/cli.o $(OBJ)/runtime/input.o $(OBJ)/runtime/safe_write.o
 HOSTCHECK_NVCC := $(NVCC) -std=c++17 -Ic_ref -Icuda -Xcompiler -ffp-contract=off,-fno-fast-math
 hostcheck: $(HOSTCHECK_BINS)
-$(BUILD)/hostcheck/model_hostcheck_reference: HOSTCHECK_MODE := -O2 -DHB_REFERENCE_ARITHMETIC=1
-$(BUILD)/hostcheck/model_hostcheck_free: HOSTCHECK_MODE := -O2
-$(BUILD)/hostcheck/model_hostcheck_%: cuda/hostcheck/model_hostcheck.cu cuda/model.cuh cuda/tmath.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/paper_hostcheck_reference: HOSTCHECK_MODE := -O2 -DHB_REFERENCE_ARITHMETIC=1
+$(BUILD)/hostcheck/paper_hostcheck_free: HOSTCHECK_MODE := -O2
+$(BUILD)/hostcheck/paper_hostcheck_%: cuda/hostcheck/paper_hostcheck.cu cuda/paper/model.cuh cuda/tmath.cuh $(C_HEADERS) \
   $(OBJ)/paper/model.o $(OBJ)/runtime/params.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) $(HOSTCHECK_MODE) $< $(OBJ)/paper/model.o $(OBJ)/runtime/params.o -o $@ -lm
-$(BUILD)/hostcheck/dyn_hostcheck: cuda/hostcheck/dyn_hostcheck.cu cuda/hostcheck/hostcheck_scene.h cuda/dyn_model.cuh cuda/tmath.cuh cuda/dyn_kernels.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/dyn_hostcheck: cuda/hostcheck/dyn_hostcheck.cu cuda/hostcheck/hostcheck_scene.h cuda/dynamic/model.cuh cuda/tmath.cuh cuda/dynamic/kernels.cuh $(C_HEADERS) \
   $(OBJ)/dynamic/dynamics_f32.o $(OBJ)/dynamic/dynamics_f64.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o \
   $(HOSTCHECK_WORLD_OBJ)
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
-$(BUILD)/hostcheck/post_hostcheck: cuda/hostcheck/post_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/hostcheck/hostcheck_scene.h cuda/dyn_post.cuh cuda/dyn_model.cuh cuda/tmath.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/post_hostcheck: cuda/hostcheck/post_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/hostcheck/hostcheck_scene.h cuda/dynamic/post.cuh cuda/dynamic/model.cuh cuda/tmath.cuh $(C_HEADERS) \
   $(OBJ)/dynamic/dyn_followers.o $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o $(HOSTCHECK_WORLD_OBJ)
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
-$(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/dyn_lod.cuh cuda/dyn_model.cuh cuda/tmath.cuh $(C_HEADERS) \
+$(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/hostcheck/hostcheck_rng.h cuda/dynamic/lod.cuh cuda/dynamic/model.cuh cuda/tmath.cuh $(C_HEADERS) \
   $(OBJ)/dynamic/dyn_lod.o
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< $(filter %.o,$^) -o $@ -lm
 # --draw's two paths on the host (OpenGL through EGL: loaded at run time, no GL library linked)
-$(BUILD)/hostcheck/draw_hostcheck: cuda/hostcheck/draw_hostcheck.cu cuda/draw_view.cuh cuda/egl_gl.cuh
+$(BUILD)/hostcheck/draw_hostcheck: cuda/hostcheck/draw_hostcheck.cu cuda/draw/view.cuh cuda/draw/egl_gl.cuh
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< -o $@ -ldl -lm
 else
@@ -305,7 +309,7 @@ docs: setup
 sanitize: setup check-hdf5
 	$(MAKE) BUILD=build/asan COPT="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" \
 	  CC="$(CC) -fsanitize=address,undefined" build/asan/hairsim-cpu
-	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 $(RUN_PY) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume or fault_probe or fault_matrix or binary_inputs"
+	HAIRBENCH_CPU_BIN=build/asan/hairsim-cpu ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/support/lsan-hdf5.supp:print_suppressions=0 $(RUN_PY) -m pytest tests -q -m "not gpu" -k "cpu or rng or bad_input or resume or fault_probe or fault_matrix or binary_inputs"
 	@for f in tests/fuzz/corpus/hair/*; do ASAN_OPTIONS=detect_leaks=1 build/asan/hairsim-cpu --groom $$f --stages init,simulate \
 	  --quiet >/dev/null 2>&1; rc=$$?; if [ $$rc -ne 0 ] && [ $$rc -ne 2 ] && [ $$rc -ne 3 ]; then \
 	  echo "error: build/asan/hairsim-cpu --groom $$f exited $$rc"; exit 1; fi; done; echo "sanitize: the HAIR seed corpus ran clean"
@@ -361,7 +365,7 @@ sanitize-gpu: cuda
 
 # ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----
 PY_SRC     := harness tests
-C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*/*.c c_ref/*/*.h cuda/*.cu cuda/*.cuh cuda/hostcheck/*.cu tests/cpu/c/*.c tests/fuzz/*.c)
+C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*/*.c c_ref/*/*.h cuda/*.cu cuda/*.cuh cuda/*/*.cu cuda/*/*.cuh tests/cpu/c/*.c tests/fuzz/*.c)
 CLANG_FORMAT ?= clang-format
 
 lint: lint-py lint-c

@@ -16,7 +16,7 @@
 #include <sys/mman.h>
 #include <time.h>
 
-#include "runtime/backend.h"
+#include "app/backend.h"
 #include "runtime/checked.h"
 #include "runtime/cli.h"
 #include "dynamic/dyn_followers.h"
@@ -28,7 +28,7 @@
 #include "dynamic/dyn_lod.h"
 #include "paper/model.h"
 #include "simd/model_simd.h"
-#include "runtime/record.h"
+#include "app/record.h"
 
 typedef struct {
     hb_scene scene;

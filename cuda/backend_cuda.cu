@@ -1,5 +1,5 @@
 /* backend_cuda.cu — the CUDA backend (docs/model.md §5.1): the hb_backend the shared driver
- * (c_ref/runtime/driver.c) runs, and main().
+ * (c_ref/app/driver.c) runs, and main().
  *
  * Variants (docs/cuda.md):
  *   paper  the paper's scheme, kept as the baseline and not tuned: the canonical
@@ -32,13 +32,13 @@
 #include <string.h>
 #include <vector>
 
-#include "runtime/backend.h"
+#include "app/backend.h"
 #include "runtime/checked.h"
 #include "backend_cuda.cuh"
 #include "check.cuh"
-#include "dyn_kernels.cuh"
+#include "dynamic/kernels.cuh"
 #include "runtime/host.h"
-#include "kernels.cuh"
+#include "paper/kernels.cuh"
 #include "paper/model.h"
 
 using hb::Model;

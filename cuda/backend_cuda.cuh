@@ -8,8 +8,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "kernels.cuh"
-#include "runtime/backend.h"
+#include "paper/kernels.cuh"
+#include "app/backend.h"
 
 namespace hb_cuda {
 

@@ -32,9 +32,9 @@
 
 #include "backend_cuda.cuh"
 #include "check.cuh"
-#include "dyn_kernels.cuh"
-#include "dyn_lod.cuh"
-#include "dyn_post.cuh"
+#include "dynamic/kernels.cuh"
+#include "dynamic/lod.cuh"
+#include "dynamic/post.cuh"
 #include "dynamic/dyn_followers.h"
 #include "dynamic/dyn_sagfree.h"
 #include "dynamic/world_host.h"
@@ -56,7 +56,7 @@ struct DynState {
     hbd::DModel<float> m32;
     hbd::DModel<double> m64;
     hbd::ObsScene obs;
-    /* §3.14 guides and followers (cuda/dyn_post.cu): the plan on the host and the device */
+    /* §3.14 guides and followers (cuda/dynamic/post.cu): the plan on the host and the device */
     int guided;
     hb_followers fl;
     int64_t *d_guide, *d_follower, *d_src;
@@ -681,7 +681,7 @@ int cuda_dyn_fetch_velocity(hb_backend *b, void *canonical, char *err, size_t er
 }
 
 /* --render-points (docs/model.md §3.14): the rendered points of the current state by
- * cuda/dyn_lod.cu's kernel, timed by events around its launch; then copied to the host. */
+ * cuda/dynamic/lod.cu's kernel, timed by events around its launch; then copied to the host. */
 int cuda_dyn_render(hb_backend *b, void *position, void *velocity, double *ms, char *err, size_t errlen)
 {
     cuda_impl *c = (cuda_impl *)b->impl;

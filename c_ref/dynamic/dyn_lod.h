@@ -1,7 +1,7 @@
 /* dyn_lod.h — simulated-point LOD (docs/model.md §3.14, --render-points): each strand is
  * written with P_r points, a centripetal Catmull–Rom spline through its P_s simulated ones.
  * The C reference of the rendering; the CUDA backend has its own kernel with the same
- * arithmetic (cuda/dyn_lod.cu). c_ref/dynamic/dyn_lod_impl.h is the normative text. */
+ * arithmetic (cuda/dynamic/lod.cu). c_ref/dynamic/dyn_lod_impl.h is the normative text. */
 #ifndef HB_DYN_LOD_H
 #define HB_DYN_LOD_H
 

@@ -10,7 +10,7 @@
  * Layout: point k of a strand at s[3k + 0..2] = (x, y, z).
  */
 
-#include "dynamic/obs_point.h"    /* hb_obs_point: §3.8 per point, shared with cuda/dyn_model.cuh */
+#include "dynamic/obs_point.h"    /* hb_obs_point: §3.8 per point, shared with cuda/dynamic/model.cuh */
 #include "dynamic/contact_impl.h" /* §3.16 grid, §3.17 colliders: shared with cuda/ */
 
 #define HB_ALWAYS_INLINE static inline __attribute__((always_inline))

@@ -1,5 +1,5 @@
 /* obs_point.h — one point k >= 1 of a strand's observables (docs/model.md §3.8), in double:
- * the reference (dynamics_impl.h) and the CUDA port (cuda/dyn_model.cuh) share it, so both
+ * the reference (dynamics_impl.h) and the CUDA port (cuda/dynamic/model.cuh) share it, so both
  * compute the same operations in the same order.
  */
 #ifndef HB_OBS_POINT_H

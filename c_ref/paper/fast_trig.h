@@ -1,5 +1,5 @@
 /* fast_trig.h — the fp32 atan2 and sincos of the paper model's free arithmetic (the normal
- * and fast-math CUDA builds, cuda/model.cuh; the simd variant, model_simd_impl.h).
+ * and fast-math CUDA builds, cuda/paper/model.cuh; the simd variant, model_simd_impl.h).
  *
  * Branch-free polynomials for the bounded arguments the model produces, with no slow path:
  *   hb_atan2_fast(y, x)          any finite y, x; relative error of the polynomial 1.5e-8

@@ -3,7 +3,7 @@
  * Included twice by model.c (REAL = float, then double), after paper/points_impl.h, with the
  * math functions named by SQRT, SIN, COS, ASIN, ATAN2 and the machine epsilon EPS. Each
  * stage walks a strand from the root and computes every point by points_impl.h's step, which
- * the CUDA port's strict build (cuda/model.cuh) calls too; so a strict GPU build differs from
+ * the CUDA port's strict build (cuda/paper/model.cuh) calls too; so a strict GPU build differs from
  * this file only where the platforms' sin/cos/asin/atan2 differ.
  *
  * Coordinates: s[3k+0] = x (depth, never changes), s[3k+1] = y (up), s[3k+2] = z (toward

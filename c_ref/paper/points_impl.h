@@ -1,7 +1,7 @@
 /* points_impl.h — one point's step of the paper model's stages (docs/model.md §2) in the
  * reference arithmetic, written once for a floating type REAL and shared by the C reference
  * (paper/model_impl.h, whose loops call these) and the CUDA port's strict build
- * (cuda/model.cuh's reference branches), so the two agree bit for bit by construction
+ * (cuda/paper/model.cuh's reference branches), so the two agree bit for bit by construction
  * wherever the platforms' sqrt/sin/cos/asin/atan2 agree.
  *
  * Included between precision_f32.h / precision_f64.h and precision_end.h (the names REAL,

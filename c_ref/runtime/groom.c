@@ -6,8 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "runtime/backend.h"
 #include "runtime/checked.h"
+#include "runtime/host.h"
 #include "runtime/input.h"
 
 #define HAIR_HEADER 128

@@ -22,3 +22,15 @@ void hb_memory_message(char *err, size_t errlen, const hb_scene *s, const char *
              1e-9 * (double)need, kind, (long long)s->n_strands, (long long)s->points, hb_precision_name(s->precision),
              detail ? detail : "", 1e-9 * (double)avail, where);
 }
+
+uint64_t hb_host_memory_available(void)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (!f) return 0;
+    char line[256];
+    unsigned long long kb = 0;
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) break;
+    fclose(f);
+    return (uint64_t)kb * 1024u;
+}

@@ -14,6 +14,9 @@ extern "C" {
 /* Monotonic wall-clock time in milliseconds. */
 double hb_now_ms(void);
 
+/* Bytes of host memory available for a new allocation (MemAvailable); 0 if unknown. */
+uint64_t hb_host_memory_available(void);
+
 /* The one-line "does not fit" message: "the state needs X GB of <kind> memory (N strands x
  * P points, fp32<detail>) but only Y GB is <available | free on DEVICE>". */
 void hb_memory_message(char *err, size_t errlen, const hb_scene *s, const char *kind, uint64_t need, uint64_t avail,

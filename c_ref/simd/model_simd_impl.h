@@ -16,7 +16,7 @@
  * ρ = 0) and are never selected.
  *
  * The free arithmetic (docs/cpu_simd.md): the same decisions as model_impl.h, computed more
- * cheaply and judged by tolerance, like the CUDA normal build (cuda/model.cuh). In every
+ * cheaply and judged by tolerance, like the CUDA normal build (cuda/paper/model.cuh). In every
  * precision: t = k·(w/(P−1)), and collide's pull multiplies by one quotient ℓ/len instead
  * of dividing twice (its projection keeps model_impl.h's operations: where the circle of
  * radius ℓ about the root only touches the shell, ℓ = h, √h² turns an ulp into √ε). With FAST_TRIG (fp32) the drape's step angles are computed once per

@@ -1,8 +1,8 @@
 /* draw_hostcheck.cu — --draw's two paths on the HOST with known answers (no GPU needed):
  *
- *   compute  cuda/draw_view.cuh's head_pixel and raster_segment, the functions the compute
+ *   compute  cuda/draw/view.cuh's head_pixel and raster_segment, the functions the compute
  *            rasteriser's kernels call, with a host atomicMin;
- *   gl       cuda/egl_gl.cuh's GlDraw through EGL (Mesa's llvmpipe on a CPU-only machine), the
+ *   gl       cuda/draw/egl_gl.cuh's GlDraw through EGL (Mesa's llvmpipe on a CPU-only machine), the
  *            vertex buffer filled from the host instead of by CUDA.
  *
  * Each draws, at 200×100 (hw = 20, hh = 10 cm: 5 px a cm), a head of radius 5 and
@@ -19,8 +19,8 @@
 
 #include <vector>
 
-#include "draw_view.cuh"
-#include "egl_gl.cuh"
+#include "draw/view.cuh"
+#include "draw/egl_gl.cuh"
 
 namespace {
 

@@ -1,4 +1,4 @@
-/* dyn_hostcheck.cu — runs the CUDA port's dynamic model (cuda/dyn_model.cuh,
+/* dyn_hostcheck.cu — runs the CUDA port's dynamic model (cuda/dynamic/model.cuh,
  * __host__ __device__) on the HOST and compares it bit for bit with the C reference
  * (c_ref/dynamic/dynamics_impl.h via dynamics_f32.c / dynamics_f64.c).
  *
@@ -13,13 +13,13 @@
  * kernels run the math:
  *   seq-canonical   Exec Seq, canonical layout, scratch contiguous (the C reference's own);
  *   strand          Exec Seq, point-major X|Y|Z [P][N] with the thread-interleaved scratch of
- *                   the strand kernel (cuda/dyn_kernels.cu k_strand);
+ *                   the strand kernel (cuda/dynamic/kernels.cu k_strand);
  *   warp            a host emulation of the warp kernel's Lanes: the component planes [3][P]
  *                   of its shared memory, every `each` loop run lane by lane in reverse lane
  *                   order (lane 31 first), so a group whose members were not independent
  *                   would show it.
  * Each with the feature set as a compile-time constant where the device build specialises
- * it (dyn_kernels.cuh specialised_mask) and always as the run-time mask (DynF, the generic
+ * it (cuda/dynamic/kernels.cuh specialised_mask) and always as the run-time mask (DynF, the generic
  * kernel). Also the bend rest lengths and the per-strand observables (hb_dyn_observe_strand).
  *
  * Built by `make hostcheck` (build/hostcheck/dyn_hostcheck, against the reference's objects),
@@ -35,8 +35,8 @@
 #include <utility>
 #include <vector>
 
-#include "dyn_kernels.cuh"
-#include "dyn_model.cuh"
+#include "dynamic/kernels.cuh"
+#include "dynamic/model.cuh"
 #include "dynamic/dynamics.h"
 #include "hostcheck/hostcheck_scene.h"
 #include "runtime/params.h"

@@ -1,4 +1,4 @@
-/* lod_hostcheck.cu — runs the CUDA port's rendering of simulated-point LOD (cuda/dyn_lod.cuh
+/* lod_hostcheck.cu — runs the CUDA port's rendering of simulated-point LOD (cuda/dynamic/lod.cuh
  * lod_render_point, __host__ __device__) on the HOST and compares it bit for bit with the C
  * reference (c_ref/dynamic/dyn_lod_impl.h via hb_lod_strand_f32/_f64), positions and velocities,
  * as post_hostcheck.cu does for the followers. No kernel is launched.
@@ -17,7 +17,7 @@
 
 #include <vector>
 
-#include "dyn_lod.cuh"
+#include "dynamic/lod.cuh"
 #include "dynamic/dyn_lod.h"
 #include "hostcheck/hostcheck_rng.h"
 

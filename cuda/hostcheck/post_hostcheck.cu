@@ -1,4 +1,4 @@
-/* post_hostcheck.cu — runs the CUDA port's follower placement (cuda/dyn_post.cuh
+/* post_hostcheck.cu — runs the CUDA port's follower placement (cuda/dynamic/post.cuh
  * place_follower, __host__ __device__) on the HOST and compares it bit for bit with the C
  * reference (c_ref/dynamic/dyn_followers_impl.h via hb_follower_place_f32/_f64), as dyn_hostcheck.cu
  * does for the frame. No kernel is launched.
@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "dynamic/dyn_followers.h"
-#include "dyn_post.cuh"
+#include "dynamic/post.cuh"
 #include "hostcheck/hostcheck_rng.h"
 #include "hostcheck/hostcheck_scene.h"
 

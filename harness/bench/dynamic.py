@@ -18,7 +18,8 @@
      CPU and every cuda build), modelling less (reduced: guides and followers, LRA, sag-free,
      LOD; docs/model.md §3.14), speed against accuracy (accuracy --model dynamic, on the default
      scene and on curly hair, configs/scenes/curly.toml), stability at the
-     extremes (stability), the peer (pypbd, optional), the animation;
+     extremes (stability), the peer (pypbd, optional), the grid's and the colliders' variants
+     against their converged references (world: accuracy-world/), the animation;
   4. report/dynamic.md with all of it.
 Without a GPU the GPU rows and checks are skipped with one line saying why.
 """
@@ -39,7 +40,7 @@ from harness.io.files import write_json
 from harness.render import accuracy_dynamic_report, report_dynamic
 from harness.render import peer_dynamic_report as peer_report
 from harness.render import stability_dynamic_report as stability_report
-from harness.studies import accuracy_dynamic
+from harness.studies import accuracy_dynamic, accuracy_world
 from harness.studies import animate_dynamic as animate
 from harness.studies import budget_curves_dynamic as budget_curves
 from harness.studies import featurecost_dynamic as featurecost
@@ -289,7 +290,7 @@ ACCURACY_STUDIES = (
 )
 # the studies measured once (the stability map is sharded by its cells instead), in the order
 # `--shard K/N` deals them out: study i runs on shard i mod N + 1
-ONE_MEASUREMENT_STUDIES = ("featurecost", "reduced", *(name for _, name in ACCURACY_STUDIES), "peer")
+ONE_MEASUREMENT_STUDIES = ("featurecost", "reduced", *(name for _, name in ACCURACY_STUDIES), "peer", "world")
 
 
 def accuracy(root, scene, gpu, quick, say, report_dir=None):
@@ -412,6 +413,14 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
                 peer_report.write(root / "peer", root / "peer")
 
         within("peer", measure_peer, root / "peer")
+    if mine("world") and fits("world"):
+
+        def measure_world():
+            say(f"harness: world{' --quick' if quick else ''}")
+            plan = accuracy_world.Plan.quick(gpu=gpu) if quick else accuracy_world.Plan(gpu=gpu)
+            accuracy_world.run_study(plan, out_dir=root / accuracy_world.RESULTS_NAME, log=say)
+
+        within("world", measure_world, root / accuracy_world.RESULTS_NAME)
     if render and fits("animate"):
 
         def make_animation():

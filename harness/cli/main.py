@@ -47,6 +47,7 @@ COMMANDS = (
     files.add_motion,
     studies.add_calibrate,
     studies.add_featurecost,
+    studies.add_world,
     studies.add_reduced,
     studies.add_peer,
     pictures.add_animate,

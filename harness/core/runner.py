@@ -16,6 +16,7 @@ sweep can skip the case and go on.
 
 import contextlib
 import json
+import multiprocessing
 import os
 import queue
 import signal
@@ -92,6 +93,26 @@ def _on_signal(signum: int, frame: Any) -> None:
     if signum == signal.SIGINT:
         raise KeyboardInterrupt
     raise Stopped(signum)
+
+
+def _worker_signals() -> None:
+    """A forked pool worker's signals: Ctrl-C ignored (its parent ends it), the others at their
+    defaults (the pool's terminate ends it without a traceback), then unblocked."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for s in FORWARDED[1:]:
+        signal.signal(s, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, FORWARDED)
+
+
+def fork_pool(jobs: int) -> Any:
+    """A multiprocessing pool of `jobs` forked workers that take no part in the command's signal
+    handling (forwarding()): the signals are blocked across the fork, so none reaches a worker
+    before its handlers are reset."""
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, FORWARDED)
+    try:
+        return multiprocessing.get_context("fork").Pool(jobs, _worker_signals)
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 @contextlib.contextmanager

@@ -288,7 +288,7 @@ def parse_stages(value, where="scene", key="stages"):
 
 
 # copies of one frame a backend holds: the state, its saved copy for --repeat/--warmup, and
-# the host frame written to the file (c_ref/runtime/driver.c)
+# the host frame written to the file (c_ref/app/driver.c)
 FRAME_COPIES = 3
 
 

@@ -158,7 +158,11 @@ def from_usd(path, prim_path=None, relative=False, rotation_only=False):
     Gf, Usd, UsdGeom = _pxr()
     if not Path(path).is_file():
         raise HarnessError(f"motion track {path}: no such file")
-    stage = Usd.Stage.Open(str(path))
+    try:
+        stage = Usd.Stage.Open(str(path))
+    except Exception as e:  # pxr raises Tf.ErrorException for a file it cannot read
+        why = (str(e).strip().splitlines() or [type(e).__name__])[-1].strip()
+        raise HarnessError(f"motion track {path}: USD could not read it ({why[:160]})") from None
     if stage is None:
         raise HarnessError(f"motion track {path}: USD could not open it")
     prim = _animated_prim(stage, UsdGeom, prim_path, path)

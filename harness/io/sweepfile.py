@@ -27,7 +27,9 @@
     block_size = [32, 64, 128, 256, 512, 1024]
 
 A backend table may also set strands, points or precision, replacing the shared axis for
-that backend (e.g. fewer strands for the single-thread CPU). Write [[cpu]] / [[cuda]]
+that backend (e.g. fewer strands for the single-thread CPU), and `scene = "NAME"`: that group
+runs another scene of the same model (e.g. the default scene on a body with the hair–hair grid,
+configs/scenes/body.toml), its rows named by it in the `scene` column. Write [[cpu]] / [[cuda]]
 (arrays of tables) for several groups of one backend, e.g. every block size for the
 default build but one for the fast-math build. The cases are the product of the axes of
 each group; a case that two groups both produce runs once.
@@ -35,7 +37,7 @@ each group; a case that two groups both produce runs once.
 
 import itertools
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from harness import HarnessError
@@ -96,6 +98,11 @@ class Sweep:
     axes: list  # (backend, {axis: values}) per group; the cases are each group's product
     description: str = ""
     rule: StopRule = RULE  # the stopping rule of its timed repeats ([timing]; else `repeat` once)
+    others: dict = field(default_factory=dict)  # name → scene of the groups that set `scene`
+
+    def scene_of(self, case):
+        """The scene a case runs: its group's (`scene = …`), else the sweep's."""
+        return self.others.get(case.scene, self.scene)
 
     def at_most(self, strands):
         """This sweep with every strands axis cut at `strands` (a groom file's count), kept there
@@ -114,7 +121,7 @@ class Sweep:
                 v = dict(zip(names, values))
                 out.append(
                     Case(
-                        scene=self.scene.name,
+                        scene=v.get("scene", self.scene.name),
                         backend=backend,
                         build=v.get("build", ""),
                         variant=v["variant"],
@@ -256,7 +263,7 @@ def load_sweep(ref, scene=None):
         shared_axes["solver"] = [scene.dynamic.get("--solver", "xpbd")]
     for key, value in shared.items():
         shared_axes[key] = _check_axis(where, f"axes.{key}", _list(where, f"axes.{key}", value), None)
-    groups = []
+    groups, others = [], {}
     for backend in ("cpu", "cuda"):
         if backend not in data:
             continue
@@ -265,12 +272,17 @@ def load_sweep(ref, scene=None):
             label = backend if len(tables) == 1 else f"{backend}[{n}]"
             if not isinstance(table, dict):
                 raise SweepError(f"{where}: '{backend}' must be a table [{backend}] or tables [[{backend}]]")
-            known = BACKEND_AXES[backend] + SHARED_AXES
+            known = BACKEND_AXES[backend] + SHARED_AXES + ("scene",)
             for key in table:
                 if key not in known:
                     raise SweepError(f"{where}: unknown key '{label}.{key}' (known: {', '.join(known)})")
+            table = dict(table)
             b = dict(DEFAULTS[backend])
             b.update(shared_axes)
+            if "scene" in table:
+                other = _group_scene(where, label, table.pop("scene"), scene, data.get("frames"))
+                others[other.name] = other
+                b["scene"] = [other.name]
             for key, value in table.items():
                 b[key] = _check_axis(where, f"{label}.{key}", _list(where, f"{label}.{key}", value), backend)
             groups.append((backend, b))
@@ -305,4 +317,15 @@ def load_sweep(ref, scene=None):
         axes=axes,
         description=data.get("description", ""),
         rule=_rule(where, data.get("timing"), repeat),
+        others=others,
     )
+
+
+def _group_scene(where, label, ref, scene, frames):
+    """A group's own scene (`scene = "NAME"`): of the sweep scene's model, with the sweep's frames."""
+    if not isinstance(ref, str) or not ref:
+        raise SweepError(f"{where}: {label}.scene must be a scene name or path, got {ref!r}")
+    other = load_scene(ref)
+    if other.model != scene.model:
+        raise SweepError(f"{where}: {label}.scene {other.name} is the {other.model} model, not {scene.model}")
+    return with_frames(other, frames) if frames is not None else other

@@ -21,6 +21,7 @@ from harness.io import (
 )
 from harness.render import (  # noqa: E402
     accuracy_dynamic_report,
+    accuracy_world_report,
     budget_report,
     hair_report,
     host_report,
@@ -33,7 +34,12 @@ from harness.render import peer_dynamic_report as peer_report  # noqa: E402
 from harness.render import reduced_dynamic_report as reduced_report  # noqa: E402
 from harness.render import stability_dynamic_report as stability_report  # noqa: E402
 from harness.render.headline_report import rounds_note  # noqa: E402
-from harness.studies.accuracy import curves_name, results_name  # noqa: E402
+from harness.studies.accuracy import (  # noqa: E402
+    BODY_SCENE,
+    WORLD_RESULTS_NAME,
+    curves_name,
+    results_name,
+)
 
 CURLY_SCENE = "curly"  # configs/scenes/curly.toml: the accuracy study's second scene
 CURLY_TITLE = "curly hair"
@@ -63,6 +69,15 @@ def sim_rows(results_dir):
 
     rows["label"] = rows.apply(label, axis=1)
     return rows, env
+
+
+def split_world(rows):
+    """(the sweep's rows of its own scene, those of the body scene's groups); every row stays its
+    own scene's when the sweep itself ran the body scene."""
+    body = rows["scene"].astype(str) == BODY_SCENE if "scene" in rows else None
+    if body is None or body.all():
+        return rows, rows.iloc[0:0]
+    return rows[~body], rows[body]
 
 
 def throughput_plot(rows, solver, precision, out_dir):
@@ -292,6 +307,7 @@ def build(root, report_dir=None):
     lines += ["## Throughput over strand counts", ""]
     if (sweep_dir / "runs.csv").exists():
         rows, env = sim_rows(sweep_dir)
+        rows, world = split_world(rows)
         pics = [throughput_plot(rows, s, p, out_dir) for s in ("xpbd", "ftl") for p in ("fp32", "fp64")]
         lines += [
             "Time per frame of the default scene (S = 8, I = 2, every feature), kernel or loop time "
@@ -301,6 +317,15 @@ def build(root, report_dir=None):
             "",
         ]
         lines += best_table(rows) + [""]
+        if not world.empty:
+            lines += [
+                f"The same on a body with the hair–hair grid (configs/scenes/{BODY_SCENE}.toml: four "
+                "capsules and a face-mesh SDF with friction, the 32³ grid with friction and volume), in the variants "
+                "that run them (the sweep's groups with its `scene`):",
+                "",
+                *best_table(world),
+                "",
+            ]
         for p in pics:
             if p:
                 lines += [f"![{p.stem}]({os.path.relpath(p, out_dir)})", ""]
@@ -333,6 +358,9 @@ def build(root, report_dir=None):
         out_dir,
         scene=CURLY_SCENE,
         title=CURLY_TITLE,
+    )
+    lines += _study(
+        root, WORLD_RESULTS_NAME, accuracy_world_report, accuracy_world_report.TITLE, "harness world", out_dir
     )
     lines += _study(root, "stability", stability_report, "Stability at the extremes", "harness stability", out_dir)
     lines += _study(root, "judge", judge_report, "The judge's power", "harness judge", out_dir)

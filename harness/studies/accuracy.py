@@ -113,6 +113,11 @@ def frame_errors(x, ref, L):
 # ---- the dynamic study's results (results/dynamic-accuracy/), as the renderer reads them ----
 
 RESULTS_NAME = "dynamic-accuracy"
+# the world study's (studies/accuracy_world.py): its folder, its CSV, and the scene whose grid and
+# body it and the dynamic sweep's body groups take (configs/scenes/body.toml)
+WORLD_RESULTS_NAME = "accuracy-world"
+WORLD_CSV_NAME = "world.csv"
+BODY_SCENE = "body"
 DEFAULT_SCENE = "dynamic"  # the study's scene whose results and page carry no scene name
 
 

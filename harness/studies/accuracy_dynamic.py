@@ -43,10 +43,8 @@ report/dynamic_accuracy_curly.md.
 """
 
 import itertools
-import multiprocessing
 import os
 import shutil
-import signal
 import time
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, replace
@@ -291,7 +289,7 @@ def reader_pool(jobs):
     """Processes that read and compare the modes' state files (about 15 ms each, hundreds of
     them a rung). All start at once, forked before the study starts any thread; they ignore
     Ctrl-C, and the study ends them (Study.close) however it ends."""
-    return multiprocessing.get_context("fork").Pool(jobs, signal.signal, (signal.SIGINT, signal.SIG_IGN))
+    return runner.fork_pool(jobs)
 
 
 def frame_metrics(run, ref, L, gravity, dt):

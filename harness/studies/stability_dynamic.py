@@ -19,7 +19,9 @@ harness/core/tolerances.py:
                   but within that is the physics of its springs, not an escape: it is judged
                   by its stretch like any cell (docs/model.md §3.8's blown-up count stays the
                   file's, in blown_up_frames)
-  penetrating     penetration_max > STABILITY_PENETRATION_REL · R_c in some frame
+  penetrating     penetration_max > STABILITY_PENETRATION_REL · R_c in some frame (a slice that
+                  starts inside a collider, `settles`: in the last frame, or the last frame's
+                  penetration not below the start's)
   over-stretched  stretch_max > STABILITY_STRETCH_MAX in some frame
   ok              none of these
   refused         the binary refused the scene (exit 2); timed out: it did not finish
@@ -43,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.check import invariants_dynamic
+from harness.check import colliders, invariants_dynamic
 from harness.core import env, gpus, runner, scenes, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
@@ -82,6 +84,8 @@ COLUMNS = (
     "wall_s",
     "message",
     "reach",  # the largest distance of a point from its root over any frame, over 2 × hanging_length
+    "penetration_start",  # a settling slice's deepest point in a collider at the start (frame 0), cm
+    "penetration_last",  # penetration_max of the last frame, cm
 )
 
 
@@ -100,14 +104,20 @@ def hanging_length(L, points, gravity, stretch_compliance, solver):
     return float(L) + float(stretch_compliance) * float(gravity) * points * (points - 1) / 2
 
 
-def verdict(stretch_max, penetration_rel, blown_up_frames, diverged=False, reach=None):
+def verdict(stretch_max, penetration_rel, blown_up_frames, diverged=False, reach=None, settling=None):
     """The verdict of a cell from its worst observables over the horizon (module docstring);
     `diverged`: the last frame holds a NaN or Inf; `reach`: the largest distance of a point from its
-    root over twice the hanging length (None: the model's blown-up count decides, as before it)."""
+    root over twice the hanging length (None: the model's blown-up count decides, as before it);
+    `settling`: (start, last frame) penetration over R_c for a cell that starts inside a collider,
+    judged instead of the worst frame's."""
     escaped = blown_up_frames > 0 if reach is None else reach > 1.0
     if diverged or escaped:
         return "diverged" if diverged else "escaped"
-    if penetration_rel > tolerances.STABILITY_PENETRATION_REL:
+    if settling is not None:
+        start, last = settling
+        if last > tolerances.STABILITY_PENETRATION_REL or (last > 0 and last >= start):
+            return "penetrating"
+    elif penetration_rel > tolerances.STABILITY_PENETRATION_REL:
         return "penetrating"
     if stretch_max > tolerances.STABILITY_STRETCH_MAX:
         return "over-stretched"
@@ -148,10 +158,10 @@ def cell_scene(slc, row, col, solver, precision, strands, frames):
     points = None
     dyn = dict(base.dynamic)
     for flag, value in (*slc.fixed, ("--solver", solver), (slc.rows.key, row), (slc.cols.key, col)):
-        if flag == "points":
-            points = value
-        elif value == OFF:
-            dyn.pop(flag, None)
+        if flag in ("points", "strands"):
+            points, strands = (value, strands) if flag == "points" else (points, value)
+        elif value == OFF:  # the feature undeclared, with the flags that need it (--grid: --grid-*)
+            dyn = {f: v for f, v in dyn.items() if f != flag and not f.startswith(flag + "-")}
         else:
             dyn[flag] = value
     dyn["--frames"] = frames
@@ -187,7 +197,7 @@ def run_cells(jobs, strands, frames, timeout=None, gpu=None):
         t0 = time.perf_counter()
         for i, _, error in runner.run_batch(binary, flags, timeout=timeout, env=pin):
             out, _, path = cells[i]
-            rows.append(_cell_row(out, path, error))
+            rows.append(_cell_row(out, path, error, jobs[i][0].settles))
             out["wall_s"] = time.perf_counter() - t0
             t0 = time.perf_counter()
             path.unlink(missing_ok=True)
@@ -222,8 +232,9 @@ def _cell_run(slc, row, col, solver, precision, be, strands, frames, path):
     return out, flags, path
 
 
-def _cell_row(out, path, error):
-    """The cell's row: its verdict from the run's file, or from its error."""
+def _cell_row(out, path, error, settles=False):
+    """The cell's row: its verdict from the run's file, or from its error (`settles`: the slice
+    starts inside a collider)."""
     if error is not None:
         why = "timed out" if isinstance(error, runner.TimedOut) else "refused" if error.code == 2 else "failed"
         out.update(verdict=why, message=str(error))
@@ -240,6 +251,9 @@ def _cell_row(out, path, error):
         hang = hanging_length(t.hair_length, t.points, p.get("gravity", 981.0), p.get("stretch_compliance", 0.0),
                               t.solver)  # fmt: skip
         reach = _reach(t) / (2.0 * hang)
+        last = float(obs["penetration_max"].iloc[-1])
+        start = _start_depth(t) if settles else None
+        settling = (start / t.collide_radius, last / t.collide_radius) if settles else None
     out.update(
         stretch_max=stretch,
         penetration_max=pen,
@@ -247,10 +261,21 @@ def _cell_row(out, path, error):
         blown_up_frames=int(blown.sum()),
         first_blown_frame=int(blown.argmax()) + 1 if blown.any() else "",
         reach=reach,
-        verdict=verdict(stretch, rel, int(blown.sum()), diverged, reach),
+        penetration_start=start if settles else "",
+        penetration_last=last,
+        verdict=verdict(stretch, rel, int(blown.sum()), diverged, reach, settling),
         violations="+".join(sorted({v.invariant for v in rep.violations})),
     )
     return out
+
+
+def _start_depth(t):
+    """The deepest non-root point inside a collider of the file in its first stored state (frame 0,
+    before any substep), cm; 0 where none is inside."""
+    x = t.frame(0).astype(np.float64).reshape(t.n_strands, t.points, 3)[:, 1:].reshape(-1, 3)
+    d = colliders.depths(t, x, float(t.time[0]))
+    d = d[np.isfinite(d)]
+    return max(0.0, float(d.max())) if d.size else 0.0
 
 
 def _reach(t):
@@ -356,7 +381,7 @@ def measure(
 
 def cell_weight(job, strands, frames):
     """A cell's expected cost, for the order the map starts its cells in: substeps ×
-    iterations × points (GPU cells count double: they share one device)."""
+    iterations × points × strands (GPU cells count double: they share one device)."""
     slc, r, c, solver, precision, be = job
     scene = cell_scene(slc, r, c, solver, precision, strands, frames)
 
@@ -366,7 +391,8 @@ def cell_weight(job, strands, frames):
         except (TypeError, ValueError):
             return 1.0
 
-    return number("--substeps") * number("--iterations") * scene.points * (2.0 if be.backend == "cuda" else 1.0)
+    work = number("--substeps") * number("--iterations") * scene.points * scene.strands / strands
+    return work * (2.0 if be.backend == "cuda" else 1.0)
 
 
 def write_csv(rows, path):

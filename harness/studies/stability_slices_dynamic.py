@@ -13,12 +13,12 @@ VERDICTS = ("ok", "over-stretched", "penetrating", "escaped", "diverged")
 BLOWN_UP = ("escaped", "diverged")
 OTHER = ("refused", "timed out", "failed")
 LEGACY = ("blown up",)  # a map measured before the split by cause still reads
-OFF = "off"  # an axis value that leaves its feature undeclared
+OFF = "off"  # an axis value that leaves its feature undeclared (and the flags named after it: --grid-*)
 
 
 @dataclass(frozen=True)
 class Axis:
-    key: str  # a flag of the simulate stage (--substeps, …) or "points"
+    key: str  # a flag of the simulate stage (--substeps, …), "points" or "strands"
     label: str  # how the report names it
     values: tuple  # OFF = leave the flag out (the feature undeclared)
     quick: tuple  # the subset `--quick` runs
@@ -33,6 +33,7 @@ class Slice:
     fixed: tuple  # (flag, value) changes to the base scene
     rows: Axis
     cols: Axis
+    settles: bool = False  # starts inside a collider: penetration judged by its last frame and its fall
 
 
 SUBSTEPS = Axis("--substeps", "S", (1, 2, 4, 8, 16, 32, 64), (1, 4, 16, 64))
@@ -131,6 +132,63 @@ SLICES += (
         (("--head-motion", "track"), ("--motion-track", str(MOTIONS / FAST_TURN_FILE))),
         SUBSTEPS,
         ITERATIONS,
+    ),
+)
+# Hair that touches hair (docs/model.md §3.16): the grid of configs/scenes/body.toml (32³, rebuilt
+# once a frame, friction 0.05 at the root to 0.01 at the tip, volume K_v = 2000) on dense hair
+# (strands against the volume stiffness, the default scene), under a fast nod and under a gale
+# (the grid's size against the motion's frequency and the wind's speed; off = no grid), 64 strands
+# where the axis does not set them: a grid over 16 strands holds almost no hair.
+GRID = (("--grid", 32), ("--grid-rebuild", "frame"), ("--grid-friction", [0.05, 0.01]), ("--grid-volume", 2000.0))
+GRID_SIZE = Axis("--grid", "grid n_g", (OFF, 16, 32, 64), (OFF, 32))
+GALE = (("--drag", 0.5), ("--gust-amplitude", 0.5), ("--gust-wavelength", 60.0))
+SLICES += (
+    Slice(
+        "grid-dense",
+        "dense hair with the 32³ grid (friction, volume): strands against the volume stiffness (off = no volume)",
+        "dynamic",
+        GRID,
+        Axis("strands", "N", (16, 64, 256, 1024), (16, 256)),
+        Axis("--grid-volume", "K_v", (OFF, 500, 2000, 8000, 32000), (OFF, 2000, 32000), "cm²/s²"),
+    ),
+    Slice(
+        "grid-nod",
+        "the grid (friction, volume; off = no grid) against a fast nod (A = 0.5 rad, 64 strands)",
+        "still-dynamic",
+        (*GRID, ("strands", 64), ("--head-motion", "nod"), ("--motion-amplitude", 0.5)),
+        GRID_SIZE,
+        Axis("--motion-frequency", "f", (1, 2, 4, 8, 12, 16), (4, 16), "Hz"),
+    ),
+    Slice(
+        "grid-gale",
+        "the grid (friction, volume; off = no grid) against wind speed (drag 0.5/s, gusts 0.5, 64 strands)",
+        "still-dynamic",
+        (*GRID, *GALE, ("strands", 64)),
+        GRID_SIZE,
+        Axis("--wind-speed", "U", (0, 1000, 2000, 4000, 8000, 16000), (2000, 16000), "cm/s"),
+    ),
+)
+# A body to collide with (docs/model.md §3.17): configs/scenes/body.toml without its grid. Fast
+# nods against the head sphere's friction (the body's capsules keep the file's); and the same body
+# still from the start, so that the drape starts inside the shoulders and chest: the bounded
+# depenetration against substeps (off = unbounded), judged by its last frame and its fall.
+SLICES += (
+    Slice(
+        "body-nod",
+        "on a body (capsules, face mesh, friction): the head sphere's friction against a fast nod (A = 0.5 rad)",
+        "body",
+        (("--grid", OFF), ("--motion-amplitude", 0.5)),
+        Axis("--friction", "μ_s head", (OFF, 0.1, 0.3, 1.0), (OFF, 1.0)),
+        Axis("--motion-frequency", "f", (1, 2, 4, 8, 16), (4, 16), "Hz"),
+    ),
+    Slice(
+        "body-inside",
+        "a groom started inside the body (still from the start): depenetration speed (off: unbounded) × substeps",
+        "body",
+        (("--grid", OFF), ("--body-motion", OFF), ("--body-amplitude", OFF), ("--body-frequency", OFF)),
+        Axis("--depenetration-speed", "V", (OFF, 50, 200, 1000), (OFF, 200), "cm/s"),
+        SUBSTEPS,
+        settles=True,
     ),
 )
 SLICE_NAMES = tuple(s.name for s in SLICES)

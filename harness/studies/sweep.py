@@ -111,7 +111,7 @@ def rows_of_record(case, record, copy_gbps, session, binary, figures=None):
 
 def case_flags(sweep, case, repeat=None):
     """The binary flags of a case; `repeat`: this round's timed repeats (default the case's)."""
-    scene = sweep.scene.with_overrides(strands=case.strands, points=case.points, precision=case.precision)
+    scene = sweep.scene_of(case).with_overrides(strands=case.strands, points=case.points, precision=case.precision)
     if case.solver:
         from dataclasses import replace
 

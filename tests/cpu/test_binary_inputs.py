@@ -13,6 +13,7 @@ import pytest
 from test_grooms import hair_bytes, radial_strands
 
 from support import fulldisk
+from support.faults import make_fault
 from support.statecheck import run, tmp_leftovers
 
 SIM = ["--stages", "init,simulate"]
@@ -87,13 +88,7 @@ def test_seed_parsed_exactly(cpu_bin, value, seed):
 @pytest.mark.parametrize("flag", ["--groom", "--batch", "--input"])
 @pytest.mark.parametrize("kind", ["fifo", "directory", "missing", "empty"])
 def test_input_kinds_refused_naming_the_file(cpu_bin, tmp_path, flag, kind):
-    path = tmp_path / f"in-{kind}"
-    if kind == "fifo":
-        os.mkfifo(path)
-    elif kind == "directory":
-        path.mkdir()
-    elif kind == "empty":
-        path.write_bytes(b"")
+    path = make_fault(tmp_path, kind)
     args = [flag, path] if flag == "--batch" else [flag, path, *SIM] if flag == "--groom" else [flag, path]
     if flag == "--input":
         args += ["--stages", "simulate"]

@@ -67,6 +67,7 @@ def stubbed(monkeypatch):
     monkeypatch.setattr(bench_dynamic, "budget_modes", lambda acc_dir: [])  # the frame budget's curves
     monkeypatch.setattr(budget_curves, "measure", lambda *a, **k: None)
     monkeypatch.setattr(peer, "run_study", lambda *a, **k: None)
+    monkeypatch.setattr(bench_dynamic.accuracy_world, "run_study", lambda *a, **k: None)
     monkeypatch.setattr(bench_dynamic.peer_report, "write", lambda *a, **k: None)
     monkeypatch.setattr(animate, "run", lambda **k: None)
     monkeypatch.setattr(bench_dynamic.renders, "simulate", lambda *a, **k: None)
@@ -96,6 +97,7 @@ def test_every_study_measured_once_runs_on_exactly_one_of_n_shards(stubbed, tmp_
         "accuracy": "harness: accuracy --model dynamic --quick",
         f"accuracy {CURLY}": f"harness: accuracy --model dynamic --scene {CURLY}",
         "peer": "harness: peer",
+        "world": "harness: world --quick",
     }
     assert set(started) == set(bench_dynamic.ONE_MEASUREMENT_STUDIES)
     ran = {}

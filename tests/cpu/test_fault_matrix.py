@@ -20,9 +20,9 @@ from conftest import CPU_BIN
 from harness.cli.main import main as harness_main
 from harness.cli.main import parser as harness_parser
 from support import fulldisk
+from support.faults import FILE_FAULTS, make_fault
 
 SIM = ["--stages", "init,simulate", "--strands", "4", "--points", "4", "--hair-length", "5", "--quiet"]
-FILE_FAULTS = ("fifo", "directory", "missing", "empty", "truncated", "garbage")
 BAD_VALUES = ("nan", "inf", "-inf", "1e999", "99999999999999999999999", "x1", "")
 OUTPUT_FAULTS = ("directory", "fifo", "symlink", "full-disk")
 
@@ -47,21 +47,6 @@ FILE_FLAG_CONTEXT = {
     "--motion-track": ["--head-motion", "track", "--stages", "init,simulate"],
     "--colliders": ["--stages", "init,simulate"],
 }
-
-
-def make_fault(tmp_path, kind):
-    path = tmp_path / f"input-{kind}"
-    if kind == "fifo":
-        os.mkfifo(path)
-    elif kind == "directory":
-        path.mkdir()
-    elif kind == "empty":
-        path.write_bytes(b"")
-    elif kind == "truncated":
-        path.write_bytes(b"HAIR\x01\x00\x00\x00" + b"\x89HDF\r\n\x1a\n")
-    elif kind == "garbage":
-        path.write_bytes(bytes(range(256)) * 4)
-    return path
 
 
 def refused_in_one_line(p, *words):

@@ -11,7 +11,7 @@
 #include "runtime/cli.h"
 #include "runtime/groom.h"
 
-/* driver.c's, which the fuzzer does not link: a machine of 1 GiB, so a huge groom is refused */
+/* runtime/host.c's, which the fuzzer does not link: a machine of 1 GiB, so a huge groom is refused */
 uint64_t hb_host_memory_available(void)
 {
     return 1ull << 30;

@@ -51,7 +51,7 @@ def drawn(tmp_path_factory, request):
     return record, images, p.stderr
 
 
-BACKGROUND = np.array([0xEE, 0xEE, 0xEB])  # cuda/draw_view.cuh kBackground
+BACKGROUND = np.array([0xEE, 0xEE, 0xEB])  # cuda/draw/view.cuh kBackground
 
 
 def hit(img, row, col):

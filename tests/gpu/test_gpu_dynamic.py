@@ -1,4 +1,4 @@
-"""GPU tests of the dynamic model's CUDA port (the simulate stage; cuda/dyn_kernels.cu,
+"""GPU tests of the dynamic model's CUDA port (the simulate stage; cuda/dynamic/kernels.cu,
 docs/cuda.md "The dynamic model"). Every test is marked `gpu`; conftest.py skips them, with
 the reason, where there is no usable GPU.
 
@@ -7,7 +7,7 @@ One frame on the GPU from the CPU's state: the CPU runs `init,simulate` for K fr
 --input-frame k --stages simulate --frames 1`) and its frame is compared with the CPU's
 frame k+1, positions, velocities and observables. For each variant that runs simulate (from
 the binary's --list-variants, within its most-points limit) x solver (xpbd, ftl) x precision
-x block size x build, on scenes with the feature set compiled in (cuda/dyn_kernels.cuh
+x block size x build, on scenes with the feature set compiled in (cuda/dynamic/kernels.cuh
 specialised_mask) and one that runs the generic kernel.
 
 Rules: every frame is judged by harness.check.diff_dynamic.compare, the function behind `harness

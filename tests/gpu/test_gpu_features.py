@@ -1,6 +1,6 @@
 """GPU tests of docs/model.md §3.14 (guides and followers, long-range attachments) in the CUDA
 port: guides through a strand map in the strand, warp and warpreg kernels, the followers'
-placement kernel (cuda/dyn_post.cu), LRA in the generic kernels and warpreg, the sag-free
+placement kernel (cuda/dynamic/post.cu), LRA in the generic kernels and warpreg, the sag-free
 targets (made on the host, c_ref/dynamic/dyn_sagfree.c, read by every variant). Marked `gpu`;
 conftest.py skips them where there is no usable GPU.
 

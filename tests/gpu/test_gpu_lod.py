@@ -1,5 +1,5 @@
 """GPU tests of simulated-point LOD (docs/model.md §3.14, --render-points): the rendering kernel
-(cuda/dyn_lod.cu) of every simulating variant against the C reference. Marked `gpu`;
+(cuda/dynamic/lod.cu) of every simulating variant against the C reference. Marked `gpu`;
 conftest.py skips them where there is no usable GPU.
 
 Both backends simulate from the same CPU paper state (init, collide) with --render-points. The

@@ -1,6 +1,6 @@
 """--draw's two paths run on the HOST with known answers (cuda/hostcheck/draw_hostcheck.cu): the
-compute rasteriser's functions (cuda/draw_view.cuh) with a host atomicMin, and the OpenGL path
-(cuda/egl_gl.cuh) through EGL on whatever driver is here (Mesa's llvmpipe in CI): a strand at
+compute rasteriser's functions (cuda/draw/view.cuh) with a host atomicMin, and the OpenGL path
+(cuda/draw/egl_gl.cuh) through EGL on whatever driver is here (Mesa's llvmpipe in CI): a strand at
 known coordinates covers its row and columns, a strand behind the head is hidden and one in
 front is not. Skipped, with the reason, where nvcc is missing; the GL half where EGL gives no
 context."""

@@ -1,5 +1,5 @@
-"""The CUDA port's dynamic model (cuda/dyn_model.cuh) run on the HOST, bit for bit against the
-C reference (c_ref/dynamic/dynamics_impl.h). No GPU needed: dyn_model.cuh is `__host__ __device__`,
+"""The CUDA port's dynamic model (cuda/dynamic/model.cuh) run on the HOST, bit for bit against the
+C reference (c_ref/dynamic/dynamics_impl.h). No GPU needed: cuda/dynamic/model.cuh is `__host__ __device__`,
 so a host-only program (cuda/hostcheck/dyn_hostcheck.cu, no kernel launches) runs the very
 templates the kernels run, with glibc's libm like the C reference. It covers every valid
 feature set (96) x xpbd and ftl x fp32 and fp64 x P = 2, 3, 5, 8, 33, 70, two frames each,

@@ -1,4 +1,4 @@
-"""The CUDA port's rendering of simulated-point LOD (cuda/dyn_lod.cuh lod_render_point, docs/model.md
+"""The CUDA port's rendering of simulated-point LOD (cuda/dynamic/lod.cuh lod_render_point, docs/model.md
 §3.14) run on the HOST, bit for bit against the C reference (c_ref/dynamic/dyn_lod_impl.h), positions
 and velocities, in the canonical and the point-major layout: cuda/hostcheck/lod_hostcheck.cu. No
 GPU needed; on the device the normal build contracts FMAs (tests/gpu/test_gpu_lod.py covers that).

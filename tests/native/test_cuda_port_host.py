@@ -1,6 +1,6 @@
-"""The CUDA port's model math (cuda/model.cuh) run on the HOST against the C reference
-(c_ref/paper/model.c). No GPU needed: model.cuh is `__host__ __device__`, so a host-only program
-(cuda/hostcheck/model_hostcheck.cu, no kernel launches) runs the very templates the kernels
+"""The CUDA port's model math (cuda/paper/model.cuh) run on the HOST against the C reference
+(c_ref/paper/model.c). No GPU needed: cuda/paper/model.cuh is `__host__ __device__`, so a host-only program
+(cuda/hostcheck/paper_hostcheck.cu, no kernel launches) runs the very templates the kernels
 run, on the CPU, with glibc's libm like model.c. Both layouts, fp32 and fp64, P = 2, 3, 16,
 64, four scenes, every stage, the fused wind+collide with and without the kept
 intermediate, prefetch depths 0-4. Built twice:
@@ -57,7 +57,7 @@ def build_hostcheck(*names):
 
 @pytest.fixture(scope="module")
 def hostcheck():
-    ref, free = build_hostcheck("model_hostcheck_reference", "model_hostcheck_free")
+    ref, free = build_hostcheck("paper_hostcheck_reference", "paper_hostcheck_free")
     return {"reference": ref, "free": free}
 
 

@@ -1,4 +1,4 @@
-"""The CUDA port's follower placement (cuda/dyn_post.cuh place_follower, docs/model.md §3.14) run
+"""The CUDA port's follower placement (cuda/dynamic/post.cuh place_follower, docs/model.md §3.14) run
 on the HOST, bit for bit against the C reference (c_ref/dynamic/dyn_followers_impl.h), in the
 canonical and the point-major layout, with ℓ or a groom's ℓ_k: cuda/hostcheck/post_hostcheck.cu. No GPU needed; on the
 device the normal build contracts FMAs (tests/gpu/test_gpu_features.py covers that). Built by

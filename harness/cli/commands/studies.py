@@ -1,4 +1,4 @@
-"""The studies' commands: `budget`, `hair`, `calibrate`, `featurecost`, `reduced`, `peer`, `stability`, `judge`."""
+"""The studies' commands: `budget`, `hair`, `calibrate`, `featurecost`, `world`, `reduced`, `peer`, `stability`, `judge`."""
 
 import argparse
 import json
@@ -72,6 +72,18 @@ def cmd_featurecost(args):
     )
     rows = featurecost.measure(scene_ref=args.scene, **given)
     print(featurecost_report.markdown(rows), end="")
+    return 0
+
+
+def cmd_world(args):
+    """The grid's and the colliders' variants against their converged references (studies/accuracy_world.py):
+    write world.csv into --out and print the report's section."""
+    from harness.render import accuracy_world_report
+    from harness.studies import accuracy_world
+
+    plan = accuracy_world.Plan.quick(gpu=args.gpu) if args.quick else accuracy_world.Plan(gpu=args.gpu)
+    path = accuracy_world.run_study(plan, out_dir=args.out)
+    print("\n".join(accuracy_world_report.section(path.parent)))
     return 0
 
 
@@ -259,6 +271,14 @@ def add_featurecost(sub):
         help="cpu oracle: also count, under valgrind's callgrind, the instructions per point-substep of "
         "the frame function (deterministic where times are noisy)",
     )
+
+
+def add_world(sub):
+    wd = command(sub, cmd_world, help="the hair-hair grid and the colliders: cost against effect against the "
+                 "converged reference")  # fmt: skip
+    wd.add_argument("--quick", action="store_true", help="fewer strands, sizes and seconds (a minute on 2 cores)")
+    wd.add_argument("--out", default=None, help="results folder (default results/accuracy-world)")
+    wd.add_argument("--gpu", choices=("auto", "no"), default="auto", help="time each variant on the GPU too (auto)")
 
 
 def add_reduced(sub):

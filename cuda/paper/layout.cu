@@ -7,7 +7,7 @@
  * 32 x 32 tile through shared memory (padded against bank conflicts), so that both the
  * reads and the writes of a warp are 32 consecutive elements.
  */
-#include "kernels.cuh"
+#include "paper/kernels.cuh"
 
 namespace hb {
 

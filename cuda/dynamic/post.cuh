@@ -1,4 +1,4 @@
-/* dyn_post.cuh — what the dynamic model does after a frame's substeps (cuda/dyn_post.cu):
+/* cuda/dynamic/post.cuh — what the dynamic model does after a frame's substeps (cuda/dynamic/post.cu):
  * the followers of docs/model.md §3.14, placed from their guides by a kernel of their own.
  * The per-follower math is `__host__ __device__` (place_follower), so
  * cuda/hostcheck/post_hostcheck.cu runs it on the host against c_ref/dynamic/dyn_followers_impl.h. */
@@ -8,8 +8,8 @@
 #include <cuda_runtime.h>
 #include <stdint.h>
 
-#include "dyn_kernels.cuh"
-#include "dyn_model.cuh"
+#include "dynamic/kernels.cuh"
+#include "dynamic/model.cuh"
 
 namespace hb {
 namespace dyn {

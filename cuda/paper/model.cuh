@@ -8,7 +8,7 @@
  *     c_ref/paper/model_impl.h. Without FMA contraction and with IEEE division and square root
  *     it therefore differs from the C reference only where CUDA's sinf/cosf/asinf/atan2f
  *     (sin/cos/asin/atan2) differ from glibc's; compiled for the host
- *     (cuda/hostcheck/model_hostcheck.cu) it must reproduce c_ref/paper/model.c bit for bit;
+ *     (cuda/hostcheck/paper_hostcheck.cu) it must reproduce c_ref/paper/model.c bit for bit;
  *   - the free arithmetic (the default: normal and fast-math builds): the same model and
  *     the same decisions (hanging, the wind's wrap and exactly-opposite rule, collide's
  *     threshold and tie), computed more cheaply, judged by the paper model's tolerances

@@ -1,5 +1,5 @@
 /* record.c — the run record as JSON (docs/interfaces.md) and as a short summary. */
-#include "runtime/record.h"
+#include "app/record.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,6 +1,6 @@
 /* kernels.cu — the stage kernels of the CUDA backend: init, wind, collide and the fused
  * wind+collide, one thread per strand, templated on the precision T and the layout
- * (cuda/model.cuh holds the per-strand math; this file only maps threads to strands).
+ * (cuda/paper/model.cuh holds the per-strand math; this file only maps threads to strands).
  *
  * Launch shape: `block` threads per block (--block-size, 32…1024, a multiple of 32), a
  * grid of ceil(N / block) blocks; each kernel loops with the grid's stride so that a
@@ -19,12 +19,12 @@
  * fused kernel without the intermediate never touch X. That kernel runs HB_WC_TILE strands a
  * thread in fp32 (k_wind_collide_tile; docs/cuda.md, "Two strands a thread").
  *
- * Prefetch depth (model.cuh, walk_points): the paper variant's strand-major kernels load
+ * Prefetch depth (paper/model.cuh, walk_points): the paper variant's strand-major kernels load
  * each point when its turn comes (D = 0, as the C code and the paper do: that variant is
  * the untuned baseline); the point-major kernels keep HB_PREFETCH_F32 (fp32) or HB_PREFETCH_F64 (fp64)
  * points' loads in flight per thread.
  */
-#include "kernels.cuh"
+#include "paper/kernels.cuh"
 
 namespace hb {
 

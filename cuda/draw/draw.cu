@@ -4,8 +4,8 @@
  *   compute  a CUDA strand rasteriser: the head and the background written into a W×H buffer of
  *            64-bit words (depth bits << 32 | RGBA8), one thread a segment walking its pixels with
  *            a 64-bit atomicMin each (the nearest colour wins), then the colours resolved into an
- *            RGBA8 image (cuda/draw_view.cuh);
- *   gl       OpenGL through EGL (cuda/egl_gl.cuh): a GL vertex buffer registered with CUDA
+ *            RGBA8 image (cuda/draw/view.cuh);
+ *   gl       OpenGL through EGL (cuda/draw/egl_gl.cuh): a GL vertex buffer registered with CUDA
  *            (cudaGraphicsGLRegisterBuffer), written each frame by a kernel straight from the
  *            simulation's positions (position and unit tangent a point), then drawn as line
  *            strips with Kajiya–Kay shading into a W×H framebuffer.
@@ -29,8 +29,8 @@
 
 #include "backend_cuda.cuh"
 #include "check.cuh"
-#include "draw_view.cuh"
-#include "egl_gl.cuh"
+#include "draw/view.cuh"
+#include "draw/egl_gl.cuh"
 #include "runtime/host.h"
 
 /* declared by cuda_gl_interop.h, which needs GL's headers: GLuint is an unsigned int */

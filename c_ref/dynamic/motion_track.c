@@ -1,6 +1,6 @@
 /* motion_track.c — the head transform track of --head-motion track: its CSV file and its copy
  * in the HDF5 state (docs/interfaces.md, "Motion tracks"). */
-#include "runtime/motion_track.h"
+#include "dynamic/motion_track.h"
 #include "runtime/input.h"
 
 #include <hdf5.h>

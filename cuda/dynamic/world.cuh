@@ -1,8 +1,8 @@
-/* dyn_world.cuh — the hair–hair grid (docs/model.md §3.16) and the colliders with friction
+/* cuda/dynamic/world.cuh — the hair–hair grid (docs/model.md §3.16) and the colliders with friction
  * (§3.17) for the CUDA port: c_ref/dynamic/contact_impl.h itself, included once for float and
  * once for double, so the strict build performs the reference's operations on the device
  * (the normal build contracts them into FMAs). The launchers of the grid's kernels are in
- * cuda/dyn_world.cu.
+ * cuda/dynamic/world.cu.
  */
 #ifndef HB_DYN_WORLD_CUH
 #define HB_DYN_WORLD_CUH
@@ -68,7 +68,7 @@ HB_HD double collider_depth(const World<double> &w, int i, const double *pose, c
     return hb_collider_depth_f64(&w, i, pose, x);
 }
 
-/* ---- the grid's kernels (cuda/dyn_world.cu) ---- */
+/* ---- the grid's kernels (cuda/dynamic/world.cu) ---- */
 /* §3.16 the splat of every point of x, v (canonical [N][P][3]) into mass [n³] and mom [n³][3]
  * (zeroed first by the launcher), with the grid rotation qg (device, nullptr: still); the strands
  * taken in the order perm (device, nullptr: as stored). */

@@ -1,8 +1,8 @@
-/* dyn_lod.cu — the rendered points of docs/model.md §3.14 (--render-points) as a kernel of
+/* cuda/dynamic/lod.cu — the rendered points of docs/model.md §3.14 (--render-points) as a kernel of
  * their own, launched on the frames that are written: one thread per rendered point, reading
  * the state (and velocities) in the variant's layout and writing canonical [N·P_r][3]. The
- * arithmetic is dyn_lod.cuh's, which follows c_ref/dynamic/dyn_lod_impl.h. */
-#include "dyn_lod.cuh"
+ * arithmetic is cuda/dynamic/lod.cuh's, which follows c_ref/dynamic/dyn_lod_impl.h. */
+#include "dynamic/lod.cuh"
 
 namespace hb {
 namespace dyn {

@@ -143,9 +143,6 @@ struct hb_backend {
                     hb_draw_result *out, char *err, size_t errlen);
 };
 
-/* Bytes of host memory available for a new allocation (MemAvailable); 0 if unknown. */
-uint64_t hb_host_memory_available(void);
-
 /* Runs the whole command line with this backend; returns the process exit status. */
 int hb_main(int argc, char **argv, hb_backend *b);
 

@@ -1,7 +1,7 @@
 /* egl_gl.cuh — OpenGL through EGL for --draw's GL path, loaded at run time: libEGL.so.1 by dlopen,
  * every EGL extension and GL function through eglGetProcAddress, so the build needs no GL
  * header or library and a machine without them gets one line saying what is missing. Host
- * C++ only (no CUDA): the binary (cuda/draw.cu) and the host check
+ * C++ only (no CUDA): the binary (cuda/draw/draw.cu) and the host check
  * (cuda/hostcheck/draw_hostcheck.cu, on Mesa's llvmpipe) use it alike.
  *
  * GlDraw::open makes a core 3.3 context with no surface on the EGL device whose CUDA device
@@ -9,7 +9,7 @@
  * says), a W×H framebuffer (RGBA8, depth 24), a vertex buffer of N·P points × 6 floats
  * (position, unit tangent; docs/interfaces.md "Drawing on the GPU"), line strips one a
  * strand (primitive restart), and the head sphere. draw() clears, draws the head and the
- * strands and times the draw with GL_TIME_ELAPSED; the view and shading are draw_view.cuh's. */
+ * strands and times the draw with GL_TIME_ELAPSED; the view and shading are view.cuh's. */
 #ifndef HB_EGL_GL_H
 #define HB_EGL_GL_H
 
@@ -23,7 +23,7 @@
 #include <utility>
 #include <vector>
 
-#include "draw_view.cuh"
+#include "draw/view.cuh"
 
 namespace hb_gl {
 
@@ -165,7 +165,7 @@ struct Api {
 };
 #undef HB_DECLARE
 
-/* hair: the view's orthographic mapping and Kajiya–Kay (draw_view.cuh's constants) */
+/* hair: the view's orthographic mapping and Kajiya–Kay (view.cuh's constants) */
 static const char *kHairVertex = R"(#version 330 core
 layout(location = 0) in vec3 pos;
 layout(location = 1) in vec3 tan;

@@ -5,10 +5,10 @@
 
 #include <stdio.h>
 
-#include "runtime/backend.h"
+#include "app/backend.h"
 #include "runtime/groom.h"
 #include "runtime/params.h"
-#include "runtime/state_io.h"
+#include "app/state_io.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -1,4 +1,4 @@
-/* model_hostcheck.cu — runs the CUDA port's model (cuda/model.cuh, __host__ __device__) on
+/* paper_hostcheck.cu — runs the CUDA port's model (cuda/paper/model.cuh, __host__ __device__) on
  * the HOST against the C reference (c_ref/paper/model.c).
  *
  * Built twice (tests/test_cuda_port_host.py):
@@ -15,15 +15,15 @@
  * No kernel is launched, so it runs on a machine without a GPU. Both layouts (StrandMajor =
  * canonical [N][P][3], PointMajor = X, Y, Z [P][N]), fp32 and fp64, several P and scenes,
  * every stage, the fused wind+collide with and without the kept intermediate, the prefetch
- * depths D = 0 … 4 of the walks (model.cuh walk_points; 0 and 1 are built into the kernels,
+ * depths D = 0 … 4 of the walks (paper/model.cuh walk_points; 0 and 1 are built into the kernels,
  * 2 to 4 catch queue-boundary bugs); each stage starts from the reference's previous frame
  * (per stage) and the port's own chain is compared too. Point-major wind/collide/fused
  * (without the intermediate) must not write x: X is poisoned with a NaN pattern first and
  * must come back untouched.
  *
- * Built by `make hostcheck` twice (build/hostcheck/model_hostcheck_{reference,free}, with and
+ * Built by `make hostcheck` twice (build/hostcheck/paper_hostcheck_{reference,free}, with and
  * without -DHB_REFERENCE_ARITHMETIC=1), run by tests/native/test_cuda_port_host.py.
- * Usage: model_hostcheck [N [k32 over32 k64 over64 moved]]   (default 2000 strands; the
+ * Usage: paper_hostcheck [N [k32 over32 k64 over64 moved]]   (default 2000 strands; the
  * tolerances only for the free arithmetic). Exit status 0 = all checks pass.
  */
 #include <math.h>
@@ -36,7 +36,7 @@
 #include <string>
 #include <vector>
 
-#include "model.cuh"
+#include "paper/model.cuh"
 #include "paper/model.h"
 #include "runtime/params.h"
 
@@ -334,7 +334,7 @@ template <bool Keep, int D, typename T, class Buf> int64_t port_fused(const Mode
 }
 
 /* ---- one (precision, P, scene) case ----------------------------------------------------------- */
-/* D: the prefetch depth of the walks (model.cuh walk_points; kernels use 0, 2 and 4) */
+/* D: the prefetch depth of the walks (paper/model.cuh walk_points; kernels use 0, 2 and 4) */
 template <typename T, class Buf, int D>
 void check_layout(Tally &t, const std::string &tag, const Model<T> &m, int64_t N, int64_t P,
                   const std::vector<std::vector<T>> &f, const int64_t *moved)

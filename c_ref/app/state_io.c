@@ -1,10 +1,10 @@
 /* state_io.c — HDF5 states, H5MD 1.1 shaped (layout in docs/interfaces.md). */
-#include "runtime/state_io.h"
+#include "app/state_io.h"
 #include "runtime/safe_write.h"
 #include "runtime/checked.h"
 #include "runtime/h5md_meta.h"
 #include "runtime/input.h"
-#include "runtime/motion_track.h"
+#include "dynamic/motion_track.h"
 
 #include <errno.h>
 #include <stddef.h>
@@ -1002,6 +1002,61 @@ static int input_world(hb_input *in, const char *path, hid_t p, char *err, size_
     return 0;
 }
 
+/* A dynamic file's arrays: the rest shape, the velocities where stored, the observables. */
+static int input_dynamic_arrays(hb_input *in, const char *path, char *err, size_t errlen)
+{
+    hid_t f = (hid_t)in->hid;
+    const uint64_t rows = (uint64_t)in->scene.n_strands * (uint64_t)in->scene.points;
+    if (!has_path(f, "particles/hair/rest_position") ||
+        check_rows(f, "particles/hair/rest_position", 2, rows, in->scene.precision, NULL) < 0)
+        return snprintf(err, errlen, "--input %s: a dynamic file needs /particles/hair/rest_position [%llu][3] in %s",
+                        path, (unsigned long long)rows, hb_precision_name(in->scene.precision)),
+               -1;
+    hsize_t nv = 0, ns = 0, nt = 0;
+    if (has_path(f, "particles/hair/velocity/value")) {
+        if (check_rows(f, "particles/hair/velocity/value", 3, rows, in->scene.precision, &nv) < 0)
+            return snprintf(err, errlen, "--input %s: velocity/value must be [frames][%llu][3] in %s", path,
+                            (unsigned long long)rows, hb_precision_name(in->scene.precision)),
+                   -1;
+        in->vel_step = read_1d(f, "particles/hair/velocity/step", H5T_NATIVE_INT64, sizeof(int64_t), &ns);
+        in->vel_time = read_1d(f, "particles/hair/velocity/time", H5T_NATIVE_DOUBLE, sizeof(double), &nt);
+        if (!in->vel_step || !in->vel_time || ns != nv || nt != nv)
+            return snprintf(err, errlen,
+                            "--input %s: velocity/step and velocity/time need one entry per velocity "
+                            "frame (%llu)",
+                            path, (unsigned long long)nv),
+                   -1;
+        in->n_vel = (int)nv;
+    }
+    /* observables: copied into the output when present and consistent */
+    hsize_t n1 = 0, n2 = 0, n3 = 0, n4 = 0, n5 = 0;
+    double *sm = read_1d(f, "observables/stretch_max/value", H5T_NATIVE_DOUBLE, sizeof(double), &n1);
+    double *pm = read_1d(f, "observables/penetration_max/value", H5T_NATIVE_DOUBLE, sizeof(double), &n2);
+    double *ke = read_1d(f, "observables/kinetic_energy/value", H5T_NATIVE_DOUBLE, sizeof(double), &n3);
+    int64_t *bs = read_1d(f, "observables/blown_up_strands/value", H5T_NATIVE_INT64, sizeof(int64_t), &n4);
+    in->obs_step = read_1d(f, "observables/stretch_max/step", H5T_NATIVE_INT64, sizeof(int64_t), &n5);
+    in->obs_time = read_1d(f, "observables/stretch_max/time", H5T_NATIVE_DOUBLE, sizeof(double), &ns);
+    int ok = sm && pm && ke && bs && in->obs_step && in->obs_time && n2 == n1 && n3 == n1 && n4 == n1 && n5 == n1 &&
+             ns == n1;
+    if (ok) {
+        in->obs = calloc(n1 ? n1 : 1, sizeof *in->obs);
+        ok = in->obs != NULL;
+        for (hsize_t i = 0; ok && i < n1; i++) in->obs[i] = (hb_observables){sm[i], pm[i], ke[i], bs[i]};
+        in->n_obs = (int)n1;
+    }
+    free(sm);
+    free(pm);
+    free(ke);
+    free(bs);
+    if (!ok)
+        return snprintf(err, errlen,
+                        "--input %s: /observables must hold stretch_max, penetration_max, kinetic_energy "
+                        "and blown_up_strands with one value, step and time each",
+                        path),
+               -1;
+    return 0;
+}
+
 /* The dynamic part of an --input file (docs/interfaces.md, "dynamic files"). */
 static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, size_t errlen)
 {
@@ -1105,56 +1160,7 @@ static int input_dynamic(hb_input *in, const char *path, hid_t p, char *err, siz
         return snprintf(err, errlen, "--input %s: paper_frames = %lld does not fit its %d frames", path,
                         (long long)in->paper_frames, in->n_frames),
                -1;
-
-    const uint64_t rows = (uint64_t)in->scene.n_strands * (uint64_t)in->scene.points;
-    if (!has_path(f, "particles/hair/rest_position") ||
-        check_rows(f, "particles/hair/rest_position", 2, rows, in->scene.precision, NULL) < 0)
-        return snprintf(err, errlen, "--input %s: a dynamic file needs /particles/hair/rest_position [%llu][3] in %s",
-                        path, (unsigned long long)rows, hb_precision_name(in->scene.precision)),
-               -1;
-    hsize_t nv = 0, ns = 0, nt = 0;
-    if (has_path(f, "particles/hair/velocity/value")) {
-        if (check_rows(f, "particles/hair/velocity/value", 3, rows, in->scene.precision, &nv) < 0)
-            return snprintf(err, errlen, "--input %s: velocity/value must be [frames][%llu][3] in %s", path,
-                            (unsigned long long)rows, hb_precision_name(in->scene.precision)),
-                   -1;
-        in->vel_step = read_1d(f, "particles/hair/velocity/step", H5T_NATIVE_INT64, sizeof(int64_t), &ns);
-        in->vel_time = read_1d(f, "particles/hair/velocity/time", H5T_NATIVE_DOUBLE, sizeof(double), &nt);
-        if (!in->vel_step || !in->vel_time || ns != nv || nt != nv)
-            return snprintf(err, errlen,
-                            "--input %s: velocity/step and velocity/time need one entry per velocity "
-                            "frame (%llu)",
-                            path, (unsigned long long)nv),
-                   -1;
-        in->n_vel = (int)nv;
-    }
-    /* observables: copied into the output when present and consistent */
-    hsize_t n1 = 0, n2 = 0, n3 = 0, n4 = 0, n5 = 0;
-    double *sm = read_1d(f, "observables/stretch_max/value", H5T_NATIVE_DOUBLE, sizeof(double), &n1);
-    double *pm = read_1d(f, "observables/penetration_max/value", H5T_NATIVE_DOUBLE, sizeof(double), &n2);
-    double *ke = read_1d(f, "observables/kinetic_energy/value", H5T_NATIVE_DOUBLE, sizeof(double), &n3);
-    int64_t *bs = read_1d(f, "observables/blown_up_strands/value", H5T_NATIVE_INT64, sizeof(int64_t), &n4);
-    in->obs_step = read_1d(f, "observables/stretch_max/step", H5T_NATIVE_INT64, sizeof(int64_t), &n5);
-    in->obs_time = read_1d(f, "observables/stretch_max/time", H5T_NATIVE_DOUBLE, sizeof(double), &ns);
-    int ok = sm && pm && ke && bs && in->obs_step && in->obs_time && n2 == n1 && n3 == n1 && n4 == n1 && n5 == n1 &&
-             ns == n1;
-    if (ok) {
-        in->obs = calloc(n1 ? n1 : 1, sizeof *in->obs);
-        ok = in->obs != NULL;
-        for (hsize_t i = 0; ok && i < n1; i++) in->obs[i] = (hb_observables){sm[i], pm[i], ke[i], bs[i]};
-        in->n_obs = (int)n1;
-    }
-    free(sm);
-    free(pm);
-    free(ke);
-    free(bs);
-    if (!ok)
-        return snprintf(err, errlen,
-                        "--input %s: /observables must hold stretch_max, penetration_max, kinetic_energy "
-                        "and blown_up_strands with one value, step and time each",
-                        path),
-               -1;
-    return 0;
+    return input_dynamic_arrays(in, path, err, errlen);
 }
 
 /* The first of n reals in buf that is NaN or ±Inf, or −1 when all are finite. */

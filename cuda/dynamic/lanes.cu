@@ -1,4 +1,4 @@
-/* dyn_lanes.cu — the lanes variant of the dynamic model's frame (docs/cuda.md "The lanes
+/* cuda/dynamic/lanes.cu — the lanes variant of the dynamic model's frame (docs/cuda.md "The lanes
  * variant"): a half-warp of 16 lanes per strand (two strands a warp), lane l holding the G
  * consecutive points G·l … G·l + G − 1 in registers for the whole frame, G = 2, 4 or 8
  * (P ≤ 32, 64, 128). Every group of docs/model.md §3.6 keeps nearly every lane busy:
@@ -11,13 +11,13 @@
  * sends its new position back, so every point is written by one lane.
  *
  * Arithmetic (docs/cuda.md "Builds and arithmetic"): the strict build (HB_REFERENCE_ARITHMETIC)
- * calls dyn_model.cuh's reference helpers, the same operations as c_ref/dynamic/dynamics_impl.h, so
+ * calls cuda/dynamic/model.cuh's reference helpers, the same operations as c_ref/dynamic/dynamics_impl.h, so
  * it gives the CPU's bits; the normal and fast-math builds use reciprocal square roots and
  * the scene's precomputed reciprocals (DModel::inv_*), judged by the one-frame rule.
  */
 #include <utility>
 
-#include "dyn_kernels.cuh"
+#include "dynamic/kernels.cuh"
 #include "runtime/approx.h" /* hb_rsqrt_fast, HB_FAST_FLOOR */
 
 namespace hb {
@@ -276,6 +276,18 @@ __device__ __forceinline__ void collide_world(const DModel<T> &m, Feat has, cons
     p = V3<T>{pp[0], pp[1], pp[2]};
 }
 
+/* The free builds' follow-the-leader target of p: ell from a along a→p (straight down when p is on a). */
+template <typename T> __device__ __forceinline__ V3<T> follow_target(T ell, const V3<T> &a, const V3<T> &p)
+{
+    const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
+    const T q = ex * ex + ey * ey + ez * ez;
+    if (q > floor_of<T>()) {
+        const T f = ell * rsq(q);
+        return V3<T>{a.x + f * ex, a.y + f * ey, a.z + f * ez};
+    }
+    return V3<T>{a.x, a.y - ell, a.z};
+}
+
 /* §3.7 one follow-the-leader step of p after its corrected predecessor a, ell its segment's
  * rest length; d: the correction; wc: the colliders of §3.17 (pose, back, x) instead of the head sphere. */
 template <typename T, class Feat>
@@ -285,15 +297,7 @@ __device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, 
 {
     if (wc) {
         if constexpr (kFree) {
-            const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
-            const T q = ex * ex + ey * ey + ez * ez;
-            V3<T> n;
-            if (q > floor_of<T>()) {
-                const T f = ell * rsq(q);
-                n = V3<T>{a.x + f * ex, a.y + f * ey, a.z + f * ez};
-            } else {
-                n = V3<T>{a.x, a.y - ell, a.z};
-            }
+            const V3<T> n = follow_target(ell, a, p);
             d = V3<T>{n.x - p.x, n.y - p.y, n.z - p.z};
             p = n;
         } else {
@@ -303,15 +307,7 @@ __device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, 
         return;
     }
     if constexpr (kFree) {
-        const T ex = p.x - a.x, ey = p.y - a.y, ez = p.z - a.z;
-        const T q = ex * ex + ey * ey + ez * ez;
-        V3<T> n;
-        if (q > floor_of<T>()) {
-            const T f = ell * rsq(q);
-            n = V3<T>{a.x + f * ex, a.y + f * ey, a.z + f * ez};
-        } else {
-            n = V3<T>{a.x, a.y - ell, a.z};
-        }
+        V3<T> n = follow_target(ell, a, p);
         d = V3<T>{n.x - p.x, n.y - p.y, n.z - p.z};
         if (has(HB_F_COLLIDE)) collide(m, n);
         p = n;
@@ -342,7 +338,7 @@ __device__ __forceinline__ void update(const DModel<T> &m, bool corr, const V3<T
 }
 
 template <typename T> __device__ __forceinline__ V3<T> rotated(const T *q, const V3<T> &a)
-{ /* Q·a as dyn_model.cuh's rotate: each row summed left to right */
+{ /* Q·a as cuda/dynamic/model.cuh's rotate: each row summed left to right */
     return V3<T>{q[0] * a.x + q[1] * a.y + q[2] * a.z, q[3] * a.x + q[4] * a.y + q[5] * a.z,
                  q[6] * a.x + q[7] * a.y + q[8] * a.z};
 }

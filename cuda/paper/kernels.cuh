@@ -1,5 +1,5 @@
-/* kernels.cuh — the launchers of the CUDA backend's kernels (cuda/kernels.cu: the stages,
- * cuda/layout.cu: canonical <-> point-major conversion).
+/* kernels.cuh — the launchers of the CUDA backend's kernels (cuda/paper/kernels.cu: the stages,
+ * cuda/paper/layout.cu: canonical <-> point-major conversion).
  *
  * Every launcher enqueues its kernel(s) on `stream` and returns cudaGetLastError() right
  * after the launch, so the caller checks each launch (cuda/check.cuh). Stage kernels run
@@ -13,7 +13,7 @@
 #include <cuda_runtime.h>
 #include <stdint.h>
 
-#include "model.cuh"
+#include "paper/model.cuh"
 #include "runtime/params.h" /* hb_stage */
 
 namespace hb {

@@ -1,8 +1,8 @@
-/* dyn_post.cu — the followers' placement (docs/model.md §3.14) as a kernel of its own, launched
+/* cuda/dynamic/post.cu — the followers' placement (docs/model.md §3.14) as a kernel of its own, launched
  * after each frame's simulate kernel on the same stream. One thread per follower; the guides
  * it reads are final for the frame and no follower is another's guide, so the threads are
  * independent. Follows c_ref/dynamic/dyn_followers_impl.h operation by operation. */
-#include "dyn_post.cuh"
+#include "dynamic/post.cuh"
 
 namespace hb {
 namespace dyn {

@@ -1,7 +1,7 @@
-/* dyn_world.cu — the hair–hair grid's kernels (docs/model.md §3.16; the design in docs/cuda.md
+/* cuda/dynamic/world.cu — the hair–hair grid's kernels (docs/model.md §3.16; the design in docs/cuda.md
  * "The hair–hair grid"): the splat of every point into 64-bit fixed-point sums, whose order
  * changes no bit, and the node fields. */
-#include "dyn_world.cuh"
+#include "dynamic/world.cuh"
 
 #include <climits>
 

@@ -1,15 +1,15 @@
-/* dyn_lod.cuh — simulated-point LOD (docs/model.md §3.14, --render-points): the rendered points
+/* cuda/dynamic/lod.cuh — simulated-point LOD (docs/model.md §3.14, --render-points): the rendered points
  * of a strand, a centripetal Catmull–Rom spline through its simulated points, as
  * `__host__ __device__` code that follows c_ref/dynamic/dyn_lod_impl.h operation by operation;
- * cuda/dyn_lod.cu launches it one thread per rendered point. */
+ * cuda/dynamic/lod.cu launches it one thread per rendered point. */
 #ifndef HB_DYN_LOD_CUH
 #define HB_DYN_LOD_CUH
 
 #include <cuda_runtime.h>
 #include <stdint.h>
 
-#include "dyn_kernels.cuh"
-#include "dyn_model.cuh"
+#include "dynamic/kernels.cuh"
+#include "dynamic/model.cuh"
 
 namespace hb {
 namespace dyn {

@@ -1,5 +1,5 @@
-/* dyn_kernels.cuh — the launchers of the dynamic model's kernels (cuda/dyn_kernels.cu; the
- * math is cuda/dyn_model.cuh, the design docs/cuda.md "The dynamic model").
+/* cuda/dynamic/kernels.cuh — the launchers of the dynamic model's kernels (cuda/dynamic/kernels.cu; the
+ * math is cuda/dynamic/model.cuh, the design docs/cuda.md "The dynamic model").
  *
  * Every launcher enqueues its kernel on `stream` and returns cudaGetLastError() right after
  * the launch, so the caller checks each launch (cuda/check.cuh). Instantiated for T = float
@@ -12,7 +12,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "dyn_model.cuh"
+#include "dynamic/model.cuh"
 
 namespace hb {
 namespace dyn {
@@ -121,7 +121,7 @@ template <typename T>
 cudaError_t launch_frame_warpreg(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                                  const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream,
                                  const int64_t *map = nullptr, int64_t n_run = 0);
-/* The lanes variant (cuda/dyn_lanes.cu): L lanes a strand, G consecutive points a lane in
+/* The lanes variant (cuda/dynamic/lanes.cu): L lanes a strand, G consecutive points a lane in
  * registers (xpbd: L = 16, G = 2, 4, 8; ftl: fewer lanes with more points), P ≤
  * kLanesMaxPoints; x, v, rest canonical [N][P][3], bend_rest [N][P−2]; lanes_smem_bytes of
  * dynamic shared memory a block (a warp's strands staged for coalesced loads and stores, and

@@ -1,4 +1,4 @@
-/* draw_view.cuh — what both drawing paths of --draw share (docs/interfaces.md, "Drawing on the
+/* view.cuh — what both drawing paths of --draw share (docs/interfaces.md, "Drawing on the
  * GPU"), host and device: the view, the shading, and the compute path's rasterisation of one
  * segment. Plain arithmetic, no CUDA API: the host check (cuda/hostcheck/draw_hostcheck.cu)
  * runs the same functions on the host.

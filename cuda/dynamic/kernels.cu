@@ -1,9 +1,9 @@
-/* dyn_kernels.cu — the dynamic model's kernels (docs/cuda.md "The dynamic model"): the
+/* cuda/dynamic/kernels.cu — the dynamic model's kernels (docs/cuda.md "The dynamic model"): the
  * strand and warp variants of one frame, the bend rest lengths and the observables. The
- * per-strand math is cuda/dyn_model.cuh; this file maps threads to strands and points.
+ * per-strand math is cuda/dynamic/model.cuh; this file maps threads to strands and points.
  *
  * Feature dispatch (docs/model.md §3.9): a table of kernel pointers indexed by the run's
- * feature mask. A mask for which specialised_mask() (cuda/dyn_kernels.cuh) is true has
+ * feature mask. A mask for which specialised_mask() (cuda/dynamic/kernels.cuh) is true has
  * kernels of its own, compiled with the mask as a constant (StaticF), so an undeclared
  * feature leaves no code; any other valid mask runs the generic kernel (DynF), which tests
  * the same bits at run time: uniform branches around the same expressions, so the bits are
@@ -14,7 +14,7 @@
  */
 #include <utility>
 
-#include "dyn_kernels.cuh"
+#include "dynamic/kernels.cuh"
 
 namespace hb {
 namespace dyn {
@@ -102,7 +102,7 @@ __global__ void __launch_bounds__(kMaxThreads)
 }
 
 /* ---- the warpreg variant: one warp per strand, lane k holds point k (P ≤ 32) in registers ----
- * The same per-point math as frame_body (dyn_model.cuh's scalar helpers), in the same
+ * The same per-point math as frame_body (cuda/dynamic/model.cuh's scalar helpers), in the same
  * order; a constraint between neighbouring points runs on the lane of its higher point,
  * which reads the other end with a shuffle and sends it the step (dl, n) back, so the
  * moved point computes its own p − dl·n exactly as the reference does. Within a group of

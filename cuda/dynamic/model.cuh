@@ -1,4 +1,4 @@
-/* dyn_model.cuh — the dynamic model (docs/model.md §3) for the CUDA port: c_ref/dynamic/dynamics_impl.h
+/* cuda/dynamic/model.cuh — the dynamic model (docs/model.md §3) for the CUDA port: c_ref/dynamic/dynamics_impl.h
  * written as `__host__ __device__` templates over the floating type T, the feature set, the
  * memory layout of the strand and the way a loop over points or constraints is executed.
  *
@@ -14,13 +14,13 @@
  * The three policies:
  *   Feat  the feature set (docs/model.md §3.9): StaticF<F> folds every `has(bit)` at compile
  *         time, so an undeclared feature leaves no code; DynF keeps the set as a run-time mask
- *         (the generic fallback of cuda/dyn_kernels.cu).
+ *         (the generic fallback of cuda/dynamic/kernels.cu).
  *   Arr   where coordinate c of point k of the strand is: base[k·ks + c·cs]. One type covers
  *         the canonical array (ks = 3, cs = 1), the point-major planes X|Y|Z [P][N]
  *         (ks = N, cs = N·P), a warp's shared-memory planes [3][P] (ks = 1, cs = P) and a
  *         thread's interleaved scratch (ks = T, cs = P·T for T threads).
  *   Exec  how a loop runs: Seq runs it in order on one thread (the strand variant, and the
- *         C reference's order); Lanes (cuda/dyn_kernels.cu) spreads its iterations over
+ *         C reference's order); Lanes (cuda/dynamic/kernels.cu) spreads its iterations over
  *         the 32 lanes of a warp and ends with __syncwarp(). Only loops whose iterations
  *         touch disjoint data are handed to Exec::each (a group of §3.6, the per-point
  *         velocity and position steps, the multiplier reset); the follow-the-leader chain
@@ -37,7 +37,7 @@
 #include "dynamic/obs_point.h" /* hb_obs_point: §3.8 per point, shared with the reference */
 #include "runtime/params.h"    /* HB_SOLVER_* */
 #include "tmath.cuh"           /* m_sqrt, m_sin: the float overloads for float */
-#include "dyn_world.cuh"       /* §3.16 grid, §3.17 colliders: contact_impl.h for float and double */
+#include "dynamic/world.cuh"   /* §3.16 grid, §3.17 colliders: contact_impl.h for float and double */
 
 #if defined(__CUDACC__)
 #define HB_DHD __host__ __device__ __forceinline__
@@ -170,7 +170,7 @@ template <typename T> struct Strand {
     Arr1<const T> seg_rest = {nullptr, 0}; /* §3.15 a groom's ℓ_k (b = nullptr: m.seg_len) */
 };
 
-/* The warp variant's strand in one warp's shared memory (cuda/dyn_kernels.cu k_warp, and its
+/* The warp variant's strand in one warp's shared memory (cuda/dynamic/kernels.cu k_warp, and its
  * host check): x, v, p, d [3][P], λ [3P] from base; rest and bend_rest are the caller's. */
 template <typename T> HB_DHD constexpr int64_t warp_reals(int64_t P)
 {
@@ -207,7 +207,7 @@ template <typename T> HB_DHD void rotate(const T *q, T a0, T a1, T a2, T *r)
 
 /* The math of the constraints and steps on scalars, once: the kernels that hold a strand in
  * memory (frame_body below) and the one that holds a point per lane in registers
- * (cuda/dyn_kernels.cu k_warpreg) both call these, so every variant does the same
+ * (cuda/dynamic/kernels.cu k_warpreg) both call these, so every variant does the same
  * operations in the same order. */
 
 /* §3.5 distance constraint between a and b (dynamics_impl.h distance): the multiplier step.
