@@ -40,7 +40,8 @@ from harness.io.files import write_json
 from harness.render import accuracy_dynamic_report, report_dynamic
 from harness.render import peer_dynamic_report as peer_report
 from harness.render import stability_dynamic_report as stability_report
-from harness.studies import accuracy_dynamic, accuracy_world
+from harness.studies import accuracy_dynamic
+from harness.studies import accuracy_world_dynamic as accuracy_world
 from harness.studies import animate_dynamic as animate
 from harness.studies import budget_curves_dynamic as budget_curves
 from harness.studies import featurecost_dynamic as featurecost
@@ -266,7 +267,7 @@ def featurecost_size(sweep_dir, allowance_s):
 
 
 def budget_modes(acc_dir):
-    """The modes the frame budget's curves time (studies/budget_curves.py): each backend's Pareto
+    """The modes the frame budget's curves time (studies/budget_curves_dynamic.py): each backend's Pareto
     front of the accuracy study in `acc_dir` (render/accuracy_dynamic_report.front_of: the usable
     modes no other is both faster and more accurate than, the no-simulation mode among them), as
     dicts of the study's columns."""

@@ -37,7 +37,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from harness.check import invariants
-from harness.check.head_motion import head_rotation, track_rotation  # noqa: F401 (read from here by other modules)
+from harness.check.head_motion_dynamic import head_rotation, track_rotation  # noqa: F401 (read from here by other modules)
 from harness.check.invariants import Violation
 from harness.core import tolerances
 from harness.core.guides import guide_count, guide_strands
@@ -46,8 +46,8 @@ from harness.io.trajectory import SimulatedView
 
 
 def collider_depths(traj, points, t):
-    """Each point's depth in each collider of §3.17 (harness.check.colliders), [ncol][M]."""
-    from harness.check.colliders import depths
+    """Each point's depth in each collider of §3.17 (harness.check.colliders_dynamic), [ncol][M]."""
+    from harness.check.colliders_dynamic import depths
 
     return depths(traj, points, t)
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.check import ensemble as en
+from harness.check import ensemble_dynamic as en
 from harness.core import tolerances
 from harness.core.paths import display
 from harness.io import tables
@@ -227,10 +227,10 @@ def chaos_lines(summ, ens, shown):
     )
     out += [
         f"Over the whole run ({len(members['mode'].unique())} ensemble members), every mode's statistics against "
-        "the reference ensemble (harness/check/ensemble.py): a distance is the mean over the members, a scalar the "
-        f"mode's own. The ensemble itself: {spread} (spread, or the members' range). A mode passes a use when each "
-        "distance is within the spread plus the use's allowance and the kinetic energy within the members' range "
-        "times the use's factor (tolerances.DYN_ACC_USES_CHAOS).",
+        "the reference ensemble (harness/check/ensemble_dynamic.py): a distance is the mean over the members, a "
+        f"scalar the mode's own. The ensemble itself: {spread} (spread, or the members' range). A mode passes a use "
+        "when each distance is within the spread plus the use's allowance and the kinetic energy within the members' "
+        "range times the use's factor (tolerances.DYN_ACC_USES_CHAOS).",
         "",
         "| mode | " + " | ".join(label for _, label in CHAOS_COLUMNS) + " |",
         "| --- |" + " ---: |" * len(CHAOS_COLUMNS),

@@ -120,7 +120,7 @@ def markdown(rows, refs=()):
     lines = [
         f"Checked runs: fp32, S = {first['substeps']}, {_g(_f(first, 'seconds'))} s; errors are the worst written "
         "frame up to the pointwise horizon, statistics (W1 of the tip's and the curvature's distributions, the "
-        "silhouette's area; harness/check/ensemble.py) over the whole run, stretch against each segment's own "
+        "silhouette's area; harness/check/ensemble_dynamic.py) over the whole run, stretch against each segment's own "
         f"rest length. Times per frame ({sizes}, median).",
         "",
         *references_lines(refs),

@@ -21,13 +21,13 @@ from harness.io import (
 )
 from harness.render import (  # noqa: E402
     accuracy_dynamic_report,
-    accuracy_world_report,
     budget_report,
     hair_report,
     host_report,
     judge_report,
     steps_report,
 )
+from harness.render import accuracy_world_dynamic_report as accuracy_world_report  # noqa: E402
 from harness.render import featurecost_dynamic_report as featurecost_report  # noqa: E402
 from harness.render import frame_budget_dynamic as frame_budget  # noqa: E402
 from harness.render import peer_dynamic_report as peer_report  # noqa: E402

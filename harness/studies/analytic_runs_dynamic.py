@@ -1,7 +1,7 @@
 """Hand-made input states for the analytic checks (docs/model.md §4), and the runs on them.
 
 Self-contained on purpose (it needs only h5py, numpy, harness.studies.analytic_dynamic and
-harness.check.observables' dominant_frequency): it writes a
+harness.check.observables_dynamic' dominant_frequency): it writes a
 paper-model state file (the layout of docs/interfaces.md: /h5md,
 /particles/hair/position/value [1][N·P][3], /parameters with the scene attributes and
 /parameters/stage = ["init"]) with h5py, and runs the simulate stage of a hairsim binary
@@ -271,7 +271,7 @@ def run_chain(
     shape starts with, which shifts the tip's own zero crossings. The tip's dominant
     frequency (FFT) is returned too, as a cross-check. Expected: the discrete chain's ω1
     (the solver's target); the continuum ω1 is returned for the discretisation error."""
-    from harness.check.observables import dominant_frequency
+    from harness.check.observables_dynamic import dominant_frequency
 
     an = _analytic()
     w_cont = an.chain_omega1(length, G0)

@@ -1,6 +1,6 @@
 """The long runs of `python -m harness accuracy --model dynamic`: what a hair user sees over
 seconds rather than how far each point is from one reference trajectory (docs/harness.md, "The
-dynamic accuracy study"). Measured with harness/check/observables.py and harness/check/ensemble.py.
+dynamic accuracy study"). Measured with harness/check/observables_dynamic.py and harness/check/ensemble_dynamic.py.
 
 Three scenes, all made from the study's own scene (curly hair stays curly), `long_strands`
 strands (the study's points), `long_seconds` of simulated time (rest: REST_SECONDS at most):
@@ -36,8 +36,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from harness.check import ensemble as en
-from harness.check import observables as ob
+from harness.check import ensemble_dynamic as en
+from harness.check import observables_dynamic as ob
 from harness.core import runner
 from harness.studies import predictability_dynamic as predictability
 from harness.studies.accuracy import REF_ITERATIONS, REF_PRECISION, REF_SOLVER

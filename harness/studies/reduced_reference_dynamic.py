@@ -5,7 +5,7 @@ tolerances.DYN_ACC_REF_FACTOR × the smallest RMS error of the rows it ranks (th
 rule), or the plan's ref_max. The converged (finer) rung then gets perturbed twins
 (studies/predictability_dynamic.py): their separation gives the scene's Lyapunov rate and predictability
 time, which bound the pointwise horizon; with the rung they are the reference ensemble whose
-spread the rows' statistics (harness/check/ensemble.py) are judged against.
+spread the rows' statistics (harness/check/ensemble_dynamic.py) are judged against.
 
 A row is kept as its file; its errors against a rung are read again when the rung changes.
 """
@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from harness.check import ensemble as en
-from harness.check import observables as ob
+from harness.check import ensemble_dynamic as en
+from harness.check import observables_dynamic as ob
 from harness.core import runner, tolerances
 from harness.io.trajectory import open_trajectory
 from harness.studies import predictability_dynamic as predictability

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from harness.check import observables as ob
+from harness.check import observables_dynamic as ob
 from harness.core import tolerances as tol
 from harness.studies import analytic_dynamic as an
 from harness.studies.analytic_runs_dynamic import G0, run_chain, run_pendulum, run_wind

@@ -1,4 +1,4 @@
-"""The accuracy study's observables (harness/check/observables.py) on runs of the C reference
+"""The accuracy study's observables (harness/check/observables_dynamic.py) on runs of the C reference
 with known answers: a pendulum's tip frequency against the exact period, a damped pendulum's
 damping ratio against β/(2ω0), the energy of an undamped pendulum within the scheme's
 measured drift, zero jitter for a strand resting on nothing, and the no-simulation solver
@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from harness.check import observables as ob
+from harness.check import observables_dynamic as ob
 from harness.core import tolerances as tol
 from harness.io.trajectory import open_trajectory
 from harness.studies import analytic_dynamic as an

@@ -1,4 +1,4 @@
-"""harness/check/observables.py on inputs with known answers (numpy only, no binary):
+"""harness/check/observables_dynamic.py on inputs with known answers (numpy only, no binary):
 verdicts split by cause, silhouettes, jitter, stretch, error percentiles, spectra, and the
 tip-motion fits on synthetic oscillations."""
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from harness.check import observables as ob
+from harness.check import observables_dynamic as ob
 
 L = 30.0
 

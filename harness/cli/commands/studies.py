@@ -1,4 +1,5 @@
-"""The studies' commands: `budget`, `hair`, `calibrate`, `featurecost`, `world`, `reduced`, `peer`, `stability`, `judge`."""
+"""The studies' commands: `budget`, `hair`, `calibrate`, `featurecost`, `world`, `reduced`, `peer`, `stability`,
+`judge`."""
 
 import argparse
 import json
@@ -76,10 +77,10 @@ def cmd_featurecost(args):
 
 
 def cmd_world(args):
-    """The grid's and the colliders' variants against their converged references (studies/accuracy_world.py):
+    """The grid's and the colliders' variants against their converged references (studies/accuracy_world_dynamic.py):
     write world.csv into --out and print the report's section."""
-    from harness.render import accuracy_world_report
-    from harness.studies import accuracy_world
+    from harness.render import accuracy_world_dynamic_report as accuracy_world_report
+    from harness.studies import accuracy_world_dynamic as accuracy_world
 
     plan = accuracy_world.Plan.quick(gpu=args.gpu) if args.quick else accuracy_world.Plan(gpu=args.gpu)
     path = accuracy_world.run_study(plan, out_dir=args.out)
