@@ -211,8 +211,6 @@ def split(data, where, error):
         paper[key] = value
     if not dynamic:
         return paper, None
-    if "--grid" in flags and not 2 <= flags["--grid"] <= 512:
-        raise error(f"{where}: grid.nodes must be from 2 to 512, got {flags['--grid']!r}")
     if any(f.startswith("--grid-") for f in flags) and "--grid" not in flags:
         raise error(f"{where}: the [grid] table needs grid.nodes (the grid is off without it)")
     track = flags.get("--head-motion") == "track"

@@ -27,6 +27,7 @@ import numpy as np
 from harness import HarnessError
 from harness.check import hair_volume_dynamic as hair_volume
 from harness.core import env, runner, scenes, variants
+from harness.core.limits import limits
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
@@ -115,8 +116,9 @@ def check_plan(plan):
         bad.append(f"--seconds must be in (0, 10] (got {plan.seconds:g})")
     if plan.ref_substeps <= 8:
         bad.append(f"--ref-substeps {plan.ref_substeps} must exceed the scenes' S = 8")
-    if not plan.grid_sizes or any(not 2 <= n <= 512 for n in plan.grid_sizes):
-        bad.append("--grid-sizes needs values from 2 to 512")
+    fewest, most = limits().grid_n
+    if not plan.grid_sizes or any(not fewest <= n <= most for n in plan.grid_sizes):
+        bad.append(f"--grid-sizes needs values from {fewest} to {most}")
     if not plan.sdf_sizes or any(not 8 <= n <= 512 for n in plan.sdf_sizes):
         bad.append("--sdf-sizes needs values from 8 to 512")
     if not plan.rebuilds or any(r not in ("frame", "substep") for r in plan.rebuilds):
