@@ -27,6 +27,7 @@ Without a GPU the GPU rows and checks are skipped with one line saying why.
 from pathlib import Path
 
 from harness import HarnessError
+from harness.bench import animate_dynamic as animate
 from harness.bench import renders, validation
 from harness.bench.validation import gpu_plan
 from harness.check import diff_dynamic
@@ -42,7 +43,6 @@ from harness.render import peer_dynamic_report as peer_report
 from harness.render import stability_dynamic_report as stability_report
 from harness.studies import accuracy_dynamic
 from harness.studies import accuracy_world_dynamic as accuracy_world
-from harness.studies import animate_dynamic as animate
 from harness.studies import budget_curves_dynamic as budget_curves
 from harness.studies import featurecost_dynamic as featurecost
 from harness.studies import peer_dynamic as peer

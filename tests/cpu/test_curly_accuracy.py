@@ -5,13 +5,13 @@ and page, and the report's section from a tiny real study whose reference does n
 
 import pytest
 
+from harness.bench import animate_dynamic as animate
 from harness.bench import dynamic as bench_dynamic
 from harness.core import variants
 from harness.core.budget import Budget
 from harness.core.shards import Shard
 from harness.render import accuracy_dynamic_report, report_dynamic
 from harness.studies import accuracy_dynamic
-from harness.studies import animate_dynamic as animate
 from harness.studies import budget_curves_dynamic as budget_curves
 from harness.studies import featurecost_dynamic as featurecost
 from harness.studies import peer_dynamic as peer

@@ -13,7 +13,7 @@ def cmd_animate(args):
     """Draw the frames of a dynamic HDF5 state (read through harness.io.trajectory) seen from the side and from
     the front, the head sphere drawn, as a GIF (and an MP4 beside it where ffmpeg is on PATH). Without STATE,
     runs configs/scenes/dynamic.toml on hairsim-cpu first."""
-    from harness.studies import animate_dynamic as animate
+    from harness.bench import animate_dynamic as animate
 
     for path in animate.run(args.state, **options(args, "out max_strands every fps force strands frames")):
         print(f"wrote {path}")
