@@ -42,6 +42,7 @@ from harness.render import accuracy_dynamic_report, report_dynamic
 from harness.render import peer_dynamic_report as peer_report
 from harness.render import stability_dynamic_report as stability_report
 from harness.studies import accuracy_dynamic
+from harness.studies import accuracy_rows_dynamic as accuracy_rows
 from harness.studies import accuracy_world_dynamic as accuracy_world
 from harness.studies import budget_curves_dynamic as budget_curves
 from harness.studies import featurecost_dynamic as featurecost
@@ -268,14 +269,14 @@ def featurecost_size(sweep_dir, allowance_s):
 
 def budget_modes(acc_dir):
     """The modes the frame budget's curves time (studies/budget_curves_dynamic.py): each backend's Pareto
-    front of the accuracy study in `acc_dir` (render/accuracy_dynamic_report.front_of: the usable
+    front of the accuracy study in `acc_dir` (studies/accuracy_rows_dynamic.front_of: the usable
     modes no other is both faster and more accurate than, the no-simulation mode among them), as
     dicts of the study's columns."""
     rows, study, _, _ = accuracy_dynamic_report.load(acc_dir)
-    summ = accuracy_dynamic_report.summary(rows, study["horizon_frames"])
+    summ = accuracy_rows.summary(rows, study["horizon_frames"])
     modes = []
     for backend, part in summ.groupby("backend"):
-        for _, r in accuracy_dynamic_report.front_of(part).iterrows():
+        for _, r in accuracy_rows.front_of(part).iterrows():
             s = r["ftl_damping"]
             modes.append(dict(mode=r["mode"], backend=backend, build=r["build"], variant=r["variant"],
                               solver=r["solver"], ftl_damping=None if s != s else float(s),

@@ -117,7 +117,7 @@ def _distance_gate(cell, allow):
 
 
 def checks(r, use, longm, ensm):
-    """{gate: passes} of mode row r (accuracy_dynamic_report.summary) for a use (None: not
+    """{gate: passes} of mode row r (studies/accuracy_rows_dynamic.summary) for a use (None: not
     measured): the pointwise RMS error over the horizon (min(horizon, T_p)) and stretch, the
     metrics that survive chaos against the ensemble over the whole run, and the long runs'
     motion (kinetic energy from positions), release (tip frequency, damping ratio) and rest
