@@ -718,7 +718,7 @@ static int run_one(int argc, char **argv, hb_backend *b);
 /* A batch line is a run: the words that print something else on stdout are not. */
 static int batch_word_allowed(const char *w)
 {
-    static const char *const not_runs[] = {"--help", "-h", "--version", "--list-variants", "--self-test"};
+    static const char *const not_runs[] = {"--help", "-h", "--version", "--list-variants", "--limits", "--self-test"};
     for (size_t i = 0; i < sizeof not_runs / sizeof not_runs[0]; i++)
         if (strcmp(w, not_runs[i]) == 0) return 0;
     return 1;

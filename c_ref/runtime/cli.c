@@ -271,6 +271,7 @@ static const flag_spec flags[] = {
      .help = "with --input: resume after frame K of the file (default: its last)"},
     {.flag = "--help", .kind = F_HELP, .help = "this text (also -h)"},
     {.flag = "--version", .kind = F_HELP, .help = "the version"},
+    {.flag = "--limits", .kind = F_HELP, .help = "the limits this binary checks its flags against, as one JSON object"},
     {.help = "the simulate stage (docs/model.md §3; a feature left undeclared is not evaluated):"},
     {.flag = "--frames",
      .kind = F_I64,
@@ -747,8 +748,9 @@ static int parse_run_flag(const flag_spec *fl, const char *v, const char *backen
         break;
     case F_INT:
         if (parse_i64(name, v, fl->lo, fl->hi, &iv, err, errlen)) return -1;
-        if (fl->offset == offsetof(hb_options, block_size) && iv % 32 != 0)
-            FAIL("--block-size must be a multiple of 32 from 32 to 1024 (got %s)", v);
+        if (fl->offset == offsetof(hb_options, block_size) && iv % HB_BLOCK_MULTIPLE != 0)
+            FAIL("--block-size must be a multiple of %d from %lld to %lld (got %s)", HB_BLOCK_MULTIPLE,
+                 (long long)fl->lo, (long long)fl->hi, v);
         *(int *)at = (int)iv;
         break;
     case F_U64:
@@ -874,6 +876,10 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
             printf("hairbench %s (%s backend)\n", HB_VERSION, backend);
             return 1;
         }
+        if (strcmp(a, "--limits") == 0) {
+            hb_print_limits(stdout, backend);
+            return 1;
+        }
         if (strncmp(a, "--", 2) != 0) FAIL("unexpected argument '%s' (see --help)", a);
         /* --flag V or --flag=V */
         const char *eq = strchr(a, '=');
@@ -900,6 +906,21 @@ int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, cha
         if (is_dyn(fl) ? parse_dyn(fl, v, o, err, errlen) : parse_run_flag(fl, v, backend, o, err, errlen)) return -1;
     }
     return check_combinations(o, err, errlen);
+}
+
+void hb_print_limits(FILE *f, const char *backend)
+{
+    const flag_spec *block = find_flag("--block-size"), *threads = find_flag("--threads");
+    fprintf(f, "{\"backend\": \"%s\", ", backend);
+    fprintf(f, "\"strands_min\": %lld, \"points_min\": %lld, \"stages_max\": %d, ",
+            (long long)find_flag("--strands")->lo, (long long)find_flag("--points")->lo, HB_MAX_STAGES);
+    fprintf(f, "\"substeps_max\": %d, \"iterations_max\": %d, ", HB_COUNT_MAX, HB_COUNT_MAX);
+    fprintf(f, "\"substep_s\": [%.15g, %.15g], ", HB_SUBSTEP_MIN_S, HB_SUBSTEP_MAX_S);
+    fprintf(f, "\"grid_n\": [%d, %d], \"grid_points_max\": %llu, ", HB_GRID_N_MIN, HB_GRID_N_MAX,
+            (unsigned long long)HB_GRID_POINTS_MAX);
+    fprintf(f, "\"block_size\": {\"min\": %lld, \"max\": %lld, \"multiple\": %d}, ", (long long)block->lo,
+            (long long)block->hi, HB_BLOCK_MULTIPLE);
+    fprintf(f, "\"threads\": [%lld, %lld]}\n", (long long)threads->lo, (long long)threads->hi);
 }
 
 /* The stage-list rule shared with the harness (harness/core/scenes.py parse_stages): no empty

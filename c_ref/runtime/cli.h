@@ -2,6 +2,7 @@
 #ifndef HB_CLI_H
 #define HB_CLI_H
 
+#include <stdint.h>
 #include <stdio.h>
 
 #include "runtime/params.h"
@@ -15,6 +16,18 @@ extern "C" {
 int hb_parse_args(int argc, char **argv, const char *backend, hb_options *o, char *err, size_t errlen);
 void hb_print_usage(FILE *f, const char *prog, const char *backend);
 void hb_default_options(hb_options *o);
+
+/* Limits the binaries check that the harness reads through --limits (docs/interfaces.md,
+ * "Command line"); the flag table's ranges (--block-size, --threads, ...) are printed from the table. */
+#define HB_COUNT_MAX 1000000   /* --substeps and --iterations at most */
+#define HB_SUBSTEP_MIN_S 1e-12 /* h = --frame-dt / --substeps, s */
+#define HB_SUBSTEP_MAX_S 1e3
+#define HB_GRID_N_MIN 2 /* --grid nodes per axis */
+#define HB_GRID_N_MAX 512
+#define HB_GRID_POINTS_MAX (UINT64_C(1) << 31) /* --strands x --points with --grid */
+#define HB_BLOCK_MULTIPLE 32                   /* --block-size: a whole number of warps */
+/* Prints the limits as one JSON object (--limits). */
+void hb_print_limits(FILE *f, const char *backend);
 
 /* The dynamic flags' table: bit i of hb_options.dyn_given is entry i; the run-shape flags
  * (--frames, --output-every, --velocities, --draw, --draw-image) set HB_DYN_GIVEN_RUN. */

@@ -1,6 +1,7 @@
 /* params.c — scene validation (docs/model.md §2.6: bad scenes are refused before any work, with a
  * message naming the flag). */
 #include "runtime/params.h"
+#include "runtime/cli.h"
 #include "runtime/checked.h"
 
 #include <float.h>
@@ -188,8 +189,10 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
     }
     if (d->substeps < 1) FAIL("--substeps must be at least 1 (got %lld)", (long long)d->substeps);
     if (d->iterations < 1) FAIL("--iterations must be at least 1 (got %lld)", (long long)d->iterations);
-    if (d->substeps > 1000000) FAIL("--substeps must be at most 1000000 (got %lld)", (long long)d->substeps);
-    if (d->iterations > 1000000) FAIL("--iterations must be at most 1000000 (got %lld)", (long long)d->iterations);
+    if (d->substeps > HB_COUNT_MAX)
+        FAIL("--substeps must be at most %d (got %lld)", HB_COUNT_MAX, (long long)d->substeps);
+    if (d->iterations > HB_COUNT_MAX)
+        FAIL("--iterations must be at most %d (got %lld)", HB_COUNT_MAX, (long long)d->iterations);
     if (!(d->shape_range > 0.0 && d->shape_range <= 1.0))
         FAIL("--shape-range must be in (0, 1] (got %g)", d->shape_range);
     if (!(d->ftl_damping >= 0.0 && d->ftl_damping <= 1.0))
@@ -198,8 +201,9 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
         FAIL("--guides must be a fraction in (0, 1] or a whole count > 1 (got %g)", d->guides);
     if (d->lra && !(isfinite(d->lra_scale) && d->lra_scale >= 1.0))
         FAIL("--lra scale must be a finite number >= 1 (got %g)", d->lra_scale);
-    if (d->grid && (d->grid_n < 2 || d->grid_n > 512))
-        FAIL("--grid must be from 2 to 512 nodes per axis (got %lld)", (long long)d->grid_n);
+    if (d->grid && (d->grid_n < HB_GRID_N_MIN || d->grid_n > HB_GRID_N_MAX))
+        FAIL("--grid must be from %d to %d nodes per axis (got %lld)", HB_GRID_N_MIN, HB_GRID_N_MAX,
+             (long long)d->grid_n);
     if (d->grid_box_given)
         for (int c = 0; c < 3; c++)
             if (!(d->grid_box[c] < d->grid_box[c + 3]))
@@ -215,8 +219,9 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
         FAIL("--depenetration-speed must be > 0 (got %g)", d->depen_speed);
     /* h = Δt/S and α/h² must stay normal numbers in double */
     const double h = d->frame_dt / (double)d->substeps;
-    if (!(h >= 1e-12 && h <= 1e3))
-        FAIL("--frame-dt / --substeps = %g s is outside the substep lengths this model takes [1e-12, 1e3]", h);
+    if (!(h >= HB_SUBSTEP_MIN_S && h <= HB_SUBSTEP_MAX_S))
+        FAIL("--frame-dt / --substeps = %g s is outside the substep lengths this model takes [%g, %g]", h,
+             HB_SUBSTEP_MIN_S, HB_SUBSTEP_MAX_S);
     return 0;
 }
 
@@ -254,7 +259,7 @@ int hb_dynamics_validate_scene(const hb_scene *s, char *err, size_t errlen)
     const int shape = d->shape && floor(d->shape_range * (double)(s->points - 1)) >= 1.0; /* K ≥ 1 */
     const double hi = hb_length_max(p);
     const double rc = s->head_radius + d->collision_margin;
-    if (d->grid && (uint64_t)s->n_strands * (uint64_t)s->points > (UINT64_C(1) << 31))
+    if (d->grid && (uint64_t)s->n_strands * (uint64_t)s->points > HB_GRID_POINTS_MAX)
         FAIL("--grid: --strands x --points must be at most 2^31 points, the bound that keeps the grid's fixed-point "
              "sums from overflowing (docs/model.md §3.16)");
     /* the largest acceleration of the velocity step, c_d·U·(1 + A_g) for the wind's share */

@@ -27,6 +27,7 @@ Without a GPU the GPU rows and checks are skipped with one line saying why.
 from pathlib import Path
 
 from harness import HarnessError
+from harness.bench import animate_dynamic as animate
 from harness.bench import renders, validation
 from harness.bench.validation import gpu_plan
 from harness.check import diff_dynamic
@@ -37,17 +38,17 @@ from harness.core.progress import StepTimes
 from harness.core.scenes import with_frames
 from harness.io import results_data
 from harness.io.files import write_json
-from harness.render import accuracy_dynamic_report, peer_report, report_dynamic, stability_report
-from harness.studies import (
-    accuracy_dynamic,
-    accuracy_world,
-    animate,
-    budget_curves,
-    featurecost,
-    peer,
-    reduced,
-    stability,
-)
+from harness.render import accuracy_dynamic_report, report_dynamic
+from harness.render import peer_dynamic_report as peer_report
+from harness.render import stability_dynamic_report as stability_report
+from harness.studies import accuracy_dynamic
+from harness.studies import accuracy_rows_dynamic as accuracy_rows
+from harness.studies import accuracy_world_dynamic as accuracy_world
+from harness.studies import budget_curves_dynamic as budget_curves
+from harness.studies import featurecost_dynamic as featurecost
+from harness.studies import peer_dynamic as peer
+from harness.studies import reduced_dynamic as reduced
+from harness.studies import stability_dynamic as stability
 from harness.studies.accuracy import DEFAULT_SCENE, curves_name, results_name
 from harness.studies.sweep import run_sweep
 
@@ -267,15 +268,15 @@ def featurecost_size(sweep_dir, allowance_s):
 
 
 def budget_modes(acc_dir):
-    """The modes the frame budget's curves time (studies/budget_curves.py): each backend's Pareto
-    front of the accuracy study in `acc_dir` (render/accuracy_dynamic_report.front_of: the usable
+    """The modes the frame budget's curves time (studies/budget_curves_dynamic.py): each backend's Pareto
+    front of the accuracy study in `acc_dir` (studies/accuracy_rows_dynamic.front_of: the usable
     modes no other is both faster and more accurate than, the no-simulation mode among them), as
     dicts of the study's columns."""
     rows, study, _, _ = accuracy_dynamic_report.load(acc_dir)
-    summ = accuracy_dynamic_report.summary(rows, study["horizon_frames"])
+    summ = accuracy_rows.summary(rows, study["horizon_frames"])
     modes = []
     for backend, part in summ.groupby("backend"):
-        for _, r in accuracy_dynamic_report.front_of(part).iterrows():
+        for _, r in accuracy_rows.front_of(part).iterrows():
             s = r["ftl_damping"]
             modes.append(dict(mode=r["mode"], backend=backend, build=r["build"], variant=r["variant"],
                               solver=r["solver"], ftl_damping=None if s != s else float(s),

@@ -9,8 +9,8 @@ with its own report (docs/user_scene.md):
      strand axis cut at its strand count), timed by the stopping rule;
   3. the speed-against-accuracy study of this scene (accuracy --quick, or the full one);
   4. the frame budget's throughput curves: each backend's Pareto front of (3) timed at a ladder
-     of strand counts (studies/budget_curves.py), from which `harness budget` answers;
-  5. the stability map over this scene (substeps against iterations, studies/stability.py);
+     of strand counts (studies/budget_curves_dynamic.py), from which `harness budget` answers;
+  5. the stability map over this scene (substeps against iterations, studies/stability_dynamic.py);
   6. OUT/report/scene.md (render/report_scene.py).
 With --budget the sweep and the curves fit their shares of the time left, and each study runs
 while any is left and is stopped when it runs out (core/budget.py), as the default bench does.
@@ -29,8 +29,10 @@ from harness.core.progress import StepTimes
 from harness.io import grooms, runfolder
 from harness.io.files import write_json
 from harness.io.sweepfile import load_sweep
-from harness.render import accuracy_dynamic_report, host_report, report_scene, stability_report
-from harness.studies import budget_curves, stability
+from harness.render import accuracy_dynamic_report, host_report, report_scene
+from harness.render import stability_dynamic_report as stability_report
+from harness.studies import budget_curves_dynamic as budget_curves
+from harness.studies import stability_dynamic as stability
 from harness.studies.accuracy import curves_name, results_name
 from harness.studies.sweep import run_sweep
 

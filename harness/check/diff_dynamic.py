@@ -50,7 +50,8 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.check import diff, invariants_dynamic, lod
+from harness.check import diff, invariants_dynamic
+from harness.check import lod_dynamic as lod
 from harness.core import runner, tolerances
 from harness.core.paths import build_dir, display
 from harness.core.runner import COMPLETED

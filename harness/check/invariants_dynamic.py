@@ -37,7 +37,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from harness.check import invariants
-from harness.check.head_motion import head_rotation, track_rotation  # noqa: F401 (read from here by other modules)
+from harness.check.head_motion_dynamic import head_rotation, track_rotation  # noqa: F401 (read from here by other modules)
 from harness.check.invariants import Violation
 from harness.core import tolerances
 from harness.core.guides import guide_count, guide_strands
@@ -46,8 +46,8 @@ from harness.io.trajectory import SimulatedView
 
 
 def collider_depths(traj, points, t):
-    """Each point's depth in each collider of §3.17 (harness.check.colliders), [ncol][M]."""
-    from harness.check.colliders import depths
+    """Each point's depth in each collider of §3.17 (harness.check.colliders_dynamic), [ncol][M]."""
+    from harness.check.colliders_dynamic import depths
 
     return depths(traj, points, t)
 
@@ -178,6 +178,151 @@ def is_reference_build(traj):
     return as_text(traj.params.get("backend", "")) == "cpu" and "-ffp-contract=off" in traj.flags
 
 
+class _FrameChecks:
+    """The checks of one simulated frame of a trajectory, each adding its violations to `rep`."""
+
+    def __init__(self, traj, rep, exact, kind):
+        self.traj, self.rep, self.exact = traj, rep, exact
+        self.eps = tolerances.EPS[kind]
+        R, h, L = float(traj.params["head_radius"]), float(traj.params["hair_offset"]), traj.hair_length
+        self.E = tolerances.extent(R, h, L)
+        self.rc = traj.collide_radius
+        self.ell = traj.segment_rest()
+        self.pen_allow = tolerances.DYN_PENETRATION_K * self.eps * self.rc
+        self.rest_roots = np.ascontiguousarray(traj.rest[:, 0, :])
+
+    def add(self, f, name, count, worst, message):
+        if count:
+            self.rep.violations.append(
+                Violation(
+                    f,
+                    "simulate",
+                    name,
+                    int(count),
+                    float(worst),
+                    f"frame {f} (simulate, step {int(self.traj.step[f])}): {message}",
+                )
+            )
+
+    def bound(self, f, name, values, k, worst_field, message, nan_over=True):
+        """Values (in units of ε·scale) over k, NaN included with nan_over: `name`'s violation,
+        `message` formatted with n (how many), k and worst; rep.<worst_field> the largest seen."""
+        worst = float(np.nanmax(values)) if values.size else 0.0
+        setattr(self.rep, worst_field, max(getattr(self.rep, worst_field), worst))
+        over = ~(values <= k) if nan_over else values > k
+        self.add(f, name, over.sum(), worst, message.format(n=int(over.sum()), k=k, worst=worst))
+
+    def roots(self, f, x):
+        """The roots at Q(t)·X̄0: bit-identical, or within DYN_ROOT_K·ε·R."""
+        want = expected_roots(self.traj, f, self.rest_roots)
+        got = np.ascontiguousarray(x[:, 0, :])
+        if self.exact:
+            bits = invariants._bits
+            moved = np.any(bits(got) != bits(want), axis=1)
+            if moved.any():
+                from harness.core.ulp import ulp_distance
+
+                self.rep.worst_root = max(self.rep.worst_root, float(ulp_distance(got, want, got.dtype).max()))
+            self.add(
+                f,
+                "roots",
+                moved.sum(),
+                self.rep.worst_root,
+                f"{int(moved.sum())} root(s) not bit-identical to Q(t)·X̄0 (worst {self.rep.worst_root:g} ULP)",
+            )
+        else:
+            R = float(self.traj.params["head_radius"])
+            with np.errstate(invalid="ignore"):
+                d = np.max(np.abs(got.astype(np.float64) - want.astype(np.float64)), axis=1) / (self.eps * R)
+            self.bound(
+                f,
+                "roots",
+                d,
+                tolerances.DYN_ROOT_K,
+                "worst_root",
+                "{n} root(s) farther than {k:g}·ε·R from Q(t)·X̄0 (worst {worst:.3g}·ε·R)",
+            )
+
+    def geometry(self, f, x):
+        """No point inside the collider; the segments a solver holds at rest length."""
+        xd = x.astype(np.float64)
+        with np.errstate(invalid="ignore", over="ignore"):
+            r = np.sqrt((xd[:, :, 0] * xd[:, :, 0] + xd[:, :, 1] * xd[:, :, 1]) + xd[:, :, 2] * xd[:, :, 2])
+            # with §3.17's colliders a later collider may push a point back into the head, and a
+            # bounded depenetration leaves it inside on purpose: the bound holds without them
+            bounded = int(self.traj.dynamic_params.get("depenetration_declared", 0))
+            if self.traj.collider and not self.traj.colliders and not bounded:
+                self.bound(
+                    f,
+                    "collider",
+                    (self.rc - r[:, 1:]) / (self.eps * self.rc),
+                    tolerances.DYN_PENETRATION_K,
+                    "worst_penetration_k",
+                    f"{{n}} point(s) inside the collider R_c = {self.rc:g} by more than {{k:g}}·ε·R_c "
+                    "(worst {worst:.3g}·ε·R_c)",
+                    nan_over=False,
+                )
+            held = _strands_holding_rest(self.traj)
+            if held is not None:
+                seg = np.sqrt(np.sum(np.diff(xd, axis=1) ** 2, axis=2))
+                err = np.abs(seg - self.ell) / (self.eps * self.E)
+                free = np.ones_like(err, dtype=bool)
+                # §3.17: friction moves a point in contact along the surface, which lifts it off a
+                # curved one: with friction a point within a segment's length of a surface counts as moved
+                near = self.pen_allow
+                if int(self.traj.dynamic_params.get("friction_declared", 0)) or any(
+                    c.mu_s > 0 for c in self.traj.colliders
+                ):
+                    near = float(np.max(self.ell)) if np.ndim(self.ell) else float(self.ell)
+                if self.traj.collider:
+                    free = r[:, 1:] > self.rc + near  # the collider did not move point k
+                if self.traj.colliders:  # nor any other collider
+                    d = collider_depths(self.traj, xd[:, 1:, :], frame_end_time(self.traj, f))
+                    free &= ~np.any(np.nan_to_num(d, nan=-np.inf) > -near, axis=0).reshape(free.shape)
+                err = np.where(free, err, 0.0)[held]
+                self.bound(
+                    f,
+                    "ftl_segments" if self.traj.solver == "ftl" else "follower_segments",
+                    err,
+                    tolerances.DYN_FTL_SEGMENT_K,
+                    "worst_ftl_segment_k",
+                    "{n} segment(s) not moved by the collider differ from ℓ by more than {k:g}·ε·E "
+                    "(worst {worst:.3g}·ε·self.E)",
+                )
+
+    def observables(self, f, x, v, row):
+        """The frame's observables row against what its positions and velocities give."""
+        stretch, pen, ke, blown = observe(self.traj, x, v, frame_end_time(self.traj, f))
+        msgs = []
+        # the reference computes both exactly as observe() does; another build may contract
+        # or reorder the double sums: DYN_OBSERVABLE_K·ε64 of the quantity's scale
+        e64 = tolerances.EPS["fp64"]
+        s_file, p_file = float(row["stretch_max"]), float(row["penetration_max"])
+        ds, dp = abs(stretch - s_file), abs(pen - p_file)
+        self.rep.worst_observable_k = max(
+            self.rep.worst_observable_k, ds / (e64 * (1 + abs(stretch))), dp / (e64 * self.rc)
+        )
+        if not (stretch == s_file if self.exact else ds <= tolerances.DYN_OBSERVABLE_K * e64 * (1 + abs(stretch))):
+            msgs.append(f"stretch_max {s_file:.17g} but the positions give {stretch:.17g}")
+        if not (pen == p_file if self.exact else dp <= tolerances.DYN_OBSERVABLE_K * e64 * self.rc):
+            msgs.append(f"penetration_max {p_file:.17g} but the positions give {pen:.17g}")
+        if ke is not None:
+            k = float(row["kinetic_energy"])
+            rel = abs(ke - k) / max(abs(ke), np.finfo(float).tiny) if math.isfinite(ke) else float("nan")
+            if math.isfinite(rel):
+                self.rep.worst_kinetic_rel = max(self.rep.worst_kinetic_rel, rel)
+            if math.isfinite(ke) and not rel <= tolerances.DYN_KINETIC_REL:
+                msgs.append(f"kinetic_energy {k:.17g} but the velocities give {ke:.17g}")
+        stored = int(row["blown_up_strands"])
+        if (v is not None and blown != stored) or (v is None and blown > stored):
+            msgs.append(
+                f"blown_up_strands {stored} but positions{' and velocities' if v is not None else ''} give {blown}"
+            )
+        if bool(row["blown_up"]) != (stored > 0):
+            msgs.append(f"blown_up {bool(row['blown_up'])} disagrees with blown_up_strands {stored}")
+        self.add(f, "observables", len(msgs), 0, "; ".join(msgs))
+
+
 def check(traj, exact=True, frames=None, paper=True):
     """Check a Trajectory's simulated frames (all, or the frame indices `frames`), and with
     `paper` its paper frames with invariants.check. Returns a DynamicReport."""
@@ -188,13 +333,7 @@ def check(traj, exact=True, frames=None, paper=True):
         rep.paper = invariants.check(_paper_view(traj))
     if not traj.is_dynamic:
         return rep
-    eps = tolerances.EPS[kind]
-    R, h, L = float(traj.params["head_radius"]), float(traj.params["hair_offset"]), traj.hair_length
-    E = tolerances.extent(R, h, L)
-    rc = traj.collide_radius
-    ell = traj.segment_rest()
-    pen_allow = tolerances.DYN_PENETRATION_K * eps * rc
-    rest_roots = np.ascontiguousarray(traj.rest[:, 0, :])
+    checks = _FrameChecks(traj, rep, exact, kind)
     obs = traj.observables.set_index("step")
     sim = traj.simulated if frames is None else [f for f in frames if traj.stages[f] == "simulate"]
 
@@ -210,136 +349,16 @@ def check(traj, exact=True, frames=None, paper=True):
                 f"the observables do not have one row per simulated step {traj.paper_frames} … {int(traj.step[-1])}",
             )
         )
-
-    def add(f, name, count, worst, message):
-        if count:
-            rep.violations.append(
-                Violation(
-                    f,
-                    "simulate",
-                    name,
-                    int(count),
-                    float(worst),
-                    f"frame {f} (simulate, step {int(traj.step[f])}): {message}",
-                )
-            )
-
-    def bound(f, name, values, k, worst_field, message, nan_over=True):
-        """Values (in units of ε·scale) over k, NaN included with nan_over: `name`'s violation,
-        `message` formatted with n (how many), k and worst; rep.<worst_field> the largest seen."""
-        worst = float(np.nanmax(values)) if values.size else 0.0
-        setattr(rep, worst_field, max(getattr(rep, worst_field), worst))
-        over = ~(values <= k) if nan_over else values > k
-        add(f, name, over.sum(), worst, message.format(n=int(over.sum()), k=k, worst=worst))
-
     for f in sim:
         x = traj.frame(f)
         step = int(traj.step[f])
         v = traj.velocity_at_step(step)
         nonfinite = int((~np.isfinite(x)).sum()) + (0 if v is None else int((~np.isfinite(v)).sum()))
-        add(f, "finite", nonfinite, 1, f"{nonfinite} coordinate(s) of positions or velocities are NaN or Inf")
-
-        want = expected_roots(traj, f, rest_roots)
-        got = np.ascontiguousarray(x[:, 0, :])
-        if exact:
-            bits = invariants._bits
-            moved = np.any(bits(got) != bits(want), axis=1)
-            if moved.any():
-                from harness.core.ulp import ulp_distance
-
-                rep.worst_root = max(rep.worst_root, float(ulp_distance(got, want, got.dtype).max()))
-            add(
-                f,
-                "roots",
-                moved.sum(),
-                rep.worst_root,
-                f"{int(moved.sum())} root(s) not bit-identical to Q(t)·X̄0 (worst {rep.worst_root:g} ULP)",
-            )
-        else:
-            R = float(traj.params["head_radius"])
-            with np.errstate(invalid="ignore"):
-                d = np.max(np.abs(got.astype(np.float64) - want.astype(np.float64)), axis=1) / (eps * R)
-            bound(
-                f,
-                "roots",
-                d,
-                tolerances.DYN_ROOT_K,
-                "worst_root",
-                "{n} root(s) farther than {k:g}·ε·R from Q(t)·X̄0 (worst {worst:.3g}·ε·R)",
-            )
-
-        xd = x.astype(np.float64)
-        with np.errstate(invalid="ignore", over="ignore"):
-            r = np.sqrt((xd[:, :, 0] * xd[:, :, 0] + xd[:, :, 1] * xd[:, :, 1]) + xd[:, :, 2] * xd[:, :, 2])
-            # with §3.17's colliders a later collider may push a point back into the head, and a
-            # bounded depenetration leaves it inside on purpose: the bound holds without them
-            bounded = int(traj.dynamic_params.get("depenetration_declared", 0))
-            if traj.collider and not traj.colliders and not bounded:
-                bound(
-                    f,
-                    "collider",
-                    (rc - r[:, 1:]) / (eps * rc),
-                    tolerances.DYN_PENETRATION_K,
-                    "worst_penetration_k",
-                    f"{{n}} point(s) inside the collider R_c = {rc:g} by more than {{k:g}}·ε·R_c "
-                    "(worst {worst:.3g}·ε·R_c)",
-                    nan_over=False,
-                )
-            held = _strands_holding_rest(traj)
-            if held is not None:
-                seg = np.sqrt(np.sum(np.diff(xd, axis=1) ** 2, axis=2))
-                err = np.abs(seg - ell) / (eps * E)
-                free = np.ones_like(err, dtype=bool)
-                # §3.17: friction moves a point in contact along the surface, which lifts it off a
-                # curved one: with friction a point within a segment's length of a surface counts as moved
-                near = pen_allow
-                if int(traj.dynamic_params.get("friction_declared", 0)) or any(c.mu_s > 0 for c in traj.colliders):
-                    near = float(np.max(ell)) if np.ndim(ell) else float(ell)
-                if traj.collider:
-                    free = r[:, 1:] > rc + near  # the collider did not move point k
-                if traj.colliders:  # nor any other collider
-                    d = collider_depths(traj, xd[:, 1:, :], frame_end_time(traj, f))
-                    free &= ~np.any(np.nan_to_num(d, nan=-np.inf) > -near, axis=0).reshape(free.shape)
-                err = np.where(free, err, 0.0)[held]
-                bound(
-                    f,
-                    "ftl_segments" if traj.solver == "ftl" else "follower_segments",
-                    err,
-                    tolerances.DYN_FTL_SEGMENT_K,
-                    "worst_ftl_segment_k",
-                    "{n} segment(s) not moved by the collider differ from ℓ by more than {k:g}·ε·E "
-                    "(worst {worst:.3g}·ε·E)",
-                )
-
+        checks.add(f, "finite", nonfinite, 1, f"{nonfinite} coordinate(s) of positions or velocities are NaN or Inf")
+        checks.roots(f, x)
+        checks.geometry(f, x)
         if step not in obs.index:
-            add(f, "observables", 1, 0, "no observables row for this step")
+            checks.add(f, "observables", 1, 0, "no observables row for this step")
             continue
-        row = obs.loc[step]
-        stretch, pen, ke, blown = observe(traj, x, v, frame_end_time(traj, f))
-        msgs = []
-        # the reference computes both exactly as observe() does; another build may contract
-        # or reorder the double sums: DYN_OBSERVABLE_K·ε64 of the quantity's scale
-        e64 = tolerances.EPS["fp64"]
-        s_file, p_file = float(row["stretch_max"]), float(row["penetration_max"])
-        ds, dp = abs(stretch - s_file), abs(pen - p_file)
-        rep.worst_observable_k = max(rep.worst_observable_k, ds / (e64 * (1 + abs(stretch))), dp / (e64 * rc))
-        if not (stretch == s_file if exact else ds <= tolerances.DYN_OBSERVABLE_K * e64 * (1 + abs(stretch))):
-            msgs.append(f"stretch_max {s_file:.17g} but the positions give {stretch:.17g}")
-        if not (pen == p_file if exact else dp <= tolerances.DYN_OBSERVABLE_K * e64 * rc):
-            msgs.append(f"penetration_max {p_file:.17g} but the positions give {pen:.17g}")
-        if ke is not None:
-            k = float(row["kinetic_energy"])
-            rel = abs(ke - k) / max(abs(ke), np.finfo(float).tiny) if math.isfinite(ke) else float("nan")
-            if math.isfinite(rel):
-                rep.worst_kinetic_rel = max(rep.worst_kinetic_rel, rel)
-            if math.isfinite(ke) and not rel <= tolerances.DYN_KINETIC_REL:
-                msgs.append(f"kinetic_energy {k:.17g} but the velocities give {ke:.17g}")
-        stored = int(row["blown_up_strands"])
-        if (v is not None and blown != stored) or (v is None and blown > stored):
-            msgs.append(
-                f"blown_up_strands {stored} but positions{' and velocities' if v is not None else ''} give {blown}"
-            )
-        if bool(row["blown_up"]) != (stored > 0):
-            msgs.append(f"blown_up {bool(row['blown_up'])} disagrees with blown_up_strands {stored}")
-        add(f, "observables", len(msgs), 0, "; ".join(msgs))
+        checks.observables(f, x, v, obs.loc[step])
     return rep

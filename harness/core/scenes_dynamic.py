@@ -56,6 +56,8 @@ keys in a scene whose model is not "dynamic" are refused too.
 import math
 import os
 
+from harness.core.limits import limits
+
 DEFAULT_STAGES = ("init", "collide", "simulate")
 SOLVERS = ("xpbd", "ftl", "rigid")  # rigid: no dynamics (docs/model.md §3.13)
 MOTIONS = ("still", "nod", "shake", "tilt", "track")  # track: --motion-track FILE
@@ -114,7 +116,6 @@ SHARED = {
         "motion_track": ("--motion-track", "path"),
     },
 }
-MAX_COUNT = 10**6  # the binaries' bound on S and I (docs/model.md §3)
 
 
 def _value(where, key, kind, value, error):
@@ -162,8 +163,10 @@ def _value(where, key, kind, value, error):
     if kind == "count":
         if not isinstance(value, int) or value < 1:
             raise error(f"{where}: {key} must be a whole number ≥ 1, got {value!r}")
-        if key.endswith(("substeps", "iterations")) and value > MAX_COUNT:
-            raise error(f"{where}: {key} must be at most {MAX_COUNT}, got {value}")
+        if key.endswith(("substeps", "iterations")) and (why := limits().count_error(key.rpartition(".")[2], value)):
+            raise error(f"{where}: {key} {why}")
+        if key == "grid.nodes" and not limits().grid_n[0] <= value <= limits().grid_n[1]:
+            raise error(f"{where}: {key} must lie in {limits().grid_n[0]} … {limits().grid_n[1]}, got {value}")
         return value
     x = float(value)
     if kind == "count" or kind == "real":
@@ -208,8 +211,6 @@ def split(data, where, error):
         paper[key] = value
     if not dynamic:
         return paper, None
-    if "--grid" in flags and not 2 <= flags["--grid"] <= 512:
-        raise error(f"{where}: grid.nodes must be from 2 to 512, got {flags['--grid']!r}")
     if any(f.startswith("--grid-") for f in flags) and "--grid" not in flags:
         raise error(f"{where}: the [grid] table needs grid.nodes (the grid is off without it)")
     track = flags.get("--head-motion") == "track"
@@ -221,8 +222,8 @@ def split(data, where, error):
         raise error(f"{where}: constraints.shape_range needs constraints.shape_compliance (shape is off without it)")
     if "--frame-dt" in flags or "--substeps" in flags:
         h = float(flags.get("--frame-dt", 1 / 60)) / int(flags.get("--substeps", 1))
-        if not 1e-12 <= h <= 1e3:
-            raise error(f"{where}: dynamics.frame_dt / dynamics.substeps = {h:g} s is outside [1e-12, 1e3] s")
+        if why := limits().substep_error(h):
+            raise error(f"{where}: dynamics.frame_dt / dynamics.substeps: {why}")
     return paper, flags
 
 

@@ -276,7 +276,7 @@ DYN_SAGFREE_STILL_MAX_L = 1e-3
 DYN_SAG_PLAIN_MIN_L = 3e-3
 # Simulated-point LOD (docs/model.md §3.14): the spline through simulated points on a straight
 # line stays on it to rounding: over 200 random lines per precision (50 strands each, 2–32
-# points unevenly spaced, m = 2–5 rendered points a segment; harness/check/lod.py, the same
+# points unevenly spaced, m = 2–5 rendered points a segment; harness/check/lod_dynamic.py, the same
 # operations as the binaries) the farthest rendered point lies 17.7·ε (fp32) and 15.2·ε (fp64)
 # of the strand's length off the line through its ends, the rounding of the simulated points
 # themselves included; 64 is a 3.6× margin.
@@ -357,7 +357,7 @@ DYN_FP32_VS_FP64_REL_L = 1e-5
 # (the issue's rule, not a measurement; the convergence table of report/dynamic_accuracy.md
 # shows it rung by rung, for the max measure too).
 DYN_ACC_REF_FACTOR = 0.1
-# The world study (harness/studies/accuracy_world.py): a grid or collider variant counts as
+# The world study (harness/studies/accuracy_world_dynamic.py): a grid or collider variant counts as
 # "close" to the best of its group when its RMS error against its own converged reference is at
 # most WORLD_ACC_ERROR_FACTOR times the group's smallest; the verdict names the cheapest close
 # one. A judgement, not a measurement: the quick study's grid errors span about 1.1× between its
@@ -388,7 +388,7 @@ DYN_ACC_USES = {
     "games": (1e-2, 0.02, "real-time, stretch must not show"),
     "offline": (2e-3, 0.005, "film quality, close to the converged motion"),
 }
-# What each use tolerates of the long runs' observables (harness/studies/observables_long.py),
+# What each use tolerates of the long runs' observables (harness/studies/observables_long_dynamic.py),
 # this project's statements like the budgets above: the swing's frequency off by at most this
 # share (a quarter is a visibly different hair length in a preview; 10 % players do not read
 # as wrong; 3 % an animator matching reference footage would not notice), the mean kinetic
@@ -412,7 +412,7 @@ DYN_ACC_USES_LONG = {
     "offline": dict(freq_rel=0.03, damping_rel=0.10, kinetic_factor=1.15, jitter_px=0.1, lines=2160),
 }
 # What each use allows beyond the reference ensemble's own spread in the metrics that survive
-# chaos (harness/check/ensemble.py), this project's statements like the budgets above: the tip's
+# chaos (harness/check/ensemble_dynamic.py), this project's statements like the budgets above: the tip's
 # distribution shifted by the use's RMS budget (the same displacement the pointwise budget
 # tolerates, now of the statistics), the silhouette's area off by a share of it (a tenth is a
 # visibly fuller head of hair in a preview, 5 % in a game, 2 % offline) and the curvature
@@ -433,7 +433,7 @@ DYN_ENSEMBLE_WINDOW_S = 0.25
 DYN_ACC_VIEW_CM = 40.0  # scene height across the picture (L = 30 cm of hair below a head)
 
 
-# PREDICTABILITY (harness/check/predictability.py, harness/studies/predictability.py). A twin
+# PREDICTABILITY (harness/check/predictability_dynamic.py, harness/studies/predictability_dynamic.py). A twin
 # run's one frame is perturbed by DYN_LYAPUNOV_PERTURBATION_L (RMS over the points, ·L): far
 # above fp64's rounding of a coordinate (2.2e-16 × 40 cm ≈ 9e-15 cm, 3e-16·L) and far below any
 # error a study ranks, so its growth is the model's own. The rate λ is fitted to ln(separation)
@@ -452,7 +452,7 @@ DYN_LYAPUNOV_TWINS = 3  # perturbed twins a scene (their log separations average
 # takes to grow to the games budget of the dynamic accuracy study (DYN_ACC_USES, 1e-2·L) at the
 # rate λ: ln(1e-2/2⁻²⁴)/λ = 12.0/λ. Beyond it two runs that differ in rounding alone differ by
 # more than a game tolerates, so a pointwise error no longer ranks modes: the studies judge
-# pointwise errors only up to it and compare statistics (harness/check/ensemble.py) beyond.
+# pointwise errors only up to it and compare statistics (harness/check/ensemble_dynamic.py) beyond.
 DYN_PREDICT_SEED_L = 2.0**-24
 DYN_PREDICT_TOLERANCE_L = DYN_ACC_USES["games"][0]
 
@@ -465,7 +465,7 @@ def jitter_budget_cm(use: str) -> float:
 
 # ---------------------------------------------------------------------------------------
 # ANALYTIC CHECKS of the dynamic model (docs/model.md §4; tests/cpu/test_analytic.py; the full
-# S sweeps in docs/analytic.md, made by `python -m harness.studies.analytic_table`). Measured on the
+# S sweeps in docs/analytic.md, made by `python -m harness.studies.analytic_table_dynamic`). Measured on the
 # C reference, fp64, --threads 1, Δt = 1/60 s, g0 = 981 cm/s², --iterations 1, at commit
 # 87dab6c's model (dynamics_impl.h). Relative errors are |measured − expected|/expected.
 #
@@ -493,7 +493,7 @@ ANALYTIC_FTL_XPBD_P2_REL = 1e-11  # |T_ftl − T_xpbd|/T at P = 2 (measured ≤ 
 ANALYTIC_WIND_ANGLE_ABS = 2e-12  # rad (9× the worst measured at S ≤ 8)
 # Hanging chain (§4.3): L = 30 cm, rigid links, no bend, displaced by 0.3 cm × the continuum
 # first mode; ω from the zero crossings of the first-mode coordinate over 4 periods, against
-# the linearised discrete chain's ω1 (harness.studies.analytic.discrete_chain_omega1). ftl runs with
+# the linearised discrete chain's ω1 (harness.studies.analytic_dynamic.discrete_chain_omega1). ftl runs with
 # --ftl-damping 1: with the default s = 0.9 it converges (in S) to a different frequency,
 # 13% (P = 32) and 33% (P = 64) above the chain's (docs/analytic.md).
 #   xpbd      P = 32: S = 64, 256 → 6.0e-4, 4.2e-5;  P = 64: 2.4e-3, 1.6e-4
@@ -547,7 +547,7 @@ ANALYTIC_FP32_WIND_ANGLE_ABS = 5e-4  # rad at S ≤ 8 (worst 8.7e-5; below the 3
 # 1.3e-6 (normal fp32), 8.6e-7 (fast-math fp32), 3.4e-15 (normal fp64), h·|Δv|/L 7.3e-7
 # (fp32), 1.3e-15 (fp64): margins of 15 and 11, the smallest seen.
 GPU_DYN_STRICT_EXACT_WITHOUT_GUSTS = True
-# ---- beside a peer: Bender's PositionBasedDynamics (pypbd) on chains (harness/studies/peer.py,
+# ---- beside a peer: Bender's PositionBasedDynamics (pypbd) on chains (harness/studies/peer_dynamic.py,
 # tests/cpu/test_peer.py; the mapping and the differences in docs/decisions.md, "The peer") ----
 # The converged reference of `harness peer`: S doubles until the largest change of a point
 # from S to 2S is below this fraction of the smallest error the comparison reports.
@@ -573,7 +573,7 @@ PEER_PERIOD_REL = 1e-11  # |T_peer − T_ours|/T (worst measured 1.3e-12; margin
 PEER_RIGID_STRETCH_S256 = 2e-3  # both solvers at S = 256 (measured 1.17e-3; margin 1.7×)
 
 
-# ---- verdicts of the dynamic stability map (harness/studies/stability.py, docs/decisions.md
+# ---- verdicts of the dynamic stability map (harness/studies/stability_dynamic.py, docs/decisions.md
 # "Stability map of the dynamic model") ------------------------------------------------------
 # These are not rounding tolerances but the lines a cell of the map is judged by; they live
 # here because every number that judges a result does. Each is taken over every frame of
@@ -598,7 +598,7 @@ STABILITY_PENETRATION_REL = 1e-3
 
 
 # ---------------------------------------------------------------------------------------
-# OBSERVABLES of the accuracy study (harness/check/observables.py) on runs with known answers
+# OBSERVABLES of the accuracy study (harness/check/observables_dynamic.py) on runs with known answers
 # (tests/cpu/test_observables_runs.py). Measured on the C reference, fp64, --threads 1,
 # Δt = 1/60 s, g0 = 981 cm/s², xpbd, pendulum P = 2, ℓ = 30 cm, θ0 = 0.05, 400 frames.
 # Tip frequency (spectral peak, Hann window, 16× zero padding, parabola through the log
@@ -621,7 +621,7 @@ OBS_RIGID_ROTATION_ABS_L = 1e-13
 # S = 4, 30 frames, fp64): rigid does not move a bit; xpbd and ftl move points by at most
 # 4.6e-14 and 3.6e-14 cm from frame to frame (the init shape's segments differ from ℓ by rounding).
 OBS_REST_MOVE_ABS_L = 1e-14  # of L = 30 cm: 3e-13 cm (measured 4.6e-14 cm; margin 6.5×)
-# The swing (harness.check.observables.swing) of a hanging chain, P = 32, L = 30 cm, displaced
+# The swing (harness.check.observables_dynamic.swing) of a hanging chain, P = 32, L = 30 cm, displaced
 # 0.3 cm along the continuum first mode, xpbd fp64 S = 256, 300 frames (5.5 periods), against the
 # linearised discrete chain's ω1/2π: −1.33e-4 relative (the scheme's 4e-5, tolerances above,
 # plus the spectral estimate's floor over 5.5 periods).

@@ -141,20 +141,29 @@ def simulating(backend, build="default"):
     raise HarnessError(f"{binary_path(backend, build)} declares no variant that simulates any point count")
 
 
-@lru_cache(maxsize=None)
-def _read(path):
+def ask(path, flag):
+    """The JSON object a binary prints for `flag` (--list-variants, --limits); HarnessError in one
+    line when it cannot run, fails or prints no JSON."""
     from harness.core import runner
 
     try:
-        p = runner.run_command([path, "--list-variants"], timeout=60)
+        p = runner.run_command([path, flag], timeout=60)
     except OSError as e:
         raise HarnessError(f"{path}: cannot run: {e.strerror}") from None
     except runner.TimedOut:
-        raise HarnessError(f"{path} --list-variants did not finish in 60 s") from None
+        raise HarnessError(f"{path} {flag} did not finish in 60 s") from None
     if p.returncode != 0:
-        raise HarnessError(f"{path} --list-variants exited {p.returncode}: {p.stderr.strip()}")
+        raise HarnessError(f"{path} {flag} exited {p.returncode}: {p.stderr.strip()}")
     try:
-        d = json.loads(p.stdout)
+        return json.loads(p.stdout)
+    except ValueError:
+        raise HarnessError(f"{path} {flag} did not print the documented JSON object") from None
+
+
+@lru_cache(maxsize=None)
+def _read(path):
+    d = ask(path, "--list-variants")
+    try:
         variants = [v for v in d["variants"] if isinstance(v, dict) and "name" in v]
         names = tuple(str(v["name"]) for v in variants)
         return Declared(

@@ -93,7 +93,7 @@ def minimum_jerk(fraction):
     return u**3 * (10 - 15 * u + 6 * u * u)
 
 
-# The stability map's recorded fast motion (harness/studies/stability_slices.py): a head turn
+# The stability map's recorded fast motion (harness/studies/stability_slices_dynamic.py): a head turn
 # about ŷ (shake's axis) to FAST_TURN_ANGLE and back, each way a minimum-jerk move of
 # FAST_TURN_MOVE_S seconds, held FAST_TURN_HOLD_S between, sampled every FAST_TURN_DT. The move
 # time gives a peak speed of 1.875·angle/time = 780 °/s, the group median of the largest head

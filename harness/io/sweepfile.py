@@ -41,6 +41,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from harness import HarnessError
+from harness.core.limits import limits
 from harness.core.paths import CUDA_BUILDS, SWEEPS, config_file, read_toml
 from harness.core.scenes import PRECISIONS, is_scene_file, load_scene, with_frames
 from harness.core.scenes_dynamic import SOLVERS
@@ -159,8 +160,8 @@ def _check_axis(where, label, values, backend):
             low = {"strands": 1, "points": 2, "block_size": 1}[key]
             if isinstance(v, bool) or not isinstance(v, int) or v < low:
                 raise SweepError(f"{where}: {label} values must be whole numbers ≥ {low}, got {v!r}")
-            if key == "block_size" and not (32 <= v <= 1024 and v % 32 == 0):
-                raise SweepError(f"{where}: {label} {v} is not a multiple of 32 in 32…1024")
+            if key == "block_size" and (why := limits().block_size_error(v)):
+                raise SweepError(f"{where}: {label} {why}")
         elif key == "precision" and v not in PRECISIONS:
             raise SweepError(f"{where}: {label} '{v}' is not fp32 or fp64")
         elif key == "threads" and not (v == "all" or (isinstance(v, int) and not isinstance(v, bool) and v >= 1)):

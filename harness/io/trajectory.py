@@ -339,7 +339,7 @@ class SimulatedView(Trajectory):
     """A --render-points file seen through its simulated rows only (docs/model.md §3.14): P_s
     points a strand, as the run simulated them, its rest shape and velocities likewise, no
     render_points. What the paper model's and the dynamic model's checks apply to; the rendered
-    rows are checked by recomputation (harness/check/lod.py)."""
+    rows are checked by recomputation (harness/check/lod_dynamic.py)."""
 
     rows_of: np.ndarray = None
     rendered_points: int = 0

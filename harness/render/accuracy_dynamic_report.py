@@ -10,7 +10,6 @@ each other.
 """
 
 import json
-import math
 from dataclasses import astuple, dataclass
 from pathlib import Path
 
@@ -20,8 +19,8 @@ from harness import HarnessError
 from harness.core import timing, tolerances
 from harness.core.paths import REPORT, RESULTS, display
 from harness.io import files, tables
-from harness.render import accuracy_chaos_report as chaos
-from harness.render.accuracy_chaos_report import jitter_budget_lines, load_ensemble, load_long
+from harness.render import accuracy_chaos_dynamic_report as chaos
+from harness.render.accuracy_chaos_dynamic_report import jitter_budget_lines, load_ensemble, load_long
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     CSV_NAME,
@@ -30,11 +29,19 @@ from harness.studies.accuracy import (
     NO_SIMULATION,
     REQUIRED_COLUMNS,
     RESULTS_NAME,
-    holds_until,
     results_name,
     scene_tag,
-    scheme_name,
-    smallest,
+)
+from harness.studies.accuracy_rows_dynamic import (
+    baseline,
+    better,
+    convergence_table,
+    front_of,
+    label,
+    oracle,
+    small_steps,
+    summary,
+    worst_verdict,
 )
 
 PAGE = "dynamic_accuracy.md"
@@ -42,7 +49,6 @@ PARETO_PNG = "dynamic_accuracy_pareto.png"
 GROWTH_PNG = "dynamic_accuracy_growth.png"
 STEPS_PNG = "dynamic_accuracy_steps.png"
 DEFAULT_TITLE = "the dynamic model"
-KEYS = ("backend", "build", "variant", "solver", "ftl_damping", "substeps", "iterations", "precision")
 
 
 @dataclass(frozen=True)
@@ -106,52 +112,6 @@ def load(results_dir, csv_path=None):
 # ---- what the rows say ----------------------------------------------------------------
 
 
-def summary(rows, horizon_frames):
-    """One row per mode: worst RMS and max error, stretch and penetration over the frames up
-    to the horizon; blown = strands blown up in any frame of the run; time per frame."""
-    m = rows[rows["study"] == "mode"]
-    inside = m[m["frame"] <= horizon_frames]
-    g = inside.groupby("mode", sort=False)
-    out = g[list(KEYS) + ["time_per_frame_ms", "time_strands", "device"]].first()
-    # honest timings (core/timing.py): the time's spread and why it is noise; a table measured
-    # before them has neither (its times then decide as before, without a noise flag)
-    first = g.first()
-    out["time_rsd"] = first["time_rsd"].astype(float) if "time_rsd" in first else np.nan
-    out["time_noisy"] = [x if isinstance(x, str) else "" for x in first["time_noisy"]] if "time_noisy" in first else ""
-    out["scheme"] = [scheme_name(s, d) for s, d in zip(out["solver"], out["ftl_damping"])]
-    out["rms"] = g["rms_err_L"].apply(lambda s: s.max(skipna=False))
-    out["max"] = g["max_err_L"].apply(lambda s: s.max(skipna=False))
-    out["p99"] = g["err_p99_L"].apply(lambda s: s.max(skipna=False))
-    out["stretch"] = g["stretch_max"].max()
-    out["stretch_p99"] = g["stretch_p99"].max()
-    out["iou"] = g[["iou_front", "iou_side"]].min().min(axis=1)
-    out["penetration"] = g["penetration_max"].max()
-    out["blown"] = m.groupby("mode", sort=False)["blown_up_strands"].max()
-    verdicts = m.groupby("mode", sort=False)["verdict"]
-    out["verdict"] = verdicts.apply(_worst_verdict)
-    out["usable"] = (out["blown"] == 0) & np.isfinite(out["rms"])
-    return out.reset_index()
-
-
-def _worst_verdict(s):
-    """diverged before escaped before ok, over a mode's frames ("blown up": a table written
-    before the split by cause)."""
-    v = set(s.dropna().astype(str))
-    for worst in ("diverged", "escaped", "blown up"):
-        if worst in v:
-            return worst
-    return "ok"
-
-
-def baseline(summ):
-    """The no-simulation mode's row (the oracle build's fp64 if present, else any), or None."""
-    b = summ[summ["solver"] == NO_SIMULATION]
-    if b.empty:
-        return None
-    fp64 = b[b["precision"] == "fp64"]
-    return (fp64 if len(fp64) else b).iloc[0]
-
-
 def reference_error_line(study):
     """The reference's own error, measured (two more doublings and the estimated tail)."""
     e = study["reference"].get("error")
@@ -170,115 +130,12 @@ def reference_error_line(study):
     )
 
 
-def smallest_errors(rows):
-    """Per frame, the smallest RMS and max error of the modes never blown up (as the study
-    decided convergence): two Series indexed by frame."""
-    m = rows[rows["study"] == "mode"]
-    blown = m.groupby("mode")["blown_up_strands"].max()
-    ok = m[m["mode"].isin(blown[blown == 0].index)]
-    out = []
-    for col in ("rms_err_L", "max_err_L"):
-        wide = ok.pivot(index="frame", columns="mode", values=col)
-        out.append(
-            (wide.index.to_numpy(), smallest({c: wide[c].to_numpy() for c in wide.columns}))
-            if not wide.empty
-            else (np.array([]), np.array([]))
-        )
-    return out
-
-
-def convergence_table(rows, horizon_frames):
-    """Per reference rung S: the worst over the horizon of its difference to 2S and of that
-    difference over the smallest mode error at the same frame, both measures; and the last
-    time up to which the RMS rule holds over the whole run."""
-    ref = rows[rows["study"] == "reference"]
-    (frames, min_rms), (_, min_max) = smallest_errors(rows)
-    factor = tolerances.DYN_ACC_REF_FACTOR
-    table = []
-    for S, r in ref.groupby("substeps"):
-        r = r.set_index("frame").reindex(frames)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            q_rms = r["rms_err_L"].to_numpy() / min_rms
-            q_max = r["max_err_L"].to_numpy() / min_max
-        inside = frames <= horizon_frames
-        table.append(
-            dict(
-                S=int(S),
-                S2=int(r["ref_substeps"].dropna().iloc[0]),
-                rms=float(np.nanmax(r["rms_err_L"].to_numpy()[inside])),
-                q_rms=float(np.nanmax(q_rms[inside])),
-                max=float(np.nanmax(r["max_err_L"].to_numpy()[inside])),
-                q_max=float(np.nanmax(q_max[inside])),
-                holds=bool((q_rms[inside] < factor).all()),
-                max_holds=bool((q_max[inside] < factor).all()),
-                until=holds_until(q_rms < factor, r["time_s"].to_numpy()),
-                stretch=float(r["stretch_max"].to_numpy()[inside].max()),
-            )
-        )
-    return table
-
-
-def pareto_front(times, errors, tie=0.0):
-    """Boolean mask of the points no other point beats: sorted by time, a point is on the
-    front when its error is below (1 − tie) × the smallest error of every faster point (ties
-    in time go to the smaller error). With tie > 0, errors that differ only by rounding
-    (fp32 against fp64, one build against another) do not make a slower mode a front point.
-    NaN points are never on the front."""
-    t = np.asarray(times, dtype=np.float64)
-    e = np.asarray(errors, dtype=np.float64)
-    good = np.isfinite(t) & np.isfinite(e)
-    front = np.zeros(len(t), dtype=bool)
-    best = math.inf
-    for i in sorted(np.flatnonzero(good), key=lambda i: (t[i], e[i])):
-        if e[i] < best * (1.0 - tie):
-            front[i] = True
-            best = e[i]
-    return front
-
-
-def front_of(summ):
-    """The usable modes on the front (tolerances.DYN_ACC_FRONT_TIE), fastest first."""
-    ok = summ[summ["usable"]]
-    mask = pareto_front(ok["time_per_frame_ms"], ok["rms"], tolerances.DYN_ACC_FRONT_TIE)
-    return ok[mask].sort_values("time_per_frame_ms")
-
-
-def oracle(summ, study):
-    """The rows of the study's first cpu build (the C reference's default variant) in fp64."""
-    first = study["builds"][0] if study.get("builds") else None
-    label = summ.apply(_label, axis=1)
-    return summ[(label == first) & (summ["precision"] == "fp64")] if first else summ.iloc[0:0]
-
-
-def _label(r):
-    if r["backend"] == "cpu":
-        return f"cpu {r['variant']}"
-    return f"gpu {'normal' if r['build'] == 'default' else r['build']} {r['variant']}"
-
-
-def small_steps(summ, study):
-    """Per solver: for each n > 1 of the grid, S = n × I = 1 against S = 1 × I = n (oracle
-    build, fp64). {solver: [dict(n, steps=row, iters=row)]}."""
-    o = oracle(summ, study)
-    o = o[o["solver"] != NO_SIMULATION]
-    out = {}
-    for solver, s in o.groupby("scheme", sort=False):
-        pairs = []
-        for n in sorted(set(s["substeps"]) | set(s["iterations"])):
-            a = s[(s["substeps"] == n) & (s["iterations"] == 1)]
-            b = s[(s["substeps"] == 1) & (s["iterations"] == n)]
-            if n > 1 and len(a) and len(b):
-                pairs.append(dict(n=int(n), steps=a.iloc[0], iters=b.iloc[0]))
-        out[solver] = pairs
-    return out
-
-
 def small_steps_verdict(solver, pairs, ladder=None):
     """Sentences on what the pairs show, from their numbers; `ladder`: the solver's I = 1
     modes by S (the trend of the error with S alone)."""
     if not pairs:
         return [f"- {solver}: no pair S = n × I = 1 / S = 1 × I = n in this grid."]
-    wins = [p["n"] for p in pairs if _better(p["steps"], p["iters"])]
+    wins = [p["n"] for p in pairs if better(p["steps"], p["iters"])]
     losses = [p["n"] for p in pairs if p["n"] not in wins]
     blown_iters = [p["n"] for p in pairs if p["iters"]["blown"] > 0]
     blown_steps = [p["n"] for p in pairs if p["steps"]["blown"] > 0]
@@ -328,13 +185,6 @@ def small_steps_verdict(solver, pairs, ladder=None):
 
 def _list(ns):
     return ", ".join(str(n) for n in ns)
-
-
-def _better(a, b):
-    """Mode a beats mode b: b blown up and a not, or both usable and a's RMS error smaller."""
-    if a["blown"] == 0 and b["blown"] > 0:
-        return True
-    return bool(a["usable"] and b["usable"] and a["rms"] < b["rms"])
 
 
 def _passing(summ, use, longm, ensm):
@@ -434,7 +284,7 @@ def recommend(summ, long=None, ens=None, horizon=None):
                 f"{what}: **{best['mode']}** (solver {best['solver']}"
                 + (f", s = {best['ftl_damping']:g}" if best["solver"] == "ftl" else "")
                 + f", S = {int(best['substeps'])}, I = {int(best['iterations'])}, {best['precision']}, build "
-                f"{_label(best)}; {best['time_per_frame_ms']:.3g} ms per frame at {int(best['time_strands']):,} "
+                f"{label(best)}; {best['time_per_frame_ms']:.3g} ms per frame at {int(best['time_strands']):,} "
                 f"strands; RMS error {_e(best['rms'])}, stretch {_pct(best['stretch'])}{long_note}; "
                 + (
                     f"decided by {decided}, which rejected {failed[decided]} of the {len(faster)} faster modes"
@@ -577,7 +427,7 @@ def pareto_plot(summ, study, path):
     plt = _plt()
     ok = summ[summ["usable"]].reset_index(drop=True)
     fig, ax = plt.subplots(figsize=(8.5, 5.5))
-    labels = list(dict.fromkeys(ok.apply(_label, axis=1)))
+    labels = list(dict.fromkeys(ok.apply(label, axis=1)))
     solvers = list(dict.fromkeys(ok["scheme"]))
     colors = {lab: f"C{i % 10}" for i, lab in enumerate(labels)}
     markers = {s: "osD^v<>"[i % 7] for i, s in enumerate(solvers)}
@@ -587,7 +437,7 @@ def pareto_plot(summ, study, path):
             base["rms"], color="0.3", lw=0.9, ls="--", label=f"no simulation ({NO_SIMULATION}): {_e(base['rms'])}"
         )
     for _, r in ok.iterrows():
-        c = colors[_label(r)]
+        c = colors[label(r)]
         filled = r["precision"] == "fp64"
         ax.scatter(
             r["time_per_frame_ms"],
@@ -853,7 +703,7 @@ def noise_lines(summ):
 
 
 def _all_modes_lines(summ):
-    order = summ.assign(label=summ.apply(_label, axis=1)).sort_values(
+    order = summ.assign(label=summ.apply(label, axis=1)).sort_values(
         ["label", "scheme", "precision", "substeps", "iterations"]
     )
     return [
@@ -928,7 +778,7 @@ def markdown(rows, study, env, analytic, long=None, names=Names(), title=DEFAULT
     out += ["", reference_error_line(study), "", f"![small steps against iterations]({names.steps})", ""]
     shown = list(dict.fromkeys([*front["mode"], *recommended(summ, long, ens)]))
     out += chaos.chaos_lines(summ, ens, shown)
-    out += chaos.long_lines(long, _worst_verdict)
+    out += chaos.long_lines(long, worst_verdict)
     out += [
         "### Which settings for which use",
         "",
@@ -950,7 +800,7 @@ def markdown(rows, study, env, analytic, long=None, names=Names(), title=DEFAULT
             "### Analytic checks against S",
             "",
             "docs/model.md §4 against the C reference (fp64 unless a table says fp32, `--threads 1`, no collider; "
-            "`harness/studies/analytic_table.py`, run by this study):",
+            "`harness/studies/analytic_table_dynamic.py`, run by this study):",
             "",
             *[ln.replace("### ", "#### ", 1) if ln.startswith("### ") else ln for ln in analytic],
             "",

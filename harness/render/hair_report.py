@@ -162,7 +162,7 @@ WORLD_SIZE = (420, 520)
 def world_lines(record, folder, out_dir):
     """The grid's and the body's effect (docs/model.md §3.16, §3.17): the same last frame with
     and without them, and the hair's volume, envelope, close pairs, stretch and penetration."""
-    from harness.check.hair_volume import frame_volume
+    from harness.check.hair_volume_dynamic import frame_volume
 
     runs = record.get("world") or []
     if not runs:

@@ -21,18 +21,18 @@ from harness.io import (
 )
 from harness.render import (  # noqa: E402
     accuracy_dynamic_report,
-    accuracy_world_report,
     budget_report,
-    featurecost_report,
-    frame_budget,
     hair_report,
     host_report,
     judge_report,
-    peer_report,
-    reduced_report,
-    stability_report,
     steps_report,
 )
+from harness.render import accuracy_world_dynamic_report as accuracy_world_report  # noqa: E402
+from harness.render import featurecost_dynamic_report as featurecost_report  # noqa: E402
+from harness.render import frame_budget_dynamic as frame_budget  # noqa: E402
+from harness.render import peer_dynamic_report as peer_report  # noqa: E402
+from harness.render import reduced_dynamic_report as reduced_report  # noqa: E402
+from harness.render import stability_dynamic_report as stability_report  # noqa: E402
 from harness.render.headline_report import rounds_note  # noqa: E402
 from harness.studies.accuracy import (  # noqa: E402
     BODY_SCENE,

@@ -19,7 +19,7 @@ from harness.io.results_data import curve_of, interp_time, strands_at_time
 from harness.render import budget_report, hair_report, host_report
 from harness.render.accuracy_paper_report import report_from_csv
 from harness.render.headline_report import table
-from harness.render.plots import make_all
+from harness.render.plots_paper import make_all
 
 # The paper's Fig. 3 (release) and Fig. 4 (debug), milliseconds of "applying wind".
 PAPER = {

@@ -10,14 +10,9 @@ from pathlib import Path
 from harness.core import scenes
 from harness.core.paths import display
 from harness.io import files
-from harness.render import (
-    accuracy_dynamic_report,
-    budget_report,
-    frame_budget,
-    host_report,
-    report_dynamic,
-    stability_report,
-)
+from harness.render import accuracy_dynamic_report, budget_report, host_report, report_dynamic
+from harness.render import frame_budget_dynamic as frame_budget
+from harness.render import stability_dynamic_report as stability_report
 from harness.studies.accuracy import results_name
 
 PAGE = "scene.md"

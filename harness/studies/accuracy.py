@@ -113,7 +113,7 @@ def frame_errors(x, ref, L):
 # ---- the dynamic study's results (results/dynamic-accuracy/), as the renderer reads them ----
 
 RESULTS_NAME = "dynamic-accuracy"
-# the world study's (studies/accuracy_world.py): its folder, its CSV, and the scene whose grid and
+# the world study's (studies/accuracy_world_dynamic.py): its folder, its CSV, and the scene whose grid and
 # body it and the dynamic sweep's body groups take (configs/scenes/body.toml)
 WORLD_RESULTS_NAME = "accuracy-world"
 WORLD_CSV_NAME = "world.csv"
@@ -135,7 +135,7 @@ def results_name(scene):
 
 
 CSV_NAME = "dynamic_accuracy.csv"
-# the frame budget's throughput curves of the study's modes (studies/budget_curves.py)
+# the frame budget's throughput curves of the study's modes (studies/budget_curves_dynamic.py)
 CURVES_NAME = "budget-curves"
 CURVES_CSV = "curves.csv"
 

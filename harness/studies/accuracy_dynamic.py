@@ -12,7 +12,7 @@ converged reference:
   rms_err_L, max_err_L   RMS and max over all points of |x − x_ref|, over the hair length L
   err_p50/p95/p99_L, iou_front, iou_side   error percentiles, silhouette overlap
   stretch_max, penetration_max, blown_up_strands   the mode's own observables (§3.8)
-  stretch_p99, kinetic, potential, verdict   (harness/check/observables.py)
+  stretch_p99, kinetic, potential, verdict   (harness/check/observables_dynamic.py)
 
 The reference is xpbd, fp64, I = 1, with S doubled from `ref_start` until, at every frame
 up to the horizon, the RMS difference between S and 2S is under
@@ -27,8 +27,8 @@ margin (tolerances.DYN_ACC_GPU_REF_SHARE); otherwise the CPU ladder is used.
 After the ladder, `ref_extra` more doublings measure the reference's own error
 (Study.reference_error); perturbed twins of the converged rung give the scene's Lyapunov rate
 and predictability time T_p, and pointwise errors are judged only up to min(horizon, T_p)
-(Study.predictability, studies/accuracy_ensemble.py); every mode's statistics over the whole run
-go against the reference ensemble (ensemble.csv); and the long runs (studies/observables_long.py,
+(Study.predictability, studies/accuracy_ensemble_dynamic.py); every mode's statistics over the whole run
+go against the reference ensemble (ensemble.csv); and the long runs (studies/observables_long_dynamic.py,
 observables.csv) measure what a user sees over `long_seconds`.
 
 Time per frame is measured apart from the checked run: the same mode at `time_strands`
@@ -36,7 +36,7 @@ strands, `time_frames` frames, `--repeat`, no output file (never a run that also
 it is the simulate stage's median.
 
 Writes results/dynamic-accuracy/dynamic_accuracy.csv (one row per mode and frame, plus the
-reference ladder and the GPU check), analytic.md (harness/studies/analytic_table.py's tables) and
+reference ladder and the GPU check), analytic.md (harness/studies/analytic_table_dynamic.py's tables) and
 env.json; then accuracy_dynamic_report.py writes report/dynamic_accuracy.md and its PNGs. On
 another scene (`--scene curly`) the folder is results/dynamic-accuracy-curly/ and the page
 report/dynamic_accuracy_curly.md.
@@ -53,13 +53,16 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.check import observables
-from harness.core import env, rounds, runner, scenes, scenes_dynamic, timing, tolerances, variants
+from harness.check import observables_dynamic as observables
+from harness.core import env, rounds, runner, scenes, timing, tolerances, variants
+from harness.core.limits import limits
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files, grooms
 from harness.io.trajectory import open_trajectory
-from harness.studies import accuracy_ensemble, observables_long, predictability
+from harness.studies import accuracy_ensemble_dynamic as accuracy_ensemble
+from harness.studies import observables_long_dynamic as observables_long
+from harness.studies import predictability_dynamic as predictability
 from harness.studies.accuracy import (
     ANALYTIC_NAME,
     COLUMNS,
@@ -146,14 +149,13 @@ def check_plan(plan, frame_dt):
     if not plan.substeps or not plan.iterations:
         bad.append("--substeps and --iterations need at least one value each")
     for flag, vals in (("--substeps", plan.substeps), ("--iterations", plan.iterations)):
-        if any(v < 1 or v > scenes_dynamic.MAX_COUNT for v in vals):
-            bad.append(f"{flag} values must lie in 1 … {scenes_dynamic.MAX_COUNT}")
+        bad += sorted({f"{flag} values {why}" for v in vals if (why := limits().count_error(flag[2:], v))})
     if plan.substeps and plan.first_rung <= max(plan.substeps):
         bad.append(f"--ref-start {plan.first_rung} must exceed the largest --substeps ({max(plan.substeps)})")
     if plan.ref_max < 2 * plan.first_rung:
         bad.append(f"--ref-max {plan.ref_max} must be at least twice --ref-start ({plan.first_rung})")
-    elif not frame_dt / plan.ref_max >= 1e-12:
-        bad.append(f"--ref-max {plan.ref_max} makes the substep {frame_dt / plan.ref_max:g} s, below 1e-12 s")
+    elif why := limits().substep_error(frame_dt / plan.ref_max):
+        bad.append(f"--ref-max {plan.ref_max}: {why}")
     if plan.analytic not in ("full", "quick", "none"):
         bad.append(f"--analytic must be full, quick or none (got '{plan.analytic}')")
     if not plan.ftl_damping or any(not 0.0 <= s <= 1.0 for s in plan.ftl_damping):
@@ -635,7 +637,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             futures = {}
             if plan.analytic != "none":
-                from harness.studies import analytic_table
+                from harness.studies import analytic_table_dynamic as analytic_table
 
                 futures[pool.submit(analytic_table.tables, str(cpu_oracle.binary), plan.analytic == "quick")] = None
             units = [[m] for m in modes if m.runner.backend == "cpu"]  # a process each, the pool's jobs in parallel
@@ -693,7 +695,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         ref_err = study.reference_error(ref)
         ens = study.predictability(ref, ref_err)
 
-        # the long runs: what a user sees over seconds (studies/observables_long.py)
+        # the long runs: what a user sees over seconds (studies/observables_long_dynamic.py)
         long_rows = []
         if plan.long_seconds > 0:
             oracle_modes = [m for m in modes if m.runner == builds[0]]

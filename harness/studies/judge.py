@@ -17,7 +17,7 @@ Simulated-point LOD files (--render-points) are not resumable, so stepdiff canno
 LOD scene (LOD_SCENES) is judged by (a) stepdiff of the same run without LOD (the simulation), (b)
 the LOD run's simulated rows against that run, bit for bit (rendering changes nothing the
 simulation does), and (c) its rendered rows recomputed from its simulated rows
-(harness/check/lod.py: bit for bit for the reference build, within DYN_LOD_KERNEL_K·ε·E for the
+(harness/check/lod_dynamic.py: bit for bit for the reference build, within DYN_LOD_KERNEL_K·ε·E for the
 others); the LOD plant (PLANTS, model "lod") must fail (c).
 
 Writes <out>/judge.csv (one row per compared frame) and <out>/judge.json (the counts, what
@@ -35,7 +35,8 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.check import diff, diff_dynamic, invariants_dynamic, lod
+from harness.check import diff, diff_dynamic, invariants_dynamic
+from harness.check import lod_dynamic as lod
 from harness.core import env, runner, scenes, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, build_dir, display
 from harness.core.progress import Progress

@@ -1,10 +1,10 @@
 """Analytic checks of the dynamic model (docs/model.md §4) on the C reference, fp64.
 
-Hand-made input states (harness/studies/analytic_runs.py) run through
+Hand-made input states (harness/studies/analytic_runs_dynamic.py) run through
 `hairsim-cpu --input IN --stages simulate --no-collider …`; the closed forms and the
-measurements are in harness/studies/analytic.py, the tolerances (with the measurements behind
+measurements are in harness/studies/analytic_dynamic.py, the tolerances (with the measurements behind
 them) in harness/core/tolerances.py (ANALYTIC_*). Only 2–3 substep counts S per check run here;
-the full sweeps are in docs/analytic.md (`python -m harness.studies.analytic_table`).
+the full sweeps are in docs/analytic.md (`python -m harness.studies.analytic_table_dynamic`).
 """
 
 import math
@@ -12,10 +12,10 @@ import math
 import numpy as np
 import pytest
 
-from harness.check import observables as ob
+from harness.check import observables_dynamic as ob
 from harness.core import tolerances as tol
-from harness.studies import analytic as an
-from harness.studies.analytic_runs import G0, run_chain, run_pendulum, run_wind
+from harness.studies import analytic_dynamic as an
+from harness.studies.analytic_runs_dynamic import G0, run_chain, run_pendulum, run_wind
 
 SOLVERS = ("xpbd", "ftl")
 

@@ -1,6 +1,7 @@
-"""`python -m harness animate` (harness/studies/animate.py): a tiny dynamic state becomes a GIF with
-the frames the docs promise (the rest frame, then every K-th simulated frame); bad input is
-one line, exit status 2, and no file (nor a temporary one) left behind."""
+"""`python -m harness animate` (harness/bench/animate_dynamic.py, drawn by
+harness/render/animation_dynamic.py): a tiny dynamic state becomes a GIF with the frames the docs
+promise (the rest frame, then every K-th simulated frame); bad input is one line, exit status 2, and
+no file (nor a temporary one) left behind."""
 
 import pytest
 from PIL import Image

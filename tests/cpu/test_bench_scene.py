@@ -11,7 +11,9 @@ from conftest import ROOT
 from harness.bench import dynamic as bench_dynamic
 from harness.cli.main import main as harness_main
 from harness.core import timing
-from harness.studies import accuracy_dynamic, budget_curves, stability
+from harness.studies import accuracy_dynamic
+from harness.studies import budget_curves_dynamic as budget_curves
+from harness.studies import stability_dynamic as stability
 from support.accuracy_plans import TINY
 
 SCENE = """description = "a user's groom: curls, a fine fibre"

@@ -195,7 +195,7 @@ def test_batch_line_with_a_nul_byte_refused(cpu_bin, tmp_path):
     assert len(p.stdout.splitlines()) == 1
 
 
-@pytest.mark.parametrize("word", ["--help", "--version", "--list-variants"])
+@pytest.mark.parametrize("word", ["--help", "--version", "--list-variants", "--limits"])
 def test_batch_line_asking_for_help_refused(cpu_bin, tmp_path, word):
     p = batch(cpu_bin, tmp_path, [[*TINY, "--json"], [word]])
     refused(p, f"line 2 holds {word}")

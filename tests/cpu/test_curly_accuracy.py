@@ -5,12 +5,18 @@ and page, and the report's section from a tiny real study whose reference does n
 
 import pytest
 
+from harness.bench import animate_dynamic as animate
 from harness.bench import dynamic as bench_dynamic
 from harness.core import variants
 from harness.core.budget import Budget
 from harness.core.shards import Shard
 from harness.render import accuracy_dynamic_report, report_dynamic
-from harness.studies import accuracy_dynamic, animate, budget_curves, featurecost, peer, reduced, stability
+from harness.studies import accuracy_dynamic
+from harness.studies import budget_curves_dynamic as budget_curves
+from harness.studies import featurecost_dynamic as featurecost
+from harness.studies import peer_dynamic as peer
+from harness.studies import reduced_dynamic as reduced
+from harness.studies import stability_dynamic as stability
 from harness.studies.accuracy import results_name
 from support.accuracy_plans import TINY
 

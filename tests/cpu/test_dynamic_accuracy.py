@@ -17,7 +17,9 @@ from harness.cli import main as cli
 from harness.core import env, tolerances, variants
 from harness.core.paths import ROOT
 from harness.render import accuracy_dynamic_report
-from harness.studies import accuracy_dynamic, observables_long
+from harness.studies import accuracy_dynamic
+from harness.studies import accuracy_rows_dynamic as accuracy_rows
+from harness.studies import observables_long_dynamic as observables_long
 from support.accuracy_plans import TINY
 from support.cuda_standin import install
 
@@ -60,9 +62,9 @@ def test_pareto_front_selection():
     t = [1.0, 2.0, 3.0, 4.0, 4.0, 5.0, 6.0, np.nan]
     e = [10.0, 5.0, 6.0, 1.0, 0.5, 0.499, np.nan, 0.1]
     # (3, 6) is beaten by (2, 5); (4, 1) by (4, 0.5); NaNs are never on the front
-    assert accuracy_dynamic_report.pareto_front(t, e).tolist() == [True, True, False, False, True, True, False, False]
+    assert accuracy_rows.pareto_front(t, e).tolist() == [True, True, False, False, True, True, False, False]
     # with a tie of 1 %, 0.499 is no better than 0.5: the slower mode leaves the front
-    assert accuracy_dynamic_report.pareto_front(t, e, tie=0.01).tolist()[5] is False
+    assert accuracy_rows.pareto_front(t, e, tie=0.01).tolist()[5] is False
 
 
 @pytest.mark.parametrize(

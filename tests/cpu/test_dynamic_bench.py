@@ -12,7 +12,8 @@ from conftest import CPU_BIN
 from harness import HarnessError
 from harness.core import variants
 from harness.io.sweepfile import load_sweep
-from harness.render import accuracy_world_report, headline_report, report_dynamic
+from harness.render import accuracy_world_dynamic_report as accuracy_world_report
+from harness.render import headline_report, report_dynamic
 from harness.studies import headline_dynamic, roofline
 from harness.studies.accuracy import WORLD_RESULTS_NAME, results_name
 from harness.studies.sweep import case_flags, run_sweep

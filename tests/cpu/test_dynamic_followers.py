@@ -1,5 +1,5 @@
 """Guides and followers, long-range attachments (docs/model.md §3.14) in the C reference:
-known answers. Followers recomputed from a file's guides by harness/check/followers.py match
+known answers. Followers recomputed from a file's guides by harness/check/followers_dynamic.py match
 bit for bit; the guides of a guided run are the same strands of a full run, bit for bit
 (strands are independent); a follower whose guides are identical to it equals them; an LRA
 bound is never exceeded and is inactive on a relaxed strand. Tiny scenes (≤ 40 strands,
@@ -9,7 +9,8 @@ import h5py
 import numpy as np
 import pytest
 
-from harness.check import followers, invariants_dynamic
+from harness.check import followers_dynamic as followers
+from harness.check import invariants_dynamic
 from harness.core import tolerances
 from harness.core.guides import guide_count, guide_strands
 from harness.io.trajectory import open_trajectory

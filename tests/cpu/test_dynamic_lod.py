@@ -1,5 +1,5 @@
 """Simulated-point LOD (docs/model.md §3.14, --render-points) in the C reference: known answers.
-The rendered rows of a file recompute bit for bit from its simulated rows (harness/check/lod.py);
+The rendered rows of a file recompute bit for bit from its simulated rows (harness/check/lod_dynamic.py);
 the simulated rows are, bit for bit, the frames of the same run without --render-points (the
 rendering changes nothing the simulation does); a spline through points on a straight line
 stays on it; bad values are refused in one line (exit 2) and nothing is written. Tiny scenes
@@ -8,7 +8,7 @@ stays on it; bad values are refused in one line (exit 2) and nothing is written.
 import numpy as np
 import pytest
 
-from harness.check import lod
+from harness.check import lod_dynamic as lod
 from harness.core import tolerances
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run, run_json

@@ -1,13 +1,13 @@
 """Sag-free rest adds no stiffness (docs/model.md §3.14): the still scene of the sag-free tests,
 hit at t = 0 by a steady wind (a step load), swings with the same tip frequency and damping
-ratio (harness/check/observables.py swing) with and without --sag-free, within the measured
+ratio (harness/check/observables_dynamic.py swing) with and without --sag-free, within the measured
 bounds of harness/core/tolerances.py; a softer shape spring, which does change the stiffness,
 moves the frequency far beyond that bound. Tiny scene (40 strands × 12 points, 1 s)."""
 
 import numpy as np
 import pytest
 
-from harness.check import observables as ob
+from harness.check import observables_dynamic as ob
 from harness.core import tolerances
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run

@@ -1,4 +1,4 @@
-"""The report's feature-cost section (harness/render/featurecost_report.py) from hand-made rows:
+"""The report's feature-cost section (harness/render/featurecost_dynamic_report.py) from hand-made rows:
 costs against the right base rows, spread marks, and the row faster than `none` named."""
 
 import csv
@@ -6,8 +6,8 @@ import shutil
 
 import pytest
 
-from harness.render import featurecost_report
-from harness.studies import featurecost
+from harness.render import featurecost_dynamic_report as featurecost_report
+from harness.studies import featurecost_dynamic as featurecost
 
 FIELDS = featurecost.FIELDS
 

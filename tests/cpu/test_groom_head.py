@@ -197,8 +197,9 @@ def test_the_stability_map_runs_on_a_users_groom(tmp_path, off_sphere):
     """`harness stability --scene FILE` runs substeps against iterations over a user's groom scene,
     named after it, and its report reads the shared axes; --scene with --slice is refused."""
     from harness.cli.main import main as harness_main
-    from harness.render import stability_report
-    from harness.studies import stability, stability_slices
+    from harness.render import stability_dynamic_report as stability_report
+    from harness.studies import stability_dynamic as stability
+    from harness.studies import stability_slices_dynamic as stability_slices
 
     scene = tmp_path / "mylock.toml"
     scene.write_text(SCENE.format(head=f"[head]\ncenter = [{centre_arg((0, 0, 0))}]\n"))

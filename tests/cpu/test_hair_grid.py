@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from harness.check.hair_volume import hair_volume
+from harness.check.hair_volume_dynamic import hair_volume
 from harness.core import tolerances
 from harness.io.grooms import write_hair
 from harness.io.trajectory import open_trajectory

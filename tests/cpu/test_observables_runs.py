@@ -1,4 +1,4 @@
-"""The accuracy study's observables (harness/check/observables.py) on runs of the C reference
+"""The accuracy study's observables (harness/check/observables_dynamic.py) on runs of the C reference
 with known answers: a pendulum's tip frequency against the exact period, a damped pendulum's
 damping ratio against β/(2ω0), the energy of an undamped pendulum within the scheme's
 measured drift, zero jitter for a strand resting on nothing, and the no-simulation solver
@@ -10,11 +10,11 @@ import math
 import numpy as np
 import pytest
 
-from harness.check import observables as ob
+from harness.check import observables_dynamic as ob
 from harness.core import tolerances as tol
 from harness.io.trajectory import open_trajectory
-from harness.studies import analytic as an
-from harness.studies.analytic_runs import G0, pendulum_positions, simulate, write_paper_state
+from harness.studies import analytic_dynamic as an
+from harness.studies.analytic_runs_dynamic import G0, pendulum_positions, simulate, write_paper_state
 from support.statecheck import run
 
 DT = 1 / 60
@@ -110,7 +110,7 @@ def test_energy_from_positions_of_a_still_ftl_chain_is_zero(cpu_bin, tmp_path):
     """A chain hanging straight down under gravity, ftl, collider off: its positions stay put (to
     rounding), so the kinetic energy of its motion, from positions, is zero, while the velocities
     ftl stores (its correction −s·d/h, docs/model.md §3.7) read g·h·Σ s^j along the chain."""
-    from harness.studies.analytic_runs import straight_chain_positions
+    from harness.studies.analytic_runs_dynamic import straight_chain_positions
 
     inp = write_paper_state(tmp_path / "in.h5", straight_chain_positions(32, LENGTH, 0.0), LENGTH)
     out = simulate(cpu_bin, inp, tmp_path / "still.h5", 60, 8, "ftl", extra=["--velocities", "all"])
@@ -202,7 +202,7 @@ def test_gpu_and_simd_refuse_rigid_with_one_line(cpu_bin, tmp_path):
 def test_swing_frequency_of_a_hanging_chain(cpu_bin, tmp_path):
     """A chain of 32 points displaced along its first mode swings at the linearised discrete
     chain's ω1 (docs/model.md §4.3)."""
-    from harness.studies.analytic_runs import chain_positions
+    from harness.studies.analytic_runs_dynamic import chain_positions
 
     inp = write_paper_state(tmp_path / "chain.h5", chain_positions(32, LENGTH, 0.3), LENGTH)
     out = simulate(cpu_bin, inp, tmp_path / "chain_out.h5", 300, 256, "xpbd", extra=["--velocities", "all"])

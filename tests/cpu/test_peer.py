@@ -1,4 +1,4 @@
-"""Beside a peer (harness/studies/peer.py, harness/studies/peer_pypbd.py): the parameter mapping onto
+"""Beside a peer (harness/studies/peer_dynamic.py, harness/studies/peer_pypbd_dynamic.py): the parameter mapping onto
 Bender's PositionBasedDynamics (pypbd) checked on cases with a known answer, the `peer`
 command end to end at a tiny size, and its refusals. pypbd is optional: the tests that run
 it are skipped, with the reason, where it is not installed; the skip path itself is tested
@@ -12,9 +12,10 @@ import pytest
 from harness.cli.main import main as harness_main
 from harness.core import tolerances as tol
 from harness.io import tables
-from harness.studies import analytic as an
-from harness.studies import analytic_runs as ar
-from harness.studies import peer, peer_pypbd
+from harness.studies import analytic_dynamic as an
+from harness.studies import analytic_runs_dynamic as ar
+from harness.studies import peer_dynamic as peer
+from harness.studies import peer_pypbd_dynamic as peer_pypbd
 
 PYPBD_REASON = peer_pypbd.unavailable()
 needs_pypbd = pytest.mark.skipif(PYPBD_REASON is not None, reason=f"peer tests skipped: {PYPBD_REASON}")
@@ -111,7 +112,7 @@ def test_peer_skipped_with_reason_without_pypbd(tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("harness: peer: skipped: pypbd is not installed")
     assert not out.exists() and not (tmp_path / "peer.md").exists()
-    from harness.render import peer_report
+    from harness.render import peer_dynamic_report as peer_report
 
     note = peer_report.section(out, tmp_path, missing_ok=True)
     assert any(line.startswith("Not measured here: pypbd is not installed") for line in note)

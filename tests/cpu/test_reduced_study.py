@@ -1,5 +1,5 @@
-"""The reduced-model study (harness/studies/reduced.py) and its report section
-(harness/render/reduced_report.py): a tiny plan runs every case on the cpu oracle, the references
+"""The reduced-model study (harness/studies/reduced_dynamic.py) and its report section
+(harness/render/reduced_dynamic_report.py): a tiny plan runs every case on the cpu oracle, the references
 climb their ladder and get their twins, and the report renders it; the recommendations pick, from
 known rows, the fewest guides and the fewest simulated points that pass each use's budgets (the
 followers' stretch and the ensemble's statistics included); a guide spacing has its known value."""
@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from harness.core import tolerances, variants
-from harness.render import reduced_report
-from harness.studies import reduced
+from harness.render import reduced_dynamic_report as reduced_report
+from harness.studies import reduced_dynamic as reduced
 
 TINY = reduced.Plan(strands=(8, 16), seconds=4 / 60, write_every=1 / 60, fractions=(1.0, 0.5), ref_start=8,
                     ref_max=32, lra_iterations=(1,), sag_seconds=0.25, lod_points=(33, 9), time_strands=16, repeat=1,

@@ -2,7 +2,7 @@
 search over the dynamic scene space on the CPU (and, marked `gpu`, on the strict CUDA
 build against the CPU), a slice of the stability map whose verdicts are known, and the
 map's verdict and wording rules. The map itself is `python -m harness stability`
-(harness/studies/stability.py); what the searches found and the regressions named after it are in
+(harness/studies/stability_dynamic.py); what the searches found and the regressions named after it are in
 docs/decisions.md ("Stability search of the dynamic model").
 """
 
@@ -20,8 +20,9 @@ from harness.check import diff_dynamic, invariants_dynamic
 from harness.cli.main import main as harness_main
 from harness.core import runner, tolerances, variants
 from harness.io.trajectory import open_trajectory
-from harness.render import stability_report
-from harness.studies import stability, stability_slices
+from harness.render import stability_dynamic_report as stability_report
+from harness.studies import stability_dynamic as stability
+from harness.studies import stability_slices_dynamic as stability_slices
 from support.statecheck import run
 
 # CI: 120 derandomized examples (about 30 s on the 2-core CI machine); a deeper search:

@@ -12,9 +12,12 @@ from harness import HarnessError
 from harness.cli.main import main as harness_main
 from harness.core import tolerances, variants
 from harness.io.sweepfile import SweepError, load_sweep
-from harness.render import accuracy_world_report, report_dynamic
-from harness.studies import accuracy_world, stability, stability_slices
-from harness.studies.stability_slices import OFF
+from harness.render import accuracy_world_dynamic_report as accuracy_world_report
+from harness.render import report_dynamic
+from harness.studies import accuracy_world_dynamic as accuracy_world
+from harness.studies import stability_dynamic as stability
+from harness.studies import stability_slices_dynamic as stability_slices
+from harness.studies.stability_slices_dynamic import OFF
 
 CPU = stability.Backend("cpu", "default", variants.declared("cpu").default_variant if variants.names("cpu") else "")
 
@@ -196,7 +199,7 @@ def test_the_report_keeps_the_body_rows_apart():
 def test_the_default_body_holds_no_root_of_the_default_scene(cpu_bin, tmp_path):
     """The neck clear of the scalp (configs/bodies/default.colliders): no root of the default scene lies
     in a collider of the body at rest (a root inside one holds its strand's first point in it)."""
-    from harness.check import colliders
+    from harness.check import colliders_dynamic as colliders
     from harness.core import runner, scenes
     from harness.io.trajectory import open_trajectory
 

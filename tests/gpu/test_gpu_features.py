@@ -7,7 +7,7 @@ conftest.py skips them where there is no usable GPU.
 As tests/gpu/test_gpu_dynamic.py: the CPU runs K frames with --velocities all, each GPU
 build resumes from the CPU's frame K−1 for one frame, and harness.check.diff_dynamic.compare
 judges it (the strict build bit for bit: no gusts here). The strict build's followers are
-also recomputed from its own guides by harness/check/followers.py, bit for bit. Each variant
+also recomputed from its own guides by harness/check/followers_dynamic.py, bit for bit. Each variant
 runs the scenes whose features it declares; `lanes` refuses guides and LRA (docs/cuda.md).
 """
 
@@ -16,7 +16,8 @@ import pytest
 
 from conftest import CPU_BIN, CUDA_BIN, CUDA_STRICT_BIN
 from harness import HarnessError
-from harness.check import diff_dynamic, followers
+from harness.check import diff_dynamic
+from harness.check import followers_dynamic as followers
 from harness.core import variants
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run

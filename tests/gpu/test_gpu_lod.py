@@ -5,7 +5,7 @@ conftest.py skips them where there is no usable GPU.
 Both backends simulate from the same CPU paper state (init, collide) with --render-points. The
 strict build (no FMA contraction; no gusts here) writes the CPU's file bit for bit: positions,
 velocities and rest shape, rendered rows and simulated rows alike. The default build's rendered
-rows are recomputed by harness/check/lod.py from its own simulated rows and must lie within
+rows are recomputed by harness/check/lod_dynamic.py from its own simulated rows and must lie within
 DYN_LOD_KERNEL_K·ε·E of it (E = R + c_m + 2L), the kernel's contraction of the same operations.
 """
 
@@ -16,7 +16,7 @@ import pytest
 
 from conftest import CPU_BIN, CUDA_BIN, CUDA_STRICT_BIN
 from harness import HarnessError
-from harness.check import lod
+from harness.check import lod_dynamic as lod
 from harness.core import tolerances, variants
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run

@@ -41,9 +41,22 @@ NAMES = (
     "repeat",
     "warmup",
 )
-SWITCHES = ("force", "json", "quiet", "end-to-end", "measure-bandwidth", "list-variants")
+SWITCHES = ("force", "json", "quiet", "end-to-end", "measure-bandwidth", "list-variants", "limits")
 # what --list-variants prints, per backend (the binaries declare theirs the same way)
 VARIANTS = {"cpu": ("ref", ["ref", "simd"]), "cuda": ("fused", ["paper", "soa", "fused"])}
+# what --limits prints: the fake's own bounds, in the binaries' shape (docs/interfaces.md)
+LIMITS = {
+    "strands_min": 1,
+    "points_min": 2,
+    "stages_max": 64,
+    "substeps_max": 1000,
+    "iterations_max": 1000,
+    "substep_s": [1e-9, 1.0],
+    "grid_n": [2, 64],
+    "grid_points_max": 1 << 20,
+    "block_size": {"min": 32, "max": 1024, "multiple": 32},
+    "threads": [1, 64],
+}
 
 
 def parse(argv):
@@ -84,6 +97,9 @@ def run(argv):
     prog = os.path.basename(os.environ.get("FAKE_PROG", "hairsim-cpu"))
     backend = os.environ.get("FAKE_BACKEND") or ("cuda" if "cuda" in prog else "cpu")
     o = parse(argv)
+    if o.get("limits"):
+        print(json.dumps({"backend": backend, **LIMITS}))
+        return 0
     if o.get("list-variants"):
         default, names = VARIANTS[backend]
         build = next((b for b in ("strict", "fastmath") if prog.endswith(b)), "default")

@@ -10,6 +10,7 @@ import pandas as pd
 
 from harness.core import tolerances
 from harness.render import accuracy_dynamic_report as rep
+from harness.studies.accuracy import scheme_name
 
 RMS_GAMES = tolerances.DYN_ACC_USES["games"][0]
 
@@ -22,7 +23,7 @@ def mode(name, solver, s, S, I, ms, rms, stretch=0.001, damping=math.nan):  # no
         variant="ref",
         solver=solver,
         ftl_damping=damping,
-        scheme=rep.scheme_name(solver, damping),
+        scheme=scheme_name(solver, damping),
         substeps=S,
         iterations=I,
         precision="fp32",

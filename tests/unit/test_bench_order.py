@@ -7,7 +7,7 @@ import pytest
 
 from harness.bench import dynamic as bench_dynamic
 from harness.bench import paper as bench_paper
-from harness.cli import main
+from harness.cli.commands import bench as bench_command
 
 
 def bench_args(model, tmp_path):
@@ -48,7 +48,7 @@ def test_every_validation_runs_before_any_timing(monkeypatch, tmp_path, model, e
 
     monkeypatch.setattr(bench_paper, "run", timed("paper"))
     monkeypatch.setattr(bench_dynamic, "run", timed("dynamic"))
-    assert main.cmd_bench(bench_args(model, tmp_path)) == 0
+    assert bench_command.cmd_bench(bench_args(model, tmp_path)) == 0
     assert steps == expected
 
 
@@ -62,7 +62,7 @@ def test_the_bench_log_ends_with_the_time_of_each_step(monkeypatch, tmp_path, ca
         return 0
 
     monkeypatch.setattr(bench_dynamic, "run", dynamic)
-    assert main.cmd_bench(bench_args("all", tmp_path)) == 0
+    assert bench_command.cmd_bench(bench_args("all", tmp_path)) == 0
     last = capsys.readouterr().out.strip().splitlines()[-1]
     assert last.startswith("harness: bench took ")
     assert last.endswith("(validation 0 s, dynamic validation 0 s, sweep quick and its report 0 s, sweep dynamic 0 s)")

@@ -1,4 +1,4 @@
-"""The metrics that survive chaos (harness/check/ensemble.py) on cases with known answers: the
+"""The metrics that survive chaos (harness/check/ensemble_dynamic.py) on cases with known answers: the
 curvature of points on a circle is 1/r, a tip distribution shifted by δ is δ away, identical
 runs are 0 apart, a mode equal to a member passes every use and one far outside the spread
 fails."""
@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from harness.check import ensemble as en
+from harness.check import ensemble_dynamic as en
 from harness.core import tolerances
 
 DT = 1 / 60

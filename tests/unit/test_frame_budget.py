@@ -1,4 +1,4 @@
-"""The frame budget's answer (harness/render/frame_budget.py) on synthetic Pareto data with known
+"""The frame budget's answer (harness/render/frame_budget_dynamic.py) on synthetic Pareto data with known
 answers: the most accurate mode whose predicted time fits, its prediction interpolated between
 measured sizes or extrapolated (and said so) beyond them, a blown-up mode never picked, nothing
 fitting said so, a GPU chosen by name, and the budget's edge within noise."""
@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from harness import HarnessError
-from harness.render import frame_budget
+from harness.render import frame_budget_dynamic as frame_budget
 
 # mode → (RMS error / L, usable, ms a frame per 1,000 strands): a Pareto front (faster, less accurate)
 CPU = {

@@ -156,8 +156,9 @@ def test_the_checks_see_a_hidden_cycle(tmp_path):
 def test_rendering_commands_live_in_render(command):
     """The rendering commands call only harness.render (and the paths they print)."""
     graph = import_graph()
-    tree = ast.parse((PACKAGE / "cli" / "main.py").read_text())
-    func = next(f for f in tree.body if isinstance(f, ast.FunctionDef) and f.name == f"cmd_{command.replace('-', '_')}")
+    name = f"cmd_{command.replace('-', '_')}"
+    trees = [ast.parse(p.read_text()) for p in sorted((PACKAGE / "cli" / "commands").glob("*.py"))]
+    func = next(f for tree in trees for f in tree.body if isinstance(f, ast.FunctionDef) and f.name == name)
     used = {n.module for n in ast.walk(func) if isinstance(n, ast.ImportFrom)}
     assert used and all(m in ("harness.render", "harness.core.paths") for m in used), used
     assert graph["harness.cli.main"]
@@ -237,3 +238,63 @@ def test_the_write_check_sees_a_hidden_write(tmp_path):
     path = tmp_path / "m.py"
     path.write_text("def f(p, t):\n    with open(p, 'w') as x:\n        x.write(t)\n    t.replace('a', 'b')\n")
     assert file_writes(path) == ["line 2: open"]
+
+
+MODELS = ("paper", "dynamic")
+
+
+def model_of(name):
+    """The model a studies/ or render/ module names (a word of its file name), or None."""
+    words = set(name.rpartition(".")[2].split("_"))
+    named = [m for m in MODELS if m in words]
+    return named[0] if len(named) == 1 else None
+
+
+def test_a_module_named_for_one_model_imports_none_named_for_the_other():
+    """docs/decisions/code-layout.md: in studies/ and render/ a module serving one model has its
+    name as a word of the file name; one named for a model never imports one named for the other."""
+    graph = import_graph()
+    folders = ("harness.studies.", "harness.render.")
+    crossed = [
+        f"{m} (line {line}) imports {t}"
+        for m, targets in graph.items()
+        if m.startswith(folders) and model_of(m)
+        for t, line in targets.items()
+        if t.startswith(folders) and model_of(t) and model_of(t) != model_of(m)
+    ]
+    assert not crossed, "modules named for one model importing the other's:\n" + "\n".join(crossed)
+
+
+def test_the_model_names_are_read_from_words():
+    assert model_of("harness.render.plots_paper") == "paper"
+    assert model_of("harness.studies.stability_slices_dynamic") == "dynamic"
+    assert model_of("harness.studies.sweep") is None
+    assert model_of("harness.studies.dynamicish") is None
+
+
+LONGEST_FUNCTION = 150  # lines, def to last line (#47)
+
+
+def long_functions(path, limit=LONGEST_FUNCTION):
+    """(line, name, lines) of each function in a file longer than `limit` lines."""
+    tree = ast.parse(path.read_text(), str(path))
+    return [
+        (n.lineno, n.name, n.end_lineno - n.lineno + 1)
+        for n in ast.walk(tree)
+        if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef)) and n.end_lineno - n.lineno + 1 > limit
+    ]
+
+
+def test_no_function_in_harness_is_over_150_lines():
+    long = [
+        f"{p.relative_to(ROOT)}:{line} {name} ({n} lines)"
+        for p in sorted(PACKAGE.rglob("*.py"))
+        for line, name, n in long_functions(p)
+    ]
+    assert not long, f"functions over {LONGEST_FUNCTION} lines:\n" + "\n".join(long)
+
+
+def test_the_length_scan_sees_a_long_function(tmp_path):
+    path = tmp_path / "m.py"
+    path.write_text("def f():\n" + "    x = 1\n" * 160 + "\n\ndef g():\n    return 2\n")
+    assert long_functions(path) == [(1, "f", 161)]

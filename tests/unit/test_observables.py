@@ -1,4 +1,4 @@
-"""harness/check/observables.py on inputs with known answers (numpy only, no binary):
+"""harness/check/observables_dynamic.py on inputs with known answers (numpy only, no binary):
 verdicts split by cause, silhouettes, jitter, stretch, error percentiles, spectra, and the
 tip-motion fits on synthetic oscillations."""
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from harness.check import observables as ob
+from harness.check import observables_dynamic as ob
 
 L = 30.0
 
@@ -205,7 +205,7 @@ def test_release_damping_noise_is_the_larger_of_halves_and_fit():
     (even strands 0.02 and 0.04, odd the same): the strand halves agree, so ζ's noise is
     the envelope fit's standard error; with 0.02, 0.04 on the even and 0.03, 0.05 on the odd
     strands it is half the halves' difference."""
-    from harness.studies import observables_long
+    from harness.studies import observables_long_dynamic as observables_long
 
     dt, f0 = 1 / 60, 1.1
     t = np.arange(600) * dt

@@ -1,4 +1,4 @@
-"""The Lyapunov rate and predictability time (harness/check/predictability.py) on systems whose
+"""The Lyapunov rate and predictability time (harness/check/predictability_dynamic.py) on systems whose
 rate is known: the tent map doubles a separation exactly (λ = ln 2 per step), an unstable
 linear oscillator x'' = k²x separates as cosh(k·t) (λ = k), a stable one not at all (no
 growth: predictable beyond the run)."""
@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from harness.check import predictability as pr
+from harness.check import predictability_dynamic as pr
 from harness.core import tolerances
 
 

@@ -131,7 +131,7 @@ def colliders(traj, frame):
     """The colliders of a state (docs/model.md §3.17) placed at frame `frame`: spheres and
     capsules as drawn bodies, a mesh from its OBJ file where that file is still beside the
     colliders file (the state holds its SDF, not its triangles); planes are not drawn."""
-    from harness.check.colliders import body_translation
+    from harness.check.colliders_dynamic import body_translation
 
     if not getattr(traj, "colliders", None) or frame < traj.paper_frames:
         return []

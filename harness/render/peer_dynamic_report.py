@@ -1,4 +1,4 @@
-"""The peer comparison (results/peer/, written by harness/studies/peer.py) as a Markdown section and
+"""The peer comparison (results/peer/, written by harness/studies/peer_dynamic.py) as a Markdown section and
 one plot. Rendering only; `section(results_dir, out_dir)` is what report.py calls, and
 `write(results_dir, report_dir)` writes report/peer.md on its own.
 
@@ -193,7 +193,7 @@ def section(results_dir, out_dir, missing_ok=False):
     """The report's lines for the peer comparison (and its plot in out_dir). With
     `missing_ok`, results that are absent give a short note saying why instead of an error."""
     if missing_ok and not (Path(results_dir) / "peer.json").exists():
-        from harness.studies.peer_pypbd import unavailable
+        from harness.studies.peer_pypbd_dynamic import unavailable
 
         why = unavailable() or f"no {display(Path(results_dir) / 'peer.json')}: run `python -m harness peer`"
         return ["## Beside a peer: PositionBasedDynamics (pypbd)", "", f"Not measured here: {why}.", ""]

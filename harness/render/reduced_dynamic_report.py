@@ -1,4 +1,4 @@
-"""The reduced-model trades (harness/studies/reduced.py's CSV and references.csv beside it) as
+"""The reduced-model trades (harness/studies/reduced_dynamic.py's CSV and references.csv beside it) as
 Markdown: guide fraction × scheme at each strand count with the guide spacing, LRA on/off, simulated
 points P_s against rendered points P_r (LOD), and sag-free rest (the still groom's displacement at
 each shape range, the tip's swing), each row's error against a converged, fully simulated reference
@@ -120,7 +120,7 @@ def markdown(rows, refs=()):
     lines = [
         f"Checked runs: fp32, S = {first['substeps']}, {_g(_f(first, 'seconds'))} s; errors are the worst written "
         "frame up to the pointwise horizon, statistics (W1 of the tip's and the curvature's distributions, the "
-        "silhouette's area; harness/check/ensemble.py) over the whole run, stretch against each segment's own "
+        "silhouette's area; harness/check/ensemble_dynamic.py) over the whole run, stretch against each segment's own "
         f"rest length. Times per frame ({sizes}, median).",
         "",
         *references_lines(refs),

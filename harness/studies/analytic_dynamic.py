@@ -5,7 +5,7 @@ amplitude, K(m) by the arithmetic–geometric mean), the hanging chain's first m
 ω1 and shape J0, and the linearised discrete chain of P−1 unit masses), the steady wind
 angle; and from a time series: zero crossings with linear interpolation, the period they
 give, the steady angle of a segment (a signal's dominant frequency is
-harness.check.observables.dominant_frequency).
+harness.check.observables_dynamic.dominant_frequency).
 
 `read_series(path)` gives (time, positions [F][N][P][3]) of a state file (harness.io.trajectory).
 """

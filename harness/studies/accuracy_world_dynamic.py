@@ -1,14 +1,14 @@
 """Speed against accuracy of the world around the hair (docs/model.md §3.16, §3.17): the
 hair–hair grid's size × when it is built × friction × volume on the default scene, and the
 colliders' SDF resolution × friction on the body of configs/scenes/body.toml. Measures and
-writes CSV; harness/render/accuracy_world_report.py renders the table and its verdict.
+writes CSV; harness/render/accuracy_world_dynamic_report.py renders the table and its verdict.
 
 Each variant runs the scene's own step (S = 8, I = 2, fp32) at `strands` strands for `seconds`,
 and its **converged reference**, the same features at S = `ref_substeps` in fp64 (the error is
 then the step's, not the feature's). Against it: the RMS and max error over all points and
 frames (studies.accuracy.frame_errors, over L), and the observables the features change, the
 variant's beside its reference's: the last frame's hair volume, envelope radius and close pairs
-(check/hair_volume.py), and the worst frame's penetration and stretch (§3.8). The cost is the
+(check/hair_volume_dynamic.py), and the worst frame's penetration and stretch (§3.8). The cost is the
 simulate stage's time per frame apart from the checked runs (`time_strands` strands, one thread,
 `time_frames` frames), the median of `repeat` rounds that each time every variant in turn (a
 shared machine's load then falls on all alike; the rounds' spread is kept), over the same scene
@@ -25,8 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.check import hair_volume
+from harness.check import hair_volume_dynamic as hair_volume
 from harness.core import env, runner, scenes, variants
+from harness.core.limits import limits
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
@@ -115,8 +116,9 @@ def check_plan(plan):
         bad.append(f"--seconds must be in (0, 10] (got {plan.seconds:g})")
     if plan.ref_substeps <= 8:
         bad.append(f"--ref-substeps {plan.ref_substeps} must exceed the scenes' S = 8")
-    if not plan.grid_sizes or any(not 2 <= n <= 512 for n in plan.grid_sizes):
-        bad.append("--grid-sizes needs values from 2 to 512")
+    fewest, most = limits().grid_n
+    if not plan.grid_sizes or any(not fewest <= n <= most for n in plan.grid_sizes):
+        bad.append(f"--grid-sizes needs values from {fewest} to {most}")
     if not plan.sdf_sizes or any(not 8 <= n <= 512 for n in plan.sdf_sizes):
         bad.append("--sdf-sizes needs values from 8 to 512")
     if not plan.rebuilds or any(r not in ("frame", "substep", "held") for r in plan.rebuilds):

@@ -2,7 +2,7 @@
 speed-against-accuracy study that a budget can pick (the bench passes each device's Pareto
 front), each timed at a ladder of strand counts by the stopping rule (core/rounds.py), so that a
 budget's answer at N strands comes from the mode's own measured curve
-(render/frame_budget.py). Measuring only; writes <root>/budget-curves[-<scene>]/curves.csv
+(render/frame_budget_dynamic.py). Measuring only; writes <root>/budget-curves[-<scene>]/curves.csv
 and env.json.
 
 A mode is a dict of the study's columns (mode, backend, build, variant, solver, ftl_damping,

@@ -12,7 +12,7 @@ from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, display
 from harness.io import files, tables
-from harness.studies.stability_slices import BLOWN_UP, LEGACY, OTHER, SLICES, VERDICTS, axis
+from harness.studies.stability_slices_dynamic import BLOWN_UP, LEGACY, OTHER, SLICES, VERDICTS, axis
 
 ORDER = VERDICTS + LEGACY + OTHER
 COLOURS = {
@@ -222,8 +222,8 @@ def write_markdown(rows, path, info, pngs):
     lines = [
         "# Stability of the dynamic model at the extremes",
         "",
-        "Made by `python -m harness stability` (harness/studies/stability.py measures, "
-        'harness/render/stability_report.py renders); how to read it: docs/harness.md, "Stability map".',
+        "Made by `python -m harness stability` (harness/studies/stability_dynamic.py measures, "
+        'harness/render/stability_dynamic_report.py renders); how to read it: docs/harness.md, "Stability map".',
         "",
         f"Each cell is one run of {info.get('strands', '?')} strands over {info.get('frames', '?')} frames "
         "(Δt = 1/60 s) of the base scene with one or two parameters changed; its verdict is the first of: "

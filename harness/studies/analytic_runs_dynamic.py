@@ -1,7 +1,7 @@
 """Hand-made input states for the analytic checks (docs/model.md §4), and the runs on them.
 
-Self-contained on purpose (it needs only h5py, numpy, harness.studies.analytic and
-harness.check.observables' dominant_frequency): it writes a
+Self-contained on purpose (it needs only h5py, numpy, harness.studies.analytic_dynamic and
+harness.check.observables_dynamic' dominant_frequency): it writes a
 paper-model state file (the layout of docs/interfaces.md: /h5md,
 /particles/hair/position/value [1][N·P][3], /parameters with the scene attributes and
 /parameters/stage = ["init"]) with h5py, and runs the simulate stage of a hairsim binary
@@ -35,7 +35,7 @@ def write_paper_state(path, positions, hair_length, precision="fp64", hair_offse
         h.attrs["version"] = np.array([1, 1], dtype=np.int32)
         h.create_group("author").attrs["name"] = "hairbench analytic tests"
         c = h.create_group("creator")
-        c.attrs["name"] = "harness/studies/analytic_runs.py"
+        c.attrs["name"] = "harness/studies/analytic_runs_dynamic.py"
         c.attrs["version"] = "1"
         pos = f.create_group("particles/hair/position")
         pos.create_dataset("value", data=positions.reshape(1, n * p, 3).astype(dtype))
@@ -153,14 +153,14 @@ def simulate(
 
 # ---------------------------------------------------------------- the checks' runs
 # Each returns a dict with the measured value, the expected value(s) and extras. They import
-# harness.studies.analytic for the analysis (the closed forms live there, once).
+# harness.studies.analytic_dynamic for the analysis (the closed forms live there, once).
 
 FRAME_DT = 1.0 / 60.0
 G0 = 981.0
 
 
 def _analytic():
-    from harness.studies import analytic
+    from harness.studies import analytic_dynamic as analytic
 
     return analytic
 
@@ -271,7 +271,7 @@ def run_chain(
     shape starts with, which shifts the tip's own zero crossings. The tip's dominant
     frequency (FFT) is returned too, as a cross-check. Expected: the discrete chain's ω1
     (the solver's target); the continuum ω1 is returned for the discretisation error."""
-    from harness.check.observables import dominant_frequency
+    from harness.check.observables_dynamic import dominant_frequency
 
     an = _analytic()
     w_cont = an.chain_omega1(length, G0)

@@ -1,7 +1,7 @@
 """Metrics that survive chaos (docs/model.md §5.4): what a run looks like, compared with a
 reference ensemble rather than with one trajectory. Numpy only; nothing here runs a binary.
 
-Beyond the predictability time (harness/check/predictability.py) two runs that differ in
+Beyond the predictability time (harness/check/predictability_dynamic.py) two runs that differ in
 rounding alone part, so a mode is compared with several reference runs (the converged
 reference, its perturbed twins, the next finer rung): the spread of the ensemble is what
 "equal" means, and a use's allowance (tolerances.DYN_ACC_USES_CHAOS) is added to it.
@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from harness.check import observables as ob
+from harness.check import observables_dynamic as ob
 from harness.core import tolerances
 
 QUANTILES = (np.arange(128) + 0.5) / 128

@@ -1,4 +1,4 @@
-"""The feature-cost table (harness/studies/featurecost.py's rows) as Markdown: `markdown(rows)` for
+"""The feature-cost table (harness/studies/featurecost_dynamic.py's rows) as Markdown: `markdown(rows)` for
 one run, `section(paths)` for the report (the CPU's CSV and, where present, the GPU's),
 with what each feature costs alone and inside the full scene.
 

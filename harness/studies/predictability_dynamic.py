@@ -1,6 +1,6 @@
 """Perturbed twin runs: the Lyapunov rate λ and the predictability time of a scene
-(harness/check/predictability.py fits them), and the twins themselves, which are members of a
-study's reference ensemble (harness/check/ensemble.py).
+(harness/check/predictability_dynamic.py fits them), and the twins themselves, which are members of a
+study's reference ensemble (harness/check/ensemble_dynamic.py).
 
 A twin resumes a run from its first simulated frame with that frame's positions perturbed by
 tolerances.DYN_LYAPUNOV_PERTURBATION_L (RMS over the non-root points, ·L; each twin its own
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from harness import HarnessError
-from harness.check import predictability as pr
+from harness.check import predictability_dynamic as pr
 from harness.core import runner, tolerances
 from harness.io import files
 from harness.io.trajectory import open_trajectory

@@ -1,4 +1,4 @@
-"""The world study's tables (harness/studies/accuracy_world.py's world.csv) as Markdown: the
+"""The world study's tables (harness/studies/accuracy_world_dynamic.py's world.csv) as Markdown: the
 grid's and the colliders' variants, each's cost against its effect and its error against its
 converged reference, and a verdict per group computed from those numbers."""
 

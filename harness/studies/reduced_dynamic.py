@@ -1,5 +1,5 @@
 """`python -m harness reduced`: what modelling less costs and saves (docs/model.md §3.14) — the
-measuring part; harness/render/reduced_report.py renders it.
+measuring part; harness/render/reduced_dynamic_report.py renders it.
 
 Rows of one dynamic scene (default `dynamic`), each run for `seconds` of simulated time, written
 every `write_every` s:
@@ -19,17 +19,17 @@ every `write_every` s:
   sagfreq  solver × sag-free off/on, shape range 1: the same still scene hit at t = 0 by a steady
            wind of `sag_wind` cm/s (no gusts), a step load that sets every strand swinging; tip_hz
            and tip_damping are the median over the strands that swing of the tip's frequency and
-           damping ratio (harness/check/observables.py swing): sag-free must leave them as they were
+           damping ratio (harness/check/observables_dynamic.py swing): sag-free must leave them as they were
   lod      at the largest strand count: solver × simulated points P_s (`lod_points`) written with
            `lod_render_points` points (--render-points; P_s = P_r simulates every point); the
            reference simulates P_r points
 
 Each row's checked run (fp32, the CPU oracle on every core) is compared with a converged
-reference of the same scene (studies/reduced_reference.py: xpbd fp64 I = 1, S doubled until it
+reference of the same scene (studies/reduced_reference_dynamic.py: xpbd fp64 I = 1, S doubled until it
 is ten times closer than the smallest row error, on the GPU in fp64 where one is usable): rms_err_L
 and max_err_L are the worst written frame up to the pointwise horizon (min(seconds, the scene's
 predictability time)); tip_L, curvature_rel and envelope_rel the statistics of the whole run
-against the reference ensemble (harness/check/ensemble.py); stretch_max the binary's observable,
+against the reference ensemble (harness/check/ensemble_dynamic.py); stretch_max the binary's observable,
 stretch_max_k and stretch_p99_k recomputed against each segment's own rest length over every
 strand (a LOD row: over its rendered points and rendered rest shape), stretch_followers over the
 followers alone.
@@ -49,14 +49,14 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.check import ensemble as en
-from harness.check import observables as ob
+from harness.check import ensemble_dynamic as en
+from harness.check import observables_dynamic as ob
 from harness.core import env, runner, scenes, variants
 from harness.core.guides import guide_count, guide_strands
 from harness.core.paths import binary_path
 from harness.io.files import write_csv
 from harness.studies.accuracy import frame_errors
-from harness.studies.reduced_reference import References, read_positions
+from harness.studies.reduced_reference_dynamic import References, read_positions
 
 FIELDS = (
     "study",

@@ -1,10 +1,10 @@
 """Beside a peer: the same chain scenes in our C reference and in Bender's
-PositionBasedDynamics (harness/studies/peer_pypbd.py), measured side by side. Measuring only; the
-Markdown is harness/render/peer_report.py.
+PositionBasedDynamics (harness/studies/peer_pypbd_dynamic.py), measured side by side. Measuring only; the
+Markdown is harness/render/peer_dynamic_report.py.
 
 The scene: straight chains of P points and length L hanging from a pinned root, tilted by
 θ0 from the downward vertical and released from rest (no collider, wind, bend, damping),
-built by harness/studies/analytic_runs.py and passed to the binary with --input. For each
+built by harness/studies/analytic_runs_dynamic.py and passed to the binary with --input. For each
 setting (S substeps, I iterations):
 
 - accuracy, on one chain per tilt over `frames` frames: every frame against our converged
@@ -37,8 +37,8 @@ from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
 from harness.io.trajectory import open_trajectory
-from harness.studies import analytic_runs
-from harness.studies import peer_pypbd as peer
+from harness.studies import analytic_runs_dynamic as analytic_runs
+from harness.studies import peer_pypbd_dynamic as peer
 
 SETTINGS = ((8, 1), (32, 1), (8, 4))  # (S, I)
 STRANDS = (1, 100, 1000, 10000)

@@ -1,6 +1,6 @@
 """How long a trajectory can be predicted pointwise (docs/model.md §5.4): the largest Lyapunov
 rate λ from perturbed twin runs, and the predictability time it gives. Numpy only; nothing
-here runs a binary (harness/studies/predictability.py runs the twins).
+here runs a binary (harness/studies/predictability_dynamic.py runs the twins).
 
 A twin is the same run with one frame's positions perturbed by `d0` (RMS over the points, in
 units of L). Its separation from the unperturbed run, d(t) = RMS over points of |x − x'|/L,

@@ -6,8 +6,8 @@ then every K-th simulated frame. At most `max_strands` strands are drawn, evenly
 
 Writes a GIF (matplotlib's PillowWriter) and, where ffmpeg is on PATH, an MP4 beside it.
 Each file is written to a temporary name and renamed, so an error leaves none behind; an
-existing file is refused unless `force`. Without a state, the default dynamic scene
-(configs/scenes/dynamic.toml) is run first on hairsim-cpu into results/animation/.
+existing file is refused unless `force`. Drawing only: the `animate` command's steps are
+harness/bench/animate_dynamic.py's, the state it simulates without one studies/animate_dynamic.py's.
 """
 
 import math
@@ -17,27 +17,12 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.core import runner, scenes
-from harness.core.paths import REPORT, RESULTS, binary_path, display
-from harness.core.progress import Progress
+from harness.core.paths import REPORT, display
 from harness.io import files
 from harness.io.trajectory import open_trajectory
 
 TARGET_FRAMES = 60  # drawn frames when `every` is not given
 MAX_GIF_FPS = 50  # GIF delays are whole hundredths of a second
-
-
-def simulate_default(strands, frames, out_dir=None, log=print):
-    """Run configs/scenes/dynamic.toml (strands, frames overridden) on hairsim-cpu; the state's path."""
-
-    scene = scenes.with_frames(scenes.load_scene("dynamic").with_overrides(strands=strands), frames)
-    out_dir = Path(out_dir) if out_dir else RESULTS / "animation"
-    out_dir.mkdir(parents=True, exist_ok=True)
-    path = out_dir / f"dynamic-{strands}x{frames}.h5"
-    flags = runner.run_flags(scene, "cpu", output=path, force=True)
-    log(f"animate: running the dynamic scene ({strands} strands, {frames} frames) into {display(path)}")
-    runner.run_binary(binary_path("cpu"), flags)
-    return path
 
 
 def pick(n, most):
@@ -53,7 +38,9 @@ def frames_to_draw(traj, every):
     return [traj.paper_frames - 1, *sim[every - 1 :: every]]
 
 
-def _outputs(out, force):
+def outputs(out, force):
+    """The animation's paths (the .gif, and an .mp4 beside it where ffmpeg is on PATH); refused in one line
+    when one exists without `force` or is a directory."""
     gif = Path(out) if out else REPORT / "dynamic.gif"
     if gif.suffix.lower() != ".gif":
         raise HarnessError(f"animate: --out must name a .gif file (got {out})")
@@ -152,37 +139,10 @@ def render(traj, paths, max_strands=150, every=None, fps=None, log=print):
     return written
 
 
-def _dynamic_trajectory(state):
+def dynamic_trajectory(state):
     """The open trajectory of a dynamic-model state; HarnessError for any other file."""
     traj = open_trajectory(state)
     if not traj.is_dynamic:
         traj.close()
         raise HarnessError(f"animate: {display(state)} is a paper-model state (no simulated frames)")
     return traj
-
-
-def run(
-    state=None,
-    out=None,
-    max_strands=150,
-    every=None,
-    fps=None,
-    force=False,
-    strands=300,
-    frames=120,
-    log=print,
-    state_dir=None,
-):
-    """The `animate` command: the written paths (`state_dir`: where the simulated state goes,
-    default results/animation)."""
-    paths = _outputs(out, force)
-    if state is not None:  # a bad file is refused in one line, before the progress starts
-        _dynamic_trajectory(state).close()
-    with Progress(2 if state is None else 1, "animate: simulate and draw") as bar:
-        if state is None:
-            state = simulate_default(strands, frames, out_dir=state_dir, log=log)
-            bar.update()
-        with _dynamic_trajectory(state) as traj:
-            written = render(traj, paths, max_strands=max_strands, every=every, fps=fps, log=log)
-        bar.update()
-        return written

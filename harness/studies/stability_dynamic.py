@@ -1,5 +1,5 @@
 """`python -m harness stability`: where the dynamic model is stable, the measuring part
-(render/stability_report.py renders it).
+(render/stability_dynamic_report.py renders it).
 
 A map, not anecdotes: 2-D slices through the dynamic scene space (substeps against wind
 speed, stretch compliance, bend compliance and points per strand; head-motion frequency
@@ -30,7 +30,7 @@ harness/core/tolerances.py:
 (the first that applies). Each cell's last frame also goes through
 harness.check.invariants_dynamic; its violations are recorded beside the verdict.
 
-Writes results/stability/stability.csv and env.json, and render/stability_report.py draws
+Writes results/stability/stability.csv and env.json, and render/stability_dynamic_report.py draws
 report/stability_<slice>.png and writes report/dynamic_stability.md.
 """
 
@@ -45,14 +45,15 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.check import colliders, invariants_dynamic
+from harness.check import colliders_dynamic as colliders
+from harness.check import invariants_dynamic
 from harness.core import env, gpus, runner, scenes, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
 from harness.io.files import write_json
 from harness.io.trajectory import open_trajectory
-from harness.studies.stability_slices import OFF, SLICE_NAMES, SLICES, scene_slice
+from harness.studies.stability_slices_dynamic import OFF, SLICE_NAMES, SLICES, scene_slice
 
 STRANDS = 16
 FRAMES = 60  # one second at the base scenes' Δt = 1/60 s
@@ -402,7 +403,7 @@ def write_csv(rows, path):
 
 def run_study(out_dir=None, **options):
     """Measure the slices (`options`: those of measure()); write stability.csv and env.json into
-    out_dir (the renderer, render/stability_report.py, draws them) and return the CSV's path."""
+    out_dir (the renderer, render/stability_dynamic_report.py, draws them) and return the CSV's path."""
     out_dir = Path(out_dir or RESULTS / "stability")
     bound = inspect.signature(measure).bind(**options)
     bound.apply_defaults()

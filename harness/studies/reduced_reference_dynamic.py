@@ -1,11 +1,11 @@
-"""The reduced-model study's references (harness/studies/reduced.py): every strand and every point
+"""The reduced-model study's references (harness/studies/reduced_dynamic.py): every strand and every point
 simulated, xpbd, fp64, I = 1, with S doubled from the plan's ref_start until, at every written
 frame up to the pointwise horizon, the RMS difference between S and 2S is under
 tolerances.DYN_ACC_REF_FACTOR × the smallest RMS error of the rows it ranks (the accuracy study's
 rule), or the plan's ref_max. The converged (finer) rung then gets perturbed twins
-(studies/predictability.py): their separation gives the scene's Lyapunov rate and predictability
+(studies/predictability_dynamic.py): their separation gives the scene's Lyapunov rate and predictability
 time, which bound the pointwise horizon; with the rung they are the reference ensemble whose
-spread the rows' statistics (harness/check/ensemble.py) are judged against.
+spread the rows' statistics (harness/check/ensemble_dynamic.py) are judged against.
 
 A row is kept as its file; its errors against a rung are read again when the rung changes.
 """
@@ -16,11 +16,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from harness.check import ensemble as en
-from harness.check import observables as ob
+from harness.check import ensemble_dynamic as en
+from harness.check import observables_dynamic as ob
 from harness.core import runner, tolerances
 from harness.io.trajectory import open_trajectory
-from harness.studies import predictability
+from harness.studies import predictability_dynamic as predictability
 from harness.studies.accuracy import frame_errors
 
 

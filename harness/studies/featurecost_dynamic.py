@@ -2,7 +2,7 @@
 scene with every feature undeclared, each alone, each removed from the full scene, and
 the full scene, on one binary and variant, and the full scene with the hair–hair grid and a
 body to collide with (§3.16, §3.17) where the variant runs them. Measures and writes CSV; the Markdown table is
-harness/render/featurecost_report.py.
+harness/render/featurecost_dynamic_report.py.
 
 A feature is taken out by removing its flags from the scene's command line (so the binary
 compiles it out), never by setting it to zero:

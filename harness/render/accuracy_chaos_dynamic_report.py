@@ -10,14 +10,14 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.check import ensemble as en
+from harness.check import ensemble_dynamic as en
 from harness.core import tolerances
 from harness.core.paths import display
 from harness.io import tables
 from harness.studies.accuracy import scheme_name
 
-LONG_CSV = "observables.csv"  # studies/observables_long.py's table
-ENSEMBLE_CSV = "ensemble.csv"  # studies/accuracy_ensemble.py's table
+LONG_CSV = "observables.csv"  # studies/observables_long_dynamic.py's table
+ENSEMBLE_CSV = "ensemble.csv"  # studies/accuracy_ensemble_dynamic.py's table
 CHAOS_COLUMNS = (
     ("tip_L", "tip distribution W1 / L"),
     ("curvature_rel", "curvature distribution W1, relative"),
@@ -117,7 +117,7 @@ def _distance_gate(cell, allow):
 
 
 def checks(r, use, longm, ensm):
-    """{gate: passes} of mode row r (accuracy_dynamic_report.summary) for a use (None: not
+    """{gate: passes} of mode row r (studies/accuracy_rows_dynamic.summary) for a use (None: not
     measured): the pointwise RMS error over the horizon (min(horizon, T_p)) and stretch, the
     metrics that survive chaos against the ensemble over the whole run, and the long runs'
     motion (kinetic energy from positions), release (tip frequency, damping ratio) and rest
@@ -227,10 +227,10 @@ def chaos_lines(summ, ens, shown):
     )
     out += [
         f"Over the whole run ({len(members['mode'].unique())} ensemble members), every mode's statistics against "
-        "the reference ensemble (harness/check/ensemble.py): a distance is the mean over the members, a scalar the "
-        f"mode's own. The ensemble itself: {spread} (spread, or the members' range). A mode passes a use when each "
-        "distance is within the spread plus the use's allowance and the kinetic energy within the members' range "
-        "times the use's factor (tolerances.DYN_ACC_USES_CHAOS).",
+        "the reference ensemble (harness/check/ensemble_dynamic.py): a distance is the mean over the members, a "
+        f"scalar the mode's own. The ensemble itself: {spread} (spread, or the members' range). A mode passes a use "
+        "when each distance is within the spread plus the use's allowance and the kinetic energy within the members' "
+        "range times the use's factor (tolerances.DYN_ACC_USES_CHAOS).",
         "",
         "| mode | " + " | ".join(label for _, label in CHAOS_COLUMNS) + " |",
         "| --- |" + " ---: |" * len(CHAOS_COLUMNS),
@@ -262,7 +262,8 @@ def long_lines(long, worst_verdict):
     rest_s = f"{rest['seconds'].iloc[0]:g} s" if len(rest) else "its time"
     out = head + [
         f"Long runs ({first['seconds']:g} s, {int(first['strands'])} strands × {int(first['points'])} points, "
-        "harness/studies/observables_long.py), each made from the study's own scene: **motion** the scene itself; "
+        "harness/studies/observables_long_dynamic.py), each made from the study's own scene: "
+        "**motion** the scene itself; "
         "**release** the scene with the head still, no wind and no collider, let go from its rest shape (the median "
         "over the strands whose tip swings, at least two periods, of each strand's swing frequency over the first "
         "half and of its damping ratio over the whole run; — where no strand swings); **rest** the scene still, "

@@ -3,10 +3,10 @@ scene, a strand count N and a budget B ms a frame, on each device measured, the 
 mode whose predicted time at N fits B, from measured data only:
 
   accuracy   the speed-against-accuracy study's RMS error of each mode over its horizon
-             (<run>/dynamic-accuracy[-<scene>]/, render/accuracy_dynamic_report.summary);
+             (<run>/dynamic-accuracy[-<scene>]/, studies/accuracy_rows_dynamic.summary);
   cost       the mode's own throughput curve, its time a frame measured at a ladder of strand
              counts by the stopping rule (<run>/budget-curves[-<scene>]/curves.csv,
-             studies/budget_curves.py).
+             studies/budget_curves_dynamic.py).
 
 The cost at N: measured at N; between two measured sizes, interpolated on the log-log line
 through them; beyond the largest measured size M, t(M)·N/M, said as an extrapolation (strands
@@ -26,6 +26,7 @@ from harness.core import timing
 from harness.core.paths import display
 from harness.io import tables
 from harness.render import accuracy_dynamic_report as accuracy
+from harness.studies import accuracy_rows_dynamic as accuracy_rows
 from harness.studies.accuracy import CSV_NAME, CURVES_CSV, curves_name, results_name
 
 # the report's table: budgets (ms a frame) down the side, strand counts across
@@ -37,7 +38,7 @@ TABLE_STRANDS = (10_000, 50_000, 100_000)
 class Data:
     """One run's measured data for one scene: per-mode accuracy, the curves, the study's facts."""
 
-    summ: object  # accuracy_dynamic_report.summary: mode, rms, usable, …
+    summ: object  # studies/accuracy_rows_dynamic.summary: mode, rms, usable, …
     curves: object  # budget_curves rows that ran (no error)
     horizon_s: float
     holds_until_s: float
@@ -55,7 +56,7 @@ def load(root, scene="dynamic"):
         if not path.is_file():
             raise HarnessError(f"budget: no {display(path)} (measure it: {cmd}, or give --run)", code=2)
     rows, study, _, _ = accuracy.load(acc_dir)
-    summ = accuracy.summary(rows, study["horizon_frames"])
+    summ = accuracy_rows.summary(rows, study["horizon_frames"])
     curves = tables.read_csv(curves_path)
     err = curves["error"]
     curves = curves[err.isna() | (err.astype(str) == "")].copy()  # the rows that ran
@@ -164,7 +165,8 @@ def section(root, scene="dynamic", budgets=BUDGETS_MS, sizes=TABLE_STRANDS):
         return head + [f"Not measured: {e}.", ""]
     out = head + [
         "For a budget of B ms a frame and N strands, the most accurate mode whose time at N, predicted from its "
-        "own measured curve, fits B (`python -m harness budget --strands N --frame-ms B`; render/frame_budget.py). "
+        "own measured curve, fits B (`python -m harness budget --strands N --frame-ms B`; "
+        "render/frame_budget_dynamic.py). "
         f"Each cell: the mode, its predicted ms, its RMS error over the first {data.horizon_s:g} s; * where the "
         "time is extrapolated beyond the largest measured size, ~ where the budget is within the time's noise.",
         "",

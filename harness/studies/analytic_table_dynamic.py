@@ -1,9 +1,9 @@
 """The analytic checks of docs/model.md §4 swept over the substep count S: Markdown tables.
 
-    python -m harness.studies.analytic_table [--binary build/hairsim-cpu] [--quick]
+    python -m harness.studies.analytic_table_dynamic [--binary build/hairsim-cpu] [--quick]
 
 Runs the C reference (fp64, one thread) on the hand-made states of
-harness/studies/analytic_runs.py (the same runs tests/cpu/test_analytic.py makes, over more S)
+harness/studies/analytic_runs_dynamic.py (the same runs tests/cpu/test_analytic.py makes, over more S)
 and prints one table per check: solver, S, measured, expected, relative error, and what
 shows the damping. docs/analytic.md holds its output. About 30 s on 2 cores.
 """
@@ -14,13 +14,13 @@ import sys
 import tempfile
 from pathlib import Path
 
-from harness.studies import analytic as an
+from harness.studies import analytic_dynamic as an
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def _support():
-    from harness.studies import analytic_runs
+    from harness.studies import analytic_runs_dynamic as analytic_runs
 
     return analytic_runs
 
@@ -203,7 +203,9 @@ def tables(binary, quick=False):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(prog="python -m harness.studies.analytic_table", description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(
+        prog="python -m harness.studies.analytic_table_dynamic", description=__doc__.splitlines()[0]
+    )
     p.add_argument("--binary", default=str(ROOT / "build" / "hairsim-cpu"))
     p.add_argument("--quick", action="store_true", help="fewer S (a smoke run)")
     args = p.parse_args(argv)

@@ -1,6 +1,6 @@
 """The long runs of `python -m harness accuracy --model dynamic`: what a hair user sees over
 seconds rather than how far each point is from one reference trajectory (docs/harness.md, "The
-dynamic accuracy study"). Measured with harness/check/observables.py and harness/check/ensemble.py.
+dynamic accuracy study"). Measured with harness/check/observables_dynamic.py and harness/check/ensemble_dynamic.py.
 
 Three scenes, all made from the study's own scene (curly hair stays curly), `long_strands`
 strands (the study's points), `long_seconds` of simulated time (rest: REST_SECONDS at most):
@@ -23,7 +23,7 @@ Every mode of the oracle build (the cpu default variant: solver × s × S × I �
 no-simulation baseline) runs all three. The reference ensemble of each scene: xpbd fp64 I = 1 at
 the short study's converged S (at most `long_ref_max`: statistics converge long before pointwise
 positions), the same at 2S, and DYN_LYAPUNOV_TWINS perturbed twins of the S run
-(studies/predictability.py; their separation also gives the scene's Lyapunov rate and
+(studies/predictability_dynamic.py; their separation also gives the scene's Lyapunov rate and
 predictability time, rows of the reference). A distance is the mean over the members beside the
 ensemble's spread (the largest distance between two members); a scalar beside the members'
 range. Each metric's noise is half the difference between its values on the even and the odd
@@ -36,10 +36,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from harness.check import ensemble as en
-from harness.check import observables as ob
+from harness.check import ensemble_dynamic as en
+from harness.check import observables_dynamic as ob
 from harness.core import runner
-from harness.studies import predictability
+from harness.studies import predictability_dynamic as predictability
 from harness.studies.accuracy import REF_ITERATIONS, REF_PRECISION, REF_SOLVER
 
 CSV_NAME = "observables.csv"
@@ -185,7 +185,7 @@ class LongRuns:
     def __init__(self, study, ref_build, ref_S, log, configure, read_run):
         """study: accuracy_dynamic.Study; configure and read_run: its scene-with-a-mode and
         its reader (passed in, so that this module does not import the study back)."""
-        from harness.studies import accuracy_ensemble
+        from harness.studies import accuracy_ensemble_dynamic as accuracy_ensemble
 
         self.study, self.plan, self.log = study, study.plan, log
         self.configure, self.read_run = configure, read_run

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from harness.check.head_motion import head_rotation
+from harness.check.head_motion_dynamic import head_rotation
 
 
 def body_translation(params, t):

@@ -2,11 +2,11 @@
 `python -m harness accuracy --model dynamic` measures beyond one reference trajectory.
 
 After the reference ladder, the converged rung S gets tolerances.DYN_LYAPUNOV_TWINS perturbed twins
-(harness/studies/predictability.py). Their separation from it gives the scene's Lyapunov rate λ
+(harness/studies/predictability_dynamic.py). Their separation from it gives the scene's Lyapunov rate λ
 and predictability time T_p; pointwise errors are judged only up to min(horizon, T_p). The
 ensemble is the rung S, its twins and the next finer rung 2S (the reference's own error): the
 spread of its members is what "equal" means for the metrics that survive chaos
-(harness/check/ensemble.py), computed for every mode over the whole run and written to
+(harness/check/ensemble_dynamic.py), computed for every mode over the whole run and written to
 ensemble.csv, one row per mode and metric.
 """
 
@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from harness.check import ensemble as en
-from harness.studies import predictability
+from harness.check import ensemble_dynamic as en
+from harness.studies import predictability_dynamic as predictability
 
 CSV_NAME = "ensemble.csv"
 COLUMNS = (
