@@ -73,17 +73,25 @@ struct DeviceMin {
     }
 };
 
+/* this thread's segment (one a thread): its end points a, b and its first point's index k;
+ * false past the last segment */
+template <typename T> __device__ bool load_segment(const Positions &p, float a[3], float b[3], int &k)
+{
+    const int64_t s = (int64_t)blockIdx.x * blockDim.x + threadIdx.x, per = p.P - 1;
+    if (s >= p.N * per) return false;
+    const int64_t i = s / per;
+    k = (int)(s % per);
+    load_point<T>(p, i, k, a);
+    load_point<T>(p, i, k + 1, b);
+    return true;
+}
+
 template <typename T>
 __global__ void k_segments(unsigned long long *fb, hb_draw::View v, Positions p, const uint32_t *smap)
 {
-    const int64_t s = (int64_t)blockIdx.x * blockDim.x + threadIdx.x, per = p.P - 1;
-    if (s >= p.N * per) return;
-    const int64_t i = s / per;
-    const int k = (int)(s % per);
     float a[3], b[3];
-    load_point<T>(p, i, k, a);
-    load_point<T>(p, i, k + 1, b);
-    hb_draw::raster_segment(v, a, b, k, DeviceMin{fb}, hb_draw::ShadowMap{smap});
+    int k;
+    if (load_segment<T>(p, a, b, k)) hb_draw::raster_segment(v, a, b, k, DeviceMin{fb}, hb_draw::ShadowMap{smap});
 }
 
 /* the shadow map (view.cuh): the head first, then every segment's nearest depth */
@@ -101,14 +109,9 @@ struct DeviceMin32 {
 };
 template <typename T> __global__ void k_shadow_segments(uint32_t *smap, hb_draw::View v, Positions p)
 {
-    const int64_t s = (int64_t)blockIdx.x * blockDim.x + threadIdx.x, per = p.P - 1;
-    if (s >= p.N * per) return;
-    const int64_t i = s / per;
-    const int k = (int)(s % per);
     float a[3], b[3];
-    load_point<T>(p, i, k, a);
-    load_point<T>(p, i, k + 1, b);
-    hb_draw::shadow_segment(v, a, b, DeviceMin32{smap});
+    int k;
+    if (load_segment<T>(p, a, b, k)) hb_draw::shadow_segment(v, a, b, DeviceMin32{smap});
 }
 
 __global__ void k_resolve(const unsigned long long *fb, uint32_t *rgba, int64_t n)
