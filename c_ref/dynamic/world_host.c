@@ -7,6 +7,7 @@
 
 #include "dynamic/dynamics.h"
 #include "runtime/checked.h"
+#include "runtime/cli.h" /* HB_GRID_POINTS_MAX */
 
 
 uint64_t hb_host_world_bytes(const hb_scene *s, int sums_threads)
@@ -98,7 +99,7 @@ int hb_host_world_make(hb_host_world *hw, const hb_scene *s, const void *rest, i
     const int fp32 = s->precision == HB_FP32;
     hw->real = hb_real_size(s->precision);
     if (d->grid) {
-        if ((uint64_t)s->n_strands * (uint64_t)s->points > (UINT64_C(1) << 31)) {
+        if ((uint64_t)s->n_strands * (uint64_t)s->points > HB_GRID_POINTS_MAX) {
             snprintf(err, errlen,
                      "--grid: --strands x --points must be at most 2^31 points, the bound that keeps the grid's "
                      "fixed-point sums from overflowing (docs/model.md §3.16)");
