@@ -119,6 +119,10 @@ def test_the_verdict_follows_the_numbers():
     text = accuracy_world_report.verdict(rows, "grid")
     assert "costs 3.00× the once-a-frame build" in text and "by 0.60×" in text
     assert "is a (2 ms a frame" in text  # within 2× of the smallest error, and cheaper
+    assert "held" not in text  # no held rows, no clause
+    held = _row("grid", "h", 1.5, 0.012, grid="16", rebuild="held", friction="on", volume="on")
+    text = accuracy_world_report.verdict([*rows, held], "grid")
+    assert "(held) costs 0.75× the once-a-frame build sampled every substep and moves the error by 1.20×" in text
     rows[1]["rms_err_L"] = str(0.006 * tolerances.WORLD_ACC_ERROR_FACTOR * 1.5)  # now too far from the best
     assert "is b (6 ms a frame" in accuracy_world_report.verdict(rows, "grid")
     body = [
