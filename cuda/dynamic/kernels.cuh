@@ -123,12 +123,12 @@ cudaError_t launch_frame_warpreg(const DModel<T> &m, const T *q, const T *phase,
                                  const int64_t *map = nullptr, int64_t n_run = 0);
 /* The lanes variant (cuda/dynamic/lanes.cu): L lanes a strand, G consecutive points a lane in
  * registers (xpbd: L = 16, G = 2, 4, 8; ftl: fewer lanes with more points), P ≤
- * kLanesMaxPoints; x, v, rest canonical [N][P][3], bend_rest [N][P−2]; lanes_smem_bytes of
- * dynamic shared memory a block (a warp's strands staged for coalesced loads and stores, and
- * their rest shape). The launcher sizes the grid itself: one pass over the strands. */
+ * kLanesMaxPoints; x, v, rest canonical [N][P][3], bend_rest [N][P−2]; dynamic shared memory a
+ * block (a warp's strands staged for coalesced loads and stores, their rest shape, and with the
+ * grid's `held` its samples; prepare_lanes raises the limit). The launcher sizes the grid itself:
+ * one pass over the strands. */
 constexpr int64_t kLanesMaxPoints = 128;
 constexpr int kLanesMaxBlock = 256; /* __launch_bounds__: up to 255 registers a thread */
-template <typename T> size_t lanes_smem_bytes(unsigned features, int solver, int64_t P, int block);
 /* seg: a groom's per-segment rest lengths (docs/model.md §3.15; launch with m.seg_rest set) */
 template <typename T>
 cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg, bool world = false);

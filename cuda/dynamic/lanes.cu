@@ -849,11 +849,6 @@ template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P,
 
 } /* namespace */
 
-template <typename T> size_t lanes_smem_bytes(unsigned features, int solver, int64_t P, int block)
-{
-    return (size_t)(block / 32) * (size_t)lanes_pick<T>(features, solver, P, false, 0).warp_reals * sizeof(T);
-}
-
 template <typename T>
 cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg, bool world)
 {
@@ -882,7 +877,6 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
 }
 
 #define HB_LANES_INSTANTIATE(T)                                                                                        \
-    template size_t lanes_smem_bytes<T>(unsigned, int, int64_t, int);                                                  \
     template cudaError_t prepare_lanes<T>(unsigned, int, int64_t, int, bool, bool);                                    \
     template cudaError_t launch_frame_lanes<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,           \
                                                const T *, int64_t, int, cudaStream_t);

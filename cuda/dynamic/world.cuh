@@ -34,14 +34,6 @@ template <> struct WorldOf<double> {
 template <typename T> using World = typename WorldOf<T>::type;
 
 /* The precision's functions of contact_impl.h by overload. */
-HB_HD void grid_correct(const World<float> &w, const float *qg, float h, int64_t k, const float *x, float *v)
-{
-    hb_grid_correct_f32(&w, qg, h, k, x, v);
-}
-HB_HD void grid_correct(const World<double> &w, const double *qg, double h, int64_t k, const double *x, double *v)
-{
-    hb_grid_correct_f64(&w, qg, h, k, x, v);
-}
 HB_HD void grid_sample(const World<float> &w, const float *qg, const float *x, float *s)
 {
     hb_grid_sample_f32(&w, qg, x, s);
