@@ -39,7 +39,7 @@ constexpr bool kFreeCollide = kFree && !HB_LANES_REF_COLLIDE;
 /* Blocks of kLanesMaxBlock an SM must hold (__launch_bounds__'s second argument, which caps
  * the registers a thread): fp32 at P ≤ 32 HB_LANES_MINB for xpbd and HB_LANES_FTL_MINB for
  * ftl, with the world's code HB_LANES_WORLD_MINB (all of it), HB_LANES_COL_MINB (colliders alone)
- * or HB_LANES_MINB (the held grid alone) (measured, docs/cuda.md), 1 (up to 255 registers) otherwise. */
+ * or HB_LANES_HELD_MINB (the held grid alone) (measured, docs/cuda.md), 1 (up to 255 registers) otherwise. */
 #ifndef HB_LANES_MINB
 #define HB_LANES_MINB 4
 #endif
@@ -51,6 +51,9 @@ constexpr bool kFreeCollide = kFree && !HB_LANES_REF_COLLIDE;
 #endif
 #ifndef HB_LANES_COL_MINB
 #define HB_LANES_COL_MINB 3
+#endif
+#ifndef HB_LANES_HELD_MINB
+#define HB_LANES_HELD_MINB HB_LANES_MINB
 #endif
 #ifndef HB_LANES_FTL_G
 #define HB_LANES_FTL_G 4
@@ -100,7 +103,7 @@ constexpr int kWGather = 1, kWHeld = 2, kWCol = 4, kWAll = kWGather | kWHeld | k
 template <typename T, int G, int L, bool Ftl, int W = 0> constexpr int lanes_min_blocks()
 {
     return sizeof(T) != 4                      ? 1
-           : W == kWHeld && !Ftl && G == 2     ? HB_LANES_MINB /* the held grid alone: as the default kernel */
+           : W == kWHeld && !Ftl && G == 2     ? HB_LANES_HELD_MINB /* the held grid alone */
            : W == kWCol                        ? HB_LANES_COL_MINB
            : W                                 ? HB_LANES_WORLD_MINB /* everything: 2, up to 128 registers */
            : (!Ftl && G == 2)                  ? HB_LANES_MINB
@@ -285,7 +288,7 @@ __device__ __forceinline__ Sample<T> grid_sample_at(const DModel<T> &m, const T 
             }
         }
         if (w.grid_friction && sw > (T)0) {
-            const T inv = (T)1 / sw;
+            const T inv = fdiv((T)1, sw);
             s.a = Node4<T>{svx * inv, svy * inv, svz * inv, (T)1};
         }
         s.b = Node4<T>{ax, ay, az, (T)1};
@@ -311,8 +314,11 @@ __device__ __forceinline__ void grid_apply_at(const DModel<T> &m, int k, const S
         if (w.grid_volume) v = V3<T>{v.x + m.h * s.b.x, v.y + m.h * s.b.y, v.z + m.h * s.b.z};
     }
 }
-/* A held sample in shared memory (`held`): slot i of a lane at hs[(2i + 0|1)·32 + lane], as
- * vectors, so that a warp's loads and stores are conflict-free. */
+/* A held sample in shared memory (`held`), stored as vectors so that a warp's loads and stores
+ * are conflict-free. The strict build holds contact_impl.h's sample (two vectors a slot, at
+ * hs[(2i + 0|1)·32 + lane]) and applies it with the reference's operations; the free builds hold
+ * the correction itself (one vector a slot, at hs[i·32 + lane]): friction then volume,
+ * v + f·(v̄ − v) + h·ā, is v·(1 − f) + (f·v̄ + h·ā), kept as (f·v̄ + h·ā, 1 − f). */
 template <typename T> __device__ __forceinline__ void store_node4(T *p, const Node4<T> &a)
 {
     if constexpr (sizeof(T) == sizeof(float)) {
@@ -330,6 +336,43 @@ template <typename T> __device__ __forceinline__ Node4<T> shared_node4(const T *
     } else {
         const double2 a = reinterpret_cast<const double2 *>(p)[0], b = reinterpret_cast<const double2 *>(p)[1];
         return Node4<T>{a.x, a.y, b.x, b.y};
+    }
+}
+/* vectors a held slot */
+constexpr int kHeldVectors = kFree ? 1 : 2;
+/* §3.16 `held`: point k's sample at x (the frame's first substep) into slot i of hs */
+template <typename T>
+__device__ __forceinline__ void hold_sample(const DModel<T> &m, const T *qg, int k, const V3<T> &x, T *hs, int i,
+                                            int lane)
+{
+    const Sample<T> s = grid_sample_at(m, qg, x);
+    if constexpr (!kFree) {
+        store_node4(hs + 4 * (2 * i * 32 + lane), s.a);
+        store_node4(hs + 4 * ((2 * i + 1) * 32 + lane), s.b);
+    } else {
+        const World<T> &w = m.world;
+        Node4<T> c{(T)0, (T)0, (T)0, (T)1};
+        if (s.b.w != (T)0) {
+            if (w.grid_friction && s.a.w != (T)0) {
+                const T f = w.ftab[k];
+                c = Node4<T>{f * s.a.x, f * s.a.y, f * s.a.z, (T)1 - f};
+            }
+            if (w.grid_volume) c = Node4<T>{c.x + m.h * s.b.x, c.y + m.h * s.b.y, c.z + m.h * s.b.z, c.w};
+        }
+        store_node4(hs + 4 * (i * 32 + lane), c);
+    }
+}
+/* §3.16 `held`: the correction of point k from slot i of hs */
+template <typename T>
+__device__ __forceinline__ void apply_held(const DModel<T> &m, int k, const T *hs, int i, int lane, V3<T> &v)
+{
+    if constexpr (!kFree) {
+        grid_apply_at(
+            m, k,
+            Sample<T>{shared_node4(hs + 4 * (2 * i * 32 + lane)), shared_node4(hs + 4 * ((2 * i + 1) * 32 + lane))}, v);
+    } else {
+        const Node4<T> c = shared_node4(hs + 4 * (i * 32 + lane));
+        v = V3<T>{c.w * v.x + c.x, c.w * v.y + c.y, c.w * v.z + c.z};
     }
 }
 
@@ -431,11 +474,11 @@ template <typename T, int G, int L> __host__ __device__ constexpr int64_t lanes_
 {
     return 3 * (32 / L) * 3 * P + (32 / L) * (P - 2);
 }
-/* With the grid (W): a warp's held samples of §3.16 `held`, two vectors of 4 reals a point slot,
- * before every warp's staging area (so that they stay 16-byte aligned). */
+/* With the grid (W): a warp's held samples of §3.16 `held`, kHeldVectors vectors of 4 reals a
+ * point slot, before every warp's staging area (so that they stay 16-byte aligned). */
 template <typename T, int G> __host__ __device__ constexpr int64_t lanes_held_reals()
 {
-    return 2 * 4 * G * 32;
+    return kHeldVectors * 4 * G * 32;
 }
 
 /* Slot i of a lane holds point k0 + i, or with two points a lane on an odd lane (sw) k0 + 1 − i:
@@ -500,22 +543,24 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
     for (int64_t s0 = SPW * ((int64_t)blockIdx.x * wpb + w); s0 < N; s0 += SPW * (int64_t)gridDim.x * wpb) {
         const int ns = N - s0 >= SPW ? SPW : (int)(N - s0);
         const bool live = seg < ns;
-        const int64_t base = s0 * row;
         const int n = ns * row;
-        /* where element e (< n) of the warp's strands lies: base + e, or in strand perm[s0 + e/row] */
-        auto at = [&](int e) -> int64_t {
+        /* where element e of the warp's strands lies (rows of r reals a strand): s0·r + e, or with
+         * the world at strand perm[s0 + t], t = ⌊e / r⌋ found by comparisons (SPW ≤ 4); the order
+         * is read again at each use, so that it holds no register through the substeps */
+        auto at_row = [&](int e, int r) -> int64_t {
             if constexpr (W != 0) {
-                if (m.perm) return m.perm[s0 + e / row] * (int64_t)row + e % row;
+                if (m.perm) {
+                    int t = 0;
+#pragma unroll
+                    for (int u = 1; u < SPW; u++)
+                        if (e >= u * r) t = u;
+                    return m.perm[s0 + t] * (int64_t)r + (e - t * r);
+                }
             }
-            return base + e;
+            return s0 * r + e;
         };
-        auto bat = [&](int e) -> int64_t { /* the same for the bend rest lengths, P − 2 a strand */
-                                           if constexpr (W != 0) {
-                                               if (m.perm)
-                                                   return m.perm[s0 + e / (P - 2)] * (int64_t)(P - 2) + e % (P - 2);
-                                           }
-                                           return s0 * (int64_t)(P - 2) + e;
-        };
+        auto at = [&](int e) { return at_row(e, row); };
+        auto bat = [&](int e) { return at_row(e, P - 2); }; /* the bend rest lengths, P − 2 a strand */
         V3<T> X[G], V[G], Q[G], D[G];
         T *bs = rs + SPW * row; /* the bend rest lengths of the warp's strands */
         const bool need_bend = has(HB_F_BEND) && P > 2;
@@ -580,6 +625,16 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         const bool wgrid = (W & (kWGather | kWHeld)) && m.world.grid && (m.world.grid_friction || m.world.grid_volume);
         const bool held = (W & kWHeld) && wgrid && m.world.grid_rebuild == HB_GRID_HELD;
         const bool wcol = (W & kWCol) && (m.world.ncol > 0 || m.world.head_friction || m.world.bounded);
+        if constexpr ((W & kWHeld) != 0) { /* §3.16 `held`: sampled at the frame's first substep, */
+            if (held) { /* where x is the frame's start for every point k ≥ 1 (step 1 moves the root alone) */
+                const T *qg = has(HB_F_MOTION) ? m.qs : nullptr;
+#pragma unroll
+                for (int i = 0; i < G; i++) {
+                    const int k = point_of<G>(k0, sw, i);
+                    if (k >= 1 && k < P) hold_sample(m, qg, k, X[i], hs, i, lane);
+                }
+            }
+        }
         for (int j = m.j0; j < jend; j++) {
             const T *q = qtab + 9 * j;
             /* §3.16 the rotation of the grid in use (nullptr: still); §3.17 this substep's poses */
@@ -611,13 +666,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                     /* §3.16 friction, then volume; `held`: sampled at the frame's first substep */
                     if constexpr (W != 0) {
                         if (held) {
-                            T *sa = hs + 4 * (2 * i * 32 + lane), *sb = hs + 4 * ((2 * i + 1) * 32 + lane);
-                            if (j == 0) {
-                                const Sample<T> sm = grid_sample_at(m, qg, X[i]);
-                                store_node4(sa, sm.a);
-                                store_node4(sb, sm.b);
-                            }
-                            grid_apply_at(m, k, Sample<T>{shared_node4(sa), shared_node4(sb)}, V[i]);
+                            apply_held(m, k, hs, i, lane, V[i]);
                         } else if constexpr ((W & kWGather) != 0) {
                             if (wgrid) grid_apply_at(m, k, grid_sample_at(m, qg, X[i]), V[i]);
                         }
@@ -820,6 +869,13 @@ template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int6
     else if (wk == kWHeld) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWHeld>;
     else if (wk == kWCol) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWCol>;
     else if (seg) fn = &k_lanes<T, DynF, G, L, Ftl, true, 0>;
+    /* the default scene's feature set (every feature) has its own held-grid and colliders kernels
+     * in fp32 at P ≤ 32 (the generic ones spill there: docs/cuda.md) */
+    constexpr unsigned kEvery = HB_F_COUNT - 1u;
+    if constexpr (sizeof(T) == 4 && !Ftl && G == 2 && L == 16) {
+        if (f == kEvery && wk == kWHeld) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWHeld>;
+        if (f == kEvery && wk == kWCol) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWCol>;
+    }
     return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P) + ((wk & kWHeld) ? lanes_held_reals<T, G>() : 0)};
 }
 /* The world's code a run needs (docs/cuda.md "The hair–hair grid and the colliders"): none

@@ -43,6 +43,12 @@ template <> struct Splat<double> {
 #endif
 constexpr int kSplatStrands = HB_SPLAT_STRANDS, kSplatWarps = 8; /* strands a block, its warps */
 constexpr int kWindow = HB_SPLAT_WINDOW; /* nodes: 2 × 32 bits × 4 channels each (64 KB at 2048) */
+/* the window's word (channel c: mass, p_x, p_y, p_z; part: low, high) of node i: each of the eight
+ * (channel, part) arrays whole, so that a warp's lanes at different nodes use different banks */
+__device__ __forceinline__ int win_at(int c, int part, int i)
+{
+    return (2 * c + part) * kWindow + i;
+}
 /* At most this many shares reach a window node (one a point): their low parts (< 2^16 each) sum
  * below 2^32 and their high parts (|x| ≤ 2^30, so |x >> 16| ≤ 2^14) within ±2^31. */
 constexpr int64_t kSplatWindowPoints = 65536;
@@ -66,43 +72,72 @@ template <typename T> __device__ __forceinline__ bool finite3(const T *p)
     return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
 }
 
-/* one share x (|x| ≤ 2^30) into a window node's channel: low 16 bits, then the rest */
-__device__ __forceinline__ void window_add(unsigned *ch, int64_t x)
+/* A fixed-point share: HB_RINT64 of x, whose |x| ≤ 2^30 (mass ≤ 2^24, momentum ≤ 2^20·2^10), so
+ * the 32-bit conversion to nearest, ties to even, gives the same integer in one instruction. */
+__device__ __forceinline__ int share_of(float x)
 {
-    if (x == 0) return;
-    atomicAdd(ch, (unsigned)(x & 0xffff));
-    atomicAdd(reinterpret_cast<int *>(ch) + 1, (int)(x >> 16));
+    return __float2int_rn(x);
+}
+__device__ __forceinline__ int share_of(double x)
+{
+    return __double2int_rn(x);
+}
+
+/* the cell (x, y, z) of node index b < n³ ≤ 2^31 (HB_GRID_POINTS_MAX), in 32-bit arithmetic */
+__device__ __forceinline__ void cell_of(int64_t b, unsigned n, int (&c)[3])
+{
+    const unsigned u = (unsigned)b, t = u / n;
+    c[0] = (int)(u - t * n);
+    c[1] = (int)(t % n);
+    c[2] = (int)(t / n);
+}
+
+/* one share x (|x| ≤ 2^30) into channel c of window node i: low 16 bits, then the rest */
+__device__ __forceinline__ void window_add(unsigned *win, int c, int i, int x)
+{
+    atomicAdd(win + win_at(c, 0, i), (unsigned)x & 0xffffu);
+    atomicAdd(reinterpret_cast<int *>(win) + win_at(c, 1, i), x >> 16);
 }
 
 template <typename T>
 __global__ void __launch_bounds__(kSplatWarps * 32)
-    k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, const int64_t *perm, int64_t *mass,
-                 int64_t *mom)
+    k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, int spb, const int64_t *perm,
+                 int64_t *mass, int64_t *mom)
 {
-    extern __shared__ unsigned win[]; /* [node][channel: mass, p_x, p_y, p_z][low, high] */
-    __shared__ int lo[3], hi[3];
+    extern __shared__ unsigned win[];  /* [channel: mass, p_x, p_y, p_z][low, high][node] (win_at) */
+    __shared__ int lo[3], hi[3], vmax; /* vmax: the bits of the block's largest |v| component (≥ 0) */
     const int lane = (int)(threadIdx.x & 31u), warp = (int)(threadIdx.x >> 5);
-    const int64_t s0 = (int64_t)blockIdx.x * kSplatStrands;
-    const int ns = N - s0 < kSplatStrands ? (int)(N - s0) : kSplatStrands;
+    const int64_t s0 = (int64_t)blockIdx.x * spb;
+    const int ns = N - s0 < spb ? (int)(N - s0) : spb;
     const int64_t n = w.gn;
     if (threadIdx.x < 3) lo[threadIdx.x] = INT_MAX, hi[threadIdx.x] = -1;
+    if (threadIdx.x == 0) vmax = 0;
     __syncthreads();
-    /* pass 1: the block's box of cells (points whose x is finite and in the grid) */
+    /* pass 1: the block's box of cells (points whose x is finite and in the grid) and its largest
+     * clamped |v| component */
     int cl[3] = {INT_MAX, INT_MAX, INT_MAX}, ch[3] = {-1, -1, -1};
+    float vm = 0.0f;
     for (int s = warp; s < ns; s += kSplatWarps) {
         const int64_t st = perm ? perm[s0 + s] : s0 + s;
         for (int k = lane; k < P; k += 32) {
             const T *xp = x + 3 * (st * P + k);
             int64_t b;
             T wt[8];
-            if (finite3(xp) && Locate<T>::at(w, qg, xp, &b, wt)) {
-                const int c[3] = {(int)(b % n), (int)((b / n) % n), (int)(b / (n * n))};
+            const T *vp = v + 3 * (st * P + k);
+            if (finite3(xp) && finite3(vp) && Locate<T>::at(w, qg, xp, &b, wt)) {
+                int c[3];
+                cell_of(b, (unsigned)n, c);
                 for (int a = 0; a < 3; a++) {
                     cl[a] = min(cl[a], c[a]);
                     ch[a] = max(ch[a], c[a] + 1);
+                    vm = fmaxf(vm, fminf((float)fabs(vp[a]), (float)HB_GRID_VEL_CLAMP));
                 }
             }
         }
+    }
+    { /* non-negative floats order as their bits */
+        const int vb = __reduce_max_sync(0xffffffffu, __float_as_int(vm));
+        if (lane == 0 && vb > 0) atomicMax(&vmax, vb);
     }
     for (int a = 0; a < 3; a++) { /* the warp's extremes first: one shared atomic a warp */
         const int mn = __reduce_min_sync(0xffffffffu, cl[a]), mx = __reduce_max_sync(0xffffffffu, ch[a]);
@@ -115,8 +150,15 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
     if (hi[0] < 0) return; /* no point of the block in the grid */
     const int ex = hi[0] - lo[0] + 1, ey = hi[1] - lo[1] + 1, ez = hi[2] - lo[2] + 1;
     const bool windowed = (int64_t)ex * ey * ez <= kWindow && (int64_t)ns * P <= kSplatWindowPoints;
+    /* `single`: a momentum share is |rint(w·v·2^10)| ≤ |v|·2^10 + 1 (w ≤ 1) and a node takes at
+     * most one a point, so while ns·P·(vmax·2^10 + 1) < 2^31 the block's momentum sums fit one
+     * signed 32-bit word a node (exact, one atomic a share); else the split words as for mass */
+    const bool single =
+        windowed && (double)ns * P * ((double)__int_as_float(vmax) * HB_GRID_MOM_SCALE + 1.0) < 2147483647.0;
     if (windowed) {
-        for (int i = threadIdx.x; i < 8 * ex * ey * ez; i += blockDim.x) win[i] = 0u;
+        for (int i = threadIdx.x; i < ex * ey * ez; i += blockDim.x)
+            for (int a = 0; a < 8; a++)
+                if (!single || a < 2 || (a & 1) == 0) win[a * kWindow + i] = 0u;
         __syncthreads();
     }
     /* pass 2: each point's shares (hb_grid_splat_point: the reference's integers) */
@@ -133,22 +175,28 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
                 const T lim = (T)HB_GRID_VEL_CLAMP;
                 vc[c] = vp[c] < -lim ? -lim : vp[c] > lim ? lim : vp[c];
             }
+            int cb[3];
+            cell_of(b, (unsigned)n, cb);
+            /* the window node of the cell's lowest corner (32-bit: the window holds ≤ kWindow nodes) */
+            const int wb = (cb[0] - lo[0]) + ex * ((cb[1] - lo[1]) + ey * (cb[2] - lo[2]));
 #pragma unroll
             for (int c8 = 0; c8 < 8; c8++) {
-                int64_t sm[1], sp[3];
-                sm[0] = HB_RINT64(wt[c8] * (T)HB_GRID_MASS_SCALE);
-                for (int c = 0; c < 3; c++) sp[c] = HB_RINT64((wt[c8] * vc[c]) * (T)HB_GRID_MOM_SCALE);
-                const int64_t j = hb_grid_corner_f64(b, n, c8);
+                int sp[3];
+                const int sm = share_of(wt[c8] * (T)HB_GRID_MASS_SCALE);
+                for (int c = 0; c < 3; c++) sp[c] = share_of((wt[c8] * vc[c]) * (T)HB_GRID_MOM_SCALE);
                 if (windowed) {
-                    const int jx = (int)(j % n) - lo[0], jy = (int)((j / n) % n) - lo[1],
-                              jz = (int)(j / (n * n)) - lo[2];
-                    unsigned *node = win + 8 * (jx + ex * (jy + ey * jz));
-                    window_add(node, sm[0]);
-                    for (int c = 0; c < 3; c++) window_add(node + 2 + 2 * c, sp[c]);
+                    const int i = wb + ((c8 & 1) ? 1 : 0) + ((c8 & 2) ? ex : 0) + ((c8 & 4) ? ex * ey : 0);
+                    window_add(win, 0, i, sm);
+                    if (single)
+                        for (int c = 0; c < 3; c++)
+                            atomicAdd(reinterpret_cast<int *>(win) + win_at(1 + c, 0, i), sp[c]);
+                    else
+                        for (int c = 0; c < 3; c++) window_add(win, 1 + c, i, sp[c]);
                 } else {
-                    atomicAdd((unsigned long long *)&mass[j], (unsigned long long)sm[0]);
+                    const int64_t j = hb_grid_corner_f64(b, n, c8);
+                    atomicAdd((unsigned long long *)&mass[j], (unsigned long long)(int64_t)sm);
                     for (int c = 0; c < 3; c++)
-                        atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sp[c]);
+                        atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)(int64_t)sp[c]);
                 }
             }
         }
@@ -156,11 +204,12 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
     if (!windowed) return;
     __syncthreads();
     for (int i = threadIdx.x; i < ex * ey * ez; i += blockDim.x) {
-        const unsigned *node = win + 8 * i;
         int64_t sum[4];
         bool any = false;
         for (int c = 0; c < 4; c++) {
-            sum[c] = (int64_t) reinterpret_cast<const int *>(node)[2 * c + 1] * 65536 + (int64_t)node[2 * c];
+            const int *wi = reinterpret_cast<const int *>(win);
+            sum[c] = single && c > 0 ? (int64_t)wi[win_at(c, 0, i)]
+                                     : (int64_t)wi[win_at(c, 1, i)] * 65536 + (int64_t)win[win_at(c, 0, i)];
             any |= sum[c] != 0;
         }
         if (!any) continue;
@@ -196,12 +245,19 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
     cudaError_t e = cudaMemsetAsync(mass, 0, (size_t)nodes * sizeof *mass, stream);
     if (e == cudaSuccess) e = cudaMemsetAsync(mom, 0, (size_t)nodes * 3 * sizeof *mom, stream);
     if (e != cudaSuccess) return e;
-    const int64_t blocks = (N + kSplatStrands - 1) / kSplatStrands;
+    /* kSplatStrands a block, fewer (down to one a warp) where that leaves the GPU's SMs idle */
+    int dev = 0, sms = 0;
+    if ((e = cudaGetDevice(&dev)) != cudaSuccess ||
+        (e = cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev)) != cudaSuccess)
+        return e;
+    int spb = kSplatStrands;
+    while (spb > kSplatWarps && (N + spb - 1) / spb < 4 * (int64_t)sms) spb /= 2;
+    const int64_t blocks = (N + spb - 1) / spb;
     const size_t smem = (size_t)kWindow * 8 * sizeof(unsigned);
     e = cudaFuncSetAttribute(k_grid_splat<T>, cudaFuncAttributeMaxDynamicSharedMemorySize, (int)smem);
     if (e != cudaSuccess) return e;
-    k_grid_splat<T>
-        <<<(int)(blocks < 1 ? 1 : blocks), kSplatWarps * 32, smem, stream>>>(w, qg, x, v, N, (int)P, perm, mass, mom);
+    k_grid_splat<T><<<(int)(blocks < 1 ? 1 : blocks), kSplatWarps * 32, smem, stream>>>(w, qg, x, v, N, (int)P, spb,
+                                                                                        perm, mass, mom);
     return cudaGetLastError();
 }
 
