@@ -4,7 +4,7 @@ Hand-made input states (harness/studies/analytic_runs_dynamic.py) run through
 `hairsim-cpu --input IN --stages simulate --no-collider …`; the closed forms and the
 measurements are in harness/studies/analytic_dynamic.py, the tolerances (with the measurements behind
 them) in harness/core/tolerances.py (ANALYTIC_*). Only 2–3 substep counts S per check run here;
-the full sweeps are in docs/analytic.md (`python -m harness.studies.analytic_table_dynamic`).
+the full sweeps are in docs/analytic.md (`python -m harness analytic`).
 """
 
 import math
