@@ -42,6 +42,7 @@ from harness.render import accuracy_dynamic_report, report_dynamic
 from harness.render import peer_dynamic_report as peer_report
 from harness.render import stability_dynamic_report as stability_report
 from harness.studies import accuracy_dynamic
+from harness.studies import accuracy_results_dynamic as accuracy_results
 from harness.studies import accuracy_rows_dynamic as accuracy_rows
 from harness.studies import accuracy_world_dynamic as accuracy_world
 from harness.studies import budget_curves_dynamic as budget_curves
@@ -272,7 +273,7 @@ def budget_modes(acc_dir):
     front of the accuracy study in `acc_dir` (studies/accuracy_rows_dynamic.front_of: the usable
     modes no other is both faster and more accurate than, the no-simulation mode among them), as
     dicts of the study's columns."""
-    rows, study, _, _ = accuracy_dynamic_report.load(acc_dir)
+    rows, study, _, _ = accuracy_results.load(acc_dir)
     summ = accuracy_rows.summary(rows, study["horizon_frames"])
     modes = []
     for backend, part in summ.groupby("backend"):

@@ -5,7 +5,7 @@ simulated on the C reference into ROOT/renders/, listed in ROOT/renders/renders.
                        ANIMATION_FRAMES frames, every ANIMATION_EVERY-th written: the
                        rendered animation and the hero frame
   mode-<use>-<k>.h5    each mode the dynamic accuracy study recommends for a use (preview,
-                       game, offline: accuracy_dynamic_report.recommended_modes), the same
+                       game, offline: accuracy_verdicts_dynamic.recommended_modes), the same
                        settings run once where the CPU and GPU picks share them, at
                        MODE_STRANDS strands up to the study's horizon
   reference.h5         the study's converged reference (xpbd fp64 I = 1 at its S), the same
@@ -25,10 +25,10 @@ from harness import HarnessError
 from harness.core import runner, scenes
 from harness.core.paths import binary_path, display
 from harness.io.files import write_json
-from harness.render import accuracy_dynamic_report
 from harness.render.gl import context
 from harness.studies.accuracy import results_name
 from harness.studies.accuracy_dynamic import configured
+from harness.studies.accuracy_verdicts_dynamic import recommended_modes
 
 ANIMATION_STRANDS = 3000
 ANIMATION_FRAMES = 120  # 2 s of the default scene
@@ -49,7 +49,7 @@ def mode_states(root, out, say):
     ([], None) where it has no results."""
     acc = Path(root) / results_name("dynamic")
     try:
-        picks, study = accuracy_dynamic_report.recommended_modes(acc)
+        picks, study = recommended_modes(acc)
     except HarnessError as e:
         say(f"harness: renders: no accuracy modes to draw ({e})")
         return [], None

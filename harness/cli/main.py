@@ -1,7 +1,7 @@
 """`python -m harness COMMAND …`: the command line of the hairbench harness.
 
 Commands: run, diff, stepdiff, sweep, plot, report, report-dynamic, bench, merge, compare, accuracy, headline,
-export, groom, motion, calibrate, featurecost, reduced, peer, animate, render, stability, judge, budget, hair,
+export, groom, motion, calibrate, analytic, featurecost, reduced, peer, animate, render, stability, judge, budget, hair,
 docs (`--help` on each; docs/harness.md lists them). User errors print one line
 `harness: error: …` and exit non-zero, never a traceback."""
 
@@ -46,6 +46,7 @@ COMMANDS = (
     studies.add_hair,
     files.add_motion,
     studies.add_calibrate,
+    studies.add_analytic,
     studies.add_featurecost,
     studies.add_world,
     studies.add_reduced,

@@ -465,7 +465,7 @@ def jitter_budget_cm(use: str) -> float:
 
 # ---------------------------------------------------------------------------------------
 # ANALYTIC CHECKS of the dynamic model (docs/model.md §4; tests/cpu/test_analytic.py; the full
-# S sweeps in docs/analytic.md, made by `python -m harness.studies.analytic_table_dynamic`). Measured on the
+# S sweeps in docs/analytic.md, made by `python -m harness analytic`). Measured on the
 # C reference, fp64, --threads 1, Δt = 1/60 s, g0 = 981 cm/s², --iterations 1, at commit
 # 87dab6c's model (dynamics_impl.h). Relative errors are |measured − expected|/expected.
 #

@@ -1,23 +1,17 @@
 """The parts of the dynamic accuracy page that go beyond one reference trajectory (the page is
 accuracy_dynamic_report.py's): the predictability of the scenes, the metrics that survive chaos
-against the reference ensemble (ensemble.csv), the long runs (observables.csv), and the gates a
-mode must pass on them for a use (`checks`). Every number comes from those files; a table written
-before they existed reads as "not measured"."""
+against the reference ensemble (ensemble.csv), the long runs (observables.csv) and the rest-jitter
+budgets (the gates a mode must pass on them are studies/accuracy_verdicts_dynamic.py's). Every
+number comes from those files; a table written before they existed reads as "not measured"."""
 
 import math
-from pathlib import Path
 
 import numpy as np
 
-from harness import HarnessError
 from harness.check import ensemble_dynamic as en
 from harness.core import tolerances
-from harness.core.paths import display
-from harness.io import tables
-from harness.studies.accuracy import scheme_name
+from harness.studies.accuracy_verdicts_dynamic import ensemble_cells, jitter_budgets, long_metrics
 
-LONG_CSV = "observables.csv"  # studies/observables_long_dynamic.py's table
-ENSEMBLE_CSV = "ensemble.csv"  # studies/accuracy_ensemble_dynamic.py's table
 CHAOS_COLUMNS = (
     ("tip_L", "tip distribution W1 / L"),
     ("curvature_rel", "curvature distribution W1, relative"),
@@ -39,110 +33,6 @@ LONG_COLUMNS = (
     ("jitter_rms_velocity", "rest jitter RMS v (cm/s)", "rest"),
     ("jitter_max_move", "largest rest move (cm)", "rest"),
 )
-
-
-def _read(path):
-    if not path.exists():
-        return None
-    try:
-        return tables.read_csv(path)
-    except (OSError, ValueError) as e:
-        raise HarnessError(f"{display(path)}: cannot read ({e})") from None
-
-
-def load_long(results_dir):
-    """The long runs' table as a DataFrame, or None where the study ran none."""
-    return _read(Path(results_dir) / LONG_CSV)
-
-
-def load_ensemble(results_dir):
-    """ensemble.csv as a DataFrame, or None (a study from before the ensemble)."""
-    return _read(Path(results_dir) / ENSEMBLE_CSV)
-
-
-def setting(r):
-    """What a mode's physics is, whatever build ran it: (scheme, S, I, precision)."""
-    return (r["scheme"], int(r["substeps"]), int(r["iterations"]), r["precision"])
-
-
-def ensemble_cells(ens):
-    """{mode: {metric: (value, spread, lo, hi)}} of ensemble.csv's modes."""
-    out = {}
-    if ens is None or ens.empty:
-        return out
-    for _, r in ens[ens["study"] == "mode"].iterrows():
-        out.setdefault(r["mode"], {})[r["metric"]] = (r["value"], r["spread"], r["lo"], r["hi"])
-    return out
-
-
-def long_metrics(long):
-    """{(scheme, S, I, precision): {metric: (value, noise, lo, hi, spread)}} of the long runs'
-    modes (one build ran them; the same settings of another build are the same model), and the
-    reference's {scene: {metric: value}}."""
-    out, ref = {}, {}
-    if long is None or long.empty or "ref_lo" not in long.columns:
-        return out, ref
-    for _, r in long.iterrows():
-        if r["study"] == "reference":
-            ref.setdefault(r["scene"], {})[r["metric"]] = r["value"]
-            continue
-        key = (scheme_name(r["solver"], r["ftl_damping"]), int(r["substeps"]), int(r["iterations"]), r["precision"])
-        out.setdefault(key, {})[r["metric"]] = (r["value"], r["noise"], r["ref_lo"], r["ref_hi"], r["ref_uncertainty"])
-    return out, ref
-
-
-def _noise(x):
-    return x if np.isfinite(x) else 0.0
-
-
-def _range_gate(cell, rel=0.0, factor=1.0):
-    """A scalar within the members' range widened by the use (and the mode's noise); None where
-    the reference has no value (e.g. no strand of it swings)."""
-    if cell is None:
-        return None
-    v, noise, lo, hi, _ = cell
-    if not (np.isfinite(lo) and np.isfinite(hi)):
-        return None
-    if not np.isfinite(v):
-        return False
-    slack = _noise(noise)
-    return en.within_range(v, lo - slack, hi + slack, rel=rel, factor=factor)
-
-
-def _distance_gate(cell, allow):
-    if cell is None:
-        return None
-    v, noise, _, _, spread = cell
-    return bool(np.isfinite(v) and v <= _noise(spread) + allow + _noise(noise))
-
-
-def checks(r, use, longm, ensm):
-    """{gate: passes} of mode row r (studies/accuracy_rows_dynamic.summary) for a use (None: not
-    measured): the pointwise RMS error over the horizon (min(horizon, T_p)) and stretch, the
-    metrics that survive chaos against the ensemble over the whole run, and the long runs'
-    motion (kinetic energy from positions), release (tip frequency, damping ratio) and rest
-    (jitter) where they measured its settings."""
-    rms_budget, stretch_budget, _ = tolerances.DYN_ACC_USES[use]
-    out = {"RMS error": bool(r["usable"] and r["rms"] <= rms_budget), "stretch": bool(r["stretch"] <= stretch_budget)}
-    cells = ensm.get(r["mode"])
-    if cells:
-        row = {m: (c[0], (c[2], c[3]) if m in en.SCALARS else c[1]) for m, c in cells.items()}
-        for m, ok in en.passes(row, use).items():
-            out[f"ensemble {m}"] = ok
-    lb = tolerances.DYN_ACC_USES_LONG[use]
-    allow = tolerances.DYN_ACC_USES_CHAOS[use]
-    m = longm.get(setting(r))
-    if m is not None:
-        out["kinetic energy (motion)"] = _range_gate(m.get("kinetic_pos"), factor=lb["kinetic_factor"])
-        out["tip frequency"] = _range_gate(m.get("tip_frequency_hz"), rel=lb["freq_rel"])
-        out["damping ratio"] = _range_gate(m.get("tip_damping_ratio"), rel=lb["damping_rel"])
-        for metric in ("tip_L", "curvature_rel", "envelope_rel"):
-            out[f"long {metric}"] = _distance_gate(m.get(metric), allow[metric])
-        j = m.get("jitter_max_move")
-        if j is not None:
-            v, noise = j[0], j[1]
-            out["rest jitter"] = bool(np.isfinite(v) and v <= tolerances.jitter_budget_cm(use) + _noise(noise))
-    return out
 
 
 def _fmt(v, digits=3):
@@ -302,10 +192,9 @@ def long_lines(long, worst_verdict):
 def jitter_budget_lines(long):
     """Each use's rest-jitter budget in pixels and cm, against the reference's own largest
     move and the no-simulation mode's (nothing moves)."""
-    if long is None or long.empty:
+    budgets = jitter_budgets(long)
+    if not budgets:
         return []
-    ref = long[(long["study"] == "reference") & (long["metric"] == "jitter_max_move")]
-    ref_move = float(ref["value"].iloc[0]) if len(ref) else math.nan
     out = [
         "Rest jitter budgets: the largest frame-to-frame move of any point of the settled **rest** scene, in "
         f"pixels of a picture {tolerances.DYN_ACC_VIEW_CM:g} cm high (a head-and-shoulders shot; "
@@ -316,10 +205,8 @@ def jitter_budget_lines(long):
         "| use | lines | budget (px) | budget (cm) | reference's largest move (px) | looser than the reference |",
         "| --- | ---: | ---: | ---: | ---: | --- |",
     ]
-    for use, lb in tolerances.DYN_ACC_USES_LONG.items():
-        cm = tolerances.jitter_budget_cm(use)
-        px = ref_move * lb["lines"] / tolerances.DYN_ACC_VIEW_CM
-        looser = "yes" if np.isfinite(ref_move) and cm > ref_move else "**no**"
-        out.append(f"| {use} | {lb['lines']} | {lb['jitter_px']:g} | {cm:.3g} | {px:.2g} | {looser} |")
+    for b in budgets:
+        looser = "yes" if b["looser"] else "**no**"
+        out.append(f"| {b['use']} | {b['lines']} | {b['px']:g} | {b['cm']:.3g} | {b['ref_px']:.2g} | {looser} |")
     out.append("")
     return out

@@ -1,7 +1,8 @@
-"""Render the dynamic model's speed-against-accuracy study (studies/accuracy_dynamic.py measures it):
-read results/dynamic-accuracy/ (dynamic_accuracy.csv, env.json, analytic.md) and write
-report/dynamic_accuracy.md with its pictures (the Pareto plot, the error growth over time,
-small steps against iterations). Every number and sentence comes from those files.
+"""Render the dynamic model's speed-against-accuracy study (studies/accuracy_dynamic.py measures it,
+studies/accuracy_verdicts_dynamic.py decides what its modes earn): read results/dynamic-accuracy/
+(dynamic_accuracy.csv, env.json, analytic.json) and write report/dynamic_accuracy.md with its
+pictures (the Pareto plot, the error growth over time, small steps against iterations). Every
+number and sentence comes from those files.
 
 `section(results_dir, report_dir)` gives the main report (report.py) a short section with
 a link to the full page. A study on another scene than the default one (`--scene curly`)
@@ -9,32 +10,22 @@ has its own page and pictures, named with the scene (Names), so the two never ov
 each other.
 """
 
-import json
 from dataclasses import astuple, dataclass
 from pathlib import Path
 
 import numpy as np
 
-from harness import HarnessError
 from harness.core import timing, tolerances
 from harness.core.paths import REPORT, RESULTS, display
-from harness.io import files, tables
+from harness.io import files
 from harness.render import accuracy_chaos_dynamic_report as chaos
-from harness.render.accuracy_chaos_dynamic_report import jitter_budget_lines, load_ensemble, load_long
-from harness.studies.accuracy import (
-    ANALYTIC_NAME,
-    CSV_NAME,
-    DEFAULT_SCENE,
-    LATER_COLUMNS,
-    NO_SIMULATION,
-    REQUIRED_COLUMNS,
-    RESULTS_NAME,
-    results_name,
-    scene_tag,
-)
+from harness.render import analytic_dynamic_report
+from harness.render.accuracy_chaos_dynamic_report import jitter_budget_lines
+from harness.studies import accuracy_verdicts_dynamic as verdicts
+from harness.studies.accuracy import CSV_NAME, DEFAULT_SCENE, NO_SIMULATION, RESULTS_NAME, results_name, scene_tag
+from harness.studies.accuracy_results_dynamic import load, load_ensemble, load_long
 from harness.studies.accuracy_rows_dynamic import (
     baseline,
-    better,
     convergence_table,
     front_of,
     label,
@@ -49,6 +40,7 @@ PARETO_PNG = "dynamic_accuracy_pareto.png"
 GROWTH_PNG = "dynamic_accuracy_growth.png"
 STEPS_PNG = "dynamic_accuracy_steps.png"
 DEFAULT_TITLE = "the dynamic model"
+BACKEND_WORDS = {"cpu": "CPU", "cuda": "GPU"}
 
 
 @dataclass(frozen=True)
@@ -75,41 +67,7 @@ def title_of(scene):
     return f"the {tag} scene" if tag else DEFAULT_TITLE
 
 
-# ---- reading --------------------------------------------------------------------------
-
-
-def load(results_dir, csv_path=None):
-    """(rows DataFrame, study dict of env.json, env dict, analytic Markdown lines); the rows
-    from csv_path when given, else from results_dir's table."""
-    results_dir = Path(results_dir)
-    csv_path = Path(csv_path) if csv_path else results_dir / CSV_NAME
-    try:
-        rows = tables.read_csv(csv_path)
-    except FileNotFoundError:
-        raise HarnessError(f"{display(csv_path)} not found: run `python -m harness accuracy --model dynamic`") from None
-    except (OSError, ValueError) as e:
-        raise HarnessError(f"{display(csv_path)}: cannot read ({e})") from None
-    missing = [c for c in REQUIRED_COLUMNS if c not in rows.columns]
-    if missing or rows.empty:
-        raise HarnessError(
-            f"{display(csv_path)}: not a dynamic accuracy table (missing {', '.join(missing) or 'rows'})"
-        )
-    for c in LATER_COLUMNS:
-        if c not in rows.columns:
-            rows[c] = np.nan
-    if rows["verdict"].isna().all():  # written before the split by cause
-        rows["verdict"] = np.where(rows["blown_up_strands"] > 0, "blown up", "ok")
-    try:
-        env = json.loads((results_dir / "env.json").read_text())
-        study = env["study"]
-    except (OSError, ValueError, KeyError, TypeError):
-        raise HarnessError(f"{display(results_dir / 'env.json')}: missing or not the study's record") from None
-    analytic = results_dir / ANALYTIC_NAME
-    lines = analytic.read_text().splitlines() if analytic.exists() else []
-    return rows, study, env, lines
-
-
-# ---- what the rows say ----------------------------------------------------------------
+# ---- what the rows say, in words ------------------------------------------------------
 
 
 def reference_error_line(study):
@@ -123,7 +81,7 @@ def reference_error_line(study):
         f"worst over the horizon): RMS {_e(e['rms_horizon'])}, max {_e(e['max_horizon'])}; with the tail the "
         f"last doublings predict (change ratio {q:.3g} per doubling): RMS {_e(e['est_rms_horizon'])}, max "
         f"{_e(e['est_max_horizon'])}. A mode's error below these is not resolved."
-        if q == q and q < 1
+        if verdicts.tail_estimated(e)
         else f"The reference's own error (S = {study['reference']['substeps']} against S = "
         f"{e['against_substeps']}, worst over the horizon): RMS {_e(e['rms_horizon'])}, max {_e(e['max_horizon'])}; "
         "the last doublings did not shrink the change, so no tail is estimated: read it as a lower bound."
@@ -131,14 +89,12 @@ def reference_error_line(study):
 
 
 def small_steps_verdict(solver, pairs, ladder=None):
-    """Sentences on what the pairs show, from their numbers; `ladder`: the solver's I = 1
-    modes by S (the trend of the error with S alone)."""
+    """Sentences on what the pairs show (accuracy_verdicts_dynamic.small_steps_findings); `ladder`:
+    the solver's I = 1 modes by S (the trend of the error with S alone)."""
     if not pairs:
         return [f"- {solver}: no pair S = n × I = 1 / S = 1 × I = n in this grid."]
-    wins = [p["n"] for p in pairs if better(p["steps"], p["iters"])]
-    losses = [p["n"] for p in pairs if p["n"] not in wins]
-    blown_iters = [p["n"] for p in pairs if p["iters"]["blown"] > 0]
-    blown_steps = [p["n"] for p in pairs if p["steps"]["blown"] > 0]
+    found = verdicts.small_steps_findings(pairs, ladder)
+    wins, losses = found["wins"], found["losses"]
     last = pairs[-1]
     a, b = last["steps"], last["iters"]
     line = (
@@ -155,24 +111,20 @@ def small_steps_verdict(solver, pairs, ladder=None):
             f"stretch {_pct(a['stretch'])} against {_pct(b['stretch'])}, "
             f"{a['time_per_frame_ms']:.3g} against {b['time_per_frame_ms']:.3g} ms per frame."
         )
-    if blown_iters:
-        line += f" 1 substep × n iterations blew up for n = {_list(blown_iters)}."
-    if blown_steps:
-        line += f" n substeps × 1 iteration blew up for n = {_list(blown_steps)}."
-    if ladder is not None and len(ladder) > 1:
-        ok = ladder[ladder["usable"]]
-        if len(ok):
-            best = ok.loc[ok["rms"].idxmin()]
-            top = ladder.iloc[-1]
-            falls = bool(np.all(np.diff(ladder["rms"].to_numpy()) < 0))
-            line += (
-                f" With I = 1 alone its error falls with every doubling of S, to {_e(top['rms'])} at "
-                f"S = {int(top['substeps'])}."
-                if falls
-                else f" With I = 1 alone its error is smallest at S = {int(best['substeps'])} ({_e(best['rms'])}) "
-                f"and is {_e(top['rms'])} at S = {int(top['substeps'])}: more substeps do not bring it closer "
-                "to the reference."
-            )
+    if found["blown_iters"]:
+        line += f" 1 substep × n iterations blew up for n = {_list(found['blown_iters'])}."
+    if found["blown_steps"]:
+        line += f" n substeps × 1 iteration blew up for n = {_list(found['blown_steps'])}."
+    best, top = found["best"], found["top"]
+    if best is not None:
+        line += (
+            f" With I = 1 alone its error falls with every doubling of S, to {_e(top['rms'])} at "
+            f"S = {int(top['substeps'])}."
+            if found["falls"]
+            else f" With I = 1 alone its error is smallest at S = {int(best['substeps'])} ({_e(best['rms'])}) "
+            f"and is {_e(top['rms'])} at S = {int(top['substeps'])}: more substeps do not bring it closer "
+            "to the reference."
+        )
     line += (
         " This agrees with Macklin et al. 2019."
         if not losses
@@ -187,165 +139,88 @@ def _list(ns):
     return ", ".join(str(n) for n in ns)
 
 
-def _passing(summ, use, longm, ensm):
-    """({mode: {gate: passes}}, the usable modes that pass every gate measured for them)."""
-    verdicts = {r["mode"]: chaos.checks(r, use, longm, ensm) for _, r in summ.iterrows()}
-    passes = summ[[all(v is not False for v in verdicts[m].values()) for m in summ["mode"]]]
-    return verdicts, passes[passes["usable"]]
+def _pick_words(what, pick):
+    """One backend's pick (accuracy_verdicts_dynamic.recommendations) in words."""
+    best = pick["best"]
+    if best is None:
+        near = pick["near"]
+        return f"{what}: no mode of this grid meets it" + (
+            f" (the most accurate, {near['mode']}, has RMS error {_e(near['rms'])} and stretch "
+            f"{_pct(near['stretch'])}; it fails " + ", ".join(pick["near_fails"]) + ")"
+            if near is not None
+            else ""
+        )
+    long_note = "" if pick["long_measured"] else "; no long runs at these settings"
+    return (
+        f"{what}: **{best['mode']}** (solver {best['solver']}"
+        + (f", s = {best['ftl_damping']:g}" if best["solver"] == "ftl" else "")
+        + f", S = {int(best['substeps'])}, I = {int(best['iterations'])}, {best['precision']}, build "
+        f"{label(best)}; {best['time_per_frame_ms']:.3g} ms per frame at {int(best['time_strands']):,} "
+        f"strands; RMS error {_e(best['rms'])}, stretch {_pct(best['stretch'])}{long_note}; "
+        + (
+            f"decided by {pick['decided']}, which rejected {pick['rejected']} of the {pick['faster']} faster modes"
+            if pick["decided"]
+            else "the fastest mode of all"
+        )
+        + ")"
+        + tie_note(best, pick["tied"])
+    )
 
 
-def recommended(summ, long=None, ens=None):
-    """The modes recommend() picks (each use, each backend), in order, once each."""
-    longm, _ = chaos.long_metrics(long)
-    ensm = chaos.ensemble_cells(ens)
-    out = []
-    for use in tolerances.DYN_ACC_USES:
-        _, passes = _passing(summ, use, longm, ensm)
-        for _, f in passes.groupby("backend", sort=False):
-            out.append(f.loc[f["time_per_frame_ms"].idxmin(), "mode"])
-    return list(dict.fromkeys(out))
-
-
-def recommended_modes(results_dir):
-    """The modes recommend() names, as data: [{use, backend, meets, mode, solver, ftl_damping,
-    substeps, iterations, precision}], the cheapest passing mode of each use and backend (where
-    none passes, meets False and the most accurate usable one, as recommend() names it), and
-    the study's record (env.json's "study": its scene, horizon and reference)."""
-    rows, study, _, _ = load(results_dir)
-    summ = summary(rows, study["horizon_frames"])
-    longm, _ = chaos.long_metrics(load_long(results_dir))
-    ensm = chaos.ensemble_cells(load_ensemble(results_dir))
-    out = []
-    for use in tolerances.DYN_ACC_USES:
-        _, passes = _passing(summ, use, longm, ensm)
-        for backend in ("cpu", "cuda"):
-            f = passes[passes["backend"] == backend]
-            usable = summ[(summ["backend"] == backend) & summ["usable"]]
-            if f.empty and usable.empty:
-                continue
-            best = usable.loc[usable["rms"].idxmin()] if f.empty else f.loc[f["time_per_frame_ms"].idxmin()]
-            damping = best["ftl_damping"] if best["solver"] == "ftl" else None
-            out.append(
-                {"use": use, "backend": backend, "meets": not f.empty, "mode": str(best["mode"])}
-                | {"solver": str(best["solver"])}
-                | {"ftl_damping": None if damping is None else float(damping), "precision": str(best["precision"])}
-                | {"substeps": int(best["substeps"]), "iterations": int(best["iterations"])}
-            )
-    return out, study
+def _gates_words(use, rec, horizon):
+    """A use's budgets and gates, as the recommendation's bullet states them."""
+    rms_budget, stretch_budget, why = tolerances.DYN_ACC_USES[use]
+    lb = tolerances.DYN_ACC_USES_LONG[use]
+    allow = tolerances.DYN_ACC_USES_CHAOS[use]
+    over = f" up to {horizon:.3g} s" if horizon is not None else " over the horizon"
+    chaos_txt = (
+        f"; over the whole run, within the reference ensemble's spread plus {allow['tip_L']:g}·L (tip "
+        f"distribution), {100 * allow['curvature_rel']:g} % (curvature) and {100 * allow['envelope_rel']:g} % "
+        f"(silhouette area), kinetic energy of the motion within ×{allow['kinetic_factor']:g} of the members' "
+        "range, stretch against ℓ_k within the use's budget"
+        if rec["ensemble"]
+        else ""
+    )
+    long_txt = (
+        f"; in the long runs tip frequency within {100 * lb['freq_rel']:g} % and damping ratio within "
+        f"{100 * lb['damping_rel']:g} % of the reference ensemble's range, kinetic energy from positions within "
+        f"×{lb['kinetic_factor']:g}, and no point of a still head moving more than {lb['jitter_px']:g} px from "
+        f"frame to frame at {lb['lines']} lines ({_jit(use)}; noise allowed)"
+        if rec["long"]
+        else ""
+    )
+    base_note = ""
+    if rec["base_rms"] is not None:
+        base_note = (
+            f"; the RMS budget is {rec['base_rms'] / rms_budget:.3g}× tighter than not simulating at all "
+            f"({_e(rec['base_rms'])})"
+            if rec["tighter"]
+            else f"; **the RMS budget is not tighter than not simulating at all** ({_e(rec['base_rms'])})"
+        )
+    return (
+        f"RMS error ≤ {rms_budget:g}·L and stretch ≤ {_pct(stretch_budget)}{over}{chaos_txt}"
+        f"{long_txt}, never blown up; {why}{base_note}"
+    )
 
 
 def recommend(summ, long=None, ens=None, horizon=None):
-    """Per use (tolerances.DYN_ACC_USES, DYN_ACC_USES_LONG, DYN_ACC_USES_CHAOS) and per backend:
-    the cheapest mode that meets every budget measured for it (accuracy_chaos_report.checks),
-    naming its solver, s, S, I, precision and build, and the metric that decided it (the one that
-    rejected most of the faster modes); `horizon`: the pointwise horizon (s) the RMS budget is
-    judged over. Lines of Markdown."""
+    """Per use and per backend, the pick of accuracy_verdicts_dynamic.recommendations in words:
+    the cheapest mode that meets every budget measured for it, naming its solver, s, S, I,
+    precision and build, and the metric that decided it (the one that rejected most of the faster
+    modes); `horizon`: the pointwise horizon (s) the RMS budget is judged over. Lines of Markdown."""
     lines = []
-    longm, _ = chaos.long_metrics(long)
-    ensm = chaos.ensemble_cells(ens)
-    base = baseline(summ)
-    summ = summ.assign(  # a summary without the timing columns (measured before them): no spread, no noise
-        time_rsd=summ["time_rsd"] if "time_rsd" in summ else np.nan,
-        time_noisy=summ["time_noisy"] if "time_noisy" in summ else "",
-    )
-    for use, (rms_budget, stretch_budget, why) in tolerances.DYN_ACC_USES.items():
-        verdicts, passes = _passing(summ, use, longm, ensm)
-        picks = []
-        for backend, what in (("cpu", "CPU"), ("cuda", "GPU")):
-            if not (summ["backend"] == backend).any():
-                continue
-            mine = summ[summ["backend"] == backend]
-            f = passes[passes["backend"] == backend]
-            if f.empty:
-                ok = mine[mine["usable"]]
-                near = ok.loc[ok["rms"].idxmin()] if len(ok) else None
-                picks.append(
-                    f"{what}: no mode of this grid meets it"
-                    + (
-                        f" (the most accurate, {near['mode']}, has RMS error {_e(near['rms'])} and stretch "
-                        f"{_pct(near['stretch'])}; it fails "
-                        + ", ".join(k for k, v in verdicts[near["mode"]].items() if v is False)
-                        + ")"
-                        if near is not None
-                        else ""
-                    )
-                )
-                continue
-            best, tied = _fastest_or_tie(f)
-            faster = mine[mine["time_per_frame_ms"] < best["time_per_frame_ms"]]
-            failed = {}
-            for m in faster["mode"]:
-                for k, v in verdicts[m].items():
-                    if v is False:
-                        failed[k] = failed.get(k, 0) + 1
-            decided = max(failed, key=failed.get) if failed else None
-            long_note = "" if chaos.setting(best) in longm else "; no long runs at these settings"
-            picks.append(
-                f"{what}: **{best['mode']}** (solver {best['solver']}"
-                + (f", s = {best['ftl_damping']:g}" if best["solver"] == "ftl" else "")
-                + f", S = {int(best['substeps'])}, I = {int(best['iterations'])}, {best['precision']}, build "
-                f"{label(best)}; {best['time_per_frame_ms']:.3g} ms per frame at {int(best['time_strands']):,} "
-                f"strands; RMS error {_e(best['rms'])}, stretch {_pct(best['stretch'])}{long_note}; "
-                + (
-                    f"decided by {decided}, which rejected {failed[decided]} of the {len(faster)} faster modes"
-                    if decided
-                    else "the fastest mode of all"
-                )
-                + ")"
-                + tie_note(best, tied)
-            )
-        base_note = ""
-        if base is not None and np.isfinite(base["rms"]):
-            tighter = rms_budget < base["rms"]
-            base_note = (
-                f"; the RMS budget is {base['rms'] / rms_budget:.3g}× tighter than not simulating at all "
-                f"({_e(base['rms'])})"
-                if tighter
-                else f"; **the RMS budget is not tighter than not simulating at all** ({_e(base['rms'])})"
-            )
-        lb = tolerances.DYN_ACC_USES_LONG[use]
-        allow = tolerances.DYN_ACC_USES_CHAOS[use]
-        over = f" up to {horizon:.3g} s" if horizon is not None else " over the horizon"
-        chaos_txt = (
-            f"; over the whole run, within the reference ensemble's spread plus {allow['tip_L']:g}·L (tip "
-            f"distribution), {100 * allow['curvature_rel']:g} % (curvature) and {100 * allow['envelope_rel']:g} % "
-            f"(silhouette area), kinetic energy of the motion within ×{allow['kinetic_factor']:g} of the members' "
-            "range, stretch against ℓ_k within the use's budget"
-            if ensm
-            else ""
-        )
-        long_txt = (
-            f"; in the long runs tip frequency within {100 * lb['freq_rel']:g} % and damping ratio within "
-            f"{100 * lb['damping_rel']:g} % of the reference ensemble's range, kinetic energy from positions within "
-            f"×{lb['kinetic_factor']:g}, and no point of a still head moving more than {lb['jitter_px']:g} px from "
-            f"frame to frame at {lb['lines']} lines ({_jit(use)}; noise allowed)"
-            if longm
-            else ""
-        )
-        jit = [c for c in verdicts.values() if c.get("rest jitter") is False]
-        alone = [c for c in jit if all(v is not False for k, v in c.items() if k != "rest jitter")]
+    for rec in verdicts.recommendations(summ, long, ens):
+        picks = [_pick_words(BACKEND_WORDS[b], pick) for b, pick in rec["picks"].items()]
         jit_note = (
-            f" Rest jitter rejects {len(jit)} of the {len(verdicts)} modes, {len(alone)} of them on that alone."
-            if longm
+            f" Rest jitter rejects {rec['jitter']} of the {rec['modes']} modes, {rec['jitter_alone']} of them on that "
+            "alone."
+            if rec["long"]
             else ""
         )
         lines.append(
-            f"- **{use}** (RMS error ≤ {rms_budget:g}·L and stretch ≤ {_pct(stretch_budget)}{over}{chaos_txt}"
-            f"{long_txt}, never blown up; {why}{base_note}): " + "; ".join(picks) + "." + jit_note
+            f"- **{rec['use']}** ({_gates_words(rec['use'], rec, horizon)}): " + "; ".join(picks) + "." + jit_note
         )
     return lines
-
-
-def _fastest_or_tie(f):
-    """The pick among passing modes `f` by time, and the modes tied with the fastest within their
-    noise (core/timing.tie: bands of ±2 standard deviations, at least ±0.5 %): a tie goes to the
-    most accurate of them (its RMS error, a number the timing noise does not touch)."""
-    figs = [(float(t), float(r)) for t, r in zip(f["time_per_frame_ms"], f["time_rsd"])]
-    tied = f.iloc[timing.tie(figs)]
-    if len(tied) <= 1:
-        return f.loc[f["time_per_frame_ms"].idxmin()], tied.iloc[0:0]
-    best = tied.loc[tied["rms"].idxmin()]
-    return best, tied[tied["mode"] != best["mode"]]
 
 
 def tie_note(best, tied):
@@ -388,9 +263,8 @@ def baseline_lines(summ, study):
         "| use | RMS budget / L | budget ÷ no-sim RMS | tighter than no simulation |",
         "| --- | ---: | ---: | --- |",
     ]
-    for use, (rms_budget, _, _) in tolerances.DYN_ACC_USES.items():
-        ratio = rms_budget / base["rms"] if base["rms"] > 0 else float("nan")
-        out.append(f"| {use} | {rms_budget:g} | {ratio:.3g} | {'yes' if ratio < 1 else '**no**'} |")
+    for b in verdicts.budgets_against_baseline(base):
+        out.append(f"| {b['use']} | {b['budget']:g} | {b['ratio']:.3g} | {'yes' if b['tighter'] else '**no**'} |")
     out.append("")
     return out
 
@@ -401,10 +275,6 @@ def _e(x):
 
 def _pct(x):
     return "n/a" if x is None or not np.isfinite(x) else f"{100 * x:.3g} %"
-
-
-def _short(r):
-    return f"{r['solver']} S{int(r['substeps'])} I{int(r['iterations'])} {r['precision']}"
 
 
 # ---- pictures -------------------------------------------------------------------------
@@ -570,7 +440,7 @@ def _header(study, env):
         f"are compared over the **horizon of {study['horizon']:.3g} s** ({study['horizon_frames']} frames"
         + (
             f"; the asked {study['asked_horizon']:g} s cut to the scene's predictability time, below"
-            if study.get("asked_horizon", study["horizon"]) > study["horizon"] + 1e-9
+            if verdicts.horizon_cut(study)
             else ""
         )
         + f"): the worst frame of RMS and of max |x − x_ref| over all points, over L = {study['hair_length']:g} cm; "
@@ -620,7 +490,7 @@ def convergence_lines(rows, study):
             + (
                 ": beyond that the reference is no longer ten times better than the best mode, and the "
                 "errors after it are not a measurement of the modes (they are drawn, not tabulated)."
-                if ref["converged_until_s"] < study["frames"] * study["frame_dt"] - 1e-9
+                if not verdicts.converged_to_the_end(study)
                 else "."
             )
         )
@@ -776,7 +646,7 @@ def markdown(rows, study, env, analytic, long=None, names=Names(), title=DEFAULT
         ladder = o[(o["scheme"] == solver) & (o["iterations"] == 1)].sort_values("substeps")
         out += small_steps_verdict(solver, ps, ladder)
     out += ["", reference_error_line(study), "", f"![small steps against iterations]({names.steps})", ""]
-    shown = list(dict.fromkeys([*front["mode"], *recommended(summ, long, ens)]))
+    shown = list(dict.fromkeys([*front["mode"], *verdicts.recommended(summ, long, ens)]))
     out += chaos.chaos_lines(summ, ens, shown)
     out += chaos.long_lines(long, worst_verdict)
     out += [
@@ -802,12 +672,17 @@ def markdown(rows, study, env, analytic, long=None, names=Names(), title=DEFAULT
             "docs/model.md §4 against the C reference (fp64 unless a table says fp32, `--threads 1`, no collider; "
             "`harness/studies/analytic_table_dynamic.py`, run by this study):",
             "",
-            *[ln.replace("### ", "#### ", 1) if ln.startswith("### ") else ln for ln in analytic],
+            *[ln.replace("### ", "#### ", 1) if ln.startswith("### ") else ln for ln in _analytic_lines(analytic)],
             "",
         ]
     out += _all_modes_lines(summ)
     out += [reference_error_line(study), ""]
     return out, summ, front, pairs
+
+
+def _analytic_lines(analytic):
+    """The analytic tables: rendered from the sweeps' data, or a study's Markdown from before #47."""
+    return analytic if isinstance(analytic, list) else analytic_dynamic_report.lines(analytic)
 
 
 def write(results_dir=None, report_dir=None, csv_path=None, title=None):

@@ -25,7 +25,7 @@ from harness import HarnessError
 from harness.core import timing
 from harness.core.paths import display
 from harness.io import tables
-from harness.render import accuracy_dynamic_report as accuracy
+from harness.studies import accuracy_results_dynamic as accuracy_results
 from harness.studies import accuracy_rows_dynamic as accuracy_rows
 from harness.studies.accuracy import CSV_NAME, CURVES_CSV, curves_name, results_name
 
@@ -55,7 +55,7 @@ def load(root, scene="dynamic"):
     ):
         if not path.is_file():
             raise HarnessError(f"budget: no {display(path)} (measure it: {cmd}, or give --run)", code=2)
-    rows, study, _, _ = accuracy.load(acc_dir)
+    rows, study, _, _ = accuracy_results.load(acc_dir)
     summ = accuracy_rows.summary(rows, study["horizon_frames"])
     curves = tables.read_csv(curves_path)
     err = curves["error"]

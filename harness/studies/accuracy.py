@@ -146,7 +146,8 @@ def curves_name(scene):
     return f"{CURVES_NAME}-{tag}" if tag else CURVES_NAME
 
 
-ANALYTIC_NAME = "analytic.md"
+ANALYTIC_NAME = "analytic.json"  # studies/analytic_table_dynamic.measure's data
+ANALYTIC_MD = "analytic.md"  # the same as Markdown tables, kept by a study from before #47
 # the reference family of the contract (docs/model.md §3.6), in its working precision fp64
 REF_SOLVER, REF_PRECISION, REF_ITERATIONS = "xpbd", "fp64", 1
 

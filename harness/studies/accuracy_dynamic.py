@@ -36,7 +36,7 @@ strands, `time_frames` frames, `--repeat`, no output file (never a run that also
 it is the simulate stage's median.
 
 Writes results/dynamic-accuracy/dynamic_accuracy.csv (one row per mode and frame, plus the
-reference ladder and the GPU check), analytic.md (harness/studies/analytic_table_dynamic.py's tables) and
+reference ladder and the GPU check), analytic.json (harness/studies/analytic_table_dynamic.py's sweeps) and
 env.json; then accuracy_dynamic_report.py writes report/dynamic_accuracy.md and its PNGs. On
 another scene (`--scene curly`) the folder is results/dynamic-accuracy-curly/ and the page
 report/dynamic_accuracy_curly.md.
@@ -64,6 +64,7 @@ from harness.studies import accuracy_ensemble_dynamic as accuracy_ensemble
 from harness.studies import observables_long_dynamic as observables_long
 from harness.studies import predictability_dynamic as predictability
 from harness.studies.accuracy import (
+    ANALYTIC_MD,
     ANALYTIC_NAME,
     COLUMNS,
     CSV_NAME,
@@ -599,7 +600,7 @@ def _frame_rows(run, rms, mx, extra, **shared):
 
 
 def run_study(plan, out_dir=None, force=False, command=None, log=print):
-    """Measure, write the CSV, analytic.md and env.json (render/accuracy_dynamic_report.py
+    """Measure, write the CSV, analytic.json and env.json (render/accuracy_dynamic_report.py
     draws them); return the exit status (0: reference converged over the horizon, 1: it
     did not)."""
     started = time.monotonic()
@@ -629,7 +630,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
     )
 
     # 1. the checked runs (in parallel: nothing here is timed) and the analytic tables
-    analytic_lines = []
+    analytic = None
     mode_paths, records = {}, {}
     jobs = study.jobs
     try:
@@ -639,7 +640,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
             if plan.analytic != "none":
                 from harness.studies import analytic_table_dynamic as analytic_table
 
-                futures[pool.submit(analytic_table.tables, str(cpu_oracle.binary), plan.analytic == "quick")] = None
+                futures[pool.submit(analytic_table.measure, str(cpu_oracle.binary), plan.analytic == "quick")] = None
             units = [[m] for m in modes if m.runner.backend == "cpu"]  # a process each, the pool's jobs in parallel
             on_gpu = [m for m in modes if m.runner.backend != "cpu"]
             units += runner.batches(on_gpu, lambda m: m.runner.binary, CHECKED_A_BATCH)
@@ -649,7 +650,7 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
                 for f in as_completed(futures):
                     ms = futures[f]
                     if ms is None:
-                        analytic_lines = f.result()
+                        analytic = f.result()
                         bar.update()
                         bar.write("dynamic accuracy: analytic tables done")
                         continue
@@ -720,10 +721,12 @@ def run_study(plan, out_dir=None, force=False, command=None, log=print):
         files.write_csv(long_path, observables_long.COLUMNS, long_rows)
     elif long_path.exists():
         long_path.unlink()  # stale long runs must not be rendered with these rows
-    if analytic_lines:
-        files.write_text(out_dir / ANALYTIC_NAME, "\n".join(analytic_lines) + "\n")
+    if (out_dir / ANALYTIC_MD).exists():
+        (out_dir / ANALYTIC_MD).unlink()  # tables from before #47 must not be rendered with these rows
+    if analytic:
+        files.write_json(out_dir / ANALYTIC_NAME, analytic)
     elif (out_dir / ANALYTIC_NAME).exists():
-        (out_dir / ANALYTIC_NAME).unlink()  # a stale table must not be rendered with these rows
+        (out_dir / ANALYTIC_NAME).unlink()  # a stale sweep must not be rendered with these rows
     meta = _env(study, plan, builds, (gpu_ok, gpu_why, gpu_note), ref, ref_err, ens, started, command)
     final_S = ref["steps"][-1]["S2"]
     files.write_json(out_dir / "env.json", meta)

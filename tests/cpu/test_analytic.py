@@ -4,7 +4,7 @@ Hand-made input states (harness/studies/analytic_runs_dynamic.py) run through
 `hairsim-cpu --input IN --stages simulate --no-collider …`; the closed forms and the
 measurements are in harness/studies/analytic_dynamic.py, the tolerances (with the measurements behind
 them) in harness/core/tolerances.py (ANALYTIC_*). Only 2–3 substep counts S per check run here;
-the full sweeps are in docs/analytic.md (`python -m harness.studies.analytic_table_dynamic`).
+the full sweeps are in docs/analytic.md (`python -m harness analytic`).
 """
 
 import math
@@ -13,8 +13,14 @@ import numpy as np
 import pytest
 
 from harness.check import observables_dynamic as ob
+from harness.cli import main as cli
 from harness.core import tolerances as tol
+from harness.io import files
+from harness.render import analytic_dynamic_report as analytic_report
 from harness.studies import analytic_dynamic as an
+from harness.studies import analytic_table_dynamic as analytic_table
+from harness.studies.accuracy import ANALYTIC_MD, ANALYTIC_NAME
+from harness.studies.accuracy_results_dynamic import load_analytic
 from harness.studies.analytic_runs_dynamic import G0, run_chain, run_pendulum, run_wind
 
 SOLVERS = ("xpbd", "ftl")
@@ -136,3 +142,37 @@ def test_fp32_holds_the_analytic_answers_at_moderate_substeps(cpu_bin, tmp_path,
             assert abs(r["measured"] - r["expected"]) <= tol.ANALYTIC_FP32_WIND_ANGLE_ABS, (
                 f"fp32 S={substeps} U={speed} ψ={psi}: θ={r['measured']!r}, expected {r['expected']!r}"
             )
+
+
+# ---------------------------------------------------------------- the sweeps' tables
+
+
+def test_the_sweeps_print_as_tables_and_keep_as_json(cpu_bin, tmp_path, capsys, monkeypatch):
+    """`harness analytic` prints render/analytic_dynamic_report.py's tables of
+    studies/analytic_table_dynamic.measure's data, a row for each measurement; the accuracy study
+    keeps that data as analytic.json and its page renders the same tables from it; a study from
+    before #47 kept analytic.md, read as it is, and analytic.json wins where both are."""
+    measured = []
+
+    def recording(*args, **kwargs):
+        measured.append(real(*args, **kwargs))
+        return measured[-1]
+
+    real = analytic_table.measure
+    monkeypatch.setattr(analytic_table, "measure", recording)
+    assert cli.main(["analytic", "--quick", "--binary", str(cpu_bin)]) == 0
+    (sweeps,) = measured
+    lines = analytic_report.lines(sweeps)
+    assert capsys.readouterr().out == "\n".join(lines) + "\n"
+    assert len([ln for ln in lines if ln.startswith("### ")]) == 6  # two pendulums, wind, two chains, fp32
+    heads = ("| solver |", "| check |", "| --- |")
+    rows = [ln for ln in lines if ln.startswith("| ") and not ln.startswith(heads)]
+    cases = sweeps["pendulum"] + sweeps["chain"]
+    assert len(rows) == sum(len(c["rows"]) for c in cases) + len(sweeps["wind"]) + len(sweeps["fp32"]) > 0
+    files.write_json(tmp_path / ANALYTIC_NAME, sweeps)
+    assert analytic_report.lines(load_analytic(tmp_path)) == lines
+    (tmp_path / ANALYTIC_MD).write_text("### old tables\n")
+    assert analytic_report.lines(load_analytic(tmp_path)) == lines
+    (tmp_path / ANALYTIC_NAME).unlink()
+    assert load_analytic(tmp_path) == ["### old tables"]
+    assert load_analytic(tmp_path / "nothing") is None

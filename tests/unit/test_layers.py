@@ -1,9 +1,11 @@
 """harness/ in layers with one-way imports: no import cycle inside the package (imports inside
 functions count), each layer imports only itself and the layers below it, and no renderer
-reaches the runner (the one module that starts a binary). Read statically with ast, so an
-import hidden in a function cannot slip through."""
+reaches the runner (the one module that starts a binary); below render/ nothing makes Markdown,
+and a renderer compares nothing with a tolerance (#47: measuring, deciding and drawing apart).
+Read statically with ast, so an import hidden in a function cannot slip through."""
 
 import ast
+import re
 
 import pytest
 
@@ -298,3 +300,182 @@ def test_the_length_scan_sees_a_long_function(tmp_path):
     path = tmp_path / "m.py"
     path.write_text("def f():\n" + "    x = 1\n" * 160 + "\n\ndef g():\n    return 2\n")
     assert long_functions(path) == [(1, "f", 161)]
+
+
+# ---- measuring and drawing apart (#47) ------------------------------------------------------
+# Markdown is the renderers' (render/ and above): the layers below it measure, check and decide
+# and hand back data. A renderer words what it is given: it compares nothing with a tolerance.
+
+MEASURING = ("core", "io", "check", "studies")
+MARKDOWN = re.compile(r"(?m)^(\| |#{2,6} \S)|\| ?:?-{3,}:? ?\|")  # a table row or rule, a ## heading
+WRITE_FUNCS = ("files.write_text", "files.write_bytes", "files.write_json", "files.writing", "files.copy", "open")
+
+
+def _docstrings(tree):
+    nodes = (ast.Module, ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)
+    return {
+        id(n.body[0].value)
+        for n in ast.walk(tree)
+        if isinstance(n, nodes) and n.body and isinstance(n.body[0], ast.Expr)
+        and isinstance(n.body[0].value, ast.Constant)
+    }  # fmt: skip
+
+
+def markdown_names():
+    """Names bound at a module's top level to a Markdown file's name ("analytic.md")."""
+    return {
+        t.id
+        for p in PACKAGE.rglob("*.py")
+        for n in ast.parse(p.read_text()).body
+        if isinstance(n, ast.Assign) and isinstance(n.value, ast.Constant) and str(n.value.value).endswith(".md")
+        for t in n.targets
+        if isinstance(t, ast.Name)
+    }
+
+
+def markdown_made(path, md_names):
+    """Where a file makes Markdown: a string (not a docstring) holding a table row or a heading,
+    and a write whose path names a .md file (a literal or a name of `md_names`)."""
+    tree = ast.parse(path.read_text(), str(path))
+    skip = _docstrings(tree)
+    found = [
+        f"line {n.lineno}: Markdown text {n.value[:30]!r}"
+        for n in ast.walk(tree)
+        if isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in skip and MARKDOWN.search(n.value)
+    ]
+    for n in ast.walk(tree):
+        if not isinstance(n, ast.Call):
+            continue
+        func = ast.unparse(n.func)
+        modes = [str(a.value) for a in n.args[1:2] if isinstance(a, ast.Constant)]
+        if func.endswith((".write_text", ".write_bytes")) and not func.startswith("files."):
+            target = n.func.value  # path.write_text(...)
+        elif func in WRITE_FUNCS and n.args and (func != "open" or any(set(m) & set("wax+") for m in modes)):
+            target = n.args[0]
+        else:
+            continue
+        named = [
+            x for x in ast.walk(target)
+            if (isinstance(x, ast.Constant) and str(x.value).endswith(".md"))
+            or (isinstance(x, ast.Name) and x.id in md_names) or (isinstance(x, ast.Attribute) and x.attr in md_names)
+        ]  # fmt: skip
+        if named:
+            found.append(f"line {n.lineno}: {func} writes {ast.unparse(target)}")
+    return found
+
+
+def test_the_measuring_layers_make_no_markdown():
+    """core/, io/, check/ and studies/ return data; a renderer writes it as Markdown."""
+    names = markdown_names()
+    bad = [
+        f"{module_name(p)} {m}"
+        for p in sorted(PACKAGE.rglob("*.py"))
+        if module_name(p).split(".")[1:2] and module_name(p).split(".")[1] in MEASURING
+        for m in markdown_made(p, names)
+    ]
+    assert not bad, "Markdown made below harness/render:\n" + "\n".join(bad)
+
+
+def test_the_markdown_check_sees_a_table_and_a_write(tmp_path):
+    path = tmp_path / "m.py"
+    path.write_text(
+        '"""| a docstring may show a table |"""\n'
+        'PAGE = "page.md"\n'
+        "def f(out, s):\n"
+        '    rows = [f"| {s} | 1 |", "| --- | ---: |"]\n'
+        "    files.write_text(out / PAGE, s)\n"
+        '    (out / "x.md").write_text(s)\n'
+        '    files.write_text(out / "x.json", "# not a heading")\n'
+    )
+    assert sorted(markdown_made(path, {"PAGE"})) == [
+        "line 4: Markdown text '| '",
+        "line 4: Markdown text '| --- | ---: |'",
+        "line 5: files.write_text writes out / PAGE",
+        "line 6: (out / 'x.md').write_text writes out / 'x.md'",
+    ]
+
+
+def _applies_tolerance(node, tainted):
+    """Whether an expression reads harness.core.tolerances (or a name bound from it): through a
+    call only as the callee (tolerances.f(x), a budget's .items()), not through its arguments."""
+    if isinstance(node, ast.Call):
+        return _applies_tolerance(node.func, tainted)
+    if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "tolerances":
+        return True
+    if isinstance(node, ast.Name):
+        return node.id in tainted
+    if isinstance(node, (ast.Lambda, ast.FunctionDef)):
+        return False
+    return any(_applies_tolerance(c, tainted) for c in ast.iter_child_nodes(node))
+
+
+def tolerance_comparisons(path):
+    """(line, comparison) of each comparison in a file's functions with a value from
+    harness.core.tolerances, directly or through names bound from it (for k, v in X.items():
+    v, not the key)."""
+    tree = ast.parse(path.read_text(), str(path))
+    found = set()
+    for fn in (n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))):
+        tainted, grew = set(), True
+        while grew:
+            grew = False
+            for n in ast.walk(fn):
+                if isinstance(n, ast.Assign):
+                    pairs = [(t, n.value) for t in n.targets]
+                elif isinstance(n, (ast.For, ast.comprehension)):
+                    pairs = [(n.target, n.iter)]
+                else:
+                    continue
+                for target, value in pairs:
+                    if not _applies_tolerance(value, tainted):
+                        continue
+                    items = isinstance(value, ast.Call) and ast.unparse(value.func).endswith(".items")
+                    if items and isinstance(target, ast.Tuple) and len(target.elts) == 2:
+                        target = target.elts[1]
+                    new = {x.id for x in ast.walk(target) if isinstance(x, ast.Name)} - tainted
+                    tainted |= new
+                    grew = grew or bool(new)
+        found |= {
+            (n.lineno, ast.unparse(n))
+            for n in ast.walk(fn)
+            if isinstance(n, ast.Compare) and _applies_tolerance(n, tainted)
+        }
+    return sorted(found)
+
+
+# renderers that still apply a tolerance themselves (#47's leftovers: each to hand its verdicts to
+# a studies/ module as accuracy_dynamic_report.py does through accuracy_verdicts_dynamic.py)
+DECIDING_RENDERERS = {
+    "harness.render.accuracy_world_dynamic_report",
+    "harness.render.host_report",
+    "harness.render.peer_dynamic_report",
+    "harness.render.reduced_dynamic_report",
+}
+
+
+def test_renderers_compare_nothing_with_a_tolerance():
+    """A verdict (a tolerance applied to a measurement) is made in studies/ and handed to the
+    renderer as data; the list of renderers that still decide only shrinks."""
+    deciding = {
+        module_name(p): tolerance_comparisons(p)
+        for p in sorted((PACKAGE / "render").rglob("*.py"))
+        if tolerance_comparisons(p)
+    }
+    new = [f"{m}: line {line}: {c}" for m, cs in deciding.items() if m not in DECIDING_RENDERERS for line, c in cs]
+    assert not new, "renderers that apply a tolerance (decide in harness/studies):\n" + "\n".join(new)
+    split = DECIDING_RENDERERS - set(deciding)
+    assert not split, f"no longer decide: remove from DECIDING_RENDERERS: {sorted(split)}"
+
+
+def test_the_tolerance_check_follows_a_budget_through_names(tmp_path):
+    path = tmp_path / "m.py"
+    path.write_text(
+        "def f(r, use):\n"
+        "    for name, (rms, _) in tolerances.USES.items():\n"
+        "        ratio = rms / r\n"
+        "        words = 'yes' if ratio < 1 else 'no'\n"
+        "        same = name == use\n"
+        "    ok = r <= tolerances.budget(use)\n"
+        "    return describe(tolerances.USES) is None\n"
+    )
+    assert tolerance_comparisons(path) == [(4, "ratio < 1"), (6, "r <= tolerances.budget(use)")]

@@ -1,5 +1,5 @@
-"""The studies' commands: `budget`, `hair`, `calibrate`, `featurecost`, `world`, `reduced`, `peer`, `stability`,
-`judge`."""
+"""The studies' commands: `budget`, `hair`, `calibrate`, `analytic`, `featurecost`, `world`, `reduced`, `peer`,
+`stability`, `judge`."""
 
 import argparse
 import json
@@ -211,6 +211,23 @@ def cmd_calibrate(args):
     )
 
 
+def cmd_analytic(args):
+    """The analytic checks of docs/model.md §4 swept over S on the C reference, printed as
+    docs/analytic.md's Markdown tables."""
+    from pathlib import Path
+
+    from harness.core.paths import binary_path, display
+    from harness.render import analytic_dynamic_report
+    from harness.studies import analytic_table_dynamic
+
+    binary = Path(args.binary) if args.binary else binary_path("cpu")
+    if not binary.is_file():
+        raise HarnessError(f"{display(binary)} is not built (run make cpu)")
+    sweeps = analytic_table_dynamic.measure(str(binary), args.quick)
+    print("\n".join(analytic_dynamic_report.lines(sweeps)))
+    return 0
+
+
 def add_budget(sub):
     bu = command(sub, cmd_budget, help="a frame budget's answer: the most accurate mode that fits, from measured data")
     bu.add_argument("--strands", type=whole(1), required=True, help="strands simulated a frame")
@@ -250,6 +267,12 @@ def add_calibrate(sub):
         "precision (e.g. build/hairsim-cuda on a GPU node)",
     )
     c.add_argument("--json", action="store_true")
+
+
+def add_analytic(sub):
+    a = command(sub, cmd_analytic, help="the dynamic model's analytic checks swept over S, as Markdown tables")
+    a.add_argument("--binary", default=None, help="the C reference to run (default build/hairsim-cpu)")
+    a.add_argument("--quick", action="store_true", help="fewer S (a smoke run)")
 
 
 def add_featurecost(sub):
