@@ -115,25 +115,35 @@ def passing(summ, use, longm, ensm):
 # ---- the pick of each use --------------------------------------------------------------
 
 
+def with_noise(summ):
+    """summ with its timing-noise columns (a summary measured before them: no spread, no noise)."""
+    return summ.assign(
+        time_rsd=summ["time_rsd"] if "time_rsd" in summ else np.nan,
+        time_noisy=summ["time_noisy"] if "time_noisy" in summ else "",
+    )
+
+
 def recommended(summ, long=None, ens=None):
-    """The cheapest passing mode of each use and backend (by median time), in order, once each."""
+    """The pick of each use and backend (the cheapest passing mode, a tie within timing noise to
+    the most accurate: fastest_or_tie, as the page picks), in order, once each."""
     longm, _ = long_metrics(long)
     ensm = ensemble_cells(ens)
+    summ = with_noise(summ)
     out = []
     for use in tolerances.DYN_ACC_USES:
         _, passes = passing(summ, use, longm, ensm)
         for _, f in passes.groupby("backend", sort=False):
-            out.append(f.loc[f["time_per_frame_ms"].idxmin(), "mode"])
+            out.append(fastest_or_tie(f)[0]["mode"])
     return list(dict.fromkeys(out))
 
 
 def recommended_modes(results_dir):
     """The modes the page recommends, as data: [{use, backend, meets, mode, solver, ftl_damping,
-    substeps, iterations, precision}], the cheapest passing mode of each use and backend (where
+    substeps, iterations, precision}], the pick of each use and backend (fastest_or_tie; where
     none passes, meets False and the most accurate usable one, as the page names it), and the
     study's record (env.json's "study": its scene, horizon and reference)."""
     rows, study, _, _ = load(results_dir)
-    summ = summary(rows, study["horizon_frames"])
+    summ = with_noise(summary(rows, study["horizon_frames"]))
     longm, _ = long_metrics(load_long(results_dir))
     ensm = ensemble_cells(load_ensemble(results_dir))
     out = []
@@ -144,7 +154,7 @@ def recommended_modes(results_dir):
             usable = summ[(summ["backend"] == backend) & summ["usable"]]
             if f.empty and usable.empty:
                 continue
-            best = usable.loc[usable["rms"].idxmin()] if f.empty else f.loc[f["time_per_frame_ms"].idxmin()]
+            best = usable.loc[usable["rms"].idxmin()] if f.empty else fastest_or_tie(f)[0]
             damping = best["ftl_damping"] if best["solver"] == "ftl" else None
             out.append(
                 {"use": use, "backend": backend, "meets": not f.empty, "mode": str(best["mode"])}
@@ -204,10 +214,7 @@ def recommendations(summ, long=None, ens=None):
     ensm = ensemble_cells(ens)
     base = baseline(summ)
     base_rms = float(base["rms"]) if base is not None and np.isfinite(base["rms"]) else None
-    summ = summ.assign(  # a summary without the timing columns (measured before them): no spread, no noise
-        time_rsd=summ["time_rsd"] if "time_rsd" in summ else np.nan,
-        time_noisy=summ["time_noisy"] if "time_noisy" in summ else "",
-    )
+    summ = with_noise(summ)
     out = []
     for use, (rms_budget, _, _) in tolerances.DYN_ACC_USES.items():
         verdicts, passes = passing(summ, use, longm, ensm)

@@ -201,6 +201,16 @@ def test_modes_within_timing_noise_are_a_tie_named_by_accuracy():
     assert mode_ == "cpu ref ftl s=1 S16 I1 fp32" and pick["tied"].empty
 
 
+def test_every_pick_breaks_a_tie_as_the_page_does():
+    """recommended (the ensemble table's modes) and recommendations (the page) name the same mode
+    when two passing modes tie within timing noise: the more accurate one, not the lower median."""
+    page, _ = games(summ=TIED)
+    assert page == "cpu ref ftl s=1 S16 I2 fp32"
+    assert page in verdicts.recommended(TIED) and "cpu ref ftl s=1 S16 I1 fp32" not in verdicts.recommended(TIED)
+    apart = TIED.assign(time_per_frame_ms=[8.0, 8.2, 0.1])
+    assert "cpu ref ftl s=1 S16 I1 fp32" in verdicts.recommended(apart)
+
+
 def test_small_steps_against_iterations_findings():
     """Substeps win where their error is smaller or only iterations blew up; the ladder's trend."""
     row = lambda rms, blown=0: pd.Series(dict(rms=rms, blown=blown, usable=blown == 0))  # noqa: E731
