@@ -16,7 +16,7 @@ from harness.core.runner import require_binary
 from harness.io import runfolder
 from harness.io.files import write_json
 from harness.io.sweepfile import load_sweep
-from harness.render import host_report
+from harness.studies.host_verdicts import HOST_JSON
 
 
 def run(
@@ -57,7 +57,7 @@ def run(
         sweeps["dynamic-curly"] = load_sweep(bench_dynamic.CURLY_SWEEP).path
     require_binary(binary_path("cpu"))  # before the run's folder is made
     # the host's load before anything runs: the top of the run's reports says whether it was quiet
-    write_json(output_dir(root) / host_report.HOST_JSON, load.host_load())
+    write_json(output_dir(root) / HOST_JSON, load.host_load())
     if plan:
         print(
             f"harness: budget {plan.seconds:.0f} s: the sweeps' largest sizes and the studies are left out "

@@ -29,11 +29,12 @@ from harness.core.progress import StepTimes
 from harness.io import grooms, runfolder
 from harness.io.files import write_json
 from harness.io.sweepfile import load_sweep
-from harness.render import accuracy_dynamic_report, host_report, report_scene
+from harness.render import accuracy_dynamic_report, report_scene
 from harness.render import stability_dynamic_report as stability_report
 from harness.studies import budget_curves_dynamic as budget_curves
 from harness.studies import stability_dynamic as stability
 from harness.studies.accuracy import curves_name, results_name
+from harness.studies.host_verdicts import HOST_JSON
 from harness.studies.sweep import run_sweep
 
 SWEEP_DIR = "sweep"  # OUT/sweep: the throughput sweep on the scene
@@ -71,7 +72,7 @@ def run(scene_ref, out=None, gpu="auto", report_dir=None, quick_studies=True, bu
     root = runfolder.claim(Path(out) if out else default_out(scene_ref), f"bench --scene {scene_ref}")
     report_dir = Path(report_dir) if report_dir else root / "report"
     runner.require_binary(binary_path("cpu"))
-    write_json(output_dir(root) / host_report.HOST_JSON, load.host_load())  # the report's first line
+    write_json(output_dir(root) / HOST_JSON, load.host_load())  # the report's first line
     builds, gpu_note = gpu_plan(gpu)
     if gpu_note:
         say(f"harness: GPU rows skipped: {gpu_note}")

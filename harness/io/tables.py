@@ -23,3 +23,11 @@ def read_csv(path, what="csv", **kwargs):
     if (major, minor) < (3, 1):
         kwargs.setdefault("float_precision", "round_trip")
     return pd.read_csv(path, **kwargs)
+
+
+def cell(row, key):
+    """A table row's (a dict's) value as a float: NaN where absent, empty or not a number."""
+    try:
+        return float(row[key])
+    except (TypeError, ValueError, KeyError):
+        return float("nan")

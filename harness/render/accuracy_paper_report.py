@@ -1,5 +1,6 @@
 """Render the speed-against-accuracy study (studies/accuracy_paper.py measures it): read accuracy.csv,
-draw report/accuracy_pareto.png, write report/accuracy.md."""
+draw report/accuracy_pareto.png, write report/accuracy.md with studies/accuracy_verdicts_paper.py's
+recommendation in words."""
 
 import csv
 import json
@@ -8,10 +9,11 @@ from pathlib import Path
 import numpy as np
 
 from harness import HarnessError
-from harness.core import timing
 from harness.core.paths import REPORT, display
 from harness.io import files
+from harness.studies import accuracy_verdicts_paper as verdicts
 from harness.studies.accuracy import PAPER_REFERENCE, paper_uses
+from harness.studies.accuracy_verdicts_paper import end_to_end
 
 
 def load_rows(csv_path):
@@ -66,16 +68,6 @@ def _env(csv_path):
     return meta if isinstance(meta, dict) else {}
 
 
-def _end_to_end(rows):
-    """One row per mode: its last frame (the end-to-end error)."""
-    last = {}
-    for r in rows:
-        if r["study"] == "mode":
-            if r["mode"] not in last or r["frame"] > last[r["mode"]]["frame"]:
-                last[r["mode"]] = r
-    return list(last.values())
-
-
 def pareto_plot(rows, path, strands, points):
     import matplotlib
 
@@ -84,7 +76,7 @@ def pareto_plot(rows, path, strands, points):
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     floor = 1e-17
-    for r in _end_to_end(rows):
+    for r in end_to_end(rows):
         if r["mode"] == PAPER_REFERENCE:
             continue
         err = max(r["max_err_L"], floor)
@@ -121,51 +113,32 @@ def pareto_plot(rows, path, strands, points):
     return path
 
 
-def _pick(modes):
-    """The mode to recommend among `modes` (rows that meet a use's bound): the fastest, unless
-    others tie with it within timing noise (core/timing.py `tie`: these tables keep no spread,
-    so within its floor): then the most accurate of the tie. (mode, the others it tied with)."""
-    modes = sorted(modes, key=lambda r: r["time_ms"])
-    tied = [modes[i] for i in timing.tie([(r["time_ms"], float("nan")) for r in modes])]
-    best = min(tied, key=lambda r: r["max_err_L"])
-    return best, [r["mode"] for r in tied if r is not best]
-
-
 def _tie_note(others):
     return f"; a tie within timing noise with {', '.join(others)}" if others else ""
 
 
 def recommend(rows):
-    """Which mode for which use, from the measured end-to-end errors and times; modes whose times
-    tie within noise are a tie, decided by their errors (noise never decides)."""
-    e2e = [r for r in _end_to_end(rows) if r["mode"] != PAPER_REFERENCE and np.isfinite(r["max_err_L"])]
-    if not e2e:
+    """Which mode for which use: studies/accuracy_verdicts_paper.py's recommendation in words."""
+    rec = verdicts.recommendation(rows)
+    fastest = rec.fastest
+    if fastest is None:
         return ["No mode other than the reference ran."]
-    lines = []
-    fastest = min(e2e, key=lambda r: r["time_ms"])
-    tied = [e2e[i]["mode"] for i in timing.tie([(r["time_ms"], float("nan")) for r in e2e])]
-    lines.append(
+    lines = [
         f"- Fastest overall: **{fastest['mode']}** ({fastest['time_ms']:.2f} ms, end-to-end error "
-        f"{fastest['max_err_L']:.1e}·L{_tie_note([m for m in tied if m != fastest['mode']])})."
-    )
-    for limit, use in ((1e-5, "production runs and benchmarks"), (1e-12, "references and validation")):
-        ok = [r for r in e2e if r["max_err_L"] <= limit]
-        if ok:
-            best, others = _pick(ok)
+        f"{fastest['max_err_L']:.1e}·L{_tie_note(rec.fastest_tied_with)})."
+    ]
+    for u in rec.uses:
+        if u.best is not None:
             lines.append(
-                f"- For {use} (error ≤ {limit:.0e}·L): **{best['mode']}** ({best['time_ms']:.2f} ms, "
-                f"{best['max_err_L']:.1e}·L{_tie_note(others)})."
+                f"- For {u.use} (error ≤ {u.limit:.0e}·L): **{u.best['mode']}** ({u.best['time_ms']:.2f} ms, "
+                f"{u.best['max_err_L']:.1e}·L{_tie_note(u.tied_with)})."
             )
         else:
-            lines.append(f"- For {use} (error ≤ {limit:.0e}·L): no mode measured here meets it.")
-    res = sorted(
-        (r for r in rows if r["study"] == "resolution" and np.isfinite(r["max_err_L"])), key=lambda r: r["points"]
-    )
-    enough = [r for r in res if r["max_err_L"] <= 0.01 and r["max_err_L"] > 0]
-    if enough:
+            lines.append(f"- For {u.use} (error ≤ {u.limit:.0e}·L): no mode measured here meets it.")
+    if rec.enough is not None:
         lines.append(
-            f"- Model resolution: {enough[0]['points']} points per strand stay within 1% of L of the "
-            f"finest strand measured ({max(r['points'] for r in res)} points); the discretisation error "
+            f"- Model resolution: {rec.enough['points']} points per strand stay within 1% of L of the "
+            f"finest strand measured ({rec.finest_points} points); the discretisation error "
             "dwarfs every precision's rounding error above."
         )
     return lines
@@ -189,7 +162,7 @@ def write_markdown(rows, path, strands, points, res_strands, gpu_ok, why):
         "|---|---|---|---|---|---|---|---|",
     ]
     uses = paper_uses()
-    for r in _end_to_end(rows):
+    for r in end_to_end(rows):
         frames = [x for x in rows if x["study"] == "mode" and x["mode"] == r["mode"]]
         worst = max(x["max_err_L"] for x in frames)
         drift = max(x["seg_drift"] for x in frames)

@@ -1,116 +1,65 @@
 """The world study's tables (harness/studies/accuracy_world_dynamic.py's world.csv) as Markdown: the
 grid's and the colliders' variants, each's cost against its effect and its error against its
-converged reference, and a verdict per group computed from those numbers."""
+converged reference, and each group's verdict (studies/accuracy_world_verdicts_dynamic.py) in words."""
 
-import math
-import statistics
-
-from harness.core import tolerances
 from harness.core.paths import display
+from harness.io.tables import cell as _f
 from harness.io.tables import read_csv
+from harness.studies import accuracy_world_verdicts_dynamic as verdicts
 from harness.studies.accuracy import WORLD_CSV_NAME as CSV_NAME
 
 TITLE = "The grid and the body: cost against effect against the converged reference"
 
 
-def _f(r, key):
-    try:
-        return float(r[key])
-    except (TypeError, ValueError, KeyError):
-        return math.nan
-
-
-def applied(rows, group):
-    """The group's rows that apply something: grid rows with friction or volume on; every
-    collider row but `off`."""
-    out = [r for r in rows if r["group"] == group and r["variant"] != "off"]
-    if group == "grid":
-        out = [r for r in out if "on" in (r["friction"], r["volume"])]
-    return out
-
-
-def cheapest_close(rows):
-    """The cheapest row whose RMS error is within WORLD_ACC_ERROR_FACTOR of the smallest (None: no
-    finite error)."""
-    finite = [r for r in rows if math.isfinite(_f(r, "rms_err_L")) and math.isfinite(_f(r, "ms_frame"))]
-    if not finite:
-        return None
-    best = min(_f(r, "rms_err_L") for r in finite)
-    close = [r for r in finite if _f(r, "rms_err_L") <= tolerances.WORLD_ACC_ERROR_FACTOR * best]
-    return min(close, key=lambda r: _f(r, "ms_frame"))
-
-
-def paired_ratio(rows, key, axis, a, b, match):
-    """The median over matched pairs (equal in every `match` column) of row[axis] = b's `key` over
-    a's; (ratio, pairs) with NaN where none pairs."""
-    ratios = []
-    for r in rows:
-        if r[axis] != a:
-            continue
-        twin = next((o for o in rows if o[axis] == b and all(o[m] == r[m] for m in match)), None)
-        if twin is not None and _f(r, key) > 0 and math.isfinite(_f(twin, key)):
-            ratios.append(_f(twin, key) / _f(r, key))
-    return (statistics.median(ratios) if ratios else math.nan), len(ratios)
-
-
 def verdict(rows, group):
-    """One sentence from the group's numbers."""
-    on = applied(rows, group)
-    pick = cheapest_close(on)
+    """One sentence from the group's verdict (studies/accuracy_world_verdicts_dynamic.py)."""
+    v = verdicts.verdict(rows, group)
+    pick = v.pick
     if pick is None:
         return f"No {group} variant finished with a finite error: no verdict."
-    factor = tolerances.WORLD_ACC_ERROR_FACTOR
     cheapest = (
-        f"the cheapest within {factor:g}× of the smallest error against its converged reference is "
+        f"the cheapest within {v.factor:g}× of the smallest error against its converged reference is "
         f"{pick['variant']} ({_f(pick, 'ms_frame'):.3g} ms a frame, {_f(pick, 'cost_ratio'):.2f}× the scene "
         f"without it, RMS error {_f(pick, 'rms_err_L'):.2e} L)"
     )
+    c = v.change
     if group == "grid":
-        cost, n = paired_ratio(on, "ms_frame", "rebuild", "frame", "substep", ("grid", "friction", "volume"))
-        err, _ = paired_ratio(on, "rms_err_L", "rebuild", "frame", "substep", ("grid", "friction", "volume"))
-        if n == 0:
-            return f"For the grid, {cheapest}.{held_clause(on)}"
+        if c.pairs == 0:
+            return f"For the grid, {cheapest}.{held_clause(v.held)}"
         return (
-            f"Rebuilding the grid every substep costs {cost:.2f}× the once-a-frame build and moves the error "
-            f"against its converged reference by {err:.2f}× (medians over {n} pairs); {cheapest}.{held_clause(on)}"
+            f"Rebuilding the grid every substep costs {c.cost:.2f}× the once-a-frame build and moves the error "
+            f"against its converged reference by {c.err:.2f}× (medians over {c.pairs} pairs); {cheapest}."
+            f"{held_clause(v.held)}"
         )
-    cost, n = paired_ratio(on, "ms_frame", "friction", "off", "on", ("sdf",))
-    err, _ = paired_ratio(on, "rms_err_L", "friction", "off", "on", ("sdf",))
     text = f"For the body, {cheapest}."
-    if n:
+    if c.pairs:
         text = (
-            f"On the body, friction costs {cost:.2f}× the frictionless colliders and moves the error against the "
-            f"converged reference by {err:.2f}× (medians over {n} SDF sizes); {cheapest}."
+            f"On the body, friction costs {c.cost:.2f}× the frictionless colliders and moves the error against the "
+            f"converged reference by {c.err:.2f}× (medians over {c.pairs} SDF sizes); {cheapest}."
         )
-    return text + sdf_clause(on)
+    return text + sdf_clause(v.sdf)
 
 
-def held_clause(rows):
+def held_clause(held):
     """What holding each point's sample for the frame (`held`) did against sampling every substep
     (`frame`): its cost and its error, medians over the matched pairs."""
-    match = ("grid", "friction", "volume")
-    cost, n = paired_ratio(rows, "ms_frame", "rebuild", "frame", "held", match)
-    err, _ = paired_ratio(rows, "rms_err_L", "rebuild", "frame", "held", match)
-    if n == 0:
+    if held.pairs == 0:
         return ""
     return (
-        f" Holding each point's sample for the frame (held) costs {cost:.2f}× the once-a-frame build sampled every "
-        f"substep and moves the error by {err:.2f}× (medians over {n} pairs)."
+        f" Holding each point's sample for the frame (held) costs {held.cost:.2f}× the once-a-frame build sampled "
+        f"every substep and moves the error by {held.err:.2f}× (medians over {held.pairs} pairs)."
     )
 
 
-def sdf_clause(rows):
+def sdf_clause(sdf):
     """What the mesh's SDF size did to the error: the finest against the coarsest, per friction."""
-    sizes = sorted({int(r["sdf"]) for r in rows if str(r["sdf"]).isdigit()})
-    if len(sizes) < 2:
+    if sdf is None:
         return ""
-    lo, hi = str(sizes[0]), str(sizes[-1])
-    ratio, n = paired_ratio(rows, "rms_err_L", "sdf", lo, hi, ("friction",))
-    if n == 0:
-        return ""
-    if ratio == 1.0:
-        return f" The SDF's size ({lo}³ to {hi}³) changed no error: the hair did not reach the mesh in this run."
-    return f" The {hi}³ SDF moves the error by {ratio:.2f}× over the {lo}³ (median over {n} pairs)."
+    if sdf.unchanged:
+        return (
+            f" The SDF's size ({sdf.lo}³ to {sdf.hi}³) changed no error: the hair did not reach the mesh in this run."
+        )
+    return f" The {sdf.hi}³ SDF moves the error by {sdf.ratio:.2f}× over the {sdf.lo}³ (median over {sdf.pairs} pairs)."
 
 
 def _pair(r, key, fmt):

@@ -2,12 +2,11 @@
 one plot. Rendering only; `section(results_dir, out_dir)` is what report.py calls, and
 `write(results_dir, report_dir)` writes report/peer.md on its own.
 
-"Where the peer wins" is written from the numbers: time against our fastest fp64 run at
-each (S, I, N), error and stretch against ours at the same precision, and against our fp32.
+"Where the peer wins" words studies/peer_verdicts_dynamic.py's verdict: time against our fastest
+fp64 run at each (S, I, N), error and stretch against ours at the same precision, and against our fp32.
 """
 
 import json
-import math
 import os
 from pathlib import Path
 
@@ -15,9 +14,8 @@ from harness import HarnessError
 from harness.core import tolerances
 from harness.core.paths import REPORT, RESULTS, display
 from harness.io import files, tables
-
-PEER = "pypbd"
-OURS = "hairsim-cpu"
+from harness.studies import peer_verdicts_dynamic as verdicts
+from harness.studies.peer_verdicts_dynamic import OURS, PEER
 
 
 def load(results_dir):
@@ -37,10 +35,6 @@ def load(results_dir):
         raise HarnessError(f"peer report: cannot read {display(d)}: {e}") from None
 
 
-def _label(r):
-    return f"{r['solver']} {r['variant']} {r['precision']}" if r["solver"] == OURS else f"{PEER} {r['precision']}"
-
-
 def accuracy_table(acc):
     lines = [
         "| S | I | solver | precision | max err / L | RMS err / L | last frame max / L | stretch max | "
@@ -58,7 +52,7 @@ def accuracy_table(acc):
 
 
 def timing_table(tim):
-    tim = tim.assign(label=tim.apply(_label, axis=1))
+    tim = tim.assign(label=tim.apply(verdicts.label, axis=1))
     labels = sorted(tim["label"].unique(), key=lambda s: (s.startswith(PEER), s))
     lines = [
         "| S | I | strands | " + " | ".join(labels) + " | pypbd ÷ our fastest fp64 |",
@@ -69,89 +63,55 @@ def timing_table(tim):
         for lab in labels:
             v = g[g["label"] == lab]["median_ms"]
             cells.append(f"{float(v.iloc[0]):.3g}" if len(v) else "—")
-        lines.append(f"| {s} | {i} | {n:,} | " + " | ".join(cells) + f" | {_ratio(g):.2g}× |")
+        lines.append(f"| {s} | {i} | {n:,} | " + " | ".join(cells) + f" | {verdicts.time_ratio(g):.2g}× |")
     return lines
 
 
-def _ratio(g):
-    """pypbd's time over our fastest fp64 time in one (S, I, N) group."""
-    ours = g[(g["solver"] == OURS) & (g["precision"] == "fp64")]["median_ms"]
-    theirs = g[g["solver"] == PEER]["median_ms"]
-    return float(theirs.iloc[0]) / float(ours.min()) if len(ours) and len(theirs) else math.nan
-
-
-def _peer_faster_than_each(tim):
-    """{our runner label: [((S, I, N), how many times faster the peer is)]} where the peer wins."""
-    tim = tim.assign(label=tim.apply(_label, axis=1))
-    wins: dict[str, list] = {}
-    for key, g in tim.groupby(["substeps", "iterations", "strands"]):
-        theirs = g[g["solver"] == PEER]["median_ms"]
-        if not len(theirs):
-            continue
-        for _, r in g[g["solver"] == OURS].iterrows():
-            if float(theirs.iloc[0]) < r["median_ms"]:
-                wins.setdefault(r["label"], []).append((key, r["median_ms"] / float(theirs.iloc[0])))
-    return wins
-
-
 def where_the_peer_wins(acc, tim, frames, ref_uncertainty):
-    """Sentences from the numbers: time, then error and stretch (`frames`: the accuracy
-    horizon; `ref_uncertainty`: the reference's last change from S to 2S, ·L)."""
+    """Sentences from the verdict (studies/peer_verdicts_dynamic.py): time, then error and stretch
+    (`frames`: the accuracy horizon; `ref_uncertainty`: the reference's last change from S to 2S, ·L)."""
+    v = verdicts.verdict(acc, tim, frames, ref_uncertainty)
     out = []
-    groups = [(k, _ratio(g)) for k, g in tim.groupby(["substeps", "iterations", "strands"])]
-    wins = [(k, r) for k, r in groups if r < 1]
-    ratios = [r for _, r in groups if math.isfinite(r)]
-    if wins:
+    if v.wins:
         out.append(
             "**Time: the peer is faster** than our fastest fp64 run at "
-            + ", ".join(f"S = {s}, I = {i}, N = {n:,} ({1 / r:.2g}× faster)" for (s, i, n), r in wins)
+            + ", ".join(f"S = {s}, I = {i}, N = {n:,} ({1 / r:.2g}× faster)" for (s, i, n), r in v.wins)
             + "."
         )
-    if ratios and len(wins) < len(ratios):
-        lose = [r for _, r in groups if r >= 1]
+    if v.cases and len(v.wins) < v.cases:
         out.append(
-            f"Time: {'elsewhere ' if wins else ''}our fastest fp64 run is {min(lose):.2g}–{max(lose):.2g}× faster "
-            f"than the peer ({len(lose)} of {len(ratios)} (S, I, N) cases)."
+            f"Time: {'elsewhere ' if v.wins else ''}our fastest fp64 run is {min(v.lose):.2g}–{max(v.lose):.2g}× "
+            f"faster than the peer ({len(v.lose)} of {v.cases} (S, I, N) cases)."
         )
-    mine = acc[acc["solver"] == PEER]
-    if len(mine):
-        worst = float(mine["vs_ours_fp64"].max())
-        drift = mine["vs_ours_fp64"] / (mine["substeps"] * frames)  # ·L per substep taken
-        if float(drift.max()) <= tolerances.PEER_SAME_SCHEME_PER_SUBSTEP:
-            out.append(
-                f"Error and stretch: the peer's trajectories equal our fp64 runs to {worst:.2g}·L at worst, "
-                "the rounding drift of one scheme (docs/decisions.md), so neither wins on accuracy at equal "
-                "S and I."
-            )
-        else:
-            out.append(
-                f"Error and stretch: the peer's trajectories depart from our fp64 runs by up to {worst:.2g}·L, "
-                f"more than the rounding drift measured for ≤ 30 frames "
-                f"({tolerances.PEER_SAME_SCHEME_PER_SUBSTEP:g}·L per substep): the columns above tell which "
-                "is closer to the reference."
-            )
-    for lab, cases in _peer_faster_than_each(tim).items():
+    if v.worst is not None and v.same_scheme:
+        out.append(
+            f"Error and stretch: the peer's trajectories equal our fp64 runs to {v.worst:.2g}·L at worst, "
+            "the rounding drift of one scheme (docs/decisions.md), so neither wins on accuracy at equal "
+            "S and I."
+        )
+    elif v.worst is not None:
+        out.append(
+            f"Error and stretch: the peer's trajectories depart from our fp64 runs by up to {v.worst:.2g}·L, "
+            f"more than the rounding drift measured for ≤ 30 frames "
+            f"({tolerances.PEER_SAME_SCHEME_PER_SUBSTEP:g}·L per substep): the columns above tell which "
+            "is closer to the reference."
+        )
+    for lab, cases in v.faster_than_each.items():
         out.append(
             f"Time: the peer is faster than our `{lab}` at "
             + ", ".join(f"S = {s}, I = {i}, N = {n:,} ({r:.2g}×)" for (s, i, n), r in cases)
             + "."
         )
-    # error against our fp32 (pypbd has double only), where the gap exceeds the reference's own
-    # uncertainty (its last change from S to 2S)
-    p = acc[acc["solver"] == PEER].set_index(["substeps", "iterations"])
-    o32 = acc[(acc["solver"] == OURS) & (acc["precision"] == "fp32")].set_index(["substeps", "iterations"])
-    better = [k for k in p.index if k in o32.index and o32.loc[k, "err_max"] - p.loc[k, "err_max"] > ref_uncertainty]
-    if better:
+    if v.better_than_fp32:
         out.append(
             "Error: against our fp32 runs (pypbd runs in double only) the peer's is smaller by more than the "
             "reference's uncertainty at "
             + ", ".join(
-                f"S = {s}, I = {i} ({p.loc[(s, i), 'err_max']:.3g} vs {o32.loc[(s, i), 'err_max']:.3g}·L)"
-                for s, i in better
+                f"S = {s}, I = {i} ({theirs:.3g} vs {ours:.3g}·L)" for (s, i), theirs, ours in v.better_than_fp32
             )
             + "."
         )
-    elif len(o32):
+    elif v.fp32:
         out.append(
             "Error: our fp32 runs are within the reference's uncertainty "
             f"({ref_uncertainty:.2g}·L) of the peer's double-precision error at every setting."
@@ -166,7 +126,7 @@ def plot(tim, out_dir):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    tim = tim.assign(label=tim.apply(_label, axis=1))
+    tim = tim.assign(label=tim.apply(verdicts.label, axis=1))
     s, i = tim.iloc[0]["substeps"], tim.iloc[0]["iterations"]
     g = tim[(tim["substeps"] == s) & (tim["iterations"] == i)]
     fig, ax = plt.subplots(figsize=(6, 4))

@@ -6,10 +6,9 @@ up to the pointwise horizon, its statistics against the reference ensemble over 
 stretch against each segment's own rest length, and its time per frame on every binary that timed
 it; `section(path)` for report/dynamic.md.
 
-Recommendations are read off the measured rows with the dynamic accuracy study's budgets
-(tolerances.DYN_ACC_USES: RMS error and stretch per use; DYN_ACC_USES_CHAOS: the statistics'
-allowance beyond the ensemble's spread): per use and strand count the fewest guides, and the fewest
-simulated points, whose every measure is within it; each names its scene, horizon and strand count.
+The recommendations word studies/reduced_verdicts_dynamic.py's picks (per use and strand count the
+fewest guides, and the fewest simulated points, within the use's budgets); each names its scene,
+horizon and strand count.
 """
 
 import csv
@@ -18,20 +17,14 @@ from pathlib import Path
 
 from harness.core import tolerances
 from harness.core.paths import display
-
-DISTANCES = ("tip_L", "curvature_rel", "envelope_rel")
+from harness.io.tables import cell as _f
+from harness.studies import reduced_verdicts_dynamic as verdicts
+from harness.studies.reduced_verdicts_dynamic import DISTANCES
 
 
 def read(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
-
-
-def _f(r, k):
-    try:
-        return float(r.get(k, ""))
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def _g(v, digits=3):
@@ -253,86 +246,55 @@ def _sag_lines(cases, cols):
     return out
 
 
-def _spreads(refs):
-    """{(scene, strands): {distance: spread}} of references.csv."""
-    return {(r["scene"], str(r["strands"])): {m: _f(r, f"{m}_spread") for m in DISTANCES} for r in refs}
-
-
-def passes(r, use, spreads):
-    """Whether a row meets a use: RMS error (up to the horizon) and stretch (the followers', a LOD
-    row's rendered points, else every point's, against ℓ_k) within the use's budgets, and each
-    statistic within the ensemble's spread plus the use's allowance."""
-    rms_budget, stretch_budget, _ = tolerances.DYN_ACC_USES[use]
-    if not _f(r, "rms_err_L") <= rms_budget or int(_f(r, "blown_up") or 0) > 0:
-        return False
-    stretch = _f(r, "stretch_followers") if math.isfinite(_f(r, "stretch_followers")) else _f(r, "stretch_max_k")
-    if not stretch <= stretch_budget:
-        return False
-    scene = {"guides": "scene", "lod": "lod", "lra": "nod"}.get(r["study"], "scene")
-    sp = spreads.get((scene, str(r["strands"])), {})
-    allow = tolerances.DYN_ACC_USES_CHAOS[use]
-    return all(not math.isfinite(_f(r, m)) or _f(r, m) <= sp.get(m, 0.0) + allow[m] for m in DISTANCES)
-
-
 def recommend(rows, refs=()):
-    """Per use: at each strand count the fewest guides (xpbd, the CPU's rows) and at the LOD's
-    strand count the fewest simulated points that pass it; LRA where it lowers the error without
-    raising the stretch; sag-free by how much of the sag it removes at each shape range."""
-    spreads = _spreads(refs)
-    horizon = {(r["scene"], str(r["strands"])): _f(r, "horizon_s") for r in refs}
-    cpu = [r for r in rows if r["backend"] == "cpu"]
+    """Per use, studies/reduced_verdicts_dynamic.py's picks: at each strand count the fewest guides
+    and at the LOD's strand count the fewest simulated points that pass it; LRA where it lowers the
+    error without raising the stretch; sag-free by how much of the sag it removes at each shape range."""
     out = []
-    for use in tolerances.DYN_ACC_USES:
+    for pick in verdicts.recommendations(rows, refs):
         parts = []
-        for n in sorted({int(r["strands"]) for r in cpu if r["study"] == "guides"}):
-            ok = [r for r in cpu if r["study"] == "guides" and r["solver"] == "xpbd" and int(r["strands"]) == n
-                  and passes(r, use, spreads)]  # fmt: skip
-            h = horizon.get(("scene", str(n)), math.nan)
-            if not ok:
+        for g in pick.guides:
+            r, n = g.row, g.strands
+            if r is None:
                 parts.append(f"at {n:,} strands no guide fraction (not even all simulated) passes")
                 continue
-            r = min(ok, key=lambda r: (_f(r, "guides"), _f(r, "rms_err_L")))
             stretch = _f(r, "stretch_followers") if r["follow"] else _f(r, "stretch_max_k")
             parts.append(
                 f"at {n:,} strands {_f(r, 'guides'):.0%} guides ({r['guide_count']}, "
                 f"{_g(_f(r, 'guide_spacing_cm'))} cm apart), {r['follow'] or 'every strand simulated'} "
-                f"(rms {_g(_f(r, 'rms_err_L'))}·L up to {_g(h)} s, stretch {_g(stretch)})"
+                f"(rms {_g(_f(r, 'rms_err_L'))}·L up to {_g(g.horizon)} s, stretch {_g(stretch)})"
             )
-        lod = [r for r in cpu if r["study"] == "lod" and r["solver"] == "xpbd" and passes(r, use, spreads)]
-        if lod:
-            p = min(lod, key=lambda r: (int(r["points"]), _f(r, "rms_err_L")))
+        p = pick.lod
+        if p is not None:
             parts.append(
                 f"{p['points']} simulated points rendered as {p['render_points']}"
                 if int(p["points"]) != int(p["render_points"])
                 else "every point simulated (fewer were not within it)"
             )
-        elif any(r["study"] == "lod" for r in cpu):
+        elif pick.lod_measured:
             parts.append("no P_s passes")
-        budget = tolerances.DYN_ACC_USES[use]
+        budget = pick.budget
         head = (
-            f"- **{use}** (rms ≤ {budget[0]:g}·L, stretch ≤ {budget[1]:.1%}, statistics within the ensemble's spread "
-            "plus the use's allowance; the default scene, xpbd): "
+            f"- **{pick.use}** (rms ≤ {budget[0]:g}·L, stretch ≤ {budget[1]:.1%}, statistics within the ensemble's "
+            "spread plus the use's allowance; the default scene, xpbd): "
         )
         out.append(head + "; ".join(parts) + ".")
+    cpu = [r for r in rows if r["backend"] == "cpu"]
     out += _lra_lines(cpu) + _sag_recommendation(cpu)
     return out
 
 
 def _lra_lines(rows):
-    by = {(r["solver"], str(r["iterations"]), str(r["lra"])): r for r in rows if r["study"] == "lra"}
     out = []
-    for (solver, i, lra), r in sorted(by.items()):
-        off = by.get((solver, i, "0"))
-        if lra != "1" or off is None:
-            continue
-        better = _f(r, "rms_err_L") < _f(off, "rms_err_L")
-        stretch = _f(r, "stretch_max_k") <= _f(off, "stretch_max_k")
+    for v in verdicts.lra_verdicts(rows):
+        r, off = v.on, v.off
         out.append(
-            f"- LRA, {solver}, I = {i}, fast nod: RMS error {_g(_f(off, 'rms_err_L'))} → {_g(_f(r, 'rms_err_L'))}·L "
-            f"({'lower' if better else 'not lower'}), largest stretch {_g(_f(off, 'stretch_max_k'))} → "
-            f"{_g(_f(r, 'stretch_max_k'))} ({'not raised' if stretch else 'raised'}), bound excess in the output "
+            f"- LRA, {v.solver}, I = {v.iterations}, fast nod: RMS error {_g(_f(off, 'rms_err_L'))} → "
+            f"{_g(_f(r, 'rms_err_L'))}·L ({'lower' if v.lower else 'not lower'}), largest stretch "
+            f"{_g(_f(off, 'stretch_max_k'))} → {_g(_f(r, 'stretch_max_k'))} "
+            f"({'not raised' if v.not_raised else 'raised'}), bound excess in the output "
             f"{_g(_f(off, 'lra_excess'))} → {_g(_f(r, 'lra_excess'))}, output moved up to {_g(_f(r, 'lra_moved_cm'))} "
-            f"cm: {'use it here' if better and stretch else 'not worth it here'}."
+            f"cm: {'use it here' if v.worth_it else 'not worth it here'}."
         )
     return out
 

@@ -39,11 +39,10 @@ from harness.io import files
 from harness.io.trajectory import open_trajectory
 from harness.studies import analytic_runs_dynamic as analytic_runs
 from harness.studies import peer_pypbd_dynamic as peer
+from harness.studies.peer_verdicts_dynamic import OURS, PEER
 
 SETTINGS = ((8, 1), (32, 1), (8, 4))  # (S, I)
 STRANDS = (1, 100, 1000, 10000)
-OURS = "hairsim-cpu"
-PEER = "pypbd"
 ACCURACY_FIELDS = (
     "substeps",
     "iterations",

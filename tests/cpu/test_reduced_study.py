@@ -12,6 +12,7 @@ import pytest
 from harness.core import tolerances, variants
 from harness.render import reduced_dynamic_report as reduced_report
 from harness.studies import reduced_dynamic as reduced
+from harness.studies import reduced_verdicts_dynamic as reduced_verdicts
 
 TINY = reduced.Plan(strands=(8, 16), seconds=4 / 60, write_every=1 / 60, fractions=(1.0, 0.5), ref_start=8,
                     ref_max=32, lra_iterations=(1,), sag_seconds=0.25, lod_points=(33, 9), time_strands=16, repeat=1,
@@ -76,6 +77,8 @@ def test_recommendations_take_the_fewest_guides_within_each_budget():
     prev, game = tolerances.DYN_ACC_USES["previews"][0], tolerances.DYN_ACC_USES["games"][0]
     rows = [_row(1.0, "", 0.1 * game), _row(0.5, "blend3", 0.5 * game), _row(0.25, "one", 0.5 * prev),
             _row(0.1, "blend3", 2 * prev)]  # fmt: skip
+    picks = {p.use: p.guides[0].row for p in reduced_verdicts.recommendations(rows)}
+    assert (picks["previews"]["guides"], picks["games"]["guides"]) == ("0.25", "0.5")
     lines = reduced_report.recommend(rows)
     assert "at 1,000 strands 25% guides (250, 1 cm apart), one" in _use_line(lines, "previews")
     assert "at 1,000 strands 50% guides (500, 1 cm apart), blend3" in _use_line(lines, "games")
@@ -84,10 +87,10 @@ def test_recommendations_take_the_fewest_guides_within_each_budget():
 def test_a_stretched_follower_or_a_statistic_past_the_spread_fails_a_use():
     game = tolerances.DYN_ACC_USES["games"][0]
     stretched = _row(0.5, "blend3", 0.5 * game, stretch=0.5)
-    assert not reduced_report.passes(stretched, "previews", {})
+    assert not reduced_verdicts.passes(stretched, "previews", {})
     far = dict(_row(0.5, "blend3", 0.5 * game), tip_L="0.02")
     spreads = {("scene", "1000"): {"tip_L": 0.001, "curvature_rel": 0.0, "envelope_rel": 0.0}}
-    assert reduced_report.passes(far, "previews", spreads) and not reduced_report.passes(far, "games", spreads)
+    assert reduced_verdicts.passes(far, "previews", spreads) and not reduced_verdicts.passes(far, "games", spreads)
 
 
 def _lod(points, rms):
@@ -99,6 +102,8 @@ def _lod(points, rms):
 def test_recommendations_take_the_fewest_simulated_points_within_each_budget():
     prev, game = tolerances.DYN_ACC_USES["previews"][0], tolerances.DYN_ACC_USES["games"][0]
     rows = [_row(1.0, "", 0.001), _lod(33, 0.1 * game), _lod(17, 0.5 * game), _lod(9, 0.5 * prev), _lod(5, 2 * prev)]
+    picks = {p.use: p.lod for p in reduced_verdicts.recommendations(rows)}
+    assert (picks["previews"]["points"], picks["games"]["points"]) == ("9", "17")
     lines = reduced_report.recommend(rows)
     assert "9 simulated points rendered as 33" in _use_line(lines, "previews")
     assert "17 simulated points rendered as 33" in _use_line(lines, "games")

@@ -15,6 +15,7 @@ from harness.io.sweepfile import SweepError, load_sweep
 from harness.render import accuracy_world_dynamic_report as accuracy_world_report
 from harness.render import report_dynamic
 from harness.studies import accuracy_world_dynamic as accuracy_world
+from harness.studies import accuracy_world_verdicts_dynamic as world_verdicts
 from harness.studies import stability_dynamic as stability
 from harness.studies import stability_slices_dynamic as stability_slices
 from harness.studies.stability_slices_dynamic import OFF
@@ -116,22 +117,29 @@ def test_the_verdict_follows_the_numbers():
         _row("grid", "a", 2.0, 0.010, grid="16", rebuild="frame", friction="on", volume="on"),
         _row("grid", "b", 6.0, 0.006, grid="16", rebuild="substep", friction="on", volume="on"),
     ]
+    v = world_verdicts.verdict(rows, "grid")
+    assert (v.change.cost, v.change.err, v.change.pairs) == (3.0, pytest.approx(0.6), 1)
+    assert v.pick["variant"] == "a"  # within 2× of the smallest error, and cheaper
+    assert v.held.pairs == 0 and "held" not in accuracy_world_report.verdict(rows, "grid")  # no held rows, no clause
     text = accuracy_world_report.verdict(rows, "grid")
-    assert "costs 3.00× the once-a-frame build" in text and "by 0.60×" in text
-    assert "is a (2 ms a frame" in text  # within 2× of the smallest error, and cheaper
-    assert "held" not in text  # no held rows, no clause
+    assert "costs 3.00× the once-a-frame build" in text and "by 0.60×" in text and "is a (2 ms a frame" in text
     held = _row("grid", "h", 1.5, 0.012, grid="16", rebuild="held", friction="on", volume="on")
+    v = world_verdicts.verdict([*rows, held], "grid")
+    assert (v.held.cost, v.held.err, v.held.pairs) == (0.75, pytest.approx(1.2), 1)
     text = accuracy_world_report.verdict([*rows, held], "grid")
     assert "(held) costs 0.75× the once-a-frame build sampled every substep and moves the error by 1.20×" in text
     rows[1]["rms_err_L"] = str(0.006 * tolerances.WORLD_ACC_ERROR_FACTOR * 1.5)  # now too far from the best
-    assert "is b (6 ms a frame" in accuracy_world_report.verdict(rows, "grid")
+    assert world_verdicts.verdict(rows, "grid").pick["variant"] == "b"
     body = [
         _row("body", "off", 1.0, 0.01, sdf="off", friction="off"),
         _row("body", "s on", 3.0, 0.02, sdf="32", friction="on"),
         _row("body", "s off", 2.0, 0.04, sdf="32", friction="off"),
     ]
+    v = world_verdicts.verdict(body, "body")
+    assert (v.change.cost, v.change.err, v.pick["variant"], v.sdf) == (1.5, 0.5, "s off", None)
     text = accuracy_world_report.verdict(body, "body")
     assert "friction costs 1.50×" in text and "by 0.50×" in text and "is s off" in text
+    assert world_verdicts.verdict([body[0]], "body").pick is None
 
 
 def test_the_world_section_renders_from_its_csv(world_rows, tmp_path):
@@ -224,9 +232,12 @@ def test_the_sdf_clause_says_when_the_size_changed_nothing():
         _row("body", "a", 2.0, 0.02, sdf="32", friction="on"),
         _row("body", "b", 3.0, 0.02, sdf="64", friction="on"),
     ]
-    assert "changed no error" in accuracy_world_report.sdf_clause(rows)
+    assert world_verdicts.sdf_change(rows).unchanged
+    assert "changed no error" in accuracy_world_report.sdf_clause(world_verdicts.sdf_change(rows))
     rows[1]["rms_err_L"] = "0.01"
-    assert "moves the error by 0.50× over the 32³" in accuracy_world_report.sdf_clause(rows)
+    sdf = world_verdicts.sdf_change(rows)
+    assert (sdf.lo, sdf.hi, sdf.ratio, sdf.pairs, sdf.unchanged) == ("32", "64", 0.5, 1, False)
+    assert "moves the error by 0.50× over the 32³" in accuracy_world_report.sdf_clause(sdf)
 
 
 def test_without_a_gpu_the_world_study_says_so_and_times_the_cpu_alone(monkeypatch):

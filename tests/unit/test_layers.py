@@ -443,28 +443,15 @@ def tolerance_comparisons(path):
     return sorted(found)
 
 
-# renderers that still apply a tolerance themselves (#47's leftovers: each to hand its verdicts to
-# a studies/ module as accuracy_dynamic_report.py does through accuracy_verdicts_dynamic.py)
-DECIDING_RENDERERS = {
-    "harness.render.accuracy_world_dynamic_report",
-    "harness.render.host_report",
-    "harness.render.peer_dynamic_report",
-    "harness.render.reduced_dynamic_report",
-}
-
-
 def test_renderers_compare_nothing_with_a_tolerance():
     """A verdict (a tolerance applied to a measurement) is made in studies/ and handed to the
-    renderer as data; the list of renderers that still decide only shrinks."""
-    deciding = {
-        module_name(p): tolerance_comparisons(p)
+    renderer as data (as accuracy_dynamic_report.py gets its verdicts from accuracy_verdicts_dynamic.py)."""
+    deciding = [
+        f"{module_name(p)}: line {line}: {c}"
         for p in sorted((PACKAGE / "render").rglob("*.py"))
-        if tolerance_comparisons(p)
-    }
-    new = [f"{m}: line {line}: {c}" for m, cs in deciding.items() if m not in DECIDING_RENDERERS for line, c in cs]
-    assert not new, "renderers that apply a tolerance (decide in harness/studies):\n" + "\n".join(new)
-    split = DECIDING_RENDERERS - set(deciding)
-    assert not split, f"no longer decide: remove from DECIDING_RENDERERS: {sorted(split)}"
+        for line, c in tolerance_comparisons(p)
+    ]
+    assert not deciding, "renderers that apply a tolerance (decide in harness/studies):\n" + "\n".join(deciding)
 
 
 def test_the_tolerance_check_follows_a_budget_through_names(tmp_path):
