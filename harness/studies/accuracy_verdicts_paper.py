@@ -8,12 +8,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from harness.core import timing
+from harness.core import timing, tolerances
 from harness.studies.accuracy import PAPER_REFERENCE
 
-# (end-to-end max error / L, the use that needs it)
-USE_BOUNDS = ((1e-5, "production runs and benchmarks"), (1e-12, "references and validation"))
-RESOLUTION_BOUND = 0.01  # of L: the discretisation error a strand's point count may leave
+# (end-to-end max error / L, the use that needs it); of L: what a point count may leave
+USE_BOUNDS = tolerances.PAPER_ACC_USES
+RESOLUTION_BOUND = tolerances.PAPER_ACC_RESOLUTION_L
 
 
 def end_to_end(rows):
