@@ -137,6 +137,21 @@ def results_name(scene):
 CSV_NAME = "dynamic_accuracy.csv"
 # the frame budget's throughput curves of the study's modes (studies/budget_curves_dynamic.py)
 CURVES_NAME = "budget-curves"
+# The columns that name a dynamic mode and its run's size, in the order the studies' CSVs keep
+# (budget_curves_dynamic.py, observables_long_dynamic.py).
+MODE_COLUMNS = (
+    "mode",
+    "backend",
+    "build",
+    "variant",
+    "solver",
+    "ftl_damping",
+    "substeps",
+    "iterations",
+    "precision",
+    "strands",
+    "points",
+)
 CURVES_CSV = "curves.csv"
 
 

@@ -18,24 +18,14 @@ from harness.core import env, rounds, runner, scenes, timing
 from harness.core.paths import binary_path, display, output_dir
 from harness.core.progress import Progress
 from harness.io.files import write_csv, write_json
-from harness.studies.accuracy import CURVES_CSV, curves_name
+from harness.studies.accuracy import CURVES_CSV, MODE_COLUMNS, curves_name
 from harness.studies.accuracy_dynamic import configured
 
 LADDER = (1_000, 10_000, 100_000, 1_000_000)
 CPU_MAX = 100_000  # the dynamic sweep's CPU rows stop there too (a frame of about a second)
 FRAMES = 1
 COLUMNS = (
-    "mode",
-    "backend",
-    "build",
-    "variant",
-    "solver",
-    "ftl_damping",
-    "substeps",
-    "iterations",
-    "precision",
-    "strands",
-    "points",
+    *MODE_COLUMNS,
     "median_ms",
     "min_ms",
     "max_ms",

@@ -40,7 +40,7 @@ from harness.check import ensemble_dynamic as en
 from harness.check import observables_dynamic as ob
 from harness.core import runner
 from harness.studies import predictability_dynamic as predictability
-from harness.studies.accuracy import REF_ITERATIONS, REF_PRECISION, REF_SOLVER
+from harness.studies.accuracy import MODE_COLUMNS, REF_ITERATIONS, REF_PRECISION, REF_SOLVER
 
 CSV_NAME = "observables.csv"
 SCENES = ("motion", "release", "rest")
@@ -49,17 +49,7 @@ REST_SECONDS = 5.0  # the rest scene's time (at most the long time): what the ha
 COLUMNS = (
     "study",  # mode | reference
     "scene",  # motion | release | rest
-    "mode",
-    "backend",
-    "build",
-    "variant",
-    "solver",
-    "ftl_damping",
-    "substeps",
-    "iterations",
-    "precision",
-    "strands",
-    "points",
+    *MODE_COLUMNS,
     "seconds",
     "metric",
     "value",
