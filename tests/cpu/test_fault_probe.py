@@ -238,8 +238,9 @@ def test_cleanup_needs_name_and_marker(cpu_bin, tmp_path):
 # ---- signals x moments ------------------------------------------------------------------
 
 
-def wait_for_child(proc, name, timeout=30):
-    """Whether a child of proc whose command line names `name` appears within timeout (Linux /proc)."""
+def wait_for_child(proc, name, timeout=30, also=None):
+    """Whether a child of proc whose command line names `name` (and `also`, where given) appears
+    within timeout (Linux /proc)."""
     end = time.monotonic() + timeout
     while time.monotonic() < end and proc.poll() is None:
         for pid in filter(str.isdigit, os.listdir("/proc")):
@@ -250,7 +251,7 @@ def wait_for_child(proc, name, timeout=30):
                     cmd = fh.read()
             except (OSError, ValueError, IndexError):
                 continue
-            if ppid == proc.pid and name.encode() in cmd:
+            if ppid == proc.pid and name.encode() in cmd and (also is None or also.encode() in cmd):
                 return True
         time.sleep(0.01)
     return False

@@ -64,7 +64,8 @@ def test_signal_to_the_harness_stops_its_binary(cpu_bin, tmp_path, sig):
         text=True,
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
-    assert wait_for_child(proc, "hairsim-cpu", timeout=60)
+    # the simulation itself: the harness first asks the binary for its limits (a child that exits at once)
+    assert wait_for_child(proc, "hairsim-cpu", timeout=60, also="--strands")
     kids = child_pids(proc.pid)
     time.sleep(0.3)
     proc.send_signal(sig)
