@@ -32,6 +32,7 @@
 
 #include "backend_cuda.cuh"
 #include "check.cuh"
+#include "dynamic/held.cuh"
 #include "dynamic/kernels.cuh"
 #include "dynamic/lod.cuh"
 #include "dynamic/post.cuh"
@@ -73,6 +74,7 @@ struct DynState {
     hb_host_world hw;
     int64_t *g_mass, *g_mom;
     void *g_node_v, *g_node_a, *g_target, *g_ftab;
+    void *g_held; /* §3.16 `held`: each point's sample for the frame */
     int *c_kind, *c_frame;
     int64_t *c_sdf_n;
     void *c_mu, *c_geo, *c_sdf_ptrs;
@@ -259,9 +261,9 @@ void dyn_free(cuda_impl *c)
                     d->shape_rest, d->seg_rest,  d->seg64,   d->d_render,   d->d_vrender};
     for (void *p : ptrs)
         if (p) cudaFree(p);
-    void *world[] = {d->g_mass, d->g_mom,   d->g_node_v, d->g_node_a, d->g_target, d->g_ftab,
-                     d->c_kind, d->c_frame, d->c_sdf_n,  d->c_mu,     d->c_geo,    d->c_sdf_ptrs,
-                     d->f_pose, d->f_back,  d->f_qs,     d->d_world,  d->perm};
+    void *world[] = {d->g_mass,     d->g_mom,  d->g_node_v, d->g_node_a, d->g_target, d->g_ftab,
+                     d->g_held,     d->c_kind, d->c_frame,  d->c_sdf_n,  d->c_mu,     d->c_geo,
+                     d->c_sdf_ptrs, d->f_pose, d->f_back,   d->f_qs,     d->d_world,  d->perm};
     for (void *p : world)
         if (p) cudaFree(p);
     for (void *p : d->c_sdf)
@@ -366,6 +368,13 @@ template <typename T> static int dyn_world_load(cuda_impl *c, const void *rest, 
         w.ftab = (const T *)d->g_ftab;
         w.node_v = (const T *)d->g_node_v;
         w.node_a = (const T *)d->g_node_a;
+        if (c->variant == V_LANES && c->scene.dyn.grid_rebuild == HB_GRID_HELD &&
+            (c->scene.dyn.grid_friction_declared || c->scene.dyn.grid_volume_declared)) {
+            if ((rc = device_alloc(&d->g_held, (uint64_t)c->N * (uint64_t)c->P * hbd::kHeldReals * rs, c,
+                                   "the grid's held samples", err, errlen)))
+                return rc;
+            m.held = (const T *)d->g_held;
+        }
     }
     const int nc = hw->ncol;
     if (nc > 0) {
@@ -552,8 +561,10 @@ static cudaError_t dyn_grid_build(cuda_impl *c, const hbd::DModel<T> &m, const T
     cudaError_t e = hbd::launch_grid_splat<T>(m.world, qg, (const T *)c->state, (const T *)d->vel, c->N, c->P, m.perm,
                                               d->g_mass, d->g_mom, st);
     if (e != cudaSuccess) return e;
-    return hbd::launch_grid_nodes<T>(m.world, qg, d->g_mass, d->g_mom, (const T *)d->g_target, (T)hw->inv_rho0,
-                                     (T)hw->neg_kv, (T *)d->g_node_v, (T *)d->g_node_a, st);
+    e = hbd::launch_grid_nodes<T>(m.world, qg, d->g_mass, d->g_mom, (const T *)d->g_target, (T)hw->inv_rho0,
+                                  (T)hw->neg_kv, (T *)d->g_node_v, (T *)d->g_node_a, st);
+    if (e != cudaSuccess || !d->g_held) return e;
+    return hbd::launch_grid_hold<T>(m.world, qg, m.h, (const T *)c->state, c->N, c->P, (T *)d->g_held, st);
 }
 
 /* A frame: without the grid its one kernel; with it the grid's build first, once (`frame`), or

@@ -17,6 +17,7 @@
  */
 #include <utility>
 
+#include "dynamic/held.cuh"
 #include "dynamic/kernels.cuh"
 #include "runtime/approx.h" /* hb_rsqrt_fast, HB_FAST_FLOOR */
 
@@ -222,78 +223,11 @@ __device__ __forceinline__ void predict(const DModel<T> &m, Feat has, T phase, c
     }
 }
 
-/* §3.16 the hair–hair correction of point k at x (velocity v): the strict build runs the
- * reference (contact_impl.h) itself; the free builds the same sums from registers, the eight
- * corners' nodes read as vectors through the read-only cache. */
-template <typename T> struct Node4 {
-    T x, y, z, w;
-};
-template <typename T> __device__ __forceinline__ Node4<T> load_node4(const T *p)
-{
-    if constexpr (sizeof(T) == sizeof(float)) {
-        const float4 a = __ldg(reinterpret_cast<const float4 *>(p));
-        return Node4<T>{a.x, a.y, a.z, a.w};
-    } else {
-        const double2 a = __ldg(reinterpret_cast<const double2 *>(p)),
-                      b = __ldg(reinterpret_cast<const double2 *>(p) + 1);
-        return Node4<T>{a.x, a.y, b.x, b.y};
-    }
-}
-/* §3.16 a point's grid sample as contact_impl.h's hb_grid_sample lays it out: a = (v̄, 1 where
- * friction applies, else 0), b = (ā, 1 when x is in the grid, else 0). */
-template <typename T> struct Sample {
-    Node4<T> a, b;
-};
+/* §3.16 the grid's sample at x (cuda/dynamic/held.cuh) */
 template <typename T>
 __device__ __forceinline__ Sample<T> grid_sample_at(const DModel<T> &m, const T *qg, const V3<T> &x)
 {
-    const World<T> &w = m.world;
-    Sample<T> s{{(T)0, (T)0, (T)0, (T)0}, {(T)0, (T)0, (T)0, (T)0}};
-    if constexpr (!kFree) {
-        const T xx[3] = {x.x, x.y, x.z};
-        T r[8] = {};
-        grid_sample(w, qg, xx, r);
-        s.a = Node4<T>{r[0], r[1], r[2], r[3]};
-        s.b = Node4<T>{r[4], r[5], r[6], r[7]};
-    } else {
-        V3<T> u = x;
-        if (qg)
-            u = V3<T>{(qg[0] * x.x + qg[3] * x.y) + qg[6] * x.z, (qg[1] * x.x + qg[4] * x.y) + qg[7] * x.z,
-                      (qg[2] * x.x + qg[5] * x.y) + qg[8] * x.z};
-        const T gx = (u.x - w.glo[0]) * w.gsc[0], gy = (u.y - w.glo[1]) * w.gsc[1], gz = (u.z - w.glo[2]) * w.gsc[2];
-        const T top = (T)(w.gn - 1);
-        if (!(gx >= (T)0 && gx < top && gy >= (T)0 && gy < top && gz >= (T)0 && gz < top)) return s;
-        const int ix = (int)gx, iy = (int)gy, iz = (int)gz;
-        const T fx = gx - (T)ix, fy = gy - (T)iy, fz = gz - (T)iz;
-        const int64_t n = w.gn, b = ix + n * (iy + n * (int64_t)iz);
-        T sw = 0, svx = 0, svy = 0, svz = 0, ax = 0, ay = 0, az = 0;
-#pragma unroll
-        for (int c = 0; c < 8; c++) {
-            const T wx = (c & 1) ? fx : (T)1 - fx, wy = (c & 2) ? fy : (T)1 - fy, wz = (c & 4) ? fz : (T)1 - fz;
-            const T wt = (wx * wy) * wz;
-            const int64_t j = b + ((c & 1) ? 1 : 0) + ((c & 2) ? n : 0) + ((c & 4) ? n * n : 0);
-            if (w.grid_friction) {
-                const auto nv = load_node4<T>(w.node_v + 4 * j);
-                const T wo = wt * nv.w; /* o ∈ {0, 1}; V is 0 where o is */
-                sw += wo;
-                svx += wt * nv.x;
-                svy += wt * nv.y;
-                svz += wt * nv.z;
-            }
-            if (w.grid_volume) {
-                const auto na = load_node4<T>(w.node_a + 4 * j);
-                ax += wt * na.x;
-                ay += wt * na.y;
-                az += wt * na.z;
-            }
-        }
-        if (w.grid_friction && sw > (T)0) {
-            const T inv = fdiv((T)1, sw);
-            s.a = Node4<T>{svx * inv, svy * inv, svz * inv, (T)1};
-        }
-        s.b = Node4<T>{ax, ay, az, (T)1};
-    }
-    return s;
+    return grid_sample_xyz(m.world, qg, x.x, x.y, x.z);
 }
 /* §3.16 the correction of point k from its sample (hb_grid_apply). */
 template <typename T>
@@ -339,28 +273,14 @@ template <typename T> __device__ __forceinline__ Node4<T> shared_node4(const T *
     }
 }
 /* vectors a held slot */
-constexpr int kHeldVectors = kFree ? 1 : 2;
-/* §3.16 `held`: point k's sample at x (the frame's first substep) into slot i of hs */
-template <typename T>
-__device__ __forceinline__ void hold_sample(const DModel<T> &m, const T *qg, int k, const V3<T> &x, T *hs, int i,
-                                            int lane)
+constexpr int kHeldVectors = kHeldReals / 4;
+/* §3.16 `held`: point k's sample (the frame's first substep), as k_grid_hold left it at src, into
+ * slot i of hs */
+template <typename T> __device__ __forceinline__ void hold_sample(const T *src, T *hs, int i, int lane)
 {
-    const Sample<T> s = grid_sample_at(m, qg, x);
-    if constexpr (!kFree) {
-        store_node4(hs + 4 * (2 * i * 32 + lane), s.a);
-        store_node4(hs + 4 * ((2 * i + 1) * 32 + lane), s.b);
-    } else {
-        const World<T> &w = m.world;
-        Node4<T> c{(T)0, (T)0, (T)0, (T)1};
-        if (s.b.w != (T)0) {
-            if (w.grid_friction && s.a.w != (T)0) {
-                const T f = w.ftab[k];
-                c = Node4<T>{f * s.a.x, f * s.a.y, f * s.a.z, (T)1 - f};
-            }
-            if (w.grid_volume) c = Node4<T>{c.x + m.h * s.b.x, c.y + m.h * s.b.y, c.z + m.h * s.b.z, c.w};
-        }
-        store_node4(hs + 4 * (i * 32 + lane), c);
-    }
+#pragma unroll
+    for (int u = 0; u < kHeldVectors; u++)
+        store_node4(hs + 4 * ((kHeldVectors * i + u) * 32 + lane), load_node4<T>(src + 4 * u));
 }
 /* §3.16 `held`: the correction of point k from slot i of hs */
 template <typename T>
@@ -625,13 +545,13 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         const bool wgrid = (W & (kWGather | kWHeld)) && m.world.grid && (m.world.grid_friction || m.world.grid_volume);
         const bool held = (W & kWHeld) && wgrid && m.world.grid_rebuild == HB_GRID_HELD;
         const bool wcol = (W & kWCol) && (m.world.ncol > 0 || m.world.head_friction || m.world.bounded);
-        if constexpr ((W & kWHeld) != 0) { /* §3.16 `held`: sampled at the frame's first substep, */
-            if (held) { /* where x is the frame's start for every point k ≥ 1 (step 1 moves the root alone) */
-                const T *qg = has(HB_F_MOTION) ? m.qs : nullptr;
+        if constexpr ((W & kWHeld) != 0) { /* §3.16 `held`: each point's sample, taken by k_grid_hold */
+            if (held && live) {
+                const int64_t st = m.perm ? m.perm[s0 + seg] : s0 + seg;
 #pragma unroll
                 for (int i = 0; i < G; i++) {
                     const int k = point_of<G>(k0, sw, i);
-                    if (k >= 1 && k < P) hold_sample(m, qg, k, X[i], hs, i, lane);
+                    if (k >= 1 && k < P) hold_sample(m.held + (st * P + k) * kHeldReals, hs, i, lane);
                 }
             }
         }

@@ -72,6 +72,8 @@ template <typename T> struct DModel {
     World<T> world{};
     const int64_t *perm = nullptr; /* the strands' order (lanes with a world): slot s runs strand perm[s] */
     const T *pose = nullptr, *back = nullptr, *qs = nullptr;
+    /* §3.16 `held`: each point's sample for the frame ([N][P][kHeldReals], cuda/dynamic/held.cuh) */
+    const T *held = nullptr;
     /* the substeps a launch runs: j0 … j1 − 1 (j1 < 0: all of the frame's) */
     int j0 = 0, j1 = -1;
 };

@@ -3,6 +3,8 @@
  * changes no bit, and the node fields. */
 #include "dynamic/world.cuh"
 
+#include "dynamic/held.cuh"
+
 #include <climits>
 
 namespace hb {
@@ -229,6 +231,26 @@ __global__ void k_grid_nodes(World<T> w, const T *qg, const int64_t *mass, const
     if (j < w.gn * w.gn * w.gn) Splat<T>::node(j, w, mass, mom, target, inv_rho0, neg_kv, qg, node_v, node_a);
 }
 
+/* §3.16 `held`: one thread a point, in stored order (loads and stores coalesce; neighbouring
+ * threads are neighbouring points, so the gathers share nodes). The root (k = 0) takes no
+ * correction. */
+template <typename T> __global__ void k_grid_hold(World<T> w, const T *qg, T h, const T *x, int64_t NP, int P, T *held)
+{
+    const int64_t r = (int64_t)blockIdx.x * blockDim.x + threadIdx.x;
+    if (r >= NP) return;
+    const int k = (int)(r % P);
+    if (k == 0) return;
+    const Sample<T> s = grid_sample_xyz(w, qg, x[3 * r], x[3 * r + 1], x[3 * r + 2]);
+    T *o = held + r * kHeldReals;
+    if constexpr (kGridFree) {
+        const Node4<T> c = held_correction(w, h, k, s);
+        o[0] = c.x, o[1] = c.y, o[2] = c.z, o[3] = c.w;
+    } else {
+        o[0] = s.a.x, o[1] = s.a.y, o[2] = s.a.z, o[3] = s.a.w;
+        o[4] = s.b.x, o[5] = s.b.y, o[6] = s.b.z, o[7] = s.b.w;
+    }
+}
+
 int blocks_for(int64_t items, int block)
 {
     const int64_t g = (items + block - 1) / block;
@@ -270,6 +292,18 @@ cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mas
     return cudaGetLastError();
 }
 
+template <typename T>
+cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P, T *held,
+                             cudaStream_t stream)
+{
+    k_grid_hold<T><<<blocks_for(N * P, 256), 256, 0, stream>>>(w, qg, h, x, N * P, (int)P, held);
+    return cudaGetLastError();
+}
+
+template cudaError_t launch_grid_hold<float>(const World<float> &, const float *, float, const float *, int64_t,
+                                             int64_t, float *, cudaStream_t);
+template cudaError_t launch_grid_hold<double>(const World<double> &, const double *, double, const double *, int64_t,
+                                              int64_t, double *, cudaStream_t);
 template cudaError_t launch_grid_splat<float>(const World<float> &, const float *, const float *, const float *,
                                               int64_t, int64_t, const int64_t *, int64_t *, int64_t *, cudaStream_t);
 template cudaError_t launch_grid_splat<double>(const World<double> &, const double *, const double *, const double *,
