@@ -564,7 +564,7 @@ static cudaError_t dyn_grid_build(cuda_impl *c, const hbd::DModel<T> &m, const T
     e = hbd::launch_grid_nodes<T>(m.world, qg, d->g_mass, d->g_mom, (const T *)d->g_target, (T)hw->inv_rho0,
                                   (T)hw->neg_kv, (T *)d->g_node_v, (T *)d->g_node_a, st);
     if (e != cudaSuccess || !d->g_held) return e;
-    return hbd::launch_grid_hold<T>(m.world, qg, m.h, (const T *)c->state, c->N, c->P, (T *)d->g_held, st);
+    return hbd::launch_grid_hold<T>(m.world, qg, m.h, (const T *)c->state, c->N, c->P, m.perm, (T *)d->g_held, st);
 }
 
 /* A frame: without the grid its one kernel; with it the grid's build first, once (`frame`), or

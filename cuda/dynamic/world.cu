@@ -231,23 +231,49 @@ __global__ void k_grid_nodes(World<T> w, const T *qg, const int64_t *mass, const
     if (j < w.gn * w.gn * w.gn) Splat<T>::node(j, w, mass, mom, target, inv_rho0, neg_kv, qg, node_v, node_a);
 }
 
-/* §3.16 `held`: one thread a point, in stored order (loads and stores coalesce; neighbouring
- * threads are neighbouring points, so the gathers share nodes). The root (k = 0) takes no
- * correction. */
-template <typename T> __global__ void k_grid_hold(World<T> w, const T *qg, T h, const T *x, int64_t NP, int P, T *held)
+/* §3.16 `held`: a block takes kHoldStrands neighbouring strands in the strands' order (perm) and
+ * kHoldPoints of their points; a warp samples one point index across its 32 strands, whose points
+ * lie close together (the order follows the roots), so a corner's load is shared by the warp where
+ * a strand's own points would each need a cell of their own. Positions come in and samples go out
+ * through shared memory, a strand's run of points contiguous (rows padded against bank conflicts).
+ * The root's sample (k = 0) is written but never applied. */
+constexpr int kHoldStrands = 32, kHoldPoints = 8;
+template <typename T>
+__global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
+    k_grid_hold(World<T> w, const T *qg, T h, const T *x, int64_t N, int P, const int64_t *perm, T *held)
 {
-    const int64_t r = (int64_t)blockIdx.x * blockDim.x + threadIdx.x;
-    if (r >= NP) return;
-    const int k = (int)(r % P);
-    if (k == 0) return;
-    const Sample<T> s = grid_sample_xyz(w, qg, x[3 * r], x[3 * r + 1], x[3 * r + 2]);
-    T *o = held + r * kHeldReals;
-    if constexpr (kGridFree) {
-        const Node4<T> c = held_correction(w, h, k, s);
-        o[0] = c.x, o[1] = c.y, o[2] = c.z, o[3] = c.w;
-    } else {
-        o[0] = s.a.x, o[1] = s.a.y, o[2] = s.a.z, o[3] = s.a.w;
-        o[4] = s.b.x, o[5] = s.b.y, o[6] = s.b.z, o[7] = s.b.w;
+    constexpr int R = kHeldReals, XW = 3 * kHoldPoints + 1, HW = R * kHoldPoints + 1;
+    __shared__ T xs[kHoldStrands * XW];
+    __shared__ T hs[kHoldStrands * HW];
+    __shared__ int64_t sid[kHoldStrands];
+    const int t = threadIdx.x;
+    const int64_t s0 = (int64_t)blockIdx.x * kHoldStrands;
+    const int k0 = (int)blockIdx.y * kHoldPoints;
+    const int ns = (int)(N - s0 < kHoldStrands ? N - s0 : kHoldStrands), nk = P - k0 < kHoldPoints ? P - k0 : kHoldPoints;
+    if (t < kHoldStrands) sid[t] = t < ns ? (perm ? perm[s0 + t] : s0 + t) : 0;
+    __syncthreads();
+    for (int i = t; i < kHoldStrands * 3 * kHoldPoints; i += blockDim.x) {
+        const int u = i / (3 * kHoldPoints), r = i % (3 * kHoldPoints);
+        if (u < ns && r < 3 * nk) xs[u * XW + r] = x[(sid[u] * P + k0) * 3 + r];
+    }
+    __syncthreads();
+    const int u = t & 31, kk = t >> 5;
+    if (u < ns && kk < nk) {
+        const T *p = xs + u * XW + 3 * kk;
+        const Sample<T> s = grid_sample_xyz(w, qg, p[0], p[1], p[2]);
+        T *o = hs + u * HW + R * kk;
+        if constexpr (kGridFree) {
+            const Node4<T> c = held_correction(w, h, k0 + kk, s);
+            o[0] = c.x, o[1] = c.y, o[2] = c.z, o[3] = c.w;
+        } else {
+            o[0] = s.a.x, o[1] = s.a.y, o[2] = s.a.z, o[3] = s.a.w;
+            o[4] = s.b.x, o[5] = s.b.y, o[6] = s.b.z, o[7] = s.b.w;
+        }
+    }
+    __syncthreads();
+    for (int i = t; i < kHoldStrands * R * kHoldPoints; i += blockDim.x) {
+        const int v = i / (R * kHoldPoints), r = i % (R * kHoldPoints);
+        if (v < ns && r < R * nk) held[(sid[v] * P + k0) * R + r] = hs[v * HW + r];
     }
 }
 
@@ -293,17 +319,18 @@ cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mas
 }
 
 template <typename T>
-cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P, T *held,
-                             cudaStream_t stream)
+cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P,
+                             const int64_t *perm, T *held, cudaStream_t stream)
 {
-    k_grid_hold<T><<<blocks_for(N * P, 256), 256, 0, stream>>>(w, qg, h, x, N * P, (int)P, held);
+    const dim3 grid((unsigned)((N + kHoldStrands - 1) / kHoldStrands), (unsigned)((P + kHoldPoints - 1) / kHoldPoints));
+    k_grid_hold<T><<<grid, kHoldStrands * kHoldPoints, 0, stream>>>(w, qg, h, x, N, (int)P, perm, held);
     return cudaGetLastError();
 }
 
 template cudaError_t launch_grid_hold<float>(const World<float> &, const float *, float, const float *, int64_t,
-                                             int64_t, float *, cudaStream_t);
-template cudaError_t launch_grid_hold<double>(const World<double> &, const double *, double, const double *, int64_t,
-                                              int64_t, double *, cudaStream_t);
+                                             int64_t, const int64_t *, float *, cudaStream_t);
+template cudaError_t launch_grid_hold<double>(const World<double> &, const double *, double, const double *,
+                                              int64_t, int64_t, const int64_t *, double *, cudaStream_t);
 template cudaError_t launch_grid_splat<float>(const World<float> &, const float *, const float *, const float *,
                                               int64_t, int64_t, const int64_t *, int64_t *, int64_t *, cudaStream_t);
 template cudaError_t launch_grid_splat<double>(const World<double> &, const double *, const double *, const double *,
