@@ -11,6 +11,9 @@ from pathlib import Path
 import pytest
 from hypothesis.configuration import set_hypothesis_home_dir
 
+# fixtures kept beside the helpers they use: `stubbed` (the dynamic bench's studies as recorders)
+pytest_plugins = ["support.bench_stubs"]
+
 ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "build"
 # `make sanitize` points the CPU tests at the ASan/UBSan build through HAIRBENCH_CPU_BIN.

@@ -249,7 +249,8 @@ __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
     const int t = threadIdx.x;
     const int64_t s0 = (int64_t)blockIdx.x * kHoldStrands;
     const int k0 = (int)blockIdx.y * kHoldPoints;
-    const int ns = (int)(N - s0 < kHoldStrands ? N - s0 : kHoldStrands), nk = P - k0 < kHoldPoints ? P - k0 : kHoldPoints;
+    const int ns = (int)(N - s0 < kHoldStrands ? N - s0 : kHoldStrands),
+              nk = P - k0 < kHoldPoints ? P - k0 : kHoldPoints;
     if (t < kHoldStrands) sid[t] = t < ns ? (perm ? perm[s0 + t] : s0 + t) : 0;
     __syncthreads();
     for (int i = t; i < kHoldStrands * 3 * kHoldPoints; i += blockDim.x) {
@@ -319,8 +320,8 @@ cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mas
 }
 
 template <typename T>
-cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P,
-                             const int64_t *perm, T *held, cudaStream_t stream)
+cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P, const int64_t *perm,
+                             T *held, cudaStream_t stream)
 {
     const dim3 grid((unsigned)((N + kHoldStrands - 1) / kHoldStrands), (unsigned)((P + kHoldPoints - 1) / kHoldPoints));
     k_grid_hold<T><<<grid, kHoldStrands * kHoldPoints, 0, stream>>>(w, qg, h, x, N, (int)P, perm, held);
@@ -329,8 +330,8 @@ cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, in
 
 template cudaError_t launch_grid_hold<float>(const World<float> &, const float *, float, const float *, int64_t,
                                              int64_t, const int64_t *, float *, cudaStream_t);
-template cudaError_t launch_grid_hold<double>(const World<double> &, const double *, double, const double *,
-                                              int64_t, int64_t, const int64_t *, double *, cudaStream_t);
+template cudaError_t launch_grid_hold<double>(const World<double> &, const double *, double, const double *, int64_t,
+                                              int64_t, const int64_t *, double *, cudaStream_t);
 template cudaError_t launch_grid_splat<float>(const World<float> &, const float *, const float *, const float *,
                                               int64_t, int64_t, const int64_t *, int64_t *, int64_t *, cudaStream_t);
 template cudaError_t launch_grid_splat<double>(const World<double> &, const double *, const double *, const double *,

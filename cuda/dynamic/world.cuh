@@ -95,8 +95,8 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
  * held ([N][P][kHeldReals], cuda/dynamic/held.cuh; h: the substep; perm: the strands' order, or
  * nullptr), after launch_grid_nodes. */
 template <typename T>
-cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P,
-                             const int64_t *perm, T *held, cudaStream_t stream);
+cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P, const int64_t *perm,
+                             T *held, cudaStream_t stream);
 /* §3.16 the node fields from the sums (target, inv_rho0, neg_kv: volume). */
 template <typename T>
 cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mass, const int64_t *mom, const T *target,

@@ -344,6 +344,19 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
     def mine(study):
         return shard is None or shard.takes(ONE_MEASUREMENT_STUDIES.index(study))
 
+    gpu = "auto" if builds else "no"
+    reports = [report_dir] if render else []
+    # the pictures first: short, and a report without them is blind, so a budget spends itself on
+    # the open-ended studies after them
+    if render and fits("animate"):
+
+        def make_animation():
+            say("harness: animate")
+            animate.run(out=Path(report_dir) / "dynamic.gif", force=True, log=say, state_dir=root / "animation")
+
+        within("animate", make_animation, root / "animation", *reports)
+    if render and fits("renders"):
+        within("renders", lambda: renders.simulate(root, say), root / renders.FOLDER)
     if mine("featurecost") and fits("featurecost"):
         fc = root / "featurecost"
         fc.mkdir(parents=True, exist_ok=True)
@@ -366,8 +379,6 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
                 featurecost.measure(backend="cuda", variant=v, strands=1_000_000, out=fc / f"cuda-{v}.csv")
 
         within("featurecost", measure_featurecost, fc)
-    gpu = "auto" if builds else "no"
-    reports = [report_dir] if render else []
     if mine("reduced") and fits("reduced"):
 
         def measure_reduced():
@@ -424,15 +435,6 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
             accuracy_world.run_study(plan, out_dir=root / accuracy_world.RESULTS_NAME, log=say)
 
         within("world", measure_world, root / accuracy_world.RESULTS_NAME)
-    if render and fits("animate"):
-
-        def make_animation():
-            say("harness: animate")
-            animate.run(out=Path(report_dir) / "dynamic.gif", force=True, log=say, state_dir=root / "animation")
-
-        within("animate", make_animation, root / "animation", *reports)
-    if render and fits("renders"):
-        within("renders", lambda: renders.simulate(root, say), root / renders.FOLDER)
 
 
 def curly_sweep(root, gpu, say, shard=None, budget=None):

@@ -5,20 +5,15 @@ and page, and the report's section from a tiny real study whose reference does n
 
 import pytest
 
-from harness.bench import animate_dynamic as animate
 from harness.bench import dynamic as bench_dynamic
 from harness.core import variants
 from harness.core.budget import Budget
 from harness.core.shards import Shard
 from harness.render import accuracy_dynamic_report, report_dynamic
 from harness.studies import accuracy_dynamic
-from harness.studies import budget_curves_dynamic as budget_curves
-from harness.studies import featurecost_dynamic as featurecost
-from harness.studies import peer_dynamic as peer
-from harness.studies import reduced_dynamic as reduced
-from harness.studies import stability_dynamic as stability
 from harness.studies.accuracy import results_name
 from support.accuracy_plans import TINY
+from support.bench_stubs import Clock  # the fixture `stubbed` comes from there too (tests/conftest.py)
 
 CURLY = report_dynamic.CURLY_SCENE
 HEAD = f"## Speed against accuracy: {report_dynamic.CURLY_TITLE}"
@@ -37,41 +32,6 @@ def test_each_scene_has_its_own_folder_and_page():
         "dynamic_accuracy_curly_growth.png",
         "dynamic_accuracy_curly_steps.png",
     }
-
-
-class Clock:
-    def __init__(self):
-        self.t = 0.0
-
-    def __call__(self):
-        return self.t
-
-
-@pytest.fixture
-def stubbed(monkeypatch):
-    """Every dynamic study replaced by a recorder; the accuracy study's calls in `calls`."""
-    calls = []
-    hooks = []  # run after each accuracy call (to spend the budget)
-
-    def run_study(plan, out_dir=None, force=False, command=None, log=print):
-        calls.append((plan, out_dir))
-        for h in hooks:
-            h(plan)
-        return 0
-
-    monkeypatch.setattr(accuracy_dynamic, "run_study", run_study)
-    monkeypatch.setattr(accuracy_dynamic_report, "write", lambda *a, **k: [])
-    monkeypatch.setattr(featurecost, "measure", lambda **k: None)
-    monkeypatch.setattr(reduced, "measure", lambda *a, **k: None)
-    monkeypatch.setattr(stability, "run_study", lambda **k: None)
-    monkeypatch.setattr(bench_dynamic, "budget_modes", lambda acc_dir: [])  # the frame budget's curves
-    monkeypatch.setattr(budget_curves, "measure", lambda *a, **k: None)
-    monkeypatch.setattr(peer, "run_study", lambda *a, **k: None)
-    monkeypatch.setattr(bench_dynamic.accuracy_world, "run_study", lambda *a, **k: None)
-    monkeypatch.setattr(bench_dynamic.peer_report, "write", lambda *a, **k: None)
-    monkeypatch.setattr(animate, "run", lambda **k: None)
-    monkeypatch.setattr(bench_dynamic.renders, "simulate", lambda *a, **k: None)
-    return calls, hooks
 
 
 def test_the_bench_runs_the_quick_accuracy_study_on_curly_hair_beside_the_straight_one(stubbed, tmp_path):
