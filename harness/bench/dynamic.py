@@ -347,7 +347,7 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
     gpu = "auto" if builds else "no"
     reports = [report_dir] if render else []
     # the pictures first: short, and a report without them is blind, so a budget spends itself on
-    # the open-ended studies after them
+    # the open-ended studies after them (the accuracy study's modes are drawn once it has run)
     if render and fits("animate"):
 
         def make_animation():
@@ -397,6 +397,8 @@ def studies(root, builds, say, report_dir=None, quick=False, shard=None, budget=
                 root / results_name(scene),
                 *reports,
             )
+            if ran and scene == DEFAULT_SCENE and render and fits("mode renders"):  # its modes drawn
+                within("mode renders", lambda: renders.simulate_modes(root, say), root / renders.FOLDER)
             if ran and scene == DEFAULT_SCENE and fits("budget curves"):  # the frame budget's answer needs them
                 gate = TierGate(budget.allowance("budget curves")) if budget else None
                 within(

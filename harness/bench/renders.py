@@ -14,9 +14,11 @@ simulated on the C reference into ROOT/renders/, listed in ROOT/renders/renders.
                        grid (docs/model.md §3.16, §3.17): the grid's and the body's effect
 
 A GPU pick's settings run on the CPU oracle: the model is the same (docs/model.md §1.3) and
-the picture cannot show a build's arithmetic. Where the accuracy study has no results, only
-the animation's state is made."""
+the picture cannot show a build's arithmetic. `simulate` makes the scene's and the world's
+states; `simulate_modes`, once the accuracy study has run, its modes' (none where it has no
+results)."""
 
+import json
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -103,7 +105,8 @@ def world_states(out):
 
 
 def simulate(root, say):
-    """Make ROOT/renders/ (states and renders.json); the record's path, or None (nothing made)
+    """Make ROOT/renders/ (the scene's and the world's states, and renders.json, its modes empty
+    until simulate_modes adds the accuracy study's); the record's path, or None (nothing made)
     where no OpenGL context can be made to draw them (one line says why)."""
     why = context.unavailable()
     if why:
@@ -116,18 +119,31 @@ def simulate(root, say):
     scene = scenes.with_frames(scenes.load_scene("dynamic").with_overrides(strands=ANIMATION_STRANDS), ANIMATION_FRAMES)
     scene = replace(scene, dynamic={**scene.dynamic, "--output-every": ANIMATION_EVERY})
     dynamic = _simulate(scene, out / "dynamic.h5")
-    modes, reference = mode_states(root, out, say)
     say(f"harness: renders: the grid and the body's effect at {WORLD_STRANDS} strands, {WORLD_FRAMES} frames")
     world = world_states(out)
     record = {
         "dynamic": dynamic,
         "world": world,
-        "modes": modes,
-        "reference": reference,
+        "modes": [],
+        "reference": None,
         "mode_strands": MODE_STRANDS,
         "simulate_s": round(time.perf_counter() - start, 1),
     }
     path = out / RECORD
     write_json(path, record)
     say(f"harness: renders: states in {display(out)} ({record['simulate_s']} s)")
+    return path
+
+
+def simulate_modes(root, say):
+    """Add the accuracy study's modes and its reference to ROOT/renders/renders.json, which
+    simulate made; the record's path, or None where it made none."""
+    path = Path(root) / FOLDER / RECORD
+    if not path.is_file():
+        return None
+    start = time.perf_counter()
+    record = json.loads(path.read_text())
+    record["modes"], record["reference"] = mode_states(root, path.parent, say)
+    record["simulate_s"] = round(record["simulate_s"] + time.perf_counter() - start, 1)
+    write_json(path, record)
     return path

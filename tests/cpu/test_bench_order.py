@@ -1,6 +1,7 @@
 """The dynamic bench's order of steps (harness/bench/dynamic.py `studies`): the pictures — the
 animation and the renders — come before the open-ended studies, so a budget that those studies
-spend still leaves the report its pictures (the studies stubbed: no real run)."""
+spend still leaves the report its pictures, and the accuracy study's modes are drawn right after
+the study that picks them (the studies stubbed: no real run)."""
 
 from harness.bench import dynamic as bench_dynamic
 from harness.core.budget import Budget
@@ -33,3 +34,13 @@ def test_without_a_report_the_bench_makes_no_pictures(stubbed, tmp_path):
     calls, _ = stubbed
     bench_dynamic.studies(tmp_path, [], lambda line: None, quick=True)
     assert not [c for c in calls if c[0] in ("animate", "renders")]
+
+
+def test_the_accuracy_modes_are_drawn_right_after_the_study_that_picks_them(stubbed, tmp_path):
+    calls, _ = stubbed
+    report = tmp_path / "report"
+    report.mkdir()
+    bench_dynamic.studies(tmp_path, [], lambda line: None, report_dir=report, quick=True)
+    steps = [c[0] if isinstance(c[0], str) else f"accuracy {c[0].scene}" for c in calls]
+    assert steps[:2] == ["animate", "renders"]
+    assert steps[steps.index("accuracy dynamic") + 1] == "mode renders" and steps.count("mode renders") == 1

@@ -25,7 +25,10 @@ def test_the_renders_step_and_the_report_section(cpu_bin, tmp_path, monkeypatch)
     monkeypatch.setattr(renders, "ANIMATION_FRAMES", 8)
     monkeypatch.setattr(renders, "MODE_STRANDS", 12)
     shutil.copytree(ROOT / "results" / "reference-h200" / "dynamic-accuracy", tmp_path / "dynamic-accuracy")
-    record = json.loads(renders.simulate(tmp_path, lambda m: None).read_text())
+    first = json.loads(renders.simulate(tmp_path, lambda m: None).read_text())
+    assert first["modes"] == [] and first["reference"] is None  # the bench draws them after the study
+    record = json.loads(renders.simulate_modes(tmp_path, lambda m: None).read_text())
+    assert {k: record[k] for k in ("dynamic", "world")} == {k: first[k] for k in ("dynamic", "world")}
     uses = {p["use"] for m in record["modes"] for p in m["picks"]}
     assert uses == {"previews", "games", "offline"} and record["reference"]["substeps"] == 1024
     lines = hair_report.dynamic_lines(tmp_path, tmp_path / "report")

@@ -25,7 +25,8 @@ class Clock:
 @pytest.fixture
 def stubbed(monkeypatch):
     """Every dynamic study replaced by a recorder; the accuracy study's calls in `calls` as
-    (plan, folder), the animation's and the renders' as ("animate", file) and ("renders", root)."""
+    (plan, folder), the animation's and the renders' as ("animate", file), ("renders", root) and
+    ("mode renders", root)."""
     calls = []
     hooks = []  # run after each accuracy call (to spend the budget)
 
@@ -47,4 +48,6 @@ def stubbed(monkeypatch):
     monkeypatch.setattr(bench_dynamic.peer_report, "write", lambda *a, **k: None)
     monkeypatch.setattr(animate, "run", lambda **k: calls.append(("animate", k.get("out"))))
     monkeypatch.setattr(bench_dynamic.renders, "simulate", lambda *a, **k: calls.append(("renders", a[0])))
+    monkeypatch.setattr(bench_dynamic.renders, "simulate_modes", lambda *a, **k: calls.append(("mode renders", a[0])))
+    monkeypatch.setattr(bench_dynamic.stability_report, "report_from_csv", lambda *a, **k: None)
     return calls, hooks
