@@ -110,6 +110,13 @@ def layer(name):
     return LAYERS.index(parts[1]) if len(parts) > 1 and parts[1] in LAYERS else -1
 
 
+def module_file(tmp_path, source):
+    """A module m.py holding source, for the checks' own known-answer tests."""
+    path = tmp_path / "m.py"
+    path.write_text(source)
+    return path
+
+
 def test_every_module_is_in_a_layer():
     loose = [n for n in package_modules() if layer(n) < 0 and n not in ("harness", "harness.__main__")]
     assert not loose, f"modules outside the layers {LAYERS}: {loose}"
@@ -237,8 +244,9 @@ def test_every_file_write_goes_through_files():
 
 
 def test_the_write_check_sees_a_hidden_write(tmp_path):
-    path = tmp_path / "m.py"
-    path.write_text("def f(p, t):\n    with open(p, 'w') as x:\n        x.write(t)\n    t.replace('a', 'b')\n")
+    path = module_file(
+        tmp_path, "def f(p, t):\n    with open(p, 'w') as x:\n        x.write(t)\n    t.replace('a', 'b')\n"
+    )
     assert file_writes(path) == ["line 2: open"]
 
 
@@ -297,8 +305,7 @@ def test_no_function_in_harness_is_over_150_lines():
 
 
 def test_the_length_scan_sees_a_long_function(tmp_path):
-    path = tmp_path / "m.py"
-    path.write_text("def f():\n" + "    x = 1\n" * 160 + "\n\ndef g():\n    return 2\n")
+    path = module_file(tmp_path, "def f():\n" + "    x = 1\n" * 160 + "\n\ndef g():\n    return 2\n")
     assert long_functions(path) == [(1, "f", 161)]
 
 
@@ -377,15 +384,15 @@ def test_the_measuring_layers_make_no_markdown():
 
 
 def test_the_markdown_check_sees_a_table_and_a_write(tmp_path):
-    path = tmp_path / "m.py"
-    path.write_text(
+    path = module_file(
+        tmp_path,
         '"""| a docstring may show a table |"""\n'
         'PAGE = "page.md"\n'
         "def f(out, s):\n"
         '    rows = [f"| {s} | 1 |", "| --- | ---: |"]\n'
         "    files.write_text(out / PAGE, s)\n"
         '    (out / "x.md").write_text(s)\n'
-        '    files.write_text(out / "x.json", "# not a heading")\n'
+        '    files.write_text(out / "x.json", "# not a heading")\n',
     )
     assert sorted(markdown_made(path, {"PAGE"})) == [
         "line 4: Markdown text '| '",
@@ -455,14 +462,14 @@ def test_renderers_compare_nothing_with_a_tolerance():
 
 
 def test_the_tolerance_check_follows_a_budget_through_names(tmp_path):
-    path = tmp_path / "m.py"
-    path.write_text(
+    path = module_file(
+        tmp_path,
         "def f(r, use):\n"
         "    for name, (rms, _) in tolerances.USES.items():\n"
         "        ratio = rms / r\n"
         "        words = 'yes' if ratio < 1 else 'no'\n"
         "        same = name == use\n"
         "    ok = r <= tolerances.budget(use)\n"
-        "    return describe(tolerances.USES) is None\n"
+        "    return describe(tolerances.USES) is None\n",
     )
     assert tolerance_comparisons(path) == [(4, "ratio < 1"), (6, "r <= tolerances.budget(use)")]
