@@ -227,8 +227,9 @@ def _sag_lines(cases, cols):
     if any(k[0] == "sagfreq" for k in cases):
         out += [
             "",
-            "Sag-free rest leaves the dynamics alone: the same still scene (shape range 1) hit at t = 0 by a steady "
-            "wind (a step load); the median over the strands that swing of the tip's frequency and damping ratio:",
+            "Whether sag-free rest changes the dynamics: the same still scene (shape range 1) hit at t = 0 by a "
+            "steady wind (a step load); the median over the strands that swing of the tip's frequency and damping "
+            "ratio (—: no strand swings):",
             "",
             *_table(
                 cases,
@@ -299,10 +300,25 @@ def _lra_lines(rows):
     return out
 
 
+def _swing_words(hz):
+    """Per solver, the tip's median frequency without and with sag-free rest, or that nothing swings."""
+    out = []
+    for solver in sorted({k[0] for k in hz}):
+        off, on = hz.get((solver, "0")), hz.get((solver, "1"))
+        if off is None or on is None:
+            continue
+        if off != off or on != on:  # NaN: the swing detector found no strand that swings
+            out.append(f"{solver}: no strand swings" + ("" if off != off and on != on else " in one of the two runs"))
+        else:
+            out.append(f"{solver}: the tip swings at {_g(off, 4)} Hz without it and {_g(on, 4)} Hz with it "
+                       f"({on / off - 1:+.1%})")  # fmt: skip
+    return out
+
+
 def _sag_recommendation(rows):
     sag = {(r["solver"], str(r["shape_range"]), str(r["sag_free"])): _f(r, "rest_rms_L")
            for r in rows if r["study"] == "sagfree"}  # fmt: skip
-    hz = {str(r["sag_free"]): _f(r, "tip_hz") for r in rows if r["study"] == "sagfreq" and r["solver"] == "xpbd"}
+    hz = {(r["solver"], str(r["sag_free"])): _f(r, "tip_hz") for r in rows if r["study"] == "sagfreq"}
     parts = []
     for (solver, rng, on), v in sorted(sag.items()):
         plain = sag.get((solver, rng, "0"))
@@ -313,8 +329,9 @@ def _sag_recommendation(rows):
     if not parts:
         return []
     line = "- Sag-free rest (xpbd, the scene held still): " + "; ".join(parts)
-    if "0" in hz and "1" in hz:
-        line += f"; the tip swings at {_g(hz['1'], 4)} Hz with it and {_g(hz['0'], 4)} Hz without"
+    swings = _swing_words(hz)
+    if swings:
+        line += "; under the wind step " + "; ".join(swings)
     return [line + ". It holds only the points a shape constraint holds: use it with the shape range that covers "
             "the groom it should keep."]  # fmt: skip
 
