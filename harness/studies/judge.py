@@ -44,6 +44,8 @@ from harness.io import files, runfolder
 from harness.io.files import write_json
 from harness.io.trajectory import open_trajectory, simulated_view
 
+ENV_KEYS = ("date", "hostname", "cpu_model", "cpu_cores", "device", "driver", "nvcc", "git_revision")  # judge.json's env
+
 RESULTS_NAME = "judge"
 
 
@@ -495,6 +497,7 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
         "false_alarm_runs": false_alarms,
         "honest": [label for label, _, _ in honest],
         "seconds": round(time.perf_counter() - t0, 1),
+        "env": {k: v for k, v in env.collect().items() if k in ENV_KEYS},  # where it was measured
     }
     write_csv(rows, out_dir / "judge.csv")
     write_json(out_dir / "judge.json", summary)

@@ -116,6 +116,7 @@ def test_judge_command_counts_and_report_section(contract_bin, tmp_path, capsys)
     assert "caught 1 / 1 planted" in text and "false alarms 0 / 4 honest runs" in text
     s = json.loads((out / "judge.json").read_text())
     assert (s["caught"], s["planted"], s["false_alarms"]) == (1, 1, 0)
+    assert s["env"]["git_revision"] and s["env"]["cpu_cores"] >= 1  # where it was measured
     section = "\n".join(judge_report.section(out))
     assert "**1 / 1**" in section and "**0 / 4**" in section
     assert harness_main(["judge", "--extreme", "no-such-scene", "--out", str(tmp_path / "x")]) == 2
