@@ -44,7 +44,8 @@ from harness.io import files, runfolder
 from harness.io.files import write_json
 from harness.io.trajectory import open_trajectory, simulated_view
 
-ENV_KEYS = ("date", "hostname", "cpu_model", "cpu_cores", "device", "driver", "nvcc", "git_revision")  # judge.json's env
+# judge.json's record of where it was measured
+ENV_KEYS = ("date", "hostname", "cpu_model", "cpu_cores", "device", "driver", "nvcc", "git_revision")
 
 RESULTS_NAME = "judge"
 
