@@ -45,6 +45,13 @@ def cpu_model():
     return platform.processor() or None
 
 
+def cpu_device():
+    """This machine's CPU as the cpu binary's records name it (c_ref/backend_cpu.c cpu_describe): its
+    model and the cores this process may run on."""
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return f"{cpu_model() or 'unknown CPU'} ({cores} cores)"
+
+
 GPU_QUERY = ("name", "driver_version", "memory.total", "compute_cap")
 
 

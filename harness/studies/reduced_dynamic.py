@@ -37,7 +37,9 @@ followers alone.
 Time per frame: the same settings at `time_strands` strands (no file, --repeat), on the cpu oracle
 and, with a usable GPU, on each cuda variant that runs all the features (its `--list-variants`
 entry lists them; `lanes` lacks guides and LRA, docs/cuda.md). Writes the CSV (one row per case and
-timing binary) and, beside it, references.csv (each reference's ladder, rate and horizon).
+timing binary) and, beside it, references.csv (each reference's ladder, rate and horizon), once every
+row is measured; until then the rows so far are kept beside it, and a stopped run resumed keeps their
+timings (studies/reduced_partial_dynamic.py).
 """
 
 import math
@@ -53,9 +55,10 @@ from harness.check import ensemble_dynamic as en
 from harness.check import observables_dynamic as ob
 from harness.core import env, runner, scenes, variants
 from harness.core.guides import guide_count, guide_strands
-from harness.core.paths import binary_path
+from harness.core.paths import binary_path, display
 from harness.io.files import write_csv
 from harness.studies.accuracy import frame_errors
+from harness.studies.reduced_partial_dynamic import Partial
 from harness.studies.reduced_reference_dynamic import References, read_positions
 
 FIELDS = (
@@ -100,6 +103,7 @@ FIELDS = (
     "render_ms",
     "device",
 )
+TIMING_FIELDS = ("backend", "variant", "time_strands", "median_ms", "render_ms", "device")  # a timing's columns
 REF_FIELDS = (
     "scene",
     "strands",
@@ -174,6 +178,13 @@ class Case:
     shape_range: float | None = None
     points: int | None = None  # simulated points a strand (None: the scene's)
     extra: tuple = ()
+
+    @property
+    def key(self):
+        """The case in one word (the partial file's `case` column)."""
+        shape = "-" if self.shape_range is None else repr(self.shape_range)
+        return (f"{self.study}/{self.solver}/S{self.substeps}/I{self.iterations}/N{self.strands}/g{self.guides!r}/"
+                f"{self.follow or '-'}/lra{self.lra}/sag{self.sag_free}/r{shape}/P{self.points or '-'}")  # fmt: skip
 
     @property
     def ref_key(self):
@@ -370,8 +381,7 @@ class Study:
 
 
 def _timings(plan, scene, case, timers):
-    """(backend, variant, strands, record) of each binary that times the case."""
-    out = []
+    """(backend, variant, strands, record) of each binary of `timers` that times the case, as each is measured."""
     p_sim = int(case.points or scene.points)
     for backend, variant in timers:
         d = variants.declared(backend)
@@ -382,50 +392,78 @@ def _timings(plan, scene, case, timers):
         n = plan.time_gpu_strands if backend == "cuda" else plan.time_strands
         tf = _flags(scene, solver=case.solver, substeps=case.substeps, iterations=case.iterations, precision="fp32",
                     strands=n, frames=2, extra=case.extra, variant=(backend, variant), points=case.points)  # fmt: skip
-        out.append(
-            (
-                backend,
-                variant,
-                n,
-                runner.run_binary(binary_path(backend, "default"), tf + ["--repeat", str(plan.repeat)]),
-            )
-        )
-    return out
+        rec = runner.run_binary(binary_path(backend, "default"), tf + ["--repeat", str(plan.repeat)])
+        yield backend, variant, n, rec
 
 
-def measure(plan=Plan(), out=None, work=None, progress=print, refs_into=None):
-    """Every row (module docstring); with `out`, the CSV and references.csv beside it; the
-    references' rows are appended to the list `refs_into` when given."""
+def measure(plan=Plan(), out=None, work=None, progress=print, refs_into=None, resume=False):
+    """Every row (module docstring); with `out`, the CSV and references.csv beside it once every row is
+    measured, the rows so far kept in OUT.partial until then; the references' rows are appended to the
+    list `refs_into` when given. `resume`: the timings in OUT.partial are kept, not measured again
+    (refused in one line where it is absent or not this run's: studies/reduced_partial_dynamic.py)."""
+    if resume and not out:
+        raise HarnessError("reduced: --resume needs --out, the CSV of the run it finishes")
+    timers = timing_binaries(plan)
+    partial = Partial(out, plan, timers) if out else None
+    kept = partial.kept(FIELDS, TIMING_FIELDS) if partial and resume else {}
+    if kept:
+        n = sum(len(t) for t in kept.values())
+        progress(f"reduced: resuming {display(partial.path)}: {n} timing(s) of {len(kept)} case(s) kept")
     with tempfile.TemporaryDirectory(dir=work) as tmp:
         st = Study(plan, tmp, progress)
         all_cases = cases(plan, st.scene)
         for c in all_cases:
             st.checked(c)
-        timers = timing_binaries(plan)
-        rows = []
+        done = []  # (case key, row) of every case measured
+
+        def save(case_rows):
+            if partial:
+                partial.write(FIELDS, done + case_rows)
+
         for c in all_cases:
             ref = st.reference(c, all_cases)
             m = st.metrics(c, ref)
             if c.study == "lra" and c.lra:
                 m["lra_moved_cm"] = st.lra_moved(c, all_cases)
-            base = _base(plan, st, c, m)
-            for backend, variant, n, rec in _timings(plan, st.scene, c, timers):
-                sim = next(x for x in rec["stages"] if x["stage"] == "simulate")
-                rows.append({**base, "backend": backend, "variant": variant, "time_strands": n,
-                             "median_ms": sim["median_ms"], "render_ms": sim.get("render_ms"),
-                             "device": rec["device"]})  # fmt: skip
-                progress(
-                    f"reduced: {c.study:7s} {c.solver:4s} N={c.strands} I={c.iterations} guides={c.guides:<4g} "
-                    f"{c.follow:6s} lra={c.lra} {backend}/{variant}: rms {base['rms_err_L'] or math.nan:.3g} L, "
-                    f"{sim['median_ms']:.3f} ms/frame"
-                )
+            done += _case_rows(plan, st.scene, c, _base(plan, st, c, m), timers, kept.get(c.key, {}), save, progress)
         refs = [_ref_row(st, r) for r in st.refs.cache.values()]
         if refs_into is not None:
             refs_into.extend(refs)
-    if out:
-        write_csv(out, FIELDS, rows)
+    rows = [row for _, row in done]
+    if out:  # references.csv first: the CSV itself says the run finished
         write_csv(Path(out).with_name("references.csv"), REF_FIELDS, refs)
+        write_csv(out, FIELDS, rows)
+        partial.remove()
     return rows
+
+
+def _case_rows(plan, scene, c, base, timers, kept, save, progress):
+    """The case's (key, row) pairs, one per binary of `timers` that times it, in `timers`' order: a timing
+    in `kept` as it was, the others measured, every row so far handed to `save` after each."""
+    timed = dict(kept)
+
+    def rows():
+        return [(c.key, {**base, **timed[t]}) for t in timers if t in timed]
+
+    for t in timers:
+        if t in kept:
+            _say(progress, c, base, t, kept[t]["median_ms"], " (kept)")
+    todo = [t for t in timers if t not in kept]
+    for backend, variant, n, rec in _timings(plan, scene, c, todo) if todo else ():
+        sim = next(x for x in rec["stages"] if x["stage"] == "simulate")
+        values = (backend, variant, n, sim["median_ms"], sim.get("render_ms"), rec["device"])
+        timed[(backend, variant)] = dict(zip(TIMING_FIELDS, values, strict=True))
+        save(rows())
+        _say(progress, c, base, (backend, variant), sim["median_ms"], "")
+    return rows()
+
+
+def _say(progress, c, base, timer, ms, how):
+    progress(
+        f"reduced: {c.study:7s} {c.solver:4s} N={c.strands} I={c.iterations} guides={c.guides:<4g} "
+        f"{c.follow:6s} lra={c.lra} {timer[0]}/{timer[1]}: rms {base['rms_err_L'] or math.nan:.3g} L, "
+        f"{ms:.3f} ms/frame{how}"
+    )
 
 
 def _base(plan, st, c, m):

@@ -2,16 +2,27 @@
 (harness/render/reduced_dynamic_report.py): a tiny plan runs every case on the cpu oracle, the references
 climb their ladder and get their twins, and the report renders it; the recommendations pick, from
 known rows, the fewest guides and the fewest simulated points that pass each use's budgets (the
-followers' stretch and the ensemble's statistics included); a guide spacing has its known value."""
+followers' stretch and the ensemble's statistics included); a guide spacing has its known value. A run
+stopped after some timings leaves them in OUT.partial and no CSV; --resume keeps them (not timed again)
+and ends with the CSV an uninterrupted run writes, and refuses a partial file of another device, plan or
+revision, or none, in one line."""
 
+import json
 import math
+import shutil
+import signal
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from harness.core import tolerances, variants
+from harness import HarnessError
+from harness.cli.main import main as harness_main
+from harness.core import env, runner, tolerances, variants
+from harness.io.files import write_csv, write_json
 from harness.render import reduced_dynamic_report as reduced_report
 from harness.studies import reduced_dynamic as reduced
+from harness.studies import reduced_partial_dynamic as reduced_partial
 from harness.studies import reduced_verdicts_dynamic as reduced_verdicts
 
 TINY = reduced.Plan(strands=(8, 16), seconds=4 / 60, write_every=1 / 60, fractions=(1.0, 0.5), ref_start=8,
@@ -133,3 +144,160 @@ def test_each_row_is_timed_by_the_variants_that_run_its_features():
     assert d.runs_features("v", reduced.row_features([]))
     assert not d.runs_features("v", reduced.row_features(["--guides", 0.1, "--follow", "blend3"]))
     assert not d.runs_features("v", reduced.row_features(["--lra"]))
+
+
+SMALL = replace(TINY, strands=(8,), parts=("guides",))  # 6 cases, one reference: seconds a run
+STOP_AFTER = 3  # timings before the stop
+
+
+def _quiet(*_):
+    pass
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    out = tmp_path_factory.mktemp("whole") / "reduced.csv"
+    reduced.measure(SMALL, out=out, progress=_quiet)
+    return out
+
+
+@pytest.fixture(scope="module")
+def stopped(tmp_path_factory):
+    """The folder of a run stopped (as by SIGTERM) after STOP_AFTER timings."""
+    out = tmp_path_factory.mktemp("stopped") / "reduced.csv"
+    real, made = reduced._timings, []
+
+    def timings(*args):
+        for t in real(*args):
+            if len(made) == STOP_AFTER:
+                raise runner.Stopped(signal.SIGTERM)
+            made.append(t)
+            yield t
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(reduced, "_timings", timings)
+        with pytest.raises(runner.Stopped):
+            reduced.measure(SMALL, out=out, progress=_quiet)
+    return out.parent
+
+
+def _copy(folder, tmp_path):
+    dst = tmp_path / "run"
+    shutil.copytree(folder, dst)
+    return dst / "reduced.csv"
+
+
+def test_a_stopped_run_leaves_its_rows_and_no_csv(stopped):
+    out = stopped / "reduced.csv"
+    assert not out.exists() and not (stopped / "references.csv").exists()
+    kept = reduced_report.read(reduced_partial.partial_path(out))
+    assert len(kept) == STOP_AFTER and all(float(r["median_ms"]) > 0 for r in kept)
+    assert list(kept[0]) == ["case", *reduced.FIELDS]
+    record = json.loads((stopped / "reduced.csv.partial.json").read_text())
+    assert record["plan"]["strands"] == [8] and record["git_revision"] == env.git_revision()
+
+
+def test_resume_keeps_the_timings_and_ends_as_an_uninterrupted_run(stopped, uninterrupted, tmp_path, monkeypatch):
+    out = _copy(stopped, tmp_path)
+    kept = reduced_report.read(reduced_partial.partial_path(out))
+    real, asked = reduced._timings, []
+
+    def timings(plan, scene, case, timers):
+        asked.extend((case.key, *t) for t in timers)
+        return real(plan, scene, case, timers)
+
+    monkeypatch.setattr(reduced, "_timings", timings)
+    reduced.measure(SMALL, out=out, progress=_quiet, resume=True)
+    assert not {(r["case"], r["backend"], r["variant"]) for r in kept} & set(asked)  # none timed again
+    assert len(asked) == 6 - STOP_AFTER
+    got, want = reduced_report.read(out), reduced_report.read(uninterrupted)
+    assert out.read_text().splitlines()[0] == uninterrupted.read_text().splitlines()[0]  # the header
+    assert len(got) == len(want) == 6
+    timing_values = ("median_ms", "render_ms")
+    for g, w in zip(got, want):
+        assert {k: v for k, v in g.items() if k not in timing_values} == {
+            k: v for k, v in w.items() if k not in timing_values
+        }
+    assert [r["median_ms"] for r in got[:STOP_AFTER]] == [r["median_ms"] for r in kept]  # as written before
+    assert reduced_report.read(out.with_name("references.csv")) == reduced_report.read(
+        uninterrupted.with_name("references.csv")
+    )
+    assert sorted(p.name for p in out.parent.iterdir()) == ["reduced.csv", "references.csv"]
+
+
+def _refused(out, plan=SMALL):
+    before = {p.name: p.read_bytes() for p in out.parent.iterdir()}
+    with pytest.raises(HarnessError) as e:
+        reduced.measure(plan, out=out, progress=_quiet, resume=True)
+    assert "\n" not in str(e.value)
+    assert {p.name: p.read_bytes() for p in out.parent.iterdir()} == before  # nothing written
+    return str(e.value)
+
+
+def _rewrite_rows(out, **changes):
+    path = reduced_partial.partial_path(out)
+    rows = reduced_report.read(path)
+    write_csv(path, list(rows[0]), [{**rows[0], **changes}, *rows[1:]])
+
+
+def test_resume_refuses_rows_timed_on_another_device(stopped, tmp_path, monkeypatch):
+    out = _copy(stopped, tmp_path)
+    _rewrite_rows(out, device="Another CPU 9000")
+    assert "cpu/ref timings on Another CPU 9000" in _refused(out)
+    _rewrite_rows(out, backend="cuda", device="NVIDIA H100 80GB HBM3")  # a cuda row: this machine's GPUs
+    monkeypatch.setattr(env, "gpu_info", lambda: [{"name": "NVIDIA H200"}])
+    assert "on NVIDIA H100 80GB HBM3; this machine has NVIDIA H200" in _refused(out)
+    monkeypatch.setattr(env, "gpu_info", lambda: None)
+    assert "this machine has no GPU" in _refused(out)
+
+
+def test_resume_refuses_another_plan_or_revision(stopped, tmp_path, capsys):
+    out = _copy(stopped, tmp_path)
+    assert "another plan (seconds" in _refused(out, replace(SMALL, seconds=2 / 60))
+    # the command line's plan (--quick) is not the one that measured it: one line, exit 2
+    assert harness_main(["reduced", "--quick", "--gpu", "no", "--out", str(out), "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("harness: error: reduced:") and "another plan" in err and err.count("\n") == 1
+    record = json.loads(out.with_name("reduced.csv.partial.json").read_text())
+    write_json(out.with_name("reduced.csv.partial.json"), {**record, "git_revision": "0000000"})
+    assert "at revision 0000000" in _refused(out)
+
+
+def test_resume_without_a_partial_file_and_a_fresh_run_over_one_are_refused(stopped, tmp_path, capsys):
+    out = tmp_path / "empty" / "reduced.csv"
+    assert harness_main(["reduced", "--gpu", "no", "--out", str(out), "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert "no " in err and "reduced.csv.partial to resume" in err and err.count("\n") == 1
+    assert harness_main(["reduced", "--gpu", "no", "--resume"]) == 2
+    assert "--resume needs --out" in capsys.readouterr().err
+    assert not out.parent.exists()
+    out = _copy(stopped, tmp_path)
+    before = reduced_partial.partial_path(out).read_bytes()
+    assert harness_main(["reduced", "--gpu", "no", "--out", str(out)]) == 2
+    assert "did not finish: --resume finishes it" in capsys.readouterr().err
+    assert reduced_partial.partial_path(out).read_bytes() == before and not out.exists()
+
+
+def test_a_case_partly_timed_keeps_the_binaries_order_and_saves_each_new_timing(monkeypatch):
+    timers = [("cpu", "ref"), ("cuda", "a"), ("cuda", "b")]
+    kept = {("cuda", "a"): {"backend": "cuda", "variant": "a", "time_strands": 10, "median_ms": 1.5,
+                            "render_ms": None, "device": "GPU"}}  # fmt: skip
+    asked = []
+
+    def timings(plan, scene, case, todo):
+        asked.extend(todo)
+        for backend, variant in todo:
+            yield backend, variant, 10, {"stages": [{"stage": "simulate", "median_ms": 2.0}], "device": "X"}
+
+    monkeypatch.setattr(reduced, "_timings", timings)
+    case = reduced.Case("guides", "xpbd", 8, 2, 8)
+    saved = []
+    base = {"rms_err_L": 0.1}
+    got = reduced._case_rows(SMALL, None, case, base, timers, kept, saved.append, _quiet)
+    assert asked == [("cpu", "ref"), ("cuda", "b")]
+    assert [(r["backend"], r["variant"], r["median_ms"]) for _, r in got] == [
+        ("cpu", "ref", 2.0),
+        ("cuda", "a", 1.5),
+        ("cuda", "b", 2.0),
+    ]
+    assert [len(s) for s in saved] == [2, 3] and all(k == case.key for k, _ in got)

@@ -96,8 +96,10 @@ def cmd_reduced(args):
     predictability time, and with the reference ensemble's statistics over the whole run; time it on the cpu
     oracle and, with a usable GPU, the cuda variants that run it (docs/model.md §3.14); and the still scene with
     and without sag-free rest at two shape ranges: how far it sags, and the tip's swing under a wind step.
-    Prints Markdown; --out writes the rows as CSV and references.csv beside it."""
+    Prints Markdown; --out writes the rows as CSV and references.csv beside it once every row is measured, the
+    rows so far kept in OUT.partial until then; --resume finishes a stopped run, its timings kept."""
     from harness.render import reduced_dynamic_report as reduced_report
+    from harness.studies import reduced_partial_dynamic as reduced_partial
 
     base = reduced.Plan.quick if args.quick else reduced.Plan
     changes = {k: v for k, v in (("scene", args.scene), ("seconds", args.seconds)) if v}
@@ -105,8 +107,10 @@ def cmd_reduced(args):
         changes["strands"] = tuple(args.strands)
     if args.parts:
         changes["parts"] = tuple(args.parts)
+    if args.out and not args.resume:
+        reduced_partial.refuse_unfinished(args.out)
     refs = []
-    rows = reduced.measure(base(gpu=args.gpu, **changes), out=args.out, refs_into=refs)
+    rows = reduced.measure(base(gpu=args.gpu, **changes), out=args.out, refs_into=refs, resume=args.resume)
     print(reduced_report.markdown(rows, refs), end="")
     return 0
 
@@ -326,7 +330,15 @@ def add_reduced(sub):
     )
     rd.add_argument("--quick", action="store_true", help="the small version (CI, a first look)")
     case_options(rd, gpu="the cuda variants too, where a GPU is usable", gpu_choices=("auto", "no"))
-    rd.add_argument("--out", default=None, help="CSV file to write")
+    rd.add_argument(
+        "--out", default=None, help="CSV file to write (OUT.partial keeps the rows while they are measured)"
+    )
+    rd.add_argument(
+        "--resume",
+        action="store_true",
+        help="finish a stopped run with the same options: the timings in OUT.partial are kept, the rest measured "
+        "again (refused where they were timed on another device, plan or revision)",
+    )
 
 
 def add_peer(sub):
