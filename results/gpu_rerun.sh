@@ -6,17 +6,27 @@
 #   OUT=$OUT bash results/gpu_rerun.sh build        # first: the binaries (make -j; minutes)
 #   OUT=$OUT bash results/gpu_rerun.sh accuracy     # dynamic-accuracy/: the quick study, every build
 #   OUT=$OUT bash results/gpu_rerun.sh curly        # dynamic-accuracy-curly/: the same on curly hair
-#   OUT=$OUT bash results/gpu_rerun.sh reduced      # reduced/: 1,000 and 10,000 strands, 1 s
-#   OUT=$OUT bash results/gpu_rerun.sh stability    # stability/: the quick map, CPU and every CUDA build
+#   OUT=$OUT bash results/gpu_rerun.sh reduced SHARE [--resume]
+#                                                   # reduced-SHARE/: one share of the reduced study (1,000 and
+#                                                   # 10,000 strands, 1 s): g1000 (~300 s), g10000 (~12 min: a
+#                                                   # stopped call leaves its timings; the next one, --resume,
+#                                                   # keeps them), lra (~240 s), sag (~80 s), lod (~230 s);
+#                                                   # reduced/ is the shares' CSVs joined in that order, header once
+#   OUT=$OUT bash results/gpu_rerun.sh stability [SLICE ...]
+#                                                   # stability/ (stability-SLICE/ for a share of the slices):
+#                                                   # the quick map, CPU and every CUDA build (the whole map
+#                                                   # takes more than one call: give each call a few slices)
 #   OUT=$OUT bash results/gpu_rerun.sh judge        # judge/: planted defects, honest runs, LOD scenes
 #   OUT=$OUT bash results/gpu_rerun.sh gputests     # the GPU tests of the followers and LOD (no results)
 #
-# Copy each part's folder into results/reference-h200/ (replacing the old one), then re-render the
-# committed report:  make report REPORT_FROM=results/reference-h200 REPORT_TO=report
+# Copy each part's folder into results/reference-h200/ (replacing the old one; the shares of
+# reduced/ and stability/ joined, each CSV's header once, their calls named in results/README.md),
+# then re-render the committed report:  make report REPORT_FROM=results/reference-h200 REPORT_TO=report
+# (its renders' states first: harness/bench/renders.py simulate and simulate_modes on that folder).
 # The other folders (sweep/, headline/, dynamic/, featurecost/, peer/, accuracy/, dynamic-curly/) are
 # measured by `make bench` and the headline commands of results/README.md; none of them changed here.
 set -euo pipefail
-part=${1:?"usage: OUT=DIR bash results/gpu_rerun.sh build|accuracy|curly|reduced|stability|judge|gputests"}
+part=${1:?"usage: OUT=DIR bash results/gpu_rerun.sh build|accuracy|curly|reduced SHARE|stability [SLICE ...]|judge|gputests"}
 out=${OUT:?"set OUT to the folder the runs write into"}
 py="$(cat build/python 2>/dev/null || echo python3)"
 mkdir -p "$out"
@@ -26,8 +36,27 @@ accuracy) "$py" -m harness accuracy --model dynamic --quick --gpu auto --force \
 	--out "$out/dynamic-accuracy" --report-dir "$out/report" ;;
 curly) "$py" -m harness accuracy --model dynamic --scene curly --quick --analytic none --ref-max 4096 --gpu auto --force \
 	--out "$out/dynamic-accuracy-curly" --report-dir "$out/report" ;;
-reduced) mkdir -p "$out/reduced" && "$py" -m harness reduced --gpu auto --out "$out/reduced/reduced.csv" >"$out/reduced/reduced.md" ;;
-stability) "$py" -m harness stability --quick --gpu auto --out "$out/stability" --report-dir "$out/report" ;;
+reduced)
+	share=${2:?"usage: OUT=DIR bash results/gpu_rerun.sh reduced g1000|g10000|lra|sag|lod [--resume]"}
+	case "$share" in
+	g1000) args=(--strands 1000 --parts guides) ;;
+	g10000) args=(--strands 10000 --parts guides) ;;
+	lra) args=(--strands 1000 10000 --parts lra) ;;
+	sag) args=(--strands 1000 10000 --parts sagfree sagfreq) ;;
+	lod) args=(--strands 1000 10000 --parts lod) ;;
+	*)
+		echo "error: unknown reduced share '$share' (g1000, g10000, lra, sag, lod)" >&2
+		exit 2
+		;;
+	esac
+	mkdir -p "$out/reduced-$share"
+	"$py" -m harness reduced --gpu auto "${args[@]}" ${3:+"$3"} --out "$out/reduced-$share/reduced.csv" >>"$out/reduced-$share/reduced.md"
+	;;
+stability)
+	shift
+	dir=stability${1:+-$1}
+	"$py" -m harness stability --quick --gpu auto $(printf -- '--slice %s ' "$@") --out "$out/$dir" --report-dir "$out/report-$dir"
+	;;
 judge) "$py" -m harness judge --gpu auto --out "$out/judge" ;;
 gputests) "$py" -m pytest tests/gpu/test_gpu_features.py tests/gpu/test_gpu_lod.py tests/native -q -ra ;;
 *)
