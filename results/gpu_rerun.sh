@@ -13,14 +13,14 @@
 #                                                   # keeps them), lra (~240 s), sag (~80 s), lod (~230 s);
 #                                                   # reduced/ is the shares' CSVs joined in that order, header once
 #   OUT=$OUT bash results/gpu_rerun.sh stability [SLICE ...]
-#                                                   # stability/ (stability-SLICE/ for a share of the slices):
-#                                                   # the quick map, CPU and every CUDA build (the whole map
-#                                                   # takes more than one call: give each call a few slices)
+#                                                   # stability/: the quick map, CPU and every CUDA build; given
+#                                                   # slices, those alone, added to the map already there
+#                                                   # (--add), so the map can take several calls
 #   OUT=$OUT bash results/gpu_rerun.sh judge        # judge/: planted defects, honest runs, LOD scenes
 #   OUT=$OUT bash results/gpu_rerun.sh gputests     # the GPU tests of the followers and LOD (no results)
 #
 # Copy each part's folder into results/reference-h200/ (replacing the old one; the shares of
-# reduced/ and stability/ joined, each CSV's header once, their calls named in results/README.md),
+# reduced/ joined, each CSV's header once, their calls named in results/README.md),
 # then re-render the committed report:  make report REPORT_FROM=results/reference-h200 REPORT_TO=report
 # (its renders' states first: harness/bench/renders.py simulate and simulate_modes on that folder).
 # The other folders (sweep/, headline/, dynamic/, featurecost/, peer/, accuracy/, dynamic-curly/) are
@@ -54,8 +54,9 @@ reduced)
 	;;
 stability)
 	shift
-	dir=stability${1:+-$1}
-	"$py" -m harness stability --quick --gpu auto $(printf -- '--slice %s ' "$@") --out "$out/$dir" --report-dir "$out/report-$dir"
+	add=()
+	if [ -f "$out/stability/stability.csv" ]; then add=(--add); fi
+	"$py" -m harness stability --quick --gpu auto $(printf -- '--slice %s ' "$@") "${add[@]}" --out "$out/stability" --report-dir "$out/report"
 	;;
 judge) "$py" -m harness judge --gpu auto --out "$out/judge" ;;
 gputests) "$py" -m pytest tests/gpu/test_gpu_features.py tests/gpu/test_gpu_lod.py tests/native -q -ra ;;

@@ -34,7 +34,9 @@ Writes results/stability/stability.csv and env.json, and render/stability_dynami
 report/stability_<slice>.png and writes report/dynamic_stability.md.
 """
 
+import csv
 import inspect
+import json
 import os
 import tempfile
 import time
@@ -401,16 +403,73 @@ def write_csv(rows, path):
     return files.write_csv(path, COLUMNS, rows, extrasaction="ignore")
 
 
-def run_study(out_dir=None, **options):
+# what a map measured in several calls (run_study's `add`) must share with the map it adds to
+SAME_MAP = ("git_revision", "device", "cpu_model", "quick", "strands", "frames", "backends")
+
+
+def _earlier(out_dir, info):
+    """(rows, env) of the map in out_dir that a call with `info` (env.json's fields) adds slices to;
+    refused in one line where there is none or it was measured otherwise."""
+    csv_path, env_path = out_dir / "stability.csv", out_dir / "env.json"
+    if not (csv_path.exists() and env_path.exists()):
+        raise HarnessError(
+            f"stability: --add: no map in {display(out_dir)} to add to (stability.csv, env.json)", code=2
+        )
+    old = json.loads(env_path.read_text())
+    differ = [k for k in SAME_MAP if old.get(k) != info.get(k)]
+    if differ:
+        raise HarnessError(
+            f"stability: --add: {display(out_dir)} was measured with another {', '.join(differ)}", code=2
+        )
+    with open(csv_path, newline="") as f:
+        return list(csv.DictReader(f)), old
+
+
+def _joined(earlier, rows, slices, old_env, info):
+    """The earlier map's rows of the slices not measured again (`slices`), then the new rows, in
+    SLICES' order; env.json with every call's slices, revision, date and seconds under `parts`."""
+    names = {r["slice"] for r in rows} | set(slices)
+    order = {s.name: i for i, s in enumerate(SLICES)}
+    kept = [r for r in earlier if r["slice"] not in names]
+    joined = sorted(kept + rows, key=lambda r: order.get(r["slice"], len(order)))  # stable within a slice
+    parts = old_env.get("parts") or [
+        {k: old_env.get(k) for k in ("date", "git_revision", "seconds")}
+        | {"slices": sorted({r["slice"] for r in earlier})}
+    ]
+    parts = [dict(p, slices=[s for s in p["slices"] if s not in names]) for p in parts]
+    parts = [p for p in parts if p["slices"]]
+    parts.append({"slices": sorted(names), **{k: info[k] for k in ("date", "git_revision", "seconds")}})
+    return joined, dict(info, seconds=round(sum(p["seconds"] or 0 for p in parts), 1), parts=parts)
+
+
+def run_study(out_dir=None, add=False, **options):
     """Measure the slices (`options`: those of measure()); write stability.csv and env.json into
-    out_dir (the renderer, render/stability_dynamic_report.py, draws them) and return the CSV's path."""
+    out_dir (the renderer, render/stability_dynamic_report.py, draws them) and return the CSV's path.
+    `add`: the slices replace or join those of the map already in out_dir (measured at the same
+    revision, machine and size), so a map can be measured over several calls."""
     out_dir = Path(out_dir or RESULTS / "stability")
     bound = inspect.signature(measure).bind(**options)
     bound.apply_defaults()
     opt = bound.arguments
+    if add:  # refuse before measuring
+        _earlier(out_dir, _info(opt, backends(opt["gpu"], lambda _: None), 0.0))
     rows, bes, seconds = measure(**opt)
+    info = _info(opt, bes, seconds)
+    if add:
+        earlier, old_env = _earlier(out_dir, info)
+        rows, info = _joined(earlier, rows, () if opt["scene"] else opt["slices"], old_env, info)
     csv_path = write_csv(rows, out_dir / "stability.csv")
-    info = dict(
+    env_path = out_dir / "env.json"
+    write_json(env_path, info)
+    opt["log"](
+        f"stability: {len(rows)} cells in {info['seconds']:.1f} s; wrote {display(csv_path)} and {display(env_path)}"
+    )
+    return csv_path
+
+
+def _info(opt, bes, seconds):
+    """env.json's fields of a call."""
+    return dict(
         env.collect(),
         quick=opt["quick"],
         strands=opt["strands"],
@@ -422,7 +481,3 @@ def run_study(out_dir=None, **options):
         penetration_bound_rel=tolerances.STABILITY_PENETRATION_REL,
         shard=str(opt["shard"]) if opt["shard"] else None,
     )
-    env_path = out_dir / "env.json"
-    write_json(env_path, info)
-    opt["log"](f"stability: {len(rows)} cells in {seconds:.1f} s; wrote {display(csv_path)} and {display(env_path)}")
-    return csv_path

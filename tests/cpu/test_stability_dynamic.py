@@ -6,6 +6,7 @@ map's verdict and wording rules. The map itself is `python -m harness stability`
 docs/decisions.md ("Stability search of the dynamic model").
 """
 
+import json
 import math
 import os
 from dataclasses import replace
@@ -426,6 +427,32 @@ def test_stability_command_writes_the_map(cpu_bin, tmp_path, capsys):
     rows = stability_report.load(out / "stability.csv")
     assert len(rows) == 3 * 3 * 2 * 2 and set(rows["verdict"]) <= set(stability_slices.VERDICTS)
     assert not list(out.glob("*.tmp*")) and not list(rep.glob("*.tmp*"))
+
+
+def test_a_map_measured_over_two_calls_is_one_map(cpu_bin, tmp_path, capsys):
+    """--add: a second call's slice joins the first's in one CSV, in the slices' order, env.json naming
+    both calls; its slice measured again replaces its rows; a map of another size is refused, unchanged."""
+    out = tmp_path / "res"
+    base = ["stability", "--quick", "--strands", "2", "--frames", "3", "--jobs", "2", "--gpu", "no"]
+    base += ["--out", str(out), "--report-dir", str(tmp_path / "rep")]
+    assert harness_main([*base, "--slice", "motion"]) == 0
+    one = stability_report.load(out / "stability.csv")
+    assert harness_main([*base, "--slice", "substeps-wind", "--add"]) == 0
+    both = stability_report.load(out / "stability.csv")
+    assert list(dict.fromkeys(both["slice"])) == ["substeps-wind", "motion"]  # SLICES' order
+    assert len(both) > len(one) and (both[both["slice"] == "motion"]["verdict"].tolist() == one["verdict"].tolist())
+    env = json.loads((out / "env.json").read_text())
+    assert [p["slices"] for p in env["parts"]] == [["motion"], ["substeps-wind"]]
+    assert harness_main([*base, "--slice", "motion", "--add"]) == 0  # measured again: replaced, not doubled
+    assert len(stability_report.load(out / "stability.csv")) == len(both)
+    assert [p["slices"] for p in json.loads((out / "env.json").read_text())["parts"]] == [["substeps-wind"], ["motion"]]
+    before = (out / "stability.csv").read_bytes()
+    capsys.readouterr()
+    assert harness_main([*base[:3], "3", *base[4:], "--slice", "motion", "--add"]) == 2  # 3 strands, not 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "another strands" in err[0]
+    assert (out / "stability.csv").read_bytes() == before
+    assert harness_main([*base[:-4], "--out", str(tmp_path / "none"), "--slice", "motion", "--add"]) == 2
 
 
 def test_stability_bad_input_is_one_line(tmp_path, capsys):

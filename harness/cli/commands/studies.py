@@ -167,6 +167,7 @@ def cmd_stability(args):
         slices=tuple(args.slice or stability.SLICE_NAMES),
         scene=args.scene,
         out_dir=args.out,
+        add=args.add,
         **options(args, "quick strands frames jobs gpu timeout"),
     )
     stability_report.report_from_csv(csv_path, report_dir=args.report_dir)
@@ -402,6 +403,12 @@ def add_stability(sub):
     )
     sb.add_argument("--strands", type=whole(1), default=STRANDS, help=f"strands per cell (default {STRANDS})")
     sb.add_argument("--frames", type=whole(1), default=FRAMES, help=f"frames per cell (default {FRAMES}: 1 s)")
+    sb.add_argument(
+        "--add",
+        action="store_true",
+        help="the slices replace or join those of the map already in --out (same revision, machine and size): a "
+        "map measured over several calls",
+    )
     case_options(
         sb,
         jobs="cells run at once (default: all cores)",
