@@ -36,7 +36,7 @@ report/stability_<slice>.png and writes report/dynamic_stability.md.
 
 import csv
 import inspect
-import json
+import io
 import os
 import tempfile
 import time
@@ -49,7 +49,7 @@ import numpy as np
 from harness import HarnessError
 from harness.check import colliders_dynamic as colliders
 from harness.check import invariants_dynamic
-from harness.core import env, gpus, runner, scenes, tolerances, variants
+from harness.core import env, gpus, inputs, runner, scenes, tolerances, variants
 from harness.core.paths import CUDA_BUILDS, RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
@@ -415,14 +415,18 @@ def _earlier(out_dir, info):
         raise HarnessError(
             f"stability: --add: no map in {display(out_dir)} to add to (stability.csv, env.json)", code=2
         )
-    old = json.loads(env_path.read_text())
+    old = inputs.read_json(env_path, "stability: --add:")
+    if not isinstance(old, dict):
+        raise HarnessError(f"stability: --add: {display(env_path)} is not a map's env.json", code=2)
     differ = [k for k in SAME_MAP if old.get(k) != info.get(k)]
     if differ:
         raise HarnessError(
             f"stability: --add: {display(out_dir)} was measured with another {', '.join(differ)}", code=2
         )
-    with open(csv_path, newline="") as f:
-        return list(csv.DictReader(f)), old
+    rows = list(csv.DictReader(io.StringIO(inputs.read_text(csv_path, "stability: --add:"))))
+    if any("slice" not in r for r in rows[:1]):
+        raise HarnessError(f"stability: --add: {display(csv_path)} is not a map's stability.csv", code=2)
+    return rows, old
 
 
 def _joined(earlier, rows, slices, old_env, info):

@@ -453,6 +453,10 @@ def test_a_map_measured_over_two_calls_is_one_map(cpu_bin, tmp_path, capsys):
     assert len(err) == 1 and "another strands" in err[0]
     assert (out / "stability.csv").read_bytes() == before
     assert harness_main([*base[:-4], "--out", str(tmp_path / "none"), "--slice", "motion", "--add"]) == 2
+    (out / "env.json").write_text("{not json")  # a damaged map: one line, nothing written
+    capsys.readouterr()
+    assert harness_main([*base, "--slice", "motion", "--add"]) == 2
+    assert "not valid JSON" in capsys.readouterr().err and (out / "stability.csv").read_bytes() == before
 
 
 def test_stability_bad_input_is_one_line(tmp_path, capsys):
