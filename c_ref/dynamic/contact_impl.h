@@ -194,31 +194,66 @@ HB_HD void SFX(hb_friction)(REAL *p, const REAL *x, const REAL *n, REAL m, REAL 
     }
 }
 
-/* A sphere of radius rc about c: moves p out; returns the depth removed (0: p was outside)
- * and the normal in n. With exact = 1 (unbounded) p lands on the surface as c + (rc/ρ)·e. */
-HB_HD REAL SFX(hb_push_sphere)(REAL *p, const REAL *c, REAL rc, const REAL *nperp, int bounded, REAL depen, REAL *n)
+/* The depth of p in the sphere of radius rc about c, rc − ρ > 0 with the outward normal in n
+ * (ρ = 0: nperp, or ŷ without one), or 0 outside (n unset). */
+HB_HD REAL SFX(hb_sphere_depth)(const REAL *p, const REAL *c, REAL rc, const REAL *nperp, REAL *n)
 {
     const REAL e[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
     const REAL rho = SQRT((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2]);
     if (!(rho < rc)) return (REAL)0;
-    const REAL d = rc - rho;
     if (rho == (REAL)0) {
         for (int k = 0; k < 3; k++) n[k] = nperp ? nperp[k] : (k == 1 ? (REAL)1 : (REAL)0);
     } else {
         for (int k = 0; k < 3; k++) n[k] = e[k] / rho;
     }
-    if (!bounded) {
-        if (rho == (REAL)0) {
-            for (int k = 0; k < 3; k++) p[k] = c[k] + rc * n[k];
-        } else {
-            const REAL sg = rc / rho;
-            for (int k = 0; k < 3; k++) p[k] = c[k] + e[k] * sg;
-        }
-        return d;
+    return rc - rho;
+}
+
+/* p moved out of the sphere (c, rc) along n: by m, or with exact = 1 (unbounded) onto the
+ * surface as c + (rc/ρ)·e (ρ = 0: c + rc·n). */
+HB_HD void SFX(hb_sphere_move)(REAL *p, const REAL *c, REAL rc, const REAL *n, REAL m, int exact)
+{
+    if (!exact) {
+        for (int k = 0; k < 3; k++) p[k] = p[k] + m * n[k];
+        return;
     }
-    const REAL m = d < depen ? d : depen;
-    for (int k = 0; k < 3; k++) p[k] = p[k] + m * n[k];
-    return m;
+    const REAL e[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    const REAL rho = SQRT((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2]);
+    if (rho == (REAL)0) {
+        for (int k = 0; k < 3; k++) p[k] = c[k] + rc * n[k];
+    } else {
+        const REAL sg = rc / rho;
+        for (int k = 0; k < 3; k++) p[k] = c[k] + e[k] * sg;
+    }
+}
+
+/* The bounded depenetration: of the depth d found at t + h, a point keeps what it had at the
+ * substep's start (d0) less one step V·h (depen), never more than d; returns the depth to
+ * remove, d − min(d, max(d0 − V·h, 0)). A point that was outside at the start (d0 ≤ V·h)
+ * leaves in full, whatever pushed it in. */
+HB_HD REAL SFX(hb_bounded_move)(REAL d, REAL d0, REAL depen)
+{
+    REAL keep = d0 - depen;
+    keep = keep > (REAL)0 ? keep : (REAL)0;
+    return d - (keep < d ? keep : d);
+}
+
+/* y = β⁻¹(x): the start of the substep carried with the collider frame's motion to t + h, where
+ * the collider's pose is: turn, back's transpose (Q(t+h)·Q(t)ᵀ); sway, less its shift. */
+HB_HD void SFX(hb_carry)(const REAL *back, int turn, int sway, const REAL *x, REAL *y)
+{
+    for (int c = 0; c < 3; c++)
+        y[c] = turn ? (back[c] * x[0] + back[3 + c] * x[1]) + back[6 + c] * x[2] : sway ? x[c] - back[9 + c] : x[c];
+}
+
+/* The point of capsule a–b (pose) nearest to p. */
+HB_HD void SFX(hb_capsule_centre)(const REAL *pose, const REAL *p, REAL *c)
+{
+    const REAL ab[3] = {pose[3] - pose[0], pose[4] - pose[1], pose[5] - pose[2]};
+    const REAL ap[3] = {p[0] - pose[0], p[1] - pose[1], p[2] - pose[2]};
+    REAL t = ((ap[0] * ab[0] + ap[1] * ab[1]) + ap[2] * ab[2]) / pose[10];
+    t = t < (REAL)0 ? (REAL)0 : t > (REAL)1 ? (REAL)1 : t;
+    for (int k = 0; k < 3; k++) c[k] = pose[k] + t * ab[k];
 }
 
 /* A mesh's SDF at the mesh-frame point u: 1, the value φ and the (unnormalised) gradient g in
@@ -261,6 +296,32 @@ HB_HD int SFX(hb_sdf_sample)(const REAL *sdf, int64_t n, const REAL *geo, const 
     return 1;
 }
 
+/* The mesh-frame point of p (a head mesh: Qᵀ·p, pose's rows; a body mesh: p − b). */
+HB_HD void SFX(hb_mesh_local)(const REAL *pose, int turn, int sway, const REAL *p, REAL *u)
+{
+    for (int c = 0; c < 3; c++)
+        u[c] = turn ? (pose[c] * p[0] + pose[3 + c] * p[1]) + pose[6 + c] * p[2] : sway ? p[c] - pose[9 + c] : p[c];
+}
+
+/* The depth at t + h of y (the substep's start carried, hb_carry) in collider i (kind, pose):
+ * positive inside; 0 or less outside (a sphere or capsule: 0; a mesh outside its cube: 0). */
+HB_HD REAL SFX(hb_start_depth)(const WORLD *w, int i, int kind, int turn, int sway, const REAL *pose, const REAL *y)
+{
+    REAL n[3];
+    if (kind == HB_COL_SPHERE) return SFX(hb_sphere_depth)(y, pose, pose[3], NULL, n);
+    if (kind == HB_COL_CAPSULE) {
+        REAL c[3];
+        SFX(hb_capsule_centre)(pose, y, c);
+        return SFX(hb_sphere_depth)(y, c, pose[6], pose + 7, n);
+    }
+    if (kind == HB_COL_PLANE)
+        return pose[6] - (((y[0] - pose[0]) * pose[3] + (y[1] - pose[1]) * pose[4]) + (y[2] - pose[2]) * pose[5]);
+    REAL u[3], phi, g[3];
+    SFX(hb_mesh_local)(pose, turn, sway, y, u);
+    if (!SFX(hb_sdf_sample)(w->sdf[i], w->sdf_n[i], w->sdf_geo + 4 * i, u, &phi, g)) return (REAL)0;
+    return pose[12] - phi;
+}
+
 /* Collider i (kind, pose) on p: its projection and friction. x: the point at the start of the
  * substep; back: the substep's back-transforms. */
 HB_HD void SFX(hb_collide_one)(const WORLD *w, int i, const REAL *pose, const REAL *back, REAL *p, const REAL *x)
@@ -271,50 +332,58 @@ HB_HD void SFX(hb_collide_one)(const WORLD *w, int i, const REAL *pose, const RE
     }
     const int kind = w->col_kind[i], frame = w->col_frame[i];
     const int turn = frame == HB_FRAME_HEAD && w->motion, sway = frame == HB_FRAME_BODY && w->sway;
-    REAL n[3], m = (REAL)0;
-    if (kind == HB_COL_SPHERE) {
-        m = SFX(hb_push_sphere)(p, pose, pose[3], NULL, w->bounded, w->depen, n);
-    } else if (kind == HB_COL_CAPSULE) {
-        const REAL ab[3] = {pose[3] - pose[0], pose[4] - pose[1], pose[5] - pose[2]};
-        const REAL ap[3] = {p[0] - pose[0], p[1] - pose[1], p[2] - pose[2]};
-        REAL t = ((ap[0] * ab[0] + ap[1] * ab[1]) + ap[2] * ab[2]) / pose[10];
-        t = t < (REAL)0 ? (REAL)0 : t > (REAL)1 ? (REAL)1 : t;
-        const REAL c[3] = {pose[0] + t * ab[0], pose[1] + t * ab[1], pose[2] + t * ab[2]};
-        m = SFX(hb_push_sphere)(p, c, pose[6], pose + 7, w->bounded, w->depen, n);
+    REAL n[3], c[3], d;
+    if (kind == HB_COL_SPHERE || kind == HB_COL_CAPSULE) {
+        if (kind == HB_COL_SPHERE) {
+            for (int k = 0; k < 3; k++) c[k] = pose[k];
+            d = SFX(hb_sphere_depth)(p, c, pose[3], NULL, n);
+        } else {
+            SFX(hb_capsule_centre)(pose, p, c);
+            d = SFX(hb_sphere_depth)(p, c, pose[6], pose + 7, n);
+        }
+        if (!(d > (REAL)0)) return;
     } else if (kind == HB_COL_PLANE) {
         const REAL rho = ((p[0] - pose[0]) * pose[3] + (p[1] - pose[1]) * pose[4]) + (p[2] - pose[2]) * pose[5];
         if (!(rho < pose[6])) return;
-        const REAL d = pose[6] - rho;
-        m = w->bounded && w->depen < d ? w->depen : d;
-        for (int c = 0; c < 3; c++) {
-            n[c] = pose[3 + c];
-            p[c] = p[c] + m * n[c];
-        }
+        d = pose[6] - rho;
+        for (int k = 0; k < 3; k++) n[k] = pose[3 + k];
     } else { /* mesh */
         REAL u[3], phi, g[3];
-        for (int c = 0; c < 3; c++)
-            u[c] = turn ? (pose[c] * p[0] + pose[3 + c] * p[1]) + pose[6 + c] * p[2] : sway ? p[c] - pose[9 + c] : p[c];
+        SFX(hb_mesh_local)(pose, turn, sway, p, u);
         if (!SFX(hb_sdf_sample)(w->sdf[i], w->sdf_n[i], w->sdf_geo + 4 * i, u, &phi, g)) return;
         const REAL gl = SQRT((g[0] * g[0] + g[1] * g[1]) + g[2] * g[2]);
         if (!(phi < pose[12] && gl > (REAL)0)) return;
-        const REAL d = pose[12] - phi;
+        d = pose[12] - phi;
         REAL nl[3];
-        for (int c = 0; c < 3; c++) nl[c] = g[c] / gl;
+        for (int k = 0; k < 3; k++) nl[k] = g[k] / gl;
         for (int r = 0; r < 3; r++)
             n[r] = turn ? (pose[3 * r] * nl[0] + pose[3 * r + 1] * nl[1]) + pose[3 * r + 2] * nl[2] : nl[r];
-        m = w->bounded && w->depen < d ? w->depen : d;
-        for (int c = 0; c < 3; c++) p[c] = p[c] + m * n[c];
+    }
+    REAL m = d;
+    if (w->bounded) {
+        REAL y[3];
+        SFX(hb_carry)(back, turn, sway, x, y);
+        m = SFX(hb_bounded_move)(d, SFX(hb_start_depth)(w, i, kind, turn, sway, pose, y), w->depen);
+    }
+    if (kind == HB_COL_SPHERE || kind == HB_COL_CAPSULE) {
+        SFX(hb_sphere_move)(p, c, kind == HB_COL_SPHERE ? pose[3] : pose[6], n, m, !w->bounded);
+    } else {
+        for (int k = 0; k < 3; k++) p[k] = p[k] + m * n[k];
     }
     const REAL mu_s = w->col_mu[2 * i];
     if (m > (REAL)0 && mu_s > (REAL)0) SFX(hb_friction)(p, x, n, m, mu_s, w->col_mu[2 * i + 1], turn, sway, back);
 }
 
-/* The head sphere of §3.5 with friction or a bounded depenetration (§3.17). */
+/* The head sphere of §3.5 with friction or a bounded depenetration (§3.17); its depth does not
+ * change as it turns, so x's own depth is its start's. */
 HB_HD void SFX(hb_collide_head)(const WORLD *w, REAL rc, const REAL *back, REAL *p, const REAL *x)
 {
     const REAL origin[3] = {(REAL)0, (REAL)0, (REAL)0};
-    REAL n[3];
-    const REAL m = SFX(hb_push_sphere)(p, origin, rc, NULL, w->bounded, w->depen, n);
+    REAL n[3], n0[3];
+    const REAL d = SFX(hb_sphere_depth)(p, origin, rc, NULL, n);
+    if (!(d > (REAL)0)) return;
+    const REAL m = w->bounded ? SFX(hb_bounded_move)(d, SFX(hb_sphere_depth)(x, origin, rc, NULL, n0), w->depen) : d;
+    SFX(hb_sphere_move)(p, origin, rc, n, m, !w->bounded);
     if (m > (REAL)0 && w->head_friction && w->head_mu_s > (REAL)0)
         SFX(hb_friction)(p, x, n, m, w->head_mu_s, w->head_mu_k, w->motion, 0, back);
 }

@@ -363,7 +363,7 @@ static const flag_spec flags[] = {
     {"--friction", DF_PAIR, DYN(friction), DYN(friction_declared),
      "MU_S[,MU_K]: the head sphere's Coulomb friction (default: frictionless)"},
     {"--depenetration-speed", DF_REAL, DYN(depen_speed), DYN(depen_declared),
-     "V, cm/s: a point leaves a collider by at most V*h a substep (default: unbounded)"},
+     "V, cm/s: a point inside a collider at a substep's start leaves it at V at most (default: unbounded)"},
     {"--body-motion", DF_BODY, DYN(body_motion), 0,
      "still | sway (along x) | rise (from A_b below, in 1/f_b s): the body frame's motion (default still)"},
     {"--body-amplitude", DF_REAL, DYN(body_amplitude), 0, "the body's sway or rise A_b, cm (default 2)"},

@@ -10,6 +10,8 @@ a given head centre, so each test puts its particles exactly where its answer is
 - a sphere given as a mesh SDF converges to the analytic sphere as its grid is refined;
 - a particle on the head sphere turning under it: frictionless it stays where it is, with a
   large μ_s it turns with the head, Q(t)·X̄;
+- the bounded depenetration: a particle started inside leaves at the speed named; one resting on
+  a collider that moves faster than that is still moved out in full;
 - a resumed run with colliders continues bit for bit; bad colliders files are refused in one line.
 """
 
@@ -18,6 +20,7 @@ import math
 import numpy as np
 import pytest
 
+from harness.core import tolerances
 from harness.io.grooms import write_hair
 from harness.io.meshes import icosphere, write_obj
 from harness.io.trajectory import open_trajectory
@@ -137,6 +140,41 @@ def test_particle_on_a_nodding_head(cpu_bin, tmp_path, mu):
         moved = np.max(np.linalg.norm(want[f0:] - x[f0, 0], axis=1))
         assert moved > 1.0
         assert np.max(np.linalg.norm(x[f0:, 0] - want[f0:], axis=1)) < 1e-3 * moved
+
+
+def test_bounded_depenetration_leaves_at_the_speed_it_names(cpu_bin, tmp_path):
+    # a particle started D deep in a still plane, no gravity: it leaves at V, depth D − n·V·h after
+    # n substeps (the rule that took min(δ, V·h) from each substep's depth sped it up: V, 2V, 3V, …)
+    D, V, S, F = 2.0, 30.0, 10, 3
+    cols = tmp_path / "plane.txt"
+    cols.write_text("plane body 0 0 0 0 1 0\n")
+    groom = particles(tmp_path, [[0.0, -D, 0.0]])
+    path = simulate(cpu_bin, tmp_path, groom, *FREE, "--gravity", "0", "--substeps", S, "--colliders", cols,
+                    "--depenetration-speed", V, frames=F)  # fmt: skip
+    depth = -free_points(path)[:, 0, 1]
+    vh = V / 60.0 / S
+    want = D - vh * S * np.arange(F + 1)
+    assert np.max(np.abs(depth - want)) < 1e-12, f"depths {depth}, want {want}"
+
+
+def test_bounded_depenetration_keeps_hair_on_a_collider_moving_faster(cpu_bin, tmp_path):
+    # a particle resting on a plane that rises at u = A_b·f_b = 20 cm/s, four times the bound
+    # V = 5 cm/s: it was outside at each substep's start, so it is moved out in full and rides the
+    # plane (the rule that bounded every projection let it sink by (u − V)·t, 5 cm at 0.33 s)
+    A, f_b, V, F = 10.0, 2.0, 5.0, 20
+    cols = tmp_path / "plane.txt"
+    cols.write_text("plane body 0 0 0 0 1 0\n")
+    groom = particles(tmp_path, [[0.0, -A, 0.0]])
+    rise = ["--body-motion", "rise", "--body-amplitude", A, "--body-frequency", f_b]
+    path = simulate(cpu_bin, tmp_path, groom, *FREE, "--substeps", 8, "--colliders", cols, *rise,
+                    "--depenetration-speed", V, frames=F)  # fmt: skip
+    with open_trajectory(path) as t:
+        times = np.asarray(t.time)
+    plane = -A * np.clip(1.0 - f_b * times, 0.0, None)
+    y = free_points(path)[:, 0, 1]
+    eps = np.finfo(np.float64).eps
+    assert np.max(plane - y) <= tolerances.DYN_PENETRATION_K * eps * A, f"depths {plane - y}"
+    assert y[-1] - y[0] > 0.9 * A * f_b * times[-1]  # it rose with the plane, faster than V
 
 
 def run_head(cpu_bin, tmp_path, groom, args):
