@@ -8,10 +8,11 @@
 #   OUT=$OUT bash results/gpu_rerun.sh curly        # dynamic-accuracy-curly/: the same on curly hair
 #   OUT=$OUT bash results/gpu_rerun.sh reduced SHARE [--resume]
 #                                                   # reduced-SHARE/: one share of the reduced study (1,000 and
-#                                                   # 10,000 strands, 1 s): g1000 (~300 s), g10000 (~12 min: a
-#                                                   # stopped call leaves its timings; the next one, --resume,
-#                                                   # keeps them), lra (~240 s), sag (~80 s), lod (~230 s);
-#                                                   # reduced/ is the shares' CSVs joined in that order, header once
+#                                                   # 10,000 strands, 1 s): guides (both strand counts, one timing
+#                                                   # each; over 10 minutes: a stopped call leaves its timings, the
+#                                                   # next one, --resume, keeps them), lra (~240 s), sag (~80 s),
+#                                                   # lod (~230 s); reduced/ is the shares' CSVs joined in that
+#                                                   # order, header once
 #   OUT=$OUT bash results/gpu_rerun.sh stability [SLICE ...]
 #                                                   # stability/: the quick map, CPU and every CUDA build; given
 #                                                   # slices, those alone, added to the map already there
@@ -37,15 +38,14 @@ accuracy) "$py" -m harness accuracy --model dynamic --quick --gpu auto --force \
 curly) "$py" -m harness accuracy --model dynamic --scene curly --quick --analytic none --ref-max 4096 --gpu auto --force \
 	--out "$out/dynamic-accuracy-curly" --report-dir "$out/report" ;;
 reduced)
-	share=${2:?"usage: OUT=DIR bash results/gpu_rerun.sh reduced g1000|g10000|lra|sag|lod [--resume]"}
+	share=${2:?"usage: OUT=DIR bash results/gpu_rerun.sh reduced guides|lra|sag|lod [--resume]"}
 	case "$share" in
-	g1000) args=(--strands 1000 --parts guides) ;;
-	g10000) args=(--strands 10000 --parts guides) ;;
+	guides) args=(--strands 1000 10000 --parts guides) ;;
 	lra) args=(--strands 1000 10000 --parts lra) ;;
 	sag) args=(--strands 1000 10000 --parts sagfree sagfreq) ;;
 	lod) args=(--strands 1000 10000 --parts lod) ;;
 	*)
-		echo "error: unknown reduced share '$share' (g1000, g10000, lra, sag, lod)" >&2
+		echo "error: unknown reduced share '$share' (guides, lra, sag, lod)" >&2
 		exit 2
 		;;
 	esac

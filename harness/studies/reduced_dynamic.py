@@ -34,7 +34,8 @@ stretch_max_k and stretch_p99_k recomputed against each segment's own rest lengt
 strand (a LOD row: over its rendered points and rendered rest shape), stretch_followers over the
 followers alone.
 
-Time per frame: the same settings at `time_strands` strands (no file, --repeat), on the cpu oracle
+Time per frame: the same settings at `time_strands` strands (no file, --repeat; each distinct
+binary and flags once, so a guide row at 1,000 and at 10,000 strands shares its timing), on the cpu oracle
 and, with a usable GPU, on each cuda variant that runs all the features (its `--list-variants`
 entry lists them; `lanes` lacks guides and LRA, docs/cuda.md). Writes the CSV (one row per case and
 timing binary) and, beside it, references.csv (each reference's ladder, rate and horizon), once every
@@ -380,20 +381,33 @@ class Study:
         return float(np.nanmax(np.linalg.norm(a - b, axis=-1)))
 
 
-def _timings(plan, scene, case, timers):
-    """(backend, variant, strands, record) of each binary of `timers` that times the case, as each is measured."""
+def _timing_flags(plan, scene, case, backend, variant):
+    """(strands, flags) of the case's timing on (backend, variant), or None where that binary does not time it."""
     p_sim = int(case.points or scene.points)
+    d = variants.declared(backend)
+    if backend == "cuda" and not d.runs(variant, points=p_sim):
+        return None  # more points than the variant simulates (warpreg: 32)
+    if not d.runs_features(variant, row_features(case.extra)):
+        return None  # a feature the variant does not run (--list-variants)
+    n = plan.time_gpu_strands if backend == "cuda" else plan.time_strands
+    tf = _flags(scene, solver=case.solver, substeps=case.substeps, iterations=case.iterations, precision="fp32",
+                strands=n, frames=2, extra=case.extra, variant=(backend, variant), points=case.points)  # fmt: skip
+    return n, tf + ["--repeat", str(plan.repeat)]
+
+
+def _timings(plan, scene, case, timers, memo):
+    """(backend, variant, strands, record) of each binary of `timers` that times the case, as each is measured;
+    a timing whose binary and flags an earlier case already ran (the same settings at the timing's own
+    strand count, e.g. a guide row at 1,000 and at 10,000 strands) is that case's record, from `memo`."""
     for backend, variant in timers:
-        d = variants.declared(backend)
-        if backend == "cuda" and not d.runs(variant, points=p_sim):
-            continue  # more points than the variant simulates (warpreg: 32)
-        if not d.runs_features(variant, row_features(case.extra)):
-            continue  # a feature the variant does not run (--list-variants)
-        n = plan.time_gpu_strands if backend == "cuda" else plan.time_strands
-        tf = _flags(scene, solver=case.solver, substeps=case.substeps, iterations=case.iterations, precision="fp32",
-                    strands=n, frames=2, extra=case.extra, variant=(backend, variant), points=case.points)  # fmt: skip
-        rec = runner.run_binary(binary_path(backend, "default"), tf + ["--repeat", str(plan.repeat)])
-        yield backend, variant, n, rec
+        tf = _timing_flags(plan, scene, case, backend, variant)
+        if tf is None:
+            continue
+        n, flags = tf
+        key = (backend, variant, tuple(map(str, flags)))
+        if key not in memo:
+            memo[key] = runner.run_binary(binary_path(backend, "default"), flags)
+        yield backend, variant, n, memo[key]
 
 
 def measure(plan=Plan(), out=None, work=None, progress=print, refs_into=None, resume=False):
@@ -415,6 +429,7 @@ def measure(plan=Plan(), out=None, work=None, progress=print, refs_into=None, re
         for c in all_cases:
             st.checked(c)
         done = []  # (case key, row) of every case measured
+        memo = {}  # a timing's record by its binary and flags (_timings)
 
         def save(case_rows):
             if partial:
@@ -425,7 +440,9 @@ def measure(plan=Plan(), out=None, work=None, progress=print, refs_into=None, re
             m = st.metrics(c, ref)
             if c.study == "lra" and c.lra:
                 m["lra_moved_cm"] = st.lra_moved(c, all_cases)
-            done += _case_rows(plan, st.scene, c, _base(plan, st, c, m), timers, kept.get(c.key, {}), save, progress)
+            done += _case_rows(
+                plan, st.scene, c, _base(plan, st, c, m), timers, kept.get(c.key, {}), save, progress, memo
+            )
         refs = [_ref_row(st, r) for r in st.refs.cache.values()]
         if refs_into is not None:
             refs_into.extend(refs)
@@ -437,9 +454,10 @@ def measure(plan=Plan(), out=None, work=None, progress=print, refs_into=None, re
     return rows
 
 
-def _case_rows(plan, scene, c, base, timers, kept, save, progress):
+def _case_rows(plan, scene, c, base, timers, kept, save, progress, memo):
     """The case's (key, row) pairs, one per binary of `timers` that times it, in `timers`' order: a timing
-    in `kept` as it was, the others measured, every row so far handed to `save` after each."""
+    in `kept` as it was, the others measured (or taken from `memo`: _timings), every row so far handed to
+    `save` after each."""
     timed = dict(kept)
 
     def rows():
@@ -449,7 +467,7 @@ def _case_rows(plan, scene, c, base, timers, kept, save, progress):
         if t in kept:
             _say(progress, c, base, t, kept[t]["median_ms"], " (kept)")
     todo = [t for t in timers if t not in kept]
-    for backend, variant, n, rec in _timings(plan, scene, c, todo) if todo else ():
+    for backend, variant, n, rec in _timings(plan, scene, c, todo, memo) if todo else ():
         sim = next(x for x in rec["stages"] if x["stage"] == "simulate")
         values = (backend, variant, n, sim["median_ms"], sim.get("render_ms"), rec["device"])
         timed[(backend, variant)] = dict(zip(TIMING_FIELDS, values, strict=True))

@@ -202,9 +202,9 @@ def test_resume_keeps_the_timings_and_ends_as_an_uninterrupted_run(stopped, unin
     kept = reduced_report.read(reduced_partial.partial_path(out))
     real, asked = reduced._timings, []
 
-    def timings(plan, scene, case, timers):
+    def timings(plan, scene, case, timers, memo):
         asked.extend((case.key, *t) for t in timers)
-        return real(plan, scene, case, timers)
+        return real(plan, scene, case, timers, memo)
 
     monkeypatch.setattr(reduced, "_timings", timings)
     reduced.measure(SMALL, out=out, progress=_quiet, resume=True)
@@ -284,7 +284,7 @@ def test_a_case_partly_timed_keeps_the_binaries_order_and_saves_each_new_timing(
                             "render_ms": None, "device": "GPU"}}  # fmt: skip
     asked = []
 
-    def timings(plan, scene, case, todo):
+    def timings(plan, scene, case, todo, memo):
         asked.extend(todo)
         for backend, variant in todo:
             yield backend, variant, 10, {"stages": [{"stage": "simulate", "median_ms": 2.0}], "device": "X"}
@@ -293,7 +293,7 @@ def test_a_case_partly_timed_keeps_the_binaries_order_and_saves_each_new_timing(
     case = reduced.Case("guides", "xpbd", 8, 2, 8)
     saved = []
     base = {"rms_err_L": 0.1}
-    got = reduced._case_rows(SMALL, None, case, base, timers, kept, saved.append, _quiet)
+    got = reduced._case_rows(SMALL, None, case, base, timers, kept, saved.append, _quiet, {})
     assert asked == [("cpu", "ref"), ("cuda", "b")]
     assert [(r["backend"], r["variant"], r["median_ms"]) for _, r in got] == [
         ("cpu", "ref", 2.0),
@@ -301,3 +301,29 @@ def test_a_case_partly_timed_keeps_the_binaries_order_and_saves_each_new_timing(
         ("cuda", "b", 2.0),
     ]
     assert [len(s) for s in saved] == [2, 3] and all(k == case.key for k, _ in got)
+
+
+def test_a_timing_with_the_same_binary_and_flags_runs_once(monkeypatch):
+    # a guide row at 1,000 and at 10,000 strands is timed at the timing's own strand count: one run
+    runs = []
+
+    def flags(plan, scene, case, backend, variant):
+        return (10, ["--strands", "10", "--guides", repr(case.guides), "--variant", variant])
+
+    def run_binary(path, fl):
+        runs.append(tuple(fl))
+        return {"stages": [{"stage": "simulate", "median_ms": float(len(runs))}], "device": "X"}
+
+    monkeypatch.setattr(reduced, "_timing_flags", flags)
+    monkeypatch.setattr(reduced.runner, "run_binary", run_binary)
+    timers = [("cpu", "ref"), ("cuda", "lanes")]
+    memo = {}
+    shapes = ((1000, 0.1), (10000, 0.1), (1000, 0.5))  # the first two differ in strands alone
+    got = []
+    for n, g in shapes:
+        case = reduced.Case("guides", "xpbd", 8, 2, n, g)
+        timed = reduced._timings(SMALL, None, case, timers, memo)
+        got.append([(b, v, r["stages"][0]["median_ms"]) for b, v, _, r in timed])
+    assert len(runs) == 4 and len(set(runs)) == 4
+    assert got[0] == got[1] == [("cpu", "ref", 1.0), ("cuda", "lanes", 2.0)]
+    assert got[2] == [("cpu", "ref", 3.0), ("cuda", "lanes", 4.0)]
