@@ -79,6 +79,29 @@ __device__ __forceinline__ void friction_free(T (&p)[3], const T *x, const T (&n
     }
 }
 
+/* A mesh's SDF value alone at the mesh-frame point u (hb_sdf_sample's φ, as lerps in 32-bit
+ * indices: n_s ≤ 512); false outside the cube. */
+template <typename T>
+__device__ __forceinline__ bool sdf_value_free(const T *sdf, int64_t n64, const T *geo, const T (&u)[3], T &phi)
+{
+    const int n = (int)n64;
+    T f[3];
+    int i[3];
+    for (int c = 0; c < 3; c++) {
+        const T gc = (u[c] - geo[c]) * geo[3];
+        if (!(gc >= (T)0 && gc < (T)(n - 1))) return false;
+        i[c] = (int)gc;
+        f[c] = gc - (T)i[c];
+    }
+    const T *b = sdf + (i[0] + n * (i[1] + n * i[2]));
+    const int nn = n * n;
+    const T x00 = b[0] + f[0] * (b[1] - b[0]), x10 = b[n] + f[0] * (b[n + 1] - b[n]);
+    const T x01 = b[nn] + f[0] * (b[nn + 1] - b[nn]), x11 = b[nn + n] + f[0] * (b[nn + n + 1] - b[nn + n]);
+    const T y0 = x00 + f[1] * (x10 - x00), y1 = x01 + f[1] * (x11 - x01);
+    phi = y0 + f[2] * (y1 - y0);
+    return true;
+}
+
 /* The depth at t + h of the carried start y in collider i (hb_start_depth). */
 template <typename T, class Wd>
 __device__ __forceinline__ T start_depth_free(const Wd &w, int i, int kind, bool turn, bool sway, const T *pose,
@@ -93,10 +116,10 @@ __device__ __forceinline__ T start_depth_free(const Wd &w, int i, int kind, bool
     }
     if (kind == HB_COL_PLANE)
         return pose[6] - (((y[0] - pose[0]) * pose[3] + (y[1] - pose[1]) * pose[4]) + (y[2] - pose[2]) * pose[5]);
-    T u[3], phi, g[3];
+    T u[3], phi;
     for (int c = 0; c < 3; c++)
         u[c] = turn ? (pose[c] * y[0] + pose[3 + c] * y[1]) + pose[6 + c] * y[2] : sway ? y[c] - pose[9 + c] : y[c];
-    if (!sdf_sample(w.sdf[i], w.sdf_n[i], w.sdf_geo + 4 * i, u, &phi, g)) return (T)0;
+    if (!sdf_value_free(w.sdf[i], w.sdf_n[i], w.sdf_geo + 4 * i, u, phi)) return (T)0;
     return pose[12] - phi;
 }
 
@@ -141,14 +164,16 @@ __device__ __forceinline__ void collide_one_free(const Wd &w, int i, const T *po
             n[r] = turn ? (pose[3 * r] * nl[0] + pose[3 * r + 1] * nl[1]) + pose[3 * r + 2] * nl[2] : nl[r];
     }
     T m = d;
-    if (w.bounded) {
+    if (!w.bounded) { /* unbounded: onto the surface now (c and rinv die here) */
+        if (ball) sphere_move_free(p, c, kind == HB_COL_SPHERE ? pose[3] : pose[6], n, rinv, m, true);
+        else
+            for (int k = 0; k < 3; k++) p[k] = p[k] + m * n[k];
+    } else {
         T y[3];
         carry_free(back, turn, sway, x, y);
         m = bounded_move_free(d, start_depth_free(w, i, kind, turn, sway, pose, y), w.depen);
-    }
-    if (ball) sphere_move_free(p, c, kind == HB_COL_SPHERE ? pose[3] : pose[6], n, rinv, m, !w.bounded);
-    else
         for (int k = 0; k < 3; k++) p[k] = p[k] + m * n[k];
+    }
     const T mu_s = w.col_mu[2 * i];
     if (m > (T)0 && mu_s > (T)0) friction_free(p, x, n, m, mu_s, w.col_mu[2 * i + 1], turn, sway, back);
 }
