@@ -94,7 +94,8 @@ def cmd_reduced(args):
     P_r = 33 (--render-points); compare each with a converged reference in which every strand and point is
     simulated (xpbd, fp64, S doubled until it is ten times closer than the rows it ranks) up to the scene's
     predictability time, and with the reference ensemble's statistics over the whole run; time it on the cpu
-    oracle and, with a usable GPU, the cuda variants that run it (docs/model.md §3.14); and the still scene with
+    oracle and, with a usable GPU, the cuda variants that run it (each distinct timing once: a setting shared by
+    both strand counts is timed at the timing's own size once; docs/model.md §3.14); and the still scene with
     and without sag-free rest at two shape ranges: how far it sags, and the tip's swing under a wind step.
     Prints Markdown; --out writes the rows as CSV and references.csv beside it once every row is measured, the
     rows so far kept in OUT.partial until then; --resume finishes a stopped run, its timings kept."""
