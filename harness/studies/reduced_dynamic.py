@@ -410,6 +410,20 @@ def _timings(plan, scene, case, timers, memo):
         yield backend, variant, n, memo[key]
 
 
+def _memo_from_kept(plan, scene, all_cases, kept):
+    """`_timings`' memo seeded with the timings a resumed run keeps, each under its binary and flags, so that
+    a case not measured yet whose twin was (a guide row at 10,000 strands, its 1,000-strand twin kept) is
+    not timed again."""
+    memo = {}
+    for c in all_cases:
+        for (backend, variant), t in kept.get(c.key, {}).items():
+            tf = _timing_flags(plan, scene, c, backend, variant)
+            if tf is not None:
+                sim = {"stage": "simulate", "median_ms": t["median_ms"], "render_ms": t["render_ms"]}
+                memo[(backend, variant, tuple(map(str, tf[1])))] = {"stages": [sim], "device": t["device"]}
+    return memo
+
+
 def measure(plan=Plan(), out=None, work=None, progress=print, refs_into=None, resume=False):
     """Every row (module docstring); with `out`, the CSV and references.csv beside it once every row is
     measured, the rows so far kept in OUT.partial until then; the references' rows are appended to the
@@ -429,7 +443,7 @@ def measure(plan=Plan(), out=None, work=None, progress=print, refs_into=None, re
         for c in all_cases:
             st.checked(c)
         done = []  # (case key, row) of every case measured
-        memo = {}  # a timing's record by its binary and flags (_timings)
+        memo = _memo_from_kept(plan, st.scene, all_cases, kept)  # a timing's record by its binary and flags
 
         def save(case_rows):
             if partial:

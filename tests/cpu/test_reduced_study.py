@@ -327,3 +327,19 @@ def test_a_timing_with_the_same_binary_and_flags_runs_once(monkeypatch):
     assert len(runs) == 4 and len(set(runs)) == 4
     assert got[0] == got[1] == [("cpu", "ref", 1.0), ("cuda", "lanes", 2.0)]
     assert got[2] == [("cpu", "ref", 3.0), ("cuda", "lanes", 4.0)]
+
+
+def test_a_resumed_run_does_not_time_again_the_twin_of_a_kept_timing(monkeypatch):
+    def flags(plan, scene, case, backend, variant):
+        return (10, ["--guides", repr(case.guides), "--variant", variant])
+
+    runs = []
+    monkeypatch.setattr(reduced, "_timing_flags", flags)
+    monkeypatch.setattr(reduced.runner, "run_binary", lambda path, fl: runs.append(fl))
+    small, big = (reduced.Case("guides", "xpbd", 8, 2, n, 0.1) for n in (1000, 10000))
+    kept = {small.key: {("cuda", "lanes"): {"backend": "cuda", "variant": "lanes", "time_strands": 10,
+                                             "median_ms": 1.25, "render_ms": None, "device": "GPU"}}}  # fmt: skip
+    memo = reduced._memo_from_kept(SMALL, None, [small, big], kept)
+    got = [(b, v, n, r["stages"][0]["median_ms"], r["device"]) for b, v, n, r in
+           reduced._timings(SMALL, None, big, [("cuda", "lanes")], memo)]  # fmt: skip
+    assert got == [("cuda", "lanes", 10, 1.25, "GPU")] and runs == []
