@@ -79,6 +79,14 @@ __device__ __forceinline__ void friction_free(T (&p)[3], const T *x, const T (&n
     }
 }
 
+/* The mesh-frame point of p (hb_mesh_local). */
+template <typename T>
+__device__ __forceinline__ void mesh_local_free(const T *pose, bool turn, bool sway, const T *p, T (&u)[3])
+{
+    for (int c = 0; c < 3; c++)
+        u[c] = turn ? (pose[c] * p[0] + pose[3 + c] * p[1]) + pose[6 + c] * p[2] : sway ? p[c] - pose[9 + c] : p[c];
+}
+
 /* A mesh's SDF value alone at the mesh-frame point u (hb_sdf_sample's φ, as lerps in 32-bit
  * indices: n_s ≤ 512); false outside the cube. */
 template <typename T>
@@ -117,8 +125,7 @@ __device__ __forceinline__ T start_depth_free(const Wd &w, int i, int kind, bool
     if (kind == HB_COL_PLANE)
         return pose[6] - (((y[0] - pose[0]) * pose[3] + (y[1] - pose[1]) * pose[4]) + (y[2] - pose[2]) * pose[5]);
     T u[3], phi;
-    for (int c = 0; c < 3; c++)
-        u[c] = turn ? (pose[c] * y[0] + pose[3 + c] * y[1]) + pose[6 + c] * y[2] : sway ? y[c] - pose[9 + c] : y[c];
+    mesh_local_free(pose, turn, sway, y, u);
     if (!sdf_value_free(w.sdf[i], w.sdf_n[i], w.sdf_geo + 4 * i, u, phi)) return (T)0;
     return pose[12] - phi;
 }
@@ -152,8 +159,7 @@ __device__ __forceinline__ void collide_one_free(const Wd &w, int i, const T *po
         for (int k = 0; k < 3; k++) n[k] = pose[3 + k];
     } else { /* mesh */
         T u[3], phi, g[3];
-        for (int k = 0; k < 3; k++)
-            u[k] = turn ? (pose[k] * p[0] + pose[3 + k] * p[1]) + pose[6 + k] * p[2] : sway ? p[k] - pose[9 + k] : p[k];
+        mesh_local_free(pose, turn, sway, p, u);
         if (!sdf_sample(w.sdf[i], w.sdf_n[i], w.sdf_geo + 4 * i, u, &phi, g)) return;
         const T gq = (g[0] * g[0] + g[1] * g[1]) + g[2] * g[2];
         if (!(phi < pose[12] && gq > floor_of<T>())) return;

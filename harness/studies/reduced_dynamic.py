@@ -395,6 +395,11 @@ def _timing_flags(plan, scene, case, backend, variant):
     return n, tf + ["--repeat", str(plan.repeat)]
 
 
+def _timing_key(backend, variant, flags):
+    """A timing's key in `_timings`' memo: its binary and flags."""
+    return backend, variant, tuple(map(str, flags))
+
+
 def _timings(plan, scene, case, timers, memo):
     """(backend, variant, strands, record) of each binary of `timers` that times the case, as each is measured;
     a timing whose binary and flags an earlier case already ran (the same settings at the timing's own
@@ -404,7 +409,7 @@ def _timings(plan, scene, case, timers, memo):
         if tf is None:
             continue
         n, flags = tf
-        key = (backend, variant, tuple(map(str, flags)))
+        key = _timing_key(backend, variant, flags)
         if key not in memo:
             memo[key] = runner.run_binary(binary_path(backend, "default"), flags)
         yield backend, variant, n, memo[key]
@@ -420,7 +425,7 @@ def _memo_from_kept(plan, scene, all_cases, kept):
             tf = _timing_flags(plan, scene, c, backend, variant)
             if tf is not None:
                 sim = {"stage": "simulate", "median_ms": t["median_ms"], "render_ms": t["render_ms"]}
-                memo[(backend, variant, tuple(map(str, tf[1])))] = {"stages": [sim], "device": t["device"]}
+                memo[_timing_key(backend, variant, tf[1])] = {"stages": [sim], "device": t["device"]}
     return memo
 
 
