@@ -400,6 +400,20 @@ template <typename T, int G> __host__ __device__ constexpr int64_t lanes_held_re
 {
     return kHeldVectors * 4 * G * 32;
 }
+/* §3.17 a launch's colliders in shared memory after the warps' areas, staged once a block: the
+ * poses of its nj substeps [nj][ncol][HB_COL_POSE], then their back-transforms [nj][HB_COL_BACK];
+ * at most kColStageBytes a block (more substeps run in several launches: launch_frame_lanes). */
+constexpr int64_t kColStageBytes = 16384;
+__host__ __device__ constexpr int64_t lanes_col_reals(int ncol, int nj)
+{
+    return (int64_t)nj * ((int64_t)ncol * HB_COL_POSE + HB_COL_BACK);
+}
+/* whether a kernel with the colliders' code (W) stages them: the run has colliders or the head
+ * sphere's friction or bounded depenetration */
+template <typename T> __host__ __device__ constexpr bool lanes_col_on(int W, const DModel<T> &m)
+{
+    return (W & kWCol) && (m.world.ncol > 0 || m.world.head_friction || m.world.bounded);
+}
 
 /* Slot i of a lane holds point k0 + i, or with two points a lane on an odd lane (sw) k0 + 1 − i:
  * then every lane of a bend pair finds its own point and the one its partner needs in the
@@ -458,6 +472,21 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
     T *rs = xv + 2 * SPW * row; /* the rest shape of the warp's strands */
     const bool need_rest = has(HB_F_MOTION) || has(HB_F_SHAPE);
     const int stages = (P + G - 1) / G; /* lanes that hold points */
+    const int jend = m.j1 < 0 ? (int)m.substeps : m.j1;
+    const bool wcol = lanes_col_on<T>(W, m);
+    /* §3.17 the launch's poses and back-transforms, staged once a block (lanes_col_reals) */
+    const T *cs = (const T *)hb_lanes_smem +
+                  (int64_t)wpb * (((W & kWHeld) ? lanes_held_reals<T, G>() : 0) + lanes_warp_reals<T, G, L>(P));
+    if constexpr ((W & kWCol) != 0) {
+        if (wcol) {
+            T *st = (T *)cs;
+            const int np = (jend - m.j0) * m.world.ncol * HB_COL_POSE, nb = (jend - m.j0) * HB_COL_BACK;
+            const T *gp = m.pose + (int64_t)m.j0 * m.world.ncol * HB_COL_POSE, *gb = m.back + HB_COL_BACK * m.j0;
+            for (int e = (int)threadIdx.x; e < np; e += (int)blockDim.x) st[e] = gp[e];
+            for (int e = (int)threadIdx.x; e < nb; e += (int)blockDim.x) st[np + e] = gb[e];
+        }
+        __syncthreads(); /* before any warp's strand loop, whose trip count differs between warps */
+    }
 
     /* the loop bound is the same for every lane of a warp: whole warps take each group of strands */
     for (int64_t s0 = SPW * ((int64_t)blockIdx.x * wpb + w); s0 < N; s0 += SPW * (int64_t)gridDim.x * wpb) {
@@ -541,10 +570,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
             Q[i] = X[i];
         }
 
-        const int jend = m.j1 < 0 ? (int)m.substeps : m.j1;
         const bool wgrid = (W & (kWGather | kWHeld)) && m.world.grid && (m.world.grid_friction || m.world.grid_volume);
         const bool held = (W & kWHeld) && wgrid && m.world.grid_rebuild == HB_GRID_HELD;
-        const bool wcol = (W & kWCol) && (m.world.ncol > 0 || m.world.head_friction || m.world.bounded);
         if constexpr ((W & kWHeld) != 0) { /* §3.16 `held`: each point's sample, taken by k_grid_hold */
             if (held && live) {
                 const int64_t st = m.perm ? m.perm[s0 + seg] : s0 + seg;
@@ -561,8 +588,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
             const T *qg = !has(HB_F_MOTION)                                    ? nullptr
                           : (m.world.grid_rebuild == HB_GRID_SUBSTEP && j > 0) ? qtab + 9 * (j - 1)
                                                                                : m.qs;
-            const T *pose = wcol ? m.pose + (int64_t)j * (m.world.ncol > 0 ? m.world.ncol : 1) * HB_COL_POSE : nullptr;
-            const T *back = wcol ? m.back + HB_COL_BACK * j : nullptr;
+            const T *pose = cs + (j - m.j0) * m.world.ncol * HB_COL_POSE;
+            const T *back = cs + (jend - m.j0) * m.world.ncol * HB_COL_POSE + (j - m.j0) * HB_COL_BACK;
             /* 1. the root on the head, then p0 = x0 */
             if (l == 0) {
                 if (has(HB_F_MOTION)) {
@@ -831,8 +858,14 @@ cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, b
     for (int wk : {kWHeld, kWCol, kWAll}) { /* a world's run launches one of its three kernels */
         const LanesPick<T> k = lanes_pick<T>(features, solver, P, seg, world ? wk : 0);
         if (!k.fn) return cudaErrorInvalidValue;
-        const cudaError_t e = cudaFuncSetAttribute(k.fn, cudaFuncAttributeMaxDynamicSharedMemorySize,
-                                                   (int)((size_t)(block / 32) * (size_t)k.warp_reals * sizeof(T)));
+        int bytes = (int)((size_t)(block / 32) * (size_t)k.warp_reals * sizeof(T)), dev = 0;
+        cudaError_t e = cudaSuccess;
+        if (world && (wk & kWCol)) { /* with the staged colliders: up to the device's limit (launch_frame_lanes) */
+            if ((e = cudaGetDevice(&dev)) != cudaSuccess) return e;
+            if ((e = cudaDeviceGetAttribute(&bytes, cudaDevAttrMaxSharedMemoryPerBlockOptin, dev)) != cudaSuccess)
+                return e;
+        }
+        e = cudaFuncSetAttribute(k.fn, cudaFuncAttributeMaxDynamicSharedMemorySize, bytes);
         if (e != cudaSuccess || !world) return e;
     }
     return cudaSuccess;
@@ -842,14 +875,47 @@ template <typename T>
 cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                                const T *bend_rest, int64_t N, int block, cudaStream_t stream)
 {
-    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, world_kind(m));
+    const int wk = world_kind(m);
+    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, wk);
     if (!k.fn) return cudaErrorInvalidValue;
-    const int64_t per_block = (int64_t)(block / 32) * (32 / k.lanes);
+    /* §3.17 the staged colliders take at most kColStageBytes a block, within the device's limit:
+     * fewer substeps a launch (x and v carry all state between launches), and only where one
+     * substep does not fit beside the warps' areas, fewer warps a block (the same results) */
+    const bool col = lanes_col_on<T>(wk, m);
+    const int j1 = m.j1 < 0 ? (int)m.substeps : m.j1;
+    const size_t per = sizeof(T) * (size_t)lanes_col_reals(m.world.ncol, 1);
+    int b = block, chunk = j1 - m.j0;
+    if (col) {
+        int dev = 0, optin = 0;
+        cudaError_t e = cudaGetDevice(&dev);
+        if (e == cudaSuccess) e = cudaDeviceGetAttribute(&optin, cudaDevAttrMaxSharedMemoryPerBlockOptin, dev);
+        if (e != cudaSuccess) return e;
+        for (;;) {
+            const size_t used = (size_t)(b / 32) * (size_t)k.warp_reals * sizeof(T);
+            const size_t room = used < (size_t)optin ? (size_t)optin - used : 0;
+            const size_t budget = room < (size_t)kColStageBytes ? room : (size_t)kColStageBytes;
+            if (budget >= per) {
+                chunk = (int)(budget / per);
+                break;
+            }
+            if (b < 64) return cudaErrorInvalidConfiguration;
+            b = (b / 64) * 32; /* half the warps */
+        }
+    }
+    const int64_t per_block = (int64_t)(b / 32) * (32 / k.lanes);
     const int64_t g = (N + per_block - 1) / per_block;
     const int grid = (int)(g < 1 ? 1 : g > 2147483647 ? 2147483647 : g);
-    k.fn<<<grid, block, (size_t)(block / 32) * (size_t)k.warp_reals * sizeof(T), stream>>>(m, q, phase, x, v, rest,
-                                                                                           bend_rest, N);
-    return cudaGetLastError();
+    const size_t smem = (size_t)(b / 32) * (size_t)k.warp_reals * sizeof(T);
+    DModel<T> mc = m;
+    do { /* one launch at least, as before */
+        mc.j1 = chunk < j1 - mc.j0 ? mc.j0 + chunk : j1;
+        const size_t cb = col ? (size_t)lanes_col_reals(m.world.ncol, mc.j1 - mc.j0) * sizeof(T) : 0;
+        k.fn<<<grid, b, smem + cb, stream>>>(mc, q, phase, x, v, rest, bend_rest, N);
+        const cudaError_t e = cudaGetLastError();
+        if (e != cudaSuccess) return e;
+        mc.j0 = mc.j1;
+    } while (mc.j0 < j1);
+    return cudaSuccess;
 }
 
 #define HB_LANES_INSTANTIATE(T)                                                                                        \
