@@ -130,15 +130,12 @@ __device__ __forceinline__ T start_depth_free(const Wd &w, int i, int kind, bool
     return pose[12] - phi;
 }
 
-/* Collider i of the world w on p (hb_collide_one); x: p at the start of the substep. */
+/* Collider i of the world w on p (hb_collide_one) inside its bounding sphere (the caller tests
+ * it: lanes.cu col_in_bound); x: p at the start of the substep. */
 template <typename T, class Wd>
 __device__ __forceinline__ void collide_one_free(const Wd &w, int i, const T *pose, const T *back, T (&p)[3],
                                                  const T *x)
 {
-    {
-        const T bx = p[0] - pose[16], by = p[1] - pose[17], bz = p[2] - pose[18];
-        if (!((bx * bx + by * by) + bz * bz < pose[19])) return;
-    }
     const int kind = w.col_kind[i], frame = w.col_frame[i];
     const bool turn = frame == HB_FRAME_HEAD && w.motion, sway = frame == HB_FRAME_BODY && w.sway;
     const bool ball = kind == HB_COL_SPHERE || kind == HB_COL_CAPSULE;

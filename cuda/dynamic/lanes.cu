@@ -296,29 +296,65 @@ __device__ __forceinline__ void apply_held(const DModel<T> &m, int k, const T *h
     }
 }
 
-/* §3.6 step 7 and §3.7 with the colliders of §3.17: the head sphere (with its friction or a
- * bounded depenetration), then each collider with its friction; x: p's start of the substep. */
-template <typename T, class Feat>
-__device__ __forceinline__ void collide_world(const DModel<T> &m, Feat has, const T *pose, const T *back, V3<T> &p,
-                                              const V3<T> &x)
+/* §3.17 hb_collide_one's first test, the same operations: outside its bounding sphere a collider
+ * leaves p as it is. */
+template <typename T> __device__ __forceinline__ bool col_in_bound(const T *pose, const V3<T> &p)
+{
+    const T bx = p.x - pose[16], by = p.y - pose[17], bz = p.z - pose[18];
+    return (bx * bx + by * by) + bz * bz < pose[19];
+}
+
+/* §3.6 step 7 and §3.7 with the colliders of §3.17 on a lane's NP points p (on: those that
+ * collide; x: their positions at the substep's start): on each, the head sphere (with its friction
+ * or a bounded depenetration), then each collider with its friction. The points are independent,
+ * so taking them collider by collider keeps each point's order. A point outside a collider's bound
+ * skips it (hb_collide_one would return p as it is: the strict build keeps the CPU's bits), and
+ * the lanes of `mask`, which call this together, skip it together when none of theirs is inside. */
+template <int NP, typename T, class Feat>
+__device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, const T *pose, const T *back, V3<T> *p,
+                                               const V3<T> *x, const bool *on, unsigned mask)
 {
     const World<T> &w = m.world;
-    T pp[3] = {p.x, p.y, p.z};
-    const T xx[3] = {x.x, x.y, x.z};
-    if (has(HB_F_COLLIDE)) {
+#pragma unroll
+    for (int s = 0; s < NP; s++) {
+        if (!on[s] || !has(HB_F_COLLIDE)) continue;
         if (w.head_friction || w.bounded) {
+            T pp[3] = {p[s].x, p[s].y, p[s].z};
+            const T xx[3] = {x[s].x, x[s].y, x[s].z};
             if constexpr (kFreeCollide) collide_head_free(w, m.collide_r, back, pp, xx);
             else collide_head(w, m.collide_r, back, pp, xx);
+            p[s] = V3<T>{pp[0], pp[1], pp[2]};
         } else {
-            collide(m, p);
-            pp[0] = p.x, pp[1] = p.y, pp[2] = p.z;
+            collide(m, p[s]);
         }
     }
     for (int i = 0; i < w.ncol; i++) {
-        if constexpr (kFreeCollide) collide_one_free(w, i, pose + i * HB_COL_POSE, back, pp, xx);
-        else collide_one(w, i, pose + i * HB_COL_POSE, back, pp, xx);
+        const T *pi = pose + i * HB_COL_POSE;
+        bool in[NP], any = false;
+#pragma unroll
+        for (int s = 0; s < NP; s++) {
+            in[s] = on[s] && col_in_bound(pi, p[s]);
+            any = any || in[s];
+        }
+        if (!__any_sync(mask, any)) continue;
+#pragma unroll
+        for (int s = 0; s < NP; s++) {
+            if (!in[s]) continue;
+            T pp[3] = {p[s].x, p[s].y, p[s].z};
+            const T xx[3] = {x[s].x, x[s].y, x[s].z};
+            if constexpr (kFreeCollide) collide_one_free(w, i, pi, back, pp, xx);
+            else collide_one(w, i, pi, back, pp, xx);
+            p[s] = V3<T>{pp[0], pp[1], pp[2]};
+        }
     }
-    p = V3<T>{pp[0], pp[1], pp[2]};
+}
+
+/* the lanes l = 0 of a warp's strands (L lanes a strand) */
+template <int L> __device__ __forceinline__ constexpr unsigned first_lanes()
+{
+    unsigned r = 0;
+    for (int s = 0; s < 32 / L; s++) r |= 1u << (s * L);
+    return r;
 }
 
 /* The free builds' follow-the-leader target of p: ell from a along a→p (straight down when p is on a). */
@@ -334,11 +370,12 @@ template <typename T> __device__ __forceinline__ V3<T> follow_target(T ell, cons
 }
 
 /* §3.7 one follow-the-leader step of p after its corrected predecessor a, ell its segment's
- * rest length; d: the correction; wc: the colliders of §3.17 (pose, back, x) instead of the head sphere. */
+ * rest length; d: the correction; wc: the colliders of §3.17 (pose, back, x; mask: the lanes that
+ * take this step together) instead of the head sphere. */
 template <typename T, class Feat>
 __device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, const V3<T> &a, V3<T> &p, V3<T> &d,
                                            bool wc = false, const T *pose = nullptr, const T *back = nullptr,
-                                           const V3<T> *x = nullptr)
+                                           const V3<T> *x = nullptr, unsigned mask = kAll)
 {
     if (wc) {
         if constexpr (kFree) {
@@ -348,7 +385,8 @@ __device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, 
         } else {
             follow(a.x, a.y, a.z, p.x, p.y, p.z, ell, false, m.collide_r, d.x, d.y, d.z);
         }
-        collide_world(m, has, pose, back, p, *x);
+        const bool on = true;
+        collide_points<1>(m, has, pose, back, &p, x, &on, mask);
         return;
     }
     if constexpr (kFree) {
@@ -718,11 +756,11 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                         bend(1);
                     }
                     if (has(HB_F_SHAPE)) shapes();
-                    if ((W & kWCol) && wcol) {
+                    if ((W & kWCol) && wcol) { /* every lane of the warp */
+                        bool on[G];
 #pragma unroll
-                        for (int i = 0; i < G; i++)
-                            if (point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P)
-                                collide_world(m, has, pose, back, Q[i], X[i]);
+                        for (int i = 0; i < G; i++) on[i] = point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P;
+                        collide_points<G>(m, has, pose, back, Q, X, on, kAll);
                     } else if (has(HB_F_COLLIDE)) {
 #pragma unroll
                         for (int i = 0; i < G; i++)
@@ -739,6 +777,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                 }
                 /* §3.7 follow the leader, k ascending: lane st takes its points after lane st − 1 */
                 for (int st = 0; st < stages; st++) {
+                    const unsigned smask = first_lanes<L>() << st; /* the lanes l = st */
                     const V3<T> a = up<L>(Q[G - 1]);
                     if (l == st) {
 #pragma unroll
@@ -746,7 +785,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                             const int k = k0 + i;
                             if (k >= 1 && k < P)
                                 follow_one(m, has, ell(i), i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i],
-                                           (W & kWCol) && wcol, pose, back, &X[i]);
+                                           (W & kWCol) && wcol, pose, back, &X[i], smask);
                         }
                     }
                 }
