@@ -98,7 +98,7 @@ HOSTCHECK_BINS := $(BUILD)/hostcheck/paper_hostcheck_reference $(BUILD)/hostchec
                   $(BUILD)/hostcheck/dyn_hostcheck $(BUILD)/hostcheck/post_hostcheck $(BUILD)/hostcheck/lod_hostcheck \
                   $(BUILD)/hostcheck/draw_hostcheck
 
-.PHONY: all cpu planted cuda hostcheck test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu fuzz lint lint-py lint-c fmt docs
+.PHONY: all cpu planted cuda hostcheck test bench report report-dynamic help clean setup check-python check-hdf5 sanitize sanitize-gpu sanitize-gpu-world fuzz lint lint-py lint-c fmt docs
 
 # The Python that runs the tests and the harness: harness/setup.sh picks it (PYTHON when it has
 # the packages, else ./.venv) after installing what is missing, and writes its path here.
@@ -121,6 +121,7 @@ help:
 	@echo "make sanitize build the C reference with ASan+UBSan and run the CPU tests under it"
 	@echo "make fuzz     libFuzzer over the HAIR groom reader under ASan+UBSan for FUZZ_SECONDS (default 30) from tests/fuzz/corpus/"
 	@echo "make sanitize-gpu  compute-sanitizer memcheck + racecheck over every CUDA variant (GPU node)"
+	@echo "make sanitize-gpu-world  the same over the grid and the colliders alone (part of sanitize-gpu)"
 	@echo "make lint     ruff check, ruff format --check, mypy (lint-py) and clang-format --dry-run (lint-c)"
 	@echo "make fmt      ruff format the Python and clang-format -i the C and CUDA sources"
 	@echo "make docs     remake docs/harness.md's command and module reference (python3 -m harness docs)"
@@ -338,7 +339,13 @@ SAN_RUN := --strands 1000 --points 16 --hair-length 10 --repeat 2 --end-to-end -
 SAN_SIM := --strands 300 --points 45 --hair-length 10 --stages init,simulate --frames 3 --velocities all --repeat 2 \
   --substeps 2 --iterations 2 --bend-compliance 1e-6 --shape-compliance 1e-5 --wind-speed 300 --drag 2 \
   --gust-amplitude 0.5 --head-motion nod --quiet
-sanitize-gpu: cuda
+# the world (docs/model.md §3.16, §3.17: lanes alone runs it): the grid at each rebuild and the default
+# body with friction and bounded depenetration, both solvers and precisions; 40 substeps make a frame
+# take several launches where the staged colliders do not fit one (docs/cuda.md)
+SAN_WORLD := --strands 300 --points 32 --stages init,simulate --frames 2 --velocities all --variant lanes \
+  --wind-speed 150 --gust-amplitude 0.5 --head-motion nod --quiet
+SAN_BODY := --colliders configs/bodies/default.colliders --friction 0.3,0.2 --depenetration-speed 200
+sanitize-gpu: cuda sanitize-gpu-world
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
 	@set -e; for v in $$($(PYTHON) -c "from harness.core import variants; print(*variants.names('cuda'))"); do for p in fp32 fp64; do \
 	  echo "memcheck $$v $$p"; \
@@ -362,6 +369,22 @@ sanitize-gpu: cuda
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --points $$np --variant $$v --frames 1; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_SIM) --points $$np --variant $$v --frames 1 --solver ftl; \
 	done; rm -f $(BUILD)/san-*.h5; echo "compute-sanitizer: memcheck and racecheck found no errors in any variant"
+
+sanitize-gpu-world: cuda
+	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
+	@set -e; for p in fp32 fp64; do for s in xpbd ftl; do for w in "--grid 16 --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild held" \
+	  "--grid 16 --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild substep" "$(SAN_BODY)" "$(SAN_BODY) --grid 16 --grid-friction 0.05"; do \
+	  echo "memcheck world $$p $$s $$w"; \
+	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $$w \
+	    --precision $$p --solver $$s --substeps 4 --output $(BUILD)/san-world-$$p-$$s.h5 --force; \
+	  done; done; \
+	  echo "memcheck world $$p 40 substeps"; \
+	  compute-sanitizer --tool memcheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) --precision $$p \
+	    --substeps 40 --frames 1 --output $(BUILD)/san-world-$$p-40.h5 --force; \
+	  echo "racecheck world $$p"; \
+	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) --grid 16 \
+	    --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild held --precision $$p --substeps 40 --frames 1; \
+	done; rm -f $(BUILD)/san-world-*.h5; echo "compute-sanitizer: memcheck and racecheck found no errors in the world's kernels"
 
 # ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----
 PY_SRC     := harness tests
