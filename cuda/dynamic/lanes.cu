@@ -304,6 +304,31 @@ template <typename T> __device__ __forceinline__ bool col_in_bound(const T *pose
     return (bx * bx + by * by) + bz * bz < pose[19];
 }
 
+/* The free builds' collider i of kind K on a lane's NP points p (collide_points): each point the
+ * collider may move (may_touch_free: the exact test for a sphere, capsule or plane, the bounding
+ * sphere for a mesh), skipped by the lanes of `mask` together where none of theirs may. */
+template <int K, int NP, typename T>
+__device__ __forceinline__ void collide_kind(const World<T> &w, int i, bool turn, bool sway, const T *pi, const T *back,
+                                             V3<T> *p, const V3<T> *x, const bool *on, unsigned mask)
+{
+    bool in[NP], any = false;
+#pragma unroll
+    for (int s = 0; s < NP; s++) {
+        const T ps[3] = {p[s].x, p[s].y, p[s].z};
+        in[s] = on[s] && may_touch_free<K>(pi, ps);
+        any = any || in[s];
+    }
+    if (!__any_sync(mask, any)) return;
+#pragma unroll
+    for (int s = 0; s < NP; s++) {
+        if (!in[s]) continue;
+        T pp[3] = {p[s].x, p[s].y, p[s].z};
+        const T xx[3] = {x[s].x, x[s].y, x[s].z};
+        collide_one_free<K>(w, i, turn, sway, pi, back, pp, xx);
+        p[s] = V3<T>{pp[0], pp[1], pp[2]};
+    }
+}
+
 /* §3.6 step 7 and §3.7 with the colliders of §3.17 on a lane's NP points p (on: those that
  * collide; x: their positions at the substep's start): on each, the head sphere (with its friction
  * or a bounded depenetration), then each collider with its friction. The points are independent,
@@ -330,6 +355,16 @@ __device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, con
     }
     for (int i = 0; i < w.ncol; i++) {
         const T *pi = pose + i * HB_COL_POSE;
+        if constexpr (kFreeCollide) { /* the kind's own code, chosen by the warp as one */
+            const bool turn = (m.col_turn >> i) & 1u, sway = (m.col_sway >> i) & 1u;
+            switch (col_kind_of(m, i)) {
+            case HB_COL_SPHERE: collide_kind<HB_COL_SPHERE, NP>(w, i, turn, sway, pi, back, p, x, on, mask); break;
+            case HB_COL_CAPSULE: collide_kind<HB_COL_CAPSULE, NP>(w, i, turn, sway, pi, back, p, x, on, mask); break;
+            case HB_COL_PLANE: collide_kind<HB_COL_PLANE, NP>(w, i, turn, sway, pi, back, p, x, on, mask); break;
+            default: collide_kind<HB_COL_MESH, NP>(w, i, turn, sway, pi, back, p, x, on, mask); break;
+            }
+            continue;
+        }
         bool in[NP], any = false;
 #pragma unroll
         for (int s = 0; s < NP; s++) {
@@ -342,8 +377,7 @@ __device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, con
             if (!in[s]) continue;
             T pp[3] = {p[s].x, p[s].y, p[s].z};
             const T xx[3] = {x[s].x, x[s].y, x[s].z};
-            if constexpr (kFreeCollide) collide_one_free(w, i, pi, back, pp, xx);
-            else collide_one(w, i, pi, back, pp, xx);
+            collide_one(w, i, pi, back, pp, xx);
             p[s] = V3<T>{pp[0], pp[1], pp[2]};
         }
     }
