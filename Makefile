@@ -127,6 +127,7 @@ help:
 	@echo "make docs     remake docs/harness.md's command and module reference (python3 -m harness docs)"
 	@echo "make setup    install what is missing (apt as root/sudo, pip into the project environment .venv); nothing when all is there"
 	@echo "make hostcheck  build the CUDA port's host checks (cuda/hostcheck/, run by tests/native)"
+	@echo "make build/sdf-sampling  issue #43's SDF benchmark: plain loads against a 3-D texture (part of make cuda; docs/cuda.md)"
 	@echo "make planted  build/planted/: the C reference with each planted defect (python -m harness judge)"
 	@echo "make clean    remove build/"
 
@@ -190,7 +191,7 @@ $(BUILD)/planted/hairsim-cpu-plant%: $(BUILD)/planted/obj%/dynamics_f32.o \
 	$(CC) -fopenmp $(BUILD)/planted/obj$*/*.o $(filter-out $(BUILD)/planted/%,$^) -o $@ $(HDF5_LIBS) -lm
 
 ifeq ($(HAVE_NVCC),yes)
-cuda: $(CUDA_BINS)
+cuda: $(CUDA_BINS) $(BUILD)/sdf-sampling
 # One object per source and math mode, so that make -j compiles them side by side; the two
 # sources that hold the dynamic model's kernel tables once per precision (-DHB_DYN_REAL), which
 # halves the longest compile. Only backend_cuda.cu takes the build's flags string.
@@ -249,6 +250,11 @@ $(BUILD)/hostcheck/lod_hostcheck: cuda/hostcheck/lod_hostcheck.cu cuda/hostcheck
 $(BUILD)/hostcheck/draw_hostcheck: cuda/hostcheck/draw_hostcheck.cu cuda/draw/view.cuh cuda/draw/egl_gl.cuh
 	@mkdir -p $(@D)
 	$(HOSTCHECK_NVCC) -O1 $< -o $@ -ldl -lm
+# Issue #43's SDF sampling benchmark (tools/sdf_sampling.cu, docs/cuda.md): the reference builds
+# the mesh's field; plain loads against a 3-D texture on the device. The normal build's flags.
+SDF_TOOL_OBJ := $(HOSTCHECK_WORLD_OBJ) $(OBJ)/dynamic/dynamics_host.o $(OBJ)/runtime/params.o
+$(BUILD)/sdf-sampling: tools/sdf_sampling.cu $(C_HEADERS) $(SDF_TOOL_OBJ) $(REV_STAMP)
+	$(NVCC) $(NVCC_BASE) -DHB_GIT_REV='"$(GIT_REV)"' -DHB_FLAGS='"$(NVCC) $(NVCC_BASE)"' $< $(SDF_TOOL_OBJ) -o $@ -lm
 else
 hostcheck:
 	@echo "error: nvcc not found: the host checks (cuda/hostcheck/) need it"; exit 1
@@ -388,7 +394,7 @@ sanitize-gpu-world: cuda
 
 # ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----
 PY_SRC     := harness tests
-C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*/*.c c_ref/*/*.h cuda/*.cu cuda/*.cuh cuda/*/*.cu cuda/*/*.cuh tests/cpu/c/*.c tests/fuzz/*.c)
+C_FMT_SRC  := $(wildcard c_ref/*.c c_ref/*/*.c c_ref/*/*.h cuda/*.cu cuda/*.cuh cuda/*/*.cu cuda/*/*.cuh tools/*.cu tests/cpu/c/*.c tests/fuzz/*.c)
 CLANG_FORMAT ?= clang-format
 
 lint: lint-py lint-c
