@@ -132,21 +132,28 @@ __device__ __forceinline__ T start_depth_free(const Wd &w, int i, bool turn, boo
 }
 
 /* Whether p can be moved by collider i of kind K (pose): inside a sphere, capsule or plane, or
- * inside a mesh's bounding sphere. Outside, hb_collide_one leaves p as it is. */
-template <int K, typename T> __device__ __forceinline__ bool may_touch_free(const T *pose, const T *p)
+ * inside a mesh's bounding sphere. Outside, hb_collide_one leaves p as it is, and `clear` is a
+ * lower bound of p's distance from what the test takes (the surface, or a mesh's bounding
+ * sphere), less a margin for rounding (2⁻¹² of the distance and of 1 + |p|₁); inside, 0. */
+template <int K, typename T> __device__ __forceinline__ bool may_touch_free(const T *pose, const T *p, T &clear)
 {
-    if constexpr (K == HB_COL_SPHERE || K == HB_COL_CAPSULE) {
-        T c[3];
-        if constexpr (K == HB_COL_SPHERE) c[0] = pose[0], c[1] = pose[1], c[2] = pose[2];
-        else capsule_centre_free(pose, p, c);
-        const T r = K == HB_COL_SPHERE ? pose[3] : pose[6];
-        const T e0 = p[0] - c[0], e1 = p[1] - c[1], e2 = p[2] - c[2];
-        return (e0 * e0 + e1 * e1) + e2 * e2 < r * r;
-    } else if constexpr (K == HB_COL_PLANE) {
-        return ((p[0] - pose[0]) * pose[3] + (p[1] - pose[1]) * pose[4]) + (p[2] - pose[2]) * pose[5] < pose[6];
+    constexpr T rel = (T)(1.0 / 4096.0);
+    const T scale = (T)1 + (fabs(p[0]) + fabs(p[1])) + fabs(p[2]);
+    if constexpr (K == HB_COL_PLANE) {
+        const T rho = ((p[0] - pose[0]) * pose[3] + (p[1] - pose[1]) * pose[4]) + (p[2] - pose[2]) * pose[5];
+        clear = (T)0; /* a plane's drift is not bounded here: never skipped (lanes.cu skin_drift) */
+        return rho < pose[6];
     } else {
-        const T bx = p[0] - pose[16], by = p[1] - pose[17], bz = p[2] - pose[18];
-        return (bx * bx + by * by) + bz * bz < pose[19];
+        T c[3], r2;
+        if constexpr (K == HB_COL_SPHERE) c[0] = pose[0], c[1] = pose[1], c[2] = pose[2], r2 = pose[3] * pose[3];
+        else if constexpr (K == HB_COL_CAPSULE) capsule_centre_free(pose, p, c), r2 = pose[6] * pose[6];
+        else c[0] = pose[16], c[1] = pose[17], c[2] = pose[18], r2 = pose[19];
+        const T e0 = p[0] - c[0], e1 = p[1] - c[1], e2 = p[2] - c[2];
+        const T q = (e0 * e0 + e1 * e1) + e2 * e2;
+        const bool in = q < r2;
+        const T dist = q * rsq(q) - r2 * rsq(r2); /* q > r2 > 0 where it is used */
+        clear = in ? (T)0 : dist * ((T)1 - rel) - rel * scale;
+        return in;
     }
 }
 
