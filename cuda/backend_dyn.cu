@@ -424,13 +424,6 @@ template <typename T> static int dyn_world_load(cuda_impl *c, const void *rest, 
     if ((rc = dev_copy(&d->d_world, &w, sizeof w, c, "the world", err, errlen))) return rc;
     m.has_world = 1;
     m.world = w;
-    for (int i = 0; i < nc; i++) {
-        const uint64_t kind = (uint64_t)hw->kind[i] & 3u, bit = 1ull << i;
-        if (i < 32) m.col_kind_lo |= kind << (2 * i);
-        else m.col_kind_hi |= kind << (2 * (i - 32));
-        if (hw->frame[i] == HB_FRAME_HEAD && w.motion) m.col_turn |= bit;
-        if (hw->frame[i] == HB_FRAME_BODY && w.sway) m.col_sway |= bit;
-    }
     m.pose = (const T *)d->f_pose;
     m.back = (const T *)d->f_back;
     m.qs = (const T *)d->f_qs;

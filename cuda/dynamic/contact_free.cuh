@@ -110,63 +110,38 @@ __device__ __forceinline__ bool sdf_value_free(const T *sdf, int64_t n64, const 
     return true;
 }
 
-/* The depth at t + h of the carried start y in collider i of kind K (hb_start_depth). */
-template <int K, typename T, class Wd>
-__device__ __forceinline__ T start_depth_free(const Wd &w, int i, bool turn, bool sway, const T *pose, const T (&y)[3])
+/* The depth at t + h of the carried start y in collider i (hb_start_depth). */
+template <typename T, class Wd>
+__device__ __forceinline__ T start_depth_free(const Wd &w, int i, int kind, bool turn, bool sway, const T *pose,
+                                              const T (&y)[3])
 {
     T n[3], rinv;
-    if constexpr (K == HB_COL_SPHERE) {
-        return sphere_depth_free(y, pose, pose[3], (const T *)nullptr, n, rinv);
-    } else if constexpr (K == HB_COL_CAPSULE) {
+    if (kind == HB_COL_SPHERE) return sphere_depth_free(y, pose, pose[3], (const T *)nullptr, n, rinv);
+    if (kind == HB_COL_CAPSULE) {
         T c[3];
         capsule_centre_free(pose, y, c);
         return sphere_depth_free(y, c, pose[6], pose + 7, n, rinv);
-    } else if constexpr (K == HB_COL_PLANE) {
+    }
+    if (kind == HB_COL_PLANE)
         return pose[6] - (((y[0] - pose[0]) * pose[3] + (y[1] - pose[1]) * pose[4]) + (y[2] - pose[2]) * pose[5]);
-    } else {
-        T u[3], phi;
-        mesh_local_free(pose, turn, sway, y, u);
-        if (!sdf_value_free(w.sdf[i], w.sdf_n[i], w.sdf_geo + 4 * i, u, phi)) return (T)0;
-        return pose[12] - phi;
-    }
+    T u[3], phi;
+    mesh_local_free(pose, turn, sway, y, u);
+    if (!sdf_value_free(w.sdf[i], w.sdf_n[i], w.sdf_geo + 4 * i, u, phi)) return (T)0;
+    return pose[12] - phi;
 }
 
-/* Whether p can be moved by collider i of kind K (pose): inside a sphere, capsule or plane, or
- * inside a mesh's bounding sphere. Outside, hb_collide_one leaves p as it is, and `clear` is a
- * lower bound of p's distance from what the test takes (the surface, or a mesh's bounding
- * sphere), less a margin for rounding (2⁻¹² of the distance and of 1 + |p|₁); inside, 0. */
-template <int K, typename T> __device__ __forceinline__ bool may_touch_free(const T *pose, const T *p, T &clear)
+/* Collider i of the world w on p (hb_collide_one) inside its bounding sphere (the caller tests
+ * it: lanes.cu col_in_bound); x: p at the start of the substep. */
+template <typename T, class Wd>
+__device__ __forceinline__ void collide_one_free(const Wd &w, int i, const T *pose, const T *back, T (&p)[3],
+                                                 const T *x)
 {
-    constexpr T rel = (T)(1.0 / 4096.0);
-    const T scale = (T)1 + (fabs(p[0]) + fabs(p[1])) + fabs(p[2]);
-    if constexpr (K == HB_COL_PLANE) {
-        const T rho = ((p[0] - pose[0]) * pose[3] + (p[1] - pose[1]) * pose[4]) + (p[2] - pose[2]) * pose[5];
-        clear = (T)0; /* a plane's drift is not bounded here: never skipped (lanes.cu skin_drift) */
-        return rho < pose[6];
-    } else {
-        T c[3], r2;
-        if constexpr (K == HB_COL_SPHERE) c[0] = pose[0], c[1] = pose[1], c[2] = pose[2], r2 = pose[3] * pose[3];
-        else if constexpr (K == HB_COL_CAPSULE) capsule_centre_free(pose, p, c), r2 = pose[6] * pose[6];
-        else c[0] = pose[16], c[1] = pose[17], c[2] = pose[18], r2 = pose[19];
-        const T e0 = p[0] - c[0], e1 = p[1] - c[1], e2 = p[2] - c[2];
-        const T q = (e0 * e0 + e1 * e1) + e2 * e2;
-        const bool in = q < r2;
-        const T dist = q * rsq(q) - r2 * rsq(r2); /* q > r2 > 0 where it is used */
-        clear = in ? (T)0 : dist * ((T)1 - rel) - rel * scale;
-        return in;
-    }
-}
-
-/* Collider i, of kind K, of the world w on p (hb_collide_one) where may_touch_free<K> holds (the
- * caller tests it); turn, sway: its frame's motion; x: p at the start of the substep. */
-template <int K, typename T, class Wd>
-__device__ __forceinline__ void collide_one_free(const Wd &w, int i, bool turn, bool sway, const T *pose, const T *back,
-                                                 T (&p)[3], const T *x)
-{
-    constexpr bool ball = K == HB_COL_SPHERE || K == HB_COL_CAPSULE;
+    const int kind = w.col_kind[i], frame = w.col_frame[i];
+    const bool turn = frame == HB_FRAME_HEAD && w.motion, sway = frame == HB_FRAME_BODY && w.sway;
+    const bool ball = kind == HB_COL_SPHERE || kind == HB_COL_CAPSULE;
     T n[3], c[3], d, rinv = (T)0;
-    if constexpr (ball) {
-        if constexpr (K == HB_COL_SPHERE) {
+    if (ball) {
+        if (kind == HB_COL_SPHERE) {
             for (int k = 0; k < 3; k++) c[k] = pose[k];
             d = sphere_depth_free(p, c, pose[3], (const T *)nullptr, n, rinv);
         } else {
@@ -174,7 +149,7 @@ __device__ __forceinline__ void collide_one_free(const Wd &w, int i, bool turn, 
             d = sphere_depth_free(p, c, pose[6], pose + 7, n, rinv);
         }
         if (!(d > (T)0)) return;
-    } else if constexpr (K == HB_COL_PLANE) {
+    } else if (kind == HB_COL_PLANE) {
         const T rho = ((p[0] - pose[0]) * pose[3] + (p[1] - pose[1]) * pose[4]) + (p[2] - pose[2]) * pose[5];
         if (!(rho < pose[6])) return;
         d = pose[6] - rho;
@@ -193,13 +168,13 @@ __device__ __forceinline__ void collide_one_free(const Wd &w, int i, bool turn, 
     }
     T m = d;
     if (!w.bounded) { /* unbounded: onto the surface now (c and rinv die here) */
-        if constexpr (ball) sphere_move_free(p, c, K == HB_COL_SPHERE ? pose[3] : pose[6], n, rinv, m, true);
+        if (ball) sphere_move_free(p, c, kind == HB_COL_SPHERE ? pose[3] : pose[6], n, rinv, m, true);
         else
             for (int k = 0; k < 3; k++) p[k] = p[k] + m * n[k];
     } else {
         T y[3];
         carry_free(back, turn, sway, x, y);
-        m = bounded_move_free(d, start_depth_free<K>(w, i, turn, sway, pose, y), w.depen);
+        m = bounded_move_free(d, start_depth_free(w, i, kind, turn, sway, pose, y), w.depen);
         for (int k = 0; k < 3; k++) p[k] = p[k] + m * n[k];
     }
     const T mu_s = w.col_mu[2 * i];

@@ -304,42 +304,6 @@ template <typename T> __device__ __forceinline__ bool col_in_bound(const T *pose
     return (bx * bx + by * by) + bz * bz < pose[19];
 }
 
-/* The free builds' collider i of kind K on a lane's NP points p (collide_points): each point the
- * collider may move (may_touch_free: the exact test for a sphere, capsule or plane, the bounding
- * sphere for a mesh), skipped by the lanes of `mask` together where none of theirs may. */
-template <int K, int NP, typename T>
-__device__ __forceinline__ void collide_kind(const World<T> &w, int i, bool turn, bool sway, const T *pi, const T *back,
-                                             V3<T> *p, const V3<T> *x, const bool *on, unsigned mask,
-                                             T *clear = nullptr)
-{
-    bool in[NP], any = false;
-#pragma unroll
-    for (int s = 0; s < NP; s++) {
-        const T ps[3] = {p[s].x, p[s].y, p[s].z};
-        T c;
-        in[s] = on[s] && may_touch_free<K>(pi, ps, c);
-        if (clear) clear[s] = c < clear[s] ? c : clear[s];
-        any = any || in[s];
-    }
-    if (!__any_sync(mask, any)) return;
-#pragma unroll
-    for (int s = 0; s < NP; s++) {
-        if (!in[s]) continue;
-        T pp[3] = {p[s].x, p[s].y, p[s].z};
-        const T xx[3] = {x[s].x, x[s].y, x[s].z};
-        collide_one_free<K>(w, i, turn, sway, pi, back, pp, xx);
-        p[s] = V3<T>{pp[0], pp[1], pp[2]};
-    }
-}
-
-/* The free builds' skin of the colliders (docs/cuda.md): for each point slot s of a lane, the
- * place its colliders were last tested at (k = 0, 1, 2) and its clearance there plus the drift
- * before it (k = 3; negative: none), lane-major in the warp's area after its lane's offset */
-__host__ __device__ constexpr int skin_at(int s, int k)
-{
-    return (s * 4 + k) * 32;
-}
-
 /* §3.6 step 7 and §3.7 with the colliders of §3.17 on a lane's NP points p (on: those that
  * collide; x: their positions at the substep's start): on each, the head sphere (with its friction
  * or a bounded depenetration), then each collider with its friction. The points are independent,
@@ -348,8 +312,7 @@ __host__ __device__ constexpr int skin_at(int s, int k)
  * the lanes of `mask`, which call this together, skip it together when none of theirs is inside. */
 template <int NP, typename T, class Feat>
 __device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, const T *pose, const T *back, V3<T> *p,
-                                               const V3<T> *x, const bool *on, unsigned mask, T *sk = nullptr,
-                                               T drift = (T)0)
+                                               const V3<T> *x, const bool *on, unsigned mask)
 {
     const World<T> &w = m.world;
 #pragma unroll
@@ -365,41 +328,8 @@ __device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, con
             collide(m, p[s]);
         }
     }
-    /* the free builds' skin (sk: skin_at): a point that has moved less than its clearance, less
-     * the colliders' drift since it was taken, is outside every collider and skips them all */
-    bool act[NP];
-    T clear[NP];
-    if constexpr (kFreeCollide) {
-        bool any = false;
-#pragma unroll
-        for (int s = 0; s < NP; s++) {
-            act[s] = on[s];
-            clear[s] = (T)3.0e38;
-            if (sk && on[s]) {
-                const T lim = sk[skin_at(s, 3)] - drift;
-                const T d0 = p[s].x - sk[skin_at(s, 0)], d1 = p[s].y - sk[skin_at(s, 1)],
-                        d2 = p[s].z - sk[skin_at(s, 2)];
-                act[s] = !(lim > (T)0 && (d0 * d0 + d1 * d1) + d2 * d2 < lim * lim);
-            }
-            any = any || act[s];
-        }
-        if (sk && !__any_sync(mask, any)) return;
-    }
     for (int i = 0; i < w.ncol; i++) {
         const T *pi = pose + i * HB_COL_POSE;
-        if constexpr (kFreeCollide) { /* the kind's own code, chosen by the warp as one */
-            const bool turn = (m.col_turn >> i) & 1u, sway = (m.col_sway >> i) & 1u;
-            T *cl = sk ? clear : nullptr;
-            switch (col_kind_of(m, i)) {
-            case HB_COL_SPHERE: collide_kind<HB_COL_SPHERE, NP>(w, i, turn, sway, pi, back, p, x, act, mask, cl); break;
-            case HB_COL_CAPSULE:
-                collide_kind<HB_COL_CAPSULE, NP>(w, i, turn, sway, pi, back, p, x, act, mask, cl);
-                break;
-            case HB_COL_PLANE: collide_kind<HB_COL_PLANE, NP>(w, i, turn, sway, pi, back, p, x, act, mask, cl); break;
-            default: collide_kind<HB_COL_MESH, NP>(w, i, turn, sway, pi, back, p, x, act, mask, cl); break;
-            }
-            continue;
-        }
         bool in[NP], any = false;
 #pragma unroll
         for (int s = 0; s < NP; s++) {
@@ -412,18 +342,9 @@ __device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, con
             if (!in[s]) continue;
             T pp[3] = {p[s].x, p[s].y, p[s].z};
             const T xx[3] = {x[s].x, x[s].y, x[s].z};
-            collide_one(w, i, pi, back, pp, xx);
+            if constexpr (kFreeCollide) collide_one_free(w, i, pi, back, pp, xx);
+            else collide_one(w, i, pi, back, pp, xx);
             p[s] = V3<T>{pp[0], pp[1], pp[2]};
-        }
-    }
-    if constexpr (kFreeCollide) {
-        if (sk) { /* a point no collider may have moved keeps its place and clearance, else none */
-#pragma unroll
-            for (int s = 0; s < NP; s++) {
-                if (!act[s]) continue;
-                sk[skin_at(s, 0)] = p[s].x, sk[skin_at(s, 1)] = p[s].y, sk[skin_at(s, 2)] = p[s].z;
-                sk[skin_at(s, 3)] = clear[s] > (T)0 ? clear[s] + drift : (T)-1;
-            }
         }
     }
 }
@@ -518,22 +439,12 @@ template <typename T, int G> __host__ __device__ constexpr int64_t lanes_held_re
     return kHeldVectors * 4 * G * 32;
 }
 /* §3.17 a launch's colliders in shared memory after the warps' areas, staged once a block: the
- * poses of its nj substeps [nj][ncol][HB_COL_POSE], then their back-transforms [nj][HB_COL_BACK],
- * then the colliders' drift before each substep since the launch's first [nj] (the skin's);
+ * poses of its nj substeps [nj][ncol][HB_COL_POSE], then their back-transforms [nj][HB_COL_BACK];
  * at most kColStageBytes a block (more substeps run in several launches: launch_frame_lanes). */
 constexpr int64_t kColStageBytes = 16384;
 __host__ __device__ constexpr int64_t lanes_col_reals(int ncol, int nj)
 {
-    return (int64_t)nj * ((int64_t)ncol * HB_COL_POSE + HB_COL_BACK + 1);
-}
-/* whether a kernel keeps the colliders' skin (skin_at): the free builds' xpbd at two points a lane */
-template <int G, bool Ftl, int W> __host__ __device__ constexpr bool lanes_skin()
-{
-    return kFreeCollide && G == 2 && !Ftl && (W & kWCol) != 0;
-}
-template <typename T, int G, bool Ftl, int W> __host__ __device__ constexpr int64_t lanes_skin_reals()
-{
-    return lanes_skin<G, Ftl, W>() ? 4 * G * 32 : 0;
+    return (int64_t)nj * ((int64_t)ncol * HB_COL_POSE + HB_COL_BACK);
 }
 /* whether a kernel with the colliders' code (W) stages them: the run has colliders or the head
  * sphere's friction or bounded depenetration */
@@ -575,36 +486,6 @@ __device__ __forceinline__ void pack(T *s, int k0, bool sw, int P, bool live, co
     }
 }
 
-/* The skin's drift (skin_at) of a launch's nj substeps from its poses gp: drift[j], an upper
- * bound of how far any point of any collider has moved from substep 0 to j (a capsule's points
- * no farther than its ends, a mesh's bounding sphere with its centre), with a margin of 2⁻¹² of
- * each step; a plane makes it unbounded. One thread. */
-template <typename T> __device__ void skin_drift(const DModel<T> &m, const T *gp, int nj, T *drift)
-{
-    const int nc = m.world.ncol;
-    T acc = (T)0;
-    drift[0] = (T)0;
-    for (int j = 1; j < nj; j++) {
-        T dmax = (T)0;
-        for (int i = 0; i < nc; i++) {
-            const T *a = gp + ((int64_t)(j - 1) * nc + i) * HB_COL_POSE, *b = a + (int64_t)nc * HB_COL_POSE;
-            auto moved = [&](int o) {
-                const T d0 = b[o] - a[o], d1 = b[o + 1] - a[o + 1], d2 = b[o + 2] - a[o + 2];
-                return sqrt((d0 * d0 + d1 * d1) + d2 * d2);
-            };
-            const int kind = col_kind_of(m, i);
-            T d;
-            if (kind == HB_COL_PLANE) d = (T)3.0e38;
-            else if (kind == HB_COL_SPHERE) d = moved(0) + fabs(b[3] - a[3]);
-            else if (kind == HB_COL_CAPSULE) d = fmax(moved(0), moved(3)) + fabs(b[6] - a[6]);
-            else d = moved(16) + fabs(sqrt(b[19]) - sqrt(a[19]));
-            dmax = fmax(dmax, d);
-        }
-        acc = acc + dmax * (T)(1.0 + 1.0 / 4096.0);
-        drift[j] = acc < (T)3.0e38 ? acc : (T)3.0e38;
-    }
-}
-
 /* The frame of (32/L) strands a warp, L lanes a strand, G points a lane (G·L ≥ P); Ftl: the
  * solver of §3.7, else §3.6; Seg: a groom's per-segment rest lengths (§3.15, m.seg_rest); W: the
  * grid and colliders of §3.16–3.17 (m.world), with the strands taken in the order m.perm (slot
@@ -632,11 +513,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
     const int jend = m.j1 < 0 ? (int)m.substeps : m.j1;
     const bool wcol = lanes_col_on<T>(W, m);
     /* §3.17 the launch's poses and back-transforms, staged once a block (lanes_col_reals) */
-    T *const sk0 = (T *)hb_lanes_smem +
-                   (int64_t)wpb * (((W & kWHeld) ? lanes_held_reals<T, G>() : 0) + lanes_warp_reals<T, G, L>(P));
-    T *const sk = lanes_skin<G, Ftl, W>() ? sk0 + (int64_t)w * lanes_skin_reals<T, G, Ftl, W>() + lane : nullptr;
-    const T *cs = sk0 + (int64_t)wpb * lanes_skin_reals<T, G, Ftl, W>();
-    const T *drift = cs + (jend - m.j0) * (m.world.ncol * HB_COL_POSE + HB_COL_BACK);
+    const T *cs = (const T *)hb_lanes_smem +
+                  (int64_t)wpb * (((W & kWHeld) ? lanes_held_reals<T, G>() : 0) + lanes_warp_reals<T, G, L>(P));
     if constexpr ((W & kWCol) != 0) {
         if (wcol) {
             T *st = (T *)cs;
@@ -644,7 +522,6 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
             const T *gp = m.pose + (int64_t)m.j0 * m.world.ncol * HB_COL_POSE, *gb = m.back + HB_COL_BACK * m.j0;
             for (int e = (int)threadIdx.x; e < np; e += (int)blockDim.x) st[e] = gp[e];
             for (int e = (int)threadIdx.x; e < nb; e += (int)blockDim.x) st[np + e] = gb[e];
-            if (lanes_skin<G, Ftl, W>() && threadIdx.x == 0) skin_drift(m, gp, jend - m.j0, (T *)drift);
         }
         __syncthreads(); /* before any warp's strand loop, whose trip count differs between warps */
     }
@@ -672,10 +549,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         auto at = [&](int e) { return at_row(e, row); };
         auto bat = [&](int e) { return at_row(e, P - 2); }; /* the bend rest lengths, P − 2 a strand */
         V3<T> X[G], V[G], Q[G], D[G];
-        if (sk)
-#pragma unroll
-            for (int u = 0; u < G; u++) sk[skin_at(u, 3)] = (T)-1; /* no clearance yet */
-        T *bs = rs + SPW * row;                                    /* the bend rest lengths of the warp's strands */
+        T *bs = rs + SPW * row; /* the bend rest lengths of the warp's strands */
         const bool need_bend = has(HB_F_BEND) && P > 2;
         const int nb = ns * (P - 2);
         { /* x, v, the rest shape and the bend rest lengths: every load in flight at once */
@@ -886,7 +760,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                         bool on[G];
 #pragma unroll
                         for (int i = 0; i < G; i++) on[i] = point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P;
-                        collide_points<G>(m, has, pose, back, Q, X, on, kAll, sk, sk ? drift[j - m.j0] : (T)0);
+                        collide_points<G>(m, has, pose, back, Q, X, on, kAll);
                     } else if (has(HB_F_COLLIDE)) {
 #pragma unroll
                         for (int i = 0; i < G; i++)
@@ -988,10 +862,7 @@ template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int6
         if (f == kEvery && wk == kWHeld) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWHeld>;
         if (f == kEvery && wk == kWCol) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWCol>;
     }
-    int64_t skin = 0; /* the kernel with the colliders' code keeps their skin where lanes_skin says */
-    if (wk == kWAll) skin = lanes_skin_reals<T, G, Ftl, kWAll>();
-    else if (wk == kWCol) skin = lanes_skin_reals<T, G, Ftl, kWCol>();
-    return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P) + ((wk & kWHeld) ? lanes_held_reals<T, G>() : 0) + skin};
+    return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P) + ((wk & kWHeld) ? lanes_held_reals<T, G>() : 0)};
 }
 /* The world's code a run needs (docs/cuda.md "The hair–hair grid and the colliders"): none
  * without a world; the held grid alone (or a grid that applies nothing); the colliders alone;

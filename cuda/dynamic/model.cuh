@@ -76,17 +76,7 @@ template <typename T> struct DModel {
     const T *held = nullptr;
     /* the substeps a launch runs: j0 … j1 − 1 (j1 < 0: all of the frame's) */
     int j0 = 0, j1 = -1;
-    /* §3.17 each collider i's kind (two bits: colliders 0–31 in col_kind_lo, 32–63 in col_kind_hi)
-     * and whether its frame turns (the head's, with head motion) or sways (the body's): kernel
-     * parameters, so that a warp branches on them as one (col_kind_of) */
-    uint64_t col_kind_lo = 0, col_kind_hi = 0, col_turn = 0, col_sway = 0;
 };
-
-/* Collider i's kind from the model's bits (DModel::col_kind_lo) */
-template <typename T> __host__ __device__ __forceinline__ int col_kind_of(const DModel<T> &m, int i)
-{
-    return (int)(((i < 32 ? m.col_kind_lo : m.col_kind_hi) >> (2 * (i & 31))) & 3u);
-}
 
 template <typename T, typename M> inline DModel<T> dmodel_from(const M &m)
 {
