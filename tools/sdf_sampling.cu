@@ -39,8 +39,12 @@
 
 enum { EXIT_RUNTIME = 1, EXIT_USAGE = 2 }; /* a CUDA call or the JSON write failed; bad input */
 
+/* the JSON being written (PATH.partial), removed by fail so that no partial output is left */
+static std::string g_partial;
+
 __attribute__((format(printf, 2, 3))) [[noreturn]] static void fail(int code, const char *fmt, ...)
 {
+    if (!g_partial.empty()) remove(g_partial.c_str());
     va_list ap;
     va_start(ap, fmt);
     fputs("error: ", stderr);
@@ -400,8 +404,13 @@ int main(int argc, char **argv)
 {
     const Options o = parse_args(argc, argv);
     FILE *jf = nullptr;
-    if (!o.json.empty() && !(jf = fopen(o.json.c_str(), "w")))
-        fail(EXIT_USAGE, "--json %s: %s", o.json.c_str(), strerror(errno));
+    if (!o.json.empty()) { /* refused before any work: nothing the user has is overwritten */
+        FILE *old = fopen(o.json.c_str(), "r");
+        if (old) {
+            fclose(old);
+            fail(EXIT_USAGE, "--json %s: exists (remove it or name another)", o.json.c_str());
+        }
+    }
 
     /* the field: the reference's, in double, then rounded to fp32 */
     hb_colliders cols;
@@ -545,7 +554,13 @@ int main(int argc, char **argv)
     }
     for (int s = 0; s < SAMPLERS; s++) printf("  %-15s %s\n", kSamplers[s].name, kSamplers[s].what);
 
-    if (jf) {
+    if (!o.json.empty()) { /* written whole to PATH.partial, then renamed */
+        g_partial = o.json + ".partial";
+        if (!(jf = fopen(g_partial.c_str(), "w"))) {
+            const int e = errno;
+            g_partial.clear();
+            fail(EXIT_USAGE, "--json %s: %s", o.json.c_str(), strerror(e));
+        }
         fprintf(jf, "{\n  \"tool\": \"sdf-sampling\",\n  \"revision\": ");
         json_string(jf, HB_GIT_REV);
         fprintf(jf, ",\n  \"build\": ");
@@ -601,6 +616,9 @@ int main(int argc, char **argv)
         }
         fprintf(jf, "\n  ]\n}\n");
         if (fclose(jf) != 0) fail(EXIT_RUNTIME, "--json %s: %s", o.json.c_str(), strerror(errno));
+        if (rename(g_partial.c_str(), o.json.c_str()) != 0)
+            fail(EXIT_RUNTIME, "--json %s: %s", o.json.c_str(), strerror(errno));
+        g_partial.clear();
     }
 
     for (int s = 0; s < SAMPLERS; s++) {
