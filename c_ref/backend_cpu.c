@@ -498,7 +498,7 @@ static int dyn_frame_result(hb_stage_result *r, double t0, int failed, const cha
 
 /* Dynamic blocks over threads (static schedule: the bits do not depend on it); each
  * thread's block scratch (hb_simd_dyn_scratch_reals) is its own. */
-#define SIMD_DYN_FRAME(T, SFX, M)                                                                                      \
+#define SIMD_DYN_FRAME(T, SFX, M, W)                                                                                   \
     do {                                                                                                               \
         T *X = c->pm[0], *Y = c->pm[1], *Z = c->pm[2], *VX = c->pv[0], *VY = c->pv[1], *VZ = c->pv[2];                 \
         const T *RX = c->pr[0], *RY = c->pr[1], *RZ = c->pr[2], *BR = c->pb, *SR = c->ps;                              \
@@ -511,8 +511,8 @@ static int dyn_frame_result(hb_stage_result *r, double t0, int failed, const cha
                 _Pragma("omp for schedule(static)") for (int64_t b = 0; b < nb; b++)                                   \
                 {                                                                                                      \
                     const int64_t o = b * DB;                                                                          \
-                    c->sd->frame_##SFX(M, f, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, RY + o, RZ + o,      \
-                                       BR + o, SR ? SR + o : NULL, S, scratch);                                        \
+                    c->sd->frame_##SFX(M, f, W, j0, j1, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, RY + o,   \
+                                       RZ + o, BR + o, SR ? SR + o : NULL, S, scratch);                                \
                 }                                                                                                      \
                 free(scratch);                                                                                         \
             }                                                                                                          \
@@ -524,8 +524,21 @@ static int simd_dyn_frame(cpu_impl *c, const hb_dyn_frame *f, hb_stage_result *r
     const int64_t P = c->scene.points, DB = HB_SIMD_DYN_BLOCK, nb = c->stride / HB_SIMD_DYN_BLOCK, S = c->stride;
     int failed = 0;
     const double t0 = hb_now_ms();
-    if (c->scene.precision == HB_FP32) SIMD_DYN_FRAME(float, f32, &c->d32);
-    else SIMD_DYN_FRAME(double, f64, &c->d64);
+    const hb_host_world *hw = &c->world;
+    const int fp32 = c->scene.precision == HB_FP32, still = c->scene.dyn.motion == HB_MOTION_STILL;
+    /* §3.16 as cpu_dyn_frame: the grid built from the rows once a frame, or before every substep */
+    const int64_t FS = f->substeps, step = c->scene.dyn.grid && c->scene.dyn.grid_rebuild == HB_GRID_SUBSTEP ? 1 : FS;
+    for (int64_t j0 = 0, j1 = step; j0 < FS && !failed; j0 = j1, j1 += step) {
+        if (c->scene.dyn.grid) {
+            const void *qg =
+                still     ? NULL
+                : j0 == 0 ? (fp32 ? (const void *)f->qs32 : (const void *)f->qs64)
+                          : (fp32 ? (const void *)(f->q32 + 9 * (j0 - 1)) : (const void *)(f->q64 + 9 * (j0 - 1)));
+            if (hb_host_world_build_rows(&c->world, &c->scene, c->pm, c->pv, S, qg)) failed = 1;
+        }
+        if (fp32) SIMD_DYN_FRAME(float, f32, &c->d32, hw->on ? &hw->w32 : NULL);
+        else SIMD_DYN_FRAME(double, f64, &c->d64, hw->on ? &hw->w64 : NULL);
+    }
     return dyn_frame_result(r, t0, failed, "per-thread block scratch", P, err, errlen);
 }
 #undef SIMD_DYN_FRAME
@@ -701,7 +714,10 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
         snprintf(err, errlen, "out of host memory for the sag-free shape targets");
         return -1;
     }
-    if (c->simd) return 0;
+    if (c->simd) { /* §3.16 the grid (the variant's only world: --list-variants) */
+        hb_host_world_free(&c->world);
+        return hb_host_world_make(&c->world, &c->scene, rest, 1, err, errlen);
+    }
     const int64_t N = c->scene.n_strands, P = c->scene.points;
     const size_t stride = (size_t)P * 3u, bstride = (size_t)(P - 2 > 0 ? P - 2 : 0);
     if (velocity) memcpy(c->vel, velocity, c->bytes);
@@ -1020,7 +1036,7 @@ static const hb_variant cpu_variants[] = {
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks; built for x86-64-v3 and "
      "x86-64-v4, the CPU's widest runs (the record's flags say which)",
-     0, 0, 0, 1, HB_X_GUIDES | HB_X_GRID | HB_X_COLLIDERS | HB_X_FRICTION},
+     0, 0, 0, 1, HB_X_GUIDES | HB_X_COLLIDERS | HB_X_FRICTION},
     {NULL, 0, NULL, 0, 0, 0, 0, 0},
 };
 

@@ -14,11 +14,13 @@
 #include "dynamic/precision_end.h"
 
 /* One precision's build: the splat over strands (each thread into its own sums where they fit,
- * else atomically: integer sums, so the order changes nothing), then the node fields. */
+ * else atomically: integer sums, so the order changes nothing), then the node fields. FETCH(T,
+ * r, xr, vr): point r's position and velocity, from either layout. */
 #define BUILD(T, SFX, W)                                                                                               \
     do {                                                                                                               \
-        const T *xs = (const T *)x, *vs = (const T *)v, *q = (const T *)qg;                                            \
-        const int64_t n = hw->plan.n, nodes = hw->nodes, rows = s->n_strands * s->points;                              \
+        const T *q = (const T *)qg;                                                                                    \
+        const int64_t n = hw->plan.n, nodes = hw->nodes, rows = s->n_strands * s->points, P = s->points;               \
+        (void)P;                                                                                                       \
         memset(hw->mass, 0, (size_t)nodes * sizeof *hw->mass);                                                         \
         memset(hw->mom, 0, (size_t)nodes * 3 * sizeof *hw->mom);                                                       \
         const int nt = omp_get_max_threads();                                                                          \
@@ -29,7 +31,9 @@
             _Pragma("omp for schedule(static)") for (int64_t r = 0; r < rows; r++)                                     \
             {                                                                                                          \
                 int64_t base, m[8], p[24];                                                                             \
-                if (!hb_grid_splat_point_##SFX(q, (W).glo, (W).gsc, n, xs + 3 * r, vs + 3 * r, &base, m, p)) continue; \
+                T xr[3], vr[3];                                                                                        \
+                FETCH(T, r, xr, vr);                                                                                   \
+                if (!hb_grid_splat_point_##SFX(q, (W).glo, (W).gsc, n, xr, vr, &base, m, p)) continue;                 \
                 for (int k = 0; k < 8; k++) {                                                                          \
                     const int64_t j = hb_grid_corner_##SFX(base, n, k);                                                \
                     if (pm) {                                                                                          \
@@ -57,6 +61,12 @@
                                (W).gsc, q, (T *)hw->node_v, (T *)hw->node_a);                                          \
     } while (0)
 
+/* point r (strand r / P, point r % P) of the canonical layout [N·P][3] */
+#define FETCH(T, r, xr, vr)                                                                                            \
+    for (int c = 0; c < 3; c++) {                                                                                      \
+        xr[c] = ((const T *)x)[3 * (r) + c];                                                                           \
+        vr[c] = ((const T *)v)[3 * (r) + c];                                                                           \
+    }
 int hb_host_world_build(hb_host_world *hw, const hb_scene *s, const void *x, const void *v, const void *qg)
 {
     int failed = 0;
@@ -64,4 +74,25 @@ int hb_host_world_build(hb_host_world *hw, const hb_scene *s, const void *x, con
     else BUILD(double, f64, hw->w64);
     return failed ? -1 : 0;
 }
+#undef FETCH
+
+/* the point-major rows (simd), taken row by row (point k of strand i at k·stride + i, r = k·N + i:
+ * the sums are integers, so the order changes nothing) */
+#define FETCH(T, r, xr, vr)                                                                                            \
+    {                                                                                                                  \
+        const int64_t at = ((r) / s->n_strands) * stride + (r) % s->n_strands;                                         \
+        for (int c = 0; c < 3; c++) {                                                                                  \
+            xr[c] = ((const T *)xs[c])[at];                                                                            \
+            vr[c] = ((const T *)vs[c])[at];                                                                            \
+        }                                                                                                              \
+    }
+int hb_host_world_build_rows(hb_host_world *hw, const hb_scene *s, void *const xs[3], void *const vs[3], int64_t stride,
+                             const void *qg)
+{
+    int failed = 0;
+    if (s->precision == HB_FP32) BUILD(float, f32, hw->w32);
+    else BUILD(double, f64, hw->w64);
+    return failed ? -1 : 0;
+}
+#undef FETCH
 #undef BUILD

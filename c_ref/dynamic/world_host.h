@@ -41,6 +41,10 @@ void hb_host_world_free(hb_host_world *hw);
 /* §3.16 builds the grid from the state (x, v canonical) with the rotation qg (NULL: still), in
  * the working precision of hw, on every OpenMP thread (the C reference: world_build.c). */
 int hb_host_world_build(hb_host_world *hw, const hb_scene *s, const void *x, const void *v, const void *qg);
+/* The same from the point-major rows of the simd variant (xs, vs: x, y, z rows, point k of
+ * strand i at k·stride + i): the same integer sums, so the same grid. */
+int hb_host_world_build_rows(hb_host_world *hw, const hb_scene *s, void *const xs[3], void *const vs[3], int64_t stride,
+                             const void *qg);
 /* Bytes the world adds on the host (sums_threads > 0: the C reference's grid too, on that many threads). */
 uint64_t hb_host_world_bytes(const hb_scene *s, int sums_threads);
 

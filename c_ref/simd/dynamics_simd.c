@@ -39,7 +39,7 @@ HB_SIMD_DECL double sin(double);
 
 int64_t hb_simd_dyn_scratch_reals(int64_t points)
 {
-    return (6 * points + 8) * (int64_t)HB_SIMD_DYN_BLOCK;
+    return (14 * points + 8) * (int64_t)HB_SIMD_DYN_BLOCK; /* + 8 rows a point: §3.16's held samples */
 }
 
 /* out = 1/√in over one row of lanes. fp32: the hardware estimate (relative error ≤ 1.5·2⁻¹²;
@@ -74,6 +74,7 @@ static inline __attribute__((always_inline)) void inv_sqrt_row_f64(const double 
 }
 
 #include "dynamic/precision_f32.h"
+#include "dynamic/contact_impl.h" /* §3.16 the grid's sample and correction, the reference's operations */
 #define INV_SQRT_ROW(in, out) inv_sqrt_row_f32(in, out)
 #define TINY FLT_MIN
 #include "simd/dynamics_simd_impl.h"
@@ -82,6 +83,7 @@ static inline __attribute__((always_inline)) void inv_sqrt_row_f64(const double 
 #include "dynamic/precision_end.h"
 
 #include "dynamic/precision_f64.h"
+#include "dynamic/contact_impl.h"
 #define INV_SQRT_ROW(in, out) inv_sqrt_row_f64(in, out)
 #define TINY DBL_MIN
 #include "simd/dynamics_simd_impl.h"

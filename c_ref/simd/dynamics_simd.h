@@ -21,6 +21,7 @@
 #include <stdint.h>
 
 #include "dynamic/dynamics.h"
+#include "dynamic/world.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -57,12 +58,14 @@ void hb_simd_dyn_bend_rest_block_f64(const hb_dyn_model_f64 *m, const double *RX
 /* One frame (S substeps) of one block; SR: a groom's stretch rest lengths ℓ_k as rows
  * [P−1][stride] (docs/model.md §3.15), NULL for ℓ = L/(P−1). All pointers point at the block's first strand in
  * row 0 and are 64-byte aligned; scratch holds hb_simd_dyn_scratch_reals(P) reals. */
-void hb_simd_dyn_frame_block_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *X, float *Y, float *Z,
-                                 float *VX, float *VY, float *VZ, const float *RX, const float *RY, const float *RZ,
-                                 const float *BR, const float *SR, int64_t stride, float *scratch);
-void hb_simd_dyn_frame_block_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *X, double *Y, double *Z,
-                                 double *VX, double *VY, double *VZ, const double *RX, const double *RY,
-                                 const double *RZ, const double *BR, const double *SR, int64_t stride, double *scratch);
+void hb_simd_dyn_frame_block_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, const hb_dyn_world_f32 *w,
+                                 int64_t j0, int64_t j1, float *X, float *Y, float *Z, float *VX, float *VY, float *VZ,
+                                 const float *RX, const float *RY, const float *RZ, const float *BR, const float *SR,
+                                 int64_t stride, float *scratch);
+void hb_simd_dyn_frame_block_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, const hb_dyn_world_f64 *w,
+                                 int64_t j0, int64_t j1, double *X, double *Y, double *Z, double *VX, double *VY,
+                                 double *VZ, const double *RX, const double *RY, const double *RZ, const double *BR,
+                                 const double *SR, int64_t stride, double *scratch);
 
 /* The per-strand observables (docs/model.md §3.8) of `count` consecutive strands starting
  * at lane `first` (any alignment), into out[0 … count−1]: each strand's partial is the
@@ -80,12 +83,12 @@ typedef struct {
     int64_t (*scratch_reals)(int64_t);
     void (*bend_rest_f32)(const hb_dyn_model_f32 *, const float *, const float *, const float *, float *, int64_t);
     void (*bend_rest_f64)(const hb_dyn_model_f64 *, const double *, const double *, const double *, double *, int64_t);
-    void (*frame_f32)(const hb_dyn_model_f32 *, const hb_dyn_frame *, float *, float *, float *, float *, float *,
-                      float *, const float *, const float *, const float *, const float *, const float *, int64_t,
-                      float *);
-    void (*frame_f64)(const hb_dyn_model_f64 *, const hb_dyn_frame *, double *, double *, double *, double *, double *,
-                      double *, const double *, const double *, const double *, const double *, const double *, int64_t,
-                      double *);
+    void (*frame_f32)(const hb_dyn_model_f32 *, const hb_dyn_frame *, const hb_dyn_world_f32 *, int64_t, int64_t,
+                      float *, float *, float *, float *, float *, float *, const float *, const float *, const float *,
+                      const float *, const float *, int64_t, float *);
+    void (*frame_f64)(const hb_dyn_model_f64 *, const hb_dyn_frame *, const hb_dyn_world_f64 *, int64_t, int64_t,
+                      double *, double *, double *, double *, double *, double *, const double *, const double *,
+                      const double *, const double *, const double *, int64_t, double *);
     void (*observe_f32)(const hb_scene *, const float *, const float *, const float *, const float *, const float *,
                         const float *, int64_t, int64_t, int64_t, const double *, hb_obs_partial *);
     void (*observe_f64)(const hb_scene *, const double *, const double *, const double *, const double *,

@@ -28,7 +28,8 @@
 #define ROWP(a, k) ((a) + (int64_t)(k)*stride)
 #define SROW(r) HB_ASSUME_ALIGNED(scratch + (int64_t)(r)*DB)
 #define AL(p) HB_ASSUME_ALIGNED(p)
-#define TMP(m, i) SROW(6 * (m)->points + 3 + (i)) /* 0: |e|², 1: 1/|e|, 2–4: e */
+#define TMP(m, i) SROW(6 * (m)->points + 3 + (i))    /* 0: |e|², 1: 1/|e|, 2–4: e */
+#define HS_ROW(m, k) (6 * (m)->points + 8 + 8 * (k)) /* §3.16 `held`: point k's sample, 8 rows */
 
 /* The constant denominators' reciprocals and the constants beside them. */
 typedef struct {
@@ -139,6 +140,34 @@ HB_ALWAYS_INLINE void SFX(collide_lanes)(const DMODEL *m, REAL *scratch, const i
     }
 }
 
+/* §3.16 the hair–hair correction of row k (≥ 1) in step 2, lane by lane with the reference's
+ * operations (contact_impl.h): the frame's held sample, taken at its first substep into the
+ * block's rows hs (8 a point), or a sample taken now. */
+HB_ALWAYS_INLINE void SFX(grid_row)(const WORLD *w, const REAL *qg, const REAL h, const int64_t k, const int64_t j,
+                                    const REAL *x, const REAL *y, const REAL *z, REAL *vx, REAL *vy, REAL *vz, REAL *hs)
+{
+    const int held = w->grid_rebuild == HB_GRID_HELD;
+    for (int l = 0; l < DB; l++) {
+        const REAL xk[3] = {x[l], y[l], z[l]};
+        REAL vk[3] = {vx[l], vy[l], vz[l]},
+             sm[8] = {(REAL)0, (REAL)0, (REAL)0, (REAL)0, (REAL)0, (REAL)0, (REAL)0, (REAL)0};
+        if (held) {
+            if (j == 0) {
+                SFX(hb_grid_sample)(w, qg, xk, sm);
+                for (int c = 0; c < 8; c++) hs[c * DB + l] = sm[c];
+            } else {
+                for (int c = 0; c < 8; c++) sm[c] = hs[c * DB + l];
+            }
+            SFX(hb_grid_apply)(w, h, k, sm, vk);
+        } else {
+            SFX(hb_grid_correct)(w, qg, h, k, xk, vk);
+        }
+        vx[l] = vk[0];
+        vy[l] = vk[1];
+        vz[l] = vk[2];
+    }
+}
+
 /* Phase 1 of a substep (steps 1 and 2 of dynamics_impl.h frame_body): the root on the head,
  * the velocities, the prediction p. Features: WIND, GUST, DRAG, MOTION. With `prefetch`,
  * the rows of the next block's x and v are requested (into L2) row by row, so that they
@@ -146,7 +175,8 @@ HB_ALWAYS_INLINE void SFX(collide_lanes)(const DMODEL *m, REAL *scratch, const i
 HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, const REAL phase,
                                      REAL *X, REAL *Y, REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX,
                                      const REAL *RY, const REAL *RZ, const int64_t stride, REAL *scratch,
-                                     const int prefetch, const unsigned F)
+                                     const WORLD *w, const REAL *qg, const int64_t jj, const int prefetch,
+                                     const unsigned F)
 {
     const int64_t P = m->points;
     const REAL h = K->h, ih = K->ih;
@@ -202,6 +232,7 @@ HB_ALWAYS_INLINE void SFX(vel_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
         const REAL *restrict x = AL(ROWP(X, k)), *restrict y = AL(ROWP(Y, k)), *restrict z = AL(ROWP(Z, k));
         REAL *restrict vxr = AL(ROWP(VX, k)), *restrict vyr = AL(ROWP(VY, k)), *restrict vzr = AL(ROWP(VZ, k));
         REAL *restrict px = SROW(3 * k), *restrict py = SROW(3 * k + 1), *restrict pz = SROW(3 * k + 2);
+        if (w) SFX(grid_row)(w, qg, h, k, jj, x, y, z, vxr, vyr, vzr, SROW(HS_ROW(m, k)));
 #pragma omp simd
         for (int j = 0; j < DB; j++) {
             REAL vx = vxr[j], vy = vyr[j], vz = vzr[j];
@@ -420,13 +451,15 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
 
 static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, const REAL phase,
                               REAL *X, REAL *Y, REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY,
-                              const REAL *RZ, const int64_t stride, REAL *scratch, const int prefetch)
+                              const REAL *RZ, const int64_t stride, REAL *scratch, const WORLD *w, const REAL *qg,
+                              const int64_t j, const int prefetch)
 {
 #define VCASE(i)                                                                                                       \
     case (i):                                                                                                          \
         if (((i)&2) && !((i)&1)) break; /* no gusts without wind (hb_dyn_features) */                                  \
-        if (prefetch) SFX(vel_phase)(m, K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, 1, VEL_F(i));   \
-        else SFX(vel_phase)(m, K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, 0, VEL_F(i));            \
+        if (prefetch)                                                                                                  \
+            SFX(vel_phase)(m, K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, w, qg, j, 1, VEL_F(i));   \
+        else SFX(vel_phase)(m, K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, w, qg, j, 0, VEL_F(i));  \
         break;
     switch (idx) {
         CASE16(VCASE)
@@ -451,9 +484,10 @@ static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_const
 #undef CCASE
 }
 
-void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, REAL *X, REAL *Y, REAL *Z, REAL *VX,
-                                  REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ, const REAL *BR,
-                                  const REAL *SR, int64_t stride, REAL *scratch)
+void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, const WORLD *w, int64_t j0, int64_t j1,
+                                  REAL *X, REAL *Y, REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX,
+                                  const REAL *RY, const REAL *RZ, const REAL *BR, const REAL *SR, int64_t stride,
+                                  REAL *scratch)
 {
     const unsigned F = m->features;
     const unsigned vi = ((F & HB_F_WIND) ? 1u : 0u) | ((F & HB_F_WIND) && (F & HB_F_GUST) ? 2u : 0u) |
@@ -477,11 +511,16 @@ void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, REAL 
     K.rc2 = m->collide_r * m->collide_r;
     K.ell = m->seg_len;
     K.s_ih = m->ftl_s / m->h;
-    for (int64_t j = 0; j < m->substeps; j++) {
+    /* §3.16 the grid where it corrects (w: NULL otherwise), and the rotation of the build in use */
+    const WORLD *wg = w && w->grid && (w->grid_friction || w->grid_volume) ? w : NULL;
+    for (int64_t j = j0; j < j1; j++) {
         const REAL *q = QTABLE(fr) + 9 * j;                            /* Q(t + h) */
         const REAL phase = PHASE(fr)[j];                               /* φ(t) */
         const int last = HB_SIMD_DYN_PREFETCH && j + 1 == m->substeps; /* the next block's rows arrive meanwhile */
-        SFX(vel_dispatch)(vi, m, &K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, last);
+        const REAL *qg = !(F & HB_F_MOTION)                                     ? NULL
+                         : (wg && wg->grid_rebuild == HB_GRID_SUBSTEP && j > 0) ? QTABLE(fr) + 9 * (j - 1)
+                                                                                : QSTART(fr);
+        SFX(vel_dispatch)(vi, m, &K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, wg, qg, j, last);
         SFX(con_dispatch)(ci, m, &K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch);
     }
 }
@@ -569,6 +608,7 @@ void SFX(hb_simd_dyn_observe)(const hb_scene *s, const REAL *X, const REAL *Y, c
 #undef VEL_F
 #undef CON_F
 #undef CASE16
+#undef HS_ROW
 #undef HB_ALWAYS_INLINE
 #undef DB
 #undef ROWP

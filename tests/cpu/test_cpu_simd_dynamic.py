@@ -225,6 +225,50 @@ def test_threads_and_repeats_give_the_same_bits(cpu_bin, inputs, tmp_path, preci
         assert_same_bits(one, other, f"{precision} {extra}")
 
 
+# §3.16 the hair–hair grid (friction and volume), which simd takes the reference's way (docs/cpu_simd.md)
+GRID = ["--grid", 16, "--grid-friction", "0.05,0.01", "--grid-volume", 2000]
+
+
+@needs_simd
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+@pytest.mark.parametrize("rebuild", ["frame", "substep", "held"])
+def test_the_grid_within_the_rule(cpu_bin, inputs, tmp_path, precision, solver, rebuild):
+    """Every feature and the grid at each rebuild: one frame of simd within the rule of ref's."""
+    inp = inputs(precision, 33)
+    args = ["--solver", solver, *ALL, *GRID, "--grid-rebuild", rebuild]
+    assert_one_frame_rule(cpu_bin, inp, tmp_path, f"{precision} {solver} grid {rebuild}", args)
+
+
+@needs_simd
+@pytest.mark.parametrize("rebuild", ["substep", "held"])
+def test_the_grid_gives_the_same_bits_on_any_thread_count(cpu_bin, inputs, tmp_path, rebuild):
+    """The grid's integer sums from the point-major rows: --threads 1/2/3 give the same bits."""
+    inp = inputs("fp32", 16, 1000)
+    args = ["--solver", "xpbd", *ALL, *GRID, "--grid-rebuild", rebuild, "--velocities", "all"]
+    one = simulate(cpu_bin, inp, tmp_path / "t1.h5", "simd", *args, "--threads", 1, frames=4)
+    for extra in (["--threads", 2], ["--threads", 3]):
+        other = simulate(cpu_bin, inp, tmp_path / "tn.h5", "simd", *args, *extra, frames=4)
+        assert_same_bits(one, other, f"grid {rebuild} {extra}")
+
+
+@needs_simd
+def test_the_grid_moves_the_hair(cpu_bin, inputs, tmp_path):
+    """The grid is applied, not only accepted: with it simd's frames differ from without it by
+    what ref's do (the same run of ref, with and without the grid)."""
+    inp = inputs("fp64", 16)
+    args = ["--solver", "xpbd", *ALL, "--velocities", "all"]
+    runs = {
+        (v, g): read(simulate(cpu_bin, inp, tmp_path / f"{v}{g}.h5", v, *args, *(GRID if g else []), frames=3))[0]
+        for v in ("ref", "simd")
+        for g in (0, 1)
+    }
+    effect_ref = np.abs(runs["ref", 1] - runs["ref", 0]).max()
+    effect_simd = np.abs(runs["simd", 1] - runs["simd", 0]).max()
+    assert effect_ref > 1e-3, effect_ref
+    assert abs(effect_simd - effect_ref) < 1e-6 * effect_ref, (effect_simd, effect_ref)
+
+
 @needs_simd
 @pytest.mark.parametrize("solver", ["xpbd", "ftl"])
 def test_resume_gives_the_same_bits(cpu_bin, inputs, tmp_path, solver):
