@@ -539,6 +539,10 @@ static int simd_dyn_frame(cpu_impl *c, const hb_dyn_frame *f, hb_stage_result *r
         if (fp32) SIMD_DYN_FRAME(float, f32, &c->d32, hw->on ? &hw->w32 : NULL);
         else SIMD_DYN_FRAME(double, f64, &c->d64, hw->on ? &hw->w64 : NULL);
     }
+    c->last_pose = /* §3.17 the frame's last poses, for the observables (as cpu_dyn_frame) */
+        !f->back64 ? NULL
+        : fp32     ? (const void *)(f->pose32 + (size_t)(FS - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE)
+                   : (const void *)(f->pose64 + (size_t)(FS - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE);
     return dyn_frame_result(r, t0, failed, "per-thread block scratch", P, err, errlen);
 }
 #undef SIMD_DYN_FRAME
@@ -563,11 +567,11 @@ static int simd_dyn_observe(cpu_impl *c, hb_observables *obs, char *err, size_t 
     for (int64_t ch = 0; ch < nchunks; ch++) {
         const int64_t i0 = ch * SIMD_OBS_CHUNK, i1 = i0 + SIMD_OBS_CHUNK < N ? i0 + SIMD_OBS_CHUNK : N;
         if (c->scene.precision == HB_FP32)
-            c->sd->observe_f32(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0, i1 - i0,
-                               c->seg64, strand + i0);
+            c->sd->observe_f32(&c->scene, c->world.on ? &c->world.w32 : NULL, (const float *)c->last_pose, c->pm[0],
+                               c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0, i1 - i0, c->seg64, strand + i0);
         else
-            c->sd->observe_f64(&c->scene, c->pm[0], c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0, i1 - i0,
-                               c->seg64, strand + i0);
+            c->sd->observe_f64(&c->scene, c->world.on ? &c->world.w64 : NULL, (const double *)c->last_pose, c->pm[0],
+                               c->pm[1], c->pm[2], c->pv[0], c->pv[1], c->pv[2], S, i0, i1 - i0, c->seg64, strand + i0);
         hb_obs_partial acc = {0, 0, 0, 0};
         for (int64_t i = i0; i < i1; i++) hb_dyn_reduce_into(&acc, &strand[i]);
         part[ch] = acc;
@@ -714,7 +718,7 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
         snprintf(err, errlen, "out of host memory for the sag-free shape targets");
         return -1;
     }
-    if (c->simd) { /* §3.16 the grid (the variant's only world: --list-variants) */
+    if (c->simd) { /* §3.16, §3.17 the grid and the colliders */
         hb_host_world_free(&c->world);
         return hb_host_world_make(&c->world, &c->scene, rest, 1, err, errlen);
     }
@@ -1036,7 +1040,7 @@ static const hb_variant cpu_variants[] = {
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks; built for x86-64-v3 and "
      "x86-64-v4, the CPU's widest runs (the record's flags say which)",
-     0, 0, 0, 1, HB_X_GUIDES | HB_X_COLLIDERS | HB_X_FRICTION},
+     0, 0, 0, 1, HB_X_GUIDES},
     {NULL, 0, NULL, 0, 0, 0, 0, 0},
 };
 

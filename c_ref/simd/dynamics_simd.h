@@ -70,12 +70,12 @@ void hb_simd_dyn_frame_block_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *
 /* The per-strand observables (docs/model.md §3.8) of `count` consecutive strands starting
  * at lane `first` (any alignment), into out[0 … count−1]: each strand's partial is the
  * same bits as hb_dyn_observe_strand's, so a reduction in strand order gives ref's. */
-void hb_simd_dyn_observe_f32(const hb_scene *s, const float *X, const float *Y, const float *Z, const float *VX,
-                             const float *VY, const float *VZ, int64_t stride, int64_t first, int64_t count,
-                             const double *seg64, hb_obs_partial *out);
-void hb_simd_dyn_observe_f64(const hb_scene *s, const double *X, const double *Y, const double *Z, const double *VX,
-                             const double *VY, const double *VZ, int64_t stride, int64_t first, int64_t count,
-                             const double *seg64, hb_obs_partial *out);
+void hb_simd_dyn_observe_f32(const hb_scene *s, const hb_dyn_world_f32 *w, const float *pose, const float *X,
+                             const float *Y, const float *Z, const float *VX, const float *VY, const float *VZ,
+                             int64_t stride, int64_t first, int64_t count, const double *seg64, hb_obs_partial *out);
+void hb_simd_dyn_observe_f64(const hb_scene *s, const hb_dyn_world_f64 *w, const double *pose, const double *X,
+                             const double *Y, const double *Z, const double *VX, const double *VY, const double *VZ,
+                             int64_t stride, int64_t first, int64_t count, const double *seg64, hb_obs_partial *out);
 
 /* The functions above as one table, built twice as model_simd.h's (hb_simd_dyn_v3 from
  * dynamics_simd.c, hb_simd_dyn_v4 from dynamics_simd_v4.c). */
@@ -89,10 +89,12 @@ typedef struct {
     void (*frame_f64)(const hb_dyn_model_f64 *, const hb_dyn_frame *, const hb_dyn_world_f64 *, int64_t, int64_t,
                       double *, double *, double *, double *, double *, double *, const double *, const double *,
                       const double *, const double *, const double *, int64_t, double *);
-    void (*observe_f32)(const hb_scene *, const float *, const float *, const float *, const float *, const float *,
-                        const float *, int64_t, int64_t, int64_t, const double *, hb_obs_partial *);
-    void (*observe_f64)(const hb_scene *, const double *, const double *, const double *, const double *,
-                        const double *, const double *, int64_t, int64_t, int64_t, const double *, hb_obs_partial *);
+    void (*observe_f32)(const hb_scene *, const hb_dyn_world_f32 *, const float *, const float *, const float *,
+                        const float *, const float *, const float *, const float *, int64_t, int64_t, int64_t,
+                        const double *, hb_obs_partial *);
+    void (*observe_f64)(const hb_scene *, const hb_dyn_world_f64 *, const double *, const double *, const double *,
+                        const double *, const double *, const double *, const double *, int64_t, int64_t, int64_t,
+                        const double *, hb_obs_partial *);
 } hb_simd_dyn_fns;
 extern const hb_simd_dyn_fns hb_simd_dyn_v3, hb_simd_dyn_v4;
 

@@ -140,6 +140,24 @@ HB_ALWAYS_INLINE void SFX(collide_lanes)(const DMODEL *m, REAL *scratch, const i
     }
 }
 
+/* §3.6 step 7 / §3.7 with the colliders of §3.17 on row k (≥ 1) of p, lane by lane with the
+ * reference's operations (dynamics_impl.h collide_point): the head sphere with its friction or
+ * bounded depenetration (its plain projection is collide_lanes'), then each collider with its
+ * friction; x: the row at the substep's start. */
+HB_ALWAYS_INLINE void SFX(world_row)(const WORLD *w, const REAL *pose, const REAL *back, const REAL rc, const int head,
+                                     REAL *px, REAL *py, REAL *pz, const REAL *x, const REAL *y, const REAL *z)
+{
+    for (int l = 0; l < DB; l++) {
+        REAL p[3] = {px[l], py[l], pz[l]};
+        const REAL xs[3] = {x[l], y[l], z[l]};
+        if (head) SFX(hb_collide_head)(w, rc, back, p, xs);
+        for (int i = 0; i < w->ncol; i++) SFX(hb_collide_one)(w, i, pose + (size_t)i * HB_COL_POSE, back, p, xs);
+        px[l] = p[0];
+        py[l] = p[1];
+        pz[l] = p[2];
+    }
+}
+
 /* §3.16 the hair–hair correction of row k (≥ 1) in step 2, lane by lane with the reference's
  * operations (contact_impl.h): the frame's held sample, taken at its first substep into the
  * block's rows hs (8 a point), or a sample taken now. */
@@ -369,8 +387,13 @@ HB_ALWAYS_INLINE void SFX(bend_shape_lra_lanes)(const DMODEL *m, const SFX(dyn_c
 HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, REAL *X, REAL *Y,
                                      REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY,
                                      const REAL *RZ, const REAL *BR, const REAL *SR, const int64_t stride,
-                                     REAL *scratch, const unsigned F)
+                                     REAL *scratch, const WORLD *wc, const REAL *pose, const REAL *back,
+                                     const unsigned F)
 {
+    /* §3.17 (wc: the colliders, or the head sphere's friction or bounded depenetration): the head
+     * sphere's plain projection stays collide_lanes' where the world does not take it */
+    const int head_world = wc && (F & HB_F_COLLIDE) && (wc->head_friction || wc->bounded);
+    const int plain = (F & HB_F_COLLIDE) && !head_world;
     const int64_t P = m->points;
     const REAL ell = K->ell;
     const int per_seg = SR != NULL; /* §3.15: a groom's ℓ_k, row k − 1 of SR */
@@ -393,8 +416,13 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
                                     K->st_w2, lam_s ? lam_s + (k - 1) * DB : NULL);
             // clang-format on
             SFX(bend_shape_lra_lanes)(m, K, q, RX, RY, RZ, BR, stride, scratch, F);
-            if (F & HB_F_COLLIDE)
-                for (int64_t k = 1; k < P; k++) SFX(collide_lanes)(m, scratch, k, K);
+            for (int64_t k = 1; k < P && (plain || wc); k++) {
+                if (plain) SFX(collide_lanes)(m, scratch, k, K);
+                if (wc)
+                    SFX(world_row)
+                    (wc, pose, back, K->rc, head_world, SROW(3 * k), SROW(3 * k + 1), SROW(3 * k + 2), AL(ROWP(X, k)),
+                     AL(ROWP(Y, k)), AL(ROWP(Z, k)));
+            }
         }
         /* 4. v = (p − x)/h, then x = p */
         for (int64_t k = 1; k < P; k++) SFX(update_row)(K, scratch, X, Y, Z, VX, VY, VZ, stride, k, NULL, NULL, NULL);
@@ -433,7 +461,10 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
             py[j] = qy;
             pz[j] = qz;
         }
-        if (F & HB_F_COLLIDE) SFX(collide_lanes)(m, scratch, k, K);
+        if (plain) SFX(collide_lanes)(m, scratch, k, K);
+        if (wc)
+            SFX(world_row)
+            (wc, pose, back, K->rc, head_world, px, py, pz, AL(ROWP(X, k)), AL(ROWP(Y, k)), AL(ROWP(Z, k)));
         if (k >= 2) SFX(update_row)(K, scratch, X, Y, Z, VX, VY, VZ, stride, k - 1, dx, dy, dz);
     }
     /* the last point: no correction */
@@ -470,12 +501,13 @@ static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_const
 
 static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, REAL *X, REAL *Y,
                               REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ,
-                              const REAL *BR, const REAL *SR, const int64_t stride, REAL *scratch)
+                              const REAL *BR, const REAL *SR, const int64_t stride, REAL *scratch, const WORLD *wc,
+                              const REAL *pose, const REAL *back)
 {
 #define CCASE(i)                                                                                                       \
     case (i):                                                                                                          \
         if (((i)&8) && !((i)&2)) break; /* motion matters here only through shape */                                   \
-        SFX(con_phase)(m, K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch, CON_F(i));                   \
+        SFX(con_phase)(m, K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch, wc, pose, back, CON_F(i));   \
         break;
     switch (idx) {
         CASE16(CCASE)
@@ -513,6 +545,8 @@ void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, const
     K.s_ih = m->ftl_s / m->h;
     /* §3.16 the grid where it corrects (w: NULL otherwise), and the rotation of the build in use */
     const WORLD *wg = w && w->grid && (w->grid_friction || w->grid_volume) ? w : NULL;
+    /* §3.17 the colliders, or the head sphere's friction or bounded depenetration */
+    const WORLD *wc = w && (w->ncol > 0 || w->head_friction || w->bounded) ? w : NULL;
     for (int64_t j = j0; j < j1; j++) {
         const REAL *q = QTABLE(fr) + 9 * j;                            /* Q(t + h) */
         const REAL phase = PHASE(fr)[j];                               /* φ(t) */
@@ -521,7 +555,9 @@ void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, const
                          : (wg && wg->grid_rebuild == HB_GRID_SUBSTEP && j > 0) ? QTABLE(fr) + 9 * (j - 1)
                                                                                 : QSTART(fr);
         SFX(vel_dispatch)(vi, m, &K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, wg, qg, j, last);
-        SFX(con_dispatch)(ci, m, &K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch);
+        const REAL *pose = wc ? POSES(fr) + (size_t)j * (size_t)(wc->ncol > 0 ? wc->ncol : 1) * HB_COL_POSE : NULL;
+        const REAL *back = wc ? BACKS(fr) + HB_COL_BACK * j : NULL;
+        SFX(con_dispatch)(ci, m, &K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch, wc, pose, back);
     }
 }
 
@@ -546,9 +582,9 @@ void SFX(hb_simd_dyn_bend_rest_block)(const DMODEL *m, const REAL *RX, const REA
 /* §3.8 observables of strands first … first + count − 1 (dynamics_impl.h
  * hb_dyn_observe_strand, lane by lane; the same operations, so the same bits per strand). */
 #define OBS_LANES 256
-void SFX(hb_simd_dyn_observe)(const hb_scene *s, const REAL *X, const REAL *Y, const REAL *Z, const REAL *VX,
-                              const REAL *VY, const REAL *VZ, int64_t stride, int64_t first, int64_t count,
-                              const double *seg64, hb_obs_partial *out)
+void SFX(hb_simd_dyn_observe)(const hb_scene *s, const WORLD *w, const REAL *pose, const REAL *X, const REAL *Y,
+                              const REAL *Z, const REAL *VX, const REAL *VY, const REAL *VZ, int64_t stride,
+                              int64_t first, int64_t count, const double *seg64, hb_obs_partial *out)
 {
     const int64_t P = s->points;
     const double ell = hb_segment_length(s), far2 = 4.0 * s->hair_length * s->hair_length;
@@ -593,6 +629,13 @@ void SFX(hb_simd_dyn_observe)(const hb_scene *s, const REAL *X, const REAL *Y, c
                 pmax[j] = pm;
                 v2[j] = w2;
                 blown[j] |= (!fin) | far;
+            }
+            for (int j = 0; w && pose && j < n; j++) { /* §3.17: the depth in each collider */
+                const double xk[3] = {(double)x[j], (double)y[j], (double)z[j]};
+                for (int i = 0; i < w->ncol; i++) {
+                    const double dep = SFX(hb_collider_depth)(w, i, pose + (size_t)i * HB_COL_POSE, xk);
+                    if (dep > pmax[j]) pmax[j] = dep;
+                }
             }
         }
         for (int j = 0; j < n; j++) {

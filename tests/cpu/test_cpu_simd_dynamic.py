@@ -19,6 +19,7 @@ import pytest
 from test_cpu_simd import ISAS, needs_simd, object_calls
 
 from harness.check import diff_dynamic as dyndiff
+from harness.core.paths import ROOT
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run
 
@@ -136,10 +137,11 @@ def assert_same_bits(a, b, what):
         assert np.array_equal(oa[k], ob[k]), f"{what}: observable {k} differs: {oa[k]} vs {ob[k]}"
 
 
-def assert_one_frame_rule(cpu_bin, inp, tmp_path, what, args, frames=REF_FRAMES):
-    """ref runs `frames` frames; simd steps one frame from two of them; each is judged by
-    harness.dyndiff.compare against ref's next frame. Returns the worst max/u seen."""
-    ref = simulate(cpu_bin, inp, tmp_path / "ref.h5", "ref", *args, "--velocities", "all", frames=frames)
+def assert_one_frame_rule(cpu_bin, inp, tmp_path, what, args, frames=REF_FRAMES, ref_args=()):
+    """ref runs `frames` frames (with ref_args too: what a resumed run takes from its file, e.g.
+    --colliders); simd steps one frame from two of them; each is judged by harness.dyndiff.compare
+    against ref's next frame. Returns the worst max/u seen."""
+    ref = simulate(cpu_bin, inp, tmp_path / "ref.h5", "ref", *args, *ref_args, "--velocities", "all", frames=frames)
     with open_trajectory(ref) as t:
         cand = dyndiff.step_candidates(t)
         steps = {k: int(t.step[k + 1]) for k in cand}
@@ -267,6 +269,58 @@ def test_the_grid_moves_the_hair(cpu_bin, inputs, tmp_path):
     effect_simd = np.abs(runs["simd", 1] - runs["simd", 0]).max()
     assert effect_ref > 1e-3, effect_ref
     assert abs(effect_simd - effect_ref) < 1e-6 * effect_ref, (effect_simd, effect_ref)
+
+
+# §3.17 the default body (capsules and a head-mesh SDF) with friction and a bounded depenetration
+COLLIDERS = ["--colliders", ROOT / "configs" / "bodies" / "default.colliders"]  # a resumed run keeps its file's
+BODY = ["--friction", "0.3,0.2"]
+BODIES = {
+    "body": [*BODY, "--depenetration-speed", 200],
+    "body-unbounded": BODY,
+    "body-sway": [*BODY, "--depenetration-speed", 200, "--body-motion", "sway", "--body-amplitude", 3],
+    "head-friction": ["--friction", "0.4,0.3"],  # no --colliders: the head sphere's friction alone
+    "body-and-grid": [*BODY, "--depenetration-speed", 200, *GRID, "--grid-rebuild", "held"],
+}
+
+
+@needs_simd
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("solver", ["xpbd", "ftl"])
+@pytest.mark.parametrize("body", list(BODIES))
+def test_the_colliders_within_the_rule(cpu_bin, inputs, tmp_path, precision, solver, body):
+    """Every feature, the head nodding, and the body's colliders: one frame of simd within the rule
+    of ref's (the observables' penetration among them)."""
+    inp = inputs(precision, 33)
+    args = ["--solver", solver, *ALL, *BODIES[body]]
+    cols = COLLIDERS if body != "head-friction" else []
+    assert_one_frame_rule(cpu_bin, inp, tmp_path, f"{precision} {solver} {body}", args, ref_args=cols)
+
+
+@needs_simd
+def test_the_colliders_move_the_hair(cpu_bin, inputs, tmp_path):
+    """The body is applied, not only accepted: simd's frames with it differ from without it by what
+    ref's do."""
+    inp = inputs("fp64", 16)
+    args = ["--solver", "xpbd", *ALL, "--velocities", "all"]
+    body = [*COLLIDERS, *BODIES["body"]]
+    runs = {
+        (v, b): read(simulate(cpu_bin, inp, tmp_path / f"{v}{b}.h5", v, *args, *(body if b else []), frames=3))[0]
+        for v in ("ref", "simd")
+        for b in (0, 1)
+    }
+    effect_ref = np.abs(runs["ref", 1] - runs["ref", 0]).max()
+    effect_simd = np.abs(runs["simd", 1] - runs["simd", 0]).max()
+    assert effect_ref > 1e-2, effect_ref
+    assert abs(effect_simd - effect_ref) < 1e-6 * effect_ref, (effect_simd, effect_ref)
+
+
+@needs_simd
+def test_the_colliders_give_the_same_bits_on_any_thread_count(cpu_bin, inputs, tmp_path):
+    inp = inputs("fp32", 16, 1000)
+    args = ["--solver", "xpbd", *ALL, *COLLIDERS, *BODIES["body-sway"], "--velocities", "all"]
+    one = simulate(cpu_bin, inp, tmp_path / "t1.h5", "simd", *args, "--threads", 1, frames=4)
+    other = simulate(cpu_bin, inp, tmp_path / "t3.h5", "simd", *args, "--threads", 3, frames=4)
+    assert_same_bits(one, other, "body --threads 3")
 
 
 @needs_simd
