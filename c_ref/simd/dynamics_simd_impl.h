@@ -418,10 +418,11 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
             SFX(bend_shape_lra_lanes)(m, K, q, RX, RY, RZ, BR, stride, scratch, F);
             for (int64_t k = 1; k < P && (plain || wc); k++) {
                 if (plain) SFX(collide_lanes)(m, scratch, k, K);
-                if (wc)
-                    SFX(world_row)
-                    (wc, pose, back, K->rc, head_world, SROW(3 * k), SROW(3 * k + 1), SROW(3 * k + 2), AL(ROWP(X, k)),
-                     AL(ROWP(Y, k)), AL(ROWP(Z, k)));
+                if (wc) {
+                    const REAL *xr = AL(ROWP(X, k)), *yr = AL(ROWP(Y, k)), *zr = AL(ROWP(Z, k));
+                    REAL *qx = SROW(3 * k), *qy = SROW(3 * k + 1), *qz = SROW(3 * k + 2);
+                    SFX(world_row)(wc, pose, back, K->rc, head_world, qx, qy, qz, xr, yr, zr);
+                }
             }
         }
         /* 4. v = (p − x)/h, then x = p */
@@ -462,9 +463,10 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
             pz[j] = qz;
         }
         if (plain) SFX(collide_lanes)(m, scratch, k, K);
-        if (wc)
-            SFX(world_row)
-            (wc, pose, back, K->rc, head_world, px, py, pz, AL(ROWP(X, k)), AL(ROWP(Y, k)), AL(ROWP(Z, k)));
+        if (wc) {
+            const REAL *xr = AL(ROWP(X, k)), *yr = AL(ROWP(Y, k)), *zr = AL(ROWP(Z, k));
+            SFX(world_row)(wc, pose, back, K->rc, head_world, px, py, pz, xr, yr, zr);
+        }
         if (k >= 2) SFX(update_row)(K, scratch, X, Y, Z, VX, VY, VZ, stride, k - 1, dx, dy, dz);
     }
     /* the last point: no correction */
