@@ -74,7 +74,7 @@ static inline __attribute__((always_inline)) void inv_sqrt_row_f64(const double 
 }
 
 #include "dynamic/precision_f32.h"
-#include "dynamic/contact_impl.h" /* §3.16 the grid's sample and correction, the reference's operations */
+#include "dynamic/contact_impl.h" /* §3.16, §3.17: the grid's and the colliders' per-point operations */
 #define INV_SQRT_ROW(in, out) inv_sqrt_row_f32(in, out)
 #define TINY FLT_MIN
 #include "simd/dynamics_simd_impl.h"

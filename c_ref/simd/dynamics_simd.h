@@ -55,9 +55,11 @@ void hb_simd_dyn_bend_rest_block_f32(const hb_dyn_model_f32 *m, const float *RX,
 void hb_simd_dyn_bend_rest_block_f64(const hb_dyn_model_f64 *m, const double *RX, const double *RY, const double *RZ,
                                      double *BR, int64_t stride);
 
-/* One frame (S substeps) of one block; SR: a groom's stretch rest lengths ℓ_k as rows
- * [P−1][stride] (docs/model.md §3.15), NULL for ℓ = L/(P−1). All pointers point at the block's first strand in
- * row 0 and are 64-byte aligned; scratch holds hb_simd_dyn_scratch_reals(P) reals. */
+/* Substeps j0 … j1 − 1 of a frame of one block (all S of them, or one where the grid is built
+ * before each); w: the grid and colliders (docs/model.md §3.16, §3.17), NULL without them; SR: a
+ * groom's stretch rest lengths ℓ_k as rows [P−1][stride] (docs/model.md §3.15), NULL for
+ * ℓ = L/(P−1). All pointers point at the block's first strand in row 0 and are 64-byte aligned;
+ * scratch holds hb_simd_dyn_scratch_reals(P) reals. */
 void hb_simd_dyn_frame_block_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, const hb_dyn_world_f32 *w,
                                  int64_t j0, int64_t j1, float *X, float *Y, float *Z, float *VX, float *VY, float *VZ,
                                  const float *RX, const float *RY, const float *RZ, const float *BR, const float *SR,
