@@ -519,30 +519,48 @@ static int dyn_frame_result(hb_stage_result *r, double t0, int failed, const cha
         }                                                                                                              \
     } while (0)
 
+/* §3.16 (ref and simd): without the grid, or built once a frame, the frame's substeps at once;
+ * built every substep, substep by substep over all strands */
+static int64_t grid_step(const cpu_impl *c, const hb_dyn_frame *f)
+{
+    return c->scene.dyn.grid && c->scene.dyn.grid_rebuild == HB_GRID_SUBSTEP ? 1 : f->substeps;
+}
+
+/* §3.16 the rotation of the grid built before substep j0: Q at the frame's start, then at the
+ * end of substep j0 − 1; NULL for a still head */
+static const void *grid_rotation(const cpu_impl *c, const hb_dyn_frame *f, int64_t j0)
+{
+    const int fp32 = c->scene.precision == HB_FP32;
+    if (c->scene.dyn.motion == HB_MOTION_STILL) return NULL;
+    if (j0 == 0) return fp32 ? (const void *)f->qs32 : (const void *)f->qs64;
+    return fp32 ? (const void *)(f->q32 + 9 * (j0 - 1)) : (const void *)(f->q64 + 9 * (j0 - 1));
+}
+
+/* §3.17 the frame's last poses, for the observables (NULL without colliders) */
+static const void *frame_last_pose(const cpu_impl *c, const hb_dyn_frame *f)
+{
+    const size_t at = (size_t)(f->substeps - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE;
+    if (!f->back64) return NULL;
+    return c->scene.precision == HB_FP32 ? (const void *)(f->pose32 + at) : (const void *)(f->pose64 + at);
+}
+
 static int simd_dyn_frame(cpu_impl *c, const hb_dyn_frame *f, hb_stage_result *r, char *err, size_t errlen)
 {
     const int64_t P = c->scene.points, DB = HB_SIMD_DYN_BLOCK, nb = c->stride / HB_SIMD_DYN_BLOCK, S = c->stride;
     int failed = 0;
     const double t0 = hb_now_ms();
     const hb_host_world *hw = &c->world;
-    const int fp32 = c->scene.precision == HB_FP32, still = c->scene.dyn.motion == HB_MOTION_STILL;
-    /* §3.16 as cpu_dyn_frame: the grid built from the rows once a frame, or before every substep */
-    const int64_t FS = f->substeps, step = c->scene.dyn.grid && c->scene.dyn.grid_rebuild == HB_GRID_SUBSTEP ? 1 : FS;
+    const int fp32 = c->scene.precision == HB_FP32;
+    /* §3.16 the grid built from the rows once a frame, or before every substep (grid_step) */
+    const int64_t FS = f->substeps, step = grid_step(c, f);
     for (int64_t j0 = 0, j1 = step; j0 < FS && !failed; j0 = j1, j1 += step) {
         if (c->scene.dyn.grid) {
-            const void *qg =
-                still     ? NULL
-                : j0 == 0 ? (fp32 ? (const void *)f->qs32 : (const void *)f->qs64)
-                          : (fp32 ? (const void *)(f->q32 + 9 * (j0 - 1)) : (const void *)(f->q64 + 9 * (j0 - 1)));
-            if (hb_host_world_build_rows(&c->world, &c->scene, c->pm, c->pv, S, qg)) failed = 1;
+            if (hb_host_world_build_rows(&c->world, &c->scene, c->pm, c->pv, S, grid_rotation(c, f, j0))) failed = 1;
         }
         if (fp32) SIMD_DYN_FRAME(float, f32, &c->d32, hw->on ? &hw->w32 : NULL);
         else SIMD_DYN_FRAME(double, f64, &c->d64, hw->on ? &hw->w64 : NULL);
     }
-    c->last_pose = /* §3.17 the frame's last poses, for the observables (as cpu_dyn_frame) */
-        !f->back64 ? NULL
-        : fp32     ? (const void *)(f->pose32 + (size_t)(FS - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE)
-                   : (const void *)(f->pose64 + (size_t)(FS - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE);
+    c->last_pose = frame_last_pose(c, f);
     return dyn_frame_result(r, t0, failed, "per-thread block scratch", P, err, errlen);
 }
 #undef SIMD_DYN_FRAME
@@ -794,25 +812,16 @@ static int cpu_dyn_frame(hb_backend *b, const hb_dyn_frame *f, hb_stage_result *
     int failed = 0;
     const double t0 = hb_now_ms();
     const hb_host_world *hw = &c->world;
-    const int fp32 = c->scene.precision == HB_FP32, still = c->scene.dyn.motion == HB_MOTION_STILL;
-    /* §3.16: without the grid, or built once a frame, the frame's substeps at once; built every
-     * substep, substep by substep over all strands */
-    const int64_t S = f->substeps, step = c->scene.dyn.grid && c->scene.dyn.grid_rebuild == HB_GRID_SUBSTEP ? 1 : S;
+    const int fp32 = c->scene.precision == HB_FP32;
+    const int64_t S = f->substeps, step = grid_step(c, f);
     for (int64_t j0 = 0, j1 = step; j0 < S && !failed; j0 = j1, j1 += step) {
         if (c->scene.dyn.grid) {
-            const void *qg =
-                still     ? NULL
-                : j0 == 0 ? (fp32 ? (const void *)f->qs32 : (const void *)f->qs64)
-                          : (fp32 ? (const void *)(f->q32 + 9 * (j0 - 1)) : (const void *)(f->q64 + 9 * (j0 - 1)));
-            if (hb_host_world_build(&c->world, &c->scene, c->state, c->vel, qg)) failed = 1;
+            if (hb_host_world_build(&c->world, &c->scene, c->state, c->vel, grid_rotation(c, f, j0))) failed = 1;
         }
         if (fp32) DYN_FRAME(float, f32, &c->d32, hw->on ? &hw->w32 : NULL)
         else DYN_FRAME(double, f64, &c->d64, hw->on ? &hw->w64 : NULL)
     }
-    c->last_pose =
-        !f->back64 ? NULL
-        : fp32     ? (const void *)(f->pose32 + (size_t)(S - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE)
-                   : (const void *)(f->pose64 + (size_t)(S - 1) * (size_t)(f->ncol > 0 ? f->ncol : 1) * HB_COL_POSE);
+    c->last_pose = frame_last_pose(c, f);
     if (c->scene.dyn.guided && !failed) cpu_place_followers(c, f);
     return dyn_frame_result(r, t0, failed, "per-thread scratch", P, err, errlen);
 }

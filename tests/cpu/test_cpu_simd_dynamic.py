@@ -254,21 +254,24 @@ def test_the_grid_gives_the_same_bits_on_any_thread_count(cpu_bin, inputs, tmp_p
         assert_same_bits(one, other, f"grid {rebuild} {extra}")
 
 
-@needs_simd
-def test_the_grid_moves_the_hair(cpu_bin, inputs, tmp_path):
-    """The grid is applied, not only accepted: with it simd's frames differ from without it by
-    what ref's do (the same run of ref, with and without the grid)."""
-    inp = inputs("fp64", 16)
+def assert_moves_like_ref(cpu_bin, inp, tmp_path, world, floor):
+    """`world` is applied, not only accepted: simd's frames with it differ from without it by what
+    ref's do (ref's effect above `floor` cm)."""
     args = ["--solver", "xpbd", *ALL, "--velocities", "all"]
     runs = {
-        (v, g): read(simulate(cpu_bin, inp, tmp_path / f"{v}{g}.h5", v, *args, *(GRID if g else []), frames=3))[0]
+        (v, w): read(simulate(cpu_bin, inp, tmp_path / f"{v}{w}.h5", v, *args, *(world if w else []), frames=3))[0]
         for v in ("ref", "simd")
-        for g in (0, 1)
+        for w in (0, 1)
     }
     effect_ref = np.abs(runs["ref", 1] - runs["ref", 0]).max()
     effect_simd = np.abs(runs["simd", 1] - runs["simd", 0]).max()
-    assert effect_ref > 1e-3, effect_ref
+    assert effect_ref > floor, effect_ref
     assert abs(effect_simd - effect_ref) < 1e-6 * effect_ref, (effect_simd, effect_ref)
+
+
+@needs_simd
+def test_the_grid_moves_the_hair(cpu_bin, inputs, tmp_path):
+    assert_moves_like_ref(cpu_bin, inputs("fp64", 16), tmp_path, GRID, 1e-3)
 
 
 # §3.17 the default body (capsules and a head-mesh SDF) with friction and a bounded depenetration
@@ -298,20 +301,7 @@ def test_the_colliders_within_the_rule(cpu_bin, inputs, tmp_path, precision, sol
 
 @needs_simd
 def test_the_colliders_move_the_hair(cpu_bin, inputs, tmp_path):
-    """The body is applied, not only accepted: simd's frames with it differ from without it by what
-    ref's do."""
-    inp = inputs("fp64", 16)
-    args = ["--solver", "xpbd", *ALL, "--velocities", "all"]
-    body = [*COLLIDERS, *BODIES["body"]]
-    runs = {
-        (v, b): read(simulate(cpu_bin, inp, tmp_path / f"{v}{b}.h5", v, *args, *(body if b else []), frames=3))[0]
-        for v in ("ref", "simd")
-        for b in (0, 1)
-    }
-    effect_ref = np.abs(runs["ref", 1] - runs["ref", 0]).max()
-    effect_simd = np.abs(runs["simd", 1] - runs["simd", 0]).max()
-    assert effect_ref > 1e-2, effect_ref
-    assert abs(effect_simd - effect_ref) < 1e-6 * effect_ref, (effect_simd, effect_ref)
+    assert_moves_like_ref(cpu_bin, inputs("fp64", 16), tmp_path, [*COLLIDERS, *BODIES["body"]], 1e-2)
 
 
 @needs_simd
