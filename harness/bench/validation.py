@@ -1,7 +1,6 @@
 """The bench's first step for either model: a validator's CPU checks, then its GPU checks,
 recorded in validation.json; nothing is timed unless every comparison is equivalent."""
 
-import os
 import shutil
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
@@ -59,7 +58,7 @@ def parallel_runs(jobs=None):
     share the GPU (min(GPU_RUNS_AT_ONCE, cores) at once). The validator submits every run, then
     compares them in the order submitted, so validation.json is the same as one at a time.
     On an error the runs not yet started are cancelled."""
-    pool = ThreadPoolExecutor(max_workers=jobs or min(GPU_RUNS_AT_ONCE, os.cpu_count() or 1))
+    pool = ThreadPoolExecutor(max_workers=jobs or min(GPU_RUNS_AT_ONCE, env.usable_cores()))
     try:
         yield pool
     except BaseException:

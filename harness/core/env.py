@@ -45,11 +45,18 @@ def cpu_model():
     return platform.processor() or None
 
 
+def usable_cores():
+    """The cores this process may run on (its affinity mask: a scheduler's or taskset's share of the
+    host), as OpenMP's default counts them; the harness sizes threads and worker pools by it."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0)) or 1
+    return os.cpu_count() or 1
+
+
 def cpu_device():
     """This machine's CPU as the cpu binary's records name it (c_ref/backend_cpu.c cpu_describe): its
     model and the cores this process may run on."""
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    return f"{cpu_model() or 'unknown CPU'} ({cores} cores)"
+    return f"{cpu_model() or 'unknown CPU'} ({usable_cores()} cores)"
 
 
 GPU_QUERY = ("name", "driver_version", "memory.total", "compute_cap")
@@ -119,6 +126,7 @@ def collect():
         "python": sys.version.split()[0],
         "cpu_model": cpu_model(),
         "cpu_cores": os.cpu_count(),
+        "usable_cores": usable_cores(),
         "gpus": gpus,
         "device": gpus[0]["name"] if gpus else None,
         "driver": gpus[0]["driver"] if gpus else None,

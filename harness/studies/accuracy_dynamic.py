@@ -338,7 +338,7 @@ class Study:
         self.L = self.scene.hair_length
         self.gravity = float(self.scene.dynamic.get("--gravity", 981.0))
         self.scratch = Path(out_dir) / "states"
-        self.cpu_threads = os.cpu_count() or 1
+        self.cpu_threads = env.usable_cores()
         self.jobs = plan.jobs or self.cpu_threads
         self.readers = None  # reader_pool(), from start_readers() to close()
 

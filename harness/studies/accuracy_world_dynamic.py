@@ -16,7 +16,6 @@ shared machine's load then falls on all alike; the rounds' spread is kept), over
 without the feature (the group's `off` row).
 """
 
-import os
 import shutil
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
@@ -322,7 +321,7 @@ def measure(plan, log=print):
 
         rows = []
         with Progress((1 + plan.repeat) * len(todo), "accuracy-world") as bar:
-            with ThreadPoolExecutor(plan.jobs or os.cpu_count() or 1) as pool:
+            with ThreadPoolExecutor(plan.jobs or env.usable_cores()) as pool:
                 for row in pool.map(one, range(len(todo))):
                     rows.append(row)
                     bar.update()

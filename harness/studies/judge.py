@@ -24,7 +24,6 @@ Writes <out>/judge.csv (one row per compared frame) and <out>/judge.json (the co
 each defect is and which scenes caught it); report/dynamic.md renders them.
 """
 
-import os
 import shutil
 import tempfile
 import time
@@ -451,7 +450,7 @@ def run(plan=None, out_dir=None, log=print, jobs=None):
     false_alarms, honest_runs, rows = [], {"dynamic": 0, "paper": 0, "lod": 0}, []
     bar = Progress(len(units), "judge")
     try:
-        with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
+        with ThreadPoolExecutor(max_workers=jobs or env.usable_cores()) as pool:
             futures = [pool.submit(one, i, *u) for i, u in enumerate(units)]
             for (kind, scene, precision), fut in zip(units, futures):
                 unit_rows, flagged, runs = fut.result()

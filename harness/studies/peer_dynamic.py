@@ -32,7 +32,7 @@ import numpy as np
 
 from harness import HarnessError
 from harness.check import invariants_dynamic
-from harness.core import runner, tolerances, variants
+from harness.core import env, runner, tolerances, variants
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
 from harness.io import files
@@ -395,7 +395,7 @@ def run_study(args, log=print):
         },
         "machine": {
             "cpu": rec.get("device"),
-            "cores": os.cpu_count(),
+            "cores": env.usable_cores(),
             "python": platform.python_version(),
             "load_average": list(os.getloadavg()),
         },

@@ -44,7 +44,6 @@ timings (studies/reduced_partial_dynamic.py).
 """
 
 import math
-import os
 import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -325,7 +324,7 @@ class Study:
         flags = _flags(self.scene, solver=case.solver, substeps=case.substeps, iterations=case.iterations,
                        precision="fp32", strands=case.strands, frames=self.frames_of(case), extra=case.extra,
                        output=path, points=case.points, every=every)  # fmt: skip
-        runner.run_binary(self.cpu, flags + ["--threads", str(self.plan.threads or os.cpu_count() or 1)], timeout=3600)
+        runner.run_binary(self.cpu, flags + ["--threads", str(self.plan.threads or env.usable_cores())], timeout=3600)
         self.files[case] = path
         return path
 

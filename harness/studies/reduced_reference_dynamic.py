@@ -18,7 +18,7 @@ import numpy as np
 
 from harness.check import ensemble_dynamic as en
 from harness.check import observables_dynamic as ob
-from harness.core import runner, tolerances
+from harness.core import env, runner, tolerances
 from harness.io.trajectory import open_trajectory
 from harness.studies import predictability_dynamic as predictability
 from harness.studies.accuracy import frame_errors
@@ -69,7 +69,7 @@ class References:
         if build.variant:
             flags += ["--variant", build.variant]
         if build.backend == "cpu":
-            flags += ["--threads", str(self.plan.threads or os.cpu_count() or 1)]
+            flags += ["--threads", str(self.plan.threads or env.usable_cores())]
         runner.run_binary(build.binary, flags, timeout=3600)
         return path
 

@@ -37,7 +37,6 @@ report/stability_<slice>.png and writes report/dynamic_stability.md.
 import csv
 import inspect
 import io
-import os
 import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor, as_completed
@@ -336,7 +335,7 @@ def measure(
     ]
     if shard is not None:  # a share of the cells (harness merge joins the shards' rows)
         todo = shard.share(todo)
-    jobs = jobs or os.cpu_count() or 1
+    jobs = jobs or env.usable_cores()
     log(
         f"stability: {len(todo)} cells ({len(chosen)} slice(s) × solvers × precisions × {len(bes)} backend(s)), "
         f"{strands} strands, {frames} frames, {jobs} jobs"
@@ -478,7 +477,7 @@ def _info(opt, bes, seconds):
         quick=opt["quick"],
         strands=opt["strands"],
         frames=opt["frames"],
-        jobs=opt["jobs"] or os.cpu_count(),
+        jobs=opt["jobs"] or env.usable_cores(),
         seconds=round(seconds, 1),
         backends=[b.label for b in bes],
         stretch_bound=tolerances.STABILITY_STRETCH_MAX,

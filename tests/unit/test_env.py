@@ -1,8 +1,10 @@
 """harness.core.env.git_revision: which code a result says it came from (docs/harness.md,
 "Which code a result came from")."""
 
+import os
 import shutil
 import subprocess
+import sys
 
 import pytest
 
@@ -43,3 +45,18 @@ def test_no_revision_file_is_committed():
     if tracked.returncode != 0:
         pytest.skip("this tree is not a git checkout")
     assert tracked.stdout.strip() == "", "REVISION is tracked: git rm --cached REVISION"
+
+
+def test_usable_cores_follow_the_affinity_mask():
+    # a scheduler or taskset gives the process a share of the host: threads and pools are sized by that
+    # share (as OpenMP's default is), not by the host's core count
+    if not hasattr(os, "sched_setaffinity"):
+        pytest.skip("this platform has no affinity mask")
+    code = (
+        "import os; from harness.core import env; os.sched_setaffinity(0, {min(os.sched_getaffinity(0))}); "
+        "print(env.usable_cores(), env.cpu_device())"
+    )
+    out = subprocess.run([sys.executable, "-c", code], cwd=env.ROOT, capture_output=True, text=True, check=True)
+    cores, device = out.stdout.split(" ", 1)
+    assert cores == "1" and device.strip().endswith("(1 cores)"), out.stdout
+    assert env.usable_cores() == len(os.sched_getaffinity(0))
