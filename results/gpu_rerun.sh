@@ -56,7 +56,9 @@ stability)
 	shift
 	add=()
 	if [ -f "$out/stability/stability.csv" ]; then add=(--add); fi
-	"$py" -m harness stability --quick --gpu auto $(printf -- '--slice %s ' "$@") "${add[@]}" --out "$out/stability" --report-dir "$out/report"
+	slices=()
+	for s in "$@"; do slices+=(--slice "$s"); done
+	"$py" -m harness stability --quick --gpu auto "${slices[@]}" "${add[@]}" --out "$out/stability" --report-dir "$out/report"
 	;;
 judge) "$py" -m harness judge --gpu auto --out "$out/judge" ;;
 gputests) "$py" -m pytest tests/gpu/test_gpu_features.py tests/gpu/test_gpu_lod.py tests/native -q -ra ;;
