@@ -131,6 +131,7 @@ def markdown(rows, refs=()):
                 "scheme",
                 "rms err / L",
                 "max err / L",
+                "stretch max (ℓ_k)",
                 "stretch of followers",
                 "tip W1 / L",
                 "curvature W1",
@@ -143,6 +144,7 @@ def markdown(rows, refs=()):
                 _g(_f(r, "guide_spacing_cm")),
                 r["follow"] or "all simulated",
                 *_errs(r),
+                _g(_f(r, "stretch_max_k")),
                 _g(_f(r, "stretch_followers")),
                 *_stats(r),
             ),  # fmt: skip
@@ -247,6 +249,19 @@ def _sag_lines(cases, cols):
     return out
 
 
+MISS_WORDS = {"blown_up": "blown up", "rms_err_L": "RMS error", "stretch": "stretch", "tip_L": "tip W1",
+              "curvature_rel": "curvature W1", "envelope_rel": "area"}  # fmt: skip
+
+
+def _misses(r, fails):
+    """The measures a row misses a use by, each with the row's value."""
+    out = []
+    for m in fails:
+        v = verdicts.stretch_of(r) if m == "stretch" else math.nan if m == "blown_up" else _f(r, m)
+        out.append(MISS_WORDS[m] + ("" if math.isnan(v) else f" {_g(v)}"))
+    return ", ".join(out)
+
+
 def recommend(rows, refs=()):
     """Per use, studies/reduced_verdicts_dynamic.py's picks: at each strand count the fewest guides
     and at the LOD's strand count the fewest simulated points that pass it; LRA where it lowers the
@@ -256,10 +271,16 @@ def recommend(rows, refs=()):
         parts = []
         for g in pick.guides:
             r, n = g.row, g.strands
-            if r is None:
-                parts.append(f"at {n:,} strands no guide fraction (not even all simulated) passes")
+            if r is None and g.full_fails:
+                parts.append(
+                    f"at {n:,} strands the scene's step misses it with every strand simulated "
+                    f"({_misses(g.full, g.full_fails)}), so no guide fraction is recommended"
+                )
                 continue
-            stretch = _f(r, "stretch_followers") if r["follow"] else _f(r, "stretch_max_k")
+            if r is None:
+                parts.append(f"at {n:,} strands no guide fraction passes")
+                continue
+            stretch = verdicts.stretch_of(r)
             parts.append(
                 f"at {n:,} strands {_f(r, 'guides'):.0%} guides ({r['guide_count']}, "
                 f"{_g(_f(r, 'guide_spacing_cm'))} cm apart), {r['follow'] or 'every strand simulated'} "
@@ -271,6 +292,11 @@ def recommend(rows, refs=()):
                 f"{p['points']} simulated points rendered as {p['render_points']}"
                 if int(p["points"]) != int(p["render_points"])
                 else "every point simulated (fewer were not within it)"
+            )
+        elif pick.lod_full_fails:
+            parts.append(
+                "no P_s is recommended: the step misses it with every point simulated "
+                f"({', '.join(MISS_WORDS[m] for m in pick.lod_full_fails)})"
             )
         elif pick.lod_measured:
             parts.append("no P_s passes")

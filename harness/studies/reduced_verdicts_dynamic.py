@@ -2,8 +2,10 @@
 (render/reduced_dynamic_report.py words it), with the dynamic accuracy study's budgets
 (tolerances.DYN_ACC_USES: RMS error and stretch per use; DYN_ACC_USES_CHAOS: the statistics'
 allowance beyond the reference ensemble's spread): per use and strand count the fewest guides, and
-the fewest simulated points, whose every measure is within it; whether LRA lowers the error
-without raising the stretch."""
+the fewest simulated points, whose every measure is within it, where the same step with every strand
+and point simulated is within it too (a reduction is not recommended for a use its own full model
+fails: a guided row that passes where the full one fails passes by the statistics' noise); whether
+LRA lowers the error without raising the stretch."""
 
 import math
 from dataclasses import dataclass
@@ -19,42 +21,64 @@ def spreads(refs):
     return {(r["scene"], str(r["strands"])): {m: cell(r, f"{m}_spread") for m in DISTANCES} for r in refs}
 
 
-def passes(r, use, spreads):
-    """Whether a row meets a use: RMS error (up to the horizon) and stretch (the followers', a LOD
-    row's rendered points, else every point's, against ℓ_k) within the use's budgets, and each
-    statistic within the ensemble's spread plus the use's allowance."""
+def failures(r, use, spreads):
+    """The measures by which a row misses a use, in this order: blown_up, rms_err_L (up to the
+    horizon), stretch (stretch_of) past the use's budgets, and each statistic past the ensemble's
+    spread plus the use's allowance."""
     rms_budget, stretch_budget, _ = tolerances.DYN_ACC_USES[use]
-    if not cell(r, "rms_err_L") <= rms_budget or int(cell(r, "blown_up") or 0) > 0:
-        return False
-    stretch = cell(r, "stretch_followers") if math.isfinite(cell(r, "stretch_followers")) else cell(r, "stretch_max_k")
+    out = []
+    if int(cell(r, "blown_up") or 0) > 0:
+        out.append("blown_up")
+    if not cell(r, "rms_err_L") <= rms_budget:
+        out.append("rms_err_L")
+    stretch = stretch_of(r)
     if not stretch <= stretch_budget:
-        return False
+        out.append("stretch")
     scene = {"guides": "scene", "lod": "lod", "lra": "nod"}.get(r["study"], "scene")
     sp = spreads.get((scene, str(r["strands"])), {})
     allow = tolerances.DYN_ACC_USES_CHAOS[use]
-    return all(not math.isfinite(cell(r, m)) or cell(r, m) <= sp.get(m, 0.0) + allow[m] for m in DISTANCES)
+    out += [m for m in DISTANCES if math.isfinite(cell(r, m)) and not cell(r, m) <= sp.get(m, 0.0) + allow[m]]
+    return out
+
+
+def stretch_of(r):
+    """A row's largest stretch against ℓ_k: every strand's (a guided row's guides and followers alike;
+    a LOD row's rendered points), and the followers' where only they were measured."""
+    vals = [cell(r, c) for c in ("stretch_max_k", "stretch_followers")]
+    vals = [v for v in vals if math.isfinite(v)]
+    return max(vals) if vals else math.nan
+
+
+def passes(r, use, spreads):
+    """Whether a row meets a use: no failures()."""
+    return not failures(r, use, spreads)
 
 
 @dataclass(frozen=True)
 class GuidePick:
-    """At `strands` strands the row with the fewest guides that passes (None: none does), and the
-    scene's pointwise horizon (s)."""
+    """At `strands` strands the row with the fewest guides that passes (None: none does, or the full
+    row fails), the scene's pointwise horizon (s), and the row with every strand simulated with the
+    measures by which it misses the use (empty: it meets it; `full` None: not measured)."""
 
     strands: int
     row: dict | None
     horizon: float
+    full: dict | None = None
+    full_fails: tuple = ()
 
 
 @dataclass(frozen=True)
 class UsePick:
     """A use's budgets (tolerances.DYN_ACC_USES), its guide pick at each strand count, the LOD row
-    with the fewest simulated points that passes (None: none does) and whether any LOD row ran."""
+    with the fewest simulated points that passes (None: none does, or the row simulating every point
+    fails), whether any LOD row ran, and the measures by which the every-point row misses the use."""
 
     use: str
     budget: tuple
     guides: list
     lod: dict | None
     lod_measured: bool
+    lod_full_fails: tuple = ()
 
 
 def recommendations(rows, refs=()):
@@ -67,14 +91,19 @@ def recommendations(rows, refs=()):
     for use in tolerances.DYN_ACC_USES:
         guides = []
         for n in sorted({int(r["strands"]) for r in cpu if r["study"] == "guides"}):
-            ok = [r for r in cpu if r["study"] == "guides" and r["solver"] == "xpbd" and int(r["strands"]) == n
-                  and passes(r, use, sp)]  # fmt: skip
+            rows_n = [r for r in cpu if r["study"] == "guides" and r["solver"] == "xpbd" and int(r["strands"]) == n]
+            full = next((r for r in rows_n if cell(r, "guides") >= 1.0), None)
+            full_fails = tuple(failures(full, use, sp)) if full is not None else ()
+            ok = [r for r in rows_n if passes(r, use, sp)] if not full_fails else []
             pick = min(ok, key=lambda r: (cell(r, "guides"), cell(r, "rms_err_L"))) if ok else None
-            guides.append(GuidePick(n, pick, horizon.get(("scene", str(n)), math.nan)))
-        lod = [r for r in cpu if r["study"] == "lod" and r["solver"] == "xpbd" and passes(r, use, sp)]
+            guides.append(GuidePick(n, pick, horizon.get(("scene", str(n)), math.nan), full, full_fails))
+        lod_rows = [r for r in cpu if r["study"] == "lod" and r["solver"] == "xpbd"]
+        every = [r for r in lod_rows if int(r["points"]) == int(r.get("render_points") or r["points"])]
+        every_fails = tuple(failures(every[0], use, sp)) if every else ()
+        lod = [r for r in lod_rows if passes(r, use, sp)] if not every_fails else []
         fewest = min(lod, key=lambda r: (int(r["points"]), cell(r, "rms_err_L"))) if lod else None
         measured = any(r["study"] == "lod" for r in cpu)
-        out.append(UsePick(use, tolerances.DYN_ACC_USES[use], guides, fewest, measured))
+        out.append(UsePick(use, tolerances.DYN_ACC_USES[use], guides, fewest, measured, every_fails))
     return out
 
 

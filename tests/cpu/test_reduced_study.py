@@ -99,6 +99,9 @@ def test_a_stretched_follower_or_a_statistic_past_the_spread_fails_a_use():
     game = tolerances.DYN_ACC_USES["games"][0]
     stretched = _row(0.5, "blend3", 0.5 * game, stretch=0.5)
     assert not reduced_verdicts.passes(stretched, "previews", {})
+    # the guides are simulated strands too: their stretch counts, however well the followers keep ℓ_k
+    stretched_guides = dict(_row(0.5, "blend3", 0.5 * game, stretch=1e-6), stretch_max_k="0.5")
+    assert reduced_verdicts.failures(stretched_guides, "previews", {}) == ["stretch"]
     far = dict(_row(0.5, "blend3", 0.5 * game), tip_L="0.02")
     spreads = {("scene", "1000"): {"tip_L": 0.001, "curvature_rel": 0.0, "envelope_rel": 0.0}}
     assert reduced_verdicts.passes(far, "previews", spreads) and not reduced_verdicts.passes(far, "games", spreads)
@@ -343,3 +346,30 @@ def test_a_resumed_run_does_not_time_again_the_twin_of_a_kept_timing(monkeypatch
     got = [(b, v, n, r["stages"][0]["median_ms"], r["device"]) for b, v, n, r in
            reduced._timings(SMALL, None, big, [("cuda", "lanes")], memo)]  # fmt: skip
     assert got == [("cuda", "lanes", 10, 1.25, "GPU")] and runs == []
+
+
+def test_no_reduction_is_recommended_for_a_use_the_full_model_misses():
+    # every strand simulated misses the previews' curvature allowance; a guided row that happens to
+    # pass it passes by the statistic's noise and is not recommended
+    prev = tolerances.DYN_ACC_USES["previews"][0]
+    allow = tolerances.DYN_ACC_USES_CHAOS["previews"]["curvature_rel"]
+    full = dict(_row(1.0, "", 0.1 * prev), curvature_rel=str(allow * 1.05))
+    guided = dict(_row(0.1, "blend3", 0.2 * prev), curvature_rel=str(allow * 0.95))
+    (pick,) = [p.guides[0] for p in reduced_verdicts.recommendations([full, guided]) if p.use == "previews"]
+    assert pick.row is None and pick.full_fails == ("curvature_rel",)
+    line = _use_line(reduced_report.recommend([full, guided]), "previews")
+    assert "misses it with every strand simulated (curvature W1" in line and "10% guides" not in line
+    # the same guided row is recommended once the full model meets the use
+    full_ok = dict(full, curvature_rel=str(allow * 0.5))
+    (pick,) = [p.guides[0] for p in reduced_verdicts.recommendations([full_ok, guided]) if p.use == "previews"]
+    assert pick.row is guided and pick.full_fails == ()
+
+
+def test_no_lod_is_recommended_for_a_use_every_point_simulated_misses():
+    prev = tolerances.DYN_ACC_USES["previews"][0]
+    rows = [_row(1.0, "", 0.001), _lod(33, 2 * prev), _lod(9, 0.5 * prev)]
+    (pick,) = [p for p in reduced_verdicts.recommendations(rows) if p.use == "previews"]
+    assert pick.lod is None and pick.lod_full_fails == ("rms_err_L",)
+    assert "no P_s is recommended: the step misses it with every point simulated (RMS error)" in _use_line(
+        reduced_report.recommend(rows), "previews"
+    )
