@@ -10,9 +10,10 @@
 #                                                   # reduced-SHARE/: one share of the reduced study (1,000 and
 #                                                   # 10,000 strands, 1 s): guides (both strand counts, one timing
 #                                                   # each; over 10 minutes: a stopped call leaves its timings, the
-#                                                   # next one, --resume, keeps them), lra (~240 s), sag (~80 s),
-#                                                   # lod (~230 s); reduced/ is the shares' CSVs joined in that
-#                                                   # order, header once
+#                                                   # next one, --resume, keeps them; or in two shares that
+#                                                   # share no timing, guides-xpbd and guides-ftl, a GPU each),
+#                                                   # lra (~240 s), sag (~80 s), lod (~230 s); reduced/ is the
+#                                                   # shares' CSVs joined in that order, header once
 #   OUT=$OUT bash results/gpu_rerun.sh stability [SLICE ...]
 #                                                   # stability/: the quick map, CPU and every CUDA build; given
 #                                                   # slices, those alone, added to the map already there
@@ -38,14 +39,15 @@ accuracy) "$py" -m harness accuracy --model dynamic --quick --gpu auto --force \
 curly) "$py" -m harness accuracy --model dynamic --scene curly --quick --analytic none --ref-max 4096 --gpu auto --force \
 	--out "$out/dynamic-accuracy-curly" --report-dir "$out/report" ;;
 reduced)
-	share=${2:?"usage: OUT=DIR bash results/gpu_rerun.sh reduced guides|lra|sag|lod [--resume]"}
+	share=${2:?"usage: OUT=DIR bash results/gpu_rerun.sh reduced guides|guides-xpbd|guides-ftl|lra|sag|lod [--resume]"}
 	case "$share" in
 	guides) args=(--strands 1000 10000 --parts guides) ;;
+	guides-xpbd | guides-ftl) args=(--strands 1000 10000 --parts guides --solvers "${share#guides-}") ;;
 	lra) args=(--strands 1000 10000 --parts lra) ;;
 	sag) args=(--strands 1000 10000 --parts sagfree sagfreq) ;;
 	lod) args=(--strands 1000 10000 --parts lod) ;;
 	*)
-		echo "error: unknown reduced share '$share' (guides, lra, sag, lod)" >&2
+		echo "error: unknown reduced share '$share' (guides, guides-xpbd, guides-ftl, lra, sag, lod)" >&2
 		exit 2
 		;;
 	esac

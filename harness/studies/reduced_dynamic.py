@@ -122,6 +122,7 @@ REF_FIELDS = (
 )
 SCHEMES = ("one", "blend3")
 PARTS = ("guides", "lra", "sagfree", "sagfreq", "lod")
+SOLVERS = ("xpbd", "ftl")
 STUDIED = ("guides", "lra", "sagfree", "lod")  # the §3.14 features the rows declare
 
 
@@ -147,6 +148,7 @@ class Plan:
     gpu: str = "auto"  # auto | no
     threads: int | None = None  # the CPU's checked runs and references (None: every core)
     parts: tuple = PARTS  # which rows to measure
+    solvers: tuple = SOLVERS  # whose rows (a share of the study: no timing is shared across solvers)
 
     @classmethod
     def quick(cls, **changes):
@@ -200,16 +202,16 @@ def cases(plan, scene):
     big, small = max(plan.strands), min(plan.strands)
     out = []
     for n in plan.strands:
-        for solver in ("xpbd", "ftl"):
+        for solver in plan.solvers:
             for frac in plan.fractions:
                 for follow in SCHEMES if frac < 1.0 else ("",):
                     extra = ("--guides", repr(frac), "--follow", follow) if frac < 1.0 else ()
                     out.append(Case("guides", solver, s, it, n, frac, follow, extra=extra))
-    for solver in ("xpbd", "ftl"):
+    for solver in plan.solvers:
         for i in plan.lra_iterations:
             for lra in (0, 1):
                 out.append(Case("lra", solver, s, i, big, lra=lra, extra=_fast(plan) + (("--lra",) if lra else ())))
-    for solver in ("xpbd", "ftl"):
+    for solver in plan.solvers:
         for rng in plan.sag_ranges:
             for sag in (0, 1):
                 out.append(Case("sagfree", solver, s, it, small, sag_free=sag, shape_range=rng,
@@ -219,7 +221,7 @@ def cases(plan, scene):
             out.append(Case("sagfreq", solver, s, it, small, sag_free=sag, shape_range=1.0,
                             extra=wind + (("--sag-free",) if sag else ())))  # fmt: skip
     pr = plan.lod_render_points
-    for solver in ("xpbd", "ftl"):
+    for solver in plan.solvers:
         for ps in plan.lod_points:
             out.append(
                 Case("lod", solver, s, it, big, points=ps, extra=("--render-points", str(pr)) if ps < pr else ())

@@ -373,3 +373,29 @@ def test_no_lod_is_recommended_for_a_use_every_point_simulated_misses():
     assert "no P_s is recommended: the step misses it with every point simulated (RMS error)" in _use_line(
         reduced_report.recommend(rows), "previews"
     )
+
+
+def test_a_study_split_by_solver_has_every_case_once_and_shares_no_timing():
+    scene = reduced.scenes.load_scene(reduced.Plan().scene)
+    whole = reduced.cases(reduced.Plan(), scene)
+    shares = [reduced.cases(reduced.Plan(solvers=(s,)), scene) for s in reduced.SOLVERS]
+    assert sorted(c.key for c in shares[0] + shares[1]) == sorted(c.key for c in whole)
+    assert {c.solver for c in shares[0]} == {"xpbd"} and {c.solver for c in shares[1]} == {"ftl"}
+    timed = [{tuple(map(str, reduced._timing_flags(reduced.Plan(), scene, c, "cpu", "ref")[1])) for c in share}
+             for share in shares]  # fmt: skip
+    assert timed[0] and timed[1] and not timed[0] & timed[1]
+
+
+def test_the_solvers_option_reaches_the_plan(monkeypatch):
+    plans = []
+
+    def measure(plan, **_):
+        plans.append(plan)
+        return []
+
+    monkeypatch.setattr(reduced, "measure", measure)
+    monkeypatch.setattr(reduced_report, "markdown", lambda rows, refs: "")
+    assert harness_main(["reduced", "--solvers", "ftl", "--gpu", "no"]) == 0
+    assert harness_main(["reduced", "--solvers", "ftl", "xpbd", "--gpu", "no"]) == 0
+    assert harness_main(["reduced", "--gpu", "no"]) == 0
+    assert [p.solvers for p in plans] == [("ftl",), ("xpbd", "ftl"), ("xpbd", "ftl")]

@@ -108,6 +108,8 @@ def cmd_reduced(args):
         changes["strands"] = tuple(args.strands)
     if args.parts:
         changes["parts"] = tuple(args.parts)
+    if args.solvers:
+        changes["solvers"] = tuple(s for s in reduced.SOLVERS if s in args.solvers)
     if args.out and not args.resume:
         reduced_partial.refuse_unfinished(args.out)
     refs = []
@@ -329,6 +331,14 @@ def add_reduced(sub):
         choices=reduced.PARTS,
         default=None,
         help="which rows to measure (default all: guides lra sagfree sagfreq lod)",
+    )
+    rd.add_argument(
+        "--solvers",
+        nargs="+",
+        choices=reduced.SOLVERS,
+        default=None,
+        help="whose rows to measure (default both: xpbd ftl); the two solvers share no timing, so a study split "
+        "by solver times each setting once",
     )
     rd.add_argument("--quick", action="store_true", help="the small version (CI, a first look)")
     case_options(rd, gpu="the cuda variants too, where a GPU is usable", gpu_choices=("auto", "no"))
