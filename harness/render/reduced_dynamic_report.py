@@ -296,7 +296,7 @@ def recommend(rows, refs=()):
         elif pick.lod_full_fails:
             parts.append(
                 "no P_s is recommended: the step misses it with every point simulated "
-                f"({', '.join(MISS_WORDS[m] for m in pick.lod_full_fails)})"
+                f"({_misses(pick.lod_full, pick.lod_full_fails)})"
             )
         elif pick.lod_measured:
             parts.append("no P_s passes")

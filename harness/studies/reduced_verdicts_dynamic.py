@@ -71,13 +71,14 @@ class GuidePick:
 class UsePick:
     """A use's budgets (tolerances.DYN_ACC_USES), its guide pick at each strand count, the LOD row
     with the fewest simulated points that passes (None: none does, or the row simulating every point
-    fails), whether any LOD row ran, and the measures by which the every-point row misses the use."""
+    fails), whether any LOD row ran, and the every-point row with the measures by which it misses the use."""
 
     use: str
     budget: tuple
     guides: list
     lod: dict | None
     lod_measured: bool
+    lod_full: dict | None = None
     lod_full_fails: tuple = ()
 
 
@@ -103,7 +104,8 @@ def recommendations(rows, refs=()):
         lod = [r for r in lod_rows if passes(r, use, sp)] if not every_fails else []
         fewest = min(lod, key=lambda r: (int(r["points"]), cell(r, "rms_err_L"))) if lod else None
         measured = any(r["study"] == "lod" for r in cpu)
-        out.append(UsePick(use, tolerances.DYN_ACC_USES[use], guides, fewest, measured, every_fails))
+        out.append(UsePick(use, tolerances.DYN_ACC_USES[use], guides, fewest, measured, every[0] if every else None,
+                           every_fails))  # fmt: skip
     return out
 
 

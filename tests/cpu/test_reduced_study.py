@@ -370,8 +370,9 @@ def test_no_lod_is_recommended_for_a_use_every_point_simulated_misses():
     rows = [_row(1.0, "", 0.001), _lod(33, 2 * prev), _lod(9, 0.5 * prev)]
     (pick,) = [p for p in reduced_verdicts.recommendations(rows) if p.use == "previews"]
     assert pick.lod is None and pick.lod_full_fails == ("rms_err_L",)
-    assert "no P_s is recommended: the step misses it with every point simulated (RMS error)" in _use_line(
-        reduced_report.recommend(rows), "previews"
+    assert (
+        f"no P_s is recommended: the step misses it with every point simulated (RMS error {2 * prev:g})"
+        in _use_line(reduced_report.recommend(rows), "previews")
     )
 
 
