@@ -4,8 +4,12 @@ frame up to the pointwise horizon, the RMS difference between S and 2S is under
 tolerances.DYN_ACC_REF_FACTOR × the smallest RMS error of the rows it ranks (the accuracy study's
 rule), or the plan's ref_max. The converged (finer) rung then gets perturbed twins
 (studies/predictability_dynamic.py): their separation gives the scene's Lyapunov rate and predictability
-time, which bound the pointwise horizon; with the rung they are the reference ensemble whose
-spread the rows' statistics (harness/check/ensemble_dynamic.py) are judged against.
+time. The pointwise horizon is the written frames within that time over which the ladder's rule
+holds from the start (`pointwise_frames`): a rung's truncation error grows with the scene's
+sensitivity like any perturbation, so a reference converged early is not converged late, and no
+row is judged pointwise where its reference is not. The rung, the coarser rung it was compared with
+and the twins are the reference ensemble whose spread the rows' statistics
+(harness/check/ensemble_dynamic.py) are judged against.
 
 A row is kept as its file; its errors against a rung are read again when the rung changes.
 """
@@ -47,13 +51,26 @@ class Reference:
     steps: np.ndarray
     rest: np.ndarray
     substeps: int  # the finer rung of the last comparison
-    ladder: list  # (S, 2S, worst RMS of S − 2S over the horizon, worst ratio to the smallest row error)
-    converged: bool
+    ladder: list  # (S, 2S, worst RMS of S − 2S, worst ratio to the smallest row error): within T_p
+    converged: bool  # the rule holds over at least the first written frame (horizon_frames ≥ 1)
     build: str = ""  # the binary and variant that ran it
     rate: object = None  # predictability.Rate of the twins
     members: list = field(default_factory=list)  # ensemble signatures: the rung, then its twins
     spread: dict = field(default_factory=dict)
-    horizon_frames: int = 0  # written frames judged pointwise
+    horizon_frames: int = 0  # written frames judged pointwise: within T_p and converged
+    converged_frames: int = 0  # written frames from the start over which the ladder's rule holds
+    coarse: object = None  # the coarser rung's positions (an ensemble member)
+
+
+def pointwise_frames(ratio, within):
+    """The written frames judged pointwise: of the first `within` (those within the predictability
+    time), the leading ones whose ladder ratio (S − 2S over the smallest row error) is under
+    tolerances.DYN_ACC_REF_FACTOR; a frame where both are zero (NaN) counts as converged.
+    Returns (judged frames, leading converged frames over the whole run)."""
+    q = np.asarray(ratio, dtype=np.float64)
+    ok = np.isnan(q) | (q < tolerances.DYN_ACC_REF_FACTOR)
+    lead = int(np.argmin(ok)) if not ok.all() else int(ok.size)
+    return min(lead, int(within)), lead
 
 
 class References:
@@ -87,6 +104,7 @@ class References:
         while True:
             cur = self.rung(flags_for, tag, 2 * S, build)
             a, b = read_positions(prev)[0], read_positions(cur)[0]
+            coarse = a
             d_rms, _ = frame_errors(a, b, self.L)
             low = np.nanmin(np.array([frame_errors(read_positions(p)[0], b, self.L)[0] for p in row_paths]), axis=0)
             with np.errstate(invalid="ignore", divide="ignore"):
@@ -99,7 +117,7 @@ class References:
                 break
             prev, S = cur, 2 * S
         pos, steps, rest, _, _ = read_positions(cur)
-        ref = Reference(key, pos, steps, rest, 2 * S, ladder, ok, build=build.label)
+        ref = Reference(key, pos, steps, rest, 2 * S, ladder, ok, build=build.label, coarse=coarse)
         self._ensemble(ref, cur, written_dt, build)
         self.cache[key] = ref
         return ref
@@ -114,17 +132,18 @@ class References:
         twins = predictability.run_twins(build, path, self.scratch, threads=self.plan.threads, reduce=sig)
         os.unlink(path)
         ref.rate = twins.rate
-        ref.members = [m for m in [sig(ref.pos), *twins.positions] if m is not None]
+        ref.members = [m for m in [sig(ref.pos), sig(ref.coarse), *twins.positions] if m is not None]
+        ref.coarse = None
         ref.spread = en.spread(ref.members)
         tp = twins.rate.predictability
         F = len(ref.steps)
-        within = F if math.isinf(tp) else int(math.floor(tp / written_dt + 1e-9))
-        ref.horizon_frames = max(1, min(F, within))
-        # convergence re-read over the pointwise horizon
-        ref.converged = bool(np.all(ref.ladder[-1][3][: ref.horizon_frames] < tolerances.DYN_ACC_REF_FACTOR))
+        within = max(1, min(F, F if math.isinf(tp) else int(math.floor(tp / written_dt + 1e-9))))
+        ref.horizon_frames, ref.converged_frames = pointwise_frames(ref.ladder[-1][3], within)
+        ref.converged = ref.horizon_frames > 0
         self.log(
             f"reduced: reference {ref.key}: S = {ref.substeps}, Lyapunov rate {twins.rate.lam:.3g} /s, "
-            f"predictability {tp:.3g} s; pointwise over {ref.horizon_frames} of {F} written frames"
+            f"predictability {tp:.3g} s, converged over {ref.converged_frames} written frames; "
+            f"pointwise over {ref.horizon_frames} of {F}"
         )
-        ref.ladder = [(S, S2, float(np.nanmax(d[: ref.horizon_frames])), float(np.nanmax(q[: ref.horizon_frames])))
+        ref.ladder = [(S, S2, float(np.nanmax(d[:within])), float(np.nanmax(q[:within])))
                       for S, S2, d, q in ref.ladder]  # fmt: skip

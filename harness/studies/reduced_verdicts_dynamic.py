@@ -23,13 +23,13 @@ def spreads(refs):
 
 def failures(r, use, spreads):
     """The measures by which a row misses a use, in this order: blown_up, rms_err_L (up to the
-    horizon), stretch (stretch_of) past the use's budgets, and each statistic past the ensemble's
-    spread plus the use's allowance."""
+    horizon; not where the horizon is no frame), stretch (stretch_of) past the use's budgets, and
+    each statistic past the ensemble's spread plus the use's allowance."""
     rms_budget, stretch_budget, _ = tolerances.DYN_ACC_USES[use]
     out = []
     if int(cell(r, "blown_up") or 0) > 0:
         out.append("blown_up")
-    if not cell(r, "rms_err_L") <= rms_budget:
+    if cell(r, "horizon_s") != 0 and not cell(r, "rms_err_L") <= rms_budget:  # 0: no frame judged pointwise
         out.append("rms_err_L")
     stretch = stretch_of(r)
     if not stretch <= stretch_budget:
@@ -111,8 +111,9 @@ def recommendations(rows, refs=()):
 
 @dataclass(frozen=True)
 class LraVerdict:
-    """LRA on against off (the same solver and I, the fast nod): whether it lowered the RMS error
-    and left the largest stretch no higher."""
+    """LRA on against off (the same solver and I, the fast nod): whether it lowered the error
+    (`measure`: the RMS error up to the pointwise horizon, or the tip distribution's distance from
+    the reference ensemble where no frame is judged pointwise) and left the largest stretch no higher."""
 
     solver: str
     iterations: str
@@ -120,6 +121,7 @@ class LraVerdict:
     off: dict
     lower: bool
     not_raised: bool
+    measure: str = "rms_err_L"
 
     @property
     def worth_it(self):
@@ -134,7 +136,8 @@ def lra_verdicts(rows):
         off = by.get((solver, i, "0"))
         if lra != "1" or off is None:
             continue
-        lower = cell(r, "rms_err_L") < cell(off, "rms_err_L")
+        measure = "rms_err_L" if cell(r, "horizon_s") != 0 else "tip_L"
+        lower = cell(r, measure) < cell(off, measure)
         not_raised = cell(r, "stretch_max_k") <= cell(off, "stretch_max_k")
-        out.append(LraVerdict(solver, i, r, off, lower, not_raised))
+        out.append(LraVerdict(solver, i, r, off, lower, not_raised, measure))
     return out

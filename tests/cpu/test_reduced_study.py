@@ -23,6 +23,7 @@ from harness.io.files import write_csv, write_json
 from harness.render import reduced_dynamic_report as reduced_report
 from harness.studies import reduced_dynamic as reduced
 from harness.studies import reduced_partial_dynamic as reduced_partial
+from harness.studies import reduced_reference_dynamic as reduced_ref
 from harness.studies import reduced_verdicts_dynamic as reduced_verdicts
 
 TINY = reduced.Plan(strands=(8, 16), seconds=4 / 60, write_every=1 / 60, fractions=(1.0, 0.5), ref_start=8,
@@ -47,7 +48,10 @@ def test_every_case_is_measured_and_written(rows):
     for r in got:
         assert r["median_ms"] > 0 and r["rest_max_L"] >= r["rest_rms_L"] >= 0
         if not r["study"].startswith("sag"):
-            assert r["rms_err_L"] >= 0 and r["max_err_L"] >= r["rms_err_L"] and r["horizon_s"] > 0
+            if r["horizon_s"] > 0:  # else the reference holds the ladder's rule at no frame: none judged pointwise
+                assert r["rms_err_L"] >= 0 and r["max_err_L"] >= r["rms_err_L"]
+            else:
+                assert r["horizon_s"] == 0 and r.get("rms_err_L") is None
             assert all(r[m] >= 0 for m in ("tip_L", "curvature_rel", "envelope_rel"))
         if r["study"] == "sagfreq":
             assert r["tip_hz"] > 0
@@ -61,7 +65,11 @@ def test_every_case_is_measured_and_written(rows):
     assert all(sag[(s, 1.0, 1)] < 0.1 * sag[(s, 1.0, 0)] for s in ("xpbd", "ftl")), sag
     refs = reduced_report.read(out.with_name("references.csv"))
     assert {(r["scene"], int(r["strands"])) for r in refs} == {("scene", 8), ("scene", 16), ("nod", 16), ("lod", 16)}
-    assert all(int(r["substeps"]) in (16, 32) and float(r["horizon_s"]) > 0 for r in refs)
+    assert all(int(r["substeps"]) in (16, 32) for r in refs)
+    for r in refs:  # the pointwise horizon: within T_p and the frames the ladder's rule holds over
+        h, c = float(r["horizon_s"]), float(r["converged_s"])
+        assert 0 <= h <= min(c, float(r["predictability_s"]) + 1 / 60, TINY.seconds) + 1e-9
+        assert (str(r["converged"]) == "True") == (h > 0)
 
 
 def test_report_section_renders_every_table(rows):
@@ -400,3 +408,24 @@ def test_the_solvers_option_reaches_the_plan(monkeypatch):
     assert harness_main(["reduced", "--solvers", "ftl", "xpbd", "--gpu", "no"]) == 0
     assert harness_main(["reduced", "--gpu", "no"]) == 0
     assert [p.solvers for p in plans] == [("ftl",), ("xpbd", "ftl"), ("xpbd", "ftl")]
+
+
+def test_the_pointwise_horizon_is_where_the_reference_holds_the_rule_from_the_start():
+    f = tolerances.DYN_ACC_REF_FACTOR
+    q = [math.nan, 0.5 * f, 0.9 * f, 2 * f, 0.5 * f]  # converged over 3 frames, not the 4th, again the 5th
+    assert reduced_ref.pointwise_frames(q, within=5) == (3, 3)
+    assert reduced_ref.pointwise_frames(q, within=2) == (2, 3)
+    assert reduced_ref.pointwise_frames([2 * f, 0.5 * f], within=2) == (0, 0)
+    assert reduced_ref.pointwise_frames([0.5 * f] * 4, within=4) == (4, 4)
+
+
+def test_with_no_frame_judged_pointwise_a_row_is_judged_by_its_statistics_alone():
+    row = dict(_row(1.0, "", math.nan), horizon_s="0", rms_err_L="")
+    assert "rms_err_L" not in reduced_verdicts.failures(row, "previews", {})
+    judged = dict(row, horizon_s="0.05")
+    assert "rms_err_L" in reduced_verdicts.failures(judged, "previews", {})
+    lra = {"study": "lra", "solver": "xpbd", "iterations": "1", "horizon_s": "0", "rms_err_L": "",
+           "stretch_max_k": "0.1"}  # fmt: skip
+    off, on = dict(lra, lra="0", tip_L="0.02"), dict(lra, lra="1", tip_L="0.01")
+    (v,) = reduced_verdicts.lra_verdicts([off, on])
+    assert v.measure == "tip_L" and v.lower and v.worth_it
