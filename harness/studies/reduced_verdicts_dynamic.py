@@ -16,9 +16,17 @@ from harness.io.tables import cell
 DISTANCES = ("tip_L", "curvature_rel", "envelope_rel")
 
 
+def _ref_key(scene, strands, substeps=None):
+    s = cell({"s": substeps}, "s")
+    return (scene, str(strands)) + ((int(s),) if math.isfinite(s) else ())
+
+
 def spreads(refs):
-    """{(scene, strands): {distance: spread}} of references.csv."""
-    return {(r["scene"], str(r["strands"])): {m: cell(r, f"{m}_spread") for m in DISTANCES} for r in refs}
+    """{(scene, strands, S): {distance: spread}} of references.csv: a study run in shares may hold two
+    references of one scene and strand count (each share's ladder ranks its own rows), so a row is
+    judged against the spread of the reference it was compared with (its ref_substeps)."""
+    return {_ref_key(r["scene"], r["strands"], r["substeps"]): {m: cell(r, f"{m}_spread") for m in DISTANCES}
+            for r in refs}  # fmt: skip
 
 
 def failures(r, use, spreads):
@@ -35,7 +43,10 @@ def failures(r, use, spreads):
     if not stretch <= stretch_budget:
         out.append("stretch")
     scene = {"guides": "scene", "lod": "lod", "lra": "nod"}.get(r["study"], "scene")
-    sp = spreads.get((scene, str(r["strands"])), {})
+    sp = spreads.get(_ref_key(scene, r["strands"], r.get("ref_substeps")))
+    if sp is None:  # a row without its reference's S (older files): the one reference of its scene
+        same = [v for k, v in spreads.items() if k[:2] == (scene, str(r["strands"]))]
+        sp = same[0] if len(same) == 1 else {}
     allow = tolerances.DYN_ACC_USES_CHAOS[use]
     out += [m for m in DISTANCES if math.isfinite(cell(r, m)) and not cell(r, m) <= sp.get(m, 0.0) + allow[m]]
     return out
@@ -86,7 +97,7 @@ def recommendations(rows, refs=()):
     """Per use: at each strand count the fewest guides (xpbd, the CPU's rows) and at the LOD's
     strand count the fewest simulated points that pass it."""
     sp = spreads(refs)
-    horizon = {(r["scene"], str(r["strands"])): cell(r, "horizon_s") for r in refs}
+    horizon = {(r["scene"], str(r["strands"])): cell(r, "horizon_s") for r in refs}  # rows without horizon_s
     cpu = [r for r in rows if r["backend"] == "cpu"]
     out = []
     for use in tolerances.DYN_ACC_USES:
@@ -97,7 +108,9 @@ def recommendations(rows, refs=()):
             full_fails = tuple(failures(full, use, sp)) if full is not None else ()
             ok = [r for r in rows_n if passes(r, use, sp)] if not full_fails else []
             pick = min(ok, key=lambda r: (cell(r, "guides"), cell(r, "rms_err_L"))) if ok else None
-            guides.append(GuidePick(n, pick, horizon.get(("scene", str(n)), math.nan), full, full_fails))
+            h = cell(pick or full or {}, "horizon_s")
+            h = h if math.isfinite(h) else horizon.get(("scene", str(n)), math.nan)
+            guides.append(GuidePick(n, pick, h, full, full_fails))
         lod_rows = [r for r in cpu if r["study"] == "lod" and r["solver"] == "xpbd"]
         every = [r for r in lod_rows if int(r["points"]) == int(r.get("render_points") or r["points"])]
         every_fails = tuple(failures(every[0], use, sp)) if every else ()

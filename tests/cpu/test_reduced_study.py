@@ -115,6 +115,18 @@ def test_a_stretched_follower_or_a_statistic_past_the_spread_fails_a_use():
     assert reduced_verdicts.passes(far, "previews", spreads) and not reduced_verdicts.passes(far, "games", spreads)
 
 
+def test_a_row_is_judged_against_the_spread_of_the_reference_it_was_compared_with():
+    # a study run in shares: the ftl share's ladder stopped at S = 256, the xpbd share's at 4096
+    game = tolerances.DYN_ACC_USES["games"][0]
+    zero = {"curvature_rel_spread": "0", "envelope_rel_spread": "0"}
+    refs = [{"scene": "scene", "strands": "1000", "substeps": str(S), "tip_L_spread": str(w), **zero}
+            for S, w in ((256, 0.5), (4096, 0.0))]  # fmt: skip
+    sp = reduced_verdicts.spreads(refs)
+    row = dict(_row(0.5, "blend3", 0.5 * game), tip_L=str(2 * game))
+    assert not reduced_verdicts.passes(dict(row, ref_substeps="4096"), "games", sp)
+    assert reduced_verdicts.passes(dict(row, ref_substeps="256"), "games", sp)
+
+
 def _lod(points, rms):
     return {"study": "lod", "solver": "xpbd", "backend": "cpu", "points": str(points), "render_points": "33",
             "rms_err_L": str(rms), "strands": "1000", "stretch_max_k": "0.001", "stretch_followers": "",
