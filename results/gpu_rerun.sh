@@ -10,8 +10,9 @@
 #                                                   # reduced-SHARE/: one share of the reduced study (1,000 and
 #                                                   # 10,000 strands, 1 s): guides (both strand counts, one timing
 #                                                   # each; over 10 minutes: a stopped call leaves its timings, the
-#                                                   # next one, --resume, keeps them; or in two shares that
-#                                                   # share no timing, guides-xpbd and guides-ftl, a GPU each),
+#                                                   # next one, --resume, keeps them; or in shares that
+#                                                   # share no timing, a GPU each: guides-xpbd and guides-ftl,
+#                                                   # or by strand count too, guides-xpbd-1k … guides-ftl-10k),
 #                                                   # lra (~240 s), sag (~80 s), lod (~230 s); reduced/ is the
 #                                                   # shares' CSVs joined in that order, header once
 #   OUT=$OUT bash results/gpu_rerun.sh stability [SLICE ...]
@@ -39,15 +40,20 @@ accuracy) "$py" -m harness accuracy --model dynamic --quick --gpu auto --force \
 curly) "$py" -m harness accuracy --model dynamic --scene curly --quick --analytic none --ref-max 4096 --gpu auto --force \
 	--out "$out/dynamic-accuracy-curly" --report-dir "$out/report" ;;
 reduced)
-	share=${2:?"usage: OUT=DIR bash results/gpu_rerun.sh reduced guides|guides-xpbd|guides-ftl|lra|sag|lod [--resume]"}
+	share=${2:?"usage: OUT=DIR bash results/gpu_rerun.sh reduced guides|guides-SOLVER[-1k|-10k]|lra|sag|lod [--resume]"}
 	case "$share" in
 	guides) args=(--strands 1000 10000 --parts guides) ;;
 	guides-xpbd | guides-ftl) args=(--strands 1000 10000 --parts guides --solvers "${share#guides-}") ;;
+	guides-xpbd-1k | guides-ftl-1k | guides-xpbd-10k | guides-ftl-10k)
+		solver=${share#guides-}
+		args=(--strands "${solver#*-}" --parts guides --solvers "${solver%-*}")
+		args[1]=${args[1]/k/000}
+		;;
 	lra) args=(--strands 1000 10000 --parts lra) ;;
 	sag) args=(--strands 1000 10000 --parts sagfree sagfreq) ;;
 	lod) args=(--strands 1000 10000 --parts lod) ;;
 	*)
-		echo "error: unknown reduced share '$share' (guides, guides-xpbd, guides-ftl, lra, sag, lod)" >&2
+		echo "error: unknown reduced share '$share' (guides, guides-xpbd, guides-ftl, guides-xpbd-1k … guides-ftl-10k, lra, sag, lod)" >&2
 		exit 2
 		;;
 	esac
