@@ -346,11 +346,13 @@ SAN_SIM := --strands 300 --points 45 --hair-length 10 --stages init,simulate --f
   --substeps 2 --iterations 2 --bend-compliance 1e-6 --shape-compliance 1e-5 --wind-speed 300 --drag 2 \
   --gust-amplitude 0.5 --head-motion nod --quiet
 # the world (docs/model.md §3.16, §3.17: lanes alone runs it): the grid at each rebuild and the default
-# body with friction and bounded depenetration, both solvers and precisions; 40 substeps make a frame
+# body with friction and bounded depenetration (also in 4 sweeps), both solvers and precisions; 40 substeps make a frame
 # take several launches where the staged colliders do not fit one (docs/cuda.md)
 SAN_WORLD := --strands 300 --points 32 --stages init,simulate --frames 2 --velocities all --variant lanes \
   --wind-speed 150 --gust-amplitude 0.5 --head-motion nod --quiet
 SAN_BODY := --colliders configs/bodies/default.colliders --friction 0.3,0.2 --depenetration-speed 200
+# the body's collision step in sweeps (docs/model.md §3.17): the warp's vote and the repeated sweep
+SAN_SWEEPS := --collider-sweeps 4
 sanitize-gpu: cuda sanitize-gpu-world
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
 	@set -e; for v in $$($(PYTHON) -c "from harness.core import variants; print(*variants.names('cuda'))"); do for p in fp32 fp64; do \
@@ -379,7 +381,8 @@ sanitize-gpu: cuda sanitize-gpu-world
 sanitize-gpu-world: cuda
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
 	@set -e; for p in fp32 fp64; do for s in xpbd ftl; do for w in "--grid 16 --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild held" \
-	  "--grid 16 --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild substep" "$(SAN_BODY)" "$(SAN_BODY) --grid 16 --grid-friction 0.05"; do \
+	  "--grid 16 --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild substep" "$(SAN_BODY)" "$(SAN_BODY) --grid 16 --grid-friction 0.05" \
+	  "$(SAN_BODY) $(SAN_SWEEPS)"; do \
 	  echo "memcheck world $$p $$s $$w"; \
 	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $$w \
 	    --precision $$p --solver $$s --substeps 4 --output $(BUILD)/san-world-$$p-$$s.h5 --force; \
@@ -390,6 +393,9 @@ sanitize-gpu-world: cuda
 	  echo "racecheck world $$p"; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) --grid 16 \
 	    --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild held --precision $$p --substeps 40 --frames 1; \
+	  echo "racecheck world $$p $(SAN_SWEEPS)"; \
+	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) $(SAN_SWEEPS) \
+	    --precision $$p --substeps 40 --frames 1; \
 	done; rm -f $(BUILD)/san-world-*.h5; echo "compute-sanitizer: memcheck and racecheck found no errors in the world's kernels"
 
 # ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----

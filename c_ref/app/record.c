@@ -198,6 +198,7 @@ void hb_record_json(FILE *f, const hb_record *r)
             fprintf(f, ", \"frames\": %lld, \"substeps\": %lld, \"iterations\": %lld, \"solver\": \"%s\"",
                     (long long)st->frames, (long long)d->substeps, (long long)d->iterations, hb_solver_name(d->solver));
             json_key_str(f, "features", st->features);
+            fprintf(f, ", \"collider_sweeps\": %lld", (long long)d->collider_sweeps); /* §3.17 */
             json_key_num(f, "frame_dt", d->frame_dt);
             /* point-substeps per second of the median frame */
             json_key_num(f, "point_substeps_per_s",

@@ -2,6 +2,7 @@
 #include "app/state_io.h"
 #include "runtime/safe_write.h"
 #include "runtime/checked.h"
+#include "runtime/cli.h" /* HB_COLLIDER_SWEEPS_MAX */
 #include "runtime/h5md_meta.h"
 #include "runtime/input.h"
 #include "dynamic/motion_track.h"
@@ -510,6 +511,7 @@ static int write_world(hid_t p, const hb_dynamics *d)
     bad |= attr_f64v(p, "friction", d->friction, 2) < 0;
     bad |= attr_i64(p, "depenetration_declared", d->depen_declared) < 0;
     bad |= attr_f64(p, "depenetration_speed", d->depen_speed) < 0;
+    bad |= attr_i64(p, "collider_sweeps", d->collider_sweeps) < 0;
     bad |= attr_str(p, "body_motion",
                     d->body_motion == HB_BODY_SWAY   ? "sway"
                     : d->body_motion == HB_BODY_RISE ? "rise"
@@ -948,6 +950,10 @@ static int input_world(hb_input *in, const char *path, hid_t p, char *err, size_
         d->depen_declared = 1;
         if (read_attr(p, "depenetration_speed", H5T_NATIVE_DOUBLE, &d->depen_speed) < 0) BAD("depenetration_speed");
     }
+    d->collider_sweeps = 1; /* absent in files written before sweeps: one */
+    if (read_attr(p, "collider_sweeps", H5T_NATIVE_INT64, &d->collider_sweeps) == 0 &&
+        !(d->collider_sweeps >= 1 && d->collider_sweeps <= HB_COLLIDER_SWEEPS_MAX))
+        BAD("collider_sweeps");
     if (read_attr_str(p, "body_motion", word, sizeof word) == 0) {
         if (strcmp(word, "sway") == 0) d->body_motion = HB_BODY_SWAY;
         else if (strcmp(word, "rise") == 0) d->body_motion = HB_BODY_RISE;

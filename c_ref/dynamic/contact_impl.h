@@ -7,6 +7,7 @@
  */
 #include <math.h>
 #include <stdint.h>
+#include <string.h> /* memcpy */
 
 #include "runtime/philox.h" /* HB_HD */
 
@@ -23,6 +24,9 @@
 #define HB_GRID_VEL_SCALE 16384.0                     /* 2^14 = 2^24 / 2^10 */
 #define HB_GRID_VEL_CLAMP 1048576.0                   /* 2^20 cm/s */
 #define HB_GRID_INV_MASS_SCALE 5.9604644775390625e-08 /* 2^-24 */
+/* §3.17 the head sphere in a sweep (hb_collide_sweeps): none (undeclared, or a judge's plant), its
+ * plain projection of §3.5, or with its friction or a bounded depenetration (hb_collide_head) */
+enum { HB_HEAD_NONE = 0, HB_HEAD_PLAIN = 1, HB_HEAD_WORLD = 2 };
 #endif
 
 /* §3.16 the grid coordinates of x (u = Q_gᵀ·x, or x with qg = NULL): 1 and the index of its
@@ -332,7 +336,7 @@ HB_HD void SFX(hb_collide_one)(const WORLD *w, int i, const REAL *pose, const RE
     }
     const int kind = w->col_kind[i], frame = w->col_frame[i];
     const int turn = frame == HB_FRAME_HEAD && w->motion, sway = frame == HB_FRAME_BODY && w->sway;
-    REAL n[3], c[3], d;
+    REAL n[3], c[3] = {(REAL)0, (REAL)0, (REAL)0}, d; /* c: a sphere's or capsule's centre */
     if (kind == HB_COL_SPHERE || kind == HB_COL_CAPSULE) {
         if (kind == HB_COL_SPHERE) {
             for (int k = 0; k < 3; k++) c[k] = pose[k];
@@ -386,6 +390,64 @@ HB_HD void SFX(hb_collide_head)(const WORLD *w, REAL rc, const REAL *back, REAL 
     SFX(hb_sphere_move)(p, origin, rc, n, m, !w->bounded);
     if (m > (REAL)0 && w->head_friction && w->head_mu_s > (REAL)0)
         SFX(hb_friction)(p, x, n, m, w->head_mu_s, w->head_mu_k, w->motion, 0, back);
+}
+
+/* The head sphere of §3.5 alone (no friction, unbounded): a point inside R_c goes to its surface
+ * along the ray from the centre; the centre itself goes to (0, R_c, 0). */
+HB_HD void SFX(hb_head_sphere)(REAL *p, REAL rc)
+{
+    const REAL len = SQRT(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    if (!(len < rc)) return;
+    if (len == (REAL)0) {
+        p[0] = (REAL)0;
+        p[1] = rc;
+        p[2] = (REAL)0;
+        return;
+    }
+    const REAL sc = rc / len;
+    p[0] = p[0] * sc;
+    p[1] = p[1] * sc;
+    p[2] = p[2] * sc;
+}
+
+/* Whether any bit of p differs from q's (a sweep that changes no bit of p would change none again),
+ * and q ← p. */
+HB_HD int SFX(hb_moved)(const REAL *p, REAL *q)
+{
+    int moved = 0;
+    for (int c = 0; c < 3; c++) {
+        RBITS a, b;
+        memcpy(&a, &p[c], sizeof a);
+        memcpy(&b, &q[c], sizeof b);
+        moved |= a != b;
+        q[c] = p[c];
+    }
+    return moved;
+}
+
+/* §3.17 the collision step of one point p (x: where it was at the substep's start): the sweep,
+ * the head sphere (head: HB_HEAD_*) then each collider in order with its friction, run again
+ * while it moves p (any of them changes a bit of it), w->sweeps sweeps at most. One sweep (w->sweeps = 1)
+ * is the collision step as it was before sweeps, the same operations. pose: collider i's at
+ * pose + i·HB_COL_POSE; back: the substep's back-transforms. The C reference (dynamics_impl.h)
+ * and the SIMD backend (dynamics_simd_impl.h) call this; the CUDA port's lanes kernel takes the
+ * same steps a warp at a time (cuda/dynamic/lanes.cu collide_points). */
+HB_HD void SFX(hb_collide_sweeps)(const WORLD *w, REAL rc, int head, const REAL *pose, const REAL *back, REAL *p,
+                                  const REAL *x)
+{
+    for (int s = 1;; s++) {              /* one sweep at least, whatever w->sweeps says */
+        const int track = s < w->sweeps; /* whether another sweep may follow */
+        int moved = 0;
+        REAL q[3] = {p[0], p[1], p[2]};
+        if (head == HB_HEAD_PLAIN) SFX(hb_head_sphere)(p, rc);
+        else if (head == HB_HEAD_WORLD) SFX(hb_collide_head)(w, rc, back, p, x);
+        if (track && head != HB_HEAD_NONE) moved |= SFX(hb_moved)(p, q);
+        for (int i = 0; i < w->ncol; i++) {
+            SFX(hb_collide_one)(w, i, pose + (size_t)i * HB_COL_POSE, back, p, x);
+            if (track) moved |= SFX(hb_moved)(p, q);
+        }
+        if (!moved) return;
+    }
 }
 
 /* The depth of x (double) inside collider i with pose `pose` (§3.8 penetration_max), or 0. */

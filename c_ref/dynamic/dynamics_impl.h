@@ -80,21 +80,10 @@ HB_ALWAYS_INLINE void SFX(shape_pull)(REAL *p, const REAL *t, REAL at, REAL *lam
 }
 
 /* §3.5 head collision: a point inside the sphere R_c goes to its surface along the ray
- * from the centre; the centre itself goes to (0, R_c, 0). */
+ * from the centre; the centre itself goes to (0, R_c, 0) (contact_impl.h hb_head_sphere). */
 HB_ALWAYS_INLINE void SFX(collide_sphere)(REAL *p, REAL rc)
 {
-    const REAL len = SQRT(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-    if (!(len < rc)) return;
-    if (len == (REAL)0) {
-        p[0] = (REAL)0;
-        p[1] = rc;
-        p[2] = (REAL)0;
-        return;
-    }
-    const REAL sc = rc / len;
-    p[0] = p[0] * sc;
-    p[1] = p[1] * sc;
-    p[2] = p[2] * sc;
+    SFX(hb_head_sphere)(p, rc);
 }
 
 #if HB_PLANT == 5 /* judge test: the bend rest length from the current shape, not the rest shape */
@@ -154,18 +143,17 @@ HB_ALWAYS_INLINE void SFX(lra_all)(const DMODEL *m, REAL *p)
 }
 
 /* §3.6 step 7 / §3.7's collision of one point p (x: where it was at the substep's start): the
- * head sphere, then the colliders of §3.17, each with its friction. */
+ * head sphere, then the colliders of §3.17, each with its friction, in sweeps (contact_impl.h
+ * hb_collide_sweeps, which the SIMD backend calls too). */
 HB_ALWAYS_INLINE void SFX(collide_point)(const DMODEL *m, const WORLD *w, const REAL *pose, const REAL *back, REAL *p,
                                          const REAL *x, int64_t k, const unsigned F)
 {
     const int64_t P = m->points; /* PLANT_SKIPPED's */
     (void)P;
-    if ((F & HB_F_COLLIDE) && !PLANT_SKIPPED(k)) {
-        if (w && (w->head_friction || w->bounded)) SFX(hb_collide_head)(w, m->collide_r, back, p, x);
-        else SFX(collide_sphere)(p, m->collide_r);
-    }
-    if (w)
-        for (int i = 0; i < w->ncol; i++) SFX(hb_collide_one)(w, i, pose + (size_t)i * HB_COL_POSE, back, p, x);
+    const int head = !(F & HB_F_COLLIDE) || PLANT_SKIPPED(k) ? HB_HEAD_NONE
+                     : w->head_friction || w->bounded        ? HB_HEAD_WORLD
+                                                             : HB_HEAD_PLAIN;
+    SFX(hb_collide_sweeps)(w, m->collide_r, head, pose, back, p, x);
 }
 
 /* Substeps j0 … j1 − 1 of a frame of one strand: §3.4, the solver of §3.6, §3.7 or §3.13 (rigid).

@@ -2,6 +2,7 @@
  * simd/dynamics_simd_impl.h), for float; precision_end.h removes them. Included by the files
  * that instantiate the math (dynamic/dynamics_f32.c, simd/dynamics_simd.c). */
 #define REAL float
+#define RBITS uint32_t /* REAL's bits */
 #define SFX(name) name##_f32
 #define DMODEL hb_dyn_model_f32
 #define WORLD hb_dyn_world_f32

@@ -1,5 +1,6 @@
 /* precision_f64.h — as precision_f32.h, for double. */
 #define REAL double
+#define RBITS uint64_t /* REAL's bits */
 #define SFX(name) name##_f64
 #define DMODEL hb_dyn_model_f64
 #define WORLD hb_dyn_world_f64

@@ -62,6 +62,7 @@ typedef struct hb_colliders {
         int ncol;                                                                                                      \
         int bounded; /* --depenetration-speed declared */                                                              \
         T depen;     /* V·h */                                                                                        \
+        int sweeps;  /* the collision sweeps a point, at most: --collider-sweeps with colliders, else 1 */             \
         int head_friction;                                                                                             \
         T head_mu_s, head_mu_k;                                                                                        \
         int motion, sway; /* the head turns (its back-transform is evaluated); the body sways */                       \

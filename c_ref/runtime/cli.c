@@ -364,6 +364,9 @@ static const flag_spec flags[] = {
      "MU_S[,MU_K]: the head sphere's Coulomb friction (default: frictionless)"},
     {"--depenetration-speed", DF_REAL, DYN(depen_speed), DYN(depen_declared),
      "V, cm/s: a point inside a collider at a substep's start leaves it at V at most (default: unbounded)"},
+    {"--collider-sweeps", DF_COUNT, DYN(collider_sweeps), 0,
+     "N in 1..8: the collision sweep (head sphere, then each collider) runs again while it moves a point, N\n"
+     "sweeps at most (default 1; docs/model.md §3.17)"},
     {"--body-motion", DF_BODY, DYN(body_motion), 0,
      "still | sway (along x) | rise (from A_b below, in 1/f_b s): the body frame's motion (default still)"},
     {"--body-amplitude", DF_REAL, DYN(body_amplitude), 0, "the body's sway or rise A_b, cm (default 2)"},
@@ -918,6 +921,7 @@ void hb_print_limits(FILE *f, const char *backend)
     fprintf(f, "\"substep_s\": [%.15g, %.15g], ", HB_SUBSTEP_MIN_S, HB_SUBSTEP_MAX_S);
     fprintf(f, "\"grid_n\": [%d, %d], \"grid_points_max\": %llu, ", HB_GRID_N_MIN, HB_GRID_N_MAX,
             (unsigned long long)HB_GRID_POINTS_MAX);
+    fprintf(f, "\"collider_sweeps\": [1, %d], ", HB_COLLIDER_SWEEPS_MAX);
     fprintf(f, "\"block_size\": {\"min\": %lld, \"max\": %lld, \"multiple\": %d}, ", (long long)block->lo,
             (long long)block->hi, HB_BLOCK_MULTIPLE);
     fprintf(f, "\"threads\": [%lld, %lld]}\n", (long long)threads->lo, (long long)threads->hi);

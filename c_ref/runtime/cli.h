@@ -25,6 +25,7 @@ void hb_default_options(hb_options *o);
 #define HB_GRID_N_MIN 2 /* --grid nodes per axis */
 #define HB_GRID_N_MAX 512
 #define HB_GRID_POINTS_MAX (UINT64_C(1) << 31) /* --strands x --points with --grid */
+#define HB_COLLIDER_SWEEPS_MAX 8               /* --collider-sweeps at most (docs/model.md §3.17) */
 #define HB_BLOCK_MULTIPLE 32                   /* --block-size: a whole number of warps */
 /* Prints the limits as one JSON object (--limits). */
 void hb_print_limits(FILE *f, const char *backend);

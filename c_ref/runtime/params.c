@@ -153,6 +153,7 @@ void hb_dynamics_defaults(hb_dynamics *d)
     d->grid_padding = 2.0;
     d->body_amplitude = 2.0;
     d->body_frequency = 1.0;
+    d->collider_sweeps = 1;
 }
 
 int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
@@ -217,6 +218,9 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
         FAIL("--friction needs 0 <= MU_K <= MU_S, finite (got %g,%g)", d->friction[0], d->friction[1]);
     if (d->depen_declared && !(d->depen_speed > 0.0))
         FAIL("--depenetration-speed must be > 0 (got %g)", d->depen_speed);
+    if (d->collider_sweeps < 1 || d->collider_sweeps > HB_COLLIDER_SWEEPS_MAX)
+        FAIL("--collider-sweeps must be from 1 to %d (got %lld)", HB_COLLIDER_SWEEPS_MAX,
+             (long long)d->collider_sweeps);
     /* h = Δt/S and α/h² must stay normal numbers in double */
     const double h = d->frame_dt / (double)d->substeps;
     if (!(h >= HB_SUBSTEP_MIN_S && h <= HB_SUBSTEP_MAX_S))

@@ -85,6 +85,7 @@ typedef struct {
     double friction[2];                    /* μ_s, μ_k of the head sphere */
     int depen_declared;                    /* --depenetration-speed given */
     double depen_speed;                    /* V, cm/s */
+    int64_t collider_sweeps;               /* --collider-sweeps: the collision sweep a point, at most (1: once) */
     int body_motion;                       /* hb_body_motion */
     double body_amplitude, body_frequency; /* A_b (cm), f_b (Hz) */
 } hb_dynamics;

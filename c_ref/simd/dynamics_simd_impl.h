@@ -140,18 +140,17 @@ HB_ALWAYS_INLINE void SFX(collide_lanes)(const DMODEL *m, REAL *scratch, const i
     }
 }
 
-/* §3.6 step 7 / §3.7 with the colliders of §3.17 on row k (≥ 1) of p, lane by lane with the
- * reference's operations (dynamics_impl.h collide_point): the head sphere with its friction or
- * bounded depenetration (its plain projection is collide_lanes'), then each collider with its
- * friction; x: the row at the substep's start. */
+/* §3.6 step 7 / §3.7 with the colliders of §3.17 on row k (≥ 1) of p, lane by lane: the
+ * reference's collision step itself (contact_impl.h hb_collide_sweeps: the head sphere as `head`
+ * says, HB_HEAD_NONE where collide_lanes projected it already, then each collider with its
+ * friction, in sweeps); x: the row at the substep's start. */
 HB_ALWAYS_INLINE void SFX(world_row)(const WORLD *w, const REAL *pose, const REAL *back, const REAL rc, const int head,
                                      REAL *px, REAL *py, REAL *pz, const REAL *x, const REAL *y, const REAL *z)
 {
     for (int l = 0; l < DB; l++) {
         REAL p[3] = {px[l], py[l], pz[l]};
         const REAL xs[3] = {x[l], y[l], z[l]};
-        if (head) SFX(hb_collide_head)(w, rc, back, p, xs);
-        for (int i = 0; i < w->ncol; i++) SFX(hb_collide_one)(w, i, pose + (size_t)i * HB_COL_POSE, back, p, xs);
+        SFX(hb_collide_sweeps)(w, rc, head, pose, back, p, xs);
         px[l] = p[0];
         py[l] = p[1];
         pz[l] = p[2];
@@ -391,9 +390,12 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
                                      const unsigned F)
 {
     /* §3.17 (wc: the colliders, or the head sphere's friction or bounded depenetration): the head
-     * sphere's plain projection stays collide_lanes' where the world does not take it */
+     * sphere's plain projection stays collide_lanes' where the world does not take it, and where
+     * its sweep is not repeated (a repeated sweep holds the head sphere: hb_collide_sweeps) */
     const int head_world = wc && (F & HB_F_COLLIDE) && (wc->head_friction || wc->bounded);
-    const int plain = (F & HB_F_COLLIDE) && !head_world;
+    const int head_swept = wc && (F & HB_F_COLLIDE) && !head_world && wc->sweeps > 1;
+    const int plain = (F & HB_F_COLLIDE) && !head_world && !head_swept;
+    const int head = head_world ? HB_HEAD_WORLD : head_swept ? HB_HEAD_PLAIN : HB_HEAD_NONE;
     const int64_t P = m->points;
     const REAL ell = K->ell;
     const int per_seg = SR != NULL; /* §3.15: a groom's ℓ_k, row k − 1 of SR */
@@ -421,7 +423,7 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
                 if (wc) {
                     const REAL *xr = AL(ROWP(X, k)), *yr = AL(ROWP(Y, k)), *zr = AL(ROWP(Z, k));
                     REAL *qx = SROW(3 * k), *qy = SROW(3 * k + 1), *qz = SROW(3 * k + 2);
-                    SFX(world_row)(wc, pose, back, K->rc, head_world, qx, qy, qz, xr, yr, zr);
+                    SFX(world_row)(wc, pose, back, K->rc, head, qx, qy, qz, xr, yr, zr);
                 }
             }
         }
@@ -465,7 +467,7 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
         if (plain) SFX(collide_lanes)(m, scratch, k, K);
         if (wc) {
             const REAL *xr = AL(ROWP(X, k)), *yr = AL(ROWP(Y, k)), *zr = AL(ROWP(Z, k));
-            SFX(world_row)(wc, pose, back, K->rc, head_world, px, py, pz, xr, yr, zr);
+            SFX(world_row)(wc, pose, back, K->rc, head, px, py, pz, xr, yr, zr);
         }
         if (k >= 2) SFX(update_row)(K, scratch, X, Y, Z, VX, VY, VZ, stride, k - 1, dx, dy, dz);
     }

@@ -304,48 +304,78 @@ template <typename T> __device__ __forceinline__ bool col_in_bound(const T *pose
     return (bx * bx + by * by) + bz * bz < pose[19];
 }
 
+/* Whether any bit of p differs from q's (contact_impl.h hb_moved); maybe_unused: each object is one
+ * precision */
+[[maybe_unused]] __device__ __forceinline__ bool bits_differ(float a, float b)
+{
+    return __float_as_uint(a) != __float_as_uint(b);
+}
+[[maybe_unused]] __device__ __forceinline__ bool bits_differ(double a, double b)
+{
+    return __double_as_longlong(a) != __double_as_longlong(b);
+}
+template <typename T> __device__ __forceinline__ bool moved_from(const V3<T> &q, const V3<T> &p)
+{
+    return bits_differ(p.x, q.x) || bits_differ(p.y, q.y) || bits_differ(p.z, q.z);
+}
+
 /* §3.6 step 7 and §3.7 with the colliders of §3.17 on a lane's NP points p (on: those that
- * collide; x: their positions at the substep's start): on each, the head sphere (with its friction
- * or a bounded depenetration), then each collider with its friction. The points are independent,
- * so taking them collider by collider keeps each point's order. A point outside a collider's bound
- * skips it (hb_collide_one would return p as it is: the strict build keeps the CPU's bits), and
- * the lanes of `mask`, which call this together, skip it together when none of theirs is inside. */
+ * collide; x: their positions at the substep's start): contact_impl.h hb_collide_sweeps's steps,
+ * the sweep (on each point the head sphere, with its friction or a bounded depenetration, then
+ * each collider with its friction) run again while it moves a point, w.sweeps sweeps at most.
+ * The points are independent, so taking them collider by collider keeps each point's order. A
+ * point outside a collider's bound skips it (hb_collide_one would return p as it is: the strict
+ * build keeps the CPU's bits), and the lanes of `mask`, which call this together, skip it together
+ * when none of theirs is inside. They sweep all their points again while any lane's point moved
+ * (a warp vote): a point the CPU has stopped (its last sweep changed no bit of it) goes through a
+ * sweep on the same bits, which changes none again, so each point ends with the CPU's bits. No
+ * flag a point or a lane: the fewest registers (ptxas, docs/cuda.md "The hair–hair grid and the
+ * colliders"). */
 template <int NP, typename T, class Feat>
 __device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, const T *pose, const T *back, V3<T> *p,
                                                const V3<T> *x, const bool *on, unsigned mask)
 {
     const World<T> &w = m.world;
-#pragma unroll
-    for (int s = 0; s < NP; s++) {
-        if (!on[s] || !has(HB_F_COLLIDE)) continue;
-        if (w.head_friction || w.bounded) {
-            T pp[3] = {p[s].x, p[s].y, p[s].z};
-            const T xx[3] = {x[s].x, x[s].y, x[s].z};
-            if constexpr (kFreeCollide) collide_head_free(w, m.collide_r, back, pp, xx);
-            else collide_head(w, m.collide_r, back, pp, xx);
-            p[s] = V3<T>{pp[0], pp[1], pp[2]};
-        } else {
-            collide(m, p[s]);
-        }
-    }
-    for (int i = 0; i < w.ncol; i++) {
-        const T *pi = pose + i * HB_COL_POSE;
-        bool in[NP], any = false;
+    for (int sweep = 1;; sweep++) {
+        const bool track = sweep < w.sweeps; /* whether another sweep may follow */
+        bool moved = false;
 #pragma unroll
         for (int s = 0; s < NP; s++) {
-            in[s] = on[s] && col_in_bound(pi, p[s]);
-            any = any || in[s];
+            if (!on[s] || !has(HB_F_COLLIDE)) continue;
+            const V3<T> was = p[s];
+            if (w.head_friction || w.bounded) {
+                T pp[3] = {p[s].x, p[s].y, p[s].z};
+                const T xx[3] = {x[s].x, x[s].y, x[s].z};
+                if constexpr (kFreeCollide) collide_head_free(w, m.collide_r, back, pp, xx);
+                else collide_head(w, m.collide_r, back, pp, xx);
+                p[s] = V3<T>{pp[0], pp[1], pp[2]};
+            } else {
+                collide(m, p[s]);
+            }
+            moved = moved || (track && moved_from(was, p[s]));
         }
-        if (!__any_sync(mask, any)) continue;
+        for (int i = 0; i < w.ncol; i++) {
+            const T *pi = pose + i * HB_COL_POSE;
+            bool in[NP], any = false;
 #pragma unroll
-        for (int s = 0; s < NP; s++) {
-            if (!in[s]) continue;
-            T pp[3] = {p[s].x, p[s].y, p[s].z};
-            const T xx[3] = {x[s].x, x[s].y, x[s].z};
-            if constexpr (kFreeCollide) collide_one_free(w, i, pi, back, pp, xx);
-            else collide_one(w, i, pi, back, pp, xx);
-            p[s] = V3<T>{pp[0], pp[1], pp[2]};
+            for (int s = 0; s < NP; s++) {
+                in[s] = on[s] && col_in_bound(pi, p[s]);
+                any = any || in[s];
+            }
+            if (!__any_sync(mask, any)) continue;
+#pragma unroll
+            for (int s = 0; s < NP; s++) {
+                if (!in[s]) continue;
+                T pp[3] = {p[s].x, p[s].y, p[s].z};
+                const T xx[3] = {x[s].x, x[s].y, x[s].z};
+                if constexpr (kFreeCollide) collide_one_free(w, i, pi, back, pp, xx);
+                else collide_one(w, i, pi, back, pp, xx);
+                const V3<T> np{pp[0], pp[1], pp[2]};
+                moved = moved || (track && moved_from(p[s], np));
+                p[s] = np;
+            }
         }
+        if (!track || !__any_sync(mask, moved)) return;
     }
 }
 

@@ -17,6 +17,7 @@ class Limits:
     substep_s: tuple  # (shortest, longest) h = frame_dt / substeps, s
     grid_n: tuple  # (fewest, most) grid nodes per axis
     grid_points_max: int  # strands x points with a grid
+    collider_sweeps: tuple  # (fewest, most) --collider-sweeps
     block_size: tuple  # (min, max, multiple) cuda threads per block
     threads: tuple  # (min, max) cpu threads
 
@@ -47,6 +48,7 @@ def _read(path):
             substep_s=(float(d["substep_s"][0]), float(d["substep_s"][1])),
             grid_n=(int(d["grid_n"][0]), int(d["grid_n"][1])),
             grid_points_max=int(d["grid_points_max"]),
+            collider_sweeps=(int(d["collider_sweeps"][0]), int(d["collider_sweeps"][1])),
             block_size=(int(block["min"]), int(block["max"]), int(block["multiple"])),
             threads=(int(d["threads"][0]), int(d["threads"][1])),
         )

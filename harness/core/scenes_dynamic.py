@@ -44,6 +44,7 @@ A scene with `model = "dynamic"` may hold, besides the paper keys:
     colliders = "FILE"         # relative to the scene file's folder  --colliders
     friction = [0.3, 0.2]      # the head sphere's μ_s[, μ_k]  --friction
     depenetration_speed = 200  # V > 0 (cm/s)   --depenetration-speed
+    collider_sweeps = 4        # N in 1 … 8     --collider-sweeps (the collision sweep again while it moves a point)
     motion = "rise"            # still | sway | rise  --body-motion
     amplitude = 20.0           # A_b ≥ 0 (cm)   --body-amplitude
     frequency = 2.0            # f_b ≥ 0 (Hz)   --body-frequency
@@ -96,6 +97,7 @@ TABLES = {
         "colliders": ("--colliders", "path"),
         "friction": ("--friction", "pair"),
         "depenetration_speed": ("--depenetration-speed", "pos"),
+        "collider_sweeps": ("--collider-sweeps", "count"),
         "motion": ("--body-motion", ("still", "sway", "rise")),
         "amplitude": ("--body-amplitude", "nonneg"),
         "frequency": ("--body-frequency", "nonneg"),
@@ -167,6 +169,9 @@ def _value(where, key, kind, value, error):
             raise error(f"{where}: {key} {why}")
         if key == "grid.nodes" and not limits().grid_n[0] <= value <= limits().grid_n[1]:
             raise error(f"{where}: {key} must lie in {limits().grid_n[0]} … {limits().grid_n[1]}, got {value}")
+        if key == "body.collider_sweeps" and not limits().collider_sweeps[0] <= value <= limits().collider_sweeps[1]:
+            lo, hi = limits().collider_sweeps
+            raise error(f"{where}: {key} must lie in {lo} … {hi}, got {value}")
         return value
     x = float(value)
     if kind == "count" or kind == "real":

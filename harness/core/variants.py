@@ -101,6 +101,7 @@ FEATURE_FLAGS = {
     "--colliders": "colliders",
     "--friction": "friction",
     "--depenetration-speed": "friction",
+    "--collider-sweeps": "colliders",  # the colliders' step repeated (no effect without them)
 }
 
 

@@ -87,6 +87,7 @@ DYNAMIC_ATTRS = (
     "friction",
     "depenetration_declared",
     "depenetration_speed",
+    "collider_sweeps",
     "body_motion",
     "body_amplitude",
     "body_frequency",

@@ -137,7 +137,7 @@ def _grid_flag(f):
 
 
 def _body_flag(f):
-    return f in ("--colliders", "--friction", "--depenetration-speed") or f.startswith("--body-")
+    return f in ("--colliders", "--friction", "--depenetration-speed", "--collider-sweeps") or f.startswith("--body-")
 
 
 def grid_variants(plan):

@@ -78,7 +78,8 @@ def world_rows(flags):
     (colliders and friction), and both, from WORLD_SCENE's [grid] and [body] tables."""
     extra = scenes.load_scene(WORLD_SCENE).flags()
     grid = _pick(extra, lambda f: f.startswith("--grid"))
-    body = _pick(extra, lambda f: f in ("--colliders", "--friction", "--depenetration-speed") or f.startswith("--body"))
+    body_flags = ("--colliders", "--friction", "--depenetration-speed", "--collider-sweeps")
+    body = _pick(extra, lambda f: f in body_flags or f.startswith("--body"))
     substep = _set(grid, "--grid-rebuild", "substep")
     return [
         ("full + grid (once a frame)", [*flags, *grid]),

@@ -283,6 +283,10 @@ BODIES = {
     "body-sway": [*BODY, "--depenetration-speed", 200, "--body-motion", "sway", "--body-amplitude", 3],
     "head-friction": ["--friction", "0.4,0.3"],  # no --colliders: the head sphere's friction alone
     "body-and-grid": [*BODY, "--depenetration-speed", 200, *GRID, "--grid-rebuild", "held"],
+    # §3.17 the collision step in sweeps: with the head sphere's friction and the bound, and with its
+    # plain projection (which simd then takes inside the sweep, not collide_lanes')
+    "body-sweeps": [*BODY, "--depenetration-speed", 200, "--collider-sweeps", 4],
+    "body-plain-sweeps": ["--collider-sweeps", 4],
 }
 
 
@@ -302,6 +306,24 @@ def test_the_colliders_within_the_rule(cpu_bin, inputs, tmp_path, precision, sol
 @needs_simd
 def test_the_colliders_move_the_hair(cpu_bin, inputs, tmp_path):
     assert_moves_like_ref(cpu_bin, inputs("fp64", 16), tmp_path, [*COLLIDERS, *BODIES["body"]], 1e-2)
+
+
+@needs_simd
+@pytest.mark.parametrize("body", ["body-sweeps", "body-plain-sweeps"])
+def test_the_sweeps_move_the_hair_as_refs_do(cpu_bin, inputs, tmp_path, body):
+    """4 sweeps against 1 on the default body (its shoulders overlap its neck): simd's frames move by
+    what ref's do (the sweeps are the reference's own hb_collide_sweeps in both)."""
+    inp = inputs("fp64", 16)
+    args = ["--solver", "xpbd", *ALL, *COLLIDERS, *BODIES[body], "--velocities", "all"]
+    runs = {
+        (v, n): read(simulate(cpu_bin, inp, tmp_path / f"{v}{n}.h5", v, *args, "--collider-sweeps", n, frames=3))[0]
+        for v in ("ref", "simd")
+        for n in (1, 4)
+    }
+    effect_ref = np.abs(runs["ref", 4] - runs["ref", 1]).max()
+    effect_simd = np.abs(runs["simd", 4] - runs["simd", 1]).max()
+    assert effect_ref > 1e-3, effect_ref
+    assert abs(effect_simd - effect_ref) < 1e-6 * effect_ref, (effect_simd, effect_ref)
 
 
 @needs_simd

@@ -23,6 +23,7 @@ def test_the_binary_prints_one_json_object_and_the_harness_reads_it(cpu_bin):
     got = limits()
     assert got.substeps_max == printed["substeps_max"] and got.iterations_max == printed["iterations_max"]
     assert got.substep_s == tuple(printed["substep_s"]) and got.grid_n == tuple(printed["grid_n"])
+    assert got.collider_sweeps == tuple(printed["collider_sweeps"])
     assert got.block_size == (
         printed["block_size"]["min"],
         printed["block_size"]["max"],

@@ -54,6 +54,7 @@ LIMITS = {
     "substep_s": [1e-9, 1.0],
     "grid_n": [2, 64],
     "grid_points_max": 1 << 20,
+    "collider_sweeps": [1, 8],
     "block_size": {"min": 32, "max": 1024, "multiple": 32},
     "threads": [1, 64],
 }
