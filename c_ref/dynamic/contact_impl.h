@@ -27,6 +27,12 @@
 /* §3.17 the head sphere in a sweep (hb_collide_sweeps): none (undeclared, or a judge's plant), its
  * plain projection of §3.5, or with its friction or a bounded depenetration (hb_collide_head) */
 enum { HB_HEAD_NONE = 0, HB_HEAD_PLAIN = 1, HB_HEAD_WORLD = 2 };
+/* HB_HD, inlined where the C compiler would call it (the collision step, in every feature set's loop) */
+#ifdef __CUDACC__
+#define HB_HD_INLINE HB_HD
+#else
+#define HB_HD_INLINE static inline __attribute__((always_inline))
+#endif
 #endif
 
 /* §3.16 the grid coordinates of x (u = Q_gᵀ·x, or x with qg = NULL): 1 and the index of its
@@ -432,10 +438,16 @@ HB_HD int SFX(hb_moved)(const REAL *p, REAL *q)
  * pose + i·HB_COL_POSE; back: the substep's back-transforms. The C reference (dynamics_impl.h)
  * and the SIMD backend (dynamics_simd_impl.h) call this; the CUDA port's lanes kernel takes the
  * same steps a warp at a time (cuda/dynamic/lanes.cu collide_points). */
-HB_HD void SFX(hb_collide_sweeps)(const WORLD *w, REAL rc, int head, const REAL *pose, const REAL *back, REAL *p,
-                                  const REAL *x)
+HB_HD_INLINE void SFX(hb_collide_sweeps)(const WORLD *w, REAL rc, int head, const REAL *pose, const REAL *back, REAL *p,
+                                         const REAL *x)
 {
-    for (int s = 1;; s++) {              /* one sweep at least, whatever w->sweeps says */
+    if (w->sweeps <= 1) { /* one sweep: nothing to compare */
+        if (head == HB_HEAD_PLAIN) SFX(hb_head_sphere)(p, rc);
+        else if (head == HB_HEAD_WORLD) SFX(hb_collide_head)(w, rc, back, p, x);
+        for (int i = 0; i < w->ncol; i++) SFX(hb_collide_one)(w, i, pose + (size_t)i * HB_COL_POSE, back, p, x);
+        return;
+    }
+    for (int s = 1;; s++) {
         const int track = s < w->sweeps; /* whether another sweep may follow */
         int moved = 0;
         REAL q[3] = {p[0], p[1], p[2]};
