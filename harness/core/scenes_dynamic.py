@@ -103,6 +103,9 @@ TABLES = {
         "frequency": ("--body-frequency", "nonneg"),
     },
 }
+# the flags a scene's [grid] and [body] tables set: one place for the studies that split a scene into them
+GRID_FLAGS = frozenset(flag for flag, _ in TABLES["grid"].values())
+BODY_FLAGS = frozenset(flag for flag, _ in TABLES["body"].values())
 # dynamic keys inside the paper model's [wind] and [head] tables
 SHARED = {
     "wind": {

@@ -30,6 +30,7 @@ from harness.core import env, runner, scenes, variants
 from harness.core.limits import limits
 from harness.core.paths import RESULTS, binary_path, display
 from harness.core.progress import Progress
+from harness.core.scenes_dynamic import BODY_FLAGS, GRID_FLAGS
 from harness.io import files
 from harness.io.trajectory import open_trajectory
 from harness.studies.accuracy import BODY_SCENE, WORLD_CSV_NAME, WORLD_RESULTS_NAME, frame_errors
@@ -133,11 +134,11 @@ def _without(dyn, drop):
 
 
 def _grid_flag(f):
-    return f == "--grid" or f.startswith("--grid-")
+    return f in GRID_FLAGS
 
 
 def _body_flag(f):
-    return f in ("--colliders", "--friction", "--depenetration-speed", "--collider-sweeps") or f.startswith("--body-")
+    return f in BODY_FLAGS
 
 
 def grid_variants(plan):

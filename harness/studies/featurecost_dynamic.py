@@ -19,7 +19,7 @@ from harness import HarnessError
 from harness.core import load, runner, scenes, timing, variants
 from harness.core.paths import binary_path
 from harness.core.progress import Progress
-from harness.core.scenes_dynamic import DECLARING, FEATURES, NEEDS
+from harness.core.scenes_dynamic import BODY_FLAGS, DECLARING, FEATURES, GRID_FLAGS, NEEDS
 from harness.io.files import write_csv
 
 FIELDS = (
@@ -77,9 +77,8 @@ def world_rows(flags):
     """(row name, flags): the full scene with the grid once a frame, every substep, the body
     (colliders and friction), and both, from WORLD_SCENE's [grid] and [body] tables."""
     extra = scenes.load_scene(WORLD_SCENE).flags()
-    grid = _pick(extra, lambda f: f.startswith("--grid"))
-    body_flags = ("--colliders", "--friction", "--depenetration-speed", "--collider-sweeps")
-    body = _pick(extra, lambda f: f in body_flags or f.startswith("--body"))
+    grid = _pick(extra, lambda f: f in GRID_FLAGS)
+    body = _pick(extra, lambda f: f in BODY_FLAGS)
     substep = _set(grid, "--grid-rebuild", "substep")
     return [
         ("full + grid (once a frame)", [*flags, *grid]),
