@@ -51,6 +51,14 @@ def child_pids(pid):
 # ---- D1: every terminating signal forwarded to the child's group, waited for ---------------
 
 
+def default_signals():
+    """In the child: every forwarded signal back to its default. The harness keeps a signal its caller
+    ignores ignored (nohup; a background job of a script ignores SIGINT and SIGQUIT), so a suite run
+    from one would otherwise test nothing."""
+    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT):
+        signal.signal(s, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT, signal.SIGINT], ids=lambda s: s.name)
 def test_signal_to_the_harness_stops_its_binary(cpu_bin, tmp_path, sig):
     out = tmp_path / "x.h5"
@@ -62,7 +70,7 @@ def test_signal_to_the_harness_stops_its_binary(cpu_bin, tmp_path, sig):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        preexec_fn=default_signals,
     )
     # the simulation itself: the harness first asks the binary for its limits (a child that exits at once)
     assert wait_for_child(proc, "hairsim-cpu", timeout=60, also="--strands")
@@ -264,7 +272,7 @@ def test_interrupt_stops_a_budgeted_study_and_removes_what_it_added(tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        preexec_fn=default_signals,
     )
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and not (tmp_path / "reduced" / "part3.csv").exists():
