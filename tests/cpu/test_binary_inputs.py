@@ -10,9 +10,9 @@ import subprocess
 import threading
 
 import pytest
-from harness.core import env
 from test_grooms import hair_bytes, radial_strands
 
+from harness.core import env
 from support import fulldisk
 from support.faults import make_fault
 from support.statecheck import run, tmp_leftovers
