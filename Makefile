@@ -180,12 +180,21 @@ PLANT_SRC := c_ref/dynamic/dynamics_f32.c c_ref/dynamic/dynamics_f64.c c_ref/dyn
              c_ref/dynamic/dyn_lod.c
 PLANT_BINS := $(PLANTS:%=$(BUILD)/planted/hairsim-cpu-plant%)
 planted: $(PLANT_BINS)
-.SECONDARY: $(foreach n,$(PLANTS),$(PLANT_SRC:c_ref/%.c=$(BUILD)/planted/obj$(n)/%.o))
+PLANT_CC := $(CC) $(CFLAGS_REF) -Ic_ref -O0 -g0 -fopenmp $(HDF5_CFLAGS)
+PLANT_BASE := $(PLANT_SRC:c_ref/%.c=$(BUILD)/planted/base/%.o)
+.SECONDARY: $(PLANT_BASE) $(foreach n,$(PLANTS),$(foreach f,$(PLANT_SRC),$(BUILD)/planted/obj$(n)/$(notdir $(f:.c=.o))))
+# each source once without a plant (and its preprocessed text): a plant's source whose text that
+# plant leaves unchanged links this object, the same bytes as compiling it again
+$(BUILD)/planted/base/%.o: c_ref/%.c $(C_HEADERS) | check-hdf5
+	@mkdir -p $(@D)
+	$(PLANT_CC) -E $< -o $(@:.o=.i) && $(PLANT_CC) -c $< -o $@
 $(BUILD)/planted/obj%/dynamics_f32.o $(BUILD)/planted/obj%/dynamics_f64.o $(BUILD)/planted/obj%/dynamics_host.o \
-  $(BUILD)/planted/obj%/model.o $(BUILD)/planted/obj%/dyn_lod.o: $(PLANT_SRC) $(C_HEADERS) | check-hdf5
+  $(BUILD)/planted/obj%/model.o $(BUILD)/planted/obj%/dyn_lod.o: $(PLANT_SRC) $(C_HEADERS) $(PLANT_BASE) | check-hdf5
 	@mkdir -p $(BUILD)/planted/obj$*
-	for f in $(PLANT_SRC); do $(CC) $(CFLAGS_REF) -Ic_ref -O0 -g0 -fopenmp $(HDF5_CFLAGS) -DHB_PLANT=$* -c $$f \
-	  -o $(BUILD)/planted/obj$*/$$(basename $${f%.c}).o || exit 1; done
+	@for f in $(PLANT_SRC); do b=$(BUILD)/planted/base/$${f#c_ref/}; b=$${b%.c}; o=$(BUILD)/planted/obj$*/$$(basename $${f%.c}); \
+	  $(PLANT_CC) -DHB_PLANT=$* -E $$f -o $$o.i || exit 1; \
+	  if cmp -s $$o.i $$b.i; then cp $$b.o $$o.o; else echo "$(CC) … -DHB_PLANT=$* -c $$f"; \
+	    $(PLANT_CC) -DHB_PLANT=$* -c $$f -o $$o.o || exit 1; fi; rm -f $$o.i; done
 $(BUILD)/planted/hairsim-cpu-plant%: $(BUILD)/planted/obj%/dynamics_f32.o \
   $(filter-out $(PLANT_SRC:c_ref/%.c=$(OBJ)/%.o),$(SHARED_OBJ) $(CPU_OBJ))
 	$(CC) -fopenmp $(BUILD)/planted/obj$*/*.o $(filter-out $(BUILD)/planted/%,$^) -o $@ $(HDF5_LIBS) -lm
