@@ -79,7 +79,13 @@ def main(argv=None):
     try:
         gpus.wanted()  # a bad HB_GPUS is refused on every machine, with or without a GPU
         with runner.forwarding(), interrupts.redelivered():
-            rc = args.func(args)
+            try:
+                rc = args.func(args)
+            except SystemError as e:  # a signal's exception raised inside a C extension's callback
+                signalled = interrupts.signal_cause(e, (KeyboardInterrupt, runner.Stopped))
+                if signalled is None:
+                    raise
+                raise signalled from None
             sys.stdout.flush()  # a closed pipe shows here, inside the handlers below
         return rc
     except runner.Stopped as e:  # forwarded to every child, each waited for: nothing runs on

@@ -5,7 +5,8 @@ weakref callback or a `__del__` it cannot propagate: Python prints "Exception ig
 with a traceback and carries on, and the command would run to its end. While `redelivered`
 is active, such a dropped interrupt is silenced and raised again a millisecond later (by
 SIGALRM: raised from the hook itself, it would be dropped again), so the command still
-ends in its one line and exit 130."""
+ends in its one line and exit 130. One raised inside a C extension's callback can come out as a
+SystemError caused by it (h5py iterating a file's attributes): `signal_cause` finds it there."""
 
 import contextlib
 import signal
@@ -50,3 +51,15 @@ def redelivered():
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous_alarm if previous_alarm is not None else signal.SIG_DFL)
         sys.unraisablehook = previous_hook
+
+
+def signal_cause(error, kinds):
+    """The exception of one of `kinds` (a signal's: KeyboardInterrupt, the runner's Stopped) among
+    `error`'s causes and contexts, else None."""
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, kinds):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
