@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 from test_fault_probe import harness, no_traceback, temporaries, wait_for_child
 
+from harness.core import runner
 from support import fulldisk
 from support.sweeps import sweep_toml
 
@@ -55,7 +56,7 @@ def default_signals():
     """In the child: every forwarded signal back to its default. The harness keeps a signal its caller
     ignores ignored (nohup; a background job of a script ignores SIGINT and SIGQUIT), so a suite run
     from one would otherwise test nothing."""
-    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT):
+    for s in runner.FORWARDED:
         signal.signal(s, signal.SIG_DFL)
 
 
