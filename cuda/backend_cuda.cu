@@ -75,7 +75,15 @@ int pick_device(char *name, size_t n, char *err, size_t errlen)
     cudaDeviceProp p;
     HB_CUDA(cudaGetDeviceProperties(&p, 0));
     snprintf(name, n, "%s", p.name);
+#ifdef HB_DEVICE_OPT_CHECK
+    snprintf(err, errlen,
+             "this binary's device code is not optimised (built with make CUDA_DEVICE_OPT=check, to compile "
+             "without a GPU): rebuild with make to run on %s",
+             p.name);
+    return -1;
+#else
     return 0;
+#endif
 }
 
 } /* namespace */
