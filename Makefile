@@ -53,13 +53,16 @@ else ifeq ($(IN_GIT),true)
 else
   GIT_REV := unknown
 endif
-# record.c compiles GIT_REV in; this stamp changes only when GIT_REV does, so a commit or a
-# new REVISION rebuilds record.o and relinks the binaries instead of keeping an old revision.
+# stamp FILE,VALUE: FILE holds VALUE and is rewritten only when VALUE changes, so what depends on
+# FILE is rebuilt exactly then
+stamp = $(shell mkdir -p $(BUILD) && { [ "$$(cat $(1) 2>/dev/null)" = '$(2)' ] || printf '%s\n' '$(2)' > $(1); })
+# record.c compiles GIT_REV in: a commit or a new REVISION rebuilds record.o and relinks the
+# binaries instead of keeping an old revision
 REV_STAMP := $(BUILD)/revision.stamp
-$(shell mkdir -p $(BUILD) && { [ "$$(cat $(REV_STAMP) 2>/dev/null)" = '$(GIT_REV)' ] || printf '%s\n' '$(GIT_REV)' > $(REV_STAMP); })
-# the same for CUDA_DEVICE_OPT: the CUDA objects depend on this stamp
+$(call stamp,$(REV_STAMP),$(GIT_REV))
+# the CUDA objects depend on CUDA_DEVICE_OPT
 DEVICE_OPT_STAMP := $(BUILD)/cuda-device-opt.stamp
-$(shell { [ "$$(cat $(DEVICE_OPT_STAMP) 2>/dev/null)" = '$(CUDA_DEVICE_OPT)' ] || printf '%s\n' '$(CUDA_DEVICE_OPT)' > $(DEVICE_OPT_STAMP); })
+$(call stamp,$(DEVICE_OPT_STAMP),$(CUDA_DEVICE_OPT))
 
 # The C reference: C11, no fast-math and no FMA contraction, so it is the oracle.
 CSTD    := -std=c11 -D_DEFAULT_SOURCE
