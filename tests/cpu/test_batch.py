@@ -56,8 +56,10 @@ def test_a_failing_run_is_reported_and_the_runs_after_it_go_on(cpu_bin, tmp_path
 
 def test_a_run_past_its_timeout_is_killed_and_the_rest_run(cpu_bin, tmp_path):
     out = tmp_path / "slow.h5"
-    slow = ["--strands", "400000", "--points", "64", "--repeat", "50", "--output", str(out)]
-    ended = list(runner.run_batch(cpu_bin, [SMALL, slow, SMALL], timeout=1.0))
+    # The slow run takes minutes on any machine; the timeout leaves a small run (0.1 s alone) room on a
+    # loaded node (1 s was not enough beside 32 test workers on a GPU node's 32 cores).
+    slow = ["--strands", "400000", "--points", "64", "--repeat", "100000", "--output", str(out)]
+    ended = list(runner.run_batch(cpu_bin, [SMALL, slow, SMALL], timeout=10.0))
     assert ended[0][2] is None and ended[2][2] is None
     assert isinstance(ended[1][2], TimedOut) and ended[1][2].code == 124
     assert list(tmp_path.iterdir()) == []  # the killed run's temporary output is gone
