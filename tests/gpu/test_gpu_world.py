@@ -8,6 +8,7 @@ feature refuse it in one line. Marked `gpu`; conftest.py skips them where there 
 
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 from conftest import CPU_BIN, CUDA_BIN, CUDA_STRICT_BIN
@@ -155,6 +156,38 @@ def check_frame(work, cpu_files, build, variant, scene, solver, precision):
     exact = build == "strict"
     r = diff_dynamic.compare(cpu, out, frames=[step], exact=exact, check_paper=False)
     assert r.equivalent, f"{build} {variant} {scene}: " + "; ".join(r.failures()[:5])
+
+
+# A window node's mass sum past 32 bits (docs/cuda.md "The hair–hair grid": a mass share is added
+# to one word and its carries counted in another). One cell whose low corner sits at the hair, so
+# every point's weight at node 0 is above 0.7 and a splat block of at least 8 strands of 64 points
+# (the fewest a block takes) adds more than 2^32 there. The strict build bit for bit.
+CARRY = ["--strands", "300", "--points", "64", "--substeps", "4", "--iterations", "2", "--bend-compliance", "1e-6",
+         "--shape-compliance", "1e-4", "--drag", "0.5", "--wind-speed", "150", "--grid", "2",
+         "--grid-box=-13,-45,-13,250,250,250", "--grid-friction", "0.1,0.02", "--grid-volume", "2000"]  # fmt: skip
+MASS_SCALE = 2**24  # HB_GRID_MASS_SCALE, c_ref/dynamic/contact_impl.h
+SPLAT_STRANDS_MIN = 8  # kSplatWarps, cuda/dynamic/world.cu
+
+
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("variant", FAST_RUNS)
+def test_gpu_splat_whose_window_sums_carry_matches_cpu_bit_for_bit(work, variant, precision):
+    cpu = work / f"cpu_carry_{precision}.h5"
+    if not cpu.exists():
+        run(CPU_BIN, "--stages", "init,collide,simulate", *CARRY, "--precision", precision, "--frames", FRAMES,
+            "--velocities", "all", "--output", cpu, "--quiet")  # fmt: skip
+    with open_trajectory(cpu) as t:
+        k = t.n_frames - 2
+        step = int(t.step[-1])
+        x = t.frame(k).astype(np.float64)
+    lo, hi = np.array([-13.0, -45.0, -13.0]), np.array([250.0, 250.0, 250.0])
+    weight = np.prod(1.0 - (x - lo) / (hi - lo), axis=-1)  # each point's trilinear weight at node 0
+    assert SPLAT_STRANDS_MIN * x.shape[1] * weight.min() * MASS_SCALE > 2**32
+    out = work / f"gpu_carry_{variant}_{precision}.h5"
+    run(CUDA_STRICT_BIN, "--input", cpu, "--input-frame", k, "--stages", "simulate", "--frames", 1,
+        "--variant", variant, "--output", out, "--force", "--quiet")  # fmt: skip
+    r = diff_dynamic.compare(cpu, out, frames=[step], exact=True, check_paper=False)
+    assert r.equivalent, f"strict {variant} carry {precision}: " + "; ".join(r.failures()[:5])
 
 
 # §3.17 the collision step in 4 sweeps on the body scene (configs/scenes/body.toml: the default
