@@ -16,7 +16,7 @@ row() { # binary name strands frames repeat flags...
   [ $rc -ne 0 ] && { echo "$name $n FAILED rc=$rc: $(echo "$js" | head -c 300)" | tee -a $OUTD/bench.txt; return; }
   python3 -c "import json,sys; r=json.loads(sys.argv[1]); s=r['stages'][-1]; print('%-34s %9d  median %9.4f ms  min %9.4f  max %9.4f' % (sys.argv[2], r['strands'], s['median_ms'], s['min_ms'], s['max_ms']))" "$js" "$name" | tee -a $OUTD/bench.txt
 }
-A=build/hairsim-cuda
+A=${HAIRSIM_CUDA:-build/hairsim-cuda} # another build to compare: HAIRSIM_CUDA=PATH
 BODIES="$OUTD/bodies"; mkdir -p "$BODIES"; cp configs/bodies/head.obj "$BODIES/"
 sed 's/head.obj 64/head.obj 128/' configs/bodies/default.colliders > "$BODIES/body128.colliders"
 for n in 4194304 10000; do
