@@ -52,6 +52,24 @@ SCENES = {
         "--grid-rebuild",
         "held",
     ],
+    # `held` with colliders: the samples from k_grid_hold (the held grid alone at this size is
+    # sampled by the lanes kernel itself, "grid-held"; docs/cuda.md)
+    "grid-held-body": [
+        "--head-motion",
+        "nod",
+        "--grid",
+        "16",
+        "--grid-friction",
+        "0.1,0.02",
+        "--grid-volume",
+        "2000",
+        "--grid-rebuild",
+        "held",
+        "--friction",
+        "0.3",
+        "--colliders",
+        "BODY",
+    ],  # fmt: skip
     "body": ["--head-motion", "nod", "--friction", "0.4,0.3", "--depenetration-speed", "150", "--colliders", "BODY"],
     "body-sway": ["--colliders", "BODY", "--body-motion", "sway", "--body-amplitude", "3"],
     "all": [
@@ -188,6 +206,34 @@ def test_gpu_splat_whose_window_sums_carry_matches_cpu_bit_for_bit(work, variant
         "--variant", variant, "--output", out, "--force", "--quiet")  # fmt: skip
     r = diff_dynamic.compare(cpu, out, frames=[step], exact=True, check_paper=False)
     assert r.equivalent, f"strict {variant} carry {precision}: " + "; ".join(r.failures()[:5])
+
+
+# k_grid_hold in blocks of 16 points (two rounds), which it takes where blocks of 8 would leave a
+# second, partial wave and blocks of 16 fit at once: 12,000 strands of 24 points with colliders
+# (so that the lanes kernel does not sample itself) on a GPU of 132 SMs (H100, H200). The strict
+# build bit for bit.
+HELD_WIDE = ["--strands", "12000", "--points", "24", "--substeps", "4", "--iterations", "2", "--bend-compliance",
+             "1e-6", "--shape-compliance", "1e-4", "--drag", "0.5", "--head-motion", "nod", "--grid", "16",
+             "--grid-friction", "0.1,0.02", "--grid-volume", "2000", "--grid-rebuild", "held", "--friction", "0.3",
+             "--colliders", "BODY"]  # fmt: skip
+
+
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("variant", [v for v in VARIANTS if _DECLARED.runs_features(v, {"grid", "colliders"})])
+def test_gpu_held_samples_in_wide_blocks_match_cpu_bit_for_bit(work, variant, precision):
+    cpu = work / f"cpu_held_wide_{precision}.h5"
+    if not cpu.exists():
+        flags = [str(work / "body.txt") if a == "BODY" else a for a in HELD_WIDE]
+        run(CPU_BIN, "--stages", "init,collide,simulate", *flags, "--precision", precision, "--frames", FRAMES,
+            "--velocities", "all", "--output", cpu, "--quiet")  # fmt: skip
+    with open_trajectory(cpu) as t:
+        k = t.n_frames - 2
+        step = int(t.step[-1])
+    out = work / f"gpu_held_wide_{variant}_{precision}.h5"
+    run(CUDA_STRICT_BIN, "--input", cpu, "--input-frame", k, "--stages", "simulate", "--frames", 1,
+        "--variant", variant, "--output", out, "--force", "--quiet")  # fmt: skip
+    r = diff_dynamic.compare(cpu, out, frames=[step], exact=True, check_paper=False)
+    assert r.equivalent, f"strict {variant} held wide {precision}: " + "; ".join(r.failures()[:5])
 
 
 # §3.17 the collision step in 4 sweeps on the body scene (configs/scenes/body.toml: the default
