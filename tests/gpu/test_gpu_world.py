@@ -36,40 +36,17 @@ BODY = (
     "plane body 0 -45 0 0 1 0\n"
     "mesh head chin.obj 32 band 4 mu_s 0.2 mu_k 0.1\n"
 )
+HELD = ["--head-motion", "nod", "--grid", "16", "--grid-friction", "0.1,0.02", "--grid-volume", "2000",
+        "--grid-rebuild", "held"]  # fmt: skip
+HELD_BODY = ["--friction", "0.3", "--colliders", "BODY"]
 SCENES = {
     "grid-frame": ["--head-motion", "nod", "--grid", "16", "--grid-friction", "0.1,0.02", "--grid-volume", "2000"],
     "grid-substep": ["--head-motion", "shake", "--grid", "20", "--grid-friction", "0.05", "--grid-rebuild", "substep"],
     "grid-still": ["--grid", "12", "--grid-volume", "5000"],
-    "grid-held": [
-        "--head-motion",
-        "nod",
-        "--grid",
-        "16",
-        "--grid-friction",
-        "0.1,0.02",
-        "--grid-volume",
-        "2000",
-        "--grid-rebuild",
-        "held",
-    ],
+    "grid-held": HELD,
     # `held` with colliders: the samples from k_grid_hold (the held grid alone at this size is
     # sampled by the lanes kernel itself, "grid-held"; docs/cuda.md)
-    "grid-held-body": [
-        "--head-motion",
-        "nod",
-        "--grid",
-        "16",
-        "--grid-friction",
-        "0.1,0.02",
-        "--grid-volume",
-        "2000",
-        "--grid-rebuild",
-        "held",
-        "--friction",
-        "0.3",
-        "--colliders",
-        "BODY",
-    ],  # fmt: skip
+    "grid-held-body": [*HELD, *HELD_BODY],
     "body": ["--head-motion", "nod", "--friction", "0.4,0.3", "--depenetration-speed", "150", "--colliders", "BODY"],
     "body-sway": ["--colliders", "BODY", "--body-motion", "sway", "--body-amplitude", "3"],
     "all": [
@@ -213,9 +190,7 @@ def test_gpu_splat_whose_window_sums_carry_matches_cpu_bit_for_bit(work, variant
 # (so that the lanes kernel does not sample itself) on a GPU of 132 SMs (H100, H200). The strict
 # build bit for bit.
 HELD_WIDE = ["--strands", "12000", "--points", "24", "--substeps", "4", "--iterations", "2", "--bend-compliance",
-             "1e-6", "--shape-compliance", "1e-4", "--drag", "0.5", "--head-motion", "nod", "--grid", "16",
-             "--grid-friction", "0.1,0.02", "--grid-volume", "2000", "--grid-rebuild", "held", "--friction", "0.3",
-             "--colliders", "BODY"]  # fmt: skip
+             "1e-6", "--shape-compliance", "1e-4", "--drag", "0.5", *HELD, *HELD_BODY]  # fmt: skip
 
 
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
