@@ -368,12 +368,8 @@ template <typename T> static int dyn_world_load(cuda_impl *c, const void *rest, 
         w.ftab = (const T *)d->g_ftab;
         w.node_v = (const T *)d->g_node_v;
         w.node_a = (const T *)d->g_node_a;
-        /* `held`: the samples k_grid_hold takes for the lanes kernel, or none where the lanes kernel
-         * takes them itself (few points, and a frame in one launch: no colliders) */
-        const bool sample_inline = w.ncol == 0 && !w.head_friction && !w.bounded &&
-                                   (long long)c->N * (long long)c->P <= hbd::kHeldInlinePoints;
         if (c->variant == V_LANES && c->scene.dyn.grid_rebuild == HB_GRID_HELD &&
-            (c->scene.dyn.grid_friction_declared || c->scene.dyn.grid_volume_declared) && !sample_inline) {
+            (c->scene.dyn.grid_friction_declared || c->scene.dyn.grid_volume_declared)) {
             if ((rc = device_alloc(&d->g_held, (uint64_t)c->N * (uint64_t)c->P * hbd::kHeldReals * rs, c,
                                    "the grid's held samples", err, errlen)))
                 return rc;

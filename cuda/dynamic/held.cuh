@@ -102,13 +102,6 @@ __device__ __forceinline__ Sample<T> grid_sample_xyz(const World<T> &w, const T 
  * the correction: friction then volume, v + f·(v̄ − v) + h·ā, is v·(1 − f) + (f·v̄ + h·ā), kept as
  * (f·v̄ + h·ā, 1 − f). */
 constexpr int kHeldReals = kGridFree ? 4 : 8;
-/* At most this many points (N·P), a run whose frame is one launch (the held grid without colliders)
- * has its lanes kernel take each point's sample itself, before the substeps, instead of
- * k_grid_hold's launch: small N, where that launch's waves cost more than the samples (docs/cuda.md). */
-#ifndef HB_HELD_INLINE_POINTS
-#define HB_HELD_INLINE_POINTS 524288
-#endif
-constexpr long long kHeldInlinePoints = HB_HELD_INLINE_POINTS;
 template <typename T>
 __device__ __forceinline__ Node4<T> held_correction(const World<T> &w, T h, int k, const Sample<T> &s)
 {

@@ -99,19 +99,17 @@ template <typename T> __device__ __forceinline__ constexpr T floor_of()
 #include "dynamic/contact_free.cuh" /* templates only: inside this file's namespace, after rsq, floor_of, fdiv */
 /* The world's code a kernel carries (its W, a set of these): the grid's gather every substep
  * (`frame`, `substep`), the held sample (`held`), the colliders of §3.17 and the head sphere's
- * friction or bounded depenetration; with kWHeld, kWSample: the held sample taken by the kernel
- * itself (m.held null: few points, no k_grid_hold launch; a kernel of its own, so that the other
- * held kernels keep their registers). A run takes the smallest kernel that holds what it declares. */
-constexpr int kWGather = 1, kWHeld = 2, kWCol = 4, kWAll = kWGather | kWHeld | kWCol, kWSample = 8;
+ * friction or bounded depenetration. A run takes the smallest kernel that holds what it declares. */
+constexpr int kWGather = 1, kWHeld = 2, kWCol = 4, kWAll = kWGather | kWHeld | kWCol;
 template <typename T, int G, int L, bool Ftl, int W = 0> constexpr int lanes_min_blocks()
 {
-    return sizeof(T) != 4                                ? 1
-           : (W & ~kWSample) == kWHeld && !Ftl && G == 2 ? HB_LANES_HELD_MINB /* the held grid alone */
-           : W == kWCol                                  ? HB_LANES_COL_MINB
-           : W                                           ? HB_LANES_WORLD_MINB /* everything: 2, up to 128 registers */
-           : (!Ftl && G == 2)                            ? HB_LANES_MINB
-           : (Ftl && G == kFtlG && L == kFtlL)           ? HB_LANES_FTL_MINB
-                                                         : 1;
+    return sizeof(T) != 4                      ? 1
+           : W == kWHeld && !Ftl && G == 2     ? HB_LANES_HELD_MINB /* the held grid alone */
+           : W == kWCol                        ? HB_LANES_COL_MINB
+           : W                                 ? HB_LANES_WORLD_MINB /* everything: 2, up to 128 registers */
+           : (!Ftl && G == 2)                  ? HB_LANES_MINB
+           : (Ftl && G == kFtlG && L == kFtlL) ? HB_LANES_FTL_MINB
+                                               : 1;
 }
 
 template <typename T> struct V3 {
@@ -283,20 +281,6 @@ template <typename T> __device__ __forceinline__ void hold_sample(const T *src, 
 #pragma unroll
     for (int u = 0; u < kHeldVectors; u++)
         store_node4(hs + 4 * ((kHeldVectors * i + u) * 32 + lane), load_node4<T>(src + 4 * u));
-}
-/* §3.16 `held` taken here (no k_grid_hold launch: m.held is null): point k's sample at x, its
- * place at the frame's start, into slot i of hs, as k_grid_hold would have left it */
-template <typename T>
-__device__ __forceinline__ void sample_held(const DModel<T> &m, const T *qg, int k, const V3<T> &x, T *hs, int i,
-                                            int lane)
-{
-    const Sample<T> s = grid_sample_xyz(m.world, qg, x.x, x.y, x.z);
-    if constexpr (kGridFree) {
-        store_node4(hs + 4 * (i * 32 + lane), held_correction(m.world, m.h, k, s));
-    } else {
-        store_node4(hs + 4 * ((2 * i) * 32 + lane), s.a);
-        store_node4(hs + 4 * ((2 * i + 1) * 32 + lane), s.b);
-    }
 }
 /* §3.16 `held`: the correction of point k from slot i of hs */
 template <typename T>
@@ -656,18 +640,13 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
 
         const bool wgrid = (W & (kWGather | kWHeld)) && m.world.grid && (m.world.grid_friction || m.world.grid_volume);
         const bool held = (W & kWHeld) && wgrid && m.world.grid_rebuild == HB_GRID_HELD;
-        if constexpr ((W & kWHeld) != 0) { /* §3.16 `held`: each point's sample, by k_grid_hold or here */
+        if constexpr ((W & kWHeld) != 0) { /* §3.16 `held`: each point's sample, taken by k_grid_hold */
             if (held && live) {
+                const int64_t st = m.perm ? m.perm[s0 + seg] : s0 + seg;
 #pragma unroll
                 for (int i = 0; i < G; i++) {
                     const int k = point_of<G>(k0, sw, i);
-                    if (k < 1 || k >= P) continue;
-                    if constexpr ((W & kWSample) != 0) {
-                        sample_held(m, has(HB_F_MOTION) ? m.qs : (const T *)nullptr, k, X[i], hs, i, lane);
-                    } else {
-                        const int64_t st = m.perm ? m.perm[s0 + seg] : s0 + seg;
-                        hold_sample(m.held + (st * P + k) * kHeldReals, hs, i, lane);
-                    }
+                    if (k >= 1 && k < P) hold_sample(m.held + (st * P + k) * kHeldReals, hs, i, lane);
                 }
             }
         }
@@ -904,7 +883,6 @@ template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int6
     if (wk && seg) wk = kWAll;
     if (wk == kWAll) fn = seg ? &k_lanes<T, DynF, G, L, Ftl, true, kWAll> : &k_lanes<T, DynF, G, L, Ftl, false, kWAll>;
     else if (wk == kWHeld) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWHeld>;
-    else if (wk == (kWHeld | kWSample)) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWHeld | kWSample>;
     else if (wk == kWCol) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWCol>;
     else if (seg) fn = &k_lanes<T, DynF, G, L, Ftl, true, 0>;
     /* the default scene's feature set (every feature) has its own held-grid and colliders kernels
@@ -912,8 +890,6 @@ template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int6
     constexpr unsigned kEvery = HB_F_COUNT - 1u;
     if constexpr (sizeof(T) == 4 && !Ftl && G == 2 && L == 16) {
         if (f == kEvery && wk == kWHeld) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWHeld>;
-        if (f == kEvery && wk == (kWHeld | kWSample))
-            fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWHeld | kWSample>;
         if (f == kEvery && wk == kWCol) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWCol>;
     }
     return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P) + ((wk & kWHeld) ? lanes_held_reals<T, G>() : 0)};
@@ -928,7 +904,6 @@ template <typename T> int world_kind(const DModel<T> &m)
     const bool col = w.ncol > 0 || w.head_friction || w.bounded;
     const bool apply = w.grid && (w.grid_friction || w.grid_volume);
     if (apply && (col || w.grid_rebuild != HB_GRID_HELD)) return kWAll;
-    if (!col && apply && !m.held) return kWHeld | kWSample; /* no k_grid_hold: the kernel samples */
     return col ? kWCol : kWHeld;
 }
 template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P, bool seg, int world)
@@ -949,7 +924,7 @@ template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P,
 template <typename T>
 cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg, bool world)
 {
-    for (int wk : {kWHeld, kWHeld | kWSample, kWCol, kWAll}) { /* a world's run launches one of these */
+    for (int wk : {kWHeld, kWCol, kWAll}) { /* a world's run launches one of its three kernels */
         const LanesPick<T> k = lanes_pick<T>(features, solver, P, seg, world ? wk : 0);
         if (!k.fn) return cudaErrorInvalidValue;
         int bytes = (int)((size_t)(block / 32) * (size_t)k.warp_reals * sizeof(T)), dev = 0;

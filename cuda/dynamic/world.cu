@@ -33,11 +33,10 @@ template <> struct Splat<double> {
  * strands (the order perm; nullptr: as stored); each warp takes its strands one at a time, a lane
  * a point, so that every load of x and v coalesces. Pass 1 finds the block's box of cells; when
  * its nodes fit the shared window (and no node can receive more than 2^16 shares), pass 2 adds
- * each point's fixed-point shares there by native 32-bit shared atomics: a mass share (0 … 2^24)
- * into one word whose carries a second word counts, a momentum share into one signed word where
- * the block's speeds allow (`single`), else split into its low 16 bits and the rest (exact: see
- * kSplatWindowPoints); the window goes to the grid with one 64-bit global atomic a touched node
- * and channel; otherwise pass 2 adds to the grid directly. Integer sums: no order changes a bit. */
+ * each point's fixed-point shares there, each 64-bit share split into its low 16 bits and the
+ * rest, both summed by native 32-bit shared atomics (exact: see kSplatWindowPoints), and the
+ * window goes to the grid with one 64-bit global atomic a touched node and channel; otherwise
+ * pass 2 adds to the grid directly. Integer sums: no order changes a bit. */
 #ifndef HB_SPLAT_STRANDS
 #define HB_SPLAT_STRANDS 64
 #endif
@@ -46,9 +45,8 @@ template <> struct Splat<double> {
 #endif
 constexpr int kSplatStrands = HB_SPLAT_STRANDS, kSplatWarps = 8; /* strands a block, its warps */
 constexpr int kWindow = HB_SPLAT_WINDOW; /* nodes: 2 × 32 bits × 4 channels each (64 KB at 2048) */
-/* the window's word (channel c: mass, p_x, p_y, p_z; part: low, high; mass's high word counts its
- * low word's carries) of node i: each of the eight (channel, part) arrays whole, so that a warp's
- * lanes at different nodes use different banks */
+/* the window's word (channel c: mass, p_x, p_y, p_z; part: low, high) of node i: each of the eight
+ * (channel, part) arrays whole, so that a warp's lanes at different nodes use different banks */
 __device__ __forceinline__ int win_at(int c, int part, int i)
 {
     return (2 * c + part) * kWindow + i;
@@ -101,14 +99,6 @@ __device__ __forceinline__ void window_add(unsigned *win, int c, int i, int x)
 {
     atomicAdd(win + win_at(c, 0, i), (unsigned)x & 0xffffu);
     atomicAdd(reinterpret_cast<int *>(win) + win_at(c, 1, i), x >> 16);
-}
-
-/* one mass share x (0 ≤ x ≤ 2^24: a trilinear weight, never negative, times 2^24) into window node
- * i: one word, and a carry counted where the sum passed 2^32 (the sum is carries·2^32 + word) */
-__device__ __forceinline__ void window_add_mass(unsigned *win, int i, int x)
-{
-    const unsigned was = atomicAdd(win + win_at(0, 0, i), (unsigned)x);
-    if (was + (unsigned)x < was) atomicAdd(win + win_at(0, 1, i), 1u);
 }
 
 template <typename T>
@@ -198,7 +188,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
                 for (int c = 0; c < 3; c++) sp[c] = share_of((wt[c8] * vc[c]) * (T)HB_GRID_MOM_SCALE);
                 if (windowed) {
                     const int i = wb + ((c8 & 1) ? 1 : 0) + ((c8 & 2) ? ex : 0) + ((c8 & 4) ? ex * ey : 0);
-                    window_add_mass(win, i, sm);
+                    window_add(win, 0, i, sm);
                     if (single)
                         for (int c = 0; c < 3; c++)
                             atomicAdd(reinterpret_cast<int *>(win) + win_at(1 + c, 0, i), sp[c]);
@@ -220,9 +210,8 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
         bool any = false;
         for (int c = 0; c < 4; c++) {
             const int *wi = reinterpret_cast<const int *>(win);
-            sum[c] = c == 0   ? (int64_t)win[win_at(0, 1, i)] * 4294967296 + (int64_t)win[win_at(0, 0, i)]
-                     : single ? (int64_t)wi[win_at(c, 0, i)]
-                              : (int64_t)wi[win_at(c, 1, i)] * 65536 + (int64_t)win[win_at(c, 0, i)];
+            sum[c] = single && c > 0 ? (int64_t)wi[win_at(c, 0, i)]
+                                     : (int64_t)wi[win_at(c, 1, i)] * 65536 + (int64_t)win[win_at(c, 0, i)];
             any |= sum[c] != 0;
         }
         if (!any) continue;
@@ -243,38 +232,34 @@ __global__ void k_grid_nodes(World<T> w, const T *qg, const int64_t *mass, const
 }
 
 /* §3.16 `held`: a block takes kHoldStrands neighbouring strands in the strands' order (perm) and
- * kHoldPoints·Rounds of their points; a warp samples one point index across its 32 strands (a
- * round; two where that lets every block be resident at once: launch_grid_hold), whose points lie close
- * together (the order follows the roots), so a corner's load is shared by the warp where a
- * strand's own points would each need a cell of their own. Positions come in and samples go out
+ * kHoldPoints of their points; a warp samples one point index across its 32 strands, whose points
+ * lie close together (the order follows the roots), so a corner's load is shared by the warp where
+ * a strand's own points would each need a cell of their own. Positions come in and samples go out
  * through shared memory, a strand's run of points contiguous (rows padded against bank conflicts).
  * The root's sample (k = 0) is written but never applied. */
 constexpr int kHoldStrands = 32, kHoldPoints = 8;
-template <typename T, int Rounds>
+template <typename T>
 __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
     k_grid_hold(World<T> w, const T *qg, T h, const T *x, int64_t N, int P, const int64_t *perm, T *held)
 {
-    constexpr int R = kHeldReals, NB = kHoldPoints * Rounds; /* the block's points */
-    constexpr int XW = 3 * NB + 1, HW = R * NB + 1;          /* row widths */
+    constexpr int R = kHeldReals, XW = 3 * kHoldPoints + 1, HW = R * kHoldPoints + 1;
     __shared__ T xs[kHoldStrands * XW];
     __shared__ T hs[kHoldStrands * HW];
     __shared__ int64_t sid[kHoldStrands];
     const int t = threadIdx.x;
     const int64_t s0 = (int64_t)blockIdx.x * kHoldStrands;
-    const int k0 = (int)blockIdx.y * NB;
-    const int ns = (int)(N - s0 < kHoldStrands ? N - s0 : kHoldStrands), nk = P - k0 < NB ? P - k0 : NB;
+    const int k0 = (int)blockIdx.y * kHoldPoints;
+    const int ns = (int)(N - s0 < kHoldStrands ? N - s0 : kHoldStrands),
+              nk = P - k0 < kHoldPoints ? P - k0 : kHoldPoints;
     if (t < kHoldStrands) sid[t] = t < ns ? (perm ? perm[s0 + t] : s0 + t) : 0;
     __syncthreads();
-    for (int i = t; i < kHoldStrands * 3 * NB; i += blockDim.x) {
-        const int u = i / (3 * NB), r = i % (3 * NB);
+    for (int i = t; i < kHoldStrands * 3 * kHoldPoints; i += blockDim.x) {
+        const int u = i / (3 * kHoldPoints), r = i % (3 * kHoldPoints);
         if (u < ns && r < 3 * nk) xs[u * XW + r] = x[(sid[u] * P + k0) * 3 + r];
     }
     __syncthreads();
-    const int u = t & 31;
-#pragma unroll 1
-    for (int r = 0; r < Rounds; r++) {
-        const int kk = (t >> 5) + r * kHoldPoints;
-        if (u >= ns || kk >= nk) break;
+    const int u = t & 31, kk = t >> 5;
+    if (u < ns && kk < nk) {
         const T *p = xs + u * XW + 3 * kk;
         const Sample<T> s = grid_sample_xyz(w, qg, p[0], p[1], p[2]);
         T *o = hs + u * HW + R * kk;
@@ -287,8 +272,8 @@ __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
         }
     }
     __syncthreads();
-    for (int i = t; i < kHoldStrands * R * NB; i += blockDim.x) {
-        const int v = i / (R * NB), r = i % (R * NB);
+    for (int i = t; i < kHoldStrands * R * kHoldPoints; i += blockDim.x) {
+        const int v = i / (R * kHoldPoints), r = i % (R * kHoldPoints);
         if (v < ns && r < R * nk) held[(sid[v] * P + k0) * R + r] = hs[v * HW + r];
     }
 }
@@ -309,25 +294,17 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
     cudaError_t e = cudaMemsetAsync(mass, 0, (size_t)nodes * sizeof *mass, stream);
     if (e == cudaSuccess) e = cudaMemsetAsync(mom, 0, (size_t)nodes * 3 * sizeof *mom, stream);
     if (e != cudaSuccess) return e;
-    /* the device's SMs and how many splat blocks an SM holds, asked once a device */
-    static int known_dev = -1, sms = 0, fit = 0;
-    const size_t smem = (size_t)kWindow * 8 * sizeof(unsigned);
-    int dev = 0;
-    if ((e = cudaGetDevice(&dev)) != cudaSuccess) return e;
-    if (dev != known_dev) {
-        if ((e = cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev)) != cudaSuccess ||
-            (e = cudaFuncSetAttribute(k_grid_splat<T>, cudaFuncAttributeMaxDynamicSharedMemorySize, (int)smem)) !=
-                cudaSuccess ||
-            (e = cudaOccupancyMaxActiveBlocksPerMultiprocessor(&fit, k_grid_splat<T>, kSplatWarps * 32, smem)) !=
-                cudaSuccess)
-            return e;
-        known_dev = dev;
-    }
-    /* kSplatStrands a block, halved (down to one a warp) while the blocks still fit the GPU at once:
-     * small N in one wave of more, smaller blocks */
+    /* kSplatStrands a block, fewer (down to one a warp) where that leaves the GPU's SMs idle */
+    int dev = 0, sms = 0;
+    if ((e = cudaGetDevice(&dev)) != cudaSuccess ||
+        (e = cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev)) != cudaSuccess)
+        return e;
     int spb = kSplatStrands;
-    while (spb > kSplatWarps && (N + spb / 2 - 1) / (spb / 2) <= (int64_t)(fit > 0 ? fit : 1) * sms) spb /= 2;
+    while (spb > kSplatWarps && (N + spb - 1) / spb < 4 * (int64_t)sms) spb /= 2;
     const int64_t blocks = (N + spb - 1) / spb;
+    const size_t smem = (size_t)kWindow * 8 * sizeof(unsigned);
+    e = cudaFuncSetAttribute(k_grid_splat<T>, cudaFuncAttributeMaxDynamicSharedMemorySize, (int)smem);
+    if (e != cudaSuccess) return e;
     k_grid_splat<T><<<(int)(blocks < 1 ? 1 : blocks), kSplatWarps * 32, smem, stream>>>(w, qg, x, v, N, (int)P, spb,
                                                                                         perm, mass, mom);
     return cudaGetLastError();
@@ -346,29 +323,8 @@ template <typename T>
 cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P, const int64_t *perm,
                              T *held, cudaStream_t stream)
 {
-    /* one round a block, or two where one would leave a second, partial wave and two fit at once */
-    static int known_dev = -1, sms = 0, fit[2] = {0, 0};
-    int dev = 0;
-    cudaError_t e;
-    if ((e = cudaGetDevice(&dev)) != cudaSuccess) return e;
-    if (dev != known_dev) {
-        if ((e = cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev)) != cudaSuccess ||
-            (e = cudaOccupancyMaxActiveBlocksPerMultiprocessor(&fit[0], k_grid_hold<T, 1>, kHoldStrands * kHoldPoints,
-                                                               0)) != cudaSuccess ||
-            (e = cudaOccupancyMaxActiveBlocksPerMultiprocessor(&fit[1], k_grid_hold<T, 2>, kHoldStrands * kHoldPoints,
-                                                               0)) != cudaSuccess)
-            return e;
-        known_dev = dev;
-    }
-    const int64_t sb = (N + kHoldStrands - 1) / kHoldStrands, rows1 = (P + kHoldPoints - 1) / kHoldPoints,
-                  rows2 = (P + 2 * kHoldPoints - 1) / (2 * kHoldPoints);
-    const unsigned threads = kHoldStrands * kHoldPoints;
-    if (sb * rows1 > (int64_t)fit[0] * sms && sb * rows2 <= (int64_t)fit[1] * sms)
-        k_grid_hold<T, 2>
-            <<<dim3((unsigned)sb, (unsigned)rows2), threads, 0, stream>>>(w, qg, h, x, N, (int)P, perm, held);
-    else
-        k_grid_hold<T, 1>
-            <<<dim3((unsigned)sb, (unsigned)rows1), threads, 0, stream>>>(w, qg, h, x, N, (int)P, perm, held);
+    const dim3 grid((unsigned)((N + kHoldStrands - 1) / kHoldStrands), (unsigned)((P + kHoldPoints - 1) / kHoldPoints));
+    k_grid_hold<T><<<grid, kHoldStrands * kHoldPoints, 0, stream>>>(w, qg, h, x, N, (int)P, perm, held);
     return cudaGetLastError();
 }
 

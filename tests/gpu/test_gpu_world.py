@@ -44,8 +44,7 @@ SCENES = {
     "grid-substep": ["--head-motion", "shake", "--grid", "20", "--grid-friction", "0.05", "--grid-rebuild", "substep"],
     "grid-still": ["--grid", "12", "--grid-volume", "5000"],
     "grid-held": HELD,
-    # `held` with colliders: the samples from k_grid_hold (the held grid alone at this size is
-    # sampled by the lanes kernel itself, "grid-held"; docs/cuda.md)
+    # `held` with colliders: k_grid_hold's samples used by the colliders' kernel
     "grid-held-body": [*HELD, *HELD_BODY],
     "body": ["--head-motion", "nod", "--friction", "0.4,0.3", "--depenetration-speed", "150", "--colliders", "BODY"],
     "body-sway": ["--colliders", "BODY", "--body-motion", "sway", "--body-amplitude", "3"],
@@ -153,10 +152,10 @@ def check_frame(work, cpu_files, build, variant, scene, solver, precision):
     assert r.equivalent, f"{build} {variant} {scene}: " + "; ".join(r.failures()[:5])
 
 
-# A window node's mass sum past 32 bits (docs/cuda.md "The hair–hair grid": a mass share is added
-# to one word and its carries counted in another). One cell whose low corner sits at the hair, so
-# every point's weight at node 0 is above 0.7 and a splat block of at least 8 strands of 64 points
-# (the fewest a block takes) adds more than 2^32 there. The strict build bit for bit.
+# A window node's mass sum past 32 bits (docs/cuda.md "The hair–hair grid": a mass share is summed
+# in two 32-bit shared words, its low 16 bits and the rest, and joined into 64 bits). One cell whose
+# low corner sits at the hair, so every point's weight at node 0 is above 0.7 and a splat block of at
+# least 8 strands of 64 points (the fewest a block takes) adds more than 2^32 there. The strict build bit for bit.
 CARRY = ["--strands", "300", "--points", "64", "--substeps", "4", "--iterations", "2", "--bend-compliance", "1e-6",
          "--shape-compliance", "1e-4", "--drag", "0.5", "--wind-speed", "150", "--grid", "2",
          "--grid-box=-13,-45,-13,250,250,250", "--grid-friction", "0.1,0.02", "--grid-volume", "2000"]  # fmt: skip
@@ -185,10 +184,8 @@ def test_gpu_splat_whose_window_sums_carry_matches_cpu_bit_for_bit(work, variant
     assert r.equivalent, f"strict {variant} carry {precision}: " + "; ".join(r.failures()[:5])
 
 
-# k_grid_hold in blocks of 16 points (two rounds), which it takes where blocks of 8 would leave a
-# second, partial wave and blocks of 16 fit at once: 12,000 strands of 24 points with colliders
-# (so that the lanes kernel does not sample itself) on a GPU of 132 SMs (H100, H200). The strict
-# build bit for bit.
+# k_grid_hold over more blocks than a GPU holds at once: 12,000 strands of 24 points (375 blocks of
+# strands, three of points), with colliders. The strict build bit for bit.
 HELD_WIDE = ["--strands", "12000", "--points", "24", "--substeps", "4", "--iterations", "2", "--bend-compliance",
              "1e-6", "--shape-compliance", "1e-4", "--drag", "0.5", *HELD, *HELD_BODY]  # fmt: skip
 
