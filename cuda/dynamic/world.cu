@@ -31,12 +31,13 @@ template <> struct Splat<double> {
 
 /* The splat (docs/cuda.md "The hair–hair grid"). A block takes kSplatStrands neighbouring
  * strands (the order perm; nullptr: as stored); each warp takes its strands one at a time, a lane
- * a point, so that every load of x and v coalesces. Pass 1 finds the block's box of cells; when
- * its nodes fit the shared window (and no node can receive more than 2^16 shares), pass 2 adds
- * each point's fixed-point shares there, each 64-bit share split into its low 16 bits and the
- * rest, both summed by native 32-bit shared atomics (exact: see kSplatWindowPoints), and the
- * window goes to the grid with one 64-bit global atomic a touched node and channel; otherwise
- * pass 2 adds to the grid directly. Integer sums: no order changes a bit. */
+ * a point, so that every load of x and v coalesces. Pass 1 finds the block's box of cells. Where
+ * no node can receive more than 2^16 shares, pass 2 adds each point's fixed-point shares in shared
+ * memory, each 64-bit share split into its low 16 bits and the rest, both summed by native 32-bit
+ * shared atomics (exact: see kSplatWindowPoints): in a window over the box where its nodes fit,
+ * else in a hash table of the nodes the block touches; then one 64-bit global atomic a touched
+ * node and channel. A share whose node finds no slot, or a block past the share bound, adds to the
+ * grid directly. Integer sums: no order changes a bit. */
 #ifndef HB_SPLAT_STRANDS
 #define HB_SPLAT_STRANDS 64
 #endif
@@ -45,11 +46,33 @@ template <> struct Splat<double> {
 #endif
 constexpr int kSplatStrands = HB_SPLAT_STRANDS, kSplatWarps = 8; /* strands a block, its warps */
 constexpr int kWindow = HB_SPLAT_WINDOW; /* nodes: 2 × 32 bits × 4 channels each (64 KB at 2048) */
-/* the window's word (channel c: mass, p_x, p_y, p_z; part: low, high) of node i: each of the eight
- * (channel, part) arrays whole, so that a warp's lanes at different nodes use different banks */
-__device__ __forceinline__ int win_at(int c, int part, int i)
+/* the word (channel c: mass, p_x, p_y, p_z; part: low, high) of node or slot i in arrays of S
+ * words: each of the eight (channel, part) arrays whole, so that a warp's lanes at different nodes
+ * use different banks */
+template <int S> __device__ __forceinline__ int word_at(int c, int part, int i)
 {
-    return (2 * c + part) * kWindow + i;
+    return (2 * c + part) * S + i;
+}
+/* The hash table in the window's memory: kHashSlots keys (a node's index; kEmpty: none), then the
+ * eight (channel, part) arrays of kHashSlots words. A node takes the first free slot from its hash
+ * on (linear probing, claimed by a shared compare-and-swap); past kHashProbes slots, none. */
+constexpr int kHashSlots = (kWindow * 8 / 9) & ~31;
+constexpr int kHashProbes = 32;
+static_assert(kHashSlots >= 32, "HB_SPLAT_WINDOW too small for the hash table");
+constexpr unsigned kEmpty = 0xffffffffu; /* no node: indices are below n³ ≤ 2^31 */
+__device__ __forceinline__ int hash_slot(unsigned *keys, unsigned node)
+{
+    unsigned s = __umulhi(node * 2654435761u, (unsigned)kHashSlots);
+    for (int p = 0; p < kHashProbes; p++) {
+        const unsigned k = *reinterpret_cast<volatile unsigned *>(keys + s);
+        if (k == node) return (int)s;
+        if (k == kEmpty) {
+            const unsigned was = atomicCAS(keys + s, kEmpty, node);
+            if (was == kEmpty || was == node) return (int)s;
+        }
+        s = s + 1 == (unsigned)kHashSlots ? 0u : s + 1;
+    }
+    return -1;
 }
 /* At most this many shares reach a window node (one a point): their low parts (< 2^16 each) sum
  * below 2^32 and their high parts (|x| ≤ 2^30, so |x >> 16| ≤ 2^14) within ±2^31. */
@@ -94,11 +117,41 @@ __device__ __forceinline__ void cell_of(int64_t b, unsigned n, int (&c)[3])
     c[2] = (int)(t / n);
 }
 
-/* one share x (|x| ≤ 2^30) into channel c of window node i: low 16 bits, then the rest */
-__device__ __forceinline__ void window_add(unsigned *win, int c, int i, int x)
+/* one share x (|x| ≤ 2^30) into channel c of node or slot i: low 16 bits, then the rest */
+template <int S> __device__ __forceinline__ void words_add(unsigned *win, int c, int i, int x)
 {
-    atomicAdd(win + win_at(c, 0, i), (unsigned)x & 0xffffu);
-    atomicAdd(reinterpret_cast<int *>(win) + win_at(c, 1, i), x >> 16);
+    atomicAdd(win + word_at<S>(c, 0, i), (unsigned)x & 0xffffu);
+    atomicAdd(reinterpret_cast<int *>(win) + word_at<S>(c, 1, i), x >> 16);
+}
+/* a corner's mass share sm and momentum shares sp into node or slot i (`single`: a momentum
+ * share in one signed word) */
+template <int S>
+__device__ __forceinline__ void corner_add(unsigned *win, int i, int sm, const int (&sp)[3], bool single)
+{
+    words_add<S>(win, 0, i, sm);
+    if (single)
+        for (int c = 0; c < 3; c++) atomicAdd(reinterpret_cast<int *>(win) + word_at<S>(1 + c, 0, i), sp[c]);
+    else
+        for (int c = 0; c < 3; c++) words_add<S>(win, 1 + c, i, sp[c]);
+}
+/* node or slot i's four 64-bit sums; false where all are zero */
+template <int S> __device__ __forceinline__ bool corner_sums(const unsigned *win, int i, bool single, int64_t (&sum)[4])
+{
+    const int *wi = reinterpret_cast<const int *>(win);
+    bool any = false;
+    for (int c = 0; c < 4; c++) {
+        sum[c] = single && c > 0 ? (int64_t)wi[word_at<S>(c, 0, i)]
+                                 : (int64_t)wi[word_at<S>(c, 1, i)] * 65536 + (int64_t)win[word_at<S>(c, 0, i)];
+        any |= sum[c] != 0;
+    }
+    return any;
+}
+/* node j's sums into the grid */
+__device__ __forceinline__ void node_flush(int64_t j, const int64_t (&sum)[4], int64_t *mass, int64_t *mom)
+{
+    if (sum[0]) atomicAdd((unsigned long long *)&mass[j], (unsigned long long)sum[0]);
+    for (int c = 0; c < 3; c++)
+        if (sum[1 + c]) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sum[1 + c]);
 }
 
 template <typename T>
@@ -106,7 +159,8 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
     k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, int spb, const int64_t *perm,
                  int64_t *mass, int64_t *mom)
 {
-    extern __shared__ unsigned win[];  /* [channel: mass, p_x, p_y, p_z][low, high][node] (win_at) */
+    extern __shared__ unsigned win[];  /* [channel: mass, p_x, p_y, p_z][low, high][node] (word_at);
+                                         hashed: keys[kHashSlots], then the same over slots */
     __shared__ int lo[3], hi[3], vmax; /* vmax: the bits of the block's largest |v| component (≥ 0) */
     const int lane = (int)(threadIdx.x & 31u), warp = (int)(threadIdx.x >> 5);
     const int64_t s0 = (int64_t)blockIdx.x * spb;
@@ -151,18 +205,25 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
     __syncthreads();
     if (hi[0] < 0) return; /* no point of the block in the grid */
     const int ex = hi[0] - lo[0] + 1, ey = hi[1] - lo[1] + 1, ez = hi[2] - lo[2] + 1;
-    const bool windowed = (int64_t)ex * ey * ez <= kWindow && (int64_t)ns * P <= kSplatWindowPoints;
+    const bool bounded = (int64_t)ns * P <= kSplatWindowPoints;
+    const bool windowed = bounded && (int64_t)ex * ey * ez <= kWindow, hashed = bounded && !windowed;
+    unsigned *const keys = win, *const slots = win + kHashSlots;
     /* `single`: a momentum share is |rint(w·v·2^10)| ≤ |v|·2^10 + 1 (w ≤ 1) and a node takes at
      * most one a point, so while ns·P·(vmax·2^10 + 1) < 2^31 the block's momentum sums fit one
      * signed 32-bit word a node (exact, one atomic a share); else the split words as for mass */
     const bool single =
-        windowed && (double)ns * P * ((double)__int_as_float(vmax) * HB_GRID_MOM_SCALE + 1.0) < 2147483647.0;
-    if (windowed) {
+        bounded && (double)ns * P * ((double)__int_as_float(vmax) * HB_GRID_MOM_SCALE + 1.0) < 2147483647.0;
+    if (windowed)
         for (int i = threadIdx.x; i < ex * ey * ez; i += blockDim.x)
             for (int a = 0; a < 8; a++)
                 if (!single || a < 2 || (a & 1) == 0) win[a * kWindow + i] = 0u;
-        __syncthreads();
-    }
+    if (hashed)
+        for (int i = threadIdx.x; i < kHashSlots; i += blockDim.x) {
+            keys[i] = kEmpty;
+            for (int a = 0; a < 8; a++)
+                if (!single || a < 2 || (a & 1) == 0) slots[a * kHashSlots + i] = 0u;
+        }
+    __syncthreads();
     /* pass 2: each point's shares (hb_grid_splat_point: the reference's integers) */
     for (int s = warp; s < ns; s += kSplatWarps) {
         const int64_t st = perm ? perm[s0 + s] : s0 + s;
@@ -188,14 +249,14 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
                 for (int c = 0; c < 3; c++) sp[c] = share_of((wt[c8] * vc[c]) * (T)HB_GRID_MOM_SCALE);
                 if (windowed) {
                     const int i = wb + ((c8 & 1) ? 1 : 0) + ((c8 & 2) ? ex : 0) + ((c8 & 4) ? ex * ey : 0);
-                    window_add(win, 0, i, sm);
-                    if (single)
-                        for (int c = 0; c < 3; c++)
-                            atomicAdd(reinterpret_cast<int *>(win) + win_at(1 + c, 0, i), sp[c]);
-                    else
-                        for (int c = 0; c < 3; c++) window_add(win, 1 + c, i, sp[c]);
+                    corner_add<kWindow>(win, i, sm, sp, single);
+                    continue;
+                }
+                const int64_t j = hb_grid_corner_f64(b, n, c8);
+                const int slot = hashed ? hash_slot(keys, (unsigned)j) : -1;
+                if (slot >= 0) {
+                    corner_add<kHashSlots>(slots, slot, sm, sp, single);
                 } else {
-                    const int64_t j = hb_grid_corner_f64(b, n, c8);
                     atomicAdd((unsigned long long *)&mass[j], (unsigned long long)(int64_t)sm);
                     for (int c = 0; c < 3; c++)
                         atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)(int64_t)sp[c]);
@@ -203,24 +264,19 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
             }
         }
     }
-    if (!windowed) return;
+    if (!bounded) return;
     __syncthreads();
-    for (int i = threadIdx.x; i < ex * ey * ez; i += blockDim.x) {
-        int64_t sum[4];
-        bool any = false;
-        for (int c = 0; c < 4; c++) {
-            const int *wi = reinterpret_cast<const int *>(win);
-            sum[c] = single && c > 0 ? (int64_t)wi[win_at(c, 0, i)]
-                                     : (int64_t)wi[win_at(c, 1, i)] * 65536 + (int64_t)win[win_at(c, 0, i)];
-            any |= sum[c] != 0;
+    int64_t sum[4];
+    if (windowed)
+        for (int i = threadIdx.x; i < ex * ey * ez; i += blockDim.x) {
+            if (!corner_sums<kWindow>(win, i, single, sum)) continue;
+            const int jx = i % ex + lo[0], jy = (i / ex) % ey + lo[1], jz = i / (ex * ey) + lo[2];
+            node_flush(jx + n * (jy + n * (int64_t)jz), sum, mass, mom);
         }
-        if (!any) continue;
-        const int jx = i % ex + lo[0], jy = (i / ex) % ey + lo[1], jz = i / (ex * ey) + lo[2];
-        const int64_t j = jx + n * (jy + n * (int64_t)jz);
-        if (sum[0]) atomicAdd((unsigned long long *)&mass[j], (unsigned long long)sum[0]);
-        for (int c = 0; c < 3; c++)
-            if (sum[1 + c]) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sum[1 + c]);
-    }
+    else
+        for (int i = threadIdx.x; i < kHashSlots; i += blockDim.x)
+            if (keys[i] != kEmpty && corner_sums<kHashSlots>(slots, i, single, sum))
+                node_flush((int64_t)keys[i], sum, mass, mom);
 }
 
 template <typename T>

@@ -184,6 +184,62 @@ def test_gpu_splat_whose_window_sums_carry_matches_cpu_bit_for_bit(work, variant
     assert r.equivalent, f"strict {variant} carry {precision}: " + "; ".join(r.failures()[:5])
 
 
+# The splat's hash table (docs/cuda.md "The hair–hair grid"): 64 strands on a 256³ grid, so that a
+# point's cell is its own and a block of 8 strands (the fewest a block takes; 64 strands give blocks
+# of 8 on any GPU) spans a box of more nodes than the window holds. `fill`: 64 points a strand, so
+# that every block touches more nodes than the table has slots and some shares find none (the
+# grid directly); `hashed`: 16 points, so that a block's nodes fit the table. Each premise is
+# checked from the CPU's positions at the input frame; the strict build bit for bit.
+WINDOW_NODES = 2048  # HB_SPLAT_WINDOW, cuda/dynamic/world.cu
+HASH_SLOTS = 1792  # kHashSlots: (2048 · 8 / 9) rounded down to a multiple of 32
+HASH_BOX = (-13.0, -45.0, -13.0, 13.0, 13.0, 13.0)
+HASH = ["--strands", "64", "--substeps", "4", "--iterations", "2", "--bend-compliance", "1e-6",
+        "--shape-compliance", "1e-4", "--drag", "0.5", "--wind-speed", "150", "--grid", "256",
+        "--grid-box=" + ",".join(map(str, HASH_BOX)), "--grid-friction", "0.1,0.02",
+        "--grid-volume", "2000"]  # fmt: skip
+HASH_CASES = {"fill": ("64", 3), "hashed": ("16", 4)}  # points, frames
+
+
+def corner_nodes(x, box, n):
+    """Each point's eight corner nodes [N, P, 8] (−1 outside the grid), from positions [N, P, 3]."""
+    lo, hi = np.array(box[:3]), np.array(box[3:])
+    g = (x - lo) * ((n - 1) / (hi - lo))
+    inside = np.all((g >= 0) & (g < n - 1), axis=-1)
+    i = np.floor(np.where(inside[..., None], g, 0)).astype(np.int64)
+    nodes = np.stack([(i[..., 0] + a) + n * ((i[..., 1] + b) + n * (i[..., 2] + c))
+                      for c in (0, 1) for b in (0, 1) for a in (0, 1)], axis=-1)  # fmt: skip
+    return np.where(inside[..., None], nodes, -1)
+
+
+@pytest.mark.parametrize("case", sorted(HASH_CASES))
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("variant", [v for v in VARIANTS if _DECLARED.runs_features(v, {"grid"})])
+def test_gpu_splat_in_its_hash_table_matches_cpu_bit_for_bit(work, variant, precision, case):
+    points, frames = HASH_CASES[case]
+    cpu = work / f"cpu_hash_{case}_{precision}.h5"
+    if not cpu.exists():
+        run(CPU_BIN, "--stages", "init,collide,simulate", *HASH, "--points", points, "--precision", precision,
+            "--frames", frames, "--velocities", "all", "--output", cpu, "--quiet")  # fmt: skip
+    with open_trajectory(cpu) as t:
+        k = t.n_frames - 2
+        step = int(t.step[-1])
+        nodes = corner_nodes(t.frame(k).astype(np.float64), HASH_BOX, 256)
+    assert np.all(nodes >= 0), "a point outside the grid"
+    own = [len(np.unique(s)) for s in nodes]  # each strand's nodes
+    shared = nodes.size - len(np.unique(nodes))  # shares beyond the first at a node, over all strands
+    if case == "fill":  # any 8 strands touch more nodes than the table has slots
+        assert SPLAT_STRANDS_MIN * min(own) - shared > HASH_SLOTS
+    else:  # every strand's own box of nodes exceeds the window; 8 strands' shares fit the table
+        ijk = np.stack([nodes % 256, (nodes // 256) % 256, nodes // 65536], axis=-1).reshape(len(nodes), -1, 3)
+        boxes = np.prod(ijk.max(axis=1) - ijk.min(axis=1) + 1, axis=-1)
+        assert boxes.min() > WINDOW_NODES and SPLAT_STRANDS_MIN * int(points) * 8 <= HASH_SLOTS
+    out = work / f"gpu_hash_{case}_{variant}_{precision}.h5"
+    run(CUDA_STRICT_BIN, "--input", cpu, "--input-frame", k, "--stages", "simulate", "--frames", 1,
+        "--variant", variant, "--output", out, "--force", "--quiet")  # fmt: skip
+    r = diff_dynamic.compare(cpu, out, frames=[step], exact=True, check_paper=False)
+    assert r.equivalent, f"strict {variant} hash {case} {precision}: " + "; ".join(r.failures()[:5])
+
+
 # k_grid_hold over more blocks than a GPU holds at once: 12,000 strands of 24 points (375 blocks of
 # strands, three of points), with colliders. The strict build bit for bit.
 HELD_WIDE = ["--strands", "12000", "--points", "24", "--substeps", "4", "--iterations", "2", "--bend-compliance",
