@@ -288,34 +288,40 @@ __global__ void k_grid_nodes(World<T> w, const T *qg, const int64_t *mass, const
 }
 
 /* §3.16 `held`: a block takes kHoldStrands neighbouring strands in the strands' order (perm) and
- * kHoldPoints of their points; a warp samples one point index across its 32 strands, whose points
- * lie close together (the order follows the roots), so a corner's load is shared by the warp where
- * a strand's own points would each need a cell of their own. Positions come in and samples go out
- * through shared memory, a strand's run of points contiguous (rows padded against bank conflicts).
- * The root's sample (k = 0) is written but never applied. */
-constexpr int kHoldStrands = 32, kHoldPoints = 8;
+ * kHoldPoints·kHoldRounds of their points; a warp samples one point index across its 32 strands
+ * (a round), whose points lie close together (the order follows the roots), so a corner's load is
+ * shared by the warp where a strand's own points would each need a cell of their own. Positions
+ * come in and samples go out through shared memory, a strand's run of points contiguous (rows
+ * padded against bank conflicts). The root's sample (k = 0) is written but never applied. */
+#ifndef HB_HOLD_ROUNDS
+#define HB_HOLD_ROUNDS 1
+#endif
+constexpr int kHoldStrands = 32, kHoldPoints = 8, kHoldRounds = HB_HOLD_ROUNDS;
 template <typename T>
 __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
     k_grid_hold(World<T> w, const T *qg, T h, const T *x, int64_t N, int P, const int64_t *perm, T *held)
 {
-    constexpr int R = kHeldReals, XW = 3 * kHoldPoints + 1, HW = R * kHoldPoints + 1;
+    constexpr int R = kHeldReals, NB = kHoldPoints * kHoldRounds; /* the block's points */
+    constexpr int XW = 3 * NB + 1, HW = R * NB + 1;               /* row widths */
     __shared__ T xs[kHoldStrands * XW];
     __shared__ T hs[kHoldStrands * HW];
     __shared__ int64_t sid[kHoldStrands];
     const int t = threadIdx.x;
     const int64_t s0 = (int64_t)blockIdx.x * kHoldStrands;
-    const int k0 = (int)blockIdx.y * kHoldPoints;
-    const int ns = (int)(N - s0 < kHoldStrands ? N - s0 : kHoldStrands),
-              nk = P - k0 < kHoldPoints ? P - k0 : kHoldPoints;
+    const int k0 = (int)blockIdx.y * NB;
+    const int ns = (int)(N - s0 < kHoldStrands ? N - s0 : kHoldStrands), nk = P - k0 < NB ? P - k0 : NB;
     if (t < kHoldStrands) sid[t] = t < ns ? (perm ? perm[s0 + t] : s0 + t) : 0;
     __syncthreads();
-    for (int i = t; i < kHoldStrands * 3 * kHoldPoints; i += blockDim.x) {
-        const int u = i / (3 * kHoldPoints), r = i % (3 * kHoldPoints);
+    for (int i = t; i < kHoldStrands * 3 * NB; i += blockDim.x) {
+        const int u = i / (3 * NB), r = i % (3 * NB);
         if (u < ns && r < 3 * nk) xs[u * XW + r] = x[(sid[u] * P + k0) * 3 + r];
     }
     __syncthreads();
-    const int u = t & 31, kk = t >> 5;
-    if (u < ns && kk < nk) {
+    const int u = t & 31;
+#pragma unroll 1
+    for (int r = 0; r < kHoldRounds; r++) {
+        const int kk = (t >> 5) + r * kHoldPoints;
+        if (u >= ns || kk >= nk) break;
         const T *p = xs + u * XW + 3 * kk;
         const Sample<T> s = grid_sample_xyz(w, qg, p[0], p[1], p[2]);
         T *o = hs + u * HW + R * kk;
@@ -328,8 +334,8 @@ __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
         }
     }
     __syncthreads();
-    for (int i = t; i < kHoldStrands * R * kHoldPoints; i += blockDim.x) {
-        const int v = i / (R * kHoldPoints), r = i % (R * kHoldPoints);
+    for (int i = t; i < kHoldStrands * R * NB; i += blockDim.x) {
+        const int v = i / (R * NB), r = i % (R * NB);
         if (v < ns && r < R * nk) held[(sid[v] * P + k0) * R + r] = hs[v * HW + r];
     }
 }
@@ -379,7 +385,8 @@ template <typename T>
 cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P, const int64_t *perm,
                              T *held, cudaStream_t stream)
 {
-    const dim3 grid((unsigned)((N + kHoldStrands - 1) / kHoldStrands), (unsigned)((P + kHoldPoints - 1) / kHoldPoints));
+    const dim3 grid((unsigned)((N + kHoldStrands - 1) / kHoldStrands),
+                    (unsigned)((P + kHoldPoints * kHoldRounds - 1) / (kHoldPoints * kHoldRounds)));
     k_grid_hold<T><<<grid, kHoldStrands * kHoldPoints, 0, stream>>>(w, qg, h, x, N, (int)P, perm, held);
     return cudaGetLastError();
 }
