@@ -11,9 +11,9 @@ OUTD=${1:?"usage: bash tools/world_ncu.sh OUTDIR [STRANDS]"}
 N=${2:-10000}
 mkdir -p "$OUTD"
 command -v ncu >/dev/null || { echo "error: ncu (Nsight Compute) is not on PATH" >&2; exit 1; }
-DYN="--stages init,collide,simulate --points 32 --substeps 8 --iterations 2 --solver xpbd --gravity 981 --drag 0.5 --damping 0.5 --bend-compliance 1e-6 --shape-compliance 1e-4 --shape-range 0.5 --wind-speed 150 --gust-amplitude 0.5 --gust-frequency 1 --gust-wavelength 60 --head-motion nod --motion-amplitude 0.25 --motion-frequency 1 --variant lanes --precision fp32 --strands $N --quiet"
-GRID="--grid 32 --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild held"
-BODY="--colliders configs/bodies/default.colliders --friction 0.3,0.2 --depenetration-speed 200"
+source "$(dirname "$0")/world_scene.sh"
+DYN="$DYN --strands $N --quiet"
+GRID="--grid 32 $GRID --grid-rebuild held"
 METRICS=gpu__time_duration.sum,launch__grid_size,launch__registers_per_thread,sm__throughput.avg.pct_of_peak_sustained_elapsed,dram__throughput.avg.pct_of_peak_sustained_elapsed
 for r in "base:" "grid32-held:$GRID" "body64:$BODY" "head-friction-only:--friction 0.3,0.2 --depenetration-speed 200"; do
   name=${r%%:*}; flags=${r#*:}

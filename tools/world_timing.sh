@@ -7,9 +7,7 @@
 set -u
 OUTD=${1:?"usage: bash tools/world_timing.sh OUTDIR"}
 mkdir -p "$OUTD"
-DYN="--stages init,collide,simulate --points 32 --substeps 8 --iterations 2 --solver xpbd --gravity 981 --drag 0.5 --damping 0.5 --bend-compliance 1e-6 --shape-compliance 1e-4 --shape-range 0.5 --wind-speed 150 --gust-amplitude 0.5 --gust-frequency 1 --gust-wavelength 60 --head-motion nod --motion-amplitude 0.25 --motion-frequency 1 --variant lanes --precision fp32"
-GRID="--grid-friction 0.05,0.01 --grid-volume 2000"
-BODY="--colliders configs/bodies/default.colliders --friction 0.3,0.2 --depenetration-speed 200"
+source "$(dirname "$0")/world_scene.sh"
 row() { # binary name strands frames repeat flags...
   local B=$1 name=$2 n=$3 fr=$4 rep=$5; shift 5
   local js rc; js=$($B $DYN --strands $n --frames $fr --repeat $rep --warmup 1 "$@" --json --quiet 2>>$OUTD/bench.err); rc=$?

@@ -98,7 +98,12 @@ def work(tmp_path_factory):
 
 
 def scene_args(work, scene):
-    return [str(work / "body.txt") if a == "BODY" else a for a in SCENES[scene]]
+    return body_path(work, SCENES[scene])
+
+
+def body_path(work, flags):
+    """flags with BODY as the module's body file"""
+    return [str(work / "body.txt") if a == "BODY" else a for a in flags]
 
 
 @pytest.fixture(scope="module")
@@ -141,15 +146,38 @@ def test_gpu_frame_in_several_launches_matches_cpu_bit_for_bit(work, cpu_files, 
 
 def check_frame(work, cpu_files, build, variant, scene, solver, precision):
     cpu = cpu_files(scene, solver, precision)
+    frame_matches(work, cpu, build, variant, f"{scene}_{solver}_{precision}")
+
+
+def frame_matches(work, cpu, build, variant, label):
+    """The build's frame from the CPU file's frame K−1 against the CPU's frame K: bit for bit (strict)
+    or by the one-frame rule."""
     with open_trajectory(cpu) as t:
         k = t.n_frames - 2
         step = int(t.step[-1])
-    out = work / f"gpu_{build}_{variant}_{scene}_{solver}_{precision}.h5"
+    out = work / f"gpu_{build}_{variant}_{label}.h5"
     run(BUILDS[build], "--input", cpu, "--input-frame", k, "--stages", "simulate", "--frames", 1,
         "--variant", variant, "--output", out, "--force", "--quiet")  # fmt: skip
     exact = build == "strict"
     r = diff_dynamic.compare(cpu, out, frames=[step], exact=exact, check_paper=False)
-    assert r.equivalent, f"{build} {variant} {scene}: " + "; ".join(r.failures()[:5])
+    assert r.equivalent, f"{build} {variant} {label}: " + "; ".join(r.failures()[:5])
+
+
+def cpu_scene_file(work, name, flags, precision, frames=FRAMES):
+    """The C reference's file of a scene whose flags are given whole (BODY: the module's body file), made
+    once a module."""
+    cpu = work / f"cpu_{name}_{precision}.h5"
+    if not cpu.exists():
+        args = body_path(work, flags)
+        run(CPU_BIN, "--stages", "init,collide,simulate", *args, "--precision", precision, "--frames", frames,
+            "--velocities", "all", "--output", cpu, "--quiet")  # fmt: skip
+    return cpu
+
+
+def input_positions(cpu):
+    """Positions [N, P, 3] of the CPU file's frame K−1, the GPU run's input."""
+    with open_trajectory(cpu) as t:
+        return t.frame(t.n_frames - 2).astype(np.float64)
 
 
 # A window node's mass sum past 32 bits (docs/cuda.md "The hair–hair grid": a mass share is summed
@@ -166,22 +194,12 @@ SPLAT_STRANDS_MIN = 8  # kSplatWarps, cuda/dynamic/world.cu
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 @pytest.mark.parametrize("variant", FAST_RUNS)
 def test_gpu_splat_whose_window_sums_carry_matches_cpu_bit_for_bit(work, variant, precision):
-    cpu = work / f"cpu_carry_{precision}.h5"
-    if not cpu.exists():
-        run(CPU_BIN, "--stages", "init,collide,simulate", *CARRY, "--precision", precision, "--frames", FRAMES,
-            "--velocities", "all", "--output", cpu, "--quiet")  # fmt: skip
-    with open_trajectory(cpu) as t:
-        k = t.n_frames - 2
-        step = int(t.step[-1])
-        x = t.frame(k).astype(np.float64)
+    cpu = cpu_scene_file(work, "carry", CARRY, precision)
+    x = input_positions(cpu)
     lo, hi = np.array([-13.0, -45.0, -13.0]), np.array([250.0, 250.0, 250.0])
     weight = np.prod(1.0 - (x - lo) / (hi - lo), axis=-1)  # each point's trilinear weight at node 0
     assert SPLAT_STRANDS_MIN * x.shape[1] * weight.min() * MASS_SCALE > 2**32
-    out = work / f"gpu_carry_{variant}_{precision}.h5"
-    run(CUDA_STRICT_BIN, "--input", cpu, "--input-frame", k, "--stages", "simulate", "--frames", 1,
-        "--variant", variant, "--output", out, "--force", "--quiet")  # fmt: skip
-    r = diff_dynamic.compare(cpu, out, frames=[step], exact=True, check_paper=False)
-    assert r.equivalent, f"strict {variant} carry {precision}: " + "; ".join(r.failures()[:5])
+    frame_matches(work, cpu, "strict", variant, f"carry_{precision}")
 
 
 # The splat's hash table (docs/cuda.md "The hair–hair grid"): 64 strands on a 256³ grid, so that a
@@ -216,14 +234,8 @@ def corner_nodes(x, box, n):
 @pytest.mark.parametrize("variant", [v for v in VARIANTS if _DECLARED.runs_features(v, {"grid"})])
 def test_gpu_splat_in_its_hash_table_matches_cpu_bit_for_bit(work, variant, precision, case):
     points, frames = HASH_CASES[case]
-    cpu = work / f"cpu_hash_{case}_{precision}.h5"
-    if not cpu.exists():
-        run(CPU_BIN, "--stages", "init,collide,simulate", *HASH, "--points", points, "--precision", precision,
-            "--frames", frames, "--velocities", "all", "--output", cpu, "--quiet")  # fmt: skip
-    with open_trajectory(cpu) as t:
-        k = t.n_frames - 2
-        step = int(t.step[-1])
-        nodes = corner_nodes(t.frame(k).astype(np.float64), HASH_BOX, 256)
+    cpu = cpu_scene_file(work, f"hash_{case}", [*HASH, "--points", points], precision, frames)
+    nodes = corner_nodes(input_positions(cpu), HASH_BOX, 256)
     assert np.all(nodes >= 0), "a point outside the grid"
     own = [len(np.unique(s)) for s in nodes]  # each strand's nodes
     shared = nodes.size - len(np.unique(nodes))  # shares beyond the first at a node, over all strands
@@ -233,11 +245,7 @@ def test_gpu_splat_in_its_hash_table_matches_cpu_bit_for_bit(work, variant, prec
         ijk = np.stack([nodes % 256, (nodes // 256) % 256, nodes // 65536], axis=-1).reshape(len(nodes), -1, 3)
         boxes = np.prod(ijk.max(axis=1) - ijk.min(axis=1) + 1, axis=-1)
         assert boxes.min() > WINDOW_NODES and SPLAT_STRANDS_MIN * int(points) * 8 <= HASH_SLOTS
-    out = work / f"gpu_hash_{case}_{variant}_{precision}.h5"
-    run(CUDA_STRICT_BIN, "--input", cpu, "--input-frame", k, "--stages", "simulate", "--frames", 1,
-        "--variant", variant, "--output", out, "--force", "--quiet")  # fmt: skip
-    r = diff_dynamic.compare(cpu, out, frames=[step], exact=True, check_paper=False)
-    assert r.equivalent, f"strict {variant} hash {case} {precision}: " + "; ".join(r.failures()[:5])
+    frame_matches(work, cpu, "strict", variant, f"hash_{case}_{precision}")
 
 
 # k_grid_hold over more blocks than a GPU holds at once: 12,000 strands of 24 points (375 blocks of
@@ -249,19 +257,8 @@ HELD_WIDE = ["--strands", "12000", "--points", "24", "--substeps", "4", "--itera
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 @pytest.mark.parametrize("variant", [v for v in VARIANTS if _DECLARED.runs_features(v, {"grid", "colliders"})])
 def test_gpu_held_samples_in_wide_blocks_match_cpu_bit_for_bit(work, variant, precision):
-    cpu = work / f"cpu_held_wide_{precision}.h5"
-    if not cpu.exists():
-        flags = [str(work / "body.txt") if a == "BODY" else a for a in HELD_WIDE]
-        run(CPU_BIN, "--stages", "init,collide,simulate", *flags, "--precision", precision, "--frames", FRAMES,
-            "--velocities", "all", "--output", cpu, "--quiet")  # fmt: skip
-    with open_trajectory(cpu) as t:
-        k = t.n_frames - 2
-        step = int(t.step[-1])
-    out = work / f"gpu_held_wide_{variant}_{precision}.h5"
-    run(CUDA_STRICT_BIN, "--input", cpu, "--input-frame", k, "--stages", "simulate", "--frames", 1,
-        "--variant", variant, "--output", out, "--force", "--quiet")  # fmt: skip
-    r = diff_dynamic.compare(cpu, out, frames=[step], exact=True, check_paper=False)
-    assert r.equivalent, f"strict {variant} held wide {precision}: " + "; ".join(r.failures()[:5])
+    cpu = cpu_scene_file(work, "held_wide", HELD_WIDE, precision)
+    frame_matches(work, cpu, "strict", variant, f"held_wide_{precision}")
 
 
 # §3.17 the collision step in 4 sweeps on the body scene (configs/scenes/body.toml: the default
