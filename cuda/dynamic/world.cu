@@ -42,10 +42,10 @@ template <> struct Splat<double> {
 #define HB_SPLAT_STRANDS 64
 #endif
 #ifndef HB_SPLAT_WINDOW
-#define HB_SPLAT_WINDOW 2048
+#define HB_SPLAT_WINDOW 1024
 #endif
 constexpr int kSplatStrands = HB_SPLAT_STRANDS, kSplatWarps = 8; /* strands a block, its warps */
-constexpr int kWindow = HB_SPLAT_WINDOW; /* nodes: 2 × 32 bits × 4 channels each (64 KB at 2048) */
+constexpr int kWindow = HB_SPLAT_WINDOW; /* nodes: 2 × 32 bits × 4 channels each (32 KB at 1024) */
 /* the word (channel c: mass, p_x, p_y, p_z; part: low, high) of node or slot i in arrays of S
  * words: each of the eight (channel, part) arrays whole, so that a warp's lanes at different nodes
  * use different banks */

@@ -6,12 +6,13 @@ bit; no gusts here), the normal build by the one-frame rule. Variants that do no
 feature refuse it in one line. Marked `gpu`; conftest.py skips them where there is no usable GPU.
 """
 
+import re
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from conftest import CPU_BIN, CUDA_BIN, CUDA_STRICT_BIN
+from conftest import CPU_BIN, CUDA_BIN, CUDA_STRICT_BIN, ROOT
 from harness import HarnessError
 from harness.check import diff_dynamic
 from harness.core import scenes, variants
@@ -206,16 +207,16 @@ def test_gpu_splat_whose_window_sums_carry_matches_cpu_bit_for_bit(work, variant
 # point's cell is its own and a block of 8 strands (the fewest a block takes; 64 strands give blocks
 # of 8 on any GPU) spans a box of more nodes than the window holds. `fill`: 64 points a strand, so
 # that every block touches more nodes than the table has slots and some shares find none (the
-# grid directly); `hashed`: 16 points, so that a block's nodes fit the table. Each premise is
+# grid directly); `hashed`: 10 points, so that a block's nodes fit the table. Each premise is
 # checked from the CPU's positions at the input frame; the strict build bit for bit.
-WINDOW_NODES = 2048  # HB_SPLAT_WINDOW, cuda/dynamic/world.cu
-HASH_SLOTS = 1792  # kHashSlots: (2048 · 8 / 9) rounded down to a multiple of 32
+WINDOW_NODES = int(re.search(r"^#define HB_SPLAT_WINDOW (\d+)$", (ROOT / "cuda/dynamic/world.cu").read_text(), re.M)[1])
+HASH_SLOTS = (WINDOW_NODES * 8 // 9) & ~31  # kHashSlots, cuda/dynamic/world.cu
 HASH_BOX = (-13.0, -45.0, -13.0, 13.0, 13.0, 13.0)
 HASH = ["--strands", "64", "--substeps", "4", "--iterations", "2", "--bend-compliance", "1e-6",
         "--shape-compliance", "1e-4", "--drag", "0.5", "--wind-speed", "150", "--grid", "256",
         "--grid-box=" + ",".join(map(str, HASH_BOX)), "--grid-friction", "0.1,0.02",
         "--grid-volume", "2000"]  # fmt: skip
-HASH_CASES = {"fill": ("64", 3), "hashed": ("16", 4)}  # points, frames
+HASH_CASES = {"fill": ("64", 3), "hashed": ("10", 4)}  # points, frames
 
 
 def corner_nodes(x, box, n):
