@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Builds of the CUDA binary timed side by side on the grid's rows (issue #42; docs/cuda.md "The
+# hair–hair grid and the colliders"): tools/world_timing.sh's grid32-held, grid32-frame and
+# grid32-substep rows (its scene, tools/world_scene.sh), each row run by every build in turn,
+# ROUNDS times over, so that a build's rows and its neighbours' share the GPU's state. A build is
+# NAME=PATH; make one by changing a define of cuda/dynamic/world.cu in a copy of the tree and
+# `make build/hairsim-cuda` there. Run from the repository root, on a GPU node:
+#
+#   bash tools/world_compare.sh OUTDIR head=build/hairsim-cuda w512=/tmp/hb-w512/build/hairsim-cuda
+#
+# SMALL (default 10000) and LARGE (default 4194304; empty: none) choose the strand counts; ROWS
+# (default "held frame substep") the rows. Each line of OUTDIR/compare.txt: build, round, row,
+# strands, median/min/max ms a frame (--repeat 20 of 10 frames below 100,000 strands, 5 of 3 above).
+set -u
+OUTD=${1:?"usage: bash tools/world_compare.sh OUTDIR NAME=BINARY..."}
+shift
+[ $# -ge 1 ] || { echo "error: give at least one build as NAME=BINARY" >&2; exit 2; }
+for b in "$@"; do
+  [[ $b == *=* ]] || { echo "error: '$b' is not NAME=BINARY" >&2; exit 2; }
+  [ -x "${b#*=}" ] || { echo "error: ${b#*=} is not an executable binary" >&2; exit 2; }
+done
+mkdir -p "$OUTD"
+source "$(dirname "$0")/world_scene.sh"
+G="--grid 32 $GRID"
+row() { # name binary round row strands
+  local name=$1 bin=$2 r=$3 what=$4 n=$5 fr=3 rep=5 js rc flags
+  [ "$n" -lt 100000 ] && { fr=10; rep=20; }
+  case $what in
+    held) flags="$G --grid-rebuild held" ;;
+    frame) flags="$G" ;;
+    substep) flags="$G --grid-rebuild substep" ;;
+    base) flags="" ;;
+    *) echo "error: row '$what' is none of base, held, frame, substep" >&2; exit 2 ;;
+  esac
+  # shellcheck disable=SC2086 # the flag strings split into words on purpose
+  js=$("$bin" $DYN --strands "$n" --frames $fr --repeat $rep --warmup 1 $flags --json --quiet 2>>"$OUTD/bench.err")
+  rc=$?
+  [ $rc -ne 0 ] && { echo "$name r$r $what $n FAILED rc=$rc" | tee -a "$OUTD/compare.txt"; return; }
+  python3 -c "import json,sys; r=json.loads(sys.argv[1]); s=r['stages'][-1]; print('%-12s r%s %-8s %8d  median %9.4f ms  min %9.4f  max %9.4f' % (sys.argv[2], sys.argv[3], sys.argv[4], r['strands'], s['median_ms'], s['min_ms'], s['max_ms']))" \
+    "$js" "$name" "$r" "$what" | tee -a "$OUTD/compare.txt"
+}
+for r in $(seq 1 "${ROUNDS:-2}"); do
+  for n in ${SMALL-10000} ${LARGE-4194304}; do
+    for what in ${ROWS:-held frame substep}; do
+      for b in "$@"; do row "${b%%=*}" "${b#*=}" "$r" "$what" "$n"; done
+    done
+  done
+done
