@@ -19,6 +19,9 @@ for b in "$@"; do
   [[ $b == *=* ]] || { echo "error: '$b' is not NAME=BINARY" >&2; exit 2; }
   [ -x "${b#*=}" ] || { echo "error: ${b#*=} is not an executable binary" >&2; exit 2; }
 done
+for what in ${ROWS:-held frame substep}; do
+  case $what in base | held | frame | substep) ;; *) echo "error: row '$what' is none of base, held, frame, substep" >&2; exit 2 ;; esac
+done
 mkdir -p "$OUTD"
 source "$(dirname "$0")/world_scene.sh"
 G="--grid 32 $GRID"
@@ -29,8 +32,7 @@ row() { # name binary round row strands
     held) flags="$G --grid-rebuild held" ;;
     frame) flags="$G" ;;
     substep) flags="$G --grid-rebuild substep" ;;
-    base) flags="" ;;
-    *) echo "error: row '$what' is none of base, held, frame, substep" >&2; exit 2 ;;
+    *) flags="" ;; # base
   esac
   # shellcheck disable=SC2086 # the flag strings split into words on purpose
   js=$("$bin" $DYN --strands "$n" --frames $fr --repeat $rep --warmup 1 $flags --json --quiet 2>>"$OUTD/bench.err")
