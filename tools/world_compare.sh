@@ -9,7 +9,7 @@
 #   bash tools/world_compare.sh OUTDIR head=build/hairsim-cuda w512=/tmp/hb-w512/build/hairsim-cuda
 #
 # SMALL (default 10000) and LARGE (default 4194304; empty: none) choose the strand counts; ROWS
-# (default "held frame substep") the rows. Each line of OUTDIR/compare.txt: build, round, row,
+# (default "held frame substep") the rows. Each line of OUTDIR/bench.txt: build, round, row,
 # strands, median/min/max ms a frame (--repeat 20 of 10 frames below 100,000 strands, 5 of 3 above).
 set -u
 OUTD=${1:?"usage: bash tools/world_compare.sh OUTDIR NAME=BINARY..."}
@@ -26,7 +26,7 @@ mkdir -p "$OUTD"
 source "$(dirname "$0")/world_scene.sh"
 G="--grid 32 $GRID"
 row() { # name binary round row strands
-  local name=$1 bin=$2 r=$3 what=$4 n=$5 fr=3 rep=5 js rc flags
+  local name=$1 bin=$2 r=$3 what=$4 n=$5 fr=3 rep=5 flags
   [ "$n" -lt 100000 ] && { fr=10; rep=20; }
   case $what in
     held) flags="$G --grid-rebuild held" ;;
@@ -34,12 +34,8 @@ row() { # name binary round row strands
     substep) flags="$G --grid-rebuild substep" ;;
     *) flags="" ;; # base
   esac
-  # shellcheck disable=SC2086 # the flag strings split into words on purpose
-  js=$("$bin" $DYN --strands "$n" --frames $fr --repeat $rep --warmup 1 $flags --json --quiet 2>>"$OUTD/bench.err")
-  rc=$?
-  [ $rc -ne 0 ] && { echo "$name r$r $what $n FAILED rc=$rc" | tee -a "$OUTD/compare.txt"; return; }
-  python3 -c "import json,sys; r=json.loads(sys.argv[1]); s=r['stages'][-1]; print('%-12s r%s %-8s %8d  median %9.4f ms  min %9.4f  max %9.4f' % (sys.argv[2], sys.argv[3], sys.argv[4], r['strands'], s['median_ms'], s['min_ms'], s['max_ms']))" \
-    "$js" "$name" "$r" "$what" | tee -a "$OUTD/compare.txt"
+  # shellcheck disable=SC2086 # the flag string splits into words on purpose
+  world_row "$OUTD" "$name r$r $what" "$bin" "$n" $fr $rep $flags
 }
 for r in $(seq 1 "${ROUNDS:-2}"); do
   for n in ${SMALL-10000} ${LARGE-4194304}; do
