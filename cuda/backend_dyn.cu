@@ -261,9 +261,10 @@ void dyn_free(cuda_impl *c)
                     d->shape_rest, d->seg_rest,  d->seg64,   d->d_render,   d->d_vrender};
     for (void *p : ptrs)
         if (p) cudaFree(p);
-    void *world[] = {d->g_mass,     d->g_mom,  d->g_node_v, d->g_node_a, d->g_target, d->g_ftab,
-                     d->g_held,     d->c_kind, d->c_frame,  d->c_sdf_n,  d->c_mu,     d->c_geo,
-                     d->c_sdf_ptrs, d->f_pose, d->f_back,   d->f_qs,     d->d_world,  d->perm};
+    /* g_mom lies in g_mass's allocation */
+    void *world[] = {d->g_mass, d->g_node_v, d->g_node_a, d->g_target, d->g_ftab, d->g_held,
+                     d->c_kind, d->c_frame,  d->c_sdf_n,  d->c_mu,     d->c_geo,  d->c_sdf_ptrs,
+                     d->f_pose, d->f_back,   d->f_qs,     d->d_world,  d->perm};
     for (void *p : world)
         if (p) cudaFree(p);
     for (void *p : d->c_sdf)
@@ -352,9 +353,9 @@ template <typename T> static int dyn_world_load(cuda_impl *c, const void *rest, 
     const int64_t nodes = hw->nodes;
     int rc;
     if (c->scene.dyn.grid) {
-        if ((rc = device_alloc((void **)&d->g_mass, (uint64_t)nodes * 8u, c, "grid sums", err, errlen)) ||
-            (rc = device_alloc((void **)&d->g_mom, (uint64_t)nodes * 24u, c, "grid sums", err, errlen)))
-            return rc;
+        /* mass, then momentum in the same allocation (launch_grid_splat zeroes both at once) */
+        if ((rc = device_alloc((void **)&d->g_mass, (uint64_t)nodes * 32u, c, "grid sums", err, errlen))) return rc;
+        d->g_mom = d->g_mass + nodes;
         if (c->scene.dyn.grid_friction_declared &&
             (rc = device_alloc(&d->g_node_v, (uint64_t)nodes * 4u * rs, c, "grid velocities", err, errlen)))
             return rc;

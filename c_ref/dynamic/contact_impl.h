@@ -35,13 +35,12 @@ enum { HB_HEAD_NONE = 0, HB_HEAD_PLAIN = 1, HB_HEAD_WORLD = 2 };
 #endif
 #endif
 
-/* §3.16 the grid coordinates of x (u = Q_gᵀ·x, or x with qg = NULL): 1 and the index of its
- * lowest corner and the eight corner weights (corner a + 2b + 4c) when x is in the grid. */
-HB_HD int SFX(hb_grid_locate)(const REAL *qg, const REAL *glo, const REAL *gsc, int64_t gn, const REAL *x,
-                              int64_t *base, REAL *w)
+/* §3.16 the grid cell of x (u = Q_gᵀ·x, or x with qg = NULL): 1 and its integer coordinates i and
+ * the fractions f of x within it when x is in the grid. */
+HB_HD int SFX(hb_grid_cell)(const REAL *qg, const REAL *glo, const REAL *gsc, int64_t gn, const REAL *x, int64_t *i,
+                            REAL *f)
 {
-    REAL u[3], f[3];
-    int64_t i[3];
+    REAL u[3];
     for (int c = 0; c < 3; c++) u[c] = qg ? (qg[c] * x[0] + qg[3 + c] * x[1]) + qg[6 + c] * x[2] : x[c];
     for (int c = 0; c < 3; c++) {
         const REAL g = (u[c] - glo[c]) * gsc[c];
@@ -49,13 +48,30 @@ HB_HD int SFX(hb_grid_locate)(const REAL *qg, const REAL *glo, const REAL *gsc, 
         i[c] = (int64_t)g;
         f[c] = g - (REAL)i[c];
     }
-    *base = i[0] + gn * (i[1] + gn * i[2]);
+    return 1;
+}
+
+/* §3.16 the eight corner weights (corner a + 2b + 4c) of the fractions f */
+HB_HD void SFX(hb_grid_weights)(const REAL *f, REAL *w)
+{
     for (int k = 0; k < 8; k++) {
         const REAL wx = (k & 1) ? f[0] : (REAL)1 - f[0];
         const REAL wy = (k & 2) ? f[1] : (REAL)1 - f[1];
         const REAL wz = (k & 4) ? f[2] : (REAL)1 - f[2];
         w[k] = (wx * wy) * wz;
     }
+}
+
+/* §3.16 the grid coordinates of x: 1 and the index of its lowest corner and the eight corner
+ * weights when x is in the grid. */
+HB_HD int SFX(hb_grid_locate)(const REAL *qg, const REAL *glo, const REAL *gsc, int64_t gn, const REAL *x,
+                              int64_t *base, REAL *w)
+{
+    REAL f[3];
+    int64_t i[3];
+    if (!SFX(hb_grid_cell)(qg, glo, gsc, gn, x, i, f)) return 0;
+    *base = i[0] + gn * (i[1] + gn * i[2]);
+    SFX(hb_grid_weights)(f, w);
     return 1;
 }
 

@@ -5,6 +5,7 @@
 
 #include "dynamic/held.cuh"
 
+#include <atomic>
 #include <climits>
 
 namespace hb {
@@ -45,6 +46,8 @@ template <> struct Splat<double> {
 #define HB_SPLAT_WINDOW 1024
 #endif
 constexpr int kSplatStrands = HB_SPLAT_STRANDS, kSplatWarps = 8; /* strands a block, its warps */
+/* blocks an SM holds (fp32: 48 registers, as its shared memory allows; fp64: as many as it needs) */
+template <typename T> constexpr int kSplatMinBlocks = sizeof(T) == 4 ? 5 : 1;
 constexpr int kWindow = HB_SPLAT_WINDOW; /* nodes: 2 × 32 bits × 4 channels each (32 KB at 1024) */
 /* the word (channel c: mass, p_x, p_y, p_z; part: low, high) of node or slot i in arrays of S
  * words: each of the eight (channel, part) arrays whole, so that a warp's lanes at different nodes
@@ -78,18 +81,22 @@ __device__ __forceinline__ int hash_slot(unsigned *keys, unsigned node)
  * below 2^32 and their high parts (|x| ≤ 2^30, so |x >> 16| ≤ 2^14) within ±2^31. */
 constexpr int64_t kSplatWindowPoints = 65536;
 
-template <typename T> struct Locate;
-template <> struct Locate<float> {
-    __device__ static int at(const World<float> &w, const float *qg, const float *x, int64_t *b, float *wt)
+/* contact_impl.h's cell and weights of a point by precision: the cell's coordinates come whole, so
+ * that no division takes them back out of a node index */
+template <typename T> struct Cell;
+template <> struct Cell<float> {
+    __device__ static int at(const World<float> &w, const float *qg, const float *x, int64_t *i, float *f)
     {
-        return hb_grid_locate_f32(qg, w.glo, w.gsc, w.gn, x, b, wt);
+        return hb_grid_cell_f32(qg, w.glo, w.gsc, w.gn, x, i, f);
     }
+    __device__ static void weights(const float *f, float *wt) { hb_grid_weights_f32(f, wt); }
 };
-template <> struct Locate<double> {
-    __device__ static int at(const World<double> &w, const double *qg, const double *x, int64_t *b, double *wt)
+template <> struct Cell<double> {
+    __device__ static int at(const World<double> &w, const double *qg, const double *x, int64_t *i, double *f)
     {
-        return hb_grid_locate_f64(qg, w.glo, w.gsc, w.gn, x, b, wt);
+        return hb_grid_cell_f64(qg, w.glo, w.gsc, w.gn, x, i, f);
     }
+    __device__ static void weights(const double *f, double *wt) { hb_grid_weights_f64(f, wt); }
 };
 
 template <typename T> __device__ __forceinline__ bool finite3(const T *p)
@@ -106,15 +113,6 @@ __device__ __forceinline__ int share_of(float x)
 __device__ __forceinline__ int share_of(double x)
 {
     return __double2int_rn(x);
-}
-
-/* the cell (x, y, z) of node index b < n³ ≤ 2^31 (HB_GRID_POINTS_MAX), in 32-bit arithmetic */
-__device__ __forceinline__ void cell_of(int64_t b, unsigned n, int (&c)[3])
-{
-    const unsigned u = (unsigned)b, t = u / n;
-    c[0] = (int)(u - t * n);
-    c[1] = (int)(t % n);
-    c[2] = (int)(t / n);
 }
 
 /* one share x (|x| ≤ 2^30) into channel c of node or slot i: low 16 bits, then the rest */
@@ -155,7 +153,7 @@ __device__ __forceinline__ void node_flush(int64_t j, const int64_t (&sum)[4], i
 }
 
 template <typename T>
-__global__ void __launch_bounds__(kSplatWarps * 32)
+__global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, int spb, const int64_t *perm,
                  int64_t *mass, int64_t *mom)
 {
@@ -177,15 +175,13 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
         const int64_t st = perm ? perm[s0 + s] : s0 + s;
         for (int k = lane; k < P; k += 32) {
             const T *xp = x + 3 * (st * P + k);
-            int64_t b;
-            T wt[8];
+            int64_t c[3];
+            T f[3];
             const T *vp = v + 3 * (st * P + k);
-            if (finite3(xp) && finite3(vp) && Locate<T>::at(w, qg, xp, &b, wt)) {
-                int c[3];
-                cell_of(b, (unsigned)n, c);
+            if (finite3(xp) && finite3(vp) && Cell<T>::at(w, qg, xp, c, f)) {
                 for (int a = 0; a < 3; a++) {
-                    cl[a] = min(cl[a], c[a]);
-                    ch[a] = max(ch[a], c[a] + 1);
+                    cl[a] = min(cl[a], (int)c[a]);
+                    ch[a] = max(ch[a], (int)c[a] + 1);
                     vm = fmaxf(vm, fminf((float)fabs(vp[a]), (float)HB_GRID_VEL_CLAMP));
                 }
             }
@@ -230,18 +226,18 @@ __global__ void __launch_bounds__(kSplatWarps * 32)
         for (int k = lane; k < P; k += 32) {
             const int64_t r = st * P + k;
             const T *xp = x + 3 * r, *vp = v + 3 * r;
-            int64_t b;
-            T wt[8], vc[3];
+            int64_t cb[3];
+            T f[3], wt[8], vc[3];
             /* hb_grid_splat_point's shares, a corner at a time (fewer registers, the same integers) */
-            if (!(finite3(xp) && finite3(vp)) || !Locate<T>::at(w, qg, xp, &b, wt)) continue;
+            if (!(finite3(xp) && finite3(vp)) || !Cell<T>::at(w, qg, xp, cb, f)) continue;
+            Cell<T>::weights(f, wt);
             for (int c = 0; c < 3; c++) {
                 const T lim = (T)HB_GRID_VEL_CLAMP;
                 vc[c] = vp[c] < -lim ? -lim : vp[c] > lim ? lim : vp[c];
             }
-            int cb[3];
-            cell_of(b, (unsigned)n, cb);
-            /* the window node of the cell's lowest corner (32-bit: the window holds ≤ kWindow nodes) */
-            const int wb = (cb[0] - lo[0]) + ex * ((cb[1] - lo[1]) + ey * (cb[2] - lo[2]));
+            /* the cell's lowest corner: its window node (32-bit: the window holds ≤ kWindow nodes), its node */
+            const int wb = ((int)cb[0] - lo[0]) + ex * (((int)cb[1] - lo[1]) + ey * ((int)cb[2] - lo[2]));
+            const int64_t b = cb[0] + n * (cb[1] + n * cb[2]);
 #pragma unroll
             for (int c8 = 0; c8 < 8; c8++) {
                 int sp[3];
@@ -340,6 +336,8 @@ __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
     }
 }
 
+constexpr int kSplatDevices = 64; /* devices whose attributes launch_grid_splat keeps */
+
 int blocks_for(int64_t items, int block)
 {
     const int64_t g = (items + block - 1) / block;
@@ -353,20 +351,32 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
                               const int64_t *perm, int64_t *mass, int64_t *mom, cudaStream_t stream)
 {
     const int64_t nodes = w.gn * w.gn * w.gn;
-    cudaError_t e = cudaMemsetAsync(mass, 0, (size_t)nodes * sizeof *mass, stream);
-    if (e == cudaSuccess) e = cudaMemsetAsync(mom, 0, (size_t)nodes * 3 * sizeof *mom, stream);
+    /* the sums zeroed: at once where mom follows mass (backend_dyn.cu allocates them so) */
+    cudaError_t e = cudaMemsetAsync(mass, 0, (size_t)nodes * (mom == mass + nodes ? 4 : 1) * sizeof *mass, stream);
+    if (e == cudaSuccess && mom != mass + nodes) e = cudaMemsetAsync(mom, 0, (size_t)nodes * 3 * sizeof *mom, stream);
     if (e != cudaSuccess) return e;
-    /* kSplatStrands a block, fewer (down to one a warp) where that leaves the GPU's SMs idle */
+    /* kSplatStrands a block, fewer (down to one a warp) where that leaves the GPU's SMs idle; the
+     * device's SM count and the kernel's shared-memory attribute asked once a device */
+    const size_t smem = (size_t)kWindow * 8 * sizeof(unsigned);
     int dev = 0, sms = 0;
-    if ((e = cudaGetDevice(&dev)) != cudaSuccess ||
-        (e = cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev)) != cudaSuccess)
-        return e;
+    if ((e = cudaGetDevice(&dev)) != cudaSuccess) return e;
+    static std::atomic<int> sms_of[kSplatDevices], ready[kSplatDevices];
+    const int slot = dev < kSplatDevices ? dev : -1;
+    if (slot >= 0 && (ready[slot].load() >> (sizeof(T) == 4 ? 0 : 1) & 1)) {
+        sms = sms_of[slot].load();
+    } else {
+        if ((e = cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev)) != cudaSuccess ||
+            (e = cudaFuncSetAttribute(k_grid_splat<T>, cudaFuncAttributeMaxDynamicSharedMemorySize, (int)smem)) !=
+                cudaSuccess)
+            return e;
+        if (slot >= 0) {
+            sms_of[slot].store(sms);
+            ready[slot].fetch_or(sizeof(T) == 4 ? 1 : 2);
+        }
+    }
     int spb = kSplatStrands;
     while (spb > kSplatWarps && (N + spb - 1) / spb < 4 * (int64_t)sms) spb /= 2;
     const int64_t blocks = (N + spb - 1) / spb;
-    const size_t smem = (size_t)kWindow * 8 * sizeof(unsigned);
-    e = cudaFuncSetAttribute(k_grid_splat<T>, cudaFuncAttributeMaxDynamicSharedMemorySize, (int)smem);
-    if (e != cudaSuccess) return e;
     k_grid_splat<T><<<(int)(blocks < 1 ? 1 : blocks), kSplatWarps * 32, smem, stream>>>(w, qg, x, v, N, (int)P, spb,
                                                                                         perm, mass, mom);
     return cudaGetLastError();
