@@ -24,14 +24,13 @@ for what in ${ROWS:-held frame substep}; do
 done
 mkdir -p "$OUTD"
 source "$(dirname "$0")/world_scene.sh"
-G="--grid 32 $GRID"
 row() { # name binary round row strands
   local name=$1 bin=$2 r=$3 what=$4 n=$5 fr=3 rep=5 flags
   [ "$n" -lt 100000 ] && { fr=10; rep=20; }
   case $what in
-    held) flags="$G --grid-rebuild held" ;;
-    frame) flags="$G" ;;
-    substep) flags="$G --grid-rebuild substep" ;;
+    held) flags=$HELD32 ;;
+    frame) flags=$FRAME32 ;;
+    substep) flags=$SUBSTEP32 ;;
     *) flags="" ;; # base
   esac
   # shellcheck disable=SC2086 # the flag string splits into words on purpose

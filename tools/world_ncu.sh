@@ -13,9 +13,8 @@ mkdir -p "$OUTD"
 command -v ncu >/dev/null || { echo "error: ncu (Nsight Compute) is not on PATH" >&2; exit 1; }
 source "$(dirname "$0")/world_scene.sh"
 DYN="$DYN --strands $N --quiet"
-GRID="--grid 32 $GRID --grid-rebuild held"
 METRICS=gpu__time_duration.sum,launch__grid_size,launch__registers_per_thread,sm__throughput.avg.pct_of_peak_sustained_elapsed,dram__throughput.avg.pct_of_peak_sustained_elapsed
-for r in "base:" "grid32-held:$GRID" "body64:$BODY" "head-friction-only:--friction 0.3,0.2 --depenetration-speed 200"; do
+for r in "base:" "grid32-held:$HELD32" "body64:$BODY" "head-friction-only:--friction 0.3,0.2 --depenetration-speed 200"; do
   name=${r%%:*}; flags=${r#*:}
   # shellcheck disable=SC2086 # the flag strings split into words on purpose
   ncu --print-summary per-kernel --metrics "$METRICS" build/hairsim-cuda $DYN $flags --frames 2 > "$OUTD/ncu-$name.txt" 2>&1

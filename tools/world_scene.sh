@@ -5,6 +5,10 @@
 # shellcheck disable=SC2034 # used by the scripts that source this file
 DYN="--stages init,collide,simulate --points 32 --substeps 8 --iterations 2 --solver xpbd --gravity 981 --drag 0.5 --damping 0.5 --bend-compliance 1e-6 --shape-compliance 1e-4 --shape-range 0.5 --wind-speed 150 --gust-amplitude 0.5 --gust-frequency 1 --gust-wavelength 60 --head-motion nod --motion-amplitude 0.25 --motion-frequency 1 --variant lanes --precision fp32"
 GRID="--grid-friction 0.05,0.01 --grid-volume 2000"
+# the 32³ grid rows: built once a frame and sampled once (held), sampled every substep (frame), built every substep
+HELD32="--grid 32 $GRID --grid-rebuild held"
+FRAME32="--grid 32 $GRID"
+SUBSTEP32="--grid 32 $GRID --grid-rebuild substep"
 BODY="--colliders configs/bodies/default.colliders --friction 0.3,0.2 --depenetration-speed 200"
 # world_row OUTDIR LABEL BINARY STRANDS FRAMES REPEAT [FLAGS...]: one row, the scene plus FLAGS, its median,
 # min and max ms a frame appended to OUTDIR/bench.txt and printed (a failed run: its exit status)

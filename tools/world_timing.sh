@@ -14,11 +14,11 @@ sed 's/head.obj 64/head.obj 128/' configs/bodies/default.colliders > "$BODIES/bo
 for n in 4194304 10000; do
   fr=3; rep=5; [ $n -lt 100000 ] && { fr=10; rep=20; }
   world_row "$OUTD" base "$A" $n $fr $rep
-  world_row "$OUTD" grid32-held "$A" $n $fr $rep --grid 32 $GRID --grid-rebuild held
+  world_row "$OUTD" grid32-held "$A" $n $fr $rep $HELD32
   world_row "$OUTD" grid32-held-friction-only "$A" $n $fr $rep --grid 32 --grid-friction 0.05,0.01 --grid-rebuild held
   world_row "$OUTD" grid32-splat-only "$A" $n $fr $rep --grid 32
-  world_row "$OUTD" grid32-frame "$A" $n $fr $rep --grid 32 $GRID
-  world_row "$OUTD" grid32-substep "$A" $n $fr $rep --grid 32 $GRID --grid-rebuild substep
+  world_row "$OUTD" grid32-frame "$A" $n $fr $rep $FRAME32
+  world_row "$OUTD" grid32-substep "$A" $n $fr $rep $SUBSTEP32
   world_row "$OUTD" body64 "$A" $n $fr $rep $BODY
   world_row "$OUTD" body-bounded-head-only "$A" $n $fr $rep --friction 0.3,0.2 --depenetration-speed 200
   world_row "$OUTD" base-again "$A" $n $fr $rep
