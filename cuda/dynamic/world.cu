@@ -288,7 +288,8 @@ __global__ void k_grid_nodes(World<T> w, const T *qg, const int64_t *mass, const
  * (a round), whose points lie close together (the order follows the roots), so a corner's load is
  * shared by the warp where a strand's own points would each need a cell of their own. Positions
  * come in and samples go out through shared memory, a strand's run of points contiguous (rows
- * padded against bank conflicts). The root's sample (k = 0) is written but never applied. */
+ * padded against bank conflicts), a thread's loads all issued before its first store (the loop's
+ * trip count fixed by the block's shape). The root's sample (k = 0) is written but never applied. */
 #ifndef HB_HOLD_ROUNDS
 #define HB_HOLD_ROUNDS 1
 #endif
@@ -299,18 +300,32 @@ __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
 {
     constexpr int R = kHeldReals, NB = kHoldPoints * kHoldRounds; /* the block's points */
     constexpr int XW = 3 * NB + 1, HW = R * NB + 1;               /* row widths */
+    constexpr int NT = kHoldStrands * kHoldPoints, NX = kHoldStrands * 3 * NB, NH = kHoldStrands * R * NB;
     __shared__ T xs[kHoldStrands * XW];
     __shared__ T hs[kHoldStrands * HW];
-    __shared__ int64_t sid[kHoldStrands];
+    __shared__ int64_t xo[kHoldStrands], ho[kHoldStrands]; /* each strand's first real in x and in held */
     const int t = threadIdx.x;
     const int64_t s0 = (int64_t)blockIdx.x * kHoldStrands;
     const int k0 = (int)blockIdx.y * NB;
     const int ns = (int)(N - s0 < kHoldStrands ? N - s0 : kHoldStrands), nk = P - k0 < NB ? P - k0 : NB;
-    if (t < kHoldStrands) sid[t] = t < ns ? (perm ? perm[s0 + t] : s0 + t) : 0;
+    if (t < kHoldStrands) {
+        const int64_t st = t < ns ? (perm ? perm[s0 + t] : s0 + t) : 0;
+        xo[t] = (st * P + k0) * 3;
+        ho[t] = (st * P + k0) * R;
+    }
     __syncthreads();
-    for (int i = t; i < kHoldStrands * 3 * NB; i += blockDim.x) {
-        const int u = i / (3 * NB), r = i % (3 * NB);
-        if (u < ns && r < 3 * nk) xs[u * XW + r] = x[(sid[u] * P + k0) * 3 + r];
+    { /* the positions: every load in flight at once, then into shared memory */
+        T xr[(NX + NT - 1) / NT];
+#pragma unroll
+        for (int q = 0; q < (NX + NT - 1) / NT; q++) {
+            const int i = t + q * NT, u = i / (3 * NB), r = i % (3 * NB);
+            if (i < NX && u < ns && r < 3 * nk) xr[q] = x[xo[u] + r];
+        }
+#pragma unroll
+        for (int q = 0; q < (NX + NT - 1) / NT; q++) {
+            const int i = t + q * NT, u = i / (3 * NB), r = i % (3 * NB);
+            if (i < NX && u < ns && r < 3 * nk) xs[u * XW + r] = xr[q];
+        }
     }
     __syncthreads();
     const int u = t & 31;
@@ -330,9 +345,10 @@ __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
         }
     }
     __syncthreads();
-    for (int i = t; i < kHoldStrands * R * NB; i += blockDim.x) {
-        const int v = i / (R * NB), r = i % (R * NB);
-        if (v < ns && r < R * nk) held[(sid[v] * P + k0) * R + r] = hs[v * HW + r];
+#pragma unroll
+    for (int q = 0; q < (NH + NT - 1) / NT; q++) {
+        const int i = t + q * NT, v = i / (R * NB), r = i % (R * NB);
+        if (i < NH && v < ns && r < R * nk) held[ho[v] + r] = hs[v * HW + r];
     }
 }
 
