@@ -519,13 +519,16 @@ __device__ __forceinline__ void pack(T *s, int k0, bool sw, int P, bool live, co
 /* The frame of (32/L) strands a warp, L lanes a strand, G points a lane (G·L ≥ P); Ftl: the
  * solver of §3.7, else §3.6; Seg: a groom's per-segment rest lengths (§3.15, m.seg_rest); W: the
  * grid and colliders of §3.16–3.17 (m.world), with the strands taken in the order m.perm (slot
- * s holds strand perm[s], nearby strands together, so a block's points share grid nodes). */
+ * s holds strand perm[s], nearby strands together, so a block's points share grid nodes and
+ * colliders) where the kernel reads the grid or tests colliders; the held grid's kernel (W =
+ * kWHeld) reads each point's own sample, which no order changes, and takes them as stored. */
 template <typename T, class Feat, int G, int L, bool Ftl, bool Seg, int W>
 __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl, W>())
     k_lanes(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
             const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N)
 {
-    constexpr int SPW = 32 / L; /* strands a warp */
+    constexpr int SPW = 32 / L;                             /* strands a warp */
+    constexpr bool Ordered = (W & (kWGather | kWCol)) != 0; /* strands in the order m.perm */
     extern __shared__ __align__(16) unsigned char hb_lanes_smem[];
     const Feat has = MakeFeat<Feat>::make(m.features);
     const int lane = (int)(threadIdx.x & 31u), w = (int)(threadIdx.x >> 5), wpb = (int)(blockDim.x >> 5);
@@ -565,7 +568,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
          * the world at strand perm[s0 + t], t = ⌊e / r⌋ found by comparisons (SPW ≤ 4); the order
          * is read again at each use, so that it holds no register through the substeps */
         auto at_row = [&](int e, int r) -> int64_t {
-            if constexpr (W != 0) {
+            if constexpr (Ordered) {
                 if (m.perm) {
                     int t = 0;
 #pragma unroll
@@ -624,7 +627,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
 #pragma unroll
             for (int i = 0; i < G; i++) {
                 const int k = k0 + i;
-                const int64_t st = W && m.perm ? m.perm[s0 + seg] : s0 + seg;
+                const int64_t st = Ordered && m.perm ? m.perm[s0 + seg] : s0 + seg;
                 sl[i] = live && k >= 1 && k < P ? m.seg_rest[st * m.seg_is + (int64_t)(k - 1) * m.seg_s] : m.seg_len;
             }
         }
@@ -642,7 +645,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         const bool held = (W & kWHeld) && wgrid && m.world.grid_rebuild == HB_GRID_HELD;
         if constexpr ((W & kWHeld) != 0) { /* §3.16 `held`: each point's sample, taken by k_grid_hold */
             if (held && live) {
-                const int64_t st = m.perm ? m.perm[s0 + seg] : s0 + seg;
+                const int64_t st = Ordered && m.perm ? m.perm[s0 + seg] : s0 + seg;
 #pragma unroll
                 for (int i = 0; i < G; i++) {
                     const int k = point_of<G>(k0, sw, i);
