@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <climits>
+#include <type_traits>
 
 namespace hb {
 namespace dyn {
@@ -220,46 +221,55 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
                 if (!single || a < 2 || (a & 1) == 0) slots[a * kHashSlots + i] = 0u;
         }
     __syncthreads();
-    /* pass 2: each point's shares (hb_grid_splat_point: the reference's integers) */
-    for (int s = warp; s < ns; s += kSplatWarps) {
-        const int64_t st = perm ? perm[s0 + s] : s0 + s;
-        for (int k = lane; k < P; k += 32) {
-            const int64_t r = st * P + k;
-            const T *xp = x + 3 * r, *vp = v + 3 * r;
-            int64_t cb[3];
-            T f[3], wt[8], vc[3];
-            /* hb_grid_splat_point's shares, a corner at a time (fewer registers, the same integers) */
-            if (!(finite3(xp) && finite3(vp)) || !Cell<T>::at(w, qg, xp, cb, f)) continue;
-            Cell<T>::weights(f, wt);
-            for (int c = 0; c < 3; c++) {
-                const T lim = (T)HB_GRID_VEL_CLAMP;
-                vc[c] = vp[c] < -lim ? -lim : vp[c] > lim ? lim : vp[c];
-            }
-            /* the cell's lowest corner: its window node (32-bit: the window holds ≤ kWindow nodes), its node */
-            const int wb = ((int)cb[0] - lo[0]) + ex * (((int)cb[1] - lo[1]) + ey * ((int)cb[2] - lo[2]));
-            const int64_t b = cb[0] + n * (cb[1] + n * cb[2]);
-#pragma unroll
-            for (int c8 = 0; c8 < 8; c8++) {
-                int sp[3];
-                const int sm = share_of(wt[c8] * (T)HB_GRID_MASS_SCALE);
-                for (int c = 0; c < 3; c++) sp[c] = share_of((wt[c8] * vc[c]) * (T)HB_GRID_MOM_SCALE);
-                if (windowed) {
-                    const int i = wb + ((c8 & 1) ? 1 : 0) + ((c8 & 2) ? ex : 0) + ((c8 & 4) ? ex * ey : 0);
-                    corner_add<kWindow>(win, i, sm, sp, single);
-                    continue;
+    /* pass 2: each point's shares (hb_grid_splat_point: the reference's integers). The common
+     * block (its window, one momentum word a share) runs a loop of its own (Fast), so that no
+     * corner chooses its path. A momentum share is w·(v·2^10): scaling by a power of two is exact,
+     * so it is the reference's (w·v)·2^10. */
+    static_assert(HB_GRID_MOM_SCALE == 1024.0, "the momentum shares' scaling is exact only for a power of two");
+    auto pass2 = [&](auto fast) {
+        constexpr bool Fast = decltype(fast)::value;
+        for (int s = warp; s < ns; s += kSplatWarps) {
+            const int64_t st = perm ? perm[s0 + s] : s0 + s;
+            for (int k = lane; k < P; k += 32) {
+                const int64_t r = st * P + k;
+                const T *xp = x + 3 * r, *vp = v + 3 * r;
+                int64_t cb[3];
+                T f[3], wt[8], vs[3];
+                /* hb_grid_splat_point's shares, a corner at a time (fewer registers, the same integers) */
+                if (!(finite3(xp) && finite3(vp)) || !Cell<T>::at(w, qg, xp, cb, f)) continue;
+                Cell<T>::weights(f, wt);
+                for (int c = 0; c < 3; c++) {
+                    const T lim = (T)HB_GRID_VEL_CLAMP;
+                    vs[c] = (vp[c] < -lim ? -lim : vp[c] > lim ? lim : vp[c]) * (T)HB_GRID_MOM_SCALE;
                 }
-                const int64_t j = hb_grid_corner_f64(b, n, c8);
-                const int slot = hashed ? hash_slot(keys, (unsigned)j) : -1;
-                if (slot >= 0) {
-                    corner_add<kHashSlots>(slots, slot, sm, sp, single);
-                } else {
-                    atomicAdd((unsigned long long *)&mass[j], (unsigned long long)(int64_t)sm);
-                    for (int c = 0; c < 3; c++)
-                        atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)(int64_t)sp[c]);
+                /* the cell's lowest corner: its window node (32-bit: the window holds ≤ kWindow nodes), its node */
+                const int wb = ((int)cb[0] - lo[0]) + ex * (((int)cb[1] - lo[1]) + ey * ((int)cb[2] - lo[2]));
+                const int64_t b = cb[0] + n * (cb[1] + n * cb[2]);
+#pragma unroll
+                for (int c8 = 0; c8 < 8; c8++) {
+                    int sp[3];
+                    const int sm = share_of(wt[c8] * (T)HB_GRID_MASS_SCALE);
+                    for (int c = 0; c < 3; c++) sp[c] = share_of(wt[c8] * vs[c]);
+                    if (Fast || windowed) {
+                        const int i = wb + ((c8 & 1) ? 1 : 0) + ((c8 & 2) ? ex : 0) + ((c8 & 4) ? ex * ey : 0);
+                        corner_add<kWindow>(win, i, sm, sp, Fast || single);
+                        continue;
+                    }
+                    const int64_t j = hb_grid_corner_f64(b, n, c8);
+                    const int slot = hashed ? hash_slot(keys, (unsigned)j) : -1;
+                    if (slot >= 0) {
+                        corner_add<kHashSlots>(slots, slot, sm, sp, single);
+                    } else {
+                        atomicAdd((unsigned long long *)&mass[j], (unsigned long long)(int64_t)sm);
+                        for (int c = 0; c < 3; c++)
+                            atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)(int64_t)sp[c]);
+                    }
                 }
             }
         }
-    }
+    };
+    if (windowed && single) pass2(std::true_type{});
+    else pass2(std::false_type{});
     if (!bounded) return;
     __syncthreads();
     int64_t sum[4];
