@@ -39,8 +39,9 @@ constexpr bool kFreeCollide = kFree && !HB_LANES_REF_COLLIDE;
 
 /* Blocks of kLanesMaxBlock an SM must hold (__launch_bounds__'s second argument, which caps
  * the registers a thread): fp32 at P ≤ 32 HB_LANES_MINB for xpbd and HB_LANES_FTL_MINB for
- * ftl, with the world's code HB_LANES_WORLD_MINB (all of it), HB_LANES_COL_MINB (colliders alone)
- * or HB_LANES_HELD_MINB (the held grid alone) (measured, docs/cuda.md), 1 (up to 255 registers) otherwise. */
+ * ftl, with the world's code HB_LANES_WORLD_MINB (all of it), HB_LANES_COL_MINB (colliders alone),
+ * HB_LANES_HELD_MINB (the held grid alone) or HB_LANES_GATHER_MINB (the grid's gather alone) (measured,
+ * docs/cuda.md), 1 (up to 255 registers) otherwise. */
 #ifndef HB_LANES_MINB
 #define HB_LANES_MINB 4
 #endif
@@ -55,6 +56,9 @@ constexpr bool kFreeCollide = kFree && !HB_LANES_REF_COLLIDE;
 #endif
 #ifndef HB_LANES_HELD_MINB
 #define HB_LANES_HELD_MINB HB_LANES_MINB
+#endif
+#ifndef HB_LANES_GATHER_MINB
+#define HB_LANES_GATHER_MINB 3
 #endif
 #ifndef HB_LANES_FTL_G
 #define HB_LANES_FTL_G 4
@@ -106,6 +110,7 @@ template <typename T, int G, int L, bool Ftl, int W = 0> constexpr int lanes_min
     return sizeof(T) != 4                      ? 1
            : W == kWHeld && !Ftl && G == 2     ? HB_LANES_HELD_MINB /* the held grid alone */
            : W == kWCol                        ? HB_LANES_COL_MINB
+           : W == kWGather && !Ftl && G == 2   ? HB_LANES_GATHER_MINB /* the grid's gather alone */
            : W                                 ? HB_LANES_WORLD_MINB /* everything: 2, up to 128 registers */
            : (!Ftl && G == 2)                  ? HB_LANES_MINB
            : (Ftl && G == kFtlG && L == kFtlL) ? HB_LANES_FTL_MINB
@@ -886,6 +891,7 @@ template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int6
     if (wk && seg) wk = kWAll;
     if (wk == kWAll) fn = seg ? &k_lanes<T, DynF, G, L, Ftl, true, kWAll> : &k_lanes<T, DynF, G, L, Ftl, false, kWAll>;
     else if (wk == kWHeld) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWHeld>;
+    else if (wk == kWGather) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWGather>;
     else if (wk == kWCol) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWCol>;
     else if (seg) fn = &k_lanes<T, DynF, G, L, Ftl, true, 0>;
     /* the default scene's feature set (every feature) has its own held-grid and colliders kernels
@@ -894,19 +900,21 @@ template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int6
     if constexpr (sizeof(T) == 4 && !Ftl && G == 2 && L == 16) {
         if (f == kEvery && wk == kWHeld) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWHeld>;
         if (f == kEvery && wk == kWCol) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWCol>;
+        if (f == kEvery && wk == kWGather) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWGather>;
     }
     return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P) + ((wk & kWHeld) ? lanes_held_reals<T, G>() : 0)};
 }
 /* The world's code a run needs (docs/cuda.md "The hair–hair grid and the colliders"): none
- * without a world; the held grid alone (or a grid that applies nothing); the colliders alone;
- * else all of it. */
+ * without a world; the held grid alone (or a grid that applies nothing); the grid's gather alone
+ * (`frame`, `substep`); the colliders alone; else all of it. */
 template <typename T> int world_kind(const DModel<T> &m)
 {
     if (!m.has_world) return 0;
     const World<T> &w = m.world;
     const bool col = w.ncol > 0 || w.head_friction || w.bounded;
     const bool apply = w.grid && (w.grid_friction || w.grid_volume);
-    if (apply && (col || w.grid_rebuild != HB_GRID_HELD)) return kWAll;
+    if (apply && col) return kWAll;
+    if (apply && w.grid_rebuild != HB_GRID_HELD) return kWGather;
     return col ? kWCol : kWHeld;
 }
 template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P, bool seg, int world)
@@ -927,7 +935,7 @@ template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P,
 template <typename T>
 cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg, bool world)
 {
-    for (int wk : {kWHeld, kWCol, kWAll}) { /* a world's run launches one of its three kernels */
+    for (int wk : {kWHeld, kWGather, kWCol, kWAll}) { /* a world's run launches one of its four kernels */
         const LanesPick<T> k = lanes_pick<T>(features, solver, P, seg, world ? wk : 0);
         if (!k.fn) return cudaErrorInvalidValue;
         int bytes = (int)((size_t)(block / 32) * (size_t)k.warp_reals * sizeof(T)), dev = 0;
