@@ -54,6 +54,7 @@ typedef struct {
     void *vel, *vel_saved, *rest, *bend_rest;
     void *seg_rest; /* a groom's ℓ_k [N][P−1] (docs/model.md §3.15), and in double for the observables */
     double *seg64;
+    void *contacts; /* --contact-planes: each point's planes [N·P][HB_CONTACT_POINT] (docs/model.md §3.17) */
     hb_dyn_model_f32 d32;
     hb_dyn_model_f64 d64;
     /* simulate (simd): velocities, saved velocities, rest shape as [P][stride], bend rest [P−2][stride] */
@@ -116,6 +117,8 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
     if (o->scene.dyn.per_segment)
         hb_mul3_u64((uint64_t)o->scene.n_strands, (uint64_t)(o->scene.points - 1),
                     hb_real_size(o->scene.precision) + sizeof(double), &seg_bytes);
+    if (o->scene.dyn.planes_declared) /* §3.17 the points' contact planes */
+        seg_bytes = hb_add_sat(seg_bytes, hb_mul_sat(c->bytes / 3u, HB_CONTACT_POINT));
     const uint64_t dyn = c->dynamic
                              ? hb_add_sat(hb_add_sat(hb_add_sat(hb_mul_sat(c->bytes, copies), bend_bytes), seg_bytes),
                                           hb_host_world_bytes(&o->scene, omp_get_max_threads()))
@@ -139,6 +142,7 @@ static int cpu_setup(hb_backend *b, const hb_options *o, int need_save, uint64_t
         c->bend_rest = malloc(bend_bytes);
         if (need_save) c->vel_saved = malloc(c->bytes);
         if (o->scene.dyn.sag_free) bad |= !(c->shape_rest = malloc(c->bytes));
+        if (o->scene.dyn.planes_declared) bad |= !(c->contacts = malloc(c->bytes / 3u * HB_CONTACT_POINT));
         bad |= !c->vel || !c->rest || !c->bend_rest || (need_save && !c->vel_saved);
         if (o->scene.dyn.per_segment) {
             const size_t nseg = (size_t)o->scene.n_strands * (size_t)(o->scene.points - 1);
@@ -775,11 +779,12 @@ static int cpu_dyn_load(hb_backend *b, const void *velocity, const void *rest, c
             _Pragma("omp for schedule(static)") for (int64_t j = 0; j < NS; j++)                                       \
             {                                                                                                          \
                 const int64_t i = c->scene.dyn.guided ? c->fl.guide[j] : j;                                            \
-                hb_dyn_frame_strand_##SFX(M, W, f, j0, j1, (T *)c->state + (size_t)i * stride,                         \
-                                          (T *)c->vel + (size_t)i * stride,                                            \
-                                          (const T *)(c->shape_rest ? c->shape_rest : c->rest) + (size_t)i * stride,   \
-                                          (const T *)c->bend_rest + (size_t)i * bstride,                               \
-                                          c->seg_rest ? (const T *)c->seg_rest + (size_t)i * (P - 1) : NULL, scratch); \
+                hb_dyn_frame_strand_##SFX(                                                                             \
+                    M, W, f, j0, j1, (T *)c->state + (size_t)i * stride, (T *)c->vel + (size_t)i * stride,             \
+                    (const T *)(c->shape_rest ? c->shape_rest : c->rest) + (size_t)i * stride,                         \
+                    (const T *)c->bend_rest + (size_t)i * bstride,                                                     \
+                    c->seg_rest ? (const T *)c->seg_rest + (size_t)i * (P - 1) : NULL, scratch,                        \
+                    c->contacts ? (T *)c->contacts + (size_t)i * (size_t)P * HB_CONTACT_POINT : NULL);                 \
             }                                                                                                          \
             free(scratch);                                                                                             \
         }                                                                                                              \
@@ -1023,6 +1028,7 @@ static void cpu_teardown(hb_backend *b)
     free(c->bend_rest);
     free(c->seg_rest);
     free(c->seg64);
+    free(c->contacts);
     free(c->shape_rest);
     hb_followers_free(&c->fl);
     for (int d = 0; d < 3; d++) {
@@ -1049,7 +1055,7 @@ static const hb_variant cpu_variants[] = {
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks; built for x86-64-v3 and "
      "x86-64-v4, the CPU's widest runs (the record's flags say which)",
-     0, 0, 0, 1, HB_X_GUIDES},
+     0, 0, 0, 1, HB_X_GUIDES | HB_X_PLANES},
     {NULL, 0, NULL, 0, 0, 0, 0, 0},
 };
 

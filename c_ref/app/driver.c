@@ -76,7 +76,8 @@ static const struct {
                             {"lod", "--render-points"},
                             {"grid", "--grid"},
                             {"colliders", "--colliders"},
-                            {"friction", "--friction or --depenetration-speed"}};
+                            {"friction", "--friction or --depenetration-speed"},
+                            {"planes", "--contact-planes"}};
 
 /* The §3.14 features a scene declares, HB_X_* bits. */
 static unsigned x_declared(const hb_dynamics *d)
@@ -85,7 +86,7 @@ static unsigned x_declared(const hb_dynamics *d)
     for (int i = 0; d->cols && i < d->cols->n; i++) friction |= d->cols->c[i].mu_s > 0.0;
     return (d->guided ? HB_X_GUIDES : 0u) | (d->lra ? HB_X_LRA : 0u) | (d->sag_free ? HB_X_SAGFREE : 0u) |
            (d->render_points ? HB_X_LOD : 0u) | (d->grid ? HB_X_GRID : 0u) | (d->colliders_path ? HB_X_COLLIDERS : 0u) |
-           (friction ? HB_X_FRICTION : 0u);
+           (friction ? HB_X_FRICTION : 0u) | (d->planes_declared ? HB_X_PLANES : 0u);
 }
 
 /* A JSON list of the solvers in the bit set `set` (bit 1 << hb_solver), after `key`. */
@@ -145,7 +146,7 @@ static int list_variants(const hb_backend *b)
         printf("%s\"%s\"", i ? ", " : "", name);
     }
     printf(
-        ", \"guides\", \"lra\", \"sagfree\", \"lod\", \"grid\", \"colliders\", \"friction\"]}\n"); /* §3.14, §3.16, §3.17's */
+        ", \"guides\", \"lra\", \"sagfree\", \"lod\", \"grid\", \"colliders\", \"friction\", \"planes\"]}\n"); /* §3.14, §3.16, §3.17's */
     return HB_EXIT_OK;
 }
 

@@ -447,20 +447,137 @@ HB_HD int SFX(hb_moved)(const REAL *p, REAL *q)
     return moved;
 }
 
+/* §3.17 --contact-planes: the signed distance of x from collider i (pose) at its margin-grown surface,
+ * outside positive, with the outward unit normal in n; 0 where it has none (a mesh outside its cube
+ * or at a flat spot of its field), else 1. */
+HB_HD int SFX(hb_contact_distance)(const WORLD *w, int i, const REAL *pose, const REAL *x, REAL *rho, REAL *n)
+{
+    const int kind = w->col_kind[i], frame = w->col_frame[i];
+    const int turn = frame == HB_FRAME_HEAD && w->motion, sway = frame == HB_FRAME_BODY && w->sway;
+    if (kind == HB_COL_SPHERE || kind == HB_COL_CAPSULE) {
+        REAL c[3];
+        const REAL rc = kind == HB_COL_SPHERE ? pose[3] : pose[6];
+        if (kind == HB_COL_SPHERE) {
+            for (int k = 0; k < 3; k++) c[k] = pose[k];
+        } else {
+            SFX(hb_capsule_centre)(pose, x, c);
+        }
+        const REAL e[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
+        const REAL len = SQRT((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2]);
+        if (len == (REAL)0) {
+            for (int k = 0; k < 3; k++) n[k] = kind == HB_COL_CAPSULE ? pose[7 + k] : (k == 1 ? (REAL)1 : (REAL)0);
+        } else {
+            for (int k = 0; k < 3; k++) n[k] = e[k] / len;
+        }
+        *rho = len - rc;
+        return 1;
+    }
+    if (kind == HB_COL_PLANE) {
+        for (int k = 0; k < 3; k++) n[k] = pose[3 + k];
+        *rho = (((x[0] - pose[0]) * pose[3] + (x[1] - pose[1]) * pose[4]) + (x[2] - pose[2]) * pose[5]) - pose[6];
+        return 1;
+    }
+    REAL u[3], phi, g[3];
+    SFX(hb_mesh_local)(pose, turn, sway, x, u);
+    if (!SFX(hb_sdf_sample)(w->sdf[i], w->sdf_n[i], w->sdf_geo + 4 * i, u, &phi, g)) return 0;
+    const REAL gl = SQRT((g[0] * g[0] + g[1] * g[1]) + g[2] * g[2]);
+    if (!(gl > (REAL)0)) return 0;
+    REAL nl[3];
+    for (int k = 0; k < 3; k++) nl[k] = g[k] / gl;
+    for (int r = 0; r < 3; r++)
+        n[r] = turn ? (pose[3 * r] * nl[0] + pose[3 * r + 1] * nl[1]) + pose[3 * r + 2] * nl[2] : nl[r];
+    *rho = phi - pose[12];
+    return 1;
+}
+
+/* §3.17 --contact-planes: the contacts of the point x at the frame's first substep (pose: every
+ * collider's at its t + h): among the colliders whose surface lies nearer than the margin M (signed
+ * distance ρ < M, inside too), the HB_CONTACT_K nearest (at a tie the first in the file), each kept as
+ * the plane through its surface point x − ρ·n with the normal n, (n, n·x − ρ, i), in the file's order;
+ * an unused slot has i = −1. */
+HB_HD void SFX(hb_contact_find)(const WORLD *w, const REAL *pose, const REAL *x, REAL *con)
+{
+    REAL near[HB_CONTACT_K];
+    int at[HB_CONTACT_K];
+    for (int s = 0; s < HB_CONTACT_K; s++) near[s] = w->margin, at[s] = -1;
+    for (int i = 0; i < w->ncol; i++) { /* the K nearest, nearest first (a later one only when nearer) */
+        REAL rho, n[3];
+        if (!SFX(hb_contact_distance)(w, i, pose + (size_t)i * HB_COL_POSE, x, &rho, n) ||
+            !(rho < near[HB_CONTACT_K - 1]))
+            continue;
+        int s = HB_CONTACT_K - 1;
+        for (; s > 0 && rho < near[s - 1]; s--) near[s] = near[s - 1], at[s] = at[s - 1];
+        near[s] = rho, at[s] = i;
+    }
+    for (int s = 1; s < HB_CONTACT_K; s++) /* the file's order: indices ascending, the unused last */
+        for (int t = s; t > 0 && at[t] >= 0 && (at[t - 1] < 0 || at[t] < at[t - 1]); t--) {
+            const int a = at[t];
+            at[t] = at[t - 1], at[t - 1] = a;
+        }
+    for (int s = 0; s < HB_CONTACT_K; s++) {
+        REAL *c = con + HB_CONTACT * s, rho, n[3];
+        c[4] = (REAL)at[s];
+        if (at[s] < 0) continue;
+        SFX(hb_contact_distance)(w, at[s], pose + (size_t)at[s] * HB_COL_POSE, x, &rho, n);
+        for (int k = 0; k < 3; k++) c[k] = n[k];
+        c[3] = ((n[0] * x[0] + n[1] * x[1]) + n[2] * x[2]) - rho;
+    }
+}
+
+/* §3.17 --contact-planes: a point's plane carried with its collider's frame over the substep (t to
+ * t + h, the inverse of back's transform): a turning head frame turns n (about the origin, so d
+ * stays); a swaying body frame shifts the plane by s = b(t + h) − b(t) = −back[9..11], d ← d + n·s. */
+HB_HD void SFX(hb_contact_carry)(const WORLD *w, const REAL *back, REAL *con)
+{
+    if (!(con[4] >= (REAL)0)) return; /* an unused slot */
+    const int frame = w->col_frame[(int)con[4]];
+    if (frame == HB_FRAME_HEAD && w->motion) {
+        REAL n[3];
+        SFX(hb_carry)(back, 1, 0, con, n);
+        for (int k = 0; k < 3; k++) con[k] = n[k];
+    } else if (frame == HB_FRAME_BODY && w->sway) {
+        con[3] = con[3] - ((con[0] * back[9] + con[1] * back[10]) + con[2] * back[11]);
+    }
+}
+
+/* §3.17 --contact-planes: the point's plane on p, as a plane collider: the depth δ = d − n·p > 0
+ * (bounded: δ₀ = d − n·y of the substep's start carried, hb_carry), p ← p + m·n, then the collider's
+ * friction. x: the point at the substep's start; back: the substep's back-transforms. */
+HB_HD void SFX(hb_contact_one)(const WORLD *w, const REAL *con, const REAL *back, REAL *p, const REAL *x)
+{
+    if (!(con[4] >= (REAL)0)) return;
+    const int i = (int)con[4], frame = w->col_frame[i];
+    const int turn = frame == HB_FRAME_HEAD && w->motion, sway = frame == HB_FRAME_BODY && w->sway;
+    const REAL d = con[3] - ((con[0] * p[0] + con[1] * p[1]) + con[2] * p[2]);
+    if (!(d > (REAL)0)) return;
+    REAL m = d;
+    if (w->bounded) {
+        REAL y[3];
+        SFX(hb_carry)(back, turn, sway, x, y);
+        m = SFX(hb_bounded_move)(d, con[3] - ((con[0] * y[0] + con[1] * y[1]) + con[2] * y[2]), w->depen);
+    }
+    for (int k = 0; k < 3; k++) p[k] = p[k] + m * con[k];
+    const REAL mu_s = w->col_mu[2 * i];
+    if (m > (REAL)0 && mu_s > (REAL)0) SFX(hb_friction)(p, x, con, m, mu_s, w->col_mu[2 * i + 1], turn, sway, back);
+}
+
 /* §3.17 the collision step of one point p (x: where it was at the substep's start): the sweep,
  * the head sphere (head: HB_HEAD_*) then each collider in order with its friction, run again
  * while it moves p (any of them changes a bit of it), w->sweeps sweeps at most. One sweep (w->sweeps = 1)
  * is the collision step as it was before sweeps, the same operations. pose: collider i's at
  * pose + i·HB_COL_POSE; back: the substep's back-transforms. The C reference (dynamics_impl.h)
  * and the SIMD backend (dynamics_simd_impl.h) call this; the CUDA port's lanes kernel takes the
- * same steps a warp at a time (cuda/dynamic/lanes.cu collide_points). */
+ * same steps a warp at a time (cuda/dynamic/lanes.cu collide_points). con: the point's contact plane
+ * (--contact-planes), met in place of the colliders; NULL: every collider (the reference's default). */
 HB_HD_INLINE void SFX(hb_collide_sweeps)(const WORLD *w, REAL rc, int head, const REAL *pose, const REAL *back, REAL *p,
-                                         const REAL *x)
+                                         const REAL *x, const REAL *con)
 {
     if (w->sweeps <= 1) { /* one sweep: nothing to compare */
         if (head == HB_HEAD_PLAIN) SFX(hb_head_sphere)(p, rc);
         else if (head == HB_HEAD_WORLD) SFX(hb_collide_head)(w, rc, back, p, x);
-        for (int i = 0; i < w->ncol; i++) SFX(hb_collide_one)(w, i, pose + (size_t)i * HB_COL_POSE, back, p, x);
+        for (int s = 0; con && s < HB_CONTACT_K; s++) SFX(hb_contact_one)(w, con + HB_CONTACT * s, back, p, x);
+        if (!con)
+            for (int i = 0; i < w->ncol; i++) SFX(hb_collide_one)(w, i, pose + (size_t)i * HB_COL_POSE, back, p, x);
         return;
     }
     for (int s = 1;; s++) {
@@ -470,7 +587,11 @@ HB_HD_INLINE void SFX(hb_collide_sweeps)(const WORLD *w, REAL rc, int head, cons
         if (head == HB_HEAD_PLAIN) SFX(hb_head_sphere)(p, rc);
         else if (head == HB_HEAD_WORLD) SFX(hb_collide_head)(w, rc, back, p, x);
         if (track && head != HB_HEAD_NONE) moved |= SFX(hb_moved)(p, q);
-        for (int i = 0; i < w->ncol; i++) {
+        for (int s = 0; con && s < HB_CONTACT_K; s++) {
+            SFX(hb_contact_one)(w, con + HB_CONTACT * s, back, p, x);
+            if (track) moved |= SFX(hb_moved)(p, q);
+        }
+        for (int i = 0; !con && i < w->ncol; i++) {
             SFX(hb_collide_one)(w, i, pose + (size_t)i * HB_COL_POSE, back, p, x);
             if (track) moved |= SFX(hb_moved)(p, q);
         }

@@ -107,13 +107,15 @@ void hb_dyn_reduce_into(hb_obs_partial *acc, const hb_obs_partial *o);
 void hb_dyn_bend_rest_f32(const hb_dyn_model_f32 *m, const float *rest, float *bend_rest);
 void hb_dyn_bend_rest_f64(const hb_dyn_model_f64 *m, const double *rest, double *bend_rest);
 /* `seg_rest` holds the P − 1 stretch rest lengths ℓ_k of a groom (§3.15), NULL for ℓ = L/(P−1). */
-/* Substeps j0 … j1 − 1 of the frame; w: the grid and colliders (§3.16, §3.17), NULL without them. */
+/* Substeps j0 … j1 − 1 of the frame; w: the grid and colliders (§3.16, §3.17), NULL without them; `con`:
+ * the strand's contact planes (§3.17 --contact-planes, HB_CONTACT_POINT·P reals, found at the frame's first
+ * substep and kept through its calls), NULL without them. */
 void hb_dyn_frame_strand_f32(const hb_dyn_model_f32 *m, const hb_dyn_world_f32 *w, const hb_dyn_frame *f, int64_t j0,
                              int64_t j1, float *x, float *v, const float *rest, const float *bend_rest,
-                             const float *seg_rest, float *scratch);
+                             const float *seg_rest, float *scratch, float *con);
 void hb_dyn_frame_strand_f64(const hb_dyn_model_f64 *m, const hb_dyn_world_f64 *w, const hb_dyn_frame *f, int64_t j0,
                              int64_t j1, double *x, double *v, const double *rest, const double *bend_rest,
-                             const double *seg_rest, double *scratch);
+                             const double *seg_rest, double *scratch, double *con);
 /* `seg64`: the strand's ℓ_k in double (§3.15), NULL for ℓ = L/(P−1). */
 /* w, pose: the colliders of §3.17 and their poses at the frame's end (NULL: none). */
 void hb_dyn_observe_strand_f32(const hb_scene *s, const hb_dyn_world_f32 *w, const float *pose, const float *x,

@@ -146,21 +146,21 @@ HB_ALWAYS_INLINE void SFX(lra_all)(const DMODEL *m, REAL *p)
  * head sphere, then the colliders of §3.17, each with its friction, in sweeps (contact_impl.h
  * hb_collide_sweeps, which the SIMD backend calls too). */
 HB_ALWAYS_INLINE void SFX(collide_point)(const DMODEL *m, const WORLD *w, const REAL *pose, const REAL *back, REAL *p,
-                                         const REAL *x, int64_t k, const unsigned F)
+                                         const REAL *x, const REAL *con, int64_t k, const unsigned F)
 {
     const int64_t P = m->points; /* PLANT_SKIPPED's */
     (void)P;
     const int head = !(F & HB_F_COLLIDE) || PLANT_SKIPPED(k) ? HB_HEAD_NONE
                      : w->head_friction || w->bounded        ? HB_HEAD_WORLD
                                                              : HB_HEAD_PLAIN;
-    SFX(hb_collide_sweeps)(w, m->collide_r, head, pose, back, p, x);
+    SFX(hb_collide_sweeps)(w, m->collide_r, head, pose, back, p, x, con ? con + HB_CONTACT_POINT * k : NULL);
 }
 
 /* Substeps j0 … j1 − 1 of a frame of one strand: §3.4, the solver of §3.6, §3.7 or §3.13 (rigid).
  * w: the grid and colliders (§3.16, §3.17), NULL without them. */
 HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_dyn_frame *fr, int64_t j0, int64_t j1,
                                       REAL *x, REAL *v, const REAL *rest, const REAL *bend_rest, const REAL *seg_rest,
-                                      REAL *scratch, const unsigned F)
+                                      REAL *scratch, REAL *con, const unsigned F)
 {
     const int64_t P = m->points;
     const REAL h = m->h;
@@ -186,6 +186,15 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_
         (void)q;
         (void)phase;
         (void)qg;
+        /* §3.17 --contact-planes: each point's plane found from x at the frame's first substep,
+         * carried with its collider at the others */
+        if (con && m->solver != HB_SOLVER_RIGID)
+            for (int64_t k = 1; k < P; k++) {
+                if (j == 0) SFX(hb_contact_find)(w, pose, x + 3 * k, con + HB_CONTACT_POINT * k);
+                else
+                    for (int s = 0; s < HB_CONTACT_K; s++)
+                        SFX(hb_contact_carry)(w, back, con + HB_CONTACT_POINT * k + HB_CONTACT * s);
+            }
 
         /* 1. root on the head: x0 ← Q(t+h)·X̄0, v0 ← (x0_new − x0_old)/h */
         if (F & HB_F_MOTION) {
@@ -276,7 +285,8 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_
                 if (F & HB_F_SHAPE) SFX(shape_all)(m, p, rest, q, lam_g, F);
                 if (m->lra) SFX(lra_all)(m, p);
                 if (wcol)
-                    for (int64_t k = 1; k < P; k++) SFX(collide_point)(m, w, pose, back, p + 3 * k, x + 3 * k, k, F);
+                    for (int64_t k = 1; k < P; k++)
+                        SFX(collide_point)(m, w, pose, back, p + 3 * k, x + 3 * k, con, k, F);
                 else if (F & HB_F_COLLIDE)
                     for (int64_t k = 1; k < P; k++)
                         if (!PLANT_SKIPPED(k)) SFX(collide_sphere)(p + 3 * k, m->collide_r);
@@ -308,7 +318,7 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_
                     nq[2] = pp[2];
                 }
                 for (int c = 0; c < 3; c++) d[3 * k + c] = nq[c] - pk[c];
-                if (wcol) SFX(collide_point)(m, w, pose, back, nq, x + 3 * k, k, F);
+                if (wcol) SFX(collide_point)(m, w, pose, back, nq, x + 3 * k, con, k, F);
                 else if ((F & HB_F_COLLIDE) && !PLANT_SKIPPED(k)) SFX(collide_sphere)(nq, m->collide_r);
                 for (int c = 0; c < 3; c++) pk[c] = nq[c];
             }
@@ -330,13 +340,15 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_
 
 /* One function per feature set: the switch's constant F specialises frame_body. */
 void SFX(hb_dyn_frame_strand)(const DMODEL *m, const WORLD *w, const hb_dyn_frame *fr, int64_t j0, int64_t j1, REAL *x,
-                              REAL *v, const REAL *rest, const REAL *bend_rest, const REAL *seg_rest, REAL *scratch)
+                              REAL *v, const REAL *rest, const REAL *bend_rest, const REAL *seg_rest, REAL *scratch,
+                              REAL *con)
 {
 // clang-format off
 #define HB_F_CASE(n)                                                                         \
     case (n):                                                                                \
         if (((n) & HB_F_GUST) && !((n) & HB_F_WIND)) break; /* no gusts without wind */     \
-        SFX(frame_body)(m, w, fr, j0, j1, x, v, rest, bend_rest, seg_rest, scratch, (n));    \
+        SFX(frame_body)(m, w, fr, j0, j1, x, v, rest, bend_rest, seg_rest, scratch,          \
+                        w && w->planes ? con : NULL, (n));                                   \
         break;
 #define HB_F_CASE8(n) HB_F_CASE(n) HB_F_CASE(n + 1) HB_F_CASE(n + 2) HB_F_CASE(n + 3)      \
     HB_F_CASE(n + 4) HB_F_CASE(n + 5) HB_F_CASE(n + 6) HB_F_CASE(n + 7)

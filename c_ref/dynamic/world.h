@@ -26,6 +26,12 @@ enum { HB_FRAME_HEAD = 0, HB_FRAME_BODY = 1 };
  * and for every kind a bounding sphere that holds every point the collider can move, centre
  * [16..18] and radius² [19] (+∞ for a plane): a point outside it is not tested. */
 #define HB_COL_POSE 20
+/* Reals of one contact plane (--contact-planes): its unit normal n [0..2] and offset d [3] (the
+ * point p is outside where n·p − d ≥ 0), the collider's index [4] (−1: none this frame); a point keeps
+ * HB_CONTACT_K of them (the nearest colliders: hair between two, at a neck or a shoulder, meets both) */
+#define HB_CONTACT 5
+#define HB_CONTACT_K 3
+#define HB_CONTACT_POINT (HB_CONTACT * HB_CONTACT_K)
 /* Reals of a substep's back-transforms: the head's Q(t)·Q(t+h)ᵀ [0..8], the body's b(t) − b(t+h) [9..11] */
 #define HB_COL_BACK 12
 
@@ -63,6 +69,8 @@ typedef struct hb_colliders {
         int bounded; /* --depenetration-speed declared */                                                              \
         T depen;     /* V·h */                                                                                        \
         int sweeps;  /* the collision sweeps a point, at most: --collider-sweeps with colliders, else 1 */             \
+        int planes;  /* --contact-planes with colliders: HB_CONTACT_K planes a point a frame */                        \
+        T margin;    /* M: how near a collider a point finds its plane, cm */                                          \
         int head_friction;                                                                                             \
         T head_mu_s, head_mu_k;                                                                                        \
         int motion, sway; /* the head turns (its back-transform is evaluated); the body sways */                       \

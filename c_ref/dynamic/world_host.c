@@ -66,6 +66,8 @@ void hb_host_world_free(hb_host_world *hw)
         (W).bounded = d->depen_declared;                                                                               \
         (W).depen = (T)(d->depen_speed * (d->frame_dt / (double)d->substeps));                                         \
         (W).sweeps = hw->ncol > 0 ? (int)d->collider_sweeps : 1;                                                       \
+        (W).planes = hw->ncol > 0 && d->planes_declared;                                                               \
+        (W).margin = (T)d->contact_margin;                                                                             \
         (W).head_friction = d->friction_declared;                                                                      \
         (W).head_mu_s = (T)d->friction[0];                                                                             \
         (W).head_mu_k = (T)d->friction[1];                                                                             \

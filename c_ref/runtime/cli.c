@@ -367,6 +367,9 @@ static const flag_spec flags[] = {
     {"--collider-sweeps", DF_COUNT, DYN(collider_sweeps), 0,
      "N in 1..8: the collision sweep (head sphere, then each collider) runs again while it moves a point, N\n"
      "sweeps at most (default 1; docs/model.md §3.17)"},
+    {"--contact-planes", DF_REAL, DYN(contact_margin), DYN(planes_declared),
+     "M, cm: each point finds its nearest collider within M once a frame and meets it as a plane in every\n"
+     "collision step of the frame (default: every collider tested in every step; docs/model.md §3.17)"},
     {"--body-motion", DF_BODY, DYN(body_motion), 0,
      "still | sway (along x) | rise (from A_b below, in 1/f_b s): the body frame's motion (default still)"},
     {"--body-amplitude", DF_REAL, DYN(body_amplitude), 0, "the body's sway or rise A_b, cm (default 2)"},

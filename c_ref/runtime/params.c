@@ -180,6 +180,7 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
         {"--grid-padding", d->grid_padding, 0},
         {"--grid-volume", d->grid_volume, 0},
         {"--depenetration-speed", d->depen_speed, 0},
+        {"--contact-planes", d->contact_margin, 0},
         {"--body-amplitude", d->body_amplitude, 0},
         {"--body-frequency", d->body_frequency, 0},
     };
@@ -218,6 +219,10 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
         FAIL("--friction needs 0 <= MU_K <= MU_S, finite (got %g,%g)", d->friction[0], d->friction[1]);
     if (d->depen_declared && !(d->depen_speed > 0.0))
         FAIL("--depenetration-speed must be > 0 (got %g)", d->depen_speed);
+    if (d->planes_declared && !(d->contact_margin > 0.0))
+        FAIL("--contact-planes must be > 0 (got %g)", d->contact_margin);
+    if (d->planes_declared && !d->colliders_path)
+        FAIL("--contact-planes needs --colliders (the planes are the file's colliders)");
     if (d->collider_sweeps < 1 || d->collider_sweeps > HB_COLLIDER_SWEEPS_MAX)
         FAIL("--collider-sweeps must be from 1 to %d (got %lld)", HB_COLLIDER_SWEEPS_MAX,
              (long long)d->collider_sweeps);

@@ -79,14 +79,16 @@ typedef struct {
     int grid_volume_declared;   /* --grid-volume given */
     double grid_volume;         /* K_v, cm²/s² */
     /* §3.17 colliders and friction */
-    const char *colliders_path;            /* --colliders FILE (NULL: none) */
-    const struct hb_colliders *cols;       /* the loaded colliders (runtime/colliders.c), NULL: none */
-    int friction_declared;                 /* --friction given: the head sphere's friction */
-    double friction[2];                    /* μ_s, μ_k of the head sphere */
-    int depen_declared;                    /* --depenetration-speed given */
-    double depen_speed;                    /* V, cm/s */
-    int64_t collider_sweeps;               /* --collider-sweeps: the collision sweep a point, at most (1: once) */
-    int body_motion;                       /* hb_body_motion */
+    const char *colliders_path;      /* --colliders FILE (NULL: none) */
+    const struct hb_colliders *cols; /* the loaded colliders (runtime/colliders.c), NULL: none */
+    int friction_declared;           /* --friction given: the head sphere's friction */
+    double friction[2];              /* μ_s, μ_k of the head sphere */
+    int depen_declared;              /* --depenetration-speed given */
+    double depen_speed;              /* V, cm/s */
+    int64_t collider_sweeps;         /* --collider-sweeps: the collision sweep a point, at most (1: once) */
+    int planes_declared;             /* --contact-planes given: the colliders as one contact plane a point a frame */
+    double contact_margin;           /* M, cm: how near a collider a point finds its plane */
+    int body_motion;                 /* hb_body_motion */
     double body_amplitude, body_frequency; /* A_b (cm), f_b (Hz) */
 } hb_dynamics;
 

@@ -150,7 +150,7 @@ HB_ALWAYS_INLINE void SFX(world_row)(const WORLD *w, const REAL *pose, const REA
     for (int l = 0; l < DB; l++) {
         REAL p[3] = {px[l], py[l], pz[l]};
         const REAL xs[3] = {x[l], y[l], z[l]};
-        SFX(hb_collide_sweeps)(w, rc, head, pose, back, p, xs);
+        SFX(hb_collide_sweeps)(w, rc, head, pose, back, p, xs, NULL);
         px[l] = p[0];
         py[l] = p[1];
         pz[l] = p[2];

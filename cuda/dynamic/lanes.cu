@@ -111,7 +111,7 @@ template <typename T, int G, int L, bool Ftl, int W = 0> constexpr int lanes_min
            : W == kWHeld && !Ftl && G == 2     ? HB_LANES_HELD_MINB /* the held grid alone */
            : W == kWCol                        ? HB_LANES_COL_MINB
            : W == kWGather && !Ftl && G == 2   ? HB_LANES_GATHER_MINB /* the grid's gather alone */
-           : W                                 ? HB_LANES_WORLD_MINB /* everything: 2, up to 128 registers */
+           : W                                 ? HB_LANES_WORLD_MINB  /* everything: 2, up to 128 registers */
            : (!Ftl && G == 2)                  ? HB_LANES_MINB
            : (Ftl && G == kFtlG && L == kFtlL) ? HB_LANES_FTL_MINB
                                                : 1;

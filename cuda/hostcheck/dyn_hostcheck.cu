@@ -49,12 +49,12 @@ namespace {
 void ref_frame(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, float *x, float *v, const float *r, const float *b,
                float *s)
 {
-    hb_dyn_frame_strand_f32(m, NULL, f, 0, f->substeps, x, v, r, b, NULL, s);
+    hb_dyn_frame_strand_f32(m, NULL, f, 0, f->substeps, x, v, r, b, NULL, s, NULL);
 }
 void ref_frame(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, double *x, double *v, const double *r, const double *b,
                double *s)
 {
-    hb_dyn_frame_strand_f64(m, NULL, f, 0, f->substeps, x, v, r, b, NULL, s);
+    hb_dyn_frame_strand_f64(m, NULL, f, 0, f->substeps, x, v, r, b, NULL, s, NULL);
 }
 void ref_bend(const hb_dyn_model_f32 *m, const float *r, float *b)
 {

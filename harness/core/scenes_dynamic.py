@@ -45,6 +45,7 @@ A scene with `model = "dynamic"` may hold, besides the paper keys:
     friction = [0.3, 0.2]      # the head sphere's μ_s[, μ_k]  --friction
     depenetration_speed = 200  # V > 0 (cm/s)   --depenetration-speed
     collider_sweeps = 4        # N in 1 … 8     --collider-sweeps (the collision sweep again while it moves a point)
+    contact_planes = 5.0       # M > 0 (cm)     --contact-planes (the colliders as planes found once a frame)
     motion = "rise"            # still | sway | rise  --body-motion
     amplitude = 20.0           # A_b ≥ 0 (cm)   --body-amplitude
     frequency = 2.0            # f_b ≥ 0 (Hz)   --body-frequency
@@ -98,6 +99,7 @@ TABLES = {
         "friction": ("--friction", "pair"),
         "depenetration_speed": ("--depenetration-speed", "pos"),
         "collider_sweeps": ("--collider-sweeps", "count"),
+        "contact_planes": ("--contact-planes", "pos"),
         "motion": ("--body-motion", ("still", "sway", "rise")),
         "amplitude": ("--body-amplitude", "nonneg"),
         "frequency": ("--body-frequency", "nonneg"),

@@ -102,6 +102,7 @@ FEATURE_FLAGS = {
     "--friction": "friction",
     "--depenetration-speed": "friction",
     "--collider-sweeps": "colliders",  # the colliders' step repeated (no effect without them)
+    "--contact-planes": "planes",  # the colliders met as planes found once a frame
 }
 
 

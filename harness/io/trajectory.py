@@ -88,6 +88,8 @@ DYNAMIC_ATTRS = (
     "depenetration_declared",
     "depenetration_speed",
     "collider_sweeps",
+    "planes_declared",
+    "contact_margin",
     "body_motion",
     "body_amplitude",
     "body_frequency",
