@@ -129,17 +129,22 @@ def test_particle_on_a_nodding_head(cpu_bin, tmp_path, mu):
         times = np.asarray(t.time)
     if mu == 0.0:  # a sphere turning about its centre does not move its surface: the particle stays
         assert np.max(np.abs(x[:, 0] - top[0])) < 1e-9
-    else:  # it turns with the head: after the start's slip (the nod starts at full speed, an
-        # impulse no finite friction passes on) it keeps its place on the head, Q(t)·Q(t0)ᵀ·x(t0)
-        theta = 0.25 * np.sin(2 * np.pi * times)
-        f0 = 8
-        turn = theta - theta[f0]
-        c, s = np.cos(turn), np.sin(turn)
-        y0, z0 = x[f0, 0, 1], x[f0, 0, 2]
-        want = np.stack([np.full_like(turn, x[f0, 0, 0]), c * y0 - s * z0, s * y0 + c * z0], axis=1)
-        moved = np.max(np.linalg.norm(want[f0:] - x[f0, 0], axis=1))
-        assert moved > 1.0
-        assert np.max(np.linalg.norm(x[f0:, 0] - want[f0:], axis=1)) < 1e-3 * moved
+    else:
+        assert_turns_with_the_nod(x[:, 0], times)
+
+
+def assert_turns_with_the_nod(x, times, f0=8):
+    """A particle's positions x (one a frame) turned with the nodding head: after the start's slip
+    (the nod starts at full speed, an impulse no finite friction passes on) it keeps its place on
+    the head, Q(t)·Q(t0)ᵀ·x(t0) from frame f0."""
+    theta = 0.25 * np.sin(2 * np.pi * times)
+    turn = theta - theta[f0]
+    c, s = np.cos(turn), np.sin(turn)
+    y0, z0 = x[f0, 1], x[f0, 2]
+    want = np.stack([np.full_like(turn, x[f0, 0]), c * y0 - s * z0, s * y0 + c * z0], axis=1)
+    moved = np.max(np.linalg.norm(want[f0:] - x[f0], axis=1))
+    assert moved > 1.0
+    assert np.max(np.linalg.norm(x[f0:] - want[f0:], axis=1)) < 1e-3 * moved
 
 
 def test_bounded_depenetration_leaves_at_the_speed_it_names(cpu_bin, tmp_path):

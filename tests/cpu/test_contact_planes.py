@@ -18,7 +18,7 @@ known answers, with the free particles of test_colliders.py.
 
 import numpy as np
 import pytest
-from test_colliders import FREE, free_points, particles, run_head, simulate, words
+from test_colliders import FREE, assert_turns_with_the_nod, free_points, particles, run_head, simulate, words
 
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run
@@ -94,18 +94,9 @@ def test_a_head_collider_plane_turns_with_the_head(cpu_bin, tmp_path):
     groom = particles(tmp_path, top, roots=[[20.0, 0.0, 0.0]])
     args = [*FREE, "--substeps", "8", "--head-motion", "nod", "--colliders", cols, "--contact-planes", "1"]
     path = run_head(cpu_bin, tmp_path, groom, args)
-    x = free_points(path)
     with open_trajectory(path) as t:
         times = np.asarray(t.time)
-    theta = 0.25 * np.sin(2 * np.pi * times)
-    f0 = 8  # after the start's slip (test_colliders.py test_particle_on_a_nodding_head)
-    turn = theta - theta[f0]
-    c, s = np.cos(turn), np.sin(turn)
-    y0, z0 = x[f0, 0, 1], x[f0, 0, 2]
-    want = np.stack([np.full_like(turn, x[f0, 0, 0]), c * y0 - s * z0, s * y0 + c * z0], axis=1)
-    moved = np.max(np.linalg.norm(want[f0:] - x[f0, 0], axis=1))
-    assert moved > 1.0
-    assert np.max(np.linalg.norm(x[f0:, 0] - want[f0:], axis=1)) < 1e-3 * moved
+    assert_turns_with_the_nod(free_points(path)[:, 0], times)
 
 
 def test_a_rising_body_floor_carries_its_plane(cpu_bin, tmp_path):
