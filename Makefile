@@ -379,6 +379,9 @@ SAN_WORLD := --strands 300 --points 32 --stages init,simulate --frames 2 --veloc
 SAN_BODY := --colliders configs/bodies/default.colliders --friction 0.3,0.2 --depenetration-speed 200
 # the body's collision step in sweeps (docs/model.md §3.17): the warp's vote and the repeated sweep
 SAN_SWEEPS := --collider-sweeps 4
+# the colliders as contact planes (docs/model.md §3.17): each warp's planes in shared memory, kept in
+# global memory between a frame's launches (40 substeps, or the grid built every substep)
+SAN_PLANES := --contact-planes 3
 # the splat's hash table (cuda/dynamic/world.cu): a fine grid over a small box, so that every splat
 # block's box exceeds its window and some shares find no slot
 SAN_HASH := --grid 256 --grid-box=-13,-45,-13,13,13,13 --grid-friction 0.1,0.02 --grid-volume 2000
@@ -411,7 +414,8 @@ sanitize-gpu-world: cuda
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
 	@set -e; for p in fp32 fp64; do for s in xpbd ftl; do for w in "--grid 16 --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild held" \
 	  "--grid 16 --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild substep" "$(SAN_BODY)" "$(SAN_BODY) --grid 16 --grid-friction 0.05" \
-	  "$(SAN_BODY) $(SAN_SWEEPS)" "$(SAN_HASH)"; do \
+	  "$(SAN_BODY) $(SAN_SWEEPS)" "$(SAN_HASH)" "$(SAN_BODY) $(SAN_PLANES) $(SAN_SWEEPS)" \
+	  "$(SAN_BODY) $(SAN_PLANES) --grid 16 --grid-friction 0.05 --grid-rebuild substep"; do \
 	  echo "memcheck world $$p $$s $$w"; \
 	  compute-sanitizer --tool memcheck --leak-check full --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $$w \
 	    --precision $$p --solver $$s --substeps 4 --output $(BUILD)/san-world-$$p-$$s.h5 --force; \
@@ -419,6 +423,8 @@ sanitize-gpu-world: cuda
 	  echo "memcheck world $$p 40 substeps"; \
 	  compute-sanitizer --tool memcheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) --precision $$p \
 	    --substeps 40 --frames 1 --output $(BUILD)/san-world-$$p-40.h5 --force; \
+	  compute-sanitizer --tool memcheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) $(SAN_PLANES) \
+	    --precision $$p --substeps 40 --frames 1 --output $(BUILD)/san-world-$$p-40.h5 --force; \
 	  echo "racecheck world $$p"; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) --grid 16 \
 	    --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild held --precision $$p --substeps 40 --frames 1; \
@@ -426,6 +432,9 @@ sanitize-gpu-world: cuda
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_HASH) --precision $$p; \
 	  echo "racecheck world $$p $(SAN_SWEEPS)"; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) $(SAN_SWEEPS) \
+	    --precision $$p --substeps 40 --frames 1; \
+	  echo "racecheck world $$p $(SAN_PLANES)"; \
+	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) $(SAN_PLANES) \
 	    --precision $$p --substeps 40 --frames 1; \
 	done; rm -f $(BUILD)/san-world-*.h5; echo "compute-sanitizer: memcheck and racecheck found no errors in the world's kernels"
 

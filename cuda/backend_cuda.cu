@@ -488,7 +488,7 @@ const hb_variant cuda_variants[] = {
      "strand-major like paper; simulate: L lanes a strand (16 for xpbd, 8 for ftl), 2 to 8 points a lane in "
      "registers (at most 128 points), nearly every lane busy in every constraint group; free arithmetic outside "
      "the strict build",
-     hb::dyn::kLanesMaxPoints, hb::dyn::kLanesMaxBlock, 0, 1, HB_X_GUIDES | HB_X_LRA | HB_X_PLANES},
+     hb::dyn::kLanesMaxPoints, hb::dyn::kLanesMaxBlock, 0, 1, HB_X_GUIDES | HB_X_LRA},
     {NULL, 0, NULL, 0, 0},
 };
 

@@ -81,7 +81,8 @@ struct DynState {
     void *c_sdf[HB_MAX_COLLIDERS];
     void *f_pose, *f_back, *f_qs;
     void *d_world;
-    void *perm; /* lanes: the strands' order (hb_grid_order) */
+    void *perm;     /* lanes: the strands' order (hb_grid_order) */
+    void *contacts; /* lanes, --contact-planes, a frame in several launches: each point's planes */
     uint64_t pose_bytes, back_bytes;
 };
 
@@ -172,6 +173,8 @@ int dyn_plan(cuda_impl *c, const hb_options *o, int need_save, uint64_t *bytes, 
         need = sat_add(need, hb_mul_sat(nodes, 32u + 9u * rs));
     }
     need = sat_add(need, hb_host_world_bytes(s, 0)); /* §3.17 the meshes' fields */
+    if (c->variant == V_LANES && s->dyn.planes_declared && s->dyn.grid && s->dyn.grid_rebuild == HB_GRID_SUBSTEP)
+        need = sat_add(need, hb_mul_sat(hb_mul_sat((uint64_t)N, (uint64_t)P), HB_CONTACT_POINT * rs)); /* the planes */
     if (c->variant == V_STRAND) {
         const int64_t resident = (int64_t)prop.multiProcessorCount * prop.maxThreadsPerMultiProcessor;
         d->grid = dyn_strand_grid(N, c->block, resident);
@@ -264,7 +267,7 @@ void dyn_free(cuda_impl *c)
     /* g_mom lies in g_mass's allocation */
     void *world[] = {d->g_mass, d->g_node_v, d->g_node_a, d->g_target, d->g_ftab, d->g_held,
                      d->c_kind, d->c_frame,  d->c_sdf_n,  d->c_mu,     d->c_geo,  d->c_sdf_ptrs,
-                     d->f_pose, d->f_back,   d->f_qs,     d->d_world,  d->perm};
+                     d->f_pose, d->f_back,   d->f_qs,     d->d_world,  d->perm,   d->contacts};
     for (void *p : world)
         if (p) cudaFree(p);
     for (void *p : d->c_sdf)
@@ -508,6 +511,19 @@ static int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char
         HB_CUDA_AS(hbd::prepare_lanes<T>(d->m64.features, d->m64.solver, c->P, c->block, c->scene.dyn.per_segment != 0,
                                          d->hw.on != 0),
                    "raising the lanes kernel's shared-memory limit");
+    if (c->variant == V_LANES && d->hw.on && dyn_model<T>(d).world.planes) {
+        /* §3.17 --contact-planes: a frame in several launches (the grid built every substep, or more
+         * substeps than the staged colliders fit) keeps each point's planes between them */
+        int launches = 1;
+        HB_CUDA_AS(hbd::lanes_launches<T>(dyn_model<T>(d), c->block, &launches),
+                   "planning the lanes kernel's launches");
+        if (launches > 1 || (c->scene.dyn.grid && c->scene.dyn.grid_rebuild == HB_GRID_SUBSTEP)) {
+            const uint64_t n = hb_mul_sat(hb_mul_sat((uint64_t)c->N, (uint64_t)c->P), HB_CONTACT_POINT * sizeof(T));
+            int rc;
+            if ((rc = device_alloc(&d->contacts, n, c, "the contact planes", err, errlen))) return rc;
+            dyn_model<T>(d).contacts = (T *)d->contacts;
+        }
+    }
     HB_CUDA_AS(cudaDeviceSynchronize(), "dyn_load (cudaDeviceSynchronize)");
     return 0;
 }

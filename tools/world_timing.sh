@@ -20,6 +20,7 @@ for n in 4194304 10000; do
   world_row "$OUTD" grid32-frame "$A" $n $fr $rep $FRAME32
   world_row "$OUTD" grid32-substep "$A" $n $fr $rep $SUBSTEP32
   world_row "$OUTD" body64 "$A" $n $fr $rep $BODY
+  world_row "$OUTD" body64-planes5 "$A" $n $fr $rep $BODY_PLANES
   world_row "$OUTD" body-bounded-head-only "$A" $n $fr $rep --friction 0.3,0.2 --depenetration-speed 200
   world_row "$OUTD" base-again "$A" $n $fr $rep
 done

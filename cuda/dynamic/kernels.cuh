@@ -135,6 +135,9 @@ cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, b
 template <typename T>
 cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                                const T *bend_rest, int64_t N, int block, cudaStream_t stream);
+/* The launches launch_frame_lanes makes for m's substeps (more than one where the staged colliders do
+ * not fit a block; then --contact-planes keeps each point's planes in m.contacts between them). */
+template <typename T> cudaError_t lanes_launches(const DModel<T> &m, int block, int *launches);
 /* Allows the warp kernel of this feature set `bytes` of dynamic shared memory a block (the
  * opt-in above 48 KB). */
 template <typename T> cudaError_t prepare_warp(unsigned features, size_t bytes);

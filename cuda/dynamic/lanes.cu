@@ -40,8 +40,9 @@ constexpr bool kFreeCollide = kFree && !HB_LANES_REF_COLLIDE;
 /* Blocks of kLanesMaxBlock an SM must hold (__launch_bounds__'s second argument, which caps
  * the registers a thread): fp32 at P ≤ 32 HB_LANES_MINB for xpbd and HB_LANES_FTL_MINB for
  * ftl, with the world's code HB_LANES_WORLD_MINB (all of it), HB_LANES_COL_MINB (colliders alone),
- * HB_LANES_HELD_MINB (the held grid alone) or HB_LANES_GATHER_MINB (the grid's gather alone) (measured,
- * docs/cuda.md), 1 (up to 255 registers) otherwise. */
+ * HB_LANES_PLANES_MINB (colliders as contact planes alone), HB_LANES_HELD_MINB (the held grid alone) or
+ * HB_LANES_GATHER_MINB (the grid's gather alone) (measured, docs/cuda.md), 1 (up to 255 registers)
+ * otherwise. */
 #ifndef HB_LANES_MINB
 #define HB_LANES_MINB 4
 #endif
@@ -53,6 +54,9 @@ constexpr bool kFreeCollide = kFree && !HB_LANES_REF_COLLIDE;
 #endif
 #ifndef HB_LANES_COL_MINB
 #define HB_LANES_COL_MINB 3
+#endif
+#ifndef HB_LANES_PLANES_MINB
+#define HB_LANES_PLANES_MINB 3
 #endif
 #ifndef HB_LANES_HELD_MINB
 #define HB_LANES_HELD_MINB HB_LANES_MINB
@@ -103,13 +107,16 @@ template <typename T> __device__ __forceinline__ constexpr T floor_of()
 #include "dynamic/contact_free.cuh" /* templates only: inside this file's namespace, after rsq, floor_of, fdiv */
 /* The world's code a kernel carries (its W, a set of these): the grid's gather every substep
  * (`frame`, `substep`), the held sample (`held`), the colliders of §3.17 and the head sphere's
- * friction or bounded depenetration. A run takes the smallest kernel that holds what it declares. */
-constexpr int kWGather = 1, kWHeld = 2, kWCol = 4, kWAll = kWGather | kWHeld | kWCol;
+ * friction or bounded depenetration; with kWCol, kWPlanes: the colliders as contact planes alone
+ * (--contact-planes; the kernel with all the world's code runs them too). A run takes the smallest
+ * kernel that holds what it declares. */
+constexpr int kWGather = 1, kWHeld = 2, kWCol = 4, kWPlanes = 8, kWAll = kWGather | kWHeld | kWCol;
 template <typename T, int G, int L, bool Ftl, int W = 0> constexpr int lanes_min_blocks()
 {
     return sizeof(T) != 4                      ? 1
            : W == kWHeld && !Ftl && G == 2     ? HB_LANES_HELD_MINB /* the held grid alone */
            : W == kWCol                        ? HB_LANES_COL_MINB
+           : W == (kWCol | kWPlanes)           ? HB_LANES_PLANES_MINB
            : W == kWGather && !Ftl && G == 2   ? HB_LANES_GATHER_MINB /* the grid's gather alone */
            : W                                 ? HB_LANES_WORLD_MINB  /* everything: 2, up to 128 registers */
            : (!Ftl && G == 2)                  ? HB_LANES_MINB
@@ -324,6 +331,24 @@ template <typename T> __device__ __forceinline__ bool moved_from(const V3<T> &q,
     return bits_differ(p.x, q.x) || bits_differ(p.y, q.y) || bits_differ(p.z, q.z);
 }
 
+/* §3.17 --contact-planes in shared memory: a warp's planes, HB_CONTACT_POINT reals a point slot, each
+ * real of a slot a row of 32 lanes (conflict-free): from a lane's base pl, slot i's plane c has its
+ * real e at pl[((i·K + c)·HB_CONTACT + e)·32]. */
+template <int G> __host__ __device__ constexpr int64_t lanes_plane_reals()
+{
+    return (int64_t)G * HB_CONTACT_POINT * 32;
+}
+template <typename T> __device__ __forceinline__ void plane_load(const T *pl, int i, int c, T (&con)[HB_CONTACT])
+{
+#pragma unroll
+    for (int e = 0; e < HB_CONTACT; e++) con[e] = pl[((i * HB_CONTACT_K + c) * HB_CONTACT + e) * 32];
+}
+template <typename T> __device__ __forceinline__ void plane_store(T *pl, int i, int c, const T *con)
+{
+#pragma unroll
+    for (int e = 0; e < HB_CONTACT; e++) pl[((i * HB_CONTACT_K + c) * HB_CONTACT + e) * 32] = con[e];
+}
+
 /* §3.6 step 7 and §3.7 with the colliders of §3.17 on a lane's NP points p (on: those that
  * collide; x: their positions at the substep's start): contact_impl.h hb_collide_sweeps's steps,
  * the sweep (on each point the head sphere, with its friction or a bounded depenetration, then
@@ -335,10 +360,11 @@ template <typename T> __device__ __forceinline__ bool moved_from(const V3<T> &q,
  * (a warp vote): a point the CPU has stopped (its last sweep changed no bit of it) goes through a
  * sweep on the same bits, which changes none again, so each point ends with the CPU's bits. No
  * flag a point or a lane: the fewest registers (ptxas, docs/cuda.md "The hair–hair grid and the
- * colliders"). */
-template <int NP, typename T, class Feat>
+ * colliders"). pl (--contact-planes): the points' planes (plane_load), met in place of the colliders;
+ * Exact = false: a kernel that runs no collider's own test (kWPlanes). */
+template <int NP, bool Exact = true, typename T, class Feat>
 __device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, const T *pose, const T *back, V3<T> *p,
-                                               const V3<T> *x, const bool *on, unsigned mask)
+                                               const V3<T> *x, const bool *on, unsigned mask, const T *pl = nullptr)
 {
     const World<T> &w = m.world;
     for (int sweep = 1;; sweep++) {
@@ -359,7 +385,28 @@ __device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, con
             }
             moved = moved || (track && moved_from(was, p[s]));
         }
-        for (int i = 0; i < w.ncol; i++) {
+        for (int c = 0; pl && c < HB_CONTACT_K; c++) { /* each point's planes, in their order */
+            bool used[NP], any = false;                /* a slot past the last used one is unused (hb_contact_find) */
+#pragma unroll
+            for (int s = 0; s < NP; s++) {
+                used[s] = on[s] && pl[((s * HB_CONTACT_K + c) * HB_CONTACT + 4) * 32] >= (T)0;
+                any = any || used[s];
+            }
+            if (!__any_sync(mask, any)) break;
+#pragma unroll
+            for (int s = 0; s < NP; s++) {
+                if (!used[s]) continue;
+                T con[HB_CONTACT];
+                plane_load(pl, s, c, con);
+                T pp[3] = {p[s].x, p[s].y, p[s].z};
+                const T xx[3] = {x[s].x, x[s].y, x[s].z};
+                contact_one(w, con, back, pp, xx); /* every build: contact_impl.h's (docs/cuda.md) */
+                const V3<T> np{pp[0], pp[1], pp[2]};
+                moved = moved || (track && moved_from(p[s], np));
+                p[s] = np;
+            }
+        }
+        for (int i = 0; Exact && !pl && i < w.ncol; i++) {
             const T *pi = pose + i * HB_COL_POSE;
             bool in[NP], any = false;
 #pragma unroll
@@ -406,11 +453,11 @@ template <typename T> __device__ __forceinline__ V3<T> follow_target(T ell, cons
 
 /* §3.7 one follow-the-leader step of p after its corrected predecessor a, ell its segment's
  * rest length; d: the correction; wc: the colliders of §3.17 (pose, back, x; mask: the lanes that
- * take this step together) instead of the head sphere. */
-template <typename T, class Feat>
+ * take this step together; pl: p's planes, --contact-planes) instead of the head sphere. */
+template <bool Exact = true, typename T, class Feat>
 __device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, const V3<T> &a, V3<T> &p, V3<T> &d,
                                            bool wc = false, const T *pose = nullptr, const T *back = nullptr,
-                                           const V3<T> *x = nullptr, unsigned mask = kAll)
+                                           const V3<T> *x = nullptr, unsigned mask = kAll, const T *pl = nullptr)
 {
     if (wc) {
         if constexpr (kFree) {
@@ -421,7 +468,7 @@ __device__ __forceinline__ void follow_one(const DModel<T> &m, Feat has, T ell, 
             follow(a.x, a.y, a.z, p.x, p.y, p.z, ell, false, m.collide_r, d.x, d.y, d.z);
         }
         const bool on = true;
-        collide_points<1>(m, has, pose, back, &p, x, &on, mask);
+        collide_points<1, Exact>(m, has, pose, back, &p, x, &on, mask, pl);
         return;
     }
     if constexpr (kFree) {
@@ -563,6 +610,10 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         }
         __syncthreads(); /* before any warp's strand loop, whose trip count differs between warps */
     }
+    /* §3.17 --contact-planes: each warp's planes after the staged colliders (lanes_plane_reals) */
+    const bool planes = (W & kWPlanes) != 0 || (W == kWAll && m.world.planes);
+    constexpr bool Exact = (W & kWPlanes) == 0; /* the colliders' own tests in the collision step */
+    T *ps = (T *)cs + lanes_col_reals(m.world.ncol, jend - m.j0) + (int64_t)w * lanes_plane_reals<G>() + lane;
 
     /* the loop bound is the same for every lane of a warp: whole warps take each group of strands */
     for (int64_t s0 = SPW * ((int64_t)blockIdx.x * wpb + w); s0 < N; s0 += SPW * (int64_t)gridDim.x * wpb) {
@@ -666,6 +717,50 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                                                                                : m.qs;
             const T *pose = cs + (j - m.j0) * m.world.ncol * HB_COL_POSE;
             const T *back = cs + (jend - m.j0) * m.world.ncol * HB_COL_POSE + (j - m.j0) * HB_COL_BACK;
+            /* §3.17 --contact-planes: each point's planes found from x at the frame's first substep (its
+             * poses), carried with their colliders at the others; a launch that starts later in the
+             * frame takes them from m.contacts, where the launch before left them */
+            if constexpr ((W & kWCol) != 0) {
+                if (planes) {
+                    const int64_t st = Ordered && m.perm ? m.perm[s0 + seg] : s0 + seg;
+#pragma unroll
+                    for (int i = 0; i < G; i++) {
+                        const int k = point_of<G>(k0, sw, i);
+                        const bool own = live && k >= 1 && k < P;
+                        if (j > m.j0) { /* carried in place: a plane whose collider's frame stays, as it is */
+                            for (int c = 0; own && c < HB_CONTACT_K; c++) {
+                                T one[HB_CONTACT];
+                                one[4] = ps[((i * HB_CONTACT_K + c) * HB_CONTACT + 4) * 32];
+                                if (!(one[4] >= (T)0)) break; /* the unused slots are the last */
+                                const int fr = m.world.col_frame[(int)one[4]];
+                                if (!((fr == HB_FRAME_HEAD && m.world.motion) || (fr == HB_FRAME_BODY && m.world.sway)))
+                                    continue;
+                                plane_load(ps, i, c, one);
+                                contact_carry(m.world, back, one);
+                                plane_store(ps, i, c, one);
+                            }
+                            continue;
+                        }
+                        T con[HB_CONTACT_POINT];
+#pragma unroll
+                        for (int e = 0; e < HB_CONTACT_POINT; e++) con[e] = (e % HB_CONTACT == 4) ? (T)-1 : (T)0;
+                        if (own && j == 0) {
+                            const T xx[3] = {X[i].x, X[i].y, X[i].z};
+                            contact_find(m.world, pose, xx, con);
+                        } else if (own) { /* a launch's first substep after the frame's first */
+#pragma unroll
+                            for (int c = 0; c < HB_CONTACT_K; c++) {
+                                const T *g = m.contacts + (st * P + k) * HB_CONTACT_POINT + HB_CONTACT * c;
+#pragma unroll
+                                for (int e = 0; e < HB_CONTACT; e++) con[HB_CONTACT * c + e] = g[e];
+                                contact_carry(m.world, back, con + HB_CONTACT * c);
+                            }
+                        }
+#pragma unroll
+                        for (int c = 0; c < HB_CONTACT_K; c++) plane_store(ps, i, c, con + HB_CONTACT * c);
+                    }
+                }
+            }
             /* 1. the root on the head, then p0 = x0 */
             if (l == 0) {
                 if (has(HB_F_MOTION)) {
@@ -798,7 +893,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                         bool on[G];
 #pragma unroll
                         for (int i = 0; i < G; i++) on[i] = point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P;
-                        collide_points<G>(m, has, pose, back, Q, X, on, kAll);
+                        collide_points<G, Exact>(m, has, pose, back, Q, X, on, kAll, planes ? (const T *)ps : nullptr);
                     } else if (has(HB_F_COLLIDE)) {
 #pragma unroll
                         for (int i = 0; i < G; i++)
@@ -822,8 +917,10 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                         for (int i = 0; i < G; i++) {
                             const int k = k0 + i;
                             if (k >= 1 && k < P)
-                                follow_one(m, has, ell(i), i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i],
-                                           (W & kWCol) && wcol, pose, back, &X[i], smask);
+                                follow_one<Exact>(m, has, ell(i), i == 0 ? a : Q[i > 0 ? i - 1 : 0], Q[i], D[i],
+                                                  (W & kWCol) && wcol, pose, back, &X[i], smask,
+                                                  planes ? (const T *)ps + (int64_t)i * HB_CONTACT_POINT * 32
+                                                         : nullptr);
                         }
                     }
                 }
@@ -836,6 +933,24 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                 const int k = point_of<G>(k0, sw, i);
                 if (k >= 1 && k < P)
                     update(m, Ftl && k + 1 < P, i + 1 < G ? D[i + 1 < G ? i + 1 : i] : dn, X[i], V[i], Q[i]);
+            }
+        }
+        if constexpr ((W & kWCol) != 0) { /* the planes kept for the frame's next launch */
+            if (planes && jend < (int)m.substeps && live) {
+                const int64_t st = Ordered && m.perm ? m.perm[s0 + seg] : s0 + seg;
+#pragma unroll
+                for (int i = 0; i < G; i++) {
+                    const int k = point_of<G>(k0, sw, i);
+                    if (k < 1 || k >= P) continue;
+#pragma unroll
+                    for (int c = 0; c < HB_CONTACT_K; c++) {
+                        T one[HB_CONTACT];
+                        plane_load(ps, i, c, one);
+#pragma unroll
+                        for (int e = 0; e < HB_CONTACT; e++)
+                            m.contacts[(st * P + k) * HB_CONTACT_POINT + HB_CONTACT * c + e] = one[e];
+                    }
+                }
             }
         }
         __syncwarp();
@@ -881,6 +996,7 @@ template <typename T> struct LanesPick {
     LanesFn<T> fn;
     int lanes;
     int64_t warp_reals;
+    int64_t plane_reals; /* a warp's contact planes (--contact-planes) */
 };
 /* a groom (seg) runs the generic kernel of its layout with per-segment rest lengths; a run with
  * the grid or colliders (wk, a set of kW…) the generic kernel with the world's code it needs (a
@@ -893,20 +1009,24 @@ template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int6
     else if (wk == kWHeld) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWHeld>;
     else if (wk == kWGather) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWGather>;
     else if (wk == kWCol) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWCol>;
+    else if (wk == (kWCol | kWPlanes)) fn = &k_lanes<T, DynF, G, L, Ftl, false, kWCol | kWPlanes>;
     else if (seg) fn = &k_lanes<T, DynF, G, L, Ftl, true, 0>;
-    /* the default scene's feature set (every feature) has its own held-grid and colliders kernels
-     * in fp32 at P ≤ 32 (the generic ones spill there: docs/cuda.md) */
+    /* the default scene's feature set (every feature) has its own held-grid, colliders and contact
+     * planes kernels in fp32 at P ≤ 32 (the generic ones spill there: docs/cuda.md) */
     constexpr unsigned kEvery = HB_F_COUNT - 1u;
     if constexpr (sizeof(T) == 4 && !Ftl && G == 2 && L == 16) {
         if (f == kEvery && wk == kWHeld) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWHeld>;
         if (f == kEvery && wk == kWCol) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWCol>;
+        if (f == kEvery && wk == (kWCol | kWPlanes))
+            fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWCol | kWPlanes>;
         if (f == kEvery && wk == kWGather) fn = &k_lanes<T, StaticF<kEvery>, G, L, Ftl, false, kWGather>;
     }
-    return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P) + ((wk & kWHeld) ? lanes_held_reals<T, G>() : 0)};
+    return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P) + ((wk & kWHeld) ? lanes_held_reals<T, G>() : 0),
+                        lanes_plane_reals<G>()};
 }
 /* The world's code a run needs (docs/cuda.md "The hair–hair grid and the colliders"): none
  * without a world; the held grid alone (or a grid that applies nothing); the grid's gather alone
- * (`frame`, `substep`); the colliders alone; else all of it. */
+ * (`frame`, `substep`); the colliders alone, exact or as contact planes; else all of it. */
 template <typename T> int world_kind(const DModel<T> &m)
 {
     if (!m.has_world) return 0;
@@ -915,11 +1035,11 @@ template <typename T> int world_kind(const DModel<T> &m)
     const bool apply = w.grid && (w.grid_friction || w.grid_volume);
     if (apply && col) return kWAll;
     if (apply && w.grid_rebuild != HB_GRID_HELD) return kWGather;
-    return col ? kWCol : kWHeld;
+    return !col ? kWHeld : w.planes ? kWCol | kWPlanes : kWCol;
 }
 template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P, bool seg, int world)
 {
-    if (!valid_mask(f) || P < 2 || P > kLanesMaxPoints) return LanesPick<T>{nullptr, 0, 0};
+    if (!valid_mask(f) || P < 2 || P > kLanesMaxPoints) return LanesPick<T>{nullptr, 0, 0, 0};
     if (solver == HB_SOLVER_FTL) {
         if (P <= 32) return pick<T, kFtlG, kFtlL, true>(f, P, seg, world);
         if (P <= 64) return pick<T, 8, 8, true>(f, P, seg, world);
@@ -935,7 +1055,7 @@ template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P,
 template <typename T>
 cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, bool seg, bool world)
 {
-    for (int wk : {kWHeld, kWGather, kWCol, kWAll}) { /* a world's run launches one of its four kernels */
+    for (int wk : {kWHeld, kWGather, kWCol, kWCol | kWPlanes, kWAll}) { /* a world's run launches one of these */
         const LanesPick<T> k = lanes_pick<T>(features, solver, P, seg, world ? wk : 0);
         if (!k.fn) return cudaErrorInvalidValue;
         int bytes = (int)((size_t)(block / 32) * (size_t)k.warp_reals * sizeof(T)), dev = 0;
@@ -951,27 +1071,28 @@ cudaError_t prepare_lanes(unsigned features, int solver, int64_t P, int block, b
     return cudaSuccess;
 }
 
+/* §3.17 the block and the substeps a launch of a run's kernel k with block `block`: the staged colliders
+ * take at most kColStageBytes a block, within the device's limit: fewer substeps a launch (x and v
+ * carry all state between launches, and m.contacts the contact planes), and only where one substep
+ * does not fit beside the warps' areas, fewer warps a block (the same results). chunk: the frame's
+ * substeps without colliders. */
 template <typename T>
-cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
-                               const T *bend_rest, int64_t N, int block, cudaStream_t stream)
+static cudaError_t lanes_shape(const DModel<T> &m, const LanesPick<T> &k, int wk, int block, int &b, int &chunk,
+                               size_t &smem)
 {
-    const int wk = world_kind(m);
-    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, wk);
-    if (!k.fn) return cudaErrorInvalidValue;
-    /* §3.17 the staged colliders take at most kColStageBytes a block, within the device's limit:
-     * fewer substeps a launch (x and v carry all state between launches), and only where one
-     * substep does not fit beside the warps' areas, fewer warps a block (the same results) */
     const bool col = lanes_col_on<T>(wk, m);
+    const int64_t warp = k.warp_reals + (col && m.world.planes ? k.plane_reals : 0);
     const int j1 = m.j1 < 0 ? (int)m.substeps : m.j1;
     const size_t per = sizeof(T) * (size_t)lanes_col_reals(m.world.ncol, 1);
-    int b = block, chunk = j1 - m.j0;
+    b = block;
+    chunk = j1 - m.j0;
     if (col) {
         int dev = 0, optin = 0;
         cudaError_t e = cudaGetDevice(&dev);
         if (e == cudaSuccess) e = cudaDeviceGetAttribute(&optin, cudaDevAttrMaxSharedMemoryPerBlockOptin, dev);
         if (e != cudaSuccess) return e;
         for (;;) {
-            const size_t used = (size_t)(b / 32) * (size_t)k.warp_reals * sizeof(T);
+            const size_t used = (size_t)(b / 32) * (size_t)warp * sizeof(T);
             const size_t room = used < (size_t)optin ? (size_t)optin - used : 0;
             const size_t budget = room < (size_t)kColStageBytes ? room : (size_t)kColStageBytes;
             if (budget >= per) {
@@ -982,17 +1103,49 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
             b = (b / 64) * 32; /* half the warps */
         }
     }
+    smem = (size_t)(b / 32) * (size_t)warp * sizeof(T);
+    return cudaSuccess;
+}
+
+template <typename T> cudaError_t lanes_launches(const DModel<T> &m, int block, int *launches)
+{
+    const int wk = world_kind(m);
+    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, wk);
+    if (!k.fn) return cudaErrorInvalidValue;
+    int b = 0, chunk = 0;
+    size_t smem = 0;
+    const cudaError_t e = lanes_shape(m, k, wk, block, b, chunk, smem);
+    if (e != cudaSuccess) return e;
+    const int nj = (m.j1 < 0 ? (int)m.substeps : m.j1) - m.j0;
+    *launches = nj <= chunk ? 1 : (nj + chunk - 1) / chunk;
+    return cudaSuccess;
+}
+
+template <typename T>
+cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
+                               const T *bend_rest, int64_t N, int block, cudaStream_t stream)
+{
+    const int wk = world_kind(m);
+    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, wk);
+    if (!k.fn) return cudaErrorInvalidValue;
+    const bool col = lanes_col_on<T>(wk, m);
+    const int j1 = m.j1 < 0 ? (int)m.substeps : m.j1;
+    int b = 0, chunk = 0;
+    size_t smem = 0;
+    cudaError_t e = lanes_shape(m, k, wk, block, b, chunk, smem);
+    if (e != cudaSuccess) return e;
+    /* the contact planes of a frame in several launches are kept in m.contacts (backend_dyn.cu) */
+    if (col && m.world.planes && (m.j0 > 0 || j1 < (int)m.substeps || chunk < j1 - m.j0) && !m.contacts)
+        return cudaErrorInvalidValue;
     const int64_t per_block = (int64_t)(b / 32) * (32 / k.lanes);
     const int64_t g = (N + per_block - 1) / per_block;
     const int grid = (int)(g < 1 ? 1 : g > 2147483647 ? 2147483647 : g);
-    const size_t smem = (size_t)(b / 32) * (size_t)k.warp_reals * sizeof(T);
     DModel<T> mc = m;
     do { /* one launch at least, as before */
         mc.j1 = chunk < j1 - mc.j0 ? mc.j0 + chunk : j1;
         const size_t cb = col ? (size_t)lanes_col_reals(m.world.ncol, mc.j1 - mc.j0) * sizeof(T) : 0;
         k.fn<<<grid, b, smem + cb, stream>>>(mc, q, phase, x, v, rest, bend_rest, N);
-        const cudaError_t e = cudaGetLastError();
-        if (e != cudaSuccess) return e;
+        if ((e = cudaGetLastError()) != cudaSuccess) return e;
         mc.j0 = mc.j1;
     } while (mc.j0 < j1);
     return cudaSuccess;
@@ -1000,6 +1153,7 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
 
 #define HB_LANES_INSTANTIATE(T)                                                                                        \
     template cudaError_t prepare_lanes<T>(unsigned, int, int64_t, int, bool, bool);                                    \
+    template cudaError_t lanes_launches<T>(const DModel<T> &, int, int *);                                             \
     template cudaError_t launch_frame_lanes<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,           \
                                                const T *, int64_t, int, cudaStream_t);
 /* the Makefile compiles this file once per precision (-DHB_DYN_REAL), side by side */

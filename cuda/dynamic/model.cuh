@@ -74,6 +74,9 @@ template <typename T> struct DModel {
     const T *pose = nullptr, *back = nullptr, *qs = nullptr;
     /* §3.16 `held`: each point's sample for the frame ([N][P][kHeldReals], cuda/dynamic/held.cuh) */
     const T *held = nullptr;
+    /* §3.17 --contact-planes: each point's planes [N][P][HB_CONTACT_POINT] (strands as stored), where a
+     * frame runs in several launches (lanes: kept between them; nullptr: the frame in one launch) */
+    T *contacts = nullptr;
     /* the substeps a launch runs: j0 … j1 − 1 (j1 < 0: all of the frame's) */
     int j0 = 0, j1 = -1;
 };

@@ -75,6 +75,31 @@ HB_HD void collide_head(const World<double> &w, double rc, const double *back, d
 {
     hb_collide_head_f64(&w, rc, back, p, x);
 }
+/* §3.17 --contact-planes: a point's planes found, carried, met (contact_impl.h) */
+HB_HD void contact_find(const World<float> &w, const float *pose, const float *x, float *con)
+{
+    hb_contact_find_f32(&w, pose, x, con);
+}
+HB_HD void contact_find(const World<double> &w, const double *pose, const double *x, double *con)
+{
+    hb_contact_find_f64(&w, pose, x, con);
+}
+HB_HD void contact_carry(const World<float> &w, const float *back, float *con)
+{
+    hb_contact_carry_f32(&w, back, con);
+}
+HB_HD void contact_carry(const World<double> &w, const double *back, double *con)
+{
+    hb_contact_carry_f64(&w, back, con);
+}
+HB_HD void contact_one(const World<float> &w, const float *con, const float *back, float *p, const float *x)
+{
+    hb_contact_one_f32(&w, con, back, p, x);
+}
+HB_HD void contact_one(const World<double> &w, const double *con, const double *back, double *p, const double *x)
+{
+    hb_contact_one_f64(&w, con, back, p, x);
+}
 HB_HD double collider_depth(const World<float> &w, int i, const float *pose, const double *x)
 {
     return hb_collider_depth_f32(&w, i, pose, x);

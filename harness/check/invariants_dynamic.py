@@ -279,6 +279,14 @@ class _FrameChecks:
                 if self.traj.colliders:  # nor any other collider
                     d = collider_depths(self.traj, xd[:, 1:, :], frame_end_time(self.traj, f))
                     free &= ~np.any(np.nan_to_num(d, nan=-np.inf) > -near, axis=0).reshape(free.shape)
+                    if int(self.traj.dynamic_params.get("planes_declared", 0)) and f >= 1:
+                        # --contact-planes: a point within M of a collider at the frame's start met its
+                        # plane all frame, and a plane reaches far beyond a curved surface (hair slides
+                        # along it): such a point counts as moved (M + near: the poses of the first substep)
+                        m = float(self.traj.dynamic_params["contact_margin"]) + near
+                        x0 = self.traj.frame(f - 1).astype(np.float64)[:, 1:, :]
+                        d0 = collider_depths(self.traj, x0, frame_end_time(self.traj, f - 1))
+                        free &= ~np.any(np.nan_to_num(d0, nan=-np.inf) > -m, axis=0).reshape(free.shape)
                 err = np.where(free, err, 0.0)[held]
                 self.bound(
                     f,
