@@ -183,7 +183,7 @@ def frame_matches(work, cpu, build, variant, label):
     """The build's frame from the CPU file's frame K−1 against the CPU's frame K: bit for bit (strict)
     or by the one-frame rule with the scene's spread (diff_dynamic, as tests/gpu/test_gpu_dynamic.py):
     the FMA-contracted reference itself puts a point of body-planes' ftl fp32 frame 1.1e-4 cm off, over
-    the plain rule, where friction's stick–slip decision meets its boundary (measured 2026-11-28)."""
+    the plain rule, the normal build one 1.4e-4 near a capsule with friction (measured 2026-11-28)."""
     with open_trajectory(cpu) as t:
         k = t.n_frames - 2
         step = int(t.step[-1])
