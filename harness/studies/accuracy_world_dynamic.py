@@ -1,12 +1,13 @@
 """Speed against accuracy of the world around the hair (docs/model.md §3.16, §3.17): the
 hair–hair grid's size × when it is built × friction × volume on the default scene, and the
-colliders' SDF resolution × friction on the body of configs/scenes/body.toml. Measures and
-writes CSV; accuracy_world_verdicts_dynamic.py judges it, harness/render/accuracy_world_dynamic_report.py
-renders the table and that verdict.
+colliders' SDF resolution × friction on the body of configs/scenes/body.toml, with friction also as
+contact planes (--contact-planes M). Measures and writes CSV; accuracy_world_verdicts_dynamic.py
+judges it, harness/render/accuracy_world_dynamic_report.py renders the table and that verdict.
 
 Each variant runs the scene's own step (S = 8, I = 2, fp32) at `strands` strands for `seconds`,
 and its **converged reference**, the same features at S = `ref_substeps` in fp64 (the error is
-then the step's, not the feature's). Against it: the RMS and max error over all points and
+then the step's, not the feature's), but for contact planes the exact order's (their error is the
+trade's too). Against it: the RMS and max error over all points and
 frames (studies.accuracy.frame_errors, over L), and the observables the features change, the
 variant's beside its reference's: the last frame's hair volume, envelope radius and close pairs
 (check/hair_volume_dynamic.py), and the worst frame's penetration and stretch (§3.8). The cost is the
@@ -48,6 +49,7 @@ COLUMNS = (
     "friction",  # on | off
     "volume",  # on | off (grid only)
     "sdf",  # the mesh's n_s (body only)
+    "planes",  # the contact planes' margin M in cm, or "off": every collider exactly (body only)
     "strands",
     "frames",
     "substeps",
@@ -85,6 +87,7 @@ class Plan:
     grid_sizes: tuple = (16, 32, 64)
     rebuilds: tuple = ("frame", "substep", "held")
     sdf_sizes: tuple = (32, 64, 128)
+    contact_margins: tuple = (2.0, 5.0)  # --contact-planes M of the planes rows (each SDF size, friction on)
     time_strands: int = 1000
     time_frames: int = 3
     repeat: int = 5  # timing rounds, every variant once a round (in turn, so that a load hits them alike)
@@ -96,7 +99,7 @@ class Plan:
     def quick(cls, **changes):
         """Every axis still present, fewer strands and a shorter run (a minute or two on 2 cores)."""
         base = dict(strands=32, seconds=0.75, ref_substeps=32, grid_sizes=(16, 32), sdf_sizes=(32, 64),
-                    time_strands=300, repeat=3)  # fmt: skip
+                    contact_margins=(5.0,), time_strands=300, repeat=3)  # fmt: skip
         return cls(**{**base, **changes})
 
 
@@ -106,6 +109,7 @@ class Variant:
     name: str
     scene: object  # a core.scenes scene with the variant's flags
     columns: dict  # its axis values, as the CSV writes them
+    ref_scene: object = None  # its converged reference's scene at S = ref_substeps (None: scene's)
 
 
 def check_plan(plan):
@@ -122,6 +126,8 @@ def check_plan(plan):
         bad.append(f"--grid-sizes needs values from {fewest} to {most}")
     if not plan.sdf_sizes or any(not 8 <= n <= 512 for n in plan.sdf_sizes):
         bad.append("--sdf-sizes needs values from 8 to 512")
+    if any(not 0 < m <= 100 for m in plan.contact_margins):
+        bad.append("the contact planes' margins must be in (0, 100] cm")
     if not plan.rebuilds or any(r not in ("frame", "substep", "held") for r in plan.rebuilds):
         bad.append("the grid's rebuilds are frame, substep and held")
     if bad:
@@ -163,8 +169,9 @@ def grid_variants(plan):
 
 def body_variants(plan, folder):
     """The body scene without its grid and colliders (off), then each SDF size of its mesh ×
-    friction (on: the file's μ and the head sphere's; off: every μ removed). The colliders files
-    are written into `folder` beside a link to each mesh."""
+    friction (on: the file's μ and the head sphere's; off: every μ removed), and with friction on its
+    colliders as contact planes at each margin, against the exact order's reference. The colliders
+    files are written into `folder` beside a link to each mesh."""
     body = scenes.load_scene(BODY_SCENE)
     dyn = _without(body.dynamic, _grid_flag)
     flags = body.flags()
@@ -174,7 +181,8 @@ def body_variants(plan, folder):
         words = line.split("#")[0].split()
         if words and words[0] == "mesh" and not (folder / words[2]).exists():
             (folder / words[2]).symlink_to((src.parent / words[2]).resolve())
-    out = [Variant("body", "off", replace(body, dynamic=_without(dyn, _body_flag)), dict(sdf="off", friction="off"))]
+    off = dict(sdf="off", friction="off", planes="off")
+    out = [Variant("body", "off", replace(body, dynamic=_without(dyn, _body_flag)), off)]
     for n in plan.sdf_sizes:
         for fric in ("on", "off"):
             path = folder / f"sdf{n}-friction-{fric}.colliders"
@@ -182,8 +190,12 @@ def body_variants(plan, folder):
             flags = {**dyn, "--colliders": str(path)}
             if fric == "off":
                 flags.pop("--friction", None)
-            cols = dict(sdf=n, friction=fric)
-            out.append(Variant("body", f"SDF {n}³, friction {fric}", replace(body, dynamic=flags), cols))
+            exact = replace(body, dynamic=flags)
+            out.append(Variant("body", f"SDF {n}³, friction {fric}", exact, dict(sdf=n, friction=fric, planes="off")))
+            for m in plan.contact_margins if fric == "on" else ():
+                planes = replace(body, dynamic={**flags, "--contact-planes": m})
+                cols = dict(sdf=n, friction=fric, planes=f"{m:g}")
+                out.append(Variant("body", f"SDF {n}³, friction on, planes {m:g} cm", planes, cols, ref_scene=exact))
     return out
 
 
@@ -273,14 +285,14 @@ def measure_variant(v, plan, scratch):
     """A variant's CSV row but its cost (ms_frame, cost_ratio: measure times the variants one after
     another, once every checked run is done, so that no timed run shares the cores)."""
     mode = _run(v.scene, scratch / "mode.h5", plan, "fp32", int(v.scene.dynamic.get("--substeps", 1)))
-    ref = _run(v.scene, scratch / "ref.h5", plan, "fp64", plan.ref_substeps)
+    ref = _run(v.ref_scene or v.scene, scratch / "ref.h5", plan, "fp64", plan.ref_substeps)
     x, L, vol, (pen, stretch) = _observed(mode)
     xr, _, vol_r, (pen_r, stretch_r) = _observed(ref)
     rms, mx = frame_errors(x, xr, L)
     return {
         "group": v.group,
         "variant": v.name,
-        **{k: v.columns.get(k, "") for k in ("grid", "rebuild", "friction", "volume", "sdf")},
+        **{k: v.columns.get(k, "") for k in ("grid", "rebuild", "friction", "volume", "sdf", "planes")},
         "strands": plan.strands,
         "frames": len(x),
         "substeps": v.scene.dynamic.get("--substeps", 1),
@@ -353,5 +365,5 @@ def run_study(plan, out_dir=None, log=print):
     return path
 
 
-COLUMNS_PLAN = ("strands", "seconds", "ref_substeps", "grid_sizes", "rebuilds", "sdf_sizes", "time_strands",
-                "time_frames", "repeat", "gpu", "gpu_strands")  # fmt: skip
+COLUMNS_PLAN = ("strands", "seconds", "ref_substeps", "grid_sizes", "rebuilds", "sdf_sizes", "contact_margins",
+                "time_strands", "time_frames", "repeat", "gpu", "gpu_strands")  # fmt: skip

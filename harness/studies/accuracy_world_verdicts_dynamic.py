@@ -2,7 +2,8 @@
 (render/accuracy_world_dynamic_report.py words it): per group the cheapest variant within
 tolerances.WORLD_ACC_ERROR_FACTOR of the smallest error against its converged reference, and
 the medians over matched pairs of what a setting costs and moves (the grid rebuilt every
-substep, each point's sample held for the frame, friction on the body, the SDF's size)."""
+substep, each point's sample held for the frame, friction on the body, the SDF's size, the body's
+colliders as contact planes)."""
 
 import math
 import statistics
@@ -37,9 +38,9 @@ def paired_ratio(rows, key, axis, a, b, match):
     a's; (ratio, pairs) with NaN where none pairs."""
     ratios = []
     for r in rows:
-        if r[axis] != a:
+        if r.get(axis) != a:
             continue
-        twin = next((o for o in rows if o[axis] == b and all(o[m] == r[m] for m in match)), None)
+        twin = next((o for o in rows if o.get(axis) == b and all(o.get(m, "") == r.get(m, "") for m in match)), None)
         if twin is not None and cell(r, key) > 0 and math.isfinite(cell(twin, key)):
             ratios.append(cell(twin, key) / cell(r, key))
     return (statistics.median(ratios) if ratios else math.nan), len(ratios)
@@ -82,7 +83,7 @@ def sdf_change(rows):
     if len(sizes) < 2:
         return None
     lo, hi = str(sizes[0]), str(sizes[-1])
-    ratio, n = paired_ratio(rows, "rms_err_L", "sdf", lo, hi, ("friction",))
+    ratio, n = paired_ratio(rows, "rms_err_L", "sdf", lo, hi, ("friction", "planes"))
     return SdfChange(lo, hi, ratio, n) if n else None
 
 
@@ -92,7 +93,8 @@ GRID_MATCH = ("grid", "friction", "volume")
 @dataclass(frozen=True)
 class Verdict:
     """A group's verdict: its pick (None: no finite error), the setting each group varies
-    (the grid's rebuild, the body's friction), holding the sample (grid) and the SDF's size (body)."""
+    (the grid's rebuild, the body's friction), holding the sample (grid), the SDF's size and the
+    contact planes at each margin against the exact colliders ((margin, Change), body)."""
 
     group: str
     pick: dict | None
@@ -100,6 +102,7 @@ class Verdict:
     change: Change | None = None
     held: Change | None = None
     sdf: SdfChange | None = None
+    planes: tuple = ()
 
 
 def verdict(rows, group):
@@ -120,6 +123,15 @@ def verdict(rows, group):
         group,
         pick,
         tolerances.WORLD_ACC_ERROR_FACTOR,
-        change=change(on, "friction", "off", "on", ("sdf",)),
+        change=change(on, "friction", "off", "on", ("sdf", "planes")),
         sdf=sdf_change(on),
+        planes=planes_changes(on),
     )
+
+
+def planes_changes(rows):
+    """(margin, Change) for each contact planes margin among the rows: its rows against the exact
+    colliders' of the same SDF size and friction (cost, and error against the exact order's reference)."""
+    margins = sorted({str(r.get("planes", "")) for r in rows} - {"", "off"}, key=float)
+    out = [(m, change(rows, "planes", "off", m, ("sdf", "friction"))) for m in margins]
+    return tuple((m, c) for m, c in out if c.pairs)

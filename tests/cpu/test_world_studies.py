@@ -75,7 +75,7 @@ def test_world_cells_with_known_verdicts(cpu_bin, name, row, col, solver, precis
 
 
 TINY = accuracy_world.Plan(strands=4, seconds=0.05, ref_substeps=16, grid_sizes=(8,), sdf_sizes=(16,),
-                           time_strands=8, time_frames=1, repeat=1, jobs=2)  # fmt: skip
+                           contact_margins=(5.0,), time_strands=8, time_frames=1, repeat=1, jobs=2)  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -89,11 +89,35 @@ def test_the_world_table_has_every_variant_of_both_axes(world_rows):
     assert {(r["grid"], r["rebuild"], r["friction"], r["volume"]) for r in grid if r["variant"] != "off"} == {
         (8, rb, f, v) for rb in ("frame", "substep", "held") for f in ("on", "off") for v in ("on", "off")
     }
-    assert {(r["sdf"], r["friction"]) for r in body if r["variant"] != "off"} == {(16, "on"), (16, "off")}
+    assert {(r["sdf"], r["friction"], r["planes"]) for r in body if r["variant"] != "off"} == {
+        (16, "on", "off"),
+        (16, "off", "off"),
+        (16, "on", "5"),
+    }
     for r in world_rows:
         assert r["ms_frame"] > 0 and math.isfinite(r["rms_err_L"]) and r["rms_err_L"] > 0, r
         assert r["substeps"] == 8 and r["ref_substeps"] == 16
     assert all(r["cost_ratio"] == 1.0 for r in world_rows if r["variant"] == "off")
+
+
+def test_a_planes_row_is_judged_against_the_exact_colliders_reference(tmp_path, monkeypatch):
+    """the planes variant runs its own scene in fp32 and its exact twin's at S = ref_substeps in fp64"""
+    todo = accuracy_world.body_variants(TINY, tmp_path)
+    exact = next(v for v in todo if v.columns == dict(sdf=16, friction="on", planes="off"))
+    planes = next(v for v in todo if v.columns.get("planes") == "5")
+    assert planes.scene.dynamic == {**exact.scene.dynamic, "--contact-planes": 5.0}
+    ran = []
+
+    def fake_run(scene, path, plan, precision, substeps):
+        ran.append((scene.dynamic, precision, substeps))
+        if len(ran) == 2:
+            raise StopIteration
+        return path
+
+    monkeypatch.setattr(accuracy_world, "_run", fake_run)
+    with pytest.raises(StopIteration):
+        accuracy_world.measure_variant(planes, TINY, tmp_path)
+    assert ran == [(planes.scene.dynamic, "fp32", 8), (exact.scene.dynamic, "fp64", TINY.ref_substeps)]
 
 
 def test_a_grid_that_applies_nothing_moves_no_point(world_rows):
@@ -131,15 +155,21 @@ def test_the_verdict_follows_the_numbers():
     rows[1]["rms_err_L"] = str(0.006 * tolerances.WORLD_ACC_ERROR_FACTOR * 1.5)  # now too far from the best
     assert world_verdicts.verdict(rows, "grid").pick["variant"] == "b"
     body = [
-        _row("body", "off", 1.0, 0.01, sdf="off", friction="off"),
-        _row("body", "s on", 3.0, 0.02, sdf="32", friction="on"),
-        _row("body", "s off", 2.0, 0.04, sdf="32", friction="off"),
+        _row("body", "off", 1.0, 0.01, sdf="off", friction="off", planes="off"),
+        _row("body", "s on", 3.0, 0.02, sdf="32", friction="on", planes="off"),
+        _row("body", "s off", 2.0, 0.04, sdf="32", friction="off", planes="off"),
     ]
     v = world_verdicts.verdict(body, "body")
     assert (v.change.cost, v.change.err, v.pick["variant"], v.sdf) == (1.5, 0.5, "s off", None)
     text = accuracy_world_report.verdict(body, "body")
     assert "friction costs 1.50×" in text and "by 0.50×" in text and "is s off" in text
     assert world_verdicts.verdict([body[0]], "body").pick is None
+    planes = _row("body", "s planes", 1.5, 0.03, sdf="32", friction="on", planes="5")
+    v = world_verdicts.verdict([*body, planes], "body")
+    assert (v.change.cost, v.change.err) == (1.5, 0.5)  # friction's pair is still the exact one
+    assert [(m, c.cost, c.err, c.pairs) for m, c in v.planes] == [("5", 0.5, pytest.approx(1.5), 1)]
+    text = accuracy_world_report.verdict([*body, planes], "body")
+    assert "As contact planes within 5 cm the colliders cost 0.50× the exact ones" in text and "by 1.50×" in text
 
 
 def test_the_world_section_renders_from_its_csv(world_rows, tmp_path):
@@ -159,6 +189,7 @@ def test_the_world_section_renders_from_its_csv(world_rows, tmp_path):
         (dict(ref_substeps=8), "--ref-substeps 8 must exceed"),
         (dict(grid_sizes=(1,)), "--grid-sizes"),
         (dict(sdf_sizes=(4,)), "--sdf-sizes"),
+        (dict(contact_margins=(0.0,)), "contact planes' margins"),
         (dict(seconds=0.0), "--seconds"),
         (dict(rebuilds=("never",)), "rebuilds"),
     ],
