@@ -338,15 +338,24 @@ template <int G> __host__ __device__ constexpr int64_t lanes_plane_reals()
 {
     return (int64_t)G * HB_CONTACT_POINT * 32;
 }
+__device__ __forceinline__ constexpr int plane_at(int i, int c, int e)
+{
+    return ((i * HB_CONTACT_K + c) * HB_CONTACT + e) * 32;
+}
+/* slot i's plane c's collider index (< 0: unused, and so are the slot's later planes) */
+template <typename T> __device__ __forceinline__ T plane_index(const T *pl, int i, int c)
+{
+    return pl[plane_at(i, c, 4)];
+}
 template <typename T> __device__ __forceinline__ void plane_load(const T *pl, int i, int c, T (&con)[HB_CONTACT])
 {
 #pragma unroll
-    for (int e = 0; e < HB_CONTACT; e++) con[e] = pl[((i * HB_CONTACT_K + c) * HB_CONTACT + e) * 32];
+    for (int e = 0; e < HB_CONTACT; e++) con[e] = pl[plane_at(i, c, e)];
 }
 template <typename T> __device__ __forceinline__ void plane_store(T *pl, int i, int c, const T *con)
 {
 #pragma unroll
-    for (int e = 0; e < HB_CONTACT; e++) pl[((i * HB_CONTACT_K + c) * HB_CONTACT + e) * 32] = con[e];
+    for (int e = 0; e < HB_CONTACT; e++) pl[plane_at(i, c, e)] = con[e];
 }
 
 /* §3.6 step 7 and §3.7 with the colliders of §3.17 on a lane's NP points p (on: those that
@@ -389,7 +398,7 @@ __device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, con
             bool used[NP], any = false;                /* a slot past the last used one is unused (hb_contact_find) */
 #pragma unroll
             for (int s = 0; s < NP; s++) {
-                used[s] = on[s] && pl[((s * HB_CONTACT_K + c) * HB_CONTACT + 4) * 32] >= (T)0;
+                used[s] = on[s] && plane_index(pl, s, c) >= (T)0;
                 any = any || used[s];
             }
             if (!__any_sync(mask, any)) break;
@@ -729,12 +738,12 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                         const bool own = live && k >= 1 && k < P;
                         if (j > m.j0) { /* carried in place: a plane whose collider's frame stays, as it is */
                             for (int c = 0; own && c < HB_CONTACT_K; c++) {
-                                T one[HB_CONTACT];
-                                one[4] = ps[((i * HB_CONTACT_K + c) * HB_CONTACT + 4) * 32];
-                                if (!(one[4] >= (T)0)) break; /* the unused slots are the last */
-                                const int fr = m.world.col_frame[(int)one[4]];
+                                const T at = plane_index(ps, i, c);
+                                if (!(at >= (T)0)) break; /* the unused slots are the last */
+                                const int fr = m.world.col_frame[(int)at];
                                 if (!((fr == HB_FRAME_HEAD && m.world.motion) || (fr == HB_FRAME_BODY && m.world.sway)))
                                     continue;
+                                T one[HB_CONTACT];
                                 plane_load(ps, i, c, one);
                                 contact_carry(m.world, back, one);
                                 plane_store(ps, i, c, one);
