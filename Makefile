@@ -222,7 +222,8 @@ cuda: $(CUDA_BINS) $(BUILD)/sdf-sampling
 # sources that hold the dynamic model's kernel tables once per precision (-DHB_DYN_REAL), which
 # halves the longest compile. Only backend_cuda.cu takes the build's flags string.
 CUDA_MODES := normal strict fastmath
-CUDA_SPLIT := dynamic/kernels dynamic/lanes
+CUDA_SPLIT := dynamic/kernels dynamic/lanes dynamic/lanes_grid dynamic/lanes_colliders dynamic/lanes_planes \
+              dynamic/lanes_world_xpbd dynamic/lanes_world_ftl
 CUDA_UNITS := $(filter-out $(CUDA_SPLIT) hostcheck/%,$(CUDA_SRC:cuda/%.cu=%)) $(foreach s,$(CUDA_SPLIT),$(s)-f32 $(s)-f64)
 define CUDA_MODE_RULES
 CUDA_OBJ_$(1) := $$(CUDA_UNITS:%=$$(OBJ)/cuda-$(1)/%.o)

@@ -542,14 +542,16 @@ HB_HD void SFX(hb_contact_carry)(const WORLD *w, const REAL *back, REAL *con)
 
 /* §3.17 --contact-planes: the point's plane on p, as a plane collider: the depth δ = d − n·p > 0
  * (bounded: δ₀ = d − n·y of the substep's start carried, hb_carry), p ← p + m·n, then the collider's
- * friction. x: the point at the substep's start; back: the substep's back-transforms. */
+ * friction. x: the point at the substep's start; back: the substep's back-transforms. The collider's
+ * frame and friction are looked up only for a plane that p is behind: most planes a point keeps
+ * are not met in an iteration (docs/cuda.md "Contact planes in the lanes kernel"). */
 HB_HD void SFX(hb_contact_one)(const WORLD *w, const REAL *con, const REAL *back, REAL *p, const REAL *x)
 {
     if (!(con[4] >= (REAL)0)) return;
-    const int i = (int)con[4], frame = w->col_frame[i];
-    const int turn = frame == HB_FRAME_HEAD && w->motion, sway = frame == HB_FRAME_BODY && w->sway;
     const REAL d = con[3] - ((con[0] * p[0] + con[1] * p[1]) + con[2] * p[2]);
     if (!(d > (REAL)0)) return;
+    const int i = (int)con[4], frame = w->col_frame[i];
+    const int turn = frame == HB_FRAME_HEAD && w->motion, sway = frame == HB_FRAME_BODY && w->sway;
     REAL m = d;
     if (w->bounded) {
         REAL y[3];
@@ -567,7 +569,7 @@ HB_HD void SFX(hb_contact_one)(const WORLD *w, const REAL *con, const REAL *back
  * is the collision step as it was before sweeps, the same operations. pose: collider i's at
  * pose + i·HB_COL_POSE; back: the substep's back-transforms. The C reference (dynamics_impl.h)
  * and the SIMD backend (dynamics_simd_impl.h) call this; the CUDA port's lanes kernel takes the
- * same steps a warp at a time (cuda/dynamic/lanes.cu collide_points). con: the point's contact plane
+ * same steps a warp at a time (cuda/dynamic/lanes_kernel.cuh collide_points). con: the point's contact plane
  * (--contact-planes), met in place of the colliders; NULL: every collider (the reference's default). */
 HB_HD_INLINE void SFX(hb_collide_sweeps)(const WORLD *w, REAL rc, int head, const REAL *pose, const REAL *back, REAL *p,
                                          const REAL *x, const REAL *con)

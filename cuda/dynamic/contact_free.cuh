@@ -2,7 +2,7 @@
  * and fast-math builds' free arithmetic (docs/cuda.md "Builds and arithmetic"): the operations of
  * c_ref/dynamic/contact_impl.h with each square root and division replaced by a reciprocal
  * square root (rsq) or a product, and a length below floor_of<T>() taken as zero. Judged by the
- * one-frame rule; the strict build calls contact_impl.h itself. Included by lanes.cu after its
+ * one-frame rule; the strict build calls contact_impl.h itself. Included by lanes_kernel.cuh after its
  * rsq, floor_of and fdiv, inside its namespace. */
 #ifndef HB_DYN_CONTACT_FREE_CUH
 #define HB_DYN_CONTACT_FREE_CUH
@@ -131,7 +131,7 @@ __device__ __forceinline__ T start_depth_free(const Wd &w, int i, int kind, bool
 }
 
 /* Collider i of the world w on p (hb_collide_one) inside its bounding sphere (the caller tests
- * it: lanes.cu col_in_bound); x: p at the start of the substep. */
+ * it: lanes_kernel.cuh col_in_bound); x: p at the start of the substep. */
 template <typename T, class Wd>
 __device__ __forceinline__ void collide_one_free(const Wd &w, int i, const T *pose, const T *back, T (&p)[3],
                                                  const T *x)

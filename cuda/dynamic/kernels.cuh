@@ -121,7 +121,7 @@ template <typename T>
 cudaError_t launch_frame_warpreg(const DModel<T> &m, const T *q, const T *phase, T *x, T *v, const T *rest,
                                  const T *bend_rest, int64_t N, int grid, int block, cudaStream_t stream,
                                  const int64_t *map = nullptr, int64_t n_run = 0);
-/* The lanes variant (cuda/dynamic/lanes.cu): L lanes a strand, G consecutive points a lane in
+/* The lanes variant (cuda/dynamic/lanes.cu; its kernel lanes_kernel.cuh): L lanes a strand, G consecutive points a lane in
  * registers (xpbd: L = 16, G = 2, 4, 8; ftl: fewer lanes with more points), P ≤
  * kLanesMaxPoints; x, v, rest canonical [N][P][3], bend_rest [N][P−2]; dynamic shared memory a
  * block (a warp's strands staged for coalesced loads and stores, their rest shape, and with the
