@@ -103,7 +103,10 @@ CUDA_HDR  := $(wildcard cuda/*.cuh cuda/*/*.cuh)
 comma := ,
 NVCC_ARCH = $(if $(word 2,$(CUDA_ARCH)),$(foreach a,$(CUDA_ARCH),-gencode arch=compute_$(a:sm_%=%)$(comma)code=$(a)) \
               -gencode arch=compute_$(lastword $(CUDA_ARCH:sm_%=%))$(comma)code=compute_$(lastword $(CUDA_ARCH:sm_%=%)),-arch=$(CUDA_ARCH))
-NVCC_BASE = $(NVCC_ARCH) -O3 -std=c++17 -Ic_ref -lineinfo -Xcompiler -Wall
+# -Xfatbin -compress-all: every object's device code compressed in the binary; by default nvcc left the lanes
+# kernel's split objects uncompressed (the normal binary 80 MB against 30 before the split; lanes_grid's fp32
+# object 3.4 MB against 0.83 compressed). The code itself is the same.
+NVCC_BASE = $(NVCC_ARCH) -O3 -std=c++17 -Ic_ref -lineinfo -Xcompiler -Wall -Xfatbin -compress-all
 NVCC_MODE_normal   :=
 NVCC_MODE_strict   := --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -DHB_REFERENCE_ARITHMETIC=1
 NVCC_MODE_fastmath := --use_fast_math
