@@ -20,13 +20,7 @@ template <typename T, int G, int L, bool Ftl> LanesFn<T> lanes_grid_kernel(unsig
 }
 
 #define HB_LANES_KIND(T, G, L, Ftl) template LanesFn<T> lanes_grid_kernel<T, G, L, Ftl>(unsigned, int);
-/* the Makefile compiles this file once per precision (-DHB_DYN_REAL), side by side */
-#ifdef HB_DYN_REAL
-HB_LANES_LAYOUTS(HB_LANES_KIND, HB_DYN_REAL)
-#else
-HB_LANES_LAYOUTS(HB_LANES_KIND, float)
-HB_LANES_LAYOUTS(HB_LANES_KIND, double)
-#endif
+HB_LANES_INSTANCES(HB_LANES_LAYOUTS, HB_LANES_KIND)
 #undef HB_LANES_KIND
 
 } /* namespace dyn */

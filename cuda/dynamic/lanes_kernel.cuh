@@ -1003,7 +1003,7 @@ using LanesFn = void (*)(DModel<T>, const T *, const T *, T *, T *, const T *, c
 /* The kernels with the world's code (W ≠ 0) of layout (G, L, Ftl), each kind compiled in an object of
  * its own so that make -j compiles them side by side: the grid's (kWHeld, kWGather; wk) in
  * lanes_grid.cu, the colliders' (kWCol) in lanes_colliders.cu, the contact planes' (kWCol | kWPlanes)
- * in lanes_planes.cu and all of the world's (kWAll; seg: a groom's) in lanes_world_xpbd.cu and
+ * in lanes_planes.cu and all of the world's (kWAll; seg: a groom's; lanes_world.cuh) in lanes_world_xpbd.cu and
  * lanes_world_ftl.cu, a solver's layouts each. f: the feature mask. */
 template <typename T, int G, int L, bool Ftl> LanesFn<T> lanes_grid_kernel(unsigned f, int wk);
 template <typename T, int G, int L, bool Ftl> LanesFn<T> lanes_colliders_kernel(unsigned f);
@@ -1020,6 +1020,13 @@ template <typename T, int G, int L, bool Ftl> LanesFn<T> lanes_world_kernel(bool
     X(T, 4, 16, false)                                                                                                 \
     X(T, 8, 16, false)
 #define HB_LANES_LAYOUTS(X, T) HB_LANES_LAYOUTS_FTL(X, T) HB_LANES_LAYOUTS_XPBD(X, T)
+/* X(T, G, L, Ftl) for each layout of LAYOUTS in the precision(s) of this object: the Makefile compiles each
+ * kind's file once per precision (-DHB_DYN_REAL), side by side */
+#ifdef HB_DYN_REAL
+#define HB_LANES_INSTANCES(LAYOUTS, X) LAYOUTS(X, HB_DYN_REAL)
+#else
+#define HB_LANES_INSTANCES(LAYOUTS, X) LAYOUTS(X, float) LAYOUTS(X, double)
+#endif
 
 } /* namespace dyn */
 } /* namespace hb */
