@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <climits>
+#include <cstdint>
 #include <type_traits>
 
 namespace hb {
@@ -35,10 +36,11 @@ template <> struct Splat<double> {
  * strands (the order perm; nullptr: as stored); each warp takes its strands one at a time, a lane
  * a point, so that every load of x and v coalesces. Pass 1 finds the block's box of cells. Where
  * no node can receive more than 2^16 shares, pass 2 adds each point's fixed-point shares in shared
- * memory, each 64-bit share split into its low 16 bits and the rest, both summed by native 32-bit
- * shared atomics (exact: see kSplatWindowPoints): in a window over the box where its nodes fit,
- * else in a hash table of the nodes the block touches; then one 64-bit global atomic a touched
- * node and channel. A share whose node finds no slot, or a block past the share bound, adds to the
+ * memory by native 32-bit shared atomics (exact: see kSplatWindowPoints): a mass share in one word
+ * with the carries out of it counted in another, a momentum share in one signed word where the
+ * block's speeds bound its sums, else split into its low 16 bits and the rest; in a window over
+ * the box where its nodes fit, else in a hash table of the nodes the block touches; then one
+ * 64-bit global atomic a touched node and channel. A share whose node finds no slot, or a block past the share bound, adds to the
  * grid directly. Integer sums: no order changes a bit. */
 #ifndef HB_SPLAT_STRANDS
 #define HB_SPLAT_STRANDS 64
@@ -50,9 +52,9 @@ constexpr int kSplatStrands = HB_SPLAT_STRANDS, kSplatWarps = 8; /* strands a bl
 /* blocks an SM holds (fp32: 48 registers, as its shared memory allows; fp64: as many as it needs) */
 template <typename T> constexpr int kSplatMinBlocks = sizeof(T) == 4 ? 5 : 1;
 constexpr int kWindow = HB_SPLAT_WINDOW; /* nodes: 2 × 32 bits × 4 channels each (32 KB at 1024) */
-/* the word (channel c: mass, p_x, p_y, p_z; part: low, high) of node or slot i in arrays of S
- * words: each of the eight (channel, part) arrays whole, so that a warp's lanes at different nodes
- * use different banks */
+/* the word (channel c: mass, p_x, p_y, p_z; part: low, high — for mass: the sum modulo 2^32, its
+ * carries) of node or slot i in arrays of S words: each of the eight (channel, part) arrays whole,
+ * so that a warp's lanes at different nodes use different banks */
 template <int S> __device__ __forceinline__ int word_at(int c, int part, int i)
 {
     return (2 * c + part) * S + i;
@@ -78,8 +80,9 @@ __device__ __forceinline__ int hash_slot(unsigned *keys, unsigned node)
     }
     return -1;
 }
-/* At most this many shares reach a window node (one a point): their low parts (< 2^16 each) sum
- * below 2^32 and their high parts (|x| ≤ 2^30, so |x >> 16| ≤ 2^14) within ±2^31. */
+/* At most this many shares reach a window node (one a point): a momentum share's low parts
+ * (< 2^16 each) sum below 2^32 and its high parts (|x| ≤ 2^30, so |x >> 16| ≤ 2^14) within ±2^31;
+ * the mass shares (≤ 2^24 each) carry at most 2^16·2^24/2^32 = 256 times out of their word. */
 constexpr int64_t kSplatWindowPoints = 65536;
 
 /* contact_impl.h's cell and weights of a point by precision: the cell's coordinates come whole, so
@@ -122,12 +125,19 @@ template <int S> __device__ __forceinline__ void words_add(unsigned *win, int c,
     atomicAdd(win + word_at<S>(c, 0, i), (unsigned)x & 0xffffu);
     atomicAdd(reinterpret_cast<int *>(win) + word_at<S>(c, 1, i), x >> 16);
 }
+/* a mass share sm (0 ≤ sm ≤ 2^24) into node or slot i: one word summed modulo 2^32, and the
+ * carries out of it counted in the other (each add wraps at most once; rare) */
+template <int S> __device__ __forceinline__ void mass_add(unsigned *win, int i, int sm)
+{
+    const unsigned was = atomicAdd(win + word_at<S>(0, 0, i), (unsigned)sm);
+    if (was + (unsigned)sm < was) atomicAdd(win + word_at<S>(0, 1, i), 1u);
+}
 /* a corner's mass share sm and momentum shares sp into node or slot i (`single`: a momentum
  * share in one signed word) */
 template <int S>
 __device__ __forceinline__ void corner_add(unsigned *win, int i, int sm, const int (&sp)[3], bool single)
 {
-    words_add<S>(win, 0, i, sm);
+    mass_add<S>(win, i, sm);
     if (single)
         for (int c = 0; c < 3; c++) atomicAdd(reinterpret_cast<int *>(win) + word_at<S>(1 + c, 0, i), sp[c]);
     else
@@ -139,8 +149,9 @@ template <int S> __device__ __forceinline__ bool corner_sums(const unsigned *win
     const int *wi = reinterpret_cast<const int *>(win);
     bool any = false;
     for (int c = 0; c < 4; c++) {
-        sum[c] = single && c > 0 ? (int64_t)wi[word_at<S>(c, 0, i)]
-                                 : (int64_t)wi[word_at<S>(c, 1, i)] * 65536 + (int64_t)win[word_at<S>(c, 0, i)];
+        sum[c] = c == 0   ? (int64_t)win[word_at<S>(0, 1, i)] * 4294967296 + (int64_t)win[word_at<S>(0, 0, i)]
+                 : single ? (int64_t)wi[word_at<S>(c, 0, i)]
+                          : (int64_t)wi[word_at<S>(c, 1, i)] * 65536 + (int64_t)win[word_at<S>(c, 0, i)];
         any |= sum[c] != 0;
     }
     return any;
@@ -202,8 +213,12 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     __syncthreads();
     if (hi[0] < 0) return; /* no point of the block in the grid */
     const int ex = hi[0] - lo[0] + 1, ey = hi[1] - lo[1] + 1, ez = hi[2] - lo[2] + 1;
+    /* the window's strides (y, z), both odd so that points a row or a plane apart (a hanging strand's
+     * neighbours) meet in different banks, and its nodes, padding included */
+    const int64_t sy64 = ex | 1, sz64 = (sy64 * ey) | 1;
     const bool bounded = (int64_t)ns * P <= kSplatWindowPoints;
-    const bool windowed = bounded && (int64_t)ex * ey * ez <= kWindow, hashed = bounded && !windowed;
+    const bool windowed = bounded && sz64 * ez <= kWindow, hashed = bounded && !windowed;
+    const int sy = (int)sy64, sz = (int)sz64, nw = windowed ? sz * ez : 0;
     unsigned *const keys = win, *const slots = win + kHashSlots;
     /* `single`: a momentum share is |rint(w·v·2^10)| ≤ |v|·2^10 + 1 (w ≤ 1) and a node takes at
      * most one a point, so while ns·P·(vmax·2^10 + 1) < 2^31 the block's momentum sums fit one
@@ -211,7 +226,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     const bool single =
         bounded && (double)ns * P * ((double)__int_as_float(vmax) * HB_GRID_MOM_SCALE + 1.0) < 2147483647.0;
     if (windowed)
-        for (int i = threadIdx.x; i < ex * ey * ez; i += blockDim.x)
+        for (int i = threadIdx.x; i < nw; i += blockDim.x)
             for (int a = 0; a < 8; a++)
                 if (!single || a < 2 || (a & 1) == 0) win[a * kWindow + i] = 0u;
     if (hashed)
@@ -243,7 +258,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
                     vs[c] = (vp[c] < -lim ? -lim : vp[c] > lim ? lim : vp[c]) * (T)HB_GRID_MOM_SCALE;
                 }
                 /* the cell's lowest corner: its window node (32-bit: the window holds ≤ kWindow nodes), its node */
-                const int wb = ((int)cb[0] - lo[0]) + ex * (((int)cb[1] - lo[1]) + ey * ((int)cb[2] - lo[2]));
+                const int wb = ((int)cb[0] - lo[0]) + sy * ((int)cb[1] - lo[1]) + sz * ((int)cb[2] - lo[2]);
                 const int64_t b = cb[0] + n * (cb[1] + n * cb[2]);
 #pragma unroll
                 for (int c8 = 0; c8 < 8; c8++) {
@@ -251,7 +266,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
                     const int sm = share_of(wt[c8] * (T)HB_GRID_MASS_SCALE);
                     for (int c = 0; c < 3; c++) sp[c] = share_of(wt[c8] * vs[c]);
                     if (Fast || windowed) {
-                        const int i = wb + ((c8 & 1) ? 1 : 0) + ((c8 & 2) ? ex : 0) + ((c8 & 4) ? ex * ey : 0);
+                        const int i = wb + ((c8 & 1) ? 1 : 0) + ((c8 & 2) ? sy : 0) + ((c8 & 4) ? sz : 0);
                         corner_add<kWindow>(win, i, sm, sp, Fast || single);
                         continue;
                     }
@@ -274,9 +289,9 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     __syncthreads();
     int64_t sum[4];
     if (windowed)
-        for (int i = threadIdx.x; i < ex * ey * ez; i += blockDim.x) {
-            if (!corner_sums<kWindow>(win, i, single, sum)) continue;
-            const int jx = i % ex + lo[0], jy = (i / ex) % ey + lo[1], jz = i / (ex * ey) + lo[2];
+        for (int i = threadIdx.x; i < nw; i += blockDim.x) {
+            if (!corner_sums<kWindow>(win, i, single, sum)) continue; /* padding: never added to */
+            const int jz = i / sz + lo[2], jy = i % sz / sy + lo[1], jx = i % sz % sy + lo[0];
             node_flush(jx + n * (jy + n * (int64_t)jz), sum, mass, mom);
         }
     else
@@ -324,7 +339,30 @@ __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
         ho[t] = (st * P + k0) * R;
     }
     __syncthreads();
-    { /* the positions: every load in flight at once, then into shared memory */
+    /* fp32 where every strand's run starts on 16 bytes (P a multiple of 4, the arrays aligned): the
+     * positions come in and the samples go out four reals an instruction */
+    bool vec = false;
+    if constexpr (sizeof(T) == 4) {
+        vec = (P & 3) == 0 && ((reinterpret_cast<uintptr_t>(x) | reinterpret_cast<uintptr_t>(held)) & 15) == 0;
+        if (vec) { /* a strand's run: 3·NB/4 float4 (nk is then a multiple of 4: whole float4s) */
+            constexpr int RX = 3 * NB / 4, NX4 = NX / 4, Q = (NX4 + NT - 1) / NT;
+            float4 xr[Q];
+#pragma unroll
+            for (int q = 0; q < Q; q++) {
+                const int i = t + q * NT, u = i / RX, r = i % RX;
+                if (i < NX4 && u < ns && 4 * r < 3 * nk) xr[q] = *reinterpret_cast<const float4 *>(x + xo[u] + 4 * r);
+            }
+#pragma unroll
+            for (int q = 0; q < Q; q++) {
+                const int i = t + q * NT, u = i / RX, r = i % RX;
+                if (i < NX4 && u < ns && 4 * r < 3 * nk) {
+                    T *d = xs + u * XW + 4 * r;
+                    d[0] = xr[q].x, d[1] = xr[q].y, d[2] = xr[q].z, d[3] = xr[q].w;
+                }
+            }
+        }
+    }
+    if (!vec) { /* the positions: every load in flight at once, then into shared memory */
         T xr[(NX + NT - 1) / NT];
 #pragma unroll
         for (int q = 0; q < (NX + NT - 1) / NT; q++) {
@@ -355,6 +393,20 @@ __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
         }
     }
     __syncthreads();
+    if constexpr (sizeof(T) == 4) {
+        if (vec) { /* a strand's run: R·NB/4 float4 */
+            constexpr int RH = R * NB / 4, NH4 = NH / 4;
+#pragma unroll
+            for (int q = 0; q < (NH4 + NT - 1) / NT; q++) {
+                const int i = t + q * NT, v = i / RH, r = i % RH;
+                if (i < NH4 && v < ns && 4 * r < R * nk) {
+                    const T *c = hs + v * HW + 4 * r;
+                    *reinterpret_cast<float4 *>(held + ho[v] + 4 * r) = make_float4(c[0], c[1], c[2], c[3]);
+                }
+            }
+            return;
+        }
+    }
 #pragma unroll
     for (int q = 0; q < (NH + NT - 1) / NT; q++) {
         const int i = t + q * NT, v = i / (R * NB), r = i % (R * NB);

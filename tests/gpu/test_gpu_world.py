@@ -213,7 +213,7 @@ def input_positions(cpu):
 
 
 # A window node's mass sum past 32 bits (docs/cuda.md "The hair–hair grid": a mass share is summed
-# in two 32-bit shared words, its low 16 bits and the rest, and joined into 64 bits). One cell whose
+# in one 32-bit shared word, the carries out of it counted in another, joined into 64 bits). One cell whose
 # low corner sits at the hair, so every point's weight at node 0 is above 0.7 and a splat block of at
 # least 8 strands of 64 points (the fewest a block takes) adds more than 2^32 there. The strict build bit for bit.
 CARRY = ["--strands", "300", "--points", "64", "--substeps", "4", "--iterations", "2", "--bend-compliance", "1e-6",
