@@ -410,6 +410,8 @@ static uint64_t simd_dyn_bytes(const cpu_impl *c, uint64_t one, int need_save)
     if (c->scene.dyn.per_segment)
         hb_mul3_u64((uint64_t)c->stride, (uint64_t)(c->scene.points - 1), 2u * hb_real_size(c->scene.precision) + 8u,
                     &seg);
+    if (c->scene.dyn.planes_declared) /* §3.17 the points' contact planes, [P][block][HB_CONTACT_POINT] a block */
+        seg = hb_add_sat(seg, hb_mul_sat(one, HB_CONTACT_POINT));
     return hb_add_sat(hb_add_sat(hb_mul_sat(hb_mul_sat(one, 3u), need_save ? 3u : 2u), bend), seg);
 }
 
@@ -424,6 +426,7 @@ static int simd_dyn_setup(cpu_impl *c, int need_save, uint64_t need, char *err, 
         bad |= !c->pv[d] || !c->pr[d] || (need_save && !c->pv_saved[d]);
     }
     c->pb = pm_alloc((size_t)rows * (size_t)c->stride * hb_real_size(c->scene.precision));
+    if (c->scene.dyn.planes_declared) bad |= !(c->contacts = malloc(c->pm_bytes * HB_CONTACT_POINT));
     if (c->scene.dyn.per_segment) {
         const size_t nseg = (size_t)c->scene.n_strands * (size_t)(c->scene.points - 1),
                      rs = hb_real_size(c->scene.precision);
@@ -515,8 +518,9 @@ static int dyn_frame_result(hb_stage_result *r, double t0, int failed, const cha
                 _Pragma("omp for schedule(static)") for (int64_t b = 0; b < nb; b++)                                   \
                 {                                                                                                      \
                     const int64_t o = b * DB;                                                                          \
+                    T *con = c->contacts ? (T *)c->contacts + (size_t)o * (size_t)P * HB_CONTACT_POINT : NULL;         \
                     c->sd->frame_##SFX(M, f, W, j0, j1, X + o, Y + o, Z + o, VX + o, VY + o, VZ + o, RX + o, RY + o,   \
-                                       RZ + o, BR + o, SR ? SR + o : NULL, S, scratch);                                \
+                                       RZ + o, BR + o, SR ? SR + o : NULL, S, scratch, con);                           \
                 }                                                                                                      \
                 free(scratch);                                                                                         \
             }                                                                                                          \
@@ -1055,7 +1059,7 @@ static const hb_variant cpu_variants[] = {
     {"simd", CPU_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "point-major structure of arrays, one strand per SIMD lane, OpenMP over blocks; built for x86-64-v3 and "
      "x86-64-v4, the CPU's widest runs (the record's flags say which)",
-     0, 0, 0, 1, HB_X_GUIDES | HB_X_PLANES},
+     0, 0, 0, 1, HB_X_GUIDES},
     {NULL, 0, NULL, 0, 0, 0, 0, 0},
 };
 

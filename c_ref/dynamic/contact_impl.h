@@ -515,10 +515,10 @@ HB_HD void SFX(hb_contact_find)(const WORLD *w, const REAL *pose, const REAL *x,
             at[t] = at[t - 1], at[t - 1] = a;
         }
     for (int s = 0; s < HB_CONTACT_K; s++) {
-        REAL *c = con + HB_CONTACT * s, rho, n[3];
+        REAL *c = con + HB_CONTACT * s, rho = (REAL)0, n[3] = {(REAL)0, (REAL)0, (REAL)0};
         c[4] = (REAL)at[s];
         if (at[s] < 0) continue;
-        SFX(hb_contact_distance)(w, at[s], pose + (size_t)at[s] * HB_COL_POSE, x, &rho, n);
+        SFX(hb_contact_distance)(w, at[s], pose + (size_t)at[s] * HB_COL_POSE, x, &rho, n); /* found above */
         for (int k = 0; k < 3; k++) c[k] = n[k];
         c[3] = ((n[0] * x[0] + n[1] * x[1]) + n[2] * x[2]) - rho;
     }

@@ -59,15 +59,16 @@ void hb_simd_dyn_bend_rest_block_f64(const hb_dyn_model_f64 *m, const double *RX
  * before each); w: the grid and colliders (docs/model.md §3.16, §3.17), NULL without them; SR: a
  * groom's stretch rest lengths ℓ_k as rows [P−1][stride] (docs/model.md §3.15), NULL for
  * ℓ = L/(P−1). All pointers point at the block's first strand in row 0 and are 64-byte aligned;
- * scratch holds hb_simd_dyn_scratch_reals(P) reals. */
+ * scratch holds hb_simd_dyn_scratch_reals(P) reals; con: the block's contact planes
+ * [P][block][HB_CONTACT_POINT] with --contact-planes (kept between the calls of a frame), else NULL. */
 void hb_simd_dyn_frame_block_f32(const hb_dyn_model_f32 *m, const hb_dyn_frame *f, const hb_dyn_world_f32 *w,
                                  int64_t j0, int64_t j1, float *X, float *Y, float *Z, float *VX, float *VY, float *VZ,
                                  const float *RX, const float *RY, const float *RZ, const float *BR, const float *SR,
-                                 int64_t stride, float *scratch);
+                                 int64_t stride, float *scratch, float *con);
 void hb_simd_dyn_frame_block_f64(const hb_dyn_model_f64 *m, const hb_dyn_frame *f, const hb_dyn_world_f64 *w,
                                  int64_t j0, int64_t j1, double *X, double *Y, double *Z, double *VX, double *VY,
                                  double *VZ, const double *RX, const double *RY, const double *RZ, const double *BR,
-                                 const double *SR, int64_t stride, double *scratch);
+                                 const double *SR, int64_t stride, double *scratch, double *con);
 
 /* The per-strand observables (docs/model.md §3.8) of `count` consecutive strands starting
  * at lane `first` (any alignment), into out[0 … count−1]: each strand's partial is the
@@ -87,10 +88,10 @@ typedef struct {
     void (*bend_rest_f64)(const hb_dyn_model_f64 *, const double *, const double *, const double *, double *, int64_t);
     void (*frame_f32)(const hb_dyn_model_f32 *, const hb_dyn_frame *, const hb_dyn_world_f32 *, int64_t, int64_t,
                       float *, float *, float *, float *, float *, float *, const float *, const float *, const float *,
-                      const float *, const float *, int64_t, float *);
+                      const float *, const float *, int64_t, float *, float *);
     void (*frame_f64)(const hb_dyn_model_f64 *, const hb_dyn_frame *, const hb_dyn_world_f64 *, int64_t, int64_t,
                       double *, double *, double *, double *, double *, double *, const double *, const double *,
-                      const double *, const double *, const double *, int64_t, double *);
+                      const double *, const double *, const double *, int64_t, double *, double *);
     void (*observe_f32)(const hb_scene *, const hb_dyn_world_f32 *, const float *, const float *, const float *,
                         const float *, const float *, const float *, const float *, int64_t, int64_t, int64_t,
                         const double *, hb_obs_partial *);

@@ -28,6 +28,8 @@
 #define ROWP(a, k) ((a) + (int64_t)(k)*stride)
 #define SROW(r) HB_ASSUME_ALIGNED(scratch + (int64_t)(r)*DB)
 #define AL(p) HB_ASSUME_ALIGNED(p)
+/* row k of a block's contact planes [P][DB][HB_CONTACT_POINT] (NULL without --contact-planes) */
+#define CON_ROW(c, k) ((c) ? (c) + (int64_t)(k)*DB * HB_CONTACT_POINT : NULL)
 #define TMP(m, i) SROW(6 * (m)->points + 3 + (i))    /* 0: |e|², 1: 1/|e|, 2–4: e */
 #define HS_ROW(m, k) (6 * (m)->points + 8 + 8 * (k)) /* §3.16 `held`: point k's sample, 8 rows */
 
@@ -143,14 +145,16 @@ HB_ALWAYS_INLINE void SFX(collide_lanes)(const DMODEL *m, REAL *scratch, const i
 /* §3.6 step 7 / §3.7 with the colliders of §3.17 on row k (≥ 1) of p, lane by lane: the
  * reference's collision step itself (contact_impl.h hb_collide_sweeps: the head sphere as `head`
  * says, HB_HEAD_NONE where collide_lanes projected it already, then each collider with its
- * friction, in sweeps); x: the row at the substep's start. */
+ * friction, in sweeps, or the row's contact planes con, NULL without --contact-planes); x: the row
+ * at the substep's start. */
 HB_ALWAYS_INLINE void SFX(world_row)(const WORLD *w, const REAL *pose, const REAL *back, const REAL rc, const int head,
-                                     REAL *px, REAL *py, REAL *pz, const REAL *x, const REAL *y, const REAL *z)
+                                     REAL *px, REAL *py, REAL *pz, const REAL *x, const REAL *y, const REAL *z,
+                                     const REAL *con)
 {
     for (int l = 0; l < DB; l++) {
         REAL p[3] = {px[l], py[l], pz[l]};
         const REAL xs[3] = {x[l], y[l], z[l]};
-        SFX(hb_collide_sweeps)(w, rc, head, pose, back, p, xs, NULL);
+        SFX(hb_collide_sweeps)(w, rc, head, pose, back, p, xs, con ? con + HB_CONTACT_POINT * l : NULL);
         px[l] = p[0];
         py[l] = p[1];
         pz[l] = p[2];
@@ -387,7 +391,7 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
                                      REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY,
                                      const REAL *RZ, const REAL *BR, const REAL *SR, const int64_t stride,
                                      REAL *scratch, const WORLD *wc, const REAL *pose, const REAL *back,
-                                     const unsigned F)
+                                     const REAL *con, const unsigned F)
 {
     /* §3.17 (wc: the colliders, or the head sphere's friction or bounded depenetration): the head
      * sphere's plain projection stays collide_lanes' where the world does not take it, and where
@@ -423,7 +427,7 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
                 if (wc) {
                     const REAL *xr = AL(ROWP(X, k)), *yr = AL(ROWP(Y, k)), *zr = AL(ROWP(Z, k));
                     REAL *qx = SROW(3 * k), *qy = SROW(3 * k + 1), *qz = SROW(3 * k + 2);
-                    SFX(world_row)(wc, pose, back, K->rc, head, qx, qy, qz, xr, yr, zr);
+                    SFX(world_row)(wc, pose, back, K->rc, head, qx, qy, qz, xr, yr, zr, CON_ROW(con, k));
                 }
             }
         }
@@ -467,7 +471,7 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
         if (plain) SFX(collide_lanes)(m, scratch, k, K);
         if (wc) {
             const REAL *xr = AL(ROWP(X, k)), *yr = AL(ROWP(Y, k)), *zr = AL(ROWP(Z, k));
-            SFX(world_row)(wc, pose, back, K->rc, head, px, py, pz, xr, yr, zr);
+            SFX(world_row)(wc, pose, back, K->rc, head, px, py, pz, xr, yr, zr, CON_ROW(con, k));
         }
         if (k >= 2) SFX(update_row)(K, scratch, X, Y, Z, VX, VY, VZ, stride, k - 1, dx, dy, dz);
     }
@@ -506,12 +510,13 @@ static void SFX(vel_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_const
 static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_consts) * K, const REAL *q, REAL *X, REAL *Y,
                               REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX, const REAL *RY, const REAL *RZ,
                               const REAL *BR, const REAL *SR, const int64_t stride, REAL *scratch, const WORLD *wc,
-                              const REAL *pose, const REAL *back)
+                              const REAL *pose, const REAL *back, const REAL *con)
 {
 #define CCASE(i)                                                                                                       \
     case (i):                                                                                                          \
         if (((i)&8) && !((i)&2)) break; /* motion matters here only through shape */                                   \
-        SFX(con_phase)(m, K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch, wc, pose, back, CON_F(i));   \
+        SFX(con_phase)                                                                                                 \
+        (m, K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch, wc, pose, back, con, CON_F(i));            \
         break;
     switch (idx) {
         CASE16(CCASE)
@@ -523,7 +528,7 @@ static void SFX(con_dispatch)(unsigned idx, const DMODEL *m, const SFX(dyn_const
 void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, const WORLD *w, int64_t j0, int64_t j1,
                                   REAL *X, REAL *Y, REAL *Z, REAL *VX, REAL *VY, REAL *VZ, const REAL *RX,
                                   const REAL *RY, const REAL *RZ, const REAL *BR, const REAL *SR, int64_t stride,
-                                  REAL *scratch)
+                                  REAL *scratch, REAL *con)
 {
     const unsigned F = m->features;
     const unsigned vi = ((F & HB_F_WIND) ? 1u : 0u) | ((F & HB_F_WIND) && (F & HB_F_GUST) ? 2u : 0u) |
@@ -558,10 +563,23 @@ void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, const
         const REAL *qg = !(F & HB_F_MOTION)                                     ? NULL
                          : (wg && wg->grid_rebuild == HB_GRID_SUBSTEP && j > 0) ? QTABLE(fr) + 9 * (j - 1)
                                                                                 : QSTART(fr);
-        SFX(vel_dispatch)(vi, m, &K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, wg, qg, j, last);
         const REAL *pose = wc ? POSES(fr) + (size_t)j * (size_t)(wc->ncol > 0 ? wc->ncol : 1) * HB_COL_POSE : NULL;
         const REAL *back = wc ? BACKS(fr) + HB_COL_BACK * j : NULL;
-        SFX(con_dispatch)(ci, m, &K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch, wc, pose, back);
+        /* §3.17 --contact-planes: each point's planes found from x at the frame's first substep,
+         * carried with their colliders at the others (dynamics_impl.h frame_body) */
+        if (con && wc)
+            for (int64_t k = 1; k < m->points; k++)
+                for (int l = 0; l < DB; l++) {
+                    REAL *cp = CON_ROW(con, k) + HB_CONTACT_POINT * l;
+                    if (j == 0) {
+                        const REAL xs[3] = {ROWP(X, k)[l], ROWP(Y, k)[l], ROWP(Z, k)[l]};
+                        SFX(hb_contact_find)(wc, pose, xs, cp);
+                    } else {
+                        for (int s = 0; s < HB_CONTACT_K; s++) SFX(hb_contact_carry)(wc, back, cp + HB_CONTACT * s);
+                    }
+                }
+        SFX(vel_dispatch)(vi, m, &K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, wg, qg, j, last);
+        SFX(con_dispatch)(ci, m, &K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch, wc, pose, back, con);
     }
 }
 
@@ -659,6 +677,7 @@ void SFX(hb_simd_dyn_observe)(const hb_scene *s, const WORLD *w, const REAL *pos
 #undef HB_ALWAYS_INLINE
 #undef DB
 #undef ROWP
+#undef CON_ROW
 #undef SROW
 #undef AL
 #undef TMP

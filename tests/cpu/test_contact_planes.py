@@ -12,8 +12,8 @@ known answers, with the free particles of test_colliders.py.
 - a plane carried with its collider through the frame: a particle on a rising body floor rides it,
   one on a turning head-frame floor stays on it, and one with a large μ_s on a head-frame sphere
   turns with the head;
-- the bits do not depend on the thread count, a resumed run continues bit for bit, and what cannot
-  run it is refused in one line.
+- the bits do not depend on the thread count, a resumed run continues bit for bit, and a bad margin
+  or a margin without colliders is refused in one line (simd runs the planes: test_cpu_simd_dynamic.py).
 """
 
 import numpy as np
@@ -196,10 +196,9 @@ def test_ftl_hair_sliding_off_a_plane_passes_the_dynamic_checks(cpu_bin, tmp_pat
     [
         (["--contact-planes", "2"], "--contact-planes needs --colliders"),
         (["--colliders", "C", "--contact-planes", "0"], "--contact-planes must be > 0"),
-        (["--colliders", "C", "--contact-planes", "2", "--variant", "simd"], "does not run --contact-planes"),
     ],
 )
-def test_what_cannot_run_planes_is_refused_in_one_line(cpu_bin, tmp_path, args, message):
+def test_bad_contact_planes_are_refused_in_one_line(cpu_bin, tmp_path, args, message):
     cols = tmp_path / "c.txt"
     cols.write_text("sphere head 0 -12 0 3\n")
     out = tmp_path / "o.h5"
