@@ -40,8 +40,8 @@ template <> struct Splat<double> {
  * with the carries out of it counted in another, a momentum share in one signed word where the
  * block's speeds bound its sums, else split into its low 16 bits and the rest; in a window over
  * the box where its nodes fit, else in a hash table of the nodes the block touches; then one
- * 64-bit global atomic a touched node and channel. A share whose node finds no slot, or a block past the share bound, adds to the
- * grid directly. Integer sums: no order changes a bit. */
+ * 64-bit global atomic a touched node and channel. A share whose node finds no slot, or a block
+ * past the share bound, adds to the grid directly. Integer sums: no order changes a bit. */
 #ifndef HB_SPLAT_STRANDS
 #define HB_SPLAT_STRANDS 64
 #endif
