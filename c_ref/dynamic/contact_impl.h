@@ -540,6 +540,15 @@ HB_HD void SFX(hb_contact_carry)(const WORLD *w, const REAL *back, REAL *con)
     }
 }
 
+/* §3.17 --contact-planes: point x's planes con at substep j of a frame, before the substep's first
+ * step: found from x at the frame's first substep, carried with their colliders at the others */
+HB_HD void SFX(hb_contact_step)(const WORLD *w, const REAL *pose, const REAL *back, int64_t j, const REAL *x, REAL *con)
+{
+    if (j == 0) SFX(hb_contact_find)(w, pose, x, con);
+    else
+        for (int s = 0; s < HB_CONTACT_K; s++) SFX(hb_contact_carry)(w, back, con + HB_CONTACT * s);
+}
+
 /* §3.17 --contact-planes: the point's plane on p, as a plane collider: the depth δ = d − n·p > 0
  * (bounded: δ₀ = d − n·y of the substep's start carried, hb_carry), p ← p + m·n, then the collider's
  * friction. x: the point at the substep's start; back: the substep's back-transforms. The collider's

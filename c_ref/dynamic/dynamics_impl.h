@@ -189,12 +189,8 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_
         /* §3.17 --contact-planes: each point's plane found from x at the frame's first substep,
          * carried with its collider at the others */
         if (con && m->solver != HB_SOLVER_RIGID)
-            for (int64_t k = 1; k < P; k++) {
-                if (j == 0) SFX(hb_contact_find)(w, pose, x + 3 * k, con + HB_CONTACT_POINT * k);
-                else
-                    for (int s = 0; s < HB_CONTACT_K; s++)
-                        SFX(hb_contact_carry)(w, back, con + HB_CONTACT_POINT * k + HB_CONTACT * s);
-            }
+            for (int64_t k = 1; k < P; k++)
+                SFX(hb_contact_step)(w, pose, back, j, x + 3 * k, con + HB_CONTACT_POINT * k);
 
         /* 1. root on the head: x0 ← Q(t+h)·X̄0, v0 ← (x0_new − x0_old)/h */
         if (F & HB_F_MOTION) {

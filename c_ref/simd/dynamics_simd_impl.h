@@ -570,13 +570,8 @@ void SFX(hb_simd_dyn_frame_block)(const DMODEL *m, const hb_dyn_frame *fr, const
         if (con && wc)
             for (int64_t k = 1; k < m->points; k++)
                 for (int l = 0; l < DB; l++) {
-                    REAL *cp = CON_ROW(con, k) + HB_CONTACT_POINT * l;
-                    if (j == 0) {
-                        const REAL xs[3] = {ROWP(X, k)[l], ROWP(Y, k)[l], ROWP(Z, k)[l]};
-                        SFX(hb_contact_find)(wc, pose, xs, cp);
-                    } else {
-                        for (int s = 0; s < HB_CONTACT_K; s++) SFX(hb_contact_carry)(wc, back, cp + HB_CONTACT * s);
-                    }
+                    const REAL xs[3] = {ROWP(X, k)[l], ROWP(Y, k)[l], ROWP(Z, k)[l]};
+                    SFX(hb_contact_step)(wc, pose, back, j, xs, CON_ROW(con, k) + HB_CONTACT_POINT * l);
                 }
         SFX(vel_dispatch)(vi, m, &K, q, phase, X, Y, Z, VX, VY, VZ, RX, RY, RZ, stride, scratch, wg, qg, j, last);
         SFX(con_dispatch)(ci, m, &K, q, X, Y, Z, VX, VY, VZ, RX, RY, RZ, BR, SR, stride, scratch, wc, pose, back, con);
