@@ -61,7 +61,7 @@ template <typename T> int world_kind(const DModel<T> &m)
     const bool col = w.ncol > 0 || w.head_friction || w.bounded;
     const bool apply = w.grid && (w.grid_friction || w.grid_volume);
     if (apply && col) return kWAll;
-    if (apply && w.grid_rebuild != HB_GRID_HELD) return kWGather;
+    if (apply && !lanes_holds_samples(w)) return kWGather;
     return !col ? kWHeld : w.planes ? kWCol | kWPlanes : kWCol;
 }
 template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P, bool seg, int world)

@@ -725,7 +725,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         }
 
         const bool wgrid = (W & (kWGather | kWHeld)) && m.world.grid && (m.world.grid_friction || m.world.grid_volume);
-        const bool held = (W & kWHeld) && wgrid && m.world.grid_rebuild == HB_GRID_HELD;
+        const bool held = (W & kWHeld) && wgrid && m.held; /* lanes_holds_samples: k_grid_hold took them */
         if constexpr ((W & kWHeld) != 0) { /* §3.16 `held`: each point's sample, taken by k_grid_hold */
             if (held && live) {
                 const int64_t st = Ordered && m.perm ? m.perm[s0 + seg] : s0 + seg;

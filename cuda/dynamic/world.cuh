@@ -33,6 +33,17 @@ template <> struct WorldOf<double> {
 /* The run's grid and colliders in T, pointing at device memory. */
 template <typename T> using World = typename WorldOf<T>::type;
 
+/* §3.16: the lanes kernel applies each point's sample as k_grid_hold took it (docs/cuda.md) for
+ * `held`, and for `substep` without colliders: a launch a substep there, so the sample at the
+ * launch's start is the one the substep's correction takes (as one substep a frame of `held` is
+ * `frame` bit for bit); with colliders the kernel with all the world's code gathers itself */
+template <typename WorldT> inline bool lanes_holds_samples(const WorldT &w)
+{
+    const bool col = w.ncol > 0 || w.head_friction || w.bounded;
+    return w.grid && (w.grid_friction || w.grid_volume) &&
+           (w.grid_rebuild == HB_GRID_HELD || (w.grid_rebuild == HB_GRID_SUBSTEP && !col));
+}
+
 /* The precision's functions of contact_impl.h by overload. */
 HB_HD void grid_sample(const World<float> &w, const float *qg, const float *x, float *s)
 {
