@@ -476,14 +476,14 @@ const hb_variant cuda_variants[] = {
     {"fused", CUDA_PAPER_STAGES, "point-major, wind and the collide after it in one kernel", 0, 0},
     {"strand", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "point-major like soa; simulate: one thread per strand, a frame's substeps in one launch", 0, 0, 0, 1,
-     HB_X_GRID | HB_X_COLLIDERS | HB_X_FRICTION | HB_X_PLANES},
+     HB_X_GRID | HB_X_COLLIDERS | HB_X_FRICTION | HB_X_PLANES | HB_X_ONCE},
     {"warp", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "strand-major like paper; simulate: one warp per strand, a lane per point, the frame in shared memory", 0, 0, 0, 1,
-     HB_X_GRID | HB_X_COLLIDERS | HB_X_FRICTION | HB_X_PLANES},
+     HB_X_GRID | HB_X_COLLIDERS | HB_X_FRICTION | HB_X_PLANES | HB_X_ONCE},
     {"warpreg", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "strand-major like paper; simulate: one warp per strand, lane k holds point k in registers (at most 32 points), "
      "neighbours through warp shuffles",
-     hb::dyn::kWarpregMaxPoints, 0, 0, 1, HB_X_GRID | HB_X_COLLIDERS | HB_X_FRICTION | HB_X_PLANES},
+     hb::dyn::kWarpregMaxPoints, 0, 0, 1, HB_X_GRID | HB_X_COLLIDERS | HB_X_FRICTION | HB_X_PLANES | HB_X_ONCE},
     {"lanes", CUDA_PAPER_STAGES | (1u << HB_STAGE_SIMULATE),
      "strand-major like paper; simulate: L lanes a strand (16 for xpbd, 8 for ftl), 2 to 8 points a lane in "
      "registers (at most 128 points), nearly every lane busy in every constraint group; free arithmetic outside "

@@ -12,6 +12,8 @@ SUBSTEP32="--grid 32 $GRID --grid-rebuild substep"
 BODY="--colliders configs/bodies/default.colliders --friction 0.3,0.2 --depenetration-speed 200"
 # the same body met as contact planes found once a frame within 5 cm (docs/model.md §3.17)
 BODY_PLANES="$BODY --contact-planes 5"
+# the head sphere's friction and bounded depenetration alone, without the file's colliders
+HEAD_FRICTION="--friction 0.3,0.2 --depenetration-speed 200"
 # world_row OUTDIR LABEL BINARY STRANDS FRAMES REPEAT [FLAGS...]: one row, the scene plus FLAGS, its median,
 # min and max ms a frame appended to OUTDIR/bench.txt and printed (a failed run: its exit status)
 world_row() {

@@ -21,7 +21,12 @@ for n in 4194304 10000; do
   world_row "$OUTD" grid32-substep "$A" $n $fr $rep $SUBSTEP32
   world_row "$OUTD" body64 "$A" $n $fr $rep $BODY
   world_row "$OUTD" body64-planes5 "$A" $n $fr $rep $BODY_PLANES
-  world_row "$OUTD" body-bounded-head-only "$A" $n $fr $rep --friction 0.3,0.2 --depenetration-speed 200
+  world_row "$OUTD" body-bounded-head-only "$A" $n $fr $rep $HEAD_FRICTION
+  # the collision step once a substep (--collide-once, docs/model.md §3.6)
+  world_row "$OUTD" base-once "$A" $n $fr $rep --collide-once
+  world_row "$OUTD" body64-once "$A" $n $fr $rep $BODY --collide-once
+  world_row "$OUTD" body64-planes5-once "$A" $n $fr $rep $BODY_PLANES --collide-once
+  world_row "$OUTD" body-bounded-head-only-once "$A" $n $fr $rep $HEAD_FRICTION --collide-once
   world_row "$OUTD" base-again "$A" $n $fr $rep
 done
 world_row "$OUTD" grid64-held "$A" 4194304 3 5 --grid 64 $GRID --grid-rebuild held

@@ -30,7 +30,8 @@ enum {
     HB_X_COLLIDERS = 1u << 5, /* §3.17 colliders beyond the head sphere */
     HB_X_FRICTION = 1u << 6,  /* §3.17 friction and a bounded depenetration */
     HB_X_PLANES = 1u << 7,    /* §3.17 the colliders as contact planes found once a frame */
-    HB_X_COUNT = 8
+    HB_X_ONCE = 1u << 8,      /* §3.6 xpbd's collision step in the last iteration of a substep alone */
+    HB_X_COUNT = 9
 };
 
 /* One kernel variant of a backend: its name, the stages it runs (bit 1 << hb_stage), a

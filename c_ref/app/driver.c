@@ -77,7 +77,8 @@ static const struct {
                             {"grid", "--grid"},
                             {"colliders", "--colliders"},
                             {"friction", "--friction or --depenetration-speed"},
-                            {"planes", "--contact-planes"}};
+                            {"planes", "--contact-planes"},
+                            {"collideonce", "--collide-once"}};
 
 /* The §3.14 features a scene declares, HB_X_* bits. */
 static unsigned x_declared(const hb_dynamics *d)
@@ -86,7 +87,8 @@ static unsigned x_declared(const hb_dynamics *d)
     for (int i = 0; d->cols && i < d->cols->n; i++) friction |= d->cols->c[i].mu_s > 0.0;
     return (d->guided ? HB_X_GUIDES : 0u) | (d->lra ? HB_X_LRA : 0u) | (d->sag_free ? HB_X_SAGFREE : 0u) |
            (d->render_points ? HB_X_LOD : 0u) | (d->grid ? HB_X_GRID : 0u) | (d->colliders_path ? HB_X_COLLIDERS : 0u) |
-           (friction ? HB_X_FRICTION : 0u) | (d->planes_declared ? HB_X_PLANES : 0u);
+           (friction ? HB_X_FRICTION : 0u) | (d->planes_declared ? HB_X_PLANES : 0u) |
+           (d->collide_once ? HB_X_ONCE : 0u);
 }
 
 /* A JSON list of the solvers in the bit set `set` (bit 1 << hb_solver), after `key`. */

@@ -200,6 +200,7 @@ void hb_record_json(FILE *f, const hb_record *r)
             json_key_str(f, "features", st->features);
             fprintf(f, ", \"collider_sweeps\": %lld", (long long)d->collider_sweeps); /* §3.17 */
             if (d->planes_declared) json_key_num(f, "contact_planes", d->contact_margin);
+            if (d->collide_once) fprintf(f, ", \"collide_once\": true"); /* §3.6 */
             json_key_num(f, "frame_dt", d->frame_dt);
             /* point-substeps per second of the median frame */
             json_key_num(f, "point_substeps_per_s",

@@ -514,6 +514,7 @@ static int write_world(hid_t p, const hb_dynamics *d)
     bad |= attr_i64(p, "collider_sweeps", d->collider_sweeps) < 0;
     bad |= attr_i64(p, "planes_declared", d->planes_declared) < 0;
     bad |= attr_f64(p, "contact_margin", d->contact_margin) < 0;
+    bad |= attr_i64(p, "collide_once", d->collide_once) < 0;
     bad |= attr_str(p, "body_motion",
                     d->body_motion == HB_BODY_SWAY   ? "sway"
                     : d->body_motion == HB_BODY_RISE ? "rise"
@@ -961,6 +962,8 @@ static int input_world(hb_input *in, const char *path, hid_t p, char *err, size_
         if (read_attr(p, "contact_margin", H5T_NATIVE_DOUBLE, &d->contact_margin) < 0 || !(d->contact_margin > 0.0))
             BAD("contact_margin");
     }
+    if (read_attr(p, "collide_once", H5T_NATIVE_INT64, &v) == 0) /* absent in older files: every iteration */
+        d->collide_once = v != 0;
     if (read_attr_str(p, "body_motion", word, sizeof word) == 0) {
         if (strcmp(word, "sway") == 0) d->body_motion = HB_BODY_SWAY;
         else if (strcmp(word, "rise") == 0) d->body_motion = HB_BODY_RISE;

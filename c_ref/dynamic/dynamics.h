@@ -36,6 +36,7 @@ enum {
 #define HB_DYN_MODEL(T)                                                                                                \
     struct {                                                                                                           \
         int64_t points, substeps, iterations, shape_count; /* P, S, I, K */                                            \
+        int64_t collide_from; /* xpbd: the first iteration with a collision step (0; I − 1: --collide-once) */       \
         int solver;                                                                                                    \
         unsigned features;                                                                                             \
         T h, seg_len, gravity_y;         /* h = Δt/S, ℓ, −g0 */                                                   \

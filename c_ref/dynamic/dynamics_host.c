@@ -42,6 +42,7 @@ void hb_dyn_feature_names(unsigned features, char *out, size_t n)
         (M)->points = s->points;                                                                                       \
         (M)->substeps = d->substeps;                                                                                   \
         (M)->iterations = d->iterations;                                                                               \
+        (M)->collide_from = d->collide_once ? d->iterations - 1 : 0;                                                   \
         (M)->shape_count = shape_count;                                                                                \
         (M)->solver = (int)d->solver;                                                                                  \
         (M)->features = features;                                                                                      \

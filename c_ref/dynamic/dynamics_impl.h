@@ -280,6 +280,7 @@ HB_ALWAYS_INLINE void SFX(frame_body)(const DMODEL *m, const WORLD *w, const hb_
                 }
                 if (F & HB_F_SHAPE) SFX(shape_all)(m, p, rest, q, lam_g, F);
                 if (m->lra) SFX(lra_all)(m, p);
+                if (it < m->collide_from) continue; /* --collide-once: the last iteration's alone */
                 if (wcol)
                     for (int64_t k = 1; k < P; k++)
                         SFX(collide_point)(m, w, pose, back, p + 3 * k, x + 3 * k, con, k, F);

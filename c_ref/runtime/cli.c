@@ -370,6 +370,9 @@ static const flag_spec flags[] = {
     {"--contact-planes", DF_REAL, DYN(contact_margin), DYN(planes_declared),
      "M, cm: each point finds its nearest collider within M once a frame and meets it as a plane in every\n"
      "collision step of the frame (default: every collider tested in every step; docs/model.md §3.17)"},
+    {"--collide-once", DF_FLAG, DYN(collide_once), 0,
+     "xpbd: the collision step (head sphere, colliders, friction) in the last of a substep's I iterations\n"
+     "alone, not in every one (default: every iteration; docs/model.md §3.6)"},
     {"--body-motion", DF_BODY, DYN(body_motion), 0,
      "still | sway (along x) | rise (from A_b below, in 1/f_b s): the body frame's motion (default still)"},
     {"--body-amplitude", DF_REAL, DYN(body_amplitude), 0, "the body's sway or rise A_b, cm (default 2)"},

@@ -223,6 +223,9 @@ int hb_dynamics_validate(const hb_dynamics *d, char *err, size_t errlen)
         FAIL("--contact-planes must be > 0 (got %g)", d->contact_margin);
     if (d->planes_declared && !d->colliders_path)
         FAIL("--contact-planes needs --colliders (the planes are the file's colliders)");
+    if (d->collide_once && d->solver != HB_SOLVER_XPBD)
+        FAIL("--collide-once needs --solver xpbd (ftl meets the colliders once a substep already, in its follow-the-"
+             "leader pass)");
     if (d->collider_sweeps < 1 || d->collider_sweeps > HB_COLLIDER_SWEEPS_MAX)
         FAIL("--collider-sweeps must be from 1 to %d (got %lld)", HB_COLLIDER_SWEEPS_MAX,
              (long long)d->collider_sweeps);

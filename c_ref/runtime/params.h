@@ -87,6 +87,7 @@ typedef struct {
     double depen_speed;              /* V, cm/s */
     int64_t collider_sweeps;         /* --collider-sweeps: the collision sweep a point, at most (1: once) */
     int planes_declared;             /* --contact-planes given: the colliders as one contact plane a point a frame */
+    int collide_once;                /* --collide-once: xpbd's collision step in a substep's last iteration alone */
     double contact_margin;           /* M, cm: how near a collider a point finds its plane */
     int body_motion;                 /* hb_body_motion */
     double body_amplitude, body_frequency; /* A_b (cm), f_b (Hz) */

@@ -422,6 +422,7 @@ HB_ALWAYS_INLINE void SFX(con_phase)(const DMODEL *m, const SFX(dyn_consts) * K,
                                     K->st_w2, lam_s ? lam_s + (k - 1) * DB : NULL);
             // clang-format on
             SFX(bend_shape_lra_lanes)(m, K, q, RX, RY, RZ, BR, stride, scratch, F);
+            if (it < m->collide_from) continue; /* --collide-once: the last iteration's alone */
             for (int64_t k = 1; k < P && (plain || wc); k++) {
                 if (plain) SFX(collide_lanes)(m, scratch, k, K);
                 if (wc) {

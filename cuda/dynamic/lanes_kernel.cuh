@@ -916,7 +916,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
                         bend(1);
                     }
                     if (has(HB_F_SHAPE)) shapes();
-                    if ((W & kWCol) && wcol) { /* every lane of the warp */
+                    if (it < (int)m.collide_from) continue; /* --collide-once: the last iteration's alone */
+                    if ((W & kWCol) && wcol) {              /* every lane of the warp */
                         bool on[G];
 #pragma unroll
                         for (int i = 0; i < G; i++) on[i] = point_of<G>(k0, sw, i) >= 1 && point_of<G>(k0, sw, i) < P;

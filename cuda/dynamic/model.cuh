@@ -51,6 +51,7 @@ namespace dyn {
 /* The run's constants in T: the fields of hb_dyn_model_f32/f64 (hb_dyn_round made them). */
 template <typename T> struct DModel {
     int64_t points, substeps, iterations, shape_count;
+    int64_t collide_from; /* xpbd: the first iteration with a collision step (0; I − 1: --collide-once) */
     int solver;
     unsigned features;
     T h, seg_len, gravity_y, wind_y, wind_z, dir_y, dir_z, kappa, gust, den, stretch_at, bend_at, shape_at, collide_r,
@@ -87,6 +88,7 @@ template <typename T, typename M> inline DModel<T> dmodel_from(const M &m)
     r.points = m.points;
     r.substeps = m.substeps;
     r.iterations = m.iterations;
+    r.collide_from = m.collide_from;
     r.shape_count = m.shape_count;
     r.solver = m.solver;
     r.features = m.features;

@@ -14,6 +14,7 @@ A scene with `model = "dynamic"` may hold, besides the paper keys:
     damping = 0.5           # β ≥ 0             --damping
     ftl_damping = 0.9       # s in [0, 1]       --ftl-damping
     output_every = 1        # K ≥ 1             --output-every
+    collide_once = true     # xpbd: collide in a substep's last iteration alone  --collide-once
     [constraints]
     stretch_compliance = 0.0   # α_s ≥ 0        --stretch-compliance
     bend_compliance = 1e-6     # α_b ≥ 0        --bend-compliance (declares bend)
@@ -77,6 +78,7 @@ TABLES = {
         "damping": ("--damping", "nonneg"),
         "ftl_damping": ("--ftl-damping", "unit"),
         "output_every": ("--output-every", "count"),
+        "collide_once": ("--collide-once", "switch"),
     },
     "constraints": {
         "stretch_compliance": ("--stretch-compliance", "nonneg"),
@@ -157,7 +159,7 @@ def _value(where, key, kind, value, error):
                 "TRACK.csv) and name the CSV"
             )
         return value
-    if kind == "bool":
+    if kind in ("bool", "switch"):
         if not isinstance(value, bool):
             raise error(f"{where}: {key} must be true or false, got {value!r}")
         return value
@@ -267,6 +269,10 @@ def flags(scene):
     for flag, value in scene.dynamic.items():
         if flag == "--no-collider":
             if value is False:
+                out.append(flag)
+            continue
+        if flag == "--collide-once":  # a switch: true passes it alone
+            if value is True:
                 out.append(flag)
             continue
         if flag == "--motion-track":

@@ -103,6 +103,7 @@ FEATURE_FLAGS = {
     "--depenetration-speed": "friction",
     "--collider-sweeps": "colliders",  # the colliders' step repeated (no effect without them)
     "--contact-planes": "planes",  # the colliders met as planes found once a frame
+    "--collide-once": "collideonce",  # xpbd's collision step in a substep's last iteration alone
 }
 
 

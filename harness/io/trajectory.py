@@ -90,6 +90,7 @@ DYNAMIC_ATTRS = (
     "collider_sweeps",
     "planes_declared",
     "contact_margin",
+    "collide_once",
     "body_motion",
     "body_amplitude",
     "body_frequency",

@@ -1,13 +1,13 @@
 """Speed against accuracy of the world around the hair (docs/model.md §3.16, §3.17): the
 hair–hair grid's size × when it is built × friction × volume on the default scene, and the
 colliders' SDF resolution × friction on the body of configs/scenes/body.toml, with friction also as
-contact planes (--contact-planes M). Measures and writes CSV; accuracy_world_verdicts_dynamic.py
+contact planes (--contact-planes M) and with the collision step once a substep (--collide-once). Measures and writes CSV; accuracy_world_verdicts_dynamic.py
 judges it, harness/render/accuracy_world_dynamic_report.py renders the table and that verdict.
 
 Each variant runs the scene's own step (S = 8, I = 2, fp32) at `strands` strands for `seconds`,
 and its **converged reference**, the same features at S = `ref_substeps` in fp64 (the error is
-then the step's, not the feature's), but for contact planes the exact order's (their error is the
-trade's too). Against it: the RMS and max error over all points and
+then the step's, not the feature's), but for contact planes and colliding once the exact order's
+(their error is the trade's too). Against it: the RMS and max error over all points and
 frames (studies.accuracy.frame_errors, over L), and the observables the features change, the
 variant's beside its reference's: the last frame's hair volume, envelope radius and close pairs
 (check/hair_volume_dynamic.py), and the worst frame's penetration and stretch (§3.8). The cost is the
@@ -50,6 +50,7 @@ COLUMNS = (
     "volume",  # on | off (grid only)
     "sdf",  # the mesh's n_s (body only)
     "planes",  # the contact planes' margin M in cm, or "off": every collider exactly (body only)
+    "once",  # on: xpbd's collision step in a substep's last iteration alone (--collide-once); off (body only)
     "strands",
     "frames",
     "substeps",
@@ -181,7 +182,7 @@ def body_variants(plan, folder):
         words = line.split("#")[0].split()
         if words and words[0] == "mesh" and not (folder / words[2]).exists():
             (folder / words[2]).symlink_to((src.parent / words[2]).resolve())
-    off = dict(sdf="off", friction="off", planes="off")
+    off = dict(sdf="off", friction="off", planes="off", once="off")
     out = [Variant("body", "off", replace(body, dynamic=_without(dyn, _body_flag)), off)]
     for n in plan.sdf_sizes:
         for fric in ("on", "off"):
@@ -191,11 +192,16 @@ def body_variants(plan, folder):
             if fric == "off":
                 flags.pop("--friction", None)
             exact = replace(body, dynamic=flags)
-            out.append(Variant("body", f"SDF {n}³, friction {fric}", exact, dict(sdf=n, friction=fric, planes="off")))
+            cols = dict(sdf=n, friction=fric, planes="off", once="off")
+            out.append(Variant("body", f"SDF {n}³, friction {fric}", exact, cols))
             for m in plan.contact_margins if fric == "on" else ():
                 planes = replace(body, dynamic={**flags, "--contact-planes": m})
-                cols = dict(sdf=n, friction=fric, planes=f"{m:g}")
+                cols = dict(sdf=n, friction=fric, planes=f"{m:g}", once="off")
                 out.append(Variant("body", f"SDF {n}³, friction on, planes {m:g} cm", planes, cols, ref_scene=exact))
+            if fric == "on":  # the collision step once a substep, against the exact order's reference
+                once = replace(body, dynamic={**flags, "--collide-once": True})
+                cols = dict(sdf=n, friction=fric, planes="off", once="on")
+                out.append(Variant("body", f"SDF {n}³, friction on, colliding once", once, cols, ref_scene=exact))
     return out
 
 
@@ -292,7 +298,7 @@ def measure_variant(v, plan, scratch):
     return {
         "group": v.group,
         "variant": v.name,
-        **{k: v.columns.get(k, "") for k in ("grid", "rebuild", "friction", "volume", "sdf", "planes")},
+        **{k: v.columns.get(k, "") for k in ("grid", "rebuild", "friction", "volume", "sdf", "planes", "once")},
         "strands": plan.strands,
         "frames": len(x),
         "substeps": v.scene.dynamic.get("--substeps", 1),

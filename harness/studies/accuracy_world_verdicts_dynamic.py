@@ -3,7 +3,7 @@
 tolerances.WORLD_ACC_ERROR_FACTOR of the smallest error against its converged reference, and
 the medians over matched pairs of what a setting costs and moves (the grid rebuilt every
 substep, each point's sample held for the frame, friction on the body, the SDF's size, the body's
-colliders as contact planes)."""
+colliders as contact planes, the collision step once a substep)."""
 
 import math
 import statistics
@@ -83,7 +83,7 @@ def sdf_change(rows):
     if len(sizes) < 2:
         return None
     lo, hi = str(sizes[0]), str(sizes[-1])
-    ratio, n = paired_ratio(rows, "rms_err_L", "sdf", lo, hi, ("friction", "planes"))
+    ratio, n = paired_ratio(rows, "rms_err_L", "sdf", lo, hi, ("friction", "planes", "once"))
     return SdfChange(lo, hi, ratio, n) if n else None
 
 
@@ -94,7 +94,8 @@ GRID_MATCH = ("grid", "friction", "volume")
 class Verdict:
     """A group's verdict: its pick (None: no finite error), the setting each group varies
     (the grid's rebuild, the body's friction), holding the sample (grid), the SDF's size and the
-    contact planes at each margin against the exact colliders ((margin, Change), body)."""
+    contact planes at each margin against the exact colliders ((margin, Change), body) and the collision
+    step once a substep against every iteration (body)."""
 
     group: str
     pick: dict | None
@@ -103,6 +104,7 @@ class Verdict:
     held: Change | None = None
     sdf: SdfChange | None = None
     planes: tuple = ()
+    once: Change | None = None
 
 
 def verdict(rows, group):
@@ -123,9 +125,10 @@ def verdict(rows, group):
         group,
         pick,
         tolerances.WORLD_ACC_ERROR_FACTOR,
-        change=change(on, "friction", "off", "on", ("sdf", "planes")),
+        change=change(on, "friction", "off", "on", ("sdf", "planes", "once")),
         sdf=sdf_change(on),
         planes=planes_changes(on),
+        once=change(on, "once", "off", "on", ("sdf", "friction", "planes")),
     )
 
 
@@ -133,5 +136,5 @@ def planes_changes(rows):
     """(margin, Change) for each contact planes margin among the rows: its rows against the exact
     colliders' of the same SDF size and friction (cost, and error against the exact order's reference)."""
     margins = sorted({str(r.get("planes", "")) for r in rows} - {"", "off"}, key=float)
-    out = [(m, change(rows, "planes", "off", m, ("sdf", "friction"))) for m in margins]
+    out = [(m, change(rows, "planes", "off", m, ("sdf", "friction", "once"))) for m in margins]
     return tuple((m, c) for m, c in out if c.pairs)

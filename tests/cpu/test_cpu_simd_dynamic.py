@@ -309,6 +309,22 @@ def test_the_colliders_within_the_rule(cpu_bin, inputs, tmp_path, precision, sol
     assert_one_frame_rule(cpu_bin, inp, tmp_path, f"{precision} {solver} {body}", args, ref_args=cols)
 
 
+# --collide-once (docs/model.md §3.6, xpbd alone): the collision step in a substep's last iteration alone,
+# with the exact colliders, and with the planes and the grid built every substep (a substep a call)
+ONCE = {
+    "body-once": [*BODIES["body"], "--collide-once"],
+    "body-planes-substep-once": [*BODIES["body-planes-substep"], "--collide-once"],
+}
+
+
+@needs_simd
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize("body", list(ONCE))
+def test_colliding_once_within_the_rule(cpu_bin, inputs, tmp_path, precision, body):
+    args = ["--solver", "xpbd", *ALL, *ONCE[body]]
+    assert_one_frame_rule(cpu_bin, inputs(precision, 33), tmp_path, f"{precision} {body}", args, ref_args=COLLIDERS)
+
+
 @needs_simd
 def test_the_colliders_move_the_hair(cpu_bin, inputs, tmp_path):
     assert_moves_like_ref(cpu_bin, inputs("fp64", 16), tmp_path, [*COLLIDERS, *BODIES["body"]], 1e-2)

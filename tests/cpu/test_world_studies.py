@@ -89,10 +89,11 @@ def test_the_world_table_has_every_variant_of_both_axes(world_rows):
     assert {(r["grid"], r["rebuild"], r["friction"], r["volume"]) for r in grid if r["variant"] != "off"} == {
         (8, rb, f, v) for rb in ("frame", "substep", "held") for f in ("on", "off") for v in ("on", "off")
     }
-    assert {(r["sdf"], r["friction"], r["planes"]) for r in body if r["variant"] != "off"} == {
-        (16, "on", "off"),
-        (16, "off", "off"),
-        (16, "on", "5"),
+    assert {(r["sdf"], r["friction"], r["planes"], r["once"]) for r in body if r["variant"] != "off"} == {
+        (16, "on", "off", "off"),
+        (16, "off", "off", "off"),
+        (16, "on", "5", "off"),
+        (16, "on", "off", "on"),
     }
     for r in world_rows:
         assert r["ms_frame"] > 0 and math.isfinite(r["rms_err_L"]) and r["rms_err_L"] > 0, r
@@ -100,12 +101,14 @@ def test_the_world_table_has_every_variant_of_both_axes(world_rows):
     assert all(r["cost_ratio"] == 1.0 for r in world_rows if r["variant"] == "off")
 
 
-def test_a_planes_row_is_judged_against_the_exact_colliders_reference(tmp_path, monkeypatch):
-    """the planes variant runs its own scene in fp32 and its exact twin's at S = ref_substeps in fp64"""
+@pytest.mark.parametrize("flag,column", [("--contact-planes", "planes"), ("--collide-once", "once")])
+def test_a_planes_or_once_row_is_judged_against_the_exact_colliders_reference(tmp_path, monkeypatch, flag, column):
+    """the planes (or once) variant runs its own scene in fp32 and its exact twin's at S = ref_substeps in
+    fp64"""
     todo = accuracy_world.body_variants(TINY, tmp_path)
-    exact = next(v for v in todo if v.columns == dict(sdf=16, friction="on", planes="off"))
-    planes = next(v for v in todo if v.columns.get("planes") == "5")
-    assert planes.scene.dynamic == {**exact.scene.dynamic, "--contact-planes": 5.0}
+    exact = next(v for v in todo if v.columns == dict(sdf=16, friction="on", planes="off", once="off"))
+    planes = next(v for v in todo if v.columns.get(column) in ("5", "on"))
+    assert planes.scene.dynamic == {**exact.scene.dynamic, flag: 5.0 if column == "planes" else True}
     ran = []
 
     def fake_run(scene, path, plan, precision, substeps):
@@ -170,6 +173,16 @@ def test_the_verdict_follows_the_numbers():
     assert [(m, c.cost, c.err, c.pairs) for m, c in v.planes] == [("5", 0.5, pytest.approx(1.5), 1)]
     text = accuracy_world_report.verdict([*body, planes], "body")
     assert "As contact planes within 5 cm the colliders cost 0.50× the exact ones" in text and "by 1.50×" in text
+    assert v.once.pairs == 0 and "Colliding once" not in text  # no once rows, no clause
+    once = _row("body", "s once", 2.4, 0.025, sdf="32", friction="on", planes="off", once="on")
+    for r in (*body, planes):
+        r["once"] = "off"
+    v = world_verdicts.verdict([*body, planes, once], "body")
+    assert (v.change.cost, v.change.err) == (1.5, 0.5)  # friction's pair is still the every-iteration one
+    assert [(m, c.pairs) for m, c in v.planes] == [("5", 1)]
+    assert (v.once.cost, v.once.err, v.once.pairs) == (pytest.approx(0.8), pytest.approx(1.25), 1)
+    text = accuracy_world_report.verdict([*body, planes, once], "body")
+    assert "Colliding once a substep (in the last iteration alone) costs 0.80× colliding in every iteration" in text
 
 
 def test_the_world_section_renders_from_its_csv(world_rows, tmp_path):

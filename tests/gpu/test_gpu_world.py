@@ -88,12 +88,22 @@ SCENES[LAUNCHES] = ["--head-motion", "nod", "--friction", "0.4,0.3", "--substeps
 LAUNCHES_PLANES = "body-launches-planes"  # the planes kept in m.contacts between the launches
 SCENES[LAUNCHES_PLANES] = [*SCENES[LAUNCHES], *PLANES]
 STRICT_ONLY = (FAST, LAUNCHES, LAUNCHES_PLANES)
+# --collide-once (docs/model.md §3.6, xpbd alone): the head sphere alone (the default scene's own
+# kernel), the body with the bounded depenetration, the body as planes, and with the grid built every
+# substep (a launch a substep)
+ONCE = {
+    "once-head": ["--head-motion", "nod", "--collide-once"],
+    "once-body": [*SCENES["body"], "--collide-once"],
+    "once-body-planes": [*SCENES["body-planes"], "--collide-once"],
+    "once-grid-substep": [*SCENES["grid-substep"], "--friction", "0.3", "--colliders", "BODY", "--collide-once"],
+}
+SCENES.update(ONCE)
 FRAMES = 3
 RUNS = [
     (v, s)
     for v in VARIANTS
     for s in SCENES
-    if s not in STRICT_ONLY and _DECLARED.runs_features(v, variants.features_of(SCENES[s]))
+    if s not in (*STRICT_ONLY, *ONCE) and _DECLARED.runs_features(v, variants.features_of(SCENES[s]))
 ]
 FAST_RUNS = [v for v in VARIANTS if _DECLARED.runs_features(v, variants.features_of(SCENES[FAST]))]
 REFUSING = [v for v in VARIANTS if not _DECLARED.runs_features(v, {"grid"})]
@@ -140,6 +150,16 @@ def cpu_files(work):
 @pytest.mark.parametrize("build", tuple(BUILDS))
 def test_gpu_frame_matches_cpu(work, cpu_files, build, variant, scene, solver, precision):
     check_frame(work, cpu_files, build, variant, scene, solver, precision)
+
+
+@pytest.mark.parametrize("precision", ["fp32", "fp64"])
+@pytest.mark.parametrize(
+    "variant,scene",
+    [(v, s) for v in VARIANTS for s in ONCE if _DECLARED.runs_features(v, variants.features_of(ONCE[s]))],
+)
+@pytest.mark.parametrize("build", tuple(BUILDS))
+def test_gpu_collide_once_matches_cpu(work, cpu_files, build, variant, scene, precision):
+    check_frame(work, cpu_files, build, variant, scene, "xpbd", precision)
 
 
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
@@ -344,7 +364,9 @@ def test_gpu_body_in_sweeps_matches_cpu_bit_for_bit(work, variant, planes, solve
 
 
 @pytest.mark.parametrize("variant", REFUSING)
-@pytest.mark.parametrize("flags", [["--grid", "16"], ["--friction", "0.2"], ["--colliders", "C", *PLANES]])
+@pytest.mark.parametrize(
+    "flags", [["--grid", "16"], ["--friction", "0.2"], ["--colliders", "C", *PLANES], ["--collide-once"]]
+)
 def test_variants_without_the_features_refuse_them(tmp_path, variant, flags):
     out = tmp_path / "o.h5"
     (tmp_path / "c.txt").write_text("sphere head 0 -12 0 3\n")
