@@ -1,8 +1,9 @@
 """Speed against accuracy of the world around the hair (docs/model.md §3.16, §3.17): the
 hair–hair grid's size × when it is built × friction × volume on the default scene, and the
 colliders' SDF resolution × friction on the body of configs/scenes/body.toml, with friction also as
-contact planes (--contact-planes M) and with the collision step once a substep (--collide-once). Measures and writes CSV; accuracy_world_verdicts_dynamic.py
-judges it, harness/render/accuracy_world_dynamic_report.py renders the table and that verdict.
+contact planes (--contact-planes M) and with the collision step once a substep (--collide-once).
+Measures and writes CSV; accuracy_world_verdicts_dynamic.py judges it,
+harness/render/accuracy_world_dynamic_report.py renders the table and that verdict.
 
 Each variant runs the scene's own step (S = 8, I = 2, fp32) at `strands` strands for `seconds`,
 and its **converged reference**, the same features at S = `ref_substeps` in fp64 (the error is
