@@ -31,7 +31,9 @@ def test_world_compare_refuses_an_unknown_row(tmp_path):
     env = {"PATH": "/usr/bin:/bin", "ROWS": "sideways", "SMALL": "10", "LARGE": ""}
     r = subprocess.run(["bash", str(TOOL), str(out), "t=/bin/true"], cwd=ROOT, capture_output=True, text=True, env=env)
     assert r.returncode == 2
-    assert r.stderr.strip() == "error: row 'sideways' is none of base, held, frame, substep"
+    assert r.stderr.strip() == (
+        "error: row 'sideways' is none of base, held, frame, substep, body, planes, headf (each with -once or not)"
+    )
     assert not out.exists()
 
 
@@ -60,3 +62,16 @@ def test_world_compare_runs_each_row_by_every_build_in_turn(tmp_path):
     held = (tmp_path / "a" / "calls.txt").read_text().splitlines()[0]
     assert "--grid 32 --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild held" in held
     assert "--variant lanes" in held and "--repeat 20" in held
+
+
+def test_world_compare_runs_a_once_row_with_collide_once(tmp_path):
+    b = tmp_path / "hairsim-cuda"
+    b.write_text(FAKE)
+    b.chmod(0o755)
+    env = {"PATH": "/usr/bin:/bin", "ROWS": "headf headf-once", "SMALL": "10000", "LARGE": "", "ROUNDS": "1"}
+    r = subprocess.run(["bash", str(TOOL), str(tmp_path / "out"), f"a={b}"], cwd=ROOT, capture_output=True, text=True,
+                       env=env)  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    every, once = (tmp_path / "calls.txt").read_text().splitlines()
+    assert "--friction 0.3,0.2 --depenetration-speed 200" in every and "--collide-once" not in every
+    assert once.replace(" --collide-once", "") == every and once.count("--collide-once") == 1
