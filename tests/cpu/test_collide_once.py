@@ -23,6 +23,8 @@ from harness.core.paths import ROOT
 from harness.io.grooms import write_hair
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run, run_json
+from support.statecheck import same_trajectory_bits as same_bits
+from support.statecheck import trajectory as state
 
 BODY = ["--colliders", ROOT / "configs" / "bodies" / "default.colliders", "--friction", "0.3,0.2",
         "--depenetration-speed", "200", "--grid", "16", "--grid-friction", "0.05,0.01"]  # fmt: skip
@@ -34,19 +36,6 @@ SCENE = ["--strands", "64", "--points", "16", "--stages", "init,collide,simulate
 def sim(cpu_bin, out, *args, frames=3):
     run(cpu_bin, *SCENE, *map(str, args), "--frames", frames, "--velocities", "all", "--output", out, "--quiet")
     return out
-
-
-def state(path):
-    with open_trajectory(path) as t:
-        pos = np.stack([t.frame(f) for f in range(t.n_frames)])
-        vel = np.stack([t.velocity(i) for i in range(len(t.velocity_steps))])
-        return pos, vel, t.observables.to_numpy(), dict(t.dynamic_params)
-
-
-def same_bits(a, b):
-    pa, va, oa, _ = state(a)
-    pb, vb, ob, _ = state(b)
-    return pa.tobytes() == pb.tobytes() and va.tobytes() == vb.tobytes() and np.array_equal(oa, ob)
 
 
 @pytest.mark.parametrize("variant", ["ref", "simd"])

@@ -24,6 +24,8 @@ from harness.core.paths import ROOT
 from harness.io.grooms import write_hair
 from harness.io.trajectory import open_trajectory
 from support.statecheck import run
+from support.statecheck import same_trajectory_bits as same_bits
+from support.statecheck import trajectory as frames
 
 BODY = ["--colliders", ROOT / "configs" / "bodies" / "default.colliders", "--friction", "0.3,0.2"]
 SCENE = ["--strands", "64", "--points", "16", "--stages", "init,collide,simulate", "--substeps", "4",
@@ -35,22 +37,6 @@ GRID = ["--grid", "16", "--grid-friction", "0.05,0.01", "--grid-volume", "2000"]
 def sim(cpu_bin, out, *args, frames=3):
     run(cpu_bin, *SCENE, *map(str, args), "--frames", frames, "--velocities", "all", "--output", out, "--quiet")
     return out
-
-
-def frames(path):
-    with open_trajectory(path) as t:
-        pos = np.stack([t.frame(f) for f in range(t.n_frames)])
-        vel = np.stack([t.velocity(i) for i in range(len(t.velocity_steps))])
-        obs = t.observables.to_numpy()
-        params = dict(t.dynamic_params)
-    return pos, vel, obs, params
-
-
-def same_bits(a, b):
-    pa, va, oa, _ = frames(a)
-    pb, vb, ob, _ = frames(b)
-    bits = pa.view(np.uint8).tobytes() == pb.view(np.uint8).tobytes()
-    return bits and np.array_equal(va.view(np.uint8), vb.view(np.uint8)) and np.array_equal(oa, ob)
 
 
 @pytest.mark.parametrize("variant", ["ref", "simd"])

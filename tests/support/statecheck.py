@@ -12,6 +12,7 @@ import numpy as np
 
 from harness.check import diff
 from harness.io.states import LoadedState, load_state
+from harness.io.trajectory import open_trajectory
 
 
 def run(binary, *args, check=True, timeout=600, ok=(0,)):
@@ -27,6 +28,23 @@ def run(binary, *args, check=True, timeout=600, ok=(0,)):
 def run_json(binary, *args):
     p = run(binary, *args, "--json", "--quiet")
     return json.loads(p.stdout)
+
+
+def trajectory(path):
+    """A dynamic file's every frame's positions [F][N·P][3], its stored velocities, its observables (an
+    array) and its /parameters (a dict), read by harness.io.trajectory."""
+    with open_trajectory(path) as t:
+        pos = np.stack([t.frame(f) for f in range(t.n_frames)])
+        vel = np.stack([t.velocity(i) for i in range(len(t.velocity_steps))])
+        return pos, vel, t.observables.to_numpy(), dict(t.dynamic_params)
+
+
+def same_trajectory_bits(a, b):
+    """Whether two dynamic files hold the same bits in every position, velocity and observable."""
+    pa, va, oa, _ = trajectory(a)
+    pb, vb, ob, _ = trajectory(b)
+    bits = pa.view(np.uint8).tobytes() == pb.view(np.uint8).tobytes()
+    return bits and np.array_equal(va.view(np.uint8), vb.view(np.uint8)) and np.array_equal(oa, ob)
 
 
 def State(path) -> LoadedState:  # noqa: N802 (reads like the type it returns)
