@@ -389,6 +389,10 @@ SAN_PLANES := --contact-planes 3
 # the splat's hash table (cuda/dynamic/world.cu): a fine grid over a small box, so that every splat
 # block's box exceeds its window and some shares find no slot
 SAN_HASH := --grid 256 --grid-box=-13,-45,-13,13,13,13 --grid-friction 0.1,0.02 --grid-volume 2000
+# the splat's blocks taking runs of their strands' points (cuda/dynamic/world.cu: 2,048 strands or more;
+# 29 points, so that a run's length is no power of two), the grid built every substep
+SAN_RUNS := --strands 3000 --points 29 --frames 1 --grid 32 --grid-friction 0.05,0.01 --grid-volume 2000 \
+  --grid-rebuild substep
 sanitize-gpu: cuda sanitize-gpu-world
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
 	@set -e; for v in $$($(PYTHON) -c "from harness.core import variants; print(*variants.names('cuda'))"); do for p in fp32 fp64; do \
@@ -434,6 +438,10 @@ sanitize-gpu-world: cuda
 	    --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild held --precision $$p --substeps 40 --frames 1; \
 	  echo "racecheck world $$p hash table"; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_HASH) --precision $$p; \
+	  echo "memcheck, racecheck world $$p $(SAN_RUNS)"; \
+	  compute-sanitizer --tool memcheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_RUNS) --precision $$p \
+	    --output $(BUILD)/san-world-$$p-runs.h5 --force; \
+	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_RUNS) --precision $$p; \
 	  echo "racecheck world $$p $(SAN_SWEEPS)"; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) $(SAN_SWEEPS) \
 	    --precision $$p --substeps 40 --frames 1; \

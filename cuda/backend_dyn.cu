@@ -72,7 +72,8 @@ struct DynState {
      * sums and node fields, the frame's pose tables, and the world struct on the device (for
      * the observables) */
     hb_host_world hw;
-    int64_t *g_mass, *g_mom;
+    int64_t *g_mass, *g_mom; /* two sets of sums [4·n³] (mass, then momentum): the next build's, zero, is g_cur */
+    int g_cur;
     void *g_node_v, *g_node_a, *g_target, *g_ftab;
     void *g_held; /* §3.16 `held`: each point's sample for the frame */
     int *c_kind, *c_frame;
@@ -356,9 +357,12 @@ template <typename T> static int dyn_world_load(cuda_impl *c, const void *rest, 
     const int64_t nodes = hw->nodes;
     int rc;
     if (c->scene.dyn.grid) {
-        /* mass, then momentum in the same allocation (launch_grid_splat zeroes both at once) */
-        if ((rc = device_alloc((void **)&d->g_mass, (uint64_t)nodes * 32u, c, "grid sums", err, errlen))) return rc;
+        /* two sets of sums, each mass then momentum: a build splats into the zero set and its node
+         * kernel zeroes the other for the next build, so that no build waits on a memset */
+        if ((rc = device_alloc((void **)&d->g_mass, (uint64_t)nodes * 64u, c, "grid sums", err, errlen))) return rc;
+        HB_CUDA_AS(cudaMemset(d->g_mass, 0, (size_t)nodes * 64u), "zeroing the grid sums");
         d->g_mom = d->g_mass + nodes;
+        d->g_cur = 0;
         if (c->scene.dyn.grid_friction_declared &&
             (rc = device_alloc(&d->g_node_v, (uint64_t)nodes * 4u * rs, c, "grid velocities", err, errlen)))
             return rc;
@@ -574,11 +578,14 @@ static cudaError_t dyn_grid_build(cuda_impl *c, const hbd::DModel<T> &m, const T
 {
     DynState *d = c->dyn;
     const hb_host_world *hw = &d->hw;
+    const int64_t nodes = hw->nodes;
+    int64_t *mass = d->g_mass + 4 * nodes * d->g_cur, *clear = d->g_mass + 4 * nodes * (1 - d->g_cur);
     cudaError_t e = hbd::launch_grid_splat<T>(m.world, qg, (const T *)c->state, (const T *)d->vel, c->N, c->P, m.perm,
-                                              d->g_mass, d->g_mom, st);
+                                              mass, mass + nodes, st);
     if (e != cudaSuccess) return e;
-    e = hbd::launch_grid_nodes<T>(m.world, qg, d->g_mass, d->g_mom, (const T *)d->g_target, (T)hw->inv_rho0,
+    e = hbd::launch_grid_nodes<T>(m.world, qg, mass, mass + nodes, clear, (const T *)d->g_target, (T)hw->inv_rho0,
                                   (T)hw->neg_kv, (T *)d->g_node_v, (T *)d->g_node_a, st);
+    d->g_cur = 1 - d->g_cur;
     if (e != cudaSuccess || !d->g_held) return e;
     return hbd::launch_grid_hold<T>(m.world, qg, m.h, (const T *)c->state, c->N, c->P, m.perm, (T *)d->g_held, st);
 }

@@ -33,8 +33,10 @@ template <> struct Splat<double> {
 };
 
 /* The splat (docs/cuda.md "The hair–hair grid"). A block takes kSplatStrands neighbouring
- * strands (the order perm; nullptr: as stored); each warp takes its strands one at a time, a lane
- * a point, so that every load of x and v coalesces. Pass 1 finds the block's box of cells. Where
+ * strands (the order perm; nullptr: as stored), whole or, where whole strands would leave SMs idle
+ * (few strands), a run of their points (blockIdx.y: a strand's points lie along it over many cells,
+ * neighbouring strands' points of one run close together); its threads take the points a strand's
+ * run at a time, a lane a point, so that every load of x and v coalesces. Pass 1 finds the block's box of cells. Where
  * no node can receive more than 2^16 shares, pass 2 adds each point's fixed-point shares in shared
  * memory by native 32-bit shared atomics (exact: see kSplatWindowPoints): a mass share in one word
  * with the carries out of it counted in another, a momentum share in one signed word where the
@@ -166,15 +168,19 @@ __device__ __forceinline__ void node_flush(int64_t j, const int64_t (&sum)[4], i
 
 template <typename T>
 __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
-    k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, int spb, const int64_t *perm,
-                 int64_t *mass, int64_t *mom)
+    k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, int spb, int pk,
+                 const int64_t *perm, int64_t *mass, int64_t *mom)
 {
     extern __shared__ unsigned win[];  /* [channel: mass, p_x, p_y, p_z][low, high][node] (word_at);
                                          hashed: keys[kHashSlots], then the same over slots */
     __shared__ int lo[3], hi[3], vmax; /* vmax: the bits of the block's largest |v| component (≥ 0) */
-    const int lane = (int)(threadIdx.x & 31u), warp = (int)(threadIdx.x >> 5);
+    const int lane = (int)(threadIdx.x & 31u);
     const int64_t s0 = (int64_t)blockIdx.x * spb;
     const int ns = N - s0 < spb ? (int)(N - s0) : spb;
+    /* the block's points: k0 … k0 + nk − 1 of each of its strands; item i is point k0 + i % pk of
+     * strand i / pk, so that at pk = 32 a warp takes a strand's 32 points */
+    const int k0 = (int)blockIdx.y * pk, nk = P - k0 < pk ? P - k0 : pk, items = ns * pk;
+    const int pks = (pk & (pk - 1)) == 0 ? __ffs(pk) - 1 : -1; /* log2 pk, or −1 */
     const int64_t n = w.gn;
     if (threadIdx.x < 3) lo[threadIdx.x] = INT_MAX, hi[threadIdx.x] = -1;
     if (threadIdx.x == 0) vmax = 0;
@@ -183,9 +189,10 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
      * clamped |v| component */
     int cl[3] = {INT_MAX, INT_MAX, INT_MAX}, ch[3] = {-1, -1, -1};
     float vm = 0.0f;
-    for (int s = warp; s < ns; s += kSplatWarps) {
-        const int64_t st = perm ? perm[s0 + s] : s0 + s;
-        for (int k = lane; k < P; k += 32) {
+    for (int i = (int)threadIdx.x; i < items; i += kSplatWarps * 32) {
+        const int s = pks >= 0 ? i >> pks : i / pk, k = k0 + (pks >= 0 ? i & (pk - 1) : i % pk);
+        if (k < k0 + nk) {
+            const int64_t st = perm ? perm[s0 + s] : s0 + s;
             const T *xp = x + 3 * (st * P + k);
             int64_t c[3];
             T f[3];
@@ -216,7 +223,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     /* the window's strides (y, z), both odd so that points a row or a plane apart (a hanging strand's
      * neighbours) meet in different banks, and its nodes, padding included */
     const int64_t sy64 = ex | 1, sz64 = (sy64 * ey) | 1;
-    const bool bounded = (int64_t)ns * P <= kSplatWindowPoints;
+    const bool bounded = (int64_t)ns * nk <= kSplatWindowPoints;
     const bool windowed = bounded && sz64 * ez <= kWindow, hashed = bounded && !windowed;
     const int sy = (int)sy64, sz = (int)sz64, nw = windowed ? sz * ez : 0;
     unsigned *const keys = win, *const slots = win + kHashSlots;
@@ -224,7 +231,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
      * most one a point, so while ns·P·(vmax·2^10 + 1) < 2^31 the block's momentum sums fit one
      * signed 32-bit word a node (exact, one atomic a share); else the split words as for mass */
     const bool single =
-        bounded && (double)ns * P * ((double)__int_as_float(vmax) * HB_GRID_MOM_SCALE + 1.0) < 2147483647.0;
+        bounded && (double)ns * nk * ((double)__int_as_float(vmax) * HB_GRID_MOM_SCALE + 1.0) < 2147483647.0;
     if (windowed)
         for (int i = threadIdx.x; i < nw; i += blockDim.x)
             for (int a = 0; a < 8; a++)
@@ -243,9 +250,10 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     static_assert(HB_GRID_MOM_SCALE == 1024.0, "the momentum shares' scaling is exact only for a power of two");
     auto pass2 = [&](auto fast) {
         constexpr bool Fast = decltype(fast)::value;
-        for (int s = warp; s < ns; s += kSplatWarps) {
-            const int64_t st = perm ? perm[s0 + s] : s0 + s;
-            for (int k = lane; k < P; k += 32) {
+        for (int i = (int)threadIdx.x; i < items; i += kSplatWarps * 32) {
+            const int s = pks >= 0 ? i >> pks : i / pk, k = k0 + (pks >= 0 ? i & (pk - 1) : i % pk);
+            if (k < k0 + nk) {
+                const int64_t st = perm ? perm[s0 + s] : s0 + s;
                 const int64_t r = st * P + k;
                 const T *xp = x + 3 * r, *vp = v + 3 * r;
                 int64_t cb[3];
@@ -300,12 +308,22 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
                 node_flush((int64_t)keys[i], sum, mass, mom);
 }
 
-template <typename T>
-__global__ void k_grid_nodes(World<T> w, const T *qg, const int64_t *mass, const int64_t *mom, const T *target,
-                             T inv_rho0, T neg_kv, T *node_v, T *node_a)
+/* the kernel before's writes visible (launched as a programmatic dependent: grid_chain) */
+__device__ __forceinline__ void wait_for_previous()
 {
-    const int64_t j = (int64_t)blockIdx.x * blockDim.x + threadIdx.x;
-    if (j < w.gn * w.gn * w.gn) Splat<T>::node(j, w, mass, mom, target, inv_rho0, neg_kv, qg, node_v, node_a);
+    asm volatile("griddepcontrol.wait;" ::: "memory");
+}
+
+template <typename T>
+__global__ void k_grid_nodes(World<T> w, const T *qg, const int64_t *mass, const int64_t *mom, int64_t *clear,
+                             const T *target, T inv_rho0, T neg_kv, T *node_v, T *node_a)
+{
+    wait_for_previous();
+    const int64_t j = (int64_t)blockIdx.x * blockDim.x + threadIdx.x, nodes = w.gn * w.gn * w.gn;
+    if (j >= nodes) return;
+    Splat<T>::node(j, w, mass, mom, target, inv_rho0, neg_kv, qg, node_v, node_a);
+    clear[j] = 0;
+    for (int c = 0; c < 3; c++) clear[nodes + 3 * j + c] = 0;
 }
 
 /* §3.16 `held`: a block takes kHoldStrands neighbouring strands in the strands' order (perm) and
@@ -329,6 +347,7 @@ __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
     __shared__ T xs[kHoldStrands * XW];
     __shared__ T hs[kHoldStrands * HW];
     __shared__ int64_t xo[kHoldStrands], ho[kHoldStrands]; /* each strand's first real in x and in held */
+    wait_for_previous();
     const int t = threadIdx.x;
     const int64_t s0 = (int64_t)blockIdx.x * kHoldStrands;
     const int k0 = (int)blockIdx.y * NB;
@@ -415,6 +434,11 @@ __global__ void __launch_bounds__(kHoldStrands *kHoldPoints)
 }
 
 constexpr int kSplatDevices = 64; /* devices whose attributes launch_grid_splat keeps */
+#ifndef HB_SPLAT_MIN_POINTS
+#define HB_SPLAT_MIN_POINTS 8
+#endif
+constexpr int kSplatMinPoints = HB_SPLAT_MIN_POINTS; /* the shortest run of a strand's points a splat block takes */
+constexpr int64_t kSplatRunStrands = 2048;           /* the fewest strands whose blocks take runs of points */
 
 int blocks_for(int64_t items, int block)
 {
@@ -428,13 +452,8 @@ template <typename T>
 cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const T *v, int64_t N, int64_t P,
                               const int64_t *perm, int64_t *mass, int64_t *mom, cudaStream_t stream)
 {
-    const int64_t nodes = w.gn * w.gn * w.gn;
-    /* the sums zeroed: at once where mom follows mass (backend_dyn.cu allocates them so) */
-    cudaError_t e = cudaMemsetAsync(mass, 0, (size_t)nodes * (mom == mass + nodes ? 4 : 1) * sizeof *mass, stream);
-    if (e == cudaSuccess && mom != mass + nodes) e = cudaMemsetAsync(mom, 0, (size_t)nodes * 3 * sizeof *mom, stream);
-    if (e != cudaSuccess) return e;
-    /* kSplatStrands a block, fewer (down to one a warp) where that leaves the GPU's SMs idle; the
-     * device's SM count and the kernel's shared-memory attribute asked once a device */
+    cudaError_t e;
+    /* the device's SM count and the kernel's shared-memory attribute asked once a device */
     const size_t smem = (size_t)kWindow * 8 * sizeof(unsigned);
     int dev = 0, sms = 0;
     if ((e = cudaGetDevice(&dev)) != cudaSuccess) return e;
@@ -452,21 +471,48 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
             ready[slot].fetch_or(sizeof(T) == 4 ? 1 : 2);
         }
     }
-    int spb = kSplatStrands;
-    while (spb > kSplatWarps && (N + spb - 1) / spb < 4 * (int64_t)sms) spb /= 2;
+    /* kSplatStrands whole strands a block; where that leaves SMs idle (fewer than four blocks an SM),
+     * half the strands and half the points (down to kSplatMinPoints) in turn, strands first, down
+     * to one strand a warp: a run of neighbouring strands' points lies close together, so that a
+     * block's box shrinks with its run (10,000 strands: 32 strands of 16 points, docs/cuda.md).
+     * Below kSplatRunStrands strands (a frame bound by its launches) whole strands only. */
+    int spb = kSplatStrands, pk = (int)P;
+    const bool runs = N >= kSplatRunStrands;
+    for (int step = 0; (N + spb - 1) / spb * ((P + pk - 1) / pk) < 4 * (int64_t)sms; step++) {
+        if ((step % 2 == 0 || !runs) && spb > kSplatWarps) spb /= 2;
+        else if (runs && pk >= 2 * kSplatMinPoints) pk = (pk + 1) / 2;
+        else if (spb > kSplatWarps) spb /= 2;
+        else break;
+    }
     const int64_t blocks = (N + spb - 1) / spb;
-    k_grid_splat<T><<<(int)(blocks < 1 ? 1 : blocks), kSplatWarps * 32, smem, stream>>>(w, qg, x, v, N, (int)P, spb,
-                                                                                        perm, mass, mom);
+    const dim3 grid((unsigned)(blocks < 1 ? 1 : blocks), (unsigned)((P + pk - 1) / pk));
+    k_grid_splat<T><<<grid, kSplatWarps * 32, smem, stream>>>(w, qg, x, v, N, (int)P, spb, pk, perm, mass, mom);
     return cudaGetLastError();
 }
 
-template <typename T>
-cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mass, const int64_t *mom, const T *target,
-                              T inv_rho0, T neg_kv, T *node_v, T *node_a, cudaStream_t stream)
+/* the node and hold kernels launched as programmatic dependents of the kernel before them (each
+ * waits for its output at its start: wait_for_previous), so that their launch overlaps its tail */
+template <typename K, typename... A>
+cudaError_t launch_chained(K kernel, dim3 grid, dim3 block, cudaStream_t stream, A... args)
 {
-    k_grid_nodes<T><<<blocks_for(w.gn * w.gn * w.gn, 256), 256, 0, stream>>>(w, qg, mass, mom, target, inv_rho0, neg_kv,
-                                                                             node_v, node_a);
-    return cudaGetLastError();
+    cudaLaunchConfig_t cfg = {};
+    cfg.gridDim = grid;
+    cfg.blockDim = block;
+    cfg.stream = stream;
+    cudaLaunchAttribute at[1];
+    at[0].id = cudaLaunchAttributeProgrammaticStreamSerialization;
+    at[0].val.programmaticStreamSerializationAllowed = 1;
+    cfg.attrs = at;
+    cfg.numAttrs = 1;
+    return cudaLaunchKernelEx(&cfg, kernel, args...);
+}
+
+template <typename T>
+cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mass, const int64_t *mom, int64_t *clear,
+                              const T *target, T inv_rho0, T neg_kv, T *node_v, T *node_a, cudaStream_t stream)
+{
+    return launch_chained(k_grid_nodes<T>, dim3((unsigned)blocks_for(w.gn * w.gn * w.gn, 256)), dim3(256), stream, w,
+                          qg, mass, mom, clear, target, inv_rho0, neg_kv, node_v, node_a);
 }
 
 template <typename T>
@@ -475,8 +521,8 @@ cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, in
 {
     const dim3 grid((unsigned)((N + kHoldStrands - 1) / kHoldStrands),
                     (unsigned)((P + kHoldPoints * kHoldRounds - 1) / (kHoldPoints * kHoldRounds)));
-    k_grid_hold<T><<<grid, kHoldStrands * kHoldPoints, 0, stream>>>(w, qg, h, x, N, (int)P, perm, held);
-    return cudaGetLastError();
+    return launch_chained(k_grid_hold<T>, grid, dim3(kHoldStrands * kHoldPoints), stream, w, qg, h, x, N, (int)P, perm,
+                          held);
 }
 
 template cudaError_t launch_grid_hold<float>(const World<float> &, const float *, float, const float *, int64_t,
@@ -488,9 +534,10 @@ template cudaError_t launch_grid_splat<float>(const World<float> &, const float 
 template cudaError_t launch_grid_splat<double>(const World<double> &, const double *, const double *, const double *,
                                                int64_t, int64_t, const int64_t *, int64_t *, int64_t *, cudaStream_t);
 template cudaError_t launch_grid_nodes<float>(const World<float> &, const float *, const int64_t *, const int64_t *,
-                                              const float *, float, float, float *, float *, cudaStream_t);
+                                              int64_t *, const float *, float, float, float *, float *, cudaStream_t);
 template cudaError_t launch_grid_nodes<double>(const World<double> &, const double *, const int64_t *, const int64_t *,
-                                               const double *, double, double, double *, double *, cudaStream_t);
+                                               int64_t *, const double *, double, double, double *, double *,
+                                               cudaStream_t);
 
 } /* namespace dyn */
 } /* namespace hb */

@@ -122,8 +122,8 @@ HB_HD double collider_depth(const World<double> &w, int i, const double *pose, c
 
 /* ---- the grid's kernels (cuda/dynamic/world.cu) ---- */
 /* §3.16 the splat of every point of x, v (canonical [N][P][3]) into mass [n³] and mom [n³][3]
- * (zeroed first by the launcher), with the grid rotation qg (device, nullptr: still); the strands
- * taken in the order perm (device, nullptr: as stored). */
+ * (zero: launch_grid_nodes clears the next build's), with the grid rotation qg (device, nullptr:
+ * still); the strands taken in the order perm (device, nullptr: as stored). */
 template <typename T>
 cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const T *v, int64_t N, int64_t P,
                               const int64_t *perm, int64_t *mass, int64_t *mom, cudaStream_t stream);
@@ -133,10 +133,11 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
 template <typename T>
 cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P, const int64_t *perm,
                              T *held, cudaStream_t stream);
-/* §3.16 the node fields from the sums (target, inv_rho0, neg_kv: volume). */
+/* §3.16 the node fields from the sums (target, inv_rho0, neg_kv: volume); clear ([4·n³], not mass's
+ * set) zeroed for the next build. */
 template <typename T>
-cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mass, const int64_t *mom, const T *target,
-                              T inv_rho0, T neg_kv, T *node_v, T *node_a, cudaStream_t stream);
+cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mass, const int64_t *mom, int64_t *clear,
+                              const T *target, T inv_rho0, T neg_kv, T *node_v, T *node_a, cudaStream_t stream);
 
 } /* namespace dyn */
 } /* namespace hb */

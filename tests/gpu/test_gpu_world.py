@@ -235,12 +235,17 @@ def input_positions(cpu):
 # A window node's mass sum past 32 bits (docs/cuda.md "The hair–hair grid": a mass share is summed
 # in one 32-bit shared word, the carries out of it counted in another, joined into 64 bits). One cell whose
 # low corner sits at the hair, so every point's weight at node 0 is above 0.7 and a splat block of at
-# least 8 strands of 64 points (the fewest a block takes) adds more than 2^32 there. The strict build bit for bit.
+# least 8 whole strands of 64 points (the fewest a block takes below SPLAT_RUN_STRANDS) adds more than
+# 2^32 there. The strict build bit for bit.
 CARRY = ["--strands", "300", "--points", "64", "--substeps", "4", "--iterations", "2", "--bend-compliance", "1e-6",
          "--shape-compliance", "1e-4", "--drag", "0.5", "--wind-speed", "150", "--grid", "2",
          "--grid-box=-13,-45,-13,250,250,250", "--grid-friction", "0.1,0.02", "--grid-volume", "2000"]  # fmt: skip
 MASS_SCALE = 2**24  # HB_GRID_MASS_SCALE, c_ref/dynamic/contact_impl.h
 SPLAT_STRANDS_MIN = 8  # kSplatWarps, cuda/dynamic/world.cu
+# below this many strands a splat block takes whole strands (kSplatRunStrands, cuda/dynamic/world.cu)
+SPLAT_RUN_STRANDS = int(
+    re.search(r"kSplatRunStrands = (\d+);", (ROOT / "cuda/dynamic/world.cu").read_text())[1]  # type: ignore[index]
+)
 
 
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
@@ -250,7 +255,7 @@ def test_gpu_splat_whose_window_sums_carry_matches_cpu_bit_for_bit(work, variant
     x = input_positions(cpu)
     lo, hi = np.array([-13.0, -45.0, -13.0]), np.array([250.0, 250.0, 250.0])
     weight = np.prod(1.0 - (x - lo) / (hi - lo), axis=-1)  # each point's trilinear weight at node 0
-    assert SPLAT_STRANDS_MIN * x.shape[1] * weight.min() * MASS_SCALE > 2**32
+    assert x.shape[0] < SPLAT_RUN_STRANDS and SPLAT_STRANDS_MIN * x.shape[1] * weight.min() * MASS_SCALE > 2**32
     frame_matches(work, cpu, "strict", variant, f"carry_{precision}")
 
 
@@ -289,6 +294,7 @@ def test_gpu_splat_in_its_hash_table_matches_cpu_bit_for_bit(work, variant, prec
     cpu = cpu_scene_file(work, f"hash_{case}", [*HASH, "--points", points], precision, frames)
     nodes = corner_nodes(input_positions(cpu), HASH_BOX, 256)
     assert np.all(nodes >= 0), "a point outside the grid"
+    assert len(nodes) < SPLAT_RUN_STRANDS  # blocks of whole strands
     own = [len(np.unique(s)) for s in nodes]  # each strand's nodes
     shared = nodes.size - len(np.unique(nodes))  # shares beyond the first at a node, over all strands
     if case == "fill":  # any 8 strands touch more nodes than the table has slots
@@ -300,17 +306,21 @@ def test_gpu_splat_in_its_hash_table_matches_cpu_bit_for_bit(work, variant, prec
     frame_matches(work, cpu, "strict", variant, f"hash_{case}_{precision}")
 
 
-# k_grid_hold over more blocks than a GPU holds at once: 12,000 strands of 24 points (375 blocks of
-# strands, three of points), with colliders. The strict build bit for bit.
-HELD_WIDE = ["--strands", "12000", "--points", "24", "--substeps", "4", "--iterations", "2", "--bend-compliance",
+# k_grid_hold over more blocks than a GPU holds at once, and the splat's blocks taking runs of their
+# strands' points (docs/cuda.md "The hair–hair grid"): 12,000 strands of 24 points (the hold's 375
+# blocks of strands, three of points; the splat's blocks, on a GPU of 132 SMs, 32 strands of 12 points:
+# a run whose length is no power of two) or of 32 points (32 strands of 16), with colliders. The strict
+# build bit for bit.
+HELD_WIDE = ["--strands", "12000", "--substeps", "4", "--iterations", "2", "--bend-compliance",
              "1e-6", "--shape-compliance", "1e-4", "--drag", "0.5", *HELD, *HELD_BODY]  # fmt: skip
 
 
+@pytest.mark.parametrize("points", ["24", "32"])
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 @pytest.mark.parametrize("variant", [v for v in VARIANTS if _DECLARED.runs_features(v, {"grid", "colliders"})])
-def test_gpu_held_samples_in_wide_blocks_match_cpu_bit_for_bit(work, variant, precision):
-    cpu = cpu_scene_file(work, "held_wide", HELD_WIDE, precision)
-    frame_matches(work, cpu, "strict", variant, f"held_wide_{precision}")
+def test_gpu_held_samples_in_wide_blocks_match_cpu_bit_for_bit(work, variant, precision, points):
+    cpu = cpu_scene_file(work, f"held_wide_{points}", [*HELD_WIDE, "--points", points], precision)
+    frame_matches(work, cpu, "strict", variant, f"held_wide_{points}_{precision}")
 
 
 # §3.17 the collision step in 4 sweeps on the body scene (configs/scenes/body.toml: the default
