@@ -72,7 +72,7 @@ struct DynState {
      * sums and node fields, the frame's pose tables, and the world struct on the device (for
      * the observables) */
     hb_host_world hw;
-    int64_t *g_mass, *g_mom; /* two sets of sums [4·n³] (mass, then momentum): the next build's, zero, is g_cur */
+    int64_t *g_mass; /* two sets of sums [4·n³] (mass, then momentum): g_cur, zero, the next build's */
     int g_cur;
     void *g_node_v, *g_node_a, *g_target, *g_ftab;
     void *g_held; /* §3.16 `held`: each point's sample for the frame */
@@ -265,7 +265,7 @@ void dyn_free(cuda_impl *c)
                     d->shape_rest, d->seg_rest,  d->seg64,   d->d_render,   d->d_vrender};
     for (void *p : ptrs)
         if (p) cudaFree(p);
-    /* g_mom lies in g_mass's allocation */
+    /* both sets of sums lie in g_mass's allocation */
     void *world[] = {d->g_mass, d->g_node_v, d->g_node_a, d->g_target, d->g_ftab, d->g_held,
                      d->c_kind, d->c_frame,  d->c_sdf_n,  d->c_mu,     d->c_geo,  d->c_sdf_ptrs,
                      d->f_pose, d->f_back,   d->f_qs,     d->d_world,  d->perm,   d->contacts};
@@ -361,7 +361,6 @@ template <typename T> static int dyn_world_load(cuda_impl *c, const void *rest, 
          * kernel zeroes the other for the next build, so that no build waits on a memset */
         if ((rc = device_alloc((void **)&d->g_mass, (uint64_t)nodes * 64u, c, "grid sums", err, errlen))) return rc;
         HB_CUDA_AS(cudaMemset(d->g_mass, 0, (size_t)nodes * 64u), "zeroing the grid sums");
-        d->g_mom = d->g_mass + nodes;
         d->g_cur = 0;
         if (c->scene.dyn.grid_friction_declared &&
             (rc = device_alloc(&d->g_node_v, (uint64_t)nodes * 4u * rs, c, "grid velocities", err, errlen)))

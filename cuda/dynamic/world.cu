@@ -36,8 +36,8 @@ template <> struct Splat<double> {
  * strands (the order perm; nullptr: as stored), whole or, where whole strands would leave SMs idle
  * (few strands), a run of their points (blockIdx.y: a strand's points lie along it over many cells,
  * neighbouring strands' points of one run close together); its threads take the points a strand's
- * run at a time, a lane a point, so that every load of x and v coalesces. Pass 1 finds the block's box of cells. Where
- * no node can receive more than 2^16 shares, pass 2 adds each point's fixed-point shares in shared
+ * run at a time, a lane a point, so that every load of x and v coalesces. Pass 1 finds the block's
+ * box of cells. Where no node can receive more than 2^16 shares, pass 2 adds each point's fixed-point shares in shared
  * memory by native 32-bit shared atomics (exact: see kSplatWindowPoints): a mass share in one word
  * with the carries out of it counted in another, a momentum share in one signed word where the
  * block's speeds bound its sums, else split into its low 16 bits and the rest; in a window over
@@ -308,7 +308,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
                 node_flush((int64_t)keys[i], sum, mass, mom);
 }
 
-/* the kernel before's writes visible (launched as a programmatic dependent: grid_chain) */
+/* the kernel before's writes visible (launched as a programmatic dependent: launch_chained) */
 __device__ __forceinline__ void wait_for_previous()
 {
     asm volatile("griddepcontrol.wait;" ::: "memory");
