@@ -166,6 +166,12 @@ __device__ __forceinline__ void node_flush(int64_t j, const int64_t (&sum)[4], i
         if (sum[1 + c]) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sum[1 + c]);
 }
 
+/* the kernel before's writes visible (launched as a programmatic dependent: launch_chained) */
+__device__ __forceinline__ void wait_for_previous()
+{
+    asm volatile("griddepcontrol.wait;" ::: "memory");
+}
+
 template <typename T>
 __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, int spb, int pk,
@@ -174,6 +180,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     extern __shared__ unsigned win[];  /* [channel: mass, p_x, p_y, p_z][low, high][node] (word_at);
                                          hashed: keys[kHashSlots], then the same over slots */
     __shared__ int lo[3], hi[3], vmax; /* vmax: the bits of the block's largest |v| component (≥ 0) */
+    wait_for_previous();
     const int lane = (int)(threadIdx.x & 31u);
     const int64_t s0 = (int64_t)blockIdx.x * spb;
     const int ns = N - s0 < spb ? (int)(N - s0) : spb;
@@ -308,12 +315,6 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
                 node_flush((int64_t)keys[i], sum, mass, mom);
 }
 
-/* the kernel before's writes visible (launched as a programmatic dependent: launch_chained) */
-__device__ __forceinline__ void wait_for_previous()
-{
-    asm volatile("griddepcontrol.wait;" ::: "memory");
-}
-
 template <typename T>
 __global__ void k_grid_nodes(World<T> w, const T *qg, const int64_t *mass, const int64_t *mom, int64_t *clear,
                              const T *target, T inv_rho0, T neg_kv, T *node_v, T *node_a)
@@ -333,8 +334,10 @@ __global__ void k_grid_nodes(World<T> w, const T *qg, const int64_t *mass, const
  * come in and samples go out through shared memory, a strand's run of points contiguous (rows
  * padded against bank conflicts), a thread's loads all issued before its first store (the loop's
  * trip count fixed by the block's shape). The root's sample (k = 0) is written but never applied. */
+/* rounds a thread: two in the free builds (4M strands: `held` 2.7% and `substep` 6% faster than one,
+ * bit-identical, docs/cuda.md), one in the strict build (its 8 reals a point, as tested) */
 #ifndef HB_HOLD_ROUNDS
-#define HB_HOLD_ROUNDS 1
+#define HB_HOLD_ROUNDS (kGridFree ? 2 : 1)
 #endif
 constexpr int kHoldStrands = 32, kHoldPoints = 8, kHoldRounds = HB_HOLD_ROUNDS;
 template <typename T>
@@ -448,6 +451,24 @@ int blocks_for(int64_t items, int block)
 
 } /* namespace */
 
+/* the grid's kernels launched as programmatic dependents of the kernel before them (each waits for
+ * its output at its start: wait_for_previous), so that their launch overlaps its tail */
+template <typename K, typename... A>
+cudaError_t launch_chained(K kernel, dim3 grid, dim3 block, size_t smem, cudaStream_t stream, A... args)
+{
+    cudaLaunchConfig_t cfg = {};
+    cfg.gridDim = grid;
+    cfg.blockDim = block;
+    cfg.dynamicSmemBytes = smem;
+    cfg.stream = stream;
+    cudaLaunchAttribute at[1];
+    at[0].id = cudaLaunchAttributeProgrammaticStreamSerialization;
+    at[0].val.programmaticStreamSerializationAllowed = 1;
+    cfg.attrs = at;
+    cfg.numAttrs = 1;
+    return cudaLaunchKernelEx(&cfg, kernel, args...);
+}
+
 template <typename T>
 cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const T *v, int64_t N, int64_t P,
                               const int64_t *perm, int64_t *mass, int64_t *mom, cudaStream_t stream)
@@ -486,32 +507,15 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
     }
     const int64_t blocks = (N + spb - 1) / spb;
     const dim3 grid((unsigned)(blocks < 1 ? 1 : blocks), (unsigned)((P + pk - 1) / pk));
-    k_grid_splat<T><<<grid, kSplatWarps * 32, smem, stream>>>(w, qg, x, v, N, (int)P, spb, pk, perm, mass, mom);
-    return cudaGetLastError();
-}
-
-/* the node and hold kernels launched as programmatic dependents of the kernel before them (each
- * waits for its output at its start: wait_for_previous), so that their launch overlaps its tail */
-template <typename K, typename... A>
-cudaError_t launch_chained(K kernel, dim3 grid, dim3 block, cudaStream_t stream, A... args)
-{
-    cudaLaunchConfig_t cfg = {};
-    cfg.gridDim = grid;
-    cfg.blockDim = block;
-    cfg.stream = stream;
-    cudaLaunchAttribute at[1];
-    at[0].id = cudaLaunchAttributeProgrammaticStreamSerialization;
-    at[0].val.programmaticStreamSerializationAllowed = 1;
-    cfg.attrs = at;
-    cfg.numAttrs = 1;
-    return cudaLaunchKernelEx(&cfg, kernel, args...);
+    return launch_chained(k_grid_splat<T>, grid, dim3(kSplatWarps * 32), smem, stream, w, qg, x, v, N, (int)P, spb, pk,
+                          perm, mass, mom);
 }
 
 template <typename T>
 cudaError_t launch_grid_nodes(const World<T> &w, const T *qg, const int64_t *mass, const int64_t *mom, int64_t *clear,
                               const T *target, T inv_rho0, T neg_kv, T *node_v, T *node_a, cudaStream_t stream)
 {
-    return launch_chained(k_grid_nodes<T>, dim3((unsigned)blocks_for(w.gn * w.gn * w.gn, 256)), dim3(256), stream, w,
+    return launch_chained(k_grid_nodes<T>, dim3((unsigned)blocks_for(w.gn * w.gn * w.gn, 256)), dim3(256), 0, stream, w,
                           qg, mass, mom, clear, target, inv_rho0, neg_kv, node_v, node_a);
 }
 
@@ -521,8 +525,8 @@ cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, in
 {
     const dim3 grid((unsigned)((N + kHoldStrands - 1) / kHoldStrands),
                     (unsigned)((P + kHoldPoints * kHoldRounds - 1) / (kHoldPoints * kHoldRounds)));
-    return launch_chained(k_grid_hold<T>, grid, dim3(kHoldStrands * kHoldPoints), stream, w, qg, h, x, N, (int)P, perm,
-                          held);
+    return launch_chained(k_grid_hold<T>, grid, dim3(kHoldStrands * kHoldPoints), 0, stream, w, qg, h, x, N, (int)P,
+                          perm, held);
 }
 
 template cudaError_t launch_grid_hold<float>(const World<float> &, const float *, float, const float *, int64_t,
