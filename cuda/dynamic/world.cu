@@ -188,6 +188,8 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
      * strand i / pk, so that at pk = 32 a warp takes a strand's 32 points */
     const int k0 = (int)blockIdx.y * pk, nk = P - k0 < pk ? P - k0 : pk, items = ns * pk;
     const int pks = (pk & (pk - 1)) == 0 ? __ffs(pk) - 1 : -1; /* log2 pk, or −1 */
+    auto strand_of = [&](int i) { return pks >= 0 ? i >> pks : i / pk; };
+    auto point_of = [&](int i) { return k0 + (pks >= 0 ? i & (pk - 1) : i % pk); };
     const int64_t n = w.gn;
     if (threadIdx.x < 3) lo[threadIdx.x] = INT_MAX, hi[threadIdx.x] = -1;
     if (threadIdx.x == 0) vmax = 0;
@@ -197,7 +199,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     int cl[3] = {INT_MAX, INT_MAX, INT_MAX}, ch[3] = {-1, -1, -1};
     float vm = 0.0f;
     for (int i = (int)threadIdx.x; i < items; i += kSplatWarps * 32) {
-        const int s = pks >= 0 ? i >> pks : i / pk, k = k0 + (pks >= 0 ? i & (pk - 1) : i % pk);
+        const int s = strand_of(i), k = point_of(i);
         if (k < k0 + nk) {
             const int64_t st = perm ? perm[s0 + s] : s0 + s;
             const T *xp = x + 3 * (st * P + k);
@@ -258,7 +260,7 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     auto pass2 = [&](auto fast) {
         constexpr bool Fast = decltype(fast)::value;
         for (int i = (int)threadIdx.x; i < items; i += kSplatWarps * 32) {
-            const int s = pks >= 0 ? i >> pks : i / pk, k = k0 + (pks >= 0 ? i & (pk - 1) : i % pk);
+            const int s = strand_of(i), k = point_of(i);
             if (k < k0 + nk) {
                 const int64_t st = perm ? perm[s0 + s] : s0 + s;
                 const int64_t r = st * P + k;
