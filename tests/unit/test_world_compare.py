@@ -1,7 +1,9 @@
 """tools/world_compare.sh refuses what it cannot time in one line, exit status 2, before it writes
 anything (the GPU rows themselves run on a GPU node: results/reference-h200/world_timing.txt)."""
 
+import shutil
 import subprocess
+import sys
 
 import pytest
 
@@ -16,6 +18,9 @@ TOOL = ROOT / "tools" / "world_compare.sh"
         ([], "give at least one build as NAME=BINARY"),
         (["head"], "'head' is not NAME=BINARY"),
         (["head=/nonexistent/hairsim-cuda"], "/nonexistent/hairsim-cuda is not an executable binary"),
+        (["keep=HB_KEEP=1@/nonexistent/hairsim-cuda"], "/nonexistent/hairsim-cuda is not an executable binary"),
+        (["keep=HB KEEP=1@/bin/true"], "'HB KEEP=1' in build 'keep' is not VAR=VALUE"),
+        (["keep=HB_KEEP=1,=2@/bin/true"], "'=2' in build 'keep' is not VAR=VALUE"),
     ],
 )
 def test_world_compare_refuses_bad_builds_before_writing(tmp_path, builds, says):
@@ -75,3 +80,65 @@ def test_world_compare_runs_a_once_row_with_collide_once(tmp_path):
     every, once = (tmp_path / "calls.txt").read_text().splitlines()
     assert "--friction 0.3,0.2 --depenetration-speed 200" in every and "--collide-once" not in every
     assert once.replace(" --collide-once", "") == every and once.count("--collide-once") == 1
+
+
+FAKE_ENV = """#!/bin/bash
+echo "HB_FAKE=${HB_FAKE-unset} OTHER=${OTHER-unset}" >> "$(dirname "$0")/calls.txt"
+echo "{\\"strands\\": 10000, \\"stages\\": [{\\"median_ms\\": 1.0, \\"min_ms\\": 1.0, \\"max_ms\\": 1.0}]}"
+"""
+
+
+def test_world_compare_runs_a_build_with_its_variables_alone(tmp_path):
+    b = tmp_path / "hairsim-cuda"
+    b.write_text(FAKE_ENV)
+    b.chmod(0o755)
+    env = {"PATH": "/usr/bin:/bin", "ROWS": "held", "SMALL": "10000", "LARGE": "", "ROUNDS": "1"}
+    builds = [f"main={b}", f"probe=HB_FAKE=7,OTHER=x@{b}", f"again={b}"]
+    r = subprocess.run(["bash", str(TOOL), str(tmp_path / "out"), *builds], cwd=ROOT, capture_output=True, text=True,
+                       env=env)  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "calls.txt").read_text().splitlines() == [
+        "HB_FAKE=unset OTHER=unset",
+        "HB_FAKE=7 OTHER=x",
+        "HB_FAKE=unset OTHER=unset",
+    ]
+    assert [line.split()[0] for line in (tmp_path / "out" / "bench.txt").read_text().splitlines()] == [
+        "main",
+        "probe",
+        "again",
+    ]
+
+
+# a build that writes one of two real states (HB_FAKE_ALT picks the other) wherever --output says
+FAKE_STATE = """#!/bin/bash
+src="$(dirname "$0")/a.h5"; [ -n "${HB_FAKE_ALT-}" ] && src="$(dirname "$0")/b.h5"
+while [ $# -gt 0 ]; do [ "$1" = --output ] && cp "$src" "$2"; shift; done
+echo "{\\"strands\\": 10000, \\"stages\\": [{\\"median_ms\\": 1.0, \\"min_ms\\": 1.0, \\"max_ms\\": 1.0}]}"
+"""
+
+
+def test_world_compare_bits_finds_the_build_whose_states_differ_before_timing(tmp_path, cpu_bin):
+    run = [str(cpu_bin), "--stages", "init,collide,simulate", "--strands", "6", "--points", "8", "--frames", "2"]
+    for name, gravity in (("a", "981"), ("b", "900")):
+        subprocess.run([*run, "--gravity", gravity, "--output", str(tmp_path / f"{name}.h5"), "--quiet"], check=True)
+    b = tmp_path / "hairsim-cuda"
+    b.write_text(FAKE_STATE)
+    b.chmod(0o755)
+    env = {"PATH": "/usr/bin:/bin", "ROWS": "held", "SMALL": "10000", "LARGE": "", "BITS": "1",
+           "PYTHON": sys.executable}  # fmt: skip
+    out = tmp_path / "out"
+    builds = [f"main={b}", f"copy={b}", f"other=HB_FAKE_ALT=1@{b}"]
+    r = subprocess.run(["bash", str(TOOL), str(out), *builds], cwd=ROOT, capture_output=True, text=True, env=env)
+    assert r.returncode == 1, r.stderr
+    assert r.stderr.strip().splitlines()[-1] == "error: a build's states differ from main's (OUTDIR/bits.txt)"
+    scenes = ("held", "substep", "body-once", "fp64-held")
+    lines = (out / "bits.txt").read_text().splitlines()
+    assert lines == [f"{n} {s} {v}" for n, v in (("main", "reference"), ("copy", "same"), ("other", "differs"))
+                     for s in scenes]  # fmt: skip
+    assert not (out / "bench.txt").exists()
+    shutil.copy(tmp_path / "a.h5", tmp_path / "b.h5")  # now every build writes the same state: timed after
+    shutil.rmtree(out)
+    r = subprocess.run(["bash", str(TOOL), str(out), *builds], cwd=ROOT, capture_output=True, text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    assert all(line.endswith((" reference", " same")) for line in (out / "bits.txt").read_text().splitlines())
+    assert len((out / "bench.txt").read_text().splitlines()) == 3 * 2
