@@ -46,10 +46,18 @@ for what in ${ROWS:-held frame substep}; do
 done
 mkdir -p "$OUTD"
 source "$(dirname "$0")/world_scene.sh"
+run_as() { # BUILD COMMAND...: the command run with the build's variables set, in a subshell
+  local e kv kvs
+  e=$(env_of "$1")
+  shift
+  (
+    if [ -n "$e" ]; then IFS=, read -r -a kvs <<<"$e"; for kv in "${kvs[@]}"; do export "${kv?}"; done; fi
+    "$@"
+  )
+}
 row() { # name build round row strands
-  local name=$1 bin r=$3 what=$4 n=$5 fr=3 rep=5 flags e
+  local name=$1 bin r=$3 what=$4 n=$5 fr=3 rep=5 flags
   bin=$(bin_of "$2")
-  e=$(env_of "$2")
   [ "$n" -lt 100000 ] && { fr=10; rep=20; }
   case ${what%-once} in
     held) flags=$HELD32 ;;
@@ -61,25 +69,20 @@ row() { # name build round row strands
     *) flags="" ;; # base
   esac
   [ "$what" != "${what%-once}" ] && flags="$flags --collide-once"
-  ( # the build's variables for its rows alone
-    if [ -n "$e" ]; then IFS=, read -r -a kvs <<<"$e"; for kv in "${kvs[@]}"; do export "${kv?}"; done; fi
-    # shellcheck disable=SC2086 # the flag string splits into words on purpose
-    world_row "$OUTD" "$name r$r $what" "$bin" "$n" $fr $rep $flags
-  )
+  # shellcheck disable=SC2086 # the flag string splits into words on purpose
+  run_as "$2" world_row "$OUTD" "$name r$r $what" "$bin" "$n" $fr $rep $flags
 }
 bits() { # every build's states on short scenes against the first build's, bit for bit
   local scenes=("held:4:$HELD32" "substep:3:$SUBSTEP32" "body-once:3:$BODY --collide-once" "fp64-held:3:$HELD32 --precision fp64")
-  local first="" sc name b fr flags out bad=0 e
+  local first="" sc name b fr flags out bad=0
   mkdir -p "$OUTD/bits"
   for b in "$@"; do
     name=${b%%=*}
     for sc in "${scenes[@]}"; do
       fr=${sc#*:}; flags=${fr#*:}; fr=${fr%%:*}; out="$OUTD/bits/$name-${sc%%:*}.h5"
-      e=$(env_of "$b")
       # shellcheck disable=SC2086 # DYN and the flags split into words on purpose
-      if ! ( if [ -n "$e" ]; then IFS=, read -r -a kvs <<<"$e"; for kv in "${kvs[@]}"; do export "${kv?}"; done; fi
-        "$(bin_of "$b")" $DYN --strands "${SMALL:-10000}" --frames "$fr" $flags --output "$out" --force --quiet ) \
-        2>>"$OUTD/bits.err"; then
+      if ! run_as "$b" "$(bin_of "$b")" $DYN --strands "${SMALL:-10000}" --frames "$fr" $flags --output "$out" \
+        --force --quiet 2>>"$OUTD/bits.err"; then
         echo "$name ${sc%%:*} failed" | tee -a "$OUTD/bits.txt"; bad=1; continue
       fi
       [ -z "$first" ] && { echo "$name ${sc%%:*} reference" | tee -a "$OUTD/bits.txt"; continue; }

@@ -336,8 +336,8 @@ __global__ void k_grid_nodes(World<T> w, const T *qg, const int64_t *mass, const
  * come in and samples go out through shared memory, a strand's run of points contiguous (rows
  * padded against bank conflicts), a thread's loads all issued before its first store (the loop's
  * trip count fixed by the block's shape). The root's sample (k = 0) is written but never applied. */
-/* rounds a thread: two in the free builds (4M strands: `held` 2.7% and `substep` 6% faster than one,
- * bit-identical, docs/cuda.md), one in the strict build (its 8 reals a point, as tested) */
+/* rounds a thread: two in the free builds (faster at 4M strands, bit-identical: docs/cuda.md's designs
+ * table), one in the strict build (its 8 reals a point, as tested) */
 #ifndef HB_HOLD_ROUNDS
 #define HB_HOLD_ROUNDS (kGridFree ? 2 : 1)
 #endif
