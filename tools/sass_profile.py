@@ -39,8 +39,14 @@ def read(path):
         raise ProfileError(f"{path}: no column {sorted(missing)[0]!r}: export it with --page source --print-source sass")
     out = pd.DataFrame({"sass": df["Source"].astype(str).str.strip()})
     out["n"] = pd.to_numeric(df["Instructions Executed"], errors="coerce").fillna(0.0)
-    out["op"] = out["sass"].map(lambda s: (OPCODE.match(s).group(1) if OPCODE.match(s) else "?").split(".")[0])
+    out["op"] = out["sass"].map(opcode)
     return out
+
+
+def opcode(sass):
+    """An instruction's opcode without its predicate and modifiers ("@!P2 LDS.128 …" → "LDS")."""
+    m = OPCODE.match(sass)
+    return m.group(1).split(".")[0] if m else "?"
 
 
 def by_opcode(df):
