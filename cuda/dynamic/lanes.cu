@@ -171,7 +171,10 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
     do { /* one launch at least, as before */
         mc.j1 = chunk < j1 - mc.j0 ? mc.j0 + chunk : j1;
         const size_t cb = col ? (size_t)lanes_col_reals(m.world.ncol, mc.j1 - mc.j0) * sizeof(T) : 0;
-        k.fn<<<grid, b, smem + cb, stream>>>(mc, q, phase, x, v, rest, bend_rest, N);
+        /* a programmatic dependent of the kernel before it (the grid's hold, or the launch before) */
+        if ((e = launch_chained(k.fn, dim3((unsigned)grid), dim3((unsigned)b), smem + cb, stream, mc, q, phase, x, v,
+                                rest, bend_rest, N)) != cudaSuccess)
+            return e;
         if ((e = cudaGetLastError()) != cudaSuccess) return e;
         mc.j0 = mc.j1;
     } while (mc.j0 < j1);

@@ -3,6 +3,7 @@
  * changes no bit, and the node fields. */
 #include "dynamic/world.cuh"
 
+#include "dynamic/chain.cuh" /* the grid's kernels and the lanes kernel after them: programmatic dependents */
 #include "dynamic/held.cuh"
 
 #include <atomic>
@@ -164,12 +165,6 @@ __device__ __forceinline__ void node_flush(int64_t j, const int64_t (&sum)[4], i
     if (sum[0]) atomicAdd((unsigned long long *)&mass[j], (unsigned long long)sum[0]);
     for (int c = 0; c < 3; c++)
         if (sum[1 + c]) atomicAdd((unsigned long long *)&mom[3 * j + c], (unsigned long long)sum[1 + c]);
-}
-
-/* the kernel before's writes visible (launched as a programmatic dependent: launch_chained) */
-__device__ __forceinline__ void wait_for_previous()
-{
-    asm volatile("griddepcontrol.wait;" ::: "memory");
 }
 
 template <typename T>
@@ -452,24 +447,6 @@ int blocks_for(int64_t items, int block)
 }
 
 } /* namespace */
-
-/* the grid's kernels launched as programmatic dependents of the kernel before them (each waits for
- * its output at its start: wait_for_previous), so that their launch overlaps its tail */
-template <typename K, typename... A>
-cudaError_t launch_chained(K kernel, dim3 grid, dim3 block, size_t smem, cudaStream_t stream, A... args)
-{
-    cudaLaunchConfig_t cfg = {};
-    cfg.gridDim = grid;
-    cfg.blockDim = block;
-    cfg.dynamicSmemBytes = smem;
-    cfg.stream = stream;
-    cudaLaunchAttribute at[1];
-    at[0].id = cudaLaunchAttributeProgrammaticStreamSerialization;
-    at[0].val.programmaticStreamSerializationAllowed = 1;
-    cfg.attrs = at;
-    cfg.numAttrs = 1;
-    return cudaLaunchKernelEx(&cfg, kernel, args...);
-}
 
 template <typename T>
 cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const T *v, int64_t N, int64_t P,
