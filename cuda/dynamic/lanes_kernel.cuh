@@ -607,8 +607,8 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
     k_lanes(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
             const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N)
 {
-    wait_for_previous(); /* launched as a programmatic dependent (lanes.cu: launch_chained) */
-    constexpr int SPW = 32 / L;                             /* strands a warp */
+    wait_for_previous();        /* launched as a programmatic dependent (lanes.cu: launch_chained) */
+    constexpr int SPW = 32 / L; /* strands a warp */
     constexpr bool Ordered = (W & (kWGather | kWCol)) != 0; /* strands in the order m.perm */
     extern __shared__ __align__(16) unsigned char hb_lanes_smem[];
     const Feat has = MakeFeat<Feat>::make(m.features);
