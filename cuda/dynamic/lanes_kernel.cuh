@@ -326,6 +326,30 @@ template <typename T> __device__ __forceinline__ bool col_in_bound(const T *pose
     return (bx * bx + by * by) + bz * bz < pose[19];
 }
 
+/* A mesh's second test, the one sdf_value_free and sdf_sample make first (the same operations): a
+ * point outside the SDF's cube is left as it is. Clears in[s] for such points; true while one is left. */
+template <int NP, typename T, class Wd>
+__device__ __forceinline__ bool mesh_in_cube(const Wd &w, int i, const T *pose, const V3<T> *p, bool (&in)[NP])
+{
+    const int frame = w.col_frame[i], n1 = (int)w.sdf_n[i] - 1;
+    const bool turn = frame == HB_FRAME_HEAD && w.motion, sway = frame == HB_FRAME_BODY && w.sway;
+    const T *geo = w.sdf_geo + 4 * i;
+    bool any = false;
+#pragma unroll
+    for (int s = 0; s < NP; s++) {
+        if (!in[s]) continue;
+        const T q[3] = {p[s].x, p[s].y, p[s].z};
+        T u[3];
+        mesh_local_free(pose, turn, sway, q, u);
+        for (int c = 0; c < 3; c++) {
+            const T gc = (u[c] - geo[c]) * geo[3];
+            in[s] = in[s] && gc >= (T)0 && gc < (T)n1;
+        }
+        any = any || in[s];
+    }
+    return any;
+}
+
 /* Whether any bit of p differs from q's (contact_impl.h hb_moved); maybe_unused: each object is one
  * precision */
 [[maybe_unused]] __device__ __forceinline__ bool bits_differ(float a, float b)
@@ -433,6 +457,8 @@ __device__ __forceinline__ void collide_points(const DModel<T> &m, Feat has, con
                 in[s] = on[s] && col_in_bound(pi, p[s]);
                 any = any || in[s];
             }
+            if constexpr (kFreeCollide)
+                if (any && w.col_kind[i] == HB_COL_MESH) any = mesh_in_cube<NP>(w, i, pi, p, in);
             if (!__any_sync(mask, any)) continue;
 #pragma unroll
             for (int s = 0; s < NP; s++) {
