@@ -375,7 +375,9 @@ template <typename T> static int dyn_world_load(cuda_impl *c, const void *rest, 
         w.ftab = (const T *)d->g_ftab;
         w.node_v = (const T *)d->g_node_v;
         w.node_a = (const T *)d->g_node_a;
-        if (c->variant == V_LANES && hbd::lanes_holds_samples(w)) {
+        if (c->variant == V_LANES && hbd::lanes_hold_self(w)) {
+            m.hold_self = 1;
+        } else if (c->variant == V_LANES && hbd::lanes_holds_samples(w)) {
             if ((rc = device_alloc(&d->g_held, (uint64_t)c->N * (uint64_t)c->P * hbd::kHeldReals * rs, c,
                                    "the grid's held samples", err, errlen)))
                 return rc;

@@ -168,6 +168,10 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
     const int64_t g = (N + per_block - 1) / per_block;
     const int grid = (int)(g < 1 ? 1 : g > 2147483647 ? 2147483647 : g);
     DModel<T> mc = m;
+    /* the held kernel takes the strands in the order m.perm where it samples them itself (hold_block:
+     * the frame's samples at its start, its block's strands in one pass), else as stored */
+    if (m.hold_self && (g != grid || m.j0 != 0 || chunk < j1)) return cudaErrorInvalidValue;
+    if (wk == kWHeld && !m.hold_self) mc.perm = nullptr;
     do { /* one launch at least, as before */
         mc.j1 = chunk < j1 - mc.j0 ? mc.j0 + chunk : j1;
         const size_t cb = col ? (size_t)lanes_col_reals(m.world.ncol, mc.j1 - mc.j0) * sizeof(T) : 0;

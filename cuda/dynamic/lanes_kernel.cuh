@@ -622,12 +622,45 @@ __device__ __forceinline__ void pack(T *s, int k0, bool sw, int P, bool live, co
     }
 }
 
+/* §3.16 `held` (m.hold_self): k_grid_hold's work done by the held kernel's block for its own strands
+ * (those of its one pass of the strand loop: launch_frame_lanes' grid covers N) before the loop. A
+ * warp takes 32 consecutive (strand, point) pairs, strands fastest, so that it samples one point index
+ * across neighbouring strands in the order m.perm as k_grid_hold does, with the same functions; each
+ * sample goes to the warp's area where hold_sample would have put it. */
+template <typename T, int G, int L>
+__device__ __forceinline__ void hold_block(const DModel<T> &m, const T *qtab, const T *x, int64_t N, int wpb,
+                                           bool motion)
+{
+    constexpr int SPW = 32 / L;
+    extern __shared__ __align__(16) unsigned char hb_lanes_smem[];
+    const int P = (int)m.points;
+    const int64_t b0 = (int64_t)blockIdx.x * wpb * SPW;
+    const int nbs = N - b0 < (int64_t)wpb * SPW ? (int)(N - b0) : wpb * SPW;
+    const T *qg = motion ? m.qs : nullptr; /* the frame's first build (j0 = 0) */
+    for (int e = (int)threadIdx.x + nbs; e < nbs * P; e += (int)blockDim.x) { /* k ≥ 1 */
+        const int t = e % nbs, k = e / nbs;
+        const T *p = x + (m.perm[b0 + t] * P + k) * 3;
+        const Sample<T> s = grid_sample_xyz(m.world, qg, p[0], p[1], p[2]);
+        const int ww = t / SPW, l = k / G, lane = (t % SPW) * L + l;
+        const int i = G == 2 && (l & 1) ? 1 - (k & 1) : k % G; /* point_of's slot */
+        T *hs = (T *)hb_lanes_smem + (int64_t)ww * lanes_held_reals<T, G>();
+        if constexpr (kGridFree) { /* kHeldReals: the correction, as k_grid_hold keeps it */
+            store_node4(hs + 4 * (i * 32 + lane), held_correction(m.world, m.h, k, s));
+        } else {
+            store_node4(hs + 4 * (2 * i * 32 + lane), s.a);
+            store_node4(hs + 4 * ((2 * i + 1) * 32 + lane), s.b);
+        }
+    }
+    __syncthreads(); /* before the warps read their areas */
+}
+
 /* The frame of (32/L) strands a warp, L lanes a strand, G points a lane (G·L ≥ P); Ftl: the
  * solver of §3.7, else §3.6; Seg: a groom's per-segment rest lengths (§3.15, m.seg_rest); W: the
  * grid and colliders of §3.16–3.17 (m.world), with the strands taken in the order m.perm (slot
  * s holds strand perm[s], nearby strands together, so a block's points share grid nodes and
  * colliders) where the kernel reads the grid or tests colliders; the held grid's kernel (W =
- * kWHeld) reads each point's own sample, which no order changes, and takes them as stored. */
+ * kWHeld) reads each point's own sample, which no order changes: in the order where it samples
+ * them itself (m.hold_self), else as stored (m.perm nullptr). */
 template <typename T, class Feat, int G, int L, bool Ftl, bool Seg, int W>
 __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl, W>())
     k_lanes(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
@@ -635,7 +668,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
 {
     wait_for_previous();        /* launched as a programmatic dependent (lanes.cu: launch_chained) */
     constexpr int SPW = 32 / L; /* strands a warp */
-    constexpr bool Ordered = (W & (kWGather | kWCol)) != 0; /* strands in the order m.perm */
+    constexpr bool Ordered = (W & (kWGather | kWCol | kWHeld)) != 0; /* strands in the order m.perm */
     extern __shared__ __align__(16) unsigned char hb_lanes_smem[];
     const Feat has = MakeFeat<Feat>::make(m.features);
     const int lane = (int)(threadIdx.x & 31u), w = (int)(threadIdx.x >> 5), wpb = (int)(blockDim.x >> 5);
@@ -669,6 +702,10 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
     const bool planes = (W & kWPlanes) != 0 || (W == kWAll && m.world.planes);
     constexpr bool Exact = (W & kWPlanes) == 0; /* the colliders' own tests in the collision step */
     T *ps = (T *)cs + lanes_col_reals(m.world.ncol, jend - m.j0) + (int64_t)w * lanes_plane_reals<G>() + lane;
+    if constexpr (W == kWHeld) { /* §3.16 `held`: the block's samples taken here (hold_block) */
+        if (m.perm && m.world.grid && (m.world.grid_friction || m.world.grid_volume)) /* m.hold_self (lanes.cu) */
+            hold_block<T, G, L>(m, qtab, x, N, wpb, has(HB_F_MOTION));
+    }
 
     /* the loop bound is the same for every lane of a warp: whole warps take each group of strands */
     for (int64_t s0 = SPW * ((int64_t)blockIdx.x * wpb + w); s0 < N; s0 += SPW * (int64_t)gridDim.x * wpb) {
@@ -753,9 +790,10 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         }
 
         const bool wgrid = (W & (kWGather | kWHeld)) && m.world.grid && (m.world.grid_friction || m.world.grid_volume);
-        const bool held = (W & kWHeld) && wgrid && m.held; /* lanes_holds_samples: k_grid_hold took them */
+        /* lanes_holds_samples: k_grid_hold took them, or hold_block */
+        const bool held = (W & kWHeld) && wgrid && (W == kWHeld || m.held);
         if constexpr ((W & kWHeld) != 0) { /* §3.16 `held`: each point's sample, taken by k_grid_hold */
-            if (held && live) {
+            if (held && live && !(W == kWHeld && m.perm)) {
                 const int64_t st = Ordered && m.perm ? m.perm[s0 + seg] : s0 + seg;
 #pragma unroll
                 for (int i = 0; i < G; i++) {

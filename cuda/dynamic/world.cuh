@@ -43,6 +43,13 @@ template <typename WorldT> inline bool lanes_holds_samples(const WorldT &w)
     return w.grid && (w.grid_friction || w.grid_volume) &&
            (w.grid_rebuild == HB_GRID_HELD || (w.grid_rebuild == HB_GRID_SUBSTEP && !col));
 }
+/* ... and where `held` has no colliders (a frame one launch of the held kernel), that kernel takes
+ * its block's samples itself before its strand loop (hold_block), k_grid_hold not launched */
+template <typename WorldT> inline bool lanes_hold_self(const WorldT &w)
+{
+    const bool col = w.ncol > 0 || w.head_friction || w.bounded;
+    return lanes_holds_samples(w) && w.grid_rebuild == HB_GRID_HELD && !col;
+}
 
 /* The precision's functions of contact_impl.h by overload. */
 HB_HD void grid_sample(const World<float> &w, const float *qg, const float *x, float *s)
