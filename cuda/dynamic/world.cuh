@@ -136,7 +136,7 @@ cudaError_t launch_grid_splat(const World<T> &w, const T *qg, const T *x, const 
                               const int64_t *perm, int64_t *mass, int64_t *mom, cudaStream_t stream);
 /* §3.16 `held`: every point's sample at x (canonical [N][P][3]) with the grid rotation qg, into
  * held ([N][P][kHeldReals], cuda/dynamic/held.cuh; h: the substep; perm: the strands' order, or
- * nullptr), after launch_grid_nodes. */
+ * nullptr), after launch_grid_nodes (where the lanes kernel does not take them itself: lanes_hold_self). */
 template <typename T>
 cudaError_t launch_grid_hold(const World<T> &w, const T *qg, T h, const T *x, int64_t N, int64_t P, const int64_t *perm,
                              T *held, cudaStream_t stream);
