@@ -636,8 +636,9 @@ __device__ __forceinline__ void hold_block(const DModel<T> &m, const T *qtab, co
     const int P = (int)m.points;
     const int64_t b0 = (int64_t)blockIdx.x * wpb * SPW;
     const int nbs = N - b0 < (int64_t)wpb * SPW ? (int)(N - b0) : wpb * SPW;
-    const T *qg = motion ? m.qs : nullptr; /* the frame's first build (j0 = 0) */
-    for (int e = (int)threadIdx.x + nbs; e < nbs * P; e += (int)blockDim.x) { /* k ≥ 1 */
+    const T *qg = motion ? m.qs : nullptr; /* the rotation of the frame's first build */
+    /* k ≥ 1: point 0 is the root, which takes no sample */
+    for (int e = (int)threadIdx.x + nbs; e < nbs * P; e += (int)blockDim.x) {
         const int t = e % nbs, k = e / nbs;
         const T *p = x + (m.perm[b0 + t] * P + k) * 3;
         const Sample<T> s = grid_sample_xyz(m.world, qg, p[0], p[1], p[2]);
