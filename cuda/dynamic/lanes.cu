@@ -58,7 +58,7 @@ template <typename T> int world_kind(const DModel<T> &m)
 {
     if (!m.has_world) return 0;
     const World<T> &w = m.world;
-    const bool col = w.ncol > 0 || w.head_friction || w.bounded;
+    const bool col = world_collides(w);
     const bool apply = w.grid && (w.grid_friction || w.grid_volume);
     if (apply && col) return kWAll;
     if (apply && !lanes_holds_samples(w)) return kWGather;

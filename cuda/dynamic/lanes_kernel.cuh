@@ -586,7 +586,7 @@ __host__ __device__ constexpr int64_t lanes_col_reals(int ncol, int nj)
  * sphere's friction or bounded depenetration */
 template <typename T> __host__ __device__ constexpr bool lanes_col_on(int W, const DModel<T> &m)
 {
-    return (W & kWCol) && (m.world.ncol > 0 || m.world.head_friction || m.world.bounded);
+    return (W & kWCol) && world_collides(m.world);
 }
 
 /* Slot i of a lane holds point k0 + i, or with two points a lane on an odd lane (sw) k0 + 1 − i:
@@ -704,8 +704,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
     constexpr bool Exact = (W & kWPlanes) == 0; /* the colliders' own tests in the collision step */
     T *ps = (T *)cs + lanes_col_reals(m.world.ncol, jend - m.j0) + (int64_t)w * lanes_plane_reals<G>() + lane;
     if constexpr (W == kWHeld) { /* §3.16 `held`: the block's samples taken here (hold_block) */
-        if (m.perm && m.world.grid && (m.world.grid_friction || m.world.grid_volume)) /* m.hold_self (lanes.cu) */
-            hold_block<T, G, L>(m, qtab, x, N, wpb, has(HB_F_MOTION));
+        if (m.hold_self) hold_block<T, G, L>(m, qtab, x, N, wpb, has(HB_F_MOTION));
     }
 
     /* the loop bound is the same for every lane of a warp: whole warps take each group of strands */
@@ -794,7 +793,7 @@ __global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl,
         /* lanes_holds_samples: k_grid_hold took them, or hold_block */
         const bool held = (W & kWHeld) && wgrid && (W == kWHeld || m.held);
         if constexpr ((W & kWHeld) != 0) { /* §3.16 `held`: each point's sample, taken by k_grid_hold */
-            if (held && live && !(W == kWHeld && m.perm)) {
+            if (held && live && !(W == kWHeld && m.hold_self)) {
                 const int64_t st = Ordered && m.perm ? m.perm[s0 + seg] : s0 + seg;
 #pragma unroll
                 for (int i = 0; i < G; i++) {

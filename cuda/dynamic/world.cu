@@ -56,19 +56,26 @@ constexpr int kSplatStrands = HB_SPLAT_STRANDS, kSplatWarps = 8; /* strands a bl
 template <typename T> constexpr int kSplatMinBlocks = sizeof(T) == 4 ? 5 : 1;
 constexpr int kWindow = HB_SPLAT_WINDOW; /* nodes: 2 × 32 bits × 4 channels each (32 KB at 1024) */
 /* the word (channel c: mass, p_x, p_y, p_z; part: low, high — for mass: the sum modulo 2^32, its
- * carries) of node or slot i in arrays of S words: each of the eight (channel, part) arrays whole,
- * so that a warp's lanes at different nodes use different banks */
-template <int S> __device__ __forceinline__ int word_at(int c, int part, int i)
-{
-    return (2 * c + part) * S + i;
-}
+ * carries) of window node i, each (channel, part) array whole so that a warp's lanes at different
+ * nodes use different banks: with one momentum word a share (Single) the five used (mass low, mass
+ * carries, p_x, p_y, p_z) of kWindowSingle nodes, else all eight of kWindow */
+constexpr int kWindowSingle = kWindow * 8 / 5;
+template <bool Single> struct WindowAt {
+    __device__ __forceinline__ int operator()(int c, int part, int i) const
+    {
+        return Single ? (c == 0 ? part : c + 1) * kWindowSingle + i : (2 * c + part) * kWindow + i;
+    }
+};
 /* The hash table in the window's memory: kHashSlots keys (a node's index; kEmpty: none), then the
- * eight (channel, part) arrays of kHashSlots words. A node takes the first free slot from its hash
- * on (linear probing, claimed by a shared compare-and-swap); past kHashProbes slots, none. */
+ * eight (channel, part) arrays of kHashSlots words (HashAt). A node takes the first free slot from its
+ * hash on (linear probing, claimed by a shared compare-and-swap); past kHashProbes slots, none. */
 constexpr int kHashSlots = (kWindow * 8 / 9) & ~31;
 constexpr int kHashProbes = 32;
 static_assert(kHashSlots >= 32, "HB_SPLAT_WINDOW too small for the hash table");
 constexpr unsigned kEmpty = 0xffffffffu; /* no node: indices are below n³ ≤ 2^31 */
+struct HashAt {
+    __device__ __forceinline__ int operator()(int c, int part, int i) const { return (2 * c + part) * kHashSlots + i; }
+};
 __device__ __forceinline__ int hash_slot(unsigned *keys, unsigned node)
 {
     unsigned s = __umulhi(node * 2654435761u, (unsigned)kHashSlots);
@@ -123,38 +130,39 @@ __device__ __forceinline__ int share_of(double x)
 }
 
 /* one share x (|x| ≤ 2^30) into channel c of node or slot i: low 16 bits, then the rest */
-template <int S> __device__ __forceinline__ void words_add(unsigned *win, int c, int i, int x)
+template <class At> __device__ __forceinline__ void words_add(unsigned *win, At at, int c, int i, int x)
 {
-    atomicAdd(win + word_at<S>(c, 0, i), (unsigned)x & 0xffffu);
-    atomicAdd(reinterpret_cast<int *>(win) + word_at<S>(c, 1, i), x >> 16);
+    atomicAdd(win + at(c, 0, i), (unsigned)x & 0xffffu);
+    atomicAdd(reinterpret_cast<int *>(win) + at(c, 1, i), x >> 16);
 }
 /* a mass share sm (0 ≤ sm ≤ 2^24) into node or slot i: one word summed modulo 2^32, and the
  * carries out of it counted in the other (each add wraps at most once; rare) */
-template <int S> __device__ __forceinline__ void mass_add(unsigned *win, int i, int sm)
+template <class At> __device__ __forceinline__ void mass_add(unsigned *win, At at, int i, int sm)
 {
-    const unsigned was = atomicAdd(win + word_at<S>(0, 0, i), (unsigned)sm);
-    if (was + (unsigned)sm < was) atomicAdd(win + word_at<S>(0, 1, i), 1u);
+    const unsigned was = atomicAdd(win + at(0, 0, i), (unsigned)sm);
+    if (was + (unsigned)sm < was) atomicAdd(win + at(0, 1, i), 1u);
 }
 /* a corner's mass share sm and momentum shares sp into node or slot i (`single`: a momentum
  * share in one signed word) */
-template <int S>
-__device__ __forceinline__ void corner_add(unsigned *win, int i, int sm, const int (&sp)[3], bool single)
+template <class At>
+__device__ __forceinline__ void corner_add(unsigned *win, At at, int i, int sm, const int (&sp)[3], bool single)
 {
-    mass_add<S>(win, i, sm);
+    mass_add(win, at, i, sm);
     if (single)
-        for (int c = 0; c < 3; c++) atomicAdd(reinterpret_cast<int *>(win) + word_at<S>(1 + c, 0, i), sp[c]);
+        for (int c = 0; c < 3; c++) atomicAdd(reinterpret_cast<int *>(win) + at(1 + c, 0, i), sp[c]);
     else
-        for (int c = 0; c < 3; c++) words_add<S>(win, 1 + c, i, sp[c]);
+        for (int c = 0; c < 3; c++) words_add(win, at, 1 + c, i, sp[c]);
 }
 /* node or slot i's four 64-bit sums; false where all are zero */
-template <int S> __device__ __forceinline__ bool corner_sums(const unsigned *win, int i, bool single, int64_t (&sum)[4])
+template <class At>
+__device__ __forceinline__ bool corner_sums(const unsigned *win, At at, int i, bool single, int64_t (&sum)[4])
 {
     const int *wi = reinterpret_cast<const int *>(win);
     bool any = false;
     for (int c = 0; c < 4; c++) {
-        sum[c] = c == 0   ? (int64_t)win[word_at<S>(0, 1, i)] * 4294967296 + (int64_t)win[word_at<S>(0, 0, i)]
-                 : single ? (int64_t)wi[word_at<S>(c, 0, i)]
-                          : (int64_t)wi[word_at<S>(c, 1, i)] * 65536 + (int64_t)win[word_at<S>(c, 0, i)];
+        sum[c] = c == 0   ? (int64_t)win[at(0, 1, i)] * 4294967296 + (int64_t)win[at(0, 0, i)]
+                 : single ? (int64_t)wi[at(c, 0, i)]
+                          : (int64_t)wi[at(c, 1, i)] * 65536 + (int64_t)win[at(c, 0, i)];
         any |= sum[c] != 0;
     }
     return any;
@@ -172,8 +180,8 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     k_grid_splat(World<T> w, const T *qg, const T *x, const T *v, int64_t N, int P, int spb, int pk,
                  const int64_t *perm, int64_t *mass, int64_t *mom)
 {
-    extern __shared__ unsigned win[];  /* [channel: mass, p_x, p_y, p_z][low, high][node] (word_at);
-                                         hashed: keys[kHashSlots], then the same over slots */
+    extern __shared__ unsigned win[];  /* the window: [channel: mass, p_x, p_y, p_z][low, high][node] (WindowAt);
+                                         hashed: keys[kHashSlots], then the table's arrays (HashAt) */
     __shared__ int lo[3], hi[3], vmax; /* vmax: the bits of the block's largest |v| component (≥ 0) */
     wait_for_previous();
     const int lane = (int)(threadIdx.x & 31u);
@@ -186,6 +194,17 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     auto strand_of = [&](int i) { return pks >= 0 ? i >> pks : i / pk; };
     auto point_of = [&](int i) { return k0 + (pks >= 0 ? i & (pk - 1) : i % pk); };
     const int64_t n = w.gn;
+    /* item i's point: its x and v, its cell (whole) and place in it; false where it adds nothing (past its
+     * strand's run, not finite, outside the grid) */
+    auto cell_of = [&](int i, const T *&xp, const T *&vp, int64_t(&cb)[3], T(&f)[3]) {
+        const int st_i = strand_of(i), k = point_of(i);
+        if (k >= k0 + nk) return false;
+        const int64_t st = perm ? perm[s0 + st_i] : s0 + st_i;
+        const int64_t r = st * P + k;
+        xp = x + 3 * r;
+        vp = v + 3 * r;
+        return finite3(xp) && finite3(vp) && Cell<T>::at(w, qg, xp, cb, f) != 0;
+    };
     if (threadIdx.x < 3) lo[threadIdx.x] = INT_MAX, hi[threadIdx.x] = -1;
     if (threadIdx.x == 0) vmax = 0;
     __syncthreads();
@@ -194,20 +213,14 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     int cl[3] = {INT_MAX, INT_MAX, INT_MAX}, ch[3] = {-1, -1, -1};
     float vm = 0.0f;
     for (int i = (int)threadIdx.x; i < items; i += kSplatWarps * 32) {
-        const int s = strand_of(i), k = point_of(i);
-        if (k < k0 + nk) {
-            const int64_t st = perm ? perm[s0 + s] : s0 + s;
-            const T *xp = x + 3 * (st * P + k);
-            int64_t c[3];
-            T f[3];
-            const T *vp = v + 3 * (st * P + k);
-            if (finite3(xp) && finite3(vp) && Cell<T>::at(w, qg, xp, c, f)) {
-                for (int a = 0; a < 3; a++) {
-                    cl[a] = min(cl[a], (int)c[a]);
-                    ch[a] = max(ch[a], (int)c[a] + 1);
-                    vm = fmaxf(vm, fminf((float)fabs(vp[a]), (float)HB_GRID_VEL_CLAMP));
-                }
-            }
+        const T *xp, *vp;
+        int64_t c[3];
+        T f[3];
+        if (!cell_of(i, xp, vp, c, f)) continue;
+        for (int a = 0; a < 3; a++) {
+            cl[a] = min(cl[a], (int)c[a]);
+            ch[a] = max(ch[a], (int)c[a] + 1);
+            vm = fmaxf(vm, fminf((float)fabs(vp[a]), (float)HB_GRID_VEL_CLAMP));
         }
     }
     { /* non-negative floats order as their bits */
@@ -225,21 +238,24 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     if (hi[0] < 0) return; /* no point of the block in the grid */
     const int ex = hi[0] - lo[0] + 1, ey = hi[1] - lo[1] + 1, ez = hi[2] - lo[2] + 1;
     /* the window's strides (y, z), both odd so that points a row or a plane apart (a hanging strand's
-     * neighbours) meet in different banks, and its nodes, padding included */
-    const int64_t sy64 = ex | 1, sz64 = (sy64 * ey) | 1;
+     * neighbours) meet in different banks, and the box's nodes, padding included */
+    const int64_t sy64 = ex | 1, sz64 = (sy64 * ey) | 1, nb64 = sz64 * ez;
     const bool bounded = (int64_t)ns * nk <= kSplatWindowPoints;
-    const bool windowed = bounded && sz64 * ez <= kWindow, hashed = bounded && !windowed;
-    const int sy = (int)sy64, sz = (int)sz64, nw = windowed ? sz * ez : 0;
-    unsigned *const keys = win, *const slots = win + kHashSlots;
     /* `single`: a momentum share is |rint(w·v·2^10)| ≤ |v|·2^10 + 1 (w ≤ 1) and a node takes at
      * most one a point, so while ns·P·(vmax·2^10 + 1) < 2^31 the block's momentum sums fit one
      * signed 32-bit word a node (exact, one atomic a share); else the split words as for mass */
     const bool single =
         bounded && (double)ns * nk * ((double)__int_as_float(vmax) * HB_GRID_MOM_SCALE + 1.0) < 2147483647.0;
+    const bool windowed = bounded && nb64 <= (single ? kWindowSingle : kWindow), hashed = bounded && !windowed;
+    const int sy = (int)sy64, sz = (int)sz64, nw = windowed ? (int)nb64 : 0;
+    /* the box-local node of corner c8 of the cell whose lowest corner is box node wb */
+    auto corner_in_box = [&](int wb, int c8) {
+        return wb + ((c8 & 1) ? 1 : 0) + ((c8 & 2) ? sy : 0) + ((c8 & 4) ? sz : 0);
+    };
+    unsigned *const keys = win, *const slots = win + kHashSlots;
     if (windowed)
         for (int i = threadIdx.x; i < nw; i += blockDim.x)
-            for (int a = 0; a < 8; a++)
-                if (!single || a < 2 || (a & 1) == 0) win[a * kWindow + i] = 0u;
+            for (int a = 0; a < (single ? 5 : 8); a++) win[a * (single ? kWindowSingle : kWindow) + i] = 0u;
     if (hashed)
         for (int i = threadIdx.x; i < kHashSlots; i += blockDim.x) {
             keys[i] = kEmpty;
@@ -255,37 +271,33 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     auto pass2 = [&](auto fast) {
         constexpr bool Fast = decltype(fast)::value;
         for (int i = (int)threadIdx.x; i < items; i += kSplatWarps * 32) {
-            const int s = strand_of(i), k = point_of(i);
-            if (k < k0 + nk) {
-                const int64_t st = perm ? perm[s0 + s] : s0 + s;
-                const int64_t r = st * P + k;
-                const T *xp = x + 3 * r, *vp = v + 3 * r;
-                int64_t cb[3];
-                T f[3], wt[8], vs[3];
-                /* hb_grid_splat_point's shares, a corner at a time (fewer registers, the same integers) */
-                if (!(finite3(xp) && finite3(vp)) || !Cell<T>::at(w, qg, xp, cb, f)) continue;
-                Cell<T>::weights(f, wt);
-                for (int c = 0; c < 3; c++) {
-                    const T lim = (T)HB_GRID_VEL_CLAMP;
-                    vs[c] = (vp[c] < -lim ? -lim : vp[c] > lim ? lim : vp[c]) * (T)HB_GRID_MOM_SCALE;
-                }
-                /* the cell's lowest corner: its window node (32-bit: the window holds ≤ kWindow nodes), its node */
-                const int wb = ((int)cb[0] - lo[0]) + sy * ((int)cb[1] - lo[1]) + sz * ((int)cb[2] - lo[2]);
-                const int64_t b = cb[0] + n * (cb[1] + n * cb[2]);
+            const T *xp, *vp;
+            int64_t cb[3];
+            T f[3], wt[8], vs[3];
+            /* hb_grid_splat_point's shares, a corner at a time (fewer registers, the same integers) */
+            if (!cell_of(i, xp, vp, cb, f)) continue;
+            Cell<T>::weights(f, wt);
+            for (int c = 0; c < 3; c++) {
+                const T lim = (T)HB_GRID_VEL_CLAMP;
+                vs[c] = (vp[c] < -lim ? -lim : vp[c] > lim ? lim : vp[c]) * (T)HB_GRID_MOM_SCALE;
+            }
+            /* the cell's lowest corner: its window node (32-bit: the window holds ≤ kWindowSingle nodes), its node */
+            const int wb = ((int)cb[0] - lo[0]) + sy * ((int)cb[1] - lo[1]) + sz * ((int)cb[2] - lo[2]);
+            const int64_t b = cb[0] + n * (cb[1] + n * cb[2]);
 #pragma unroll
-                for (int c8 = 0; c8 < 8; c8++) {
-                    int sp[3];
-                    const int sm = share_of(wt[c8] * (T)HB_GRID_MASS_SCALE);
-                    for (int c = 0; c < 3; c++) sp[c] = share_of(wt[c8] * vs[c]);
-                    if (Fast || windowed) {
-                        const int i = wb + ((c8 & 1) ? 1 : 0) + ((c8 & 2) ? sy : 0) + ((c8 & 4) ? sz : 0);
-                        corner_add<kWindow>(win, i, sm, sp, Fast || single);
-                        continue;
-                    }
+            for (int c8 = 0; c8 < 8; c8++) {
+                int sp[3];
+                const int sm = share_of(wt[c8] * (T)HB_GRID_MASS_SCALE);
+                for (int c = 0; c < 3; c++) sp[c] = share_of(wt[c8] * vs[c]);
+                if (Fast) { /* windowed, single */
+                    corner_add(win, WindowAt<true>{}, corner_in_box(wb, c8), sm, sp, true);
+                } else if (windowed) { /* not single */
+                    corner_add(win, WindowAt<false>{}, corner_in_box(wb, c8), sm, sp, false);
+                } else {
                     const int64_t j = hb_grid_corner_f64(b, n, c8);
                     const int slot = hashed ? hash_slot(keys, (unsigned)j) : -1;
                     if (slot >= 0) {
-                        corner_add<kHashSlots>(slots, slot, sm, sp, single);
+                        corner_add(slots, HashAt{}, slot, sm, sp, single);
                     } else {
                         atomicAdd((unsigned long long *)&mass[j], (unsigned long long)(int64_t)sm);
                         for (int c = 0; c < 3; c++)
@@ -299,17 +311,21 @@ __global__ void __launch_bounds__(kSplatWarps * 32, kSplatMinBlocks<T>)
     else pass2(std::false_type{});
     if (!bounded) return;
     __syncthreads();
+    /* box node j's node in the grid */
+    auto node_of = [&](int j) {
+        return (j % sz % sy + lo[0]) + n * ((j % sz / sy + lo[1]) + n * (int64_t)(j / sz + lo[2]));
+    };
     int64_t sum[4];
-    if (windowed)
-        for (int i = threadIdx.x; i < nw; i += blockDim.x) {
-            if (!corner_sums<kWindow>(win, i, single, sum)) continue; /* padding: never added to */
-            const int jz = i / sz + lo[2], jy = i % sz / sy + lo[1], jx = i % sz % sy + lo[0];
-            node_flush(jx + n * (jy + n * (int64_t)jz), sum, mass, mom);
-        }
-    else
-        for (int i = threadIdx.x; i < kHashSlots; i += blockDim.x)
-            if (keys[i] != kEmpty && corner_sums<kHashSlots>(slots, i, single, sum))
-                node_flush((int64_t)keys[i], sum, mass, mom);
+    if (windowed) {
+        for (int i = threadIdx.x; i < nw; i += blockDim.x) /* padding: never added to */
+            if (single ? corner_sums(win, WindowAt<true>{}, i, true, sum)
+                       : corner_sums(win, WindowAt<false>{}, i, false, sum))
+                node_flush(node_of(i), sum, mass, mom);
+        return;
+    }
+    for (int i = threadIdx.x; i < kHashSlots; i += blockDim.x)
+        if (keys[i] != kEmpty && corner_sums(slots, HashAt{}, i, single, sum))
+            node_flush((int64_t)keys[i], sum, mass, mom);
 }
 
 template <typename T>

@@ -33,13 +33,19 @@ template <> struct WorldOf<double> {
 /* The run's grid and colliders in T, pointing at device memory. */
 template <typename T> using World = typename WorldOf<T>::type;
 
+/* §3.17: whether a run's world has the colliders' work: colliders, the head sphere's friction or its
+ * bounded depenetration */
+template <typename WorldT> HB_HD constexpr bool world_collides(const WorldT &w)
+{
+    return w.ncol > 0 || w.head_friction || w.bounded;
+}
 /* §3.16: the lanes kernel applies each point's sample as k_grid_hold took it (docs/cuda.md) for
  * `held`, and for `substep` without colliders: a launch a substep there, so the sample at the
  * launch's start is the one the substep's correction takes (as one substep a frame of `held` is
  * `frame` bit for bit); with colliders the kernel with all the world's code gathers itself */
 template <typename WorldT> inline bool lanes_holds_samples(const WorldT &w)
 {
-    const bool col = w.ncol > 0 || w.head_friction || w.bounded;
+    const bool col = world_collides(w);
     return w.grid && (w.grid_friction || w.grid_volume) &&
            (w.grid_rebuild == HB_GRID_HELD || (w.grid_rebuild == HB_GRID_SUBSTEP && !col));
 }
@@ -47,8 +53,7 @@ template <typename WorldT> inline bool lanes_holds_samples(const WorldT &w)
  * its block's samples itself before its strand loop (hold_block), k_grid_hold not launched */
 template <typename WorldT> inline bool lanes_hold_self(const WorldT &w)
 {
-    const bool col = w.ncol > 0 || w.head_friction || w.bounded;
-    return lanes_holds_samples(w) && w.grid_rebuild == HB_GRID_HELD && !col;
+    return lanes_holds_samples(w) && w.grid_rebuild == HB_GRID_HELD && !world_collides(w);
 }
 
 /* The precision's functions of contact_impl.h by overload. */

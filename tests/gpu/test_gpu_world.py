@@ -261,11 +261,13 @@ def test_gpu_splat_whose_window_sums_carry_matches_cpu_bit_for_bit(work, variant
 
 # The splat's hash table (docs/cuda.md "The hair–hair grid"): 64 strands on a 256³ grid, so that a
 # point's cell is its own and a block of 8 strands (the fewest a block takes; 64 strands give blocks
-# of 8 on any GPU) spans a box of more nodes than the window holds. `fill`: 64 points a strand, so
+# of 8 on any GPU) spans a box of more nodes than the window holds (with one momentum word a node,
+# WINDOW_SINGLE: the five words' arrays in the window's memory). `fill`: 64 points a strand, so
 # that every block touches more nodes than the table has slots and some shares find none (the
 # grid directly); `hashed`: 10 points, so that a block's nodes fit the table. Each premise is
 # checked from the CPU's positions at the input frame; the strict build bit for bit.
 WINDOW_NODES = int(re.search(r"^#define HB_SPLAT_WINDOW (\d+)$", (ROOT / "cuda/dynamic/world.cu").read_text(), re.M)[1])
+WINDOW_SINGLE = WINDOW_NODES * 8 // 5  # kWindowSingle, cuda/dynamic/world.cu
 HASH_SLOTS = (WINDOW_NODES * 8 // 9) & ~31  # kHashSlots, cuda/dynamic/world.cu
 HASH_BOX = (-13.0, -45.0, -13.0, 13.0, 13.0, 13.0)
 HASH = ["--strands", "64", "--substeps", "4", "--iterations", "2", "--bend-compliance", "1e-6",
@@ -302,7 +304,7 @@ def test_gpu_splat_in_its_hash_table_matches_cpu_bit_for_bit(work, variant, prec
     else:  # every strand's own box of nodes exceeds the window; 8 strands' shares fit the table
         ijk = np.stack([nodes % 256, (nodes // 256) % 256, nodes // 65536], axis=-1).reshape(len(nodes), -1, 3)
         boxes = np.prod(ijk.max(axis=1) - ijk.min(axis=1) + 1, axis=-1)
-        assert boxes.min() > WINDOW_NODES and SPLAT_STRANDS_MIN * int(points) * 8 <= HASH_SLOTS
+        assert boxes.min() > max(WINDOW_NODES, WINDOW_SINGLE) and SPLAT_STRANDS_MIN * int(points) * 8 <= HASH_SLOTS
     frame_matches(work, cpu, "strict", variant, f"hash_{case}_{precision}")
 
 
