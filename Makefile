@@ -393,6 +393,10 @@ SAN_HASH := --grid 256 --grid-box=-13,-45,-13,13,13,13 --grid-friction 0.1,0.02 
 # 29 points, so that a run's length is no power of two), the grid built every substep
 SAN_RUNS := --strands 3000 --points 29 --frames 1 --grid 32 --grid-friction 0.05,0.01 --grid-volume 2000 \
   --grid-rebuild substep
+# the lanes kernel's one-wave layout (cuda/dynamic/lanes.cu): fp32, 32 points, every feature, alone and with
+# the held grid, at 16 strands more than one wave of G = 2 takes on this GPU (the record's layout)
+SAN_WAVE := --points 32 --stages init,simulate --frames 1 --variant lanes --precision fp32 --bend-compliance 1e-6 \
+  --shape-compliance 1e-4 --wind-speed 150 --gust-amplitude 0.5 --head-motion nod --drag 0.5 --quiet
 sanitize-gpu: cuda sanitize-gpu-world
 	@command -v compute-sanitizer >/dev/null 2>&1 || { echo "error: compute-sanitizer not found (it ships with the CUDA toolkit)"; exit 1; }
 	@set -e; for v in $$($(PYTHON) -c "from harness.core import variants; print(*variants.names('cuda'))"); do for p in fp32 fp64; do \
@@ -448,6 +452,13 @@ sanitize-gpu-world: cuda
 	  echo "racecheck world $$p $(SAN_PLANES)"; \
 	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WORLD) $(SAN_BODY) $(SAN_PLANES) \
 	    --precision $$p --substeps 40 --frames 1; \
+	done; \
+	n=$$($(BUILD)/hairsim-cuda $(SAN_WAVE) --strands 64 --json | \
+	  $(PYTHON) -c "import json, sys; print(json.load(sys.stdin)['stages'][-1]['layout']['strands_a_wave'] + 16)"); \
+	for w in "" "--grid 32 --grid-friction 0.05,0.01 --grid-volume 2000 --grid-rebuild held"; do \
+	  echo "memcheck, racecheck the one-wave layout ($$n strands) $$w"; \
+	  compute-sanitizer --tool memcheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WAVE) --strands $$n $$w; \
+	  compute-sanitizer --tool racecheck --error-exitcode 9 $(BUILD)/hairsim-cuda $(SAN_WAVE) --strands $$n $$w; \
 	done; rm -f $(BUILD)/san-world-*.h5; echo "compute-sanitizer: memcheck and racecheck found no errors in the world's kernels"
 
 # ---- lint and format: settings in pyproject.toml (ruff, mypy) and .clang-format ----

@@ -34,6 +34,7 @@ struct cuda_impl {
     Model<double> m64;
     Variant variant;
     int block;
+    int layout[4]; /* lanes: the simulate kernel's layout (hb_backend's layout; zeros: none) */
     int64_t N, P;
     uint64_t bytes;              /* one state [N·P][3] in the run's precision */
     void *state;                 /* paper: canonical; soa, fused: X | Y | Z, each [P][N] */

@@ -511,10 +511,15 @@ static int dyn_load_t(cuda_impl *c, const void *velocity, const void *rest, char
         const size_t smem = hbd::warp_smem_bytes<T>(c->P) * (size_t)(c->block / 32);
         HB_CUDA_AS(hbd::prepare_warp<T>(d->m64.features, smem), "raising the warp kernel's shared-memory limit");
     }
-    if (c->variant == V_LANES)
+    if (c->variant == V_LANES) {
         HB_CUDA_AS(hbd::prepare_lanes<T>(d->m64.features, d->m64.solver, c->P, c->block, c->scene.dyn.per_segment != 0,
                                          d->hw.on != 0),
                    "raising the lanes kernel's shared-memory limit");
+        bool wave = false;
+        HB_CUDA_AS(hbd::lanes_wave<T>(dyn_model<T>(d), c->N, c->block, &wave), "choosing the lanes kernel's layout");
+        dyn_model<T>(d).wave = wave;
+        HB_CUDA_AS(hbd::lanes_layout<T>(dyn_model<T>(d), c->block, c->layout), "the lanes kernel's layout");
+    }
     if (c->variant == V_LANES && d->hw.on && dyn_model<T>(d).world.planes) {
         /* §3.17 --contact-planes: a frame in several launches (the grid built every substep, or more
          * substeps than the staged colliders fit) keeps each point's planes between them */
@@ -539,8 +544,10 @@ int cuda_dyn_load(hb_backend *b, const void *velocity, const void *rest, char *e
         snprintf(err, errlen, "internal error: simulate was not set up");
         return -1;
     }
-    return c->scene.precision == HB_FP32 ? dyn_load_t<float>(c, velocity, rest, err, errlen)
-                                         : dyn_load_t<double>(c, velocity, rest, err, errlen);
+    const int rc = c->scene.precision == HB_FP32 ? dyn_load_t<float>(c, velocity, rest, err, errlen)
+                                                 : dyn_load_t<double>(c, velocity, rest, err, errlen);
+    memcpy(b->layout, c->layout, sizeof b->layout);
+    return rc;
 }
 
 /* One frame's kernel on `stream`, with the frame's tables q [S][9] and ph [S] on the device;

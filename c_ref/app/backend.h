@@ -88,6 +88,9 @@ struct hb_backend {
     const char *compiler;       /* NULL: the host C compiler that built the driver */
     void *impl;                 /* backend's private state */
     int threads, block_size;    /* what the run uses, set by setup (0 where not used) */
+    /* cuda lanes: the simulate kernel's points a lane, lanes a strand, threads a block and strands a
+     * wave (its blocks every SM holds at once), set by dyn_load (zeros: none; docs/interfaces.md) */
+    int layout[4];
 
     /* Check memory and allocate for the run (saving a copy for repeats when `need_save`;
      * the driver's own host buffers take `driver_host_bytes`). Returns HB_EXIT_OK or an

@@ -198,6 +198,12 @@ void hb_record_json(FILE *f, const hb_record *r)
             fprintf(f, ", \"frames\": %lld, \"substeps\": %lld, \"iterations\": %lld, \"solver\": \"%s\"",
                     (long long)st->frames, (long long)d->substeps, (long long)d->iterations, hb_solver_name(d->solver));
             json_key_str(f, "features", st->features);
+            if (st->layout[0] > 0)
+                fprintf(f,
+                        ", \"layout\": {\"points_a_lane\": %d, \"lanes_a_strand\": %d, \"block\": %d, "
+                        "\"strands_a_wave\": %d}",
+                        st->layout[0], st->layout[1], st->layout[2], st->layout[3]);
+            else fputs(", \"layout\": null", f);
             fprintf(f, ", \"collider_sweeps\": %lld", (long long)d->collider_sweeps); /* §3.17 */
             if (d->planes_declared) json_key_num(f, "contact_planes", d->contact_margin);
             if (d->collide_once) fprintf(f, ", \"collide_once\": true"); /* §3.6 */

@@ -24,6 +24,7 @@ typedef struct {
      * last frame's observables and the frames that blew up */
     int64_t frames;
     char features[192];
+    int layout[4]; /* hb_backend's layout (zeros: none) */
     hb_observables last;
     int64_t blown_frames;
     double observe_ms;             /* computing the observables, all frames, apart from the frame times */

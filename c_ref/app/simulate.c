@@ -221,6 +221,7 @@ static int simulate_frames(hb_run *r, hb_stage_record *sr, int frame, double *ti
     const double t_end = (double)(gf0 + (1 + frames_after(o)) * o->frames) * d->frame_dt;
     HB_TRY(hb_dynamics_validate_time(s, t_end, err, errlen), HB_EXIT_USAGE);
     HB_TRY(b->dyn_load(b, *vel, rest, err, errlen), HB_EXIT_RUNTIME);
+    memcpy(sr->layout, b->layout, sizeof sr->layout);
     if (r->w) HB_TRY(hb_writer_rest(r->w, hb_run_as_written(r, rest), err, errlen), HB_EXIT_RUNTIME);
 
     r->sim.dynamic = 1;

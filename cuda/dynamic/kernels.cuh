@@ -138,6 +138,11 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
 /* The launches launch_frame_lanes makes for m's substeps (more than one where the staged colliders do
  * not fit a block; then --contact-planes keeps each point's planes in m.contacts between them). */
 template <typename T> cudaError_t lanes_launches(const DModel<T> &m, int block, int *launches);
+/* Whether m's run of N strands takes the one-wave layout (lanes.cu; set m.wave by it once a run). */
+template <typename T> cudaError_t lanes_wave(const DModel<T> &m, int64_t N, int block, bool *wave);
+/* The layout m's frames launch: points a lane, lanes a strand, threads a block and the strands one wave
+ * of its blocks takes on this device (the JSON record's simulate "layout"). */
+template <typename T> cudaError_t lanes_layout(const DModel<T> &m, int block, int layout[4]);
 /* Allows the warp kernel of this feature set `bytes` of dynamic shared memory a block (the
  * opt-in above 48 KB). */
 template <typename T> cudaError_t prepare_warp(unsigned features, size_t bytes);

@@ -29,10 +29,10 @@ LanesTable<T, G, L, Ftl, Fs...> lanes_table_of(std::integer_sequence<unsigned, F
 template <typename T, int G, int L, bool Ftl>
 using LanesTableT = decltype(lanes_table_of<T, G, L, Ftl>(std::make_integer_sequence<unsigned, HB_F_COUNT>()));
 
-/* The kernel of a run, its lanes a strand and its shared memory a warp. */
+/* The kernel of a run, its points a lane, its lanes a strand and its shared memory a warp. */
 template <typename T> struct LanesPick {
     LanesFn<T> fn;
-    int lanes;
+    int g, lanes;
     int64_t warp_reals;
     int64_t plane_reals; /* a warp's contact planes (--contact-planes) */
 };
@@ -48,7 +48,7 @@ template <typename T, int G, int L, bool Ftl> LanesPick<T> pick(unsigned f, int6
     else if (wk == (kWCol | kWPlanes)) fn = lanes_planes_kernel<T, G, L, Ftl>(f);
     else if (wk) fn = lanes_grid_kernel<T, G, L, Ftl>(f, wk);
     else if (seg) fn = &k_lanes<T, DynF, G, L, Ftl, true, 0>;
-    return LanesPick<T>{fn, L, lanes_warp_reals<T, G, L>(P) + ((wk & kWHeld) ? lanes_held_reals<T, G>() : 0),
+    return LanesPick<T>{fn, G, L, lanes_warp_reals<T, G, L>(P) + ((wk & kWHeld) ? lanes_held_reals<T, G>() : 0),
                         lanes_plane_reals<G>()};
 }
 /* The world's code a run needs (docs/cuda.md "The hair–hair grid and the colliders"): none
@@ -66,7 +66,7 @@ template <typename T> int world_kind(const DModel<T> &m)
 }
 template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P, bool seg, int world)
 {
-    if (!valid_mask(f) || P < 2 || P > kLanesMaxPoints) return LanesPick<T>{nullptr, 0, 0, 0};
+    if (!valid_mask(f) || P < 2 || P > kLanesMaxPoints) return LanesPick<T>{nullptr, 0, 0, 0, 0};
     if (solver == HB_SOLVER_FTL) {
         if (P <= 32) return pick<T, kFtlG, kFtlL, true>(f, P, seg, world);
         if (P <= 64) return pick<T, 8, 8, true>(f, P, seg, world);
@@ -75,6 +75,38 @@ template <typename T> LanesPick<T> lanes_pick(unsigned f, int solver, int64_t P,
     if (P <= 32) return pick<T, 2, 16, false>(f, P, seg, world);
     if (P <= 64) return pick<T, 4, 16, false>(f, P, seg, world);
     return pick<T, 8, 16, false>(f, P, seg, world);
+}
+/* The one-wave layout's kernel (lanes_kernel.cuh kWaveG) where a run may take it: fp32 xpbd at
+ * P ≤ 32 with every feature (the default scene's set), no groom, no world or the held grid alone;
+ * else fn is nullptr */
+template <typename T> LanesPick<T> wave_pick(unsigned f, int solver, int64_t P, bool seg, int wk)
+{
+    if constexpr (sizeof(T) == 4) {
+        constexpr unsigned kEvery = HB_F_COUNT - 1u;
+        if (solver != HB_SOLVER_FTL && P >= 2 && P <= 32 && !seg && f == kEvery && (wk == 0 || wk == kWHeld))
+            return LanesPick<T>{
+                wk ? lanes_wave_held_kernel<T>() : &k_lanes<T, StaticF<kEvery>, kWaveG, kWaveL, false, false, 0>,
+                kWaveG, kWaveL, lanes_warp_reals<T, kWaveG, kWaveL>(P) + (wk ? lanes_held_reals<T, kWaveG>() : 0),
+                lanes_plane_reals<kWaveG>()};
+    }
+    return LanesPick<T>{nullptr, 0, 0, 0, 0};
+}
+/* a run's kernel: the one-wave layout's where lanes_wave chose it (m.wave), else lanes_pick's */
+template <typename T> LanesPick<T> run_pick(const DModel<T> &m, int wk)
+{
+    const bool seg = m.seg_rest != nullptr;
+    return m.wave ? wave_pick<T>(m.features, m.solver, m.points, seg, wk)
+                  : lanes_pick<T>(m.features, m.solver, m.points, seg, wk);
+}
+/* the strands one wave of kernel k takes on this device at b threads a block and smem bytes */
+template <typename T> cudaError_t wave_strands(const LanesPick<T> &k, int b, size_t smem, int64_t &strands)
+{
+    int per_sm = 0, dev = 0, sms = 0;
+    cudaError_t e = cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, k.fn, b, smem);
+    if (e == cudaSuccess) e = cudaGetDevice(&dev);
+    if (e == cudaSuccess) e = cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, dev);
+    strands = (int64_t)per_sm * sms * (b / 32) * (32 / k.lanes);
+    return e;
 }
 
 } /* namespace */
@@ -137,14 +169,60 @@ static cudaError_t lanes_shape(const DModel<T> &m, const LanesPick<T> &k, int wk
 template <typename T> cudaError_t lanes_launches(const DModel<T> &m, int block, int *launches)
 {
     const int wk = world_kind(m);
-    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, wk);
+    const LanesPick<T> k = run_pick(m, wk);
     if (!k.fn) return cudaErrorInvalidValue;
     int b = 0, chunk = 0;
     size_t smem = 0;
-    const cudaError_t e = lanes_shape(m, k, wk, block, b, chunk, smem);
+    const cudaError_t e = lanes_shape(m, k, wk, m.wave ? block / 2 : block, b, chunk, smem);
     if (e != cudaSuccess) return e;
     const int nj = (m.j1 < 0 ? (int)m.substeps : m.j1) - m.j0;
     *launches = nj <= chunk ? 1 : (nj + chunk - 1) / chunk;
+    return cudaSuccess;
+}
+
+/* The one-wave layout (docs/cuda.md "The lanes variant"): taken where the run may take it (wave_pick),
+ * its block of `block` threads holds whole warps at half of them (the same strands a block), and N
+ * strands need more than one wave of lanes_pick's kernel but fit one wave of its own; its kernel's
+ * shared-memory limit raised then. */
+template <typename T> cudaError_t lanes_wave(const DModel<T> &m, int64_t N, int block, bool *wave)
+{
+    *wave = false;
+    const int wk = world_kind(m);
+    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, wk);
+    const LanesPick<T> w = wave_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, wk);
+    if (!k.fn || !w.fn || block % 64 != 0) return cudaSuccess;
+    int b = 0, chunk = 0, bw = 0;
+    size_t smem = 0, sw = 0;
+    int64_t n = 0, nw = 0;
+    cudaError_t e;
+    if ((e = lanes_shape(m, k, wk, block, b, chunk, smem)) != cudaSuccess ||
+        (e = lanes_shape(m, w, wk, block / 2, bw, chunk, sw)) != cudaSuccess ||
+        (e = wave_strands(k, b, smem, n)) != cudaSuccess || (e = wave_strands(w, bw, sw, nw)) != cudaSuccess)
+        return e;
+    if (N <= n || N > nw) return cudaSuccess;
+    if ((e = cudaFuncSetAttribute(w.fn, cudaFuncAttributeMaxDynamicSharedMemorySize, (int)sw)) != cudaSuccess) return e;
+    *wave = true;
+    return cudaSuccess;
+}
+
+template <typename T> cudaError_t lanes_layout(const DModel<T> &m, int block, int layout[4])
+{
+    const int wk = world_kind(m);
+    const LanesPick<T> k = run_pick(m, wk);
+    if (!k.fn) return cudaErrorInvalidValue;
+    int b = 0, chunk = 0;
+    size_t smem = 0;
+    int64_t strands = 0;
+    cudaError_t e = lanes_shape(m, k, wk, m.wave ? block / 2 : block, b, chunk, smem);
+    if (e != cudaSuccess) return e;
+    const int j1 = m.j1 < 0 ? (int)m.substeps : m.j1;
+    if (lanes_col_on<T>(wk, m)) /* a launch's staged colliders (launch_frame_lanes) */
+        smem += (size_t)lanes_col_reals(m.world.ncol, chunk < j1 - m.j0 ? chunk : j1 - m.j0) * sizeof(T);
+    if ((e = wave_strands(k, b, smem, strands)) != cudaSuccess) return e;
+    layout[0] = k.g;
+    layout[1] = k.lanes;
+    layout[2] = b;
+    layout[3] = strands > 2147483647 ? 2147483647 : (int)strands;
     return cudaSuccess;
 }
 
@@ -153,13 +231,13 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
                                const T *bend_rest, int64_t N, int block, cudaStream_t stream)
 {
     const int wk = world_kind(m);
-    const LanesPick<T> k = lanes_pick<T>(m.features, m.solver, m.points, m.seg_rest != nullptr, wk);
+    const LanesPick<T> k = run_pick(m, wk);
     if (!k.fn) return cudaErrorInvalidValue;
     const bool col = lanes_col_on<T>(wk, m);
     const int j1 = m.j1 < 0 ? (int)m.substeps : m.j1;
     int b = 0, chunk = 0;
     size_t smem = 0;
-    cudaError_t e = lanes_shape(m, k, wk, block, b, chunk, smem);
+    cudaError_t e = lanes_shape(m, k, wk, m.wave ? block / 2 : block, b, chunk, smem);
     if (e != cudaSuccess) return e;
     /* the contact planes of a frame in several launches are kept in m.contacts (backend_dyn.cu) */
     if (col && m.world.planes && (m.j0 > 0 || j1 < (int)m.substeps || chunk < j1 - m.j0) && !m.contacts)
@@ -188,6 +266,8 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
 #define HB_LANES_INSTANTIATE(T)                                                                                        \
     template cudaError_t prepare_lanes<T>(unsigned, int, int64_t, int, bool, bool);                                    \
     template cudaError_t lanes_launches<T>(const DModel<T> &, int, int *);                                             \
+    template cudaError_t lanes_wave<T>(const DModel<T> &, int64_t, int, bool *);                                       \
+    template cudaError_t lanes_layout<T>(const DModel<T> &, int, int[4]);                                              \
     template cudaError_t launch_frame_lanes<T>(const DModel<T> &, const T *, const T *, T *, T *, const T *,           \
                                                const T *, int64_t, int, cudaStream_t);
 /* the Makefile compiles this file once per precision (-DHB_DYN_REAL), side by side */

@@ -74,6 +74,14 @@ constexpr bool kFreeCollide = kFree && !HB_LANES_REF_COLLIDE;
 #ifndef HB_LANES_GATHER_MINB
 #define HB_LANES_GATHER_MINB 3
 #endif
+/* The one-wave layout (lanes.cu's lanes_choice): xpbd at P ≤ 32 in fp32, the default scene's
+ * feature set with no world or the held grid alone, kWaveG points a lane on kWaveL lanes a strand
+ * in blocks of half the threads (the same strands a block), HB_LANES_WAVE_MINB blocks an SM
+ * (96 registers), so that one wave holds more strands than G = 2's */
+constexpr int kWaveG = 4, kWaveL = 8;
+#ifndef HB_LANES_WAVE_MINB
+#define HB_LANES_WAVE_MINB 5
+#endif
 #ifndef HB_LANES_FTL_G
 #define HB_LANES_FTL_G 4
 #endif
@@ -123,15 +131,22 @@ template <typename T> __device__ __forceinline__ constexpr T floor_of()
 constexpr int kWGather = 1, kWHeld = 2, kWCol = 4, kWPlanes = 8, kWAll = kWGather | kWHeld | kWCol;
 template <typename T, int G, int L, bool Ftl, int W = 0> constexpr int lanes_min_blocks()
 {
-    return sizeof(T) != 4                      ? 1
-           : W == kWHeld && !Ftl && G == 2     ? HB_LANES_HELD_MINB /* the held grid alone */
-           : W == kWCol                        ? HB_LANES_COL_MINB
-           : W == (kWCol | kWPlanes)           ? HB_LANES_PLANES_MINB
-           : W == kWGather && !Ftl && G == 2   ? HB_LANES_GATHER_MINB /* the grid's gather alone */
-           : W                                 ? HB_LANES_WORLD_MINB  /* everything: 2, up to 128 registers */
-           : (!Ftl && G == 2)                  ? HB_LANES_MINB
-           : (Ftl && G == kFtlG && L == kFtlL) ? HB_LANES_FTL_MINB
-                                               : 1;
+    return sizeof(T) != 4                       ? 1
+           : !Ftl && G == kWaveG && L == kWaveL ? HB_LANES_WAVE_MINB /* the one-wave layout */
+           : W == kWHeld && !Ftl && G == 2      ? HB_LANES_HELD_MINB /* the held grid alone */
+           : W == kWCol                         ? HB_LANES_COL_MINB
+           : W == (kWCol | kWPlanes)            ? HB_LANES_PLANES_MINB
+           : W == kWGather && !Ftl && G == 2    ? HB_LANES_GATHER_MINB /* the grid's gather alone */
+           : W                                  ? HB_LANES_WORLD_MINB  /* everything: 2, up to 128 registers */
+           : (!Ftl && G == 2)                   ? HB_LANES_MINB
+           : (Ftl && G == kFtlG && L == kFtlL)  ? HB_LANES_FTL_MINB
+                                                : 1;
+}
+
+/* __launch_bounds__'s threads a block: half kLanesMaxBlock for the one-wave layout */
+template <typename T, int G, int L, bool Ftl> constexpr int lanes_max_threads()
+{
+    return sizeof(T) == 4 && !Ftl && G == kWaveG && L == kWaveL ? kLanesMaxBlock / 2 : kLanesMaxBlock;
 }
 
 template <typename T> struct V3 {
@@ -663,7 +678,7 @@ __device__ __forceinline__ void hold_block(const DModel<T> &m, const T *qtab, co
  * kWHeld) reads each point's own sample, which no order changes: in the order where it samples
  * them itself (m.hold_self), else as stored (m.perm nullptr). */
 template <typename T, class Feat, int G, int L, bool Ftl, bool Seg, int W>
-__global__ void __launch_bounds__(kLanesMaxBlock, lanes_min_blocks<T, G, L, Ftl, W>())
+__global__ void __launch_bounds__(lanes_max_threads<T, G, L, Ftl>(), lanes_min_blocks<T, G, L, Ftl, W>())
     k_lanes(DModel<T> m, const T *__restrict__ qtab, const T *__restrict__ phtab, T *x, T *v,
             const T *__restrict__ rest, const T *__restrict__ bend_rest, int64_t N)
 {
@@ -1076,6 +1091,8 @@ template <typename T, int G, int L, bool Ftl> LanesFn<T> lanes_grid_kernel(unsig
 template <typename T, int G, int L, bool Ftl> LanesFn<T> lanes_colliders_kernel(unsigned f);
 template <typename T, int G, int L, bool Ftl> LanesFn<T> lanes_planes_kernel(unsigned f);
 template <typename T, int G, int L, bool Ftl> LanesFn<T> lanes_world_kernel(bool seg);
+/* the one-wave layout's kernel with the held grid (lanes_grid.cu; nullptr in fp64) */
+template <typename T> LanesFn<T> lanes_wave_held_kernel();
 
 /* each layout of lanes_pick (lanes.cu), for the precision T: ftl's, xpbd's, all of them */
 #define HB_LANES_LAYOUTS_FTL(X, T)                                                                                     \

@@ -78,6 +78,8 @@ template <typename T> struct DModel {
     /* §3.16 `held` without colliders: the held lanes kernel samples its block's own points before its
      * strand loop (hold_block; k_grid_hold not launched, m.held unused) */
     int hold_self = 0;
+    /* lanes: the one-wave layout (lanes_wave, decided once a run) */
+    bool wave = false;
     /* §3.17 --contact-planes: each point's planes [N][P][HB_CONTACT_POINT] (strands as stored), where a
      * frame runs in several launches (lanes: kept between them; nullptr: the frame in one launch) */
     T *contacts = nullptr;

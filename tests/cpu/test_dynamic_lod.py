@@ -32,6 +32,7 @@ def test_rendered_rows_recompute_bit_for_bit_and_keep_the_simulation(cpu_bin, tm
     rec = run_json(cpu_bin, *common, "--render-points", "22", "--output", lodf)
     sim = rec["stages"][-1]
     assert sim["render_points"] == 22 and sim["render_ms"] >= 0 and "lod" in sim["features"].split("+")
+    assert sim["layout"] is None  # the cuda lanes kernel's shape alone
     with open_trajectory(plain) as a, open_trajectory(lodf) as b:
         assert (b.points, b.render_points, b.simulated_points) == (22, 22, 8)
         assert list(b.simulated_rows) == [0, 3, 6, 9, 12, 15, 18, 21]

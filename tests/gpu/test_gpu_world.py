@@ -19,7 +19,7 @@ from harness.check import diff_dynamic
 from harness.core import scenes, variants
 from harness.io.meshes import icosphere, write_obj
 from harness.io.trajectory import open_trajectory
-from support.statecheck import run
+from support.statecheck import run, run_json
 
 pytestmark = pytest.mark.gpu
 
@@ -203,16 +203,18 @@ def frame_matches(work, cpu, build, variant, label):
     """The build's frame from the CPU file's frame K−1 against the CPU's frame K: bit for bit (strict)
     or by the one-frame rule with the scene's spread (diff_dynamic, as tests/gpu/test_gpu_dynamic.py):
     the FMA-contracted reference itself puts a point of body-planes' ftl fp32 frame 1.1e-4 cm off, over
-    the plain rule, the normal build one 1.4e-4 near a capsule with friction (measured 2026-11-28)."""
+    the plain rule, the normal build one 1.4e-4 near a capsule with friction (measured 2026-11-28).
+    Returns the build's JSON record."""
     with open_trajectory(cpu) as t:
         k = t.n_frames - 2
         step = int(t.step[-1])
     out = work / f"gpu_{build}_{variant}_{label}.h5"
-    run(BUILDS[build], "--input", cpu, "--input-frame", k, "--stages", "simulate", "--frames", 1,
-        "--variant", variant, "--output", out, "--force", "--quiet")  # fmt: skip
+    rec = run_json(BUILDS[build], "--input", cpu, "--input-frame", k, "--stages", "simulate", "--frames", 1,
+                   "--variant", variant, "--output", out, "--force")  # fmt: skip
     exact = build == "strict"
     r = diff_dynamic.compare(cpu, out, frames=[step], exact=exact, check_paper=False, spread=not exact)
     assert r.equivalent, f"{build} {variant} {label}: " + "; ".join(r.failures()[:5])
+    return rec
 
 
 def cpu_scene_file(work, name, flags, precision, frames=FRAMES):
@@ -230,6 +232,14 @@ def input_positions(cpu):
     """Positions [N, P, 3] of the CPU file's frame K−1, the GPU run's input."""
     with open_trajectory(cpu) as t:
         return t.frame(t.n_frames - 2).astype(np.float64)
+
+
+def input_velocities(cpu):
+    """Velocities [N, P, 3] of the CPU file's frame K−1 (written with --velocities all)."""
+    with open_trajectory(cpu) as t:
+        v = t.velocity_at_step(int(t.step[t.n_frames - 2]))
+        assert v is not None, f"{cpu}: no velocities at the input frame"
+        return v.astype(np.float64)
 
 
 # A window node's mass sum past 32 bits (docs/cuda.md "The hair–hair grid": a mass share is summed
@@ -264,8 +274,10 @@ def test_gpu_splat_whose_window_sums_carry_matches_cpu_bit_for_bit(work, variant
 # of 8 on any GPU) spans a box of more nodes than the window holds (with one momentum word a node,
 # WINDOW_SINGLE: the five words' arrays in the window's memory). `fill`: 64 points a strand, so
 # that every block touches more nodes than the table has slots and some shares find none (the
-# grid directly); `hashed`: 10 points, so that a block's nodes fit the table. Each premise is
-# checked from the CPU's positions at the input frame; the strict build bit for bit.
+# grid directly); `hashed`: 10 points, so that a block's nodes fit the table (one momentum word a
+# share); `fast`: the same with ftl under a gravity that takes every strand past the one-word
+# bound (SINGLE_SPEED), so that the table keeps the split words. Each premise is checked from the
+# CPU's positions and velocities at the input frame; the strict build bit for bit.
 WINDOW_NODES = int(re.search(r"^#define HB_SPLAT_WINDOW (\d+)$", (ROOT / "cuda/dynamic/world.cu").read_text(), re.M)[1])
 WINDOW_SINGLE = WINDOW_NODES * 8 // 5  # kWindowSingle, cuda/dynamic/world.cu
 HASH_SLOTS = (WINDOW_NODES * 8 // 9) & ~31  # kHashSlots, cuda/dynamic/world.cu
@@ -274,7 +286,13 @@ HASH = ["--strands", "64", "--substeps", "4", "--iterations", "2", "--bend-compl
         "--shape-compliance", "1e-4", "--drag", "0.5", "--wind-speed", "150", "--grid", "256",
         "--grid-box=" + ",".join(map(str, HASH_BOX)), "--grid-friction", "0.1,0.02",
         "--grid-volume", "2000"]  # fmt: skip
-HASH_CASES = {"fill": ("64", 3), "hashed": ("10", 4)}  # points, frames
+HASH_CASES = {  # points, frames, flags
+    "fill": ("64", 3, []),
+    "hashed": ("10", 4, []),
+    "fast": ("10", 4, ["--solver", "ftl", "--gravity", "8000000"]),
+}
+# the least |v| component (cm/s) whose block of SPLAT_STRANDS_MIN strands of P points takes split words
+SINGLE_SPEED = lambda p: 2**31 / (SPLAT_STRANDS_MIN * p * 1024)  # noqa: E731 (world.cu: `single`)
 
 
 def corner_nodes(x, box, n):
@@ -292,8 +310,8 @@ def corner_nodes(x, box, n):
 @pytest.mark.parametrize("precision", ["fp32", "fp64"])
 @pytest.mark.parametrize("variant", [v for v in VARIANTS if _DECLARED.runs_features(v, {"grid"})])
 def test_gpu_splat_in_its_hash_table_matches_cpu_bit_for_bit(work, variant, precision, case):
-    points, frames = HASH_CASES[case]
-    cpu = cpu_scene_file(work, f"hash_{case}", [*HASH, "--points", points], precision, frames)
+    points, frames, flags = HASH_CASES[case]
+    cpu = cpu_scene_file(work, f"hash_{case}", [*HASH, "--points", points, *flags], precision, frames)
     nodes = corner_nodes(input_positions(cpu), HASH_BOX, 256)
     assert np.all(nodes >= 0), "a point outside the grid"
     assert len(nodes) < SPLAT_RUN_STRANDS  # blocks of whole strands
@@ -305,6 +323,11 @@ def test_gpu_splat_in_its_hash_table_matches_cpu_bit_for_bit(work, variant, prec
         ijk = np.stack([nodes % 256, (nodes // 256) % 256, nodes // 65536], axis=-1).reshape(len(nodes), -1, 3)
         boxes = np.prod(ijk.max(axis=1) - ijk.min(axis=1) + 1, axis=-1)
         assert boxes.min() > max(WINDOW_NODES, WINDOW_SINGLE) and SPLAT_STRANDS_MIN * int(points) * 8 <= HASH_SLOTS
+    speeds = np.abs(input_velocities(cpu)).max(axis=(1, 2))  # each strand's largest |v| component
+    if case == "fast":  # every block's sums in split words
+        assert speeds.min() > SINGLE_SPEED(int(points))
+    else:  # every block's in one word
+        assert speeds.max() < SINGLE_SPEED(int(points))
     frame_matches(work, cpu, "strict", variant, f"hash_{case}_{precision}")
 
 
@@ -323,6 +346,43 @@ HELD_WIDE = ["--strands", "12000", "--substeps", "4", "--iterations", "2", "--be
 def test_gpu_held_samples_in_wide_blocks_match_cpu_bit_for_bit(work, variant, precision, points):
     cpu = cpu_scene_file(work, f"held_wide_{points}", [*HELD_WIDE, "--points", points], precision)
     frame_matches(work, cpu, "strict", variant, f"held_wide_{points}_{precision}")
+
+
+# The lanes variant's one-wave layout (docs/cuda.md "The lanes variant"): where N strands need more
+# than one wave of G = 2's blocks but fit one of G = 4's, an fp32 xpbd run of 32 points with the
+# default scene's features, with no world or the held grid alone, takes G = 4 on 8 lanes in blocks
+# of half the threads (the record's `layout`). The strands a G = 2 wave takes on this GPU come from
+# a run of 64 strands; at that count the run stays G = 2 and fp64 does at one wave and 16 strands
+# more, where fp32 takes G = 4: both builds' frame there against the reference (strict bit for bit).
+WAVE = ["--points", "32", "--substeps", "8", "--iterations", "2", "--solver", "xpbd", "--drag", "0.5",
+        "--damping", "0.5", "--bend-compliance", "1e-6", "--shape-compliance", "1e-4", "--shape-range", "0.5",
+        "--wind-speed", "150", "--gust-amplitude", "0.5", "--head-motion", "nod"]  # fmt: skip
+WAVE_WORLDS = {"none": [], "held": ["--grid", "32", "--grid-friction", "0.05,0.01", "--grid-volume", "2000",
+                                    "--grid-rebuild", "held"]}  # fmt: skip
+
+
+def lanes_layout(strands, flags, precision):
+    """The strict build's simulate `layout` for a run of the scene `flags` (one frame)."""
+    rec = run_json(CUDA_STRICT_BIN, "--stages", "init,collide,simulate", *flags, "--strands", strands,
+                   "--frames", 1, "--variant", "lanes", "--precision", precision)  # fmt: skip
+    lay = rec["stages"][-1]["layout"]
+    return (lay["points_a_lane"], lay["lanes_a_strand"], lay["block"]), lay["strands_a_wave"]
+
+
+@pytest.mark.parametrize("build", sorted(BUILDS))
+@pytest.mark.parametrize("world", sorted(WAVE_WORLDS))
+def test_gpu_lanes_one_wave_layout_matches_cpu(work, world, build):
+    if "lanes" not in VARIANTS:
+        pytest.skip("this build declares no lanes variant")
+    flags = [*WAVE, *WAVE_WORLDS[world]]
+    shape, wave = lanes_layout(64, flags, "fp32")
+    assert shape == (2, 16, 256) and wave >= 64
+    assert lanes_layout(wave, flags, "fp32")[0] == (2, 16, 256)
+    assert lanes_layout(wave + 16, flags, "fp64")[0] == (2, 16, 256)
+    cpu = cpu_scene_file(work, f"wave_{world}", [*flags, "--strands", str(wave + 16)], "fp32", 2)
+    lay = frame_matches(work, cpu, build, "lanes", f"wave_{world}")["stages"][-1]["layout"]
+    assert (lay["points_a_lane"], lay["lanes_a_strand"], lay["block"]) == (4, 8, 128)
+    assert lay["strands_a_wave"] >= wave + 16
 
 
 # §3.17 the collision step in 4 sweeps on the body scene (configs/scenes/body.toml: the default
