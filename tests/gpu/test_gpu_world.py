@@ -319,10 +319,17 @@ def test_gpu_splat_in_its_hash_table_matches_cpu_bit_for_bit(work, variant, prec
     shared = nodes.size - len(np.unique(nodes))  # shares beyond the first at a node, over all strands
     if case == "fill":  # any 8 strands touch more nodes than the table has slots
         assert SPLAT_STRANDS_MIN * min(own) - shared > HASH_SLOTS
-    else:  # every strand's own box of nodes exceeds the window; 8 strands' shares fit the table
+    else:  # every block's box of nodes exceeds its window; 8 strands' shares fit the table
         ijk = np.stack([nodes % 256, (nodes // 256) % 256, nodes // 65536], axis=-1).reshape(len(nodes), -1, 3)
-        boxes = np.prod(ijk.max(axis=1) - ijk.min(axis=1) + 1, axis=-1)
-        assert boxes.min() > max(WINDOW_NODES, WINDOW_SINGLE) and SPLAT_STRANDS_MIN * int(points) * 8 <= HASH_SLOTS
+        lo, hi = ijk.min(axis=1), ijk.max(axis=1)
+        if case == "hashed":  # each strand's own box past the one-word window
+            assert np.prod(hi - lo + 1, axis=-1).min() > max(WINDOW_NODES, WINDOW_SINGLE)
+        else:  # straight under this gravity: a block's box holds each of its strands' boxes with the
+            # 7 others', so it is past the split words' window where every strand's 7th least pair box is
+            pairs = np.prod(np.maximum(hi[:, None], hi[None]) - np.minimum(lo[:, None], lo[None]) + 1, axis=-1)
+            np.fill_diagonal(pairs, np.iinfo(np.int64).max)
+            assert np.sort(pairs, axis=1)[:, SPLAT_STRANDS_MIN - 2].min() > WINDOW_NODES
+        assert SPLAT_STRANDS_MIN * int(points) * 8 <= HASH_SLOTS
     speeds = np.abs(input_velocities(cpu)).max(axis=(1, 2))  # each strand's largest |v| component
     if case == "fast":  # every block's sums in split words
         assert speeds.min() > SINGLE_SPEED(int(points))
