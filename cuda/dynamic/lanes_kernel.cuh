@@ -74,7 +74,7 @@ constexpr bool kFreeCollide = kFree && !HB_LANES_REF_COLLIDE;
 #ifndef HB_LANES_GATHER_MINB
 #define HB_LANES_GATHER_MINB 3
 #endif
-/* The one-wave layout (lanes.cu's lanes_choice): xpbd at P ≤ 32 in fp32, the default scene's
+/* The one-wave layout (lanes.cu's lanes_wave): xpbd at P ≤ 32 in fp32, the default scene's
  * feature set with no world or the held grid alone, kWaveG points a lane on kWaveL lanes a strand
  * in blocks of half the threads (the same strands a block), HB_LANES_WAVE_MINB blocks an SM
  * (96 registers), so that one wave holds more strands than G = 2's */
