@@ -91,6 +91,11 @@ template <typename T> LanesPick<T> wave_pick(unsigned f, int solver, int64_t P, 
     }
     return LanesPick<T>{nullptr, 0, 0, 0, 0};
 }
+/* a run's threads a block: half the variant's block in the one-wave layout (the same strands a block) */
+template <typename T> int run_block(const DModel<T> &m, int block)
+{
+    return m.wave ? block / 2 : block;
+}
 /* a run's kernel: the one-wave layout's where lanes_wave chose it (m.wave), else lanes_pick's */
 template <typename T> LanesPick<T> run_pick(const DModel<T> &m, int wk)
 {
@@ -173,7 +178,7 @@ template <typename T> cudaError_t lanes_launches(const DModel<T> &m, int block, 
     if (!k.fn) return cudaErrorInvalidValue;
     int b = 0, chunk = 0;
     size_t smem = 0;
-    const cudaError_t e = lanes_shape(m, k, wk, m.wave ? block / 2 : block, b, chunk, smem);
+    const cudaError_t e = lanes_shape(m, k, wk, run_block(m, block), b, chunk, smem);
     if (e != cudaSuccess) return e;
     const int nj = (m.j1 < 0 ? (int)m.substeps : m.j1) - m.j0;
     *launches = nj <= chunk ? 1 : (nj + chunk - 1) / chunk;
@@ -213,7 +218,7 @@ template <typename T> cudaError_t lanes_layout(const DModel<T> &m, int block, in
     int b = 0, chunk = 0;
     size_t smem = 0;
     int64_t strands = 0;
-    cudaError_t e = lanes_shape(m, k, wk, m.wave ? block / 2 : block, b, chunk, smem);
+    cudaError_t e = lanes_shape(m, k, wk, run_block(m, block), b, chunk, smem);
     if (e != cudaSuccess) return e;
     const int j1 = m.j1 < 0 ? (int)m.substeps : m.j1;
     if (lanes_col_on<T>(wk, m)) /* a launch's staged colliders (launch_frame_lanes) */
@@ -237,7 +242,7 @@ cudaError_t launch_frame_lanes(const DModel<T> &m, const T *q, const T *phase, T
     const int j1 = m.j1 < 0 ? (int)m.substeps : m.j1;
     int b = 0, chunk = 0;
     size_t smem = 0;
-    cudaError_t e = lanes_shape(m, k, wk, m.wave ? block / 2 : block, b, chunk, smem);
+    cudaError_t e = lanes_shape(m, k, wk, run_block(m, block), b, chunk, smem);
     if (e != cudaSuccess) return e;
     /* the contact planes of a frame in several launches are kept in m.contacts (backend_dyn.cu) */
     if (col && m.world.planes && (m.j0 > 0 || j1 < (int)m.substeps || chunk < j1 - m.j0) && !m.contacts)
